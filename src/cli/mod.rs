@@ -1,0 +1,76 @@
+//! The command line: argument parsing and error presentation only. Each command lives in
+//! its own file and calls the library; nothing in the library depends on this module.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod color;
+
+/// metamer: prove a rendering is colour-true.
+#[derive(Parser)]
+#[command(name = "metamer", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Colour science on spectra and colour differences.
+    Color(color::Args),
+}
+
+/// A command's failure: usage errors exit 2, data and device errors exit 1.
+pub enum CliError {
+    Usage(String),
+    Failed(Box<dyn std::error::Error + Send + Sync>),
+}
+
+impl<E: std::error::Error + Send + Sync + 'static> From<E> for CliError {
+    fn from(e: E) -> Self {
+        CliError::Failed(Box::new(e))
+    }
+}
+
+pub type CliResult = Result<(), CliError>;
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Color(args) => color::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::Usage(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+        Err(CliError::Failed(error)) => {
+            eprintln!("error: {error}");
+            let mut source = error.source();
+            while let Some(cause) = source {
+                eprintln!("  caused by: {cause}");
+                source = cause.source();
+            }
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Parses `X,Y,Z` (three finite numbers) for clap.
+pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three comma-separated numbers X,Y,Z, got '{s}'"));
+    }
+    let mut out = [0.0; 3];
+    for (o, p) in out.iter_mut().zip(&parts) {
+        *o = p
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{p}' is not a number"))?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,231 @@
+//! Colour coordinates: CIE XYZ, xyY, CIELAB 1976 and its cylindrical LCh form (CIE 15:2018
+//! §8.2.1 for CIELAB, with the exact constants ε = 216/24389, κ = 24389/27 of CIE 015's
+//! technical note rather than the rounded 0.008856 / 903.3).
+
+use serde::{Deserialize, Serialize};
+
+/// CIE XYZ tristimulus values (absolute cd/m² for emission, relative Y = 100 for objects).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Xyz {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+/// Chromaticity x, y and luminance Y.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct XyY {
+    pub x: f64,
+    pub y: f64,
+    pub luminance: f64,
+}
+
+/// CIELAB 1976 L*, a*, b*.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Lab {
+    pub l: f64,
+    pub a: f64,
+    pub b: f64,
+}
+
+/// CIELAB in cylindrical form: lightness, chroma, hue angle in degrees [0, 360).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Lch {
+    pub l: f64,
+    pub c: f64,
+    pub h_deg: f64,
+}
+
+/// Chromaticity of CIE D65 (CIE 15:2018 Table T.3), used for black where x, y are undefined.
+pub const D65_XY: (f64, f64) = (0.31272, 0.32903);
+
+const EPSILON: f64 = 216.0 / 24389.0;
+const KAPPA: f64 = 24389.0 / 27.0;
+
+impl Xyz {
+    pub const fn new(x: f64, y: f64, z: f64) -> Self {
+        Xyz { x, y, z }
+    }
+
+    pub fn from_array(v: [f64; 3]) -> Self {
+        Xyz::new(v[0], v[1], v[2])
+    }
+
+    pub fn to_array(self) -> [f64; 3] {
+        [self.x, self.y, self.z]
+    }
+
+    /// xyY. Black (X+Y+Z = 0) has no chromaticity; it gets D65's so that the round trip
+    /// still gives black (Y = 0 makes X and Z zero whatever x, y are).
+    pub fn to_xyy(self) -> XyY {
+        let sum = self.x + self.y + self.z;
+        if sum == 0.0 {
+            return XyY {
+                x: D65_XY.0,
+                y: D65_XY.1,
+                luminance: self.y,
+            };
+        }
+        XyY {
+            x: self.x / sum,
+            y: self.y / sum,
+            luminance: self.y,
+        }
+    }
+
+    /// CIELAB relative to `white` (white's Y must be positive).
+    pub fn to_lab(self, white: Xyz) -> Lab {
+        let f = |t: f64| {
+            if t > EPSILON {
+                t.cbrt()
+            } else {
+                (KAPPA * t + 16.0) / 116.0
+            }
+        };
+        let fx = f(self.x / white.x);
+        let fy = f(self.y / white.y);
+        let fz = f(self.z / white.z);
+        Lab {
+            l: 116.0 * fy - 16.0,
+            a: 500.0 * (fx - fy),
+            b: 200.0 * (fy - fz),
+        }
+    }
+
+    pub fn scaled(self, k: f64) -> Xyz {
+        Xyz::new(self.x * k, self.y * k, self.z * k)
+    }
+}
+
+impl std::ops::Add for Xyz {
+    type Output = Xyz;
+    fn add(self, o: Xyz) -> Xyz {
+        Xyz::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl std::ops::Sub for Xyz {
+    type Output = Xyz;
+    fn sub(self, o: Xyz) -> Xyz {
+        Xyz::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl XyY {
+    /// XYZ from xyY; y = 0 (no light on the spectrum locus' purple line) gives black.
+    pub fn to_xyz(self) -> Xyz {
+        if self.y == 0.0 {
+            return Xyz::default();
+        }
+        let k = self.luminance / self.y;
+        Xyz::new(self.x * k, self.luminance, (1.0 - self.x - self.y) * k)
+    }
+
+    pub fn to_array(self) -> [f64; 3] {
+        [self.x, self.y, self.luminance]
+    }
+}
+
+impl Lab {
+    pub const fn new(l: f64, a: f64, b: f64) -> Self {
+        Lab { l, a, b }
+    }
+
+    pub fn to_array(self) -> [f64; 3] {
+        [self.l, self.a, self.b]
+    }
+
+    /// XYZ relative to `white` (the inverse of [`Xyz::to_lab`]).
+    pub fn to_xyz(self, white: Xyz) -> Xyz {
+        let fy = (self.l + 16.0) / 116.0;
+        let fx = fy + self.a / 500.0;
+        let fz = fy - self.b / 200.0;
+        let finv = |f: f64| {
+            let f3 = f * f * f;
+            if f3 > EPSILON {
+                f3
+            } else {
+                (116.0 * f - 16.0) / KAPPA
+            }
+        };
+        let yr = if self.l > KAPPA * EPSILON {
+            fy * fy * fy
+        } else {
+            self.l / KAPPA
+        };
+        Xyz::new(finv(fx) * white.x, yr * white.y, finv(fz) * white.z)
+    }
+
+    pub fn to_lch(self) -> Lch {
+        let h = self.b.atan2(self.a).to_degrees();
+        Lch {
+            l: self.l,
+            c: self.a.hypot(self.b),
+            h_deg: if h < 0.0 { h + 360.0 } else { h },
+        }
+    }
+}
+
+impl Lch {
+    pub fn to_lab(self) -> Lab {
+        let h = self.h_deg.to_radians();
+        Lab::new(self.l, self.c * h.cos(), self.c * h.sin())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const D65: Xyz = Xyz::new(95.047, 100.0, 108.883);
+
+    #[test]
+    fn white_is_l100_and_known_values() {
+        let lab = D65.to_lab(D65);
+        assert!((lab.l - 100.0).abs() < 1e-12 && lab.a.abs() < 1e-12 && lab.b.abs() < 1e-12);
+        // Y = 18.4186 % gives L* = 50 exactly: ((50+16)/116)^3 = 0.184186.
+        let mid = Xyz::new(0.184186 * D65.x, 0.184186 * D65.y, 0.184186 * D65.z).to_lab(D65);
+        assert!((mid.l - 50.0).abs() < 1e-4, "{mid:?}");
+        // Below ε the linear branch: Y/Yn = 0.001 → L* = κ·0.001 = 0.9033.
+        let dark = Xyz::new(0.1 * 0.95047, 0.1, 0.1 * 1.08883).to_lab(D65);
+        assert!((dark.l - 24389.0 / 27.0 * 0.001).abs() < 1e-9);
+    }
+
+    #[test]
+    fn xyy_of_equal_energy_and_black() {
+        let e = Xyz::new(1.0, 1.0, 1.0).to_xyy();
+        assert!((e.x - 1.0 / 3.0).abs() < 1e-15 && (e.y - 1.0 / 3.0).abs() < 1e-15);
+        let black = Xyz::default().to_xyy();
+        assert_eq!(black.luminance, 0.0);
+        assert_eq!(black.to_xyz(), Xyz::default());
+    }
+
+    fn xyz_strategy() -> impl Strategy<Value = Xyz> {
+        (0.0..200.0f64, 0.001..200.0f64, 0.0..200.0f64).prop_map(|(x, y, z)| Xyz::new(x, y, z))
+    }
+
+    proptest! {
+        #[test]
+        fn lab_round_trip(c in xyz_strategy()) {
+            let back = c.to_lab(D65).to_xyz(D65);
+            prop_assert!((back.x - c.x).abs() < 1e-9 * (1.0 + c.x));
+            prop_assert!((back.y - c.y).abs() < 1e-9 * (1.0 + c.y));
+            prop_assert!((back.z - c.z).abs() < 1e-9 * (1.0 + c.z));
+        }
+
+        #[test]
+        fn xyy_round_trip(c in xyz_strategy()) {
+            let back = c.to_xyy().to_xyz();
+            prop_assert!((back.x - c.x).abs() < 1e-9 * (1.0 + c.x));
+            prop_assert!((back.y - c.y).abs() < 1e-12 * (1.0 + c.y));
+            prop_assert!((back.z - c.z).abs() < 1e-9 * (1.0 + c.z));
+        }
+
+        #[test]
+        fn lch_round_trip(l in 0.0..100.0f64, a in -128.0..128.0f64, b in -128.0..128.0f64) {
+            let back = Lab::new(l, a, b).to_lch().to_lab();
+            prop_assert!((back.a - a).abs() < 1e-9 && (back.b - b).abs() < 1e-9);
+        }
+    }
+}

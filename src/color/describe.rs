@@ -1,0 +1,51 @@
+//! One call from a spectrum to its XYZ, xyY and (when a white is known) CIELAB: what
+//! `metamer color xyz` prints.
+
+use super::{
+    illuminant_white, radiance_to_xyz, reflectance_to_xyz, Lab, ObserverKind, Spectrum, XyY, Xyz,
+};
+
+/// What a spectrum is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// Spectral radiance in W·sr⁻¹·m⁻²·nm⁻¹ → absolute XYZ in cd/m².
+    Radiance,
+    /// Reflectance factor 0–1 under an illuminant → relative XYZ, Y = 100 for white.
+    Reflectance,
+}
+
+/// The colorimetry of one spectrum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Description {
+    pub xyz: Xyz,
+    pub xyy: XyY,
+    /// CIELAB against the white used, when one is known.
+    pub lab: Option<Lab>,
+    /// The reference white of `lab`.
+    pub white: Option<Xyz>,
+}
+
+/// XYZ, xyY and CIELAB of a spectrum. For a reflectance the white defaults to the
+/// illuminant's (the perfect diffuser under it); for a radiance only `white` gives Lab.
+pub fn describe(
+    spectrum: &Spectrum,
+    quantity: Quantity,
+    illuminant: &Spectrum,
+    observer: ObserverKind,
+    white: Option<Xyz>,
+) -> Description {
+    let (xyz, default_white) = match quantity {
+        Quantity::Radiance => (radiance_to_xyz(spectrum, observer), None),
+        Quantity::Reflectance => (
+            reflectance_to_xyz(spectrum, illuminant, observer),
+            Some(illuminant_white(illuminant, observer)),
+        ),
+    };
+    let white = white.or(default_white);
+    Description {
+        xyz,
+        xyy: xyz.to_xyy(),
+        lab: white.map(|w| xyz.to_lab(w)),
+        white,
+    }
+}

@@ -1,0 +1,25 @@
+//! Colour science: sampled spectra, embedded CIE and ColorChecker tables, spectra to XYZ
+//! (paper Eq. 8), XYZ ↔ xyY ↔ CIELAB ↔ LCh, and colour differences (ΔE*ab, CIEDE2000).
+
+mod colorimetry;
+mod coords;
+mod delta_e;
+mod describe;
+mod error;
+mod spectrum;
+mod table;
+mod tables;
+
+pub use colorimetry::{
+    illuminant_white, luminance, radiance_to_xyz, reflectance_to_xyz, END_NM, K_M, START_NM,
+};
+pub use coords::{Lab, Lch, XyY, Xyz, D65_XY};
+pub use delta_e::{delta_e2000, delta_e76};
+pub use describe::{describe, Description, Quantity};
+pub use error::ColorError;
+pub use spectrum::{Outside, Spectrum};
+pub use table::SpectralTable;
+pub use tables::{
+    colorchecker, observer, paper_white, ColorCheckerSet, Illuminant, Observer, ObserverKind,
+    COLORCHECKER_NAMES,
+};

@@ -1,0 +1,217 @@
+//! Sampled spectra: a function of wavelength given at increasing sample points, linearly
+//! interpolated between them (the convention of the validation-box contract and CIE 15:2018
+//! §7.2.2 for tables at 1 nm), zero outside unless the caller asks to hold the end values.
+
+use super::ColorError;
+
+/// What a spectrum is worth outside its first and last sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outside {
+    /// Zero outside the table (the default for emission and observer tables).
+    Zero,
+    /// The first value below the table, the last above it (used for reflectances measured
+    /// over a shorter range, e.g. the ColorChecker's 380–730 nm).
+    HoldEnds,
+}
+
+/// A sampled spectrum with strictly increasing wavelengths in nm.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Spectrum {
+    wavelengths_nm: Vec<f64>,
+    values: Vec<f64>,
+    outside: Outside,
+}
+
+impl Spectrum {
+    /// Builds a spectrum; wavelengths must be finite and strictly increasing, values finite.
+    pub fn new(wavelengths_nm: Vec<f64>, values: Vec<f64>) -> Result<Self, ColorError> {
+        if wavelengths_nm.is_empty() {
+            return Err(ColorError::InvalidSpectrum("no samples".into()));
+        }
+        if wavelengths_nm.len() != values.len() {
+            return Err(ColorError::InvalidSpectrum(format!(
+                "{} wavelengths but {} values",
+                wavelengths_nm.len(),
+                values.len()
+            )));
+        }
+        if let Some(i) = wavelengths_nm
+            .windows(2)
+            .position(|w| !(w[1] > w[0]) || !w[0].is_finite() || !w[1].is_finite())
+        {
+            return Err(ColorError::InvalidSpectrum(format!(
+                "wavelengths must increase: {} nm follows {} nm",
+                wavelengths_nm[i + 1],
+                wavelengths_nm[i]
+            )));
+        }
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(ColorError::InvalidSpectrum(format!("value {v} is not finite")));
+        }
+        Ok(Spectrum {
+            wavelengths_nm,
+            values,
+            outside: Outside::Zero,
+        })
+    }
+
+    /// A spectrum on an even grid `start, start+step, …`.
+    pub fn from_grid(start_nm: f64, step_nm: f64, values: Vec<f64>) -> Result<Self, ColorError> {
+        let nm = (0..values.len())
+            .map(|i| start_nm + step_nm * i as f64)
+            .collect();
+        Spectrum::new(nm, values)
+    }
+
+    /// A constant value over `[start, end]` sampled at 1 nm.
+    pub fn constant(start_nm: f64, end_nm: f64, value: f64) -> Self {
+        let n = (end_nm - start_nm).round() as usize + 1;
+        Spectrum::from_grid(start_nm, 1.0, vec![value; n]).expect("a constant grid is valid")
+    }
+
+    /// The same samples with another rule outside the table.
+    pub fn with_outside(mut self, outside: Outside) -> Self {
+        self.outside = outside;
+        self
+    }
+
+    pub fn outside(&self) -> Outside {
+        self.outside
+    }
+
+    pub fn wavelengths_nm(&self) -> &[f64] {
+        &self.wavelengths_nm
+    }
+
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// First and last sampled wavelength.
+    pub fn range_nm(&self) -> (f64, f64) {
+        (
+            self.wavelengths_nm[0],
+            *self.wavelengths_nm.last().expect("never empty"),
+        )
+    }
+
+    /// The value at `nm`, linearly interpolated between samples.
+    pub fn value_at(&self, nm: f64) -> f64 {
+        let w = &self.wavelengths_nm;
+        let (first, last) = self.range_nm();
+        if nm < first || nm > last {
+            return match self.outside {
+                Outside::Zero => 0.0,
+                Outside::HoldEnds if nm < first => self.values[0],
+                Outside::HoldEnds => *self.values.last().expect("never empty"),
+            };
+        }
+        // Index of the first sample strictly above nm; nm lies in [w[i-1], w[i]].
+        let i = w.partition_point(|&s| s <= nm);
+        if i == 0 {
+            return self.values[0];
+        }
+        if i == w.len() {
+            return self.values[w.len() - 1];
+        }
+        let t = (nm - w[i - 1]) / (w[i] - w[i - 1]);
+        self.values[i - 1] + t * (self.values[i] - self.values[i - 1])
+    }
+
+    /// Samples this spectrum on `start, start+step, …, end` (inclusive).
+    pub fn resample(&self, start_nm: f64, end_nm: f64, step_nm: f64) -> Spectrum {
+        assert!(step_nm > 0.0 && end_nm >= start_nm, "bad resampling grid");
+        let n = ((end_nm - start_nm) / step_nm).round() as usize + 1;
+        let nm: Vec<f64> = (0..n).map(|i| start_nm + step_nm * i as f64).collect();
+        let values = nm.iter().map(|&l| self.value_at(l)).collect();
+        Spectrum {
+            wavelengths_nm: nm,
+            values,
+            outside: self.outside,
+        }
+    }
+
+    /// Every value multiplied by `k`.
+    pub fn scaled(&self, k: f64) -> Spectrum {
+        Spectrum {
+            wavelengths_nm: self.wavelengths_nm.clone(),
+            values: self.values.iter().map(|v| v * k).collect(),
+            outside: self.outside,
+        }
+    }
+
+    /// The product of two spectra, sampled on the union of both grids so no sample of
+    /// either is lost. Outside both tables the product follows each factor's own rule.
+    pub fn product(&self, other: &Spectrum) -> Spectrum {
+        let mut nm: Vec<f64> = self
+            .wavelengths_nm
+            .iter()
+            .chain(other.wavelengths_nm.iter())
+            .copied()
+            .collect();
+        nm.sort_by(f64::total_cmp);
+        nm.dedup();
+        let values = nm
+            .iter()
+            .map(|&l| self.value_at(l) * other.value_at(l))
+            .collect();
+        let outside = if self.outside == Outside::HoldEnds && other.outside == Outside::HoldEnds {
+            Outside::HoldEnds
+        } else {
+            Outside::Zero
+        };
+        Spectrum {
+            wavelengths_nm: nm,
+            values,
+            outside,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp() -> Spectrum {
+        Spectrum::new(vec![400.0, 500.0, 600.0], vec![0.0, 1.0, 3.0]).unwrap()
+    }
+
+    #[test]
+    fn interpolates_linearly_between_samples() {
+        let s = ramp();
+        assert_eq!(s.value_at(400.0), 0.0);
+        assert_eq!(s.value_at(450.0), 0.5);
+        assert_eq!(s.value_at(500.0), 1.0);
+        assert!((s.value_at(575.0) - 2.5).abs() < 1e-12);
+        assert_eq!(s.value_at(600.0), 3.0);
+    }
+
+    #[test]
+    fn zero_or_held_outside() {
+        let s = ramp();
+        assert_eq!(s.value_at(399.0), 0.0);
+        assert_eq!(s.value_at(700.0), 0.0);
+        let h = s.with_outside(Outside::HoldEnds);
+        assert_eq!(h.value_at(380.0), 0.0);
+        assert_eq!(h.value_at(780.0), 3.0);
+    }
+
+    #[test]
+    fn resample_and_product() {
+        let s = ramp().resample(400.0, 600.0, 50.0);
+        assert_eq!(s.values(), &[0.0, 0.5, 1.0, 2.0, 3.0]);
+        let p = ramp().product(&Spectrum::constant(380.0, 780.0, 2.0));
+        assert_eq!(p.value_at(500.0), 2.0);
+        assert_eq!(p.value_at(390.0), 0.0);
+        assert_eq!(ramp().scaled(2.0).value_at(600.0), 6.0);
+    }
+
+    #[test]
+    fn rejects_malformed() {
+        assert!(Spectrum::new(vec![], vec![]).is_err());
+        assert!(Spectrum::new(vec![500.0, 500.0], vec![1.0, 1.0]).is_err());
+        assert!(Spectrum::new(vec![500.0], vec![f64::NAN]).is_err());
+        assert!(Spectrum::new(vec![500.0, 510.0], vec![1.0]).is_err());
+    }
+}

@@ -1,0 +1,10 @@
+//! metamer: prove that a rendering is colour-true.
+//!
+//! The library implements the chain of Bärz, Henrich and Müller, "Validating Photometric and
+//! Colorimetric Consistency of Physically-Based Image Synthesis": instruments (in the
+//! `metamer-drivers` crate), display characterization, the measured validation box, a
+//! spectral path tracer, reproduction on the display and validation in CIELAB.
+//! The `metamer` binary is a thin command line over this library.
+
+pub mod color;
+pub mod numeric_csv;
