@@ -8,3 +8,5 @@
 
 pub mod color;
 pub mod numeric_csv;
+pub mod display;
+pub mod render;

@@ -5,7 +5,13 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod characterize;
 mod color;
+mod devices;
+mod fit;
+mod render;
+mod reproduce;
+mod spot;
 
 /// metamer: prove a rendering is colour-true.
 #[derive(Parser)]
@@ -19,6 +25,18 @@ struct Cli {
 enum Command {
     /// Colour science on spectra and colour differences.
     Color(color::Args),
+    /// Serial ports and known USB/HID instruments on this machine.
+    Devices(devices::Args),
+    /// Spot readings from an instrument.
+    Spot(spot::Args),
+    /// Render the validation box: spot readings, images, convergence charts.
+    Render(render::Args),
+    /// Fit a display model to measured patches.
+    Fit(fit::Args),
+    /// XYZ targets or images to display drive values through a display profile.
+    Reproduce(reproduce::Args),
+    /// Show and measure patches on a display, fit and verify a profile.
+    Characterize(characterize::Args),
 }
 
 /// A command's failure: usage errors exit 2, data and device errors exit 1.
@@ -39,6 +57,12 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Color(args) => color::run(args),
+        Command::Devices(args) => devices::run(args),
+        Command::Spot(args) => spot::run(args),
+        Command::Render(args) => render::run(args),
+        Command::Fit(args) => fit::run(args),
+        Command::Reproduce(args) => reproduce::run(args),
+        Command::Characterize(args) => characterize::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -48,9 +72,15 @@ pub fn main() -> ExitCode {
         }
         Err(CliError::Failed(error)) => {
             eprintln!("error: {error}");
+            let mut shown = error.to_string();
             let mut source = error.source();
             while let Some(cause) = source {
-                eprintln!("  caused by: {cause}");
+                let text = cause.to_string();
+                // thiserror messages often quote their source already; say each thing once.
+                if !shown.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                    shown.push_str(&text);
+                }
                 source = cause.source();
             }
             ExitCode::from(1)

@@ -1,0 +1,10 @@
+//! `metamer devices` (placeholder until its issue's helper lands it).
+
+use super::{CliError, CliResult};
+
+#[derive(clap::Args)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> CliResult {
+    Err(CliError::Usage("'devices' is being built".into()))
+}

@@ -1,0 +1,1 @@
+//! The bundled spectral path tracer for the validation box (issue 4).
