@@ -141,11 +141,20 @@ mod tests {
     fn parses_and_reports_line_numbers() {
         let p = Path::new("p.csv");
         let t = NumericCsv::parse("# c\nX,Y,Z\n1,2,3\n\n4,5,6\n", p, &["X", "Y", "Z"]).unwrap();
-        assert_eq!(t.rows, vec![(3, vec![1.0, 2.0, 3.0]), (5, vec![4.0, 5.0, 6.0])]);
+        assert_eq!(
+            t.rows,
+            vec![(3, vec![1.0, 2.0, 3.0]), (5, vec![4.0, 5.0, 6.0])]
+        );
         let e = NumericCsv::parse("X,Y\n1,2\n", p, &["X", "Y", "Z"]).unwrap_err();
-        assert_eq!(e.to_string(), "p.csv:1: expected the header 'X,Y,Z', found 'X,Y'");
+        assert_eq!(
+            e.to_string(),
+            "p.csv:1: expected the header 'X,Y,Z', found 'X,Y'"
+        );
         let e = NumericCsv::parse("X,Y,Z\n1,2,nan\n", p, &["X", "Y", "Z"]).unwrap_err();
-        assert_eq!(e.to_string(), "p.csv:2: column 3 ('Z'): 'nan' is not a number");
+        assert_eq!(
+            e.to_string(),
+            "p.csv:2: column 3 ('Z'): 'nan' is not a number"
+        );
         let e = NumericCsv::parse("X,Y,Z\n1,2\n", p, &["X", "Y", "Z"]).unwrap_err();
         assert_eq!(e.to_string(), "p.csv:2: expected 3 values, found 2");
         let e = NumericCsv::parse("", p, &["X", "Y", "Z"]).unwrap_err();

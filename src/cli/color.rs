@@ -68,7 +68,8 @@ struct DeltaEArgs {
 }
 
 fn parse_observer(s: &str) -> Result<ObserverKind, String> {
-    s.parse().map_err(|e: metamer::color::ColorError| e.to_string())
+    s.parse()
+        .map_err(|e: metamer::color::ColorError| e.to_string())
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -83,7 +84,11 @@ fn load_illuminant(name: &str) -> Result<Spectrum, CliError> {
         return Ok(known.spectrum());
     }
     let path = PathBuf::from(name);
-    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) || path.exists() {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+        || path.exists()
+    {
         return Ok(SpectralTable::read(&path)?.first());
     }
     Err(CliError::Usage(format!(

@@ -92,7 +92,9 @@ pub fn main() -> ExitCode {
 pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        return Err(format!("expected three comma-separated numbers X,Y,Z, got '{s}'"));
+        return Err(format!(
+            "expected three comma-separated numbers X,Y,Z, got '{s}'"
+        ));
     }
     let mut out = [0.0; 3];
     for (o, p) in out.iter_mut().zip(&parts) {

@@ -42,9 +42,17 @@ pub fn luminance(radiance: &Spectrum) -> f64 {
 }
 
 /// Relative XYZ of a reflectance lit by an illuminant, Y = 100 for the perfect diffuser.
-pub fn reflectance_to_xyz(reflectance: &Spectrum, illuminant: &Spectrum, kind: ObserverKind) -> Xyz {
+pub fn reflectance_to_xyz(
+    reflectance: &Spectrum,
+    illuminant: &Spectrum,
+    kind: ObserverKind,
+) -> Xyz {
     let norm = integrate(|nm| illuminant.value_at(nm), kind).y;
-    integrate(|nm| illuminant.value_at(nm) * reflectance.value_at(nm), kind).scaled(100.0 / norm)
+    integrate(
+        |nm| illuminant.value_at(nm) * reflectance.value_at(nm),
+        kind,
+    )
+    .scaled(100.0 / norm)
 }
 
 /// The white point of an illuminant (the perfect diffuser under it), Y = 100.
@@ -68,10 +76,16 @@ mod tests {
         assert!((w.z - 108.88).abs() < 0.02, "{w:?}");
         // Illuminant A: 109.85, 100, 35.58 (CIE 15:2018 Table T.3).
         let a = illuminant_white(&Illuminant::A.spectrum(), ObserverKind::Cie1931);
-        assert!((a.x - 109.85).abs() < 0.02 && (a.z - 35.58).abs() < 0.02, "{a:?}");
+        assert!(
+            (a.x - 109.85).abs() < 0.02 && (a.z - 35.58).abs() < 0.02,
+            "{a:?}"
+        );
         // D65 with the 10° observer: 94.81, 100, 107.32.
         let w10 = illuminant_white(&Illuminant::D65.spectrum(), ObserverKind::Cie1964);
-        assert!((w10.x - 94.81).abs() < 0.02 && (w10.z - 107.32).abs() < 0.03, "{w10:?}");
+        assert!(
+            (w10.x - 94.81).abs() < 0.02 && (w10.z - 107.32).abs() < 0.03,
+            "{w10:?}"
+        );
     }
 
     #[test]

@@ -81,3 +81,31 @@ pub fn delta_e2000(lab1: Lab, lab2: Lab) -> f64 {
     let th = dhp_big / sh;
     (tl * tl + tc * tc + th * th + rt * tc * th).sqrt()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn lab() -> impl Strategy<Value = Lab> {
+        (0.0..100.0f64, -120.0..120.0f64, -120.0..120.0f64).prop_map(|(l, a, b)| Lab::new(l, a, b))
+    }
+
+    proptest! {
+        #[test]
+        fn differences_are_symmetric_and_zero_on_identity(p in lab(), q in lab()) {
+            prop_assert!((delta_e76(p, q) - delta_e76(q, p)).abs() < 1e-12);
+            prop_assert!((delta_e2000(p, q) - delta_e2000(q, p)).abs() < 1e-9);
+            prop_assert_eq!(delta_e2000(p, p), 0.0);
+            prop_assert!(delta_e2000(p, q) >= 0.0);
+        }
+    }
+
+    #[test]
+    fn de76_is_euclidean() {
+        assert_eq!(
+            delta_e76(Lab::new(0.0, 0.0, 0.0), Lab::new(3.0, 4.0, 12.0)),
+            13.0
+        );
+    }
+}

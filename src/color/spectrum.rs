@@ -47,7 +47,9 @@ impl Spectrum {
             )));
         }
         if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-            return Err(ColorError::InvalidSpectrum(format!("value {v} is not finite")));
+            return Err(ColorError::InvalidSpectrum(format!(
+                "value {v} is not finite"
+            )));
         }
         Ok(Spectrum {
             wavelengths_nm,

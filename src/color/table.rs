@@ -163,8 +163,8 @@ mod tests {
 
     #[test]
     fn parses_comments_header_and_columns() {
-        let t = SpectralTable::parse("# source: test\nnm,a,b\n400,1,2\n410, 3 ,4\n", "t.csv")
-            .unwrap();
+        let t =
+            SpectralTable::parse("# source: test\nnm,a,b\n400,1,2\n410, 3 ,4\n", "t.csv").unwrap();
         assert_eq!(t.comments, vec!["source: test"]);
         assert_eq!(t.columns, vec!["a", "b"]);
         assert_eq!(t.wavelengths_nm, vec![400.0, 410.0]);
@@ -193,12 +193,17 @@ mod tests {
         let e = SpectralTable::parse("nm,v\n400,1\n400,2\n", "i.csv")
             .unwrap_err()
             .to_string();
-        assert_eq!(e, "i.csv:3: wavelengths must increase: 400 nm follows 400 nm");
+        assert_eq!(
+            e,
+            "i.csv:3: wavelengths must increase: 400 nm follows 400 nm"
+        );
         let e = SpectralTable::parse("nm,v\n400,1,2\n", "c.csv")
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("c.csv:2: expected 2"), "{e}");
-        let e = SpectralTable::parse("nm,v\n", "d.csv").unwrap_err().to_string();
+        let e = SpectralTable::parse("nm,v\n", "d.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("no data rows"), "{e}");
     }
 }

@@ -142,7 +142,10 @@ impl Illuminant {
     /// The relative spectral power distribution (zero outside its table).
     pub fn spectrum(self) -> Spectrum {
         let (name, text) = match self {
-            Illuminant::A => ("data/illuminant_a.csv", include_str!("../../data/illuminant_a.csv")),
+            Illuminant::A => (
+                "data/illuminant_a.csv",
+                include_str!("../../data/illuminant_a.csv"),
+            ),
             Illuminant::D50 => (
                 "data/illuminant_d50.csv",
                 include_str!("../../data/illuminant_d50.csv"),
@@ -272,8 +275,14 @@ mod tests {
 
     #[test]
     fn names_parse() {
-        assert_eq!("led-rgb1".parse::<Illuminant>().unwrap(), Illuminant::LedRgb1);
-        assert_eq!("1964".parse::<ObserverKind>().unwrap(), ObserverKind::Cie1964);
+        assert_eq!(
+            "led-rgb1".parse::<Illuminant>().unwrap(),
+            Illuminant::LedRgb1
+        );
+        assert_eq!(
+            "1964".parse::<ObserverKind>().unwrap(),
+            ObserverKind::Cie1964
+        );
         assert!("D75".parse::<Illuminant>().is_err());
     }
 }
