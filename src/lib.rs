@@ -10,3 +10,4 @@ pub mod color;
 pub mod numeric_csv;
 pub mod display;
 pub mod render;
+pub mod validation;

@@ -1,0 +1,78 @@
+//! The paper's per-patch figure: ΔE*ab and ΔE00 of each ColorChecker patch as bars, with the
+//! JND line, as an SVG (text is SVG <text>, so no font files are needed).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::{Comparison, ValidationError, JND_DE76};
+
+/// Writes the per-patch ΔE chart of `comparison` to `file` (SVG).
+pub fn write_delta_e_chart(comparison: &Comparison, file: &Path) -> Result<(), ValidationError> {
+    let chart_err = |e: &dyn std::fmt::Display| ValidationError::Chart {
+        file: file.to_path_buf(),
+        message: e.to_string(),
+    };
+    let n = comparison.patches.len();
+    let top = comparison
+        .patches
+        .iter()
+        .map(|p| p.de76.max(p.de00))
+        .fold(JND_DE76, f64::max)
+        * 1.15;
+    let root = SVGBackend::new(file, (900, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| chart_err(&e))?;
+    let caption = format!(
+        "{} vs {}: {} of {} below JND",
+        comparison.test, comparison.reference, comparison.below_jnd, n
+    );
+    let mut chart = ChartBuilder::on(&root)
+        .caption(caption, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(36)
+        .y_label_area_size(48)
+        .build_cartesian_2d(0.5f64..n as f64 + 0.5, 0.0..top)
+        .map_err(|e| chart_err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("ColorChecker patch")
+        .y_desc("colour difference")
+        .x_labels(n)
+        .x_label_formatter(&|x| format!("{}", x.round() as i64))
+        .disable_x_mesh()
+        .draw()
+        .map_err(|e| chart_err(&e))?;
+    let bars = |offset: f64, pick: fn(&super::PatchComparison) -> f64, style: ShapeStyle| {
+        comparison.patches.iter().map(move |p| {
+            let x = p.patch as f64 + offset;
+            Rectangle::new([(x - 0.17, 0.0), (x + 0.17, pick(p))], style)
+        })
+    };
+    chart
+        .draw_series(bars(-0.18, |p| p.de76, BLUE.mix(0.7).filled()))
+        .map_err(|e| chart_err(&e))?
+        .label("ΔE*ab")
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], BLUE.mix(0.7).filled()));
+    chart
+        .draw_series(bars(0.18, |p| p.de00, RED.mix(0.6).filled()))
+        .map_err(|e| chart_err(&e))?
+        .label("ΔE00")
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], RED.mix(0.6).filled()));
+    chart
+        .draw_series(LineSeries::new(
+            [(0.5, JND_DE76), (n as f64 + 0.5, JND_DE76)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(|e| chart_err(&e))?
+        .label("JND 2.3")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 12, y)], BLACK));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| chart_err(&e))?;
+    root.present().map_err(|e| chart_err(&e))?;
+    Ok(())
+}
