@@ -38,7 +38,7 @@ impl Spectrum {
         }
         if let Some(i) = wavelengths_nm
             .windows(2)
-            .position(|w| !(w[1] > w[0]) || !w[0].is_finite() || !w[1].is_finite())
+            .position(|w| w[1] <= w[0] || !w[0].is_finite() || !w[1].is_finite())
         {
             return Err(ColorError::InvalidSpectrum(format!(
                 "wavelengths must increase: {} nm follows {} nm",
