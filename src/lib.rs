@@ -7,7 +7,7 @@
 //! The `metamer` binary is a thin command line over this library.
 
 pub mod color;
-pub mod numeric_csv;
 pub mod display;
+pub mod numeric_csv;
 pub mod render;
 pub mod validation;

@@ -165,7 +165,9 @@ impl CalibrationCondition {
     /// What to tell the user.
     pub fn prompt(&self) -> String {
         match self {
-            CalibrationCondition::OnWhiteTile => "place the instrument on its white calibration tile".into(),
+            CalibrationCondition::OnWhiteTile => {
+                "place the instrument on its white calibration tile".into()
+            }
             CalibrationCondition::SensorCapped => "cap the sensor so no light reaches it".into(),
             CalibrationCondition::OnTarget => "aim the instrument at the target".into(),
             CalibrationCondition::Other(s) => s.clone(),

@@ -1,10 +1,206 @@
-//! `metamer render` (placeholder until its issue's helper lands it).
+//! `metamer render`: spot readings, images and convergence charts of a scene.
 
-use super::{CliError, CliResult};
+use std::path::PathBuf;
+
+use clap::Subcommand;
+
+use super::{parse_triple, CliError, CliResult};
+use metamer::render::convergence;
+use metamer::render::image::{render_image, ImageOptions};
+use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
+use metamer::render::{render_spots, Scene, SpotOptions, Strategy};
 
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(subcommand)]
+    command: Cmd,
+}
 
-pub fn run(_args: Args) -> CliResult {
-    Err(CliError::Usage("'render' is being built".into()))
+#[derive(Subcommand)]
+enum Cmd {
+    /// The 24 simulated 1° meter readings, refined to a ΔE*ab confidence target.
+    Spots {
+        scene: PathBuf,
+        /// Stop when every patch's 95 % half-width of ΔE*ab is below this.
+        #[arg(long, default_value_t = 0.1)]
+        target_de: f64,
+        /// Reference white X,Y,Z (default: a perfect white diffuser in place of patch 19).
+        #[arg(long, value_parser = parse_triple)]
+        white: Option<[f64; 3]>,
+        #[arg(long, default_value_t = 600.0)]
+        max_seconds: f64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[arg(long)]
+        json: bool,
+    },
+    /// The camera's XYZ image (absolute cd/m², float) as .exr or .pfm.
+    Image {
+        scene: PathBuf,
+        /// Samples per pixel.
+        #[arg(long)]
+        spp: u64,
+        /// Output size (default: the scene's, 1014×1014); the field of view is kept.
+        #[arg(long)]
+        width: Option<usize>,
+        #[arg(long)]
+        height: Option<usize>,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// sRGB PNG preview, exposed so the perfect white diffuser is at 1.
+        #[arg(long)]
+        preview: Option<PathBuf>,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// CSV and SVG of ΔE*ab error against seconds for each sampling strategy.
+    Convergence {
+        scene: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Confidence target of the reference run.
+        #[arg(long, default_value_t = 0.05)]
+        reference_de: f64,
+        /// Time budget per strategy.
+        #[arg(long, default_value_t = 20.0)]
+        seconds: f64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+pub fn run(args: Args) -> CliResult {
+    match args.command {
+        Cmd::Spots {
+            scene,
+            target_de,
+            white,
+            max_seconds,
+            seed,
+            json,
+        } => {
+            if target_de.is_nan() || target_de <= 0.0 {
+                return Err(CliError::Usage("--target-de must be > 0".into()));
+            }
+            let scene = Scene::load(&scene)?;
+            let opts = SpotOptions {
+                target_de,
+                white,
+                max_seconds,
+                seed,
+                ..SpotOptions::default()
+            };
+            let r = render_spots(&scene, &opts)?;
+            if json {
+                println!("{}", serde_json::to_string(&r)?);
+            } else {
+                println!(
+                    "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
+                    r.white[0],
+                    r.white[1],
+                    r.white[2],
+                    r.seconds,
+                    if r.converged {
+                        ""
+                    } else {
+                        "  (time limit: not converged)"
+                    }
+                );
+                println!(
+                    "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>10}",
+                    "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "samples"
+                );
+                for p in &r.patches {
+                    println!(
+                        "{:>5} {:>10.4} {:>10.4} {:>10.4} {:>8.3} {:>8.3} {:>8.3} {:>8.4} {:>10}",
+                        p.patch,
+                        p.xyz[0],
+                        p.xyz[1],
+                        p.xyz[2],
+                        p.lab[0],
+                        p.lab[1],
+                        p.lab[2],
+                        p.de_ci95,
+                        p.samples
+                    );
+                }
+            }
+            Ok(())
+        }
+        Cmd::Image {
+            scene,
+            spp,
+            width,
+            height,
+            output,
+            preview,
+            seed,
+        } => {
+            if spp == 0 {
+                return Err(CliError::Usage("--spp must be ≥ 1".into()));
+            }
+            let scene = Scene::load(&scene)?;
+            let width = width.unwrap_or(scene.camera.width);
+            let height = height.unwrap_or(scene.camera.height);
+            if width == 0 || height == 0 {
+                return Err(CliError::Usage("--width and --height must be ≥ 1".into()));
+            }
+            let bar = indicatif::ProgressBar::new(height as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} rows, {elapsed} elapsed, ETA {eta}",
+                )
+                .map_err(|e| CliError::Failed(e.to_string().into()))?,
+            );
+            let opts = ImageOptions {
+                width,
+                height,
+                spp,
+                seed,
+                strategy: Strategy::default(),
+                window: None,
+            };
+            let t = std::time::Instant::now();
+            let img = render_image(&scene, &opts, &|n| bar.inc(n as u64));
+            bar.finish_and_clear();
+            let secs = t.elapsed().as_secs_f64();
+            write_xyz_image(&output, &img)?;
+            eprintln!(
+                "{width}×{height} at {spp} spp in {secs:.1} s ({:.0} samples/s), wrote {}",
+                (width * height) as f64 * spp as f64 / secs,
+                output.display()
+            );
+            if let Some(p) = preview {
+                // Expose for the perfect diffuser under the scene's light, read by the meter.
+                let white = render_spots(
+                    &scene,
+                    &SpotOptions {
+                        target_de: 0.5,
+                        ..SpotOptions::default()
+                    },
+                )?
+                .white;
+                write_srgb_preview(&p, &img, white[1])?;
+                eprintln!("preview {}", p.display());
+            }
+            Ok(())
+        }
+        Cmd::Convergence {
+            scene,
+            output,
+            reference_de,
+            seconds,
+            seed,
+        } => {
+            let scene = Scene::load(&scene)?;
+            let (points, _) =
+                convergence::run(&scene, reference_de, seconds, seed, &|m| eprintln!("{m}"))?;
+            convergence::write(&output, &points)?;
+            eprintln!(
+                "wrote {}/convergence.csv and convergence.svg",
+                output.display()
+            );
+            Ok(())
+        }
+    }
 }

@@ -1,0 +1,228 @@
+//! Reading and writing XYZ float images (absolute cd/m²): PFM (hand-written, the format of
+//! Debevec's HDRShop: "PF" header, width height, negative scale for little-endian, rows
+//! bottom to top) and OpenEXR (the `exr` crate; X, Y, Z stored in the R, G, B channels),
+//! plus an sRGB PNG preview.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::path::{Path, PathBuf};
+
+/// An XYZ image, rows top to bottom.
+#[derive(Clone, Debug, PartialEq)]
+pub struct XyzImage {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl XyzImage {
+    pub fn at(&self, x: usize, y: usize) -> [f32; 3] {
+        self.pixels[y * self.width + x]
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ImageIoError {
+    #[error("{file}: {source}")]
+    Io {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{file}: not a colour PFM: {message}")]
+    Pfm { file: PathBuf, message: String },
+    #[error("{file}: {message}")]
+    Exr { file: PathBuf, message: String },
+    #[error("{file}: PNG: {message}")]
+    Png { file: PathBuf, message: String },
+    #[error("{file}: unknown image type (use .pfm or .exr)")]
+    UnknownType { file: PathBuf },
+}
+
+fn io(file: &Path) -> impl Fn(std::io::Error) -> ImageIoError + '_ {
+    move |source| ImageIoError::Io {
+        file: file.to_path_buf(),
+        source,
+    }
+}
+
+fn ext(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+/// Writes `.pfm` or `.exr` by extension.
+pub fn write_xyz_image(path: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
+    match ext(path).as_str() {
+        "pfm" => write_pfm(path, img),
+        "exr" => exr::prelude::write_rgb_file(path, img.width, img.height, |x, y| {
+            let p = img.at(x, y);
+            (p[0], p[1], p[2])
+        })
+        .map_err(|e| ImageIoError::Exr {
+            file: path.to_path_buf(),
+            message: e.to_string(),
+        }),
+        _ => Err(ImageIoError::UnknownType {
+            file: path.to_path_buf(),
+        }),
+    }
+}
+
+/// Reads `.pfm` or `.exr` by extension.
+pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
+    match ext(path).as_str() {
+        "pfm" => read_pfm(path),
+        "exr" => {
+            use exr::prelude::*;
+            let image = read_first_rgba_layer_from_file(
+                path,
+                |res, _| XyzImage {
+                    width: res.width(),
+                    height: res.height(),
+                    pixels: vec![[0.0; 3]; res.width() * res.height()],
+                },
+                |img: &mut XyzImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    let w = img.width;
+                    img.pixels[pos.y() * w + pos.x()] = [r, g, b];
+                },
+            )
+            .map_err(|e| ImageIoError::Exr {
+                file: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
+            Ok(image.layer_data.channel_data.pixels)
+        }
+        _ => Err(ImageIoError::UnknownType {
+            file: path.to_path_buf(),
+        }),
+    }
+}
+
+fn write_pfm(path: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
+    let mut out = Vec::with_capacity(img.pixels.len() * 12 + 32);
+    out.extend_from_slice(format!("PF\n{} {}\n-1.0\n", img.width, img.height).as_bytes());
+    for y in (0..img.height).rev() {
+        for x in 0..img.width {
+            for c in img.at(x, y) {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    let mut f = std::fs::File::create(path).map_err(io(path))?;
+    f.write_all(&out).map_err(io(path))
+}
+
+fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
+    let bad = |message: String| ImageIoError::Pfm {
+        file: path.to_path_buf(),
+        message,
+    };
+    let f = std::fs::File::open(path).map_err(io(path))?;
+    let mut r = BufReader::new(f);
+    let mut tokens = Vec::new();
+    while tokens.len() < 4 {
+        let mut line = String::new();
+        if r.read_line(&mut line).map_err(io(path))? == 0 {
+            return Err(bad("header ends early".into()));
+        }
+        tokens.extend(line.split_whitespace().map(str::to_string));
+    }
+    if tokens[0] != "PF" {
+        return Err(bad(format!("magic is '{}', expected 'PF'", tokens[0])));
+    }
+    let num = |s: &str| {
+        s.parse::<usize>()
+            .map_err(|_| bad(format!("bad size '{s}'")))
+    };
+    let (w, h) = (num(&tokens[1])?, num(&tokens[2])?);
+    let scale: f32 = tokens[3]
+        .parse()
+        .map_err(|_| bad(format!("bad scale '{}'", tokens[3])))?;
+    let mut data = Vec::new();
+    r.read_to_end(&mut data).map_err(io(path))?;
+    if data.len() != w * h * 12 {
+        return Err(bad(format!(
+            "{} data bytes for {w}×{h} pixels (expected {})",
+            data.len(),
+            w * h * 12
+        )));
+    }
+    let mut pixels = vec![[0.0f32; 3]; w * h];
+    for (i, chunk) in data.chunks_exact(4).enumerate() {
+        let b = [chunk[0], chunk[1], chunk[2], chunk[3]];
+        let v = if scale < 0.0 {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
+        let (p, c) = (i / 3, i % 3);
+        let (x, yb) = (p % w, p / w);
+        pixels[(h - 1 - yb) * w + x][c] = v;
+    }
+    Ok(XyzImage {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// An sRGB (IEC 61966-2-1) 8-bit preview, exposed so that `white_y` maps to 1.
+pub fn write_srgb_preview(path: &Path, img: &XyzImage, white_y: f64) -> Result<(), ImageIoError> {
+    let enc = |v: f64| {
+        let v = v.clamp(0.0, 1.0);
+        let s = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0 + 0.5) as u8
+    };
+    let mut data = Vec::with_capacity(img.pixels.len() * 3);
+    for p in &img.pixels {
+        let [x, y, z] = p.map(|v| v as f64 / white_y);
+        // XYZ → linear sRGB, IEC 61966-2-1 matrix.
+        let r = 3.2406 * x - 1.5372 * y - 0.4986 * z;
+        let g = -0.9689 * x + 1.8758 * y + 0.0415 * z;
+        let b = 0.0557 * x - 0.2040 * y + 1.0570 * z;
+        data.extend([enc(r), enc(g), enc(b)]);
+    }
+    let png_err = |e: png::EncodingError| ImageIoError::Png {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let f = std::fs::File::create(path).map_err(io(path))?;
+    let mut enc = png::Encoder::new(
+        std::io::BufWriter::new(f),
+        img.width as u32,
+        img.height as u32,
+    );
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header().map_err(png_err)?;
+    w.write_image_data(&data).map_err(png_err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pfm_and_exr_round_trip() {
+        let img = XyzImage {
+            width: 3,
+            height: 2,
+            pixels: (0..6)
+                .map(|i| [i as f32, 0.5 * i as f32, 100.0 + i as f32])
+                .collect(),
+        };
+        let dir = std::env::temp_dir().join(format!("metamer-imgio-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for name in ["a.pfm", "a.exr"] {
+            let p = dir.join(name);
+            write_xyz_image(&p, &img).unwrap();
+            assert_eq!(read_xyz_image(&p).unwrap(), img, "{name}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

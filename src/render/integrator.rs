@@ -1,0 +1,323 @@
+//! Spectral path tracing of the scene: radiance along a ray at a few wavelengths at once.
+//!
+//! Next-event estimation picks an emitter tile with probability proportional to its power
+//! (gain × area; every tile shares one directional distribution) and a uniform point on it;
+//! BRDF sampling is cosine-weighted, so a Lambertian bounce multiplies the throughput by
+//! the reflectance alone. The two are combined with the power heuristic (Veach 1997,
+//! §9.2.2). Russian roulette on the largest throughput ends paths without bias.
+//! Geometry does not depend on wavelength here, so the hero wavelengths share every vertex
+//! and their estimates are exact per-wavelength path-tracing estimates.
+
+use super::geometry::Vec3;
+use super::scene::Scene;
+use super::spectral::{Rng, WavelengthSampler, N_BINS};
+use crate::color::K_M;
+
+/// Most wavelengths one path carries (every bin).
+pub const MAX_HERO: usize = N_BINS;
+
+/// Which wavelengths a path carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wavelengths {
+    /// `n` hero wavelengths drawn from the wavelength distribution.
+    Hero(usize),
+    /// Every 1 nm bin where the light and the observer are non-zero: no wavelength noise,
+    /// at the cost of one multiply per bin and bounce (the spot meter's default).
+    Full,
+}
+
+/// How paths are sampled (the convergence chart compares these).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Strategy {
+    /// Wavelengths per path.
+    pub wavelengths: Wavelengths,
+    /// Wavelengths drawn ∝ light spectrum × (x̄+ȳ+z̄) instead of uniformly.
+    pub wavelength_is: bool,
+    /// Next-event estimation with MIS; otherwise BRDF sampling only.
+    pub nee_mis: bool,
+}
+
+impl Default for Strategy {
+    fn default() -> Self {
+        Strategy {
+            wavelengths: Wavelengths::Full,
+            wavelength_is: true,
+            nee_mis: true,
+        }
+    }
+}
+
+/// Per-scene data the inner loop needs.
+pub struct Tracer<'a> {
+    pub scene: &'a Scene,
+    pub strategy: Strategy,
+    sampler: WavelengthSampler,
+    /// (emitter, tile) and cumulative probability.
+    tiles: Vec<(usize, usize, f64)>,
+    tile_pmf: Vec<Vec<f64>>,
+    /// Largest number of bounces (None: Russian roulette only).
+    pub max_depth: Option<usize>,
+    /// Bins that can carry light to the observer.
+    active: Vec<usize>,
+}
+
+enum Target {
+    None,
+    Surface(usize),
+    Emitter(usize, f64, f64),
+}
+
+impl<'a> Tracer<'a> {
+    pub fn new(scene: &'a Scene, strategy: Strategy) -> Tracer<'a> {
+        let strategy = Strategy {
+            wavelengths: match strategy.wavelengths {
+                Wavelengths::Hero(n) => Wavelengths::Hero(n.clamp(1, MAX_HERO)),
+                Wavelengths::Full => Wavelengths::Full,
+            },
+            ..strategy
+        };
+        let active: Vec<usize> = (0..N_BINS)
+            .filter(|&i| {
+                scene.emitters.iter().any(|e| e.radiance[i] > 0.0)
+                    && scene.cmf.iter().any(|c| c[i] > 0.0)
+            })
+            .collect();
+        let sampler = if strategy.wavelength_is {
+            let w: Vec<f64> = (0..scene.cmf[0].len())
+                .map(|i| {
+                    let s: f64 = scene.emitters.iter().map(|e| e.radiance[i]).sum();
+                    s * (scene.cmf[0][i] + scene.cmf[1][i] + scene.cmf[2][i])
+                })
+                .collect();
+            WavelengthSampler::new(&w)
+        } else {
+            WavelengthSampler::uniform()
+        };
+        let mut power = Vec::new();
+        for (ei, e) in scene.emitters.iter().enumerate() {
+            let lum: f64 = e.radiance.iter().sum();
+            for (ti, g) in e.gains.iter().enumerate() {
+                power.push((ei, ti, g * lum * e.rect.area_m2 / e.gains.len() as f64));
+            }
+        }
+        let total: f64 = power.iter().map(|p| p.2).sum();
+        let mut tile_pmf: Vec<Vec<f64>> = scene
+            .emitters
+            .iter()
+            .map(|e| vec![0.0; e.gains.len()])
+            .collect();
+        let mut acc = 0.0;
+        let mut tiles = Vec::new();
+        for (ei, ti, p) in power {
+            let p = p / total;
+            tile_pmf[ei][ti] = p;
+            acc += p;
+            tiles.push((ei, ti, acc));
+        }
+        Tracer {
+            scene,
+            strategy,
+            sampler,
+            tiles,
+            tile_pmf,
+            max_depth: None,
+            active,
+        }
+    }
+
+    fn nearest(&self, o: Vec3, d: Vec3, t_max: f64) -> (f64, Target, bool) {
+        let mut best = t_max;
+        let mut target = Target::None;
+        let mut front = false;
+        for (i, s) in self.scene.surfaces.iter().enumerate() {
+            if let Some(h) = s.rect.intersect(o, d, 1e-9, best) {
+                best = h.t;
+                target = Target::Surface(i);
+                front = h.front;
+            }
+        }
+        for (i, e) in self.scene.emitters.iter().enumerate() {
+            if let Some(h) = e.rect.intersect(o, d, 1e-9, best) {
+                best = h.t;
+                target = Target::Emitter(i, h.a, h.b);
+                front = h.front;
+            }
+        }
+        (best, target, front)
+    }
+
+    fn occluded(&self, o: Vec3, d: Vec3, t_max: f64) -> bool {
+        let t = t_max * (1.0 - 1e-9);
+        self.scene
+            .surfaces
+            .iter()
+            .any(|s| s.rect.intersect(o, d, 1e-9, t).is_some())
+            || self
+                .scene
+                .emitters
+                .iter()
+                .any(|e| e.rect.intersect(o, d, 1e-9, t).is_some())
+    }
+
+    /// Solid-angle pdf of NEE choosing the point `a, b` on emitter `ei` from distance² and
+    /// cosine at the emitter.
+    fn light_pdf_sa(&self, ei: usize, a: f64, b: f64, dist2: f64, cos_l: f64) -> f64 {
+        let e = &self.scene.emitters[ei];
+        let tile = e.tile_at(a, b);
+        let area = e.rect.area_m2 / e.gains.len() as f64;
+        self.tile_pmf[ei][tile] / area * dist2 / cos_l
+    }
+
+    /// XYZ (cd/m²) estimate of the radiance arriving at `origin` from direction `-dir`
+    /// (i.e. along the ray `origin + t·dir`), one path.
+    pub fn xyz_sample(&self, origin: Vec3, dir: Vec3, rng: &mut Rng) -> [f64; 3] {
+        let mut radiance = [0.0f64; MAX_HERO];
+        let mut xyz = [0.0; 3];
+        let cmf = &self.scene.cmf;
+        let mut hero = [0usize; MAX_HERO];
+        let (lambda, n): (&[usize], usize) = match self.strategy.wavelengths {
+            Wavelengths::Hero(n) => {
+                self.sampler.sample_hero(rng.next_f64(), n, &mut hero);
+                (&hero[..n], n)
+            }
+            Wavelengths::Full => (&self.active, self.active.len()),
+        };
+        self.trace(origin, dir, lambda, &mut radiance[..n], rng);
+        let full = self.strategy.wavelengths == Wavelengths::Full;
+        for j in 0..n {
+            let w = if full {
+                K_M * radiance[j]
+            } else {
+                K_M * radiance[j] / (n as f64 * self.sampler.pmf(lambda[j]))
+            };
+            for k in 0..3 {
+                xyz[k] += w * cmf[k][lambda[j]];
+            }
+        }
+        xyz
+    }
+
+    /// Radiance along a ray at the given wavelength bins.
+    pub fn trace(
+        &self,
+        mut o: Vec3,
+        mut d: Vec3,
+        lambda: &[usize],
+        out: &mut [f64],
+        rng: &mut Rng,
+    ) {
+        let n = lambda.len();
+        let mut beta = [1.0f64; MAX_HERO];
+        // Solid-angle pdf of the BRDF sample that produced `d` (None for camera rays).
+        let mut prev_brdf_pdf: Option<f64> = None;
+        let mut depth = 0;
+        loop {
+            let (t, target, front) = self.nearest(o, d, f64::INFINITY);
+            if !front {
+                return;
+            }
+            let p = o.plus(d.times(t));
+            let (normal, refl) = match target {
+                Target::None => return,
+                Target::Emitter(ei, a, b) => {
+                    let e = &self.scene.emitters[ei];
+                    let cos_l = -d.dot(e.rect.normal);
+                    let tile = e.tile_at(a, b);
+                    let f = e.gains[tile] * e.distribution.factor(cos_l);
+                    let w = match prev_brdf_pdf {
+                        Some(pb) if self.strategy.nee_mis => {
+                            let pl = self.light_pdf_sa(ei, a, b, t * t, cos_l);
+                            pb * pb / (pb * pb + pl * pl)
+                        }
+                        _ => 1.0,
+                    };
+                    for j in 0..n {
+                        out[j] += beta[j] * w * f * e.radiance[lambda[j]];
+                    }
+                    (e.rect.normal, &e.reflectance)
+                }
+                Target::Surface(si) => {
+                    let s = &self.scene.surfaces[si];
+                    (s.rect.normal, &s.reflectance)
+                }
+            };
+            if let Some(m) = self.max_depth {
+                if depth >= m {
+                    return;
+                }
+            }
+            depth += 1;
+            for j in 0..n {
+                beta[j] *= refl[lambda[j]];
+            }
+            if self.strategy.nee_mis {
+                self.next_event(p, normal, lambda, &beta, out, rng);
+            }
+            // Russian roulette after two bounces, on the largest throughput.
+            if depth > 2 {
+                let q = beta[..n].iter().cloned().fold(0.0, f64::max).min(0.95);
+                if rng.next_f64() >= q {
+                    return;
+                }
+                for b in beta[..n].iter_mut() {
+                    *b /= q;
+                }
+            } else if beta[..n].iter().all(|b| *b == 0.0) {
+                return;
+            }
+            // Cosine-weighted hemisphere (Malley's method): f·cos/pdf = ρ, applied above.
+            let r = rng.next_f64().sqrt();
+            let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
+            let z = (1.0 - r * r).max(0.0).sqrt();
+            let (s, tt) = normal.basis();
+            d = s
+                .times(r * phi.cos())
+                .plus(tt.times(r * phi.sin()))
+                .plus(normal.times(z))
+                .normalized();
+            prev_brdf_pdf = Some(z / std::f64::consts::PI);
+            o = p;
+        }
+    }
+
+    /// Direct light at `p` (already multiplied by ρ in `beta`) with its MIS weight.
+    fn next_event(
+        &self,
+        p: Vec3,
+        normal: Vec3,
+        lambda: &[usize],
+        beta: &[f64; MAX_HERO],
+        out: &mut [f64],
+        rng: &mut Rng,
+    ) {
+        let u = rng.next_f64();
+        let k = self
+            .tiles
+            .partition_point(|t| t.2 <= u)
+            .min(self.tiles.len() - 1);
+        let (ei, ti, _) = self.tiles[k];
+        let e = &self.scene.emitters[ei];
+        let (row, col) = (ti / e.cols, ti % e.cols);
+        let a = (col as f64 + rng.next_f64()) / e.cols as f64;
+        let b = (row as f64 + rng.next_f64()) / e.rows as f64;
+        let q = e.rect.point(a, b);
+        let to = q.minus(p);
+        let dist2 = to.dot(to);
+        let dist = dist2.sqrt();
+        let wi = to.times(1.0 / dist);
+        let cos_x = wi.dot(normal);
+        let cos_l = -wi.dot(e.rect.normal);
+        if cos_x <= 0.0 || cos_l <= 0.0 || self.occluded(p, wi, dist) {
+            return;
+        }
+        let pl = self.tile_pmf[ei][ti] / (e.rect.area_m2 / e.gains.len() as f64) * dist2 / cos_l;
+        let pb = cos_x / std::f64::consts::PI;
+        let w = pl * pl / (pl * pl + pb * pb);
+        // ρ/π · L · cos_x / pl (beta already holds ρ).
+        let g =
+            e.gains[ti] * e.distribution.factor(cos_l) * w * cos_x / (std::f64::consts::PI * pl);
+        for j in 0..lambda.len() {
+            out[j] += beta[j] * g * e.radiance[lambda[j]];
+        }
+    }
+}
