@@ -5,11 +5,18 @@
 //! byte, a record backend, and in-process pairs for emulated devices. Above the drivers sits
 //! one [`Instrument`] trait. Devices are chosen by one string (see [`open_instrument`]).
 
+pub mod cs100a;
+
 mod error;
 pub mod instrument;
+pub mod link;
+mod spec;
 
-pub use error::DriverError;
+pub use error::{DriverError, SERIAL_PERMISSION_FIX};
 pub use instrument::{
     CalibrationCondition, CalibrationOutcome, Capabilities, Flag, Instrument, InstrumentInfo,
     MeasureMode, Reading, ReadingSpectrum, Request, SharedStimulus, Speed, Stimulus,
+};
+pub use spec::{
+    open_instrument, open_instrument_with, OpenOptions, DEFAULT_STIMULUS_XYZ, TIME_SCALE_ENV,
 };

@@ -1,0 +1,346 @@
+//! A simulated CS-100A: answers the protocol from a light model (the [`Stimulus`] in front
+//! of it), with the meter's repeatability as seeded noise, its range codes and its
+//! measuring time. It serves any [`SerialLink`]: an in-process pair, or the master side of a
+//! pseudo-terminal so the real `serialport` backend is exercised (see `pty`).
+//!
+//! The light model, ours and only as good as the unconfirmed figures it rests on (fact
+//! sheet §5: repeatability ±0.2 % in Y and ±0.001 in x, y; range 0.01–299,000 cd/m²):
+//! - Y < 0.01 cd/m² → OK13 (low light), values still sent;
+//! - 299,000 < Y ≤ 598,000 → OK12 with the `-999999` placeholder (MC2 template);
+//! - Y > 598,000 (twice the range) → ER10;
+//! - no defined chromaticity (X+Y+Z ≤ 0 or y ≤ 0) → OK11 with x, y sent as .0000.
+//! - ±0.2 % and ±0.001 are taken as 2σ of Gaussian noise.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
+
+use crate::instrument::{Speed, Stimulus};
+use crate::link::{LineSettings, LinkError, SerialLink};
+
+/// Upper end of the display range, cd/m² (fact sheet §5, unconfirmed).
+pub const MAX_LUMINANCE: f64 = 299_000.0;
+/// Below this the meter flags low light, cd/m² (fact sheet §5, unconfirmed).
+pub const MIN_LUMINANCE: f64 = 0.01;
+/// Relative 1σ noise of Y: half the ±0.2 % repeatability.
+pub const SIGMA_Y_REL: f64 = 0.001;
+/// 1σ noise of x and y: half the ±0.001 repeatability.
+pub const SIGMA_XY: f64 = 0.0005;
+/// A command left without its CR LF is answered with ER00 after this long (LS-100, KM-LS
+/// p.13 [C]; the CS-100A is assumed to behave alike [I]).
+pub const COMMAND_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// How the emulator behaves besides its light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmulatorConfig {
+    /// Seed of the noise; the same seed gives the same readings.
+    pub seed: u64,
+    /// Multiplies every delay (measuring time, wire time, command timeout): 1.0 is the real
+    /// meter's pace, 0.01 a hundred times faster for tests, 0 no delay at all.
+    pub time_scale: f64,
+    /// Add the repeatability noise (off for exact checks of the range logic).
+    pub noise: bool,
+}
+
+impl Default for EmulatorConfig {
+    fn default() -> Self {
+        EmulatorConfig {
+            seed: 1,
+            time_scale: 1.0,
+            noise: true,
+        }
+    }
+}
+
+/// The simulated meter's state.
+pub struct Cs100aEmulator {
+    stimulus: Arc<dyn Stimulus>,
+    config: EmulatorConfig,
+    rng: SplitMix64,
+    speed: Speed,
+}
+
+impl Cs100aEmulator {
+    pub fn new(stimulus: Arc<dyn Stimulus>, config: EmulatorConfig) -> Cs100aEmulator {
+        Cs100aEmulator {
+            stimulus,
+            rng: SplitMix64(config.seed),
+            config,
+            // The power-on speed is not documented; FAST is assumed [I].
+            speed: Speed::Fast,
+        }
+    }
+
+    /// The reply to one command line and how long the meter takes before sending it.
+    pub fn respond(&mut self, line: &[u8]) -> (Vec<u8>, Duration) {
+        let wire = |n: usize| LineSettings::CS100A.char_time() * n as u32;
+        match cs100a::parse_command(line) {
+            Ok(Command::Measure) => {
+                let (status, value) = self.measure();
+                let reply = match value {
+                    Some(v) => cs100a::encode_measurement(status, &v),
+                    None => cs100a::encode_code(status),
+                };
+                let t = Duration::from_secs_f64(crate::cs100a::response_time_s(self.speed))
+                    + wire(reply.len());
+                (reply, self.scaled(t))
+            }
+            Ok(Command::SetMode(mode)) => {
+                let status = match mode {
+                    Mode::Fast => {
+                        self.speed = Speed::Fast;
+                        Status::Ok00
+                    }
+                    Mode::Slow => {
+                        self.speed = Speed::Slow;
+                        Status::Ok00
+                    }
+                    // The emulator has one calibration and always reports absolute Yxy.
+                    Mode::Absolute | Mode::Preset | Mode::Variable => Status::Ok00,
+                    // DIFF needs a stored target (TDW), which the emulator does not model: it
+                    // refuses the mode rather than send numbers a real meter would not.
+                    Mode::Difference => Status::Er00,
+                };
+                let reply = cs100a::encode_code(status);
+                let t = wire(reply.len());
+                (reply, self.scaled(t))
+            }
+            Ok(Command::Clear) => {
+                let reply = cs100a::encode_code(Status::Ok00);
+                let t = wire(reply.len());
+                (reply, self.scaled(t))
+            }
+            Err(_) => (cs100a::encode_code(Status::Er00), Duration::ZERO),
+        }
+    }
+
+    /// One measurement of the current stimulus by the light model in the module doc.
+    pub fn measure(&mut self) -> (Status, Option<Yxy>) {
+        let [x_, y_, z_] = self.stimulus.xyz();
+        let lum = if y_.is_finite() { y_.max(0.0) } else { 0.0 };
+        if lum > 2.0 * MAX_LUMINANCE {
+            return (Status::Er10, None);
+        }
+        let sum = x_ + y_ + z_;
+        let chroma = (sum.is_finite() && sum > 0.0 && y_ > 0.0).then(|| (x_ / sum, y_ / sum));
+        let noisy_lum = if self.config.noise {
+            lum * (1.0 + SIGMA_Y_REL * self.rng.normal())
+        } else {
+            lum
+        };
+        let noisy_chroma = chroma.map(|(x, y)| {
+            if self.config.noise {
+                (
+                    x + SIGMA_XY * self.rng.normal(),
+                    y + SIGMA_XY * self.rng.normal(),
+                )
+            } else {
+                (x, y)
+            }
+        });
+        let (x, y) = match noisy_chroma {
+            Some((x, y)) => (Some(x), Some(y)),
+            None => (None, None),
+        };
+        let (status, luminance) = if lum > MAX_LUMINANCE {
+            (Status::Ok12, None)
+        } else if chroma.is_none() {
+            (Status::Ok11, Some(noisy_lum))
+        } else if lum < MIN_LUMINANCE {
+            (Status::Ok13, Some(noisy_lum))
+        } else {
+            (Status::Ok00, Some(noisy_lum))
+        };
+        (status, Some(Yxy { luminance, x, y }))
+    }
+
+    fn scaled(&self, t: Duration) -> Duration {
+        t.mul_f64(self.config.time_scale.max(0.0))
+    }
+
+    /// Answers commands on `link` until the host disconnects or `stop` is set.
+    pub fn serve<L: SerialLink>(mut self, mut link: L, stop: &AtomicBool) {
+        // Poll in short slices so `stop` is seen promptly.
+        let slice = Duration::from_millis(20);
+        let command_timeout = self.scaled(COMMAND_TIMEOUT).max(slice);
+        let mut pending: Vec<u8> = Vec::new();
+        let mut pending_since = Instant::now();
+        while !stop.load(Ordering::Relaxed) {
+            match link.read_until(cs100a::TERMINATOR, slice) {
+                Ok(line) => {
+                    let mut full = std::mem::take(&mut pending);
+                    full.extend_from_slice(&line);
+                    let (reply, delay) = self.respond(&full);
+                    std::thread::sleep(delay);
+                    if link.write_all(&reply).is_err() {
+                        return;
+                    }
+                }
+                Err(LinkError::Timeout { received, .. }) => {
+                    if !received.is_empty() {
+                        if pending.is_empty() {
+                            pending_since = Instant::now();
+                        }
+                        pending.extend_from_slice(&received);
+                    }
+                    if !pending.is_empty() && pending_since.elapsed() >= command_timeout {
+                        pending.clear();
+                        if link.write_all(&cs100a::encode_code(Status::Er00)).is_err() {
+                            return;
+                        }
+                    }
+                }
+                Err(_) => return,
+            }
+        }
+    }
+
+    /// Serves `link` on a new thread until the host end disconnects.
+    pub fn spawn<L: SerialLink + 'static>(self, link: L) -> std::thread::JoinHandle<()> {
+        std::thread::Builder::new()
+            .name("cs100a-emulator".into())
+            .spawn(move || self.serve(link, &AtomicBool::new(false)))
+            .expect("spawning the emulator thread")
+    }
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): small, seedable, good enough for noise.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in (0, 1].
+    fn uniform(&mut self) -> f64 {
+        ((self.next_u64() >> 11) as f64 + 1.0) / (1u64 << 53) as f64
+    }
+
+    /// Standard normal by Box–Muller.
+    fn normal(&mut self) -> f64 {
+        let (u1, u2) = (self.uniform(), self.uniform());
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::instrument::SharedStimulus;
+
+    fn emu(xyz: [f64; 3], noise: bool, seed: u64) -> Cs100aEmulator {
+        Cs100aEmulator::new(
+            Arc::new(SharedStimulus::new(xyz)),
+            EmulatorConfig {
+                seed,
+                time_scale: 0.0,
+                noise,
+            },
+        )
+    }
+
+    /// XYZ of luminance `lum` at D65's chromaticity (x, y) = (0.3127, 0.3290).
+    fn d65(lum: f64) -> [f64; 3] {
+        let (x, y) = (0.3127, 0.3290);
+        [x / y * lum, lum, (1.0 - x - y) / y * lum]
+    }
+
+    #[test]
+    fn noiseless_reading_reports_the_stimulus() {
+        let (status, v) = emu(d65(123.4), false, 1).measure();
+        assert_eq!(status, Status::Ok00);
+        let v = v.unwrap();
+        assert!((v.luminance.unwrap() - 123.4).abs() < 1e-9);
+        assert!((v.x.unwrap() - 0.3127).abs() < 1e-12);
+        assert!((v.y.unwrap() - 0.3290).abs() < 1e-12);
+        let (reply, _) = emu(d65(123.4), false, 1).respond(b"MES\r\n");
+        assert_eq!(reply, b"OK00,  123.4, .3127, .3290\r\n");
+    }
+
+    #[test]
+    fn range_ends_give_the_documented_codes() {
+        assert_eq!(emu(d65(0.005), false, 1).measure().0, Status::Ok13);
+        assert_eq!(emu(d65(0.01), false, 1).measure().0, Status::Ok00);
+        assert_eq!(emu(d65(299_000.0), false, 1).measure().0, Status::Ok00);
+        let (s, v) = emu(d65(300_000.0), false, 1).measure();
+        assert_eq!((s, v.unwrap().luminance), (Status::Ok12, None));
+        assert_eq!(
+            emu(d65(700_000.0), false, 1).measure(),
+            (Status::Er10, None)
+        );
+        let (s, v) = emu([0.0, 0.0, 0.0], false, 1).measure();
+        assert_eq!(s, Status::Ok11);
+        assert_eq!(v.unwrap().x, None);
+        let (reply, _) = emu(d65(700_000.0), false, 1).respond(b"MES\r\n");
+        assert_eq!(reply, b"ER10\r\n");
+    }
+
+    #[test]
+    fn noise_matches_the_stated_repeatability() {
+        let mut e = emu(d65(100.0), true, 42);
+        let n = 4000;
+        let (mut sy, mut syy, mut sx, mut sxx) = (0.0, 0.0, 0.0, 0.0);
+        for _ in 0..n {
+            let v = e.measure().1.unwrap();
+            let l = v.luminance.unwrap();
+            sy += l;
+            syy += l * l;
+            let x = v.x.unwrap();
+            sx += x;
+            sxx += x * x;
+        }
+        let n = n as f64;
+        let (my, mx) = (sy / n, sx / n);
+        let sd_y = (syy / n - my * my).sqrt();
+        let sd_x = (sxx / n - mx * mx).sqrt();
+        // Standard error of a standard deviation over 4000 samples is ≈1.1 %; allow 5 %.
+        assert!((sd_y / 0.1 - 1.0).abs() < 0.05, "σ_Y = {sd_y}");
+        assert!((sd_x / SIGMA_XY - 1.0).abs() < 0.05, "σ_x = {sd_x}");
+        assert!((my - 100.0).abs() < 0.01 && (mx - 0.3127).abs() < 5e-5);
+        // Same seed, same readings.
+        let a: Vec<_> = (0..3).map(|_| emu(d65(50.0), true, 7).measure()).collect();
+        let mut e7 = emu(d65(50.0), true, 7);
+        assert_eq!(a[0], e7.measure());
+    }
+
+    #[test]
+    fn modes_and_bad_commands() {
+        let mut e = emu(d65(1.0), false, 1);
+        assert_eq!(e.respond(b"MDS,07\r\n").0, b"OK00\r\n");
+        assert_eq!(e.speed, Speed::Slow);
+        assert_eq!(e.respond(b"MDS,08\r\n").0, b"ER00\r\n");
+        assert_eq!(e.respond(b"FOO\r\n").0, b"ER00\r\n");
+        assert_eq!(e.respond(b"CLE\r\n").0, b"OK00\r\n");
+    }
+
+    #[test]
+    fn measuring_time_follows_speed_and_scale() {
+        let mut e = Cs100aEmulator::new(
+            Arc::new(SharedStimulus::new(d65(10.0))),
+            EmulatorConfig {
+                seed: 1,
+                time_scale: 1.0,
+                noise: false,
+            },
+        );
+        let wire = 28.0 * 11.0 / 4800.0;
+        let (_, t) = e.respond(b"MES\r\n");
+        assert!((t.as_secs_f64() - (0.1 + wire)).abs() < 1e-6, "{t:?}");
+        e.respond(b"MDS,07\r\n");
+        let (_, t) = e.respond(b"MES\r\n");
+        assert!((t.as_secs_f64() - (0.4 + wire)).abs() < 1e-6, "{t:?}");
+        e.config.time_scale = 0.01;
+        let (_, t) = e.respond(b"MES\r\n");
+        assert!(
+            (t.as_secs_f64() - (0.4 + wire) * 0.01).abs() < 1e-6,
+            "{t:?}"
+        );
+    }
+}

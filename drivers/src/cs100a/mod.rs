@@ -1,0 +1,282 @@
+//! Konica Minolta CS-100A chroma meter driver, generic over its serial link, so the real
+//! port, a replayed transcript and the emulator run the same code. Facts: fact sheet
+//! `shared/protocols/cs100a.md`; codec: `metamer_protocols::cs100a`.
+//!
+//! Session: `MDS,04` (absolute Yxy) on connect, `MDS,06`/`MDS,07` (FAST/SLOW) whenever the
+//! requested speed differs from the one last set, then `MES` per reading. Every exchange
+//! discards stale input first (PP and VCC do the same, [C2]).
+
+pub mod emulator;
+#[cfg(unix)]
+pub mod pty;
+
+use std::time::Duration;
+
+use metamer_protocols::cs100a::{self, Command, Mode, Reply, Status, Yxy};
+use metamer_protocols::transcript::show_bytes;
+
+use crate::instrument::{
+    CalibrationCondition, CalibrationOutcome, Capabilities, Flag, Instrument, InstrumentInfo,
+    MeasureMode, Reading, Request, Speed,
+};
+use crate::link::{LinkError, SerialLink};
+use crate::DriverError;
+
+/// Model name used in readings, transcripts and specs.
+pub const MODEL: &str = "cs100a";
+
+/// How long to wait for a reply. PP, VCC and PGL wait 5 s ([C2]); the LS-100 itself gives
+/// up on a half-sent command after 5 s (KM-LS p.13, [C]); SLOW takes ≈0.4 s plus ≈64 ms of
+/// wire time, so 5 s never cuts off a meter that is answering.
+pub const REPLY_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// The response time of a speed setting, seconds (MC2, VB, VCC comments; [C2]).
+pub fn response_time_s(speed: Speed) -> f64 {
+    match speed {
+        Speed::Fast => 0.1,
+        Speed::Slow => 0.4,
+    }
+}
+
+/// A CS-100A on a serial link.
+pub struct Cs100a<L: SerialLink> {
+    link: L,
+    /// Speed last acknowledged by the meter; None until set (the meter keeps whatever its
+    /// front panel or an earlier session chose).
+    speed: Option<Speed>,
+    absolute: bool,
+    timeout: Duration,
+}
+
+impl<L: SerialLink> Cs100a<L> {
+    /// Wraps a link; nothing is sent until [`Cs100a::connect`] or the first measurement.
+    pub fn new(link: L) -> Cs100a<L> {
+        Cs100a {
+            link,
+            speed: None,
+            absolute: false,
+            timeout: REPLY_TIMEOUT,
+        }
+    }
+
+    /// Changes how long to wait for each reply.
+    pub fn with_timeout(mut self, timeout: Duration) -> Cs100a<L> {
+        self.timeout = timeout;
+        self
+    }
+
+    /// Puts the meter in absolute Yxy mode; a meter that is not in remote mode fails here,
+    /// with the instructions to fix it.
+    pub fn connect(&mut self) -> Result<(), DriverError> {
+        self.ack(Command::SetMode(Mode::Absolute))?;
+        self.absolute = true;
+        Ok(())
+    }
+
+    /// Sets FAST or SLOW response.
+    pub fn set_speed(&mut self, speed: Speed) -> Result<(), DriverError> {
+        let mode = match speed {
+            Speed::Fast => Mode::Fast,
+            Speed::Slow => Mode::Slow,
+        };
+        self.ack(Command::SetMode(mode))?;
+        self.speed = Some(speed);
+        Ok(())
+    }
+
+    /// One `MES`: the status and the values as sent.
+    pub fn measure_yxy(&mut self) -> Result<(Status, Yxy), DriverError> {
+        match self.exchange(Command::Measure)? {
+            Reply::Measurement { status, value } => Ok((status, value)),
+            Reply::Code(status) if !status.is_ok() => {
+                Err(self.instrument_error(Command::Measure, status))
+            }
+            Reply::Code(status) => Err(DriverError::UnexpectedReply {
+                port: self.link.describe(),
+                command: Command::Measure.text(),
+                received: status.code().to_string(),
+                reason: "a measurement must carry Y, x and y".into(),
+            }),
+        }
+    }
+
+    /// The link, e.g. to check that a replay was played to its end.
+    pub fn link(&self) -> &L {
+        &self.link
+    }
+
+    /// Gives the link back.
+    pub fn into_link(self) -> L {
+        self.link
+    }
+
+    fn ack(&mut self, command: Command) -> Result<(), DriverError> {
+        match self.exchange(command)? {
+            Reply::Code(Status::Ok00) => Ok(()),
+            Reply::Code(status) if !status.is_ok() => Err(self.instrument_error(command, status)),
+            other => Err(DriverError::UnexpectedReply {
+                port: self.link.describe(),
+                command: command.text(),
+                received: format!("{other:?}"),
+                reason: "expected the acknowledgement OK00".into(),
+            }),
+        }
+    }
+
+    fn instrument_error(&self, command: Command, status: Status) -> DriverError {
+        DriverError::Instrument {
+            port: self.link.describe(),
+            command: command.text(),
+            status,
+        }
+    }
+
+    /// Sends a command and parses its reply.
+    ///
+    /// Retry policy: a reply that arrives complete but garbled (parity substitutes, bytes
+    /// that are not the protocol) is retried once, because every command this driver sends
+    /// is idempotent: `MES` measures the same target again, `MDS` sets the same mode again
+    /// and `CLE` clears an already clear memory. Silence, a half reply, a disconnect and ER
+    /// codes are not retried: silence means the meter is not in remote mode (waiting again
+    /// only doubles the wait), a half reply or a disconnect means the cable or the meter
+    /// needs attention, and an ER code is the meter's considered answer.
+    fn exchange(&mut self, command: Command) -> Result<Reply, DriverError> {
+        const ATTEMPTS: usize = 2;
+        let mut attempt = 0;
+        loop {
+            attempt += 1;
+            let line = self.transact(command)?;
+            match cs100a::parse_reply(&line) {
+                Ok(reply) => return Ok(reply),
+                Err(reason) if attempt < ATTEMPTS => drop(reason),
+                Err(reason) => {
+                    return Err(DriverError::BadReply {
+                        port: self.link.describe(),
+                        command: command.text(),
+                        received: show_bytes(&line),
+                        reason,
+                    })
+                }
+            }
+        }
+    }
+
+    /// Writes a command and reads one line, turning link failures into driver errors.
+    fn transact(&mut self, command: Command) -> Result<Vec<u8>, DriverError> {
+        let port = self.link.describe();
+        let text = command.text();
+        self.link.discard_input()?;
+        let r = self
+            .link
+            .write_all(&command.encode())
+            .and_then(|()| self.link.read_until(cs100a::TERMINATOR, self.timeout));
+        r.map_err(|e| match e {
+            LinkError::Timeout {
+                timeout_ms,
+                received,
+            } if received.is_empty() => DriverError::NotInRemoteMode {
+                port,
+                command: text,
+                timeout_ms,
+            },
+            LinkError::Timeout {
+                timeout_ms,
+                received,
+            } => DriverError::PartialReply {
+                port,
+                command: text,
+                received: show_bytes(&received),
+                timeout_ms,
+            },
+            LinkError::Disconnected { received } => DriverError::Disconnected {
+                port,
+                command: text,
+                received: if received.is_empty() {
+                    "nothing".into()
+                } else {
+                    show_bytes(&received)
+                },
+            },
+            other => DriverError::Link(other),
+        })
+    }
+}
+
+/// A reading from what the meter sent: Yxy → XYZ (X = xY/y, Z = (1−x−y)Y/y). Values the
+/// meter did not measure (OK11 chromaticity, OK12 placeholder luminance) are NaN, and the
+/// flags say why; JSON writes them as null.
+pub fn reading_from(status: Status, value: &Yxy, speed: Option<Speed>) -> Reading {
+    let lum = value.luminance.unwrap_or(f64::NAN);
+    let (x, y) = match (value.x, value.y) {
+        (Some(x), Some(y)) => (x, y),
+        _ => (f64::NAN, f64::NAN),
+    };
+    let mut reading = Reading::from_yxy(lum, x, y, MODEL);
+    if y.is_nan() || y <= 0.0 {
+        reading.xyz = [f64::NAN, lum, f64::NAN];
+    }
+    reading.flags = match status {
+        Status::Ok11 => vec![Flag::ChromaticityOverRange],
+        Status::Ok12 => vec![Flag::OverRange],
+        Status::Ok13 => vec![Flag::LowLight],
+        _ => Vec::new(),
+    };
+    reading.integration_s = speed.map(response_time_s);
+    reading
+}
+
+impl<L: SerialLink + 'static> Instrument for Cs100a<L> {
+    fn info(&self) -> InstrumentInfo {
+        InstrumentInfo {
+            model: MODEL.into(),
+            // The CS-100A has no identify command (fact sheet §2).
+            serial: None,
+            firmware: None,
+            connection: self.link.describe(),
+        }
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            emissive: true,
+            reflective: false,
+            spectral: false,
+            // 1° and 0.01–299,000 cd/m² are general knowledge, unconfirmed by a KM source
+            // (fact sheet §5).
+            acceptance_angle_deg: Some(1.0),
+            speeds: vec![Speed::Fast, Speed::Slow],
+            luminance_range_cd_m2: Some((0.01, 299_000.0)),
+        }
+    }
+
+    fn calibration_needed(&mut self) -> Result<Option<CalibrationCondition>, DriverError> {
+        // The meter measures with Minolta's factory calibration (MDS,00 PRESET, the power-on
+        // default [I]); it has no dark or white calibration step the host must drive.
+        Ok(None)
+    }
+
+    fn calibrate(
+        &mut self,
+        _condition: &CalibrationCondition,
+    ) -> Result<CalibrationOutcome, DriverError> {
+        Ok(CalibrationOutcome::Done)
+    }
+
+    fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
+        if request.mode == MeasureMode::Reflective {
+            return Err(DriverError::Unsupported {
+                instrument: MODEL.into(),
+                what: "reflective measurements (it has no lamp; measure a lit surface emissively)"
+                    .into(),
+            });
+        }
+        if !self.absolute {
+            self.connect()?;
+        }
+        if self.speed != Some(request.speed) {
+            self.set_speed(request.speed)?;
+        }
+        let (status, value) = self.measure_yxy()?;
+        Ok(reading_from(status, &value, self.speed))
+    }
+}

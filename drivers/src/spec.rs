@@ -1,0 +1,216 @@
+//! Choosing an instrument by one string (architecture note: "device selection by one
+//! string"):
+//!
+//! - `cs100a:PORT` — a CS-100A on a serial port (`cs100a:/dev/ttyUSB0`, `cs100a:COM3`);
+//! - `replay:FILE.jsonl` — a transcript played through the real driver;
+//! - `sim:cs100a` — the emulated CS-100A, answering from a stimulus. Options after `?`,
+//!   separated by `&`: `time_scale=F` (1 = the real meter's ≈100/400 ms per reading,
+//!   0.01 a hundred times faster, 0 instant; default 1, or the environment variable
+//!   `METAMER_SIM_TIME_SCALE`), `seed=N` (noise seed, default 1), `noise=off`.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
+use crate::cs100a::{self, Cs100a};
+use crate::instrument::{Instrument, SharedStimulus, Stimulus};
+use crate::link::pair::pair;
+use crate::link::record::RecordSerial;
+use crate::link::replay::ReplaySerial;
+use crate::link::serial::PortLink;
+use crate::link::{LineSettings, SerialLink};
+use crate::DriverError;
+
+/// The environment variable that sets the simulated meters' time scale.
+pub const TIME_SCALE_ENV: &str = "METAMER_SIM_TIME_SCALE";
+
+/// The light a simulated meter sees when no stimulus is given: 100 cd/m² at the
+/// chromaticity of CIE illuminant LED-RGB1 (x, y) = (0.45576, 0.42110), computed from
+/// `data/illuminant_led_rgb1.csv` with the CIE 1931 2° observer by `metamer color xyz`
+/// (checked by `tests/cs100a_sim.rs`).
+pub const DEFAULT_STIMULUS_XYZ: [f64; 3] = [108.229_360_132_203_85, 100.0, 29.242_246_576_178_09];
+
+/// Extra choices when opening an instrument.
+#[derive(Clone, Default)]
+pub struct OpenOptions {
+    /// What a simulated instrument sees (default: [`DEFAULT_STIMULUS_XYZ`]).
+    pub stimulus: Option<Arc<dyn Stimulus>>,
+    /// Record the session to this new transcript file (serial instruments).
+    pub record: Option<PathBuf>,
+}
+
+/// Opens the instrument `spec` names; `stimulus` is what a simulated one sees.
+pub fn open_instrument(
+    spec: &str,
+    stimulus: Option<Arc<dyn Stimulus>>,
+) -> Result<Box<dyn Instrument>, DriverError> {
+    open_instrument_with(
+        spec,
+        &OpenOptions {
+            stimulus,
+            record: None,
+        },
+    )
+}
+
+/// [`open_instrument`] with recording and other options.
+pub fn open_instrument_with(
+    spec: &str,
+    options: &OpenOptions,
+) -> Result<Box<dyn Instrument>, DriverError> {
+    let unknown = || DriverError::UnknownSpec {
+        spec: spec.to_string(),
+    };
+    let (kind, rest) = spec.split_once(':').ok_or_else(unknown)?;
+    match kind {
+        "cs100a" if !rest.is_empty() => {
+            let link = PortLink::open(rest, LineSettings::CS100A)?;
+            connect_cs100a(link, options)
+        }
+        "replay" if !rest.is_empty() => {
+            let link = ReplaySerial::open(Path::new(rest))?;
+            let instrument = link.transcript().header.instrument.clone();
+            if instrument != cs100a::MODEL {
+                return Err(DriverError::Transcript {
+                    file: rest.to_string(),
+                    line: 1,
+                    message: format!(
+                        "the transcript is of instrument '{instrument}', which has no driver yet \
+                         (known: cs100a)"
+                    ),
+                });
+            }
+            connect_cs100a(link, options)
+        }
+        "sim" => {
+            let (model, query) = rest.split_once('?').unwrap_or((rest, ""));
+            if model != cs100a::MODEL {
+                return Err(unknown());
+            }
+            let config = sim_config(spec, query)?;
+            let stimulus = options
+                .stimulus
+                .clone()
+                .unwrap_or_else(|| Arc::new(SharedStimulus::new(DEFAULT_STIMULUS_XYZ)));
+            let (host, device) = pair(LineSettings::CS100A, "sim:cs100a");
+            Cs100aEmulator::new(stimulus, config).spawn(device);
+            connect_cs100a(host, options)
+        }
+        _ => Err(unknown()),
+    }
+}
+
+fn connect_cs100a<L: SerialLink + 'static>(
+    link: L,
+    options: &OpenOptions,
+) -> Result<Box<dyn Instrument>, DriverError> {
+    match &options.record {
+        Some(path) => {
+            let description = format!("metamer session with the CS-100A on {}", link.describe());
+            let rec = RecordSerial::create(link, path, cs100a::MODEL, &description)?;
+            let mut meter = Cs100a::new(rec);
+            meter.connect()?;
+            Ok(Box::new(meter))
+        }
+        None => {
+            let mut meter = Cs100a::new(link);
+            meter.connect()?;
+            Ok(Box::new(meter))
+        }
+    }
+}
+
+/// Parses `time_scale=…&seed=…&noise=off`.
+fn sim_config(spec: &str, query: &str) -> Result<EmulatorConfig, DriverError> {
+    let bad = |message: String| DriverError::BadSpecOption {
+        spec: spec.to_string(),
+        message,
+    };
+    let mut config = EmulatorConfig::default();
+    if let Ok(v) = std::env::var(TIME_SCALE_ENV) {
+        config.time_scale = parse_scale(&v)
+            .ok_or_else(|| bad(format!("{TIME_SCALE_ENV}={v:?} is not a number ≥ 0")))?;
+    }
+    for option in query.split('&').filter(|o| !o.is_empty()) {
+        let (key, value) = option.split_once('=').unwrap_or((option, ""));
+        match key {
+            "time_scale" => {
+                config.time_scale = parse_scale(value)
+                    .ok_or_else(|| bad(format!("time_scale={value:?} is not a number ≥ 0")))?
+            }
+            "seed" => {
+                config.seed = value
+                    .parse()
+                    .map_err(|_| bad(format!("seed={value:?} is not a whole number")))?
+            }
+            "noise" => {
+                config.noise = match value {
+                    "on" => true,
+                    "off" => false,
+                    _ => return Err(bad(format!("noise={value:?}: expected on or off"))),
+                }
+            }
+            _ => {
+                return Err(bad(format!(
+                    "unknown option '{key}' (known: time_scale, seed, noise)"
+                )))
+            }
+        }
+    }
+    Ok(config)
+}
+
+fn parse_scale(v: &str) -> Option<f64> {
+    v.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite() && *s >= 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::instrument::Request;
+
+    #[test]
+    fn sim_measures_the_given_stimulus() {
+        let light = Arc::new(SharedStimulus::new([0.0; 3]));
+        let mut m = open_instrument(
+            "sim:cs100a?time_scale=0&noise=off",
+            Some(light.clone() as Arc<dyn Stimulus>),
+        )
+        .unwrap();
+        light.set([95.047, 100.0, 108.883]);
+        let r = m.measure(&Request::default()).unwrap();
+        // D65 white: x = 0.31272, y = 0.32903; the meter rounds to 4 decimals.
+        assert!((r.xyy[0] - 0.3127).abs() < 1e-9 && (r.xyy[1] - 0.3290).abs() < 1e-9);
+        assert_eq!(r.xyy[2], 100.0);
+        assert!(r.flags.is_empty());
+        assert_eq!(r.instrument, "cs100a");
+        light.set([0.3, 0.3, 0.3]);
+        let r = m.measure(&Request::default()).unwrap();
+        assert!((r.xyy[2] - 0.3).abs() < 1e-9);
+    }
+
+    #[test]
+    fn default_stimulus_and_bad_specs() {
+        let mut m = open_instrument("sim:cs100a?time_scale=0&noise=off", None).unwrap();
+        let r = m.measure(&Request::default()).unwrap();
+        assert_eq!(r.xyy[2], 100.0);
+        assert!((r.xyy[0] - 0.4558).abs() < 1e-9, "{:?}", r.xyy);
+        assert!((r.xyy[1] - 0.4211).abs() < 1e-9, "{:?}", r.xyy);
+        for spec in ["nothing", "sim:i1pro", "cs100a:", "replay:"] {
+            let e = open_instrument(spec, None).err().unwrap();
+            assert!(
+                e.to_string().contains("expected cs100a:PORT"),
+                "{spec}: {e}"
+            );
+        }
+        let e = open_instrument("sim:cs100a?speed=9", None).err().unwrap();
+        assert!(e.to_string().contains("unknown option 'speed'"), "{e}");
+        let e = open_instrument("sim:cs100a?time_scale=-1", None)
+            .err()
+            .unwrap();
+        assert!(e.to_string().contains("time_scale=\"-1\""), "{e}");
+    }
+}
