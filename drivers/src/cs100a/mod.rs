@@ -165,10 +165,10 @@ impl<L: SerialLink> Cs100a<L> {
     fn transact(&mut self, command: Command) -> Result<Vec<u8>, DriverError> {
         let port = self.link.describe();
         let text = command.text();
-        self.link.discard_input()?;
         let r = self
             .link
-            .write_all(&command.encode())
+            .discard_input()
+            .and_then(|()| self.link.write_all(&command.encode()))
             .and_then(|()| self.link.read_until(cs100a::TERMINATOR, self.timeout));
         r.map_err(|e| match e {
             LinkError::Timeout {

@@ -48,10 +48,18 @@ impl PortLink {
         }
     }
 
+    /// An I/O failure as a link error: a hang-up (the adapter unplugged, the pty peer gone)
+    /// is a disconnect, anything else an I/O error naming the port.
     fn io(&self, source: std::io::Error) -> LinkError {
-        LinkError::Io {
-            port: self.name.clone(),
-            source,
+        if is_disconnect(&source) {
+            LinkError::Disconnected {
+                received: Vec::new(),
+            }
+        } else {
+            LinkError::Io {
+                port: self.name.clone(),
+                source,
+            }
         }
     }
 }
@@ -119,15 +127,7 @@ const fn libc_enxio() -> i32 {
 impl SerialLink for PortLink {
     fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         let r = self.port.write_all(bytes).and_then(|()| self.port.flush());
-        r.map_err(|e| {
-            if is_disconnect(&e) {
-                LinkError::Disconnected {
-                    received: Vec::new(),
-                }
-            } else {
-                self.io(e)
-            }
-        })
+        r.map_err(|e| self.io(e))
     }
 
     fn read_until(&mut self, terminator: &[u8], timeout: Duration) -> Result<Vec<u8>, LinkError> {
