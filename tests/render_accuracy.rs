@@ -297,3 +297,61 @@ fn bad_field_is_named_by_json_path() {
     assert_eq!(path, "emitters[0].tiles[3].gain");
     assert_eq!(message, "must be ≥ 0");
 }
+
+#[test]
+fn spot_readings_agree_across_seeds_within_their_confidence() {
+    // Two independent runs to ΔE95 0.4: each patch's difference is a draw with standard
+    // deviation √(σ₁² + σ₂²) where σ = half-width / 1.96; allow two half-widths combined
+    // (≈ 4 σ) so 24 patches pass by chance with probability > 99.8 %, while a biased or
+    // seed-dependent estimator (or a wrong half-width) fails. A shared white keeps the
+    // comparison about the patches.
+    use metamer::color::{delta_e76, Xyz};
+    use metamer::render::{render_spots, SpotOptions};
+    let scene = build(&box_json());
+    let white = metamer::render::reference_white(
+        &scene,
+        &SpotOptions {
+            target_de: 0.3,
+            ..SpotOptions::default()
+        },
+    )
+    .unwrap();
+    let run = |seed| {
+        render_spots(
+            &scene,
+            &SpotOptions {
+                target_de: 0.4,
+                white: Some(white),
+                seed,
+                first_batch: 1024,
+                ..SpotOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let (a, b) = (run(11), run(12));
+    assert!(a.converged && b.converged);
+    let w = Xyz::from_array(white);
+    let mut worst: f64 = 0.0;
+    for (pa, pb) in a.patches.iter().zip(&b.patches) {
+        assert!(pa.de_ci95 < 0.4 && pb.de_ci95 < 0.4);
+        let de = delta_e76(
+            Xyz::from_array(pa.xyz).to_lab(w),
+            Xyz::from_array(pb.xyz).to_lab(w),
+        );
+        let allowed = 2.0 * (pa.de_ci95.powi(2) + pb.de_ci95.powi(2)).sqrt();
+        worst = worst.max(de / allowed);
+        assert!(
+            de < allowed,
+            "patch {}: ΔE {de} between seeds, allowed {allowed}",
+            pa.patch
+        );
+    }
+    eprintln!("largest difference / allowance: {worst:.3}");
+    // The half-widths must not be wildly pessimistic either: some patch differs by more
+    // than a tenth of its allowance (with honest errors, all 24 below that has p ≈ 1e-20).
+    assert!(
+        worst > 0.1,
+        "largest difference only {worst} of the allowance"
+    );
+}

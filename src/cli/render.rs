@@ -8,7 +8,7 @@ use super::{parse_triple, CliError, CliResult};
 use metamer::render::convergence;
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
-use metamer::render::{render_spots, Scene, SpotOptions, Strategy};
+use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -90,7 +90,20 @@ pub fn run(args: Args) -> CliResult {
                 seed,
                 ..SpotOptions::default()
             };
-            let r = render_spots(&scene, &opts)?;
+            // Progress on stderr (hidden when it is not a terminal, e.g. in scripts).
+            let bar = indicatif::ProgressBar::new(24);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{bar:30} {pos}/{len} patches at target, {elapsed} elapsed {msg}",
+                )
+                .map_err(|e| CliError::Failed(e.to_string().into()))?,
+            );
+            bar.set_message("(reference white)");
+            let r = render_spots_with_progress(&scene, &opts, &|p| {
+                bar.set_position(p.converged as u64);
+                bar.set_message(format!("worst ΔE95 {:.3}", p.worst_de));
+            })?;
+            bar.finish_and_clear();
             if json {
                 println!("{}", serde_json::to_string(&r)?);
             } else {
@@ -172,14 +185,13 @@ pub fn run(args: Args) -> CliResult {
             );
             if let Some(p) = preview {
                 // Expose for the perfect diffuser under the scene's light, read by the meter.
-                let white = render_spots(
+                let white = reference_white(
                     &scene,
                     &SpotOptions {
                         target_de: 0.5,
                         ..SpotOptions::default()
                     },
-                )?
-                .white;
+                )?;
                 write_srgb_preview(&p, &img, white[1])?;
                 eprintln!("preview {}", p.display());
             }

@@ -131,10 +131,11 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
     };
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let csv = dir.join("convergence.csv");
+    // Strategy names contain commas: quoted (RFC 4180).
     let mut text = String::from("strategy,samples_per_patch,seconds,max_de_ab,mean_de_ab\n");
     for p in points {
         text.push_str(&format!(
-            "{},{},{:.4},{:.5},{:.5}\n",
+            "\"{}\",{},{:.4},{:.5},{:.5}\n",
             p.strategy, p.samples_per_patch, p.seconds, p.max_de, p.mean_de
         ));
     }

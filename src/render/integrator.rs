@@ -208,9 +208,15 @@ impl<'a> Tracer<'a> {
     ) {
         let n = lambda.len();
         let mut beta = [1.0f64; MAX_HERO];
+        let mut buf = [0.0f64; MAX_HERO];
+        let bins = Bins::new(lambda);
         // Solid-angle pdf of the BRDF sample that produced `d` (None for camera rays).
         let mut prev_brdf_pdf: Option<f64> = None;
         let mut depth = 0;
+        // Throughput after the first surface: Russian roulette is judged relative to it, so
+        // a dark patch seen by the meter does not cut its own indirect light short (its
+        // reflectance scales every continuation alike and would only add variance).
+        let mut first_beta = 1.0f64;
         loop {
             let (t, target, front) = self.nearest(o, d, f64::INFINITY);
             if !front {
@@ -231,8 +237,10 @@ impl<'a> Tracer<'a> {
                         }
                         _ => 1.0,
                     };
-                    for j in 0..n {
-                        out[j] += beta[j] * w * f * e.radiance[lambda[j]];
+                    let le = bins.of(&e.radiance, &mut buf);
+                    let k = w * f;
+                    for ((o, b), l) in out.iter_mut().zip(&beta[..n]).zip(le) {
+                        *o += b * k * l;
                     }
                     (e.rect.normal, &e.reflectance)
                 }
@@ -247,15 +255,18 @@ impl<'a> Tracer<'a> {
                 }
             }
             depth += 1;
-            for j in 0..n {
-                beta[j] *= refl[lambda[j]];
+            for (b, r) in beta[..n].iter_mut().zip(bins.of(refl, &mut buf)) {
+                *b *= r;
+            }
+            if depth == 1 {
+                first_beta = beta[..n].iter().cloned().fold(0.0, f64::max);
             }
             if self.strategy.nee_mis {
-                self.next_event(p, normal, lambda, &beta, out, rng);
+                self.next_event(p, normal, &bins, &beta, out, rng);
             }
             // Russian roulette after two bounces, on the largest throughput.
             if depth > 2 {
-                let q = beta[..n].iter().cloned().fold(0.0, f64::max).min(0.95);
+                let q = (beta[..n].iter().cloned().fold(0.0, f64::max) / first_beta).min(0.95);
                 if rng.next_f64() >= q {
                     return;
                 }
@@ -285,7 +296,7 @@ impl<'a> Tracer<'a> {
         &self,
         p: Vec3,
         normal: Vec3,
-        lambda: &[usize],
+        bins: &Bins,
         beta: &[f64; MAX_HERO],
         out: &mut [f64],
         rng: &mut Rng,
@@ -316,8 +327,39 @@ impl<'a> Tracer<'a> {
         // ρ/π · L · cos_x / pl (beta already holds ρ).
         let g =
             e.gains[ti] * e.distribution.factor(cos_l) * w * cos_x / (std::f64::consts::PI * pl);
-        for j in 0..lambda.len() {
-            out[j] += beta[j] * g * e.radiance[lambda[j]];
+        let mut buf = [0.0; MAX_HERO];
+        let le = bins.of(&e.radiance, &mut buf);
+        for ((o, b), l) in out.iter_mut().zip(&beta[..bins.idx.len()]).zip(le) {
+            *o += b * g * l;
+        }
+    }
+}
+
+/// The wavelength bins a path carries. The full-spectrum mode carries a consecutive run of
+/// bins, read as plain slices so the per-bin loops vectorise; hero wavelengths are gathered.
+struct Bins<'l> {
+    idx: &'l [usize],
+    run: bool,
+}
+
+impl<'l> Bins<'l> {
+    fn new(idx: &'l [usize]) -> Bins<'l> {
+        Bins {
+            idx,
+            run: !idx.is_empty() && idx.windows(2).all(|w| w[1] == w[0] + 1),
+        }
+    }
+
+    /// `src` at these bins.
+    #[inline]
+    fn of<'b>(&self, src: &'b [f64], buf: &'b mut [f64; MAX_HERO]) -> &'b [f64] {
+        if self.run {
+            &src[self.idx[0]..self.idx[0] + self.idx.len()]
+        } else {
+            for (b, &l) in buf.iter_mut().zip(self.idx) {
+                *b = src[l];
+            }
+            &buf[..self.idx.len()]
         }
     }
 }

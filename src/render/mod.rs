@@ -14,7 +14,10 @@ pub mod spot;
 
 pub use integrator::{Strategy, Tracer, Wavelengths};
 pub use scene::{Scene, SceneError};
-pub use spot::{render_spots, SpotOptions, SpotResult};
+pub use spot::{
+    reference_white, render_spots, render_spots_with_progress, SpotOptions, SpotProgress,
+    SpotResult,
+};
 pub mod convergence;
 pub mod image;
 pub mod image_io;

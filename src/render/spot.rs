@@ -228,8 +228,48 @@ pub fn white_scene(scene: &Scene) -> Result<Scene, SpotError> {
     Ok(w)
 }
 
+/// How far a spot run has come, for a progress display.
+#[derive(Clone, Copy, Debug)]
+pub struct SpotProgress {
+    /// Patches whose half-width is below the target.
+    pub converged: usize,
+    /// The largest ΔE*ab 95 % half-width among the patches.
+    pub worst_de: f64,
+    pub seconds: f64,
+}
+
+/// The reference white: a perfect white diffuser in place of patch 19, seen by the meter and
+/// refined to a third of `opts.target_de`. Its error shifts every patch alike and is not in
+/// the patches' half-widths, so it has to be well below theirs.
+pub fn reference_white(scene: &Scene, opts: &SpotOptions) -> Result<[f64; 3], SpotError> {
+    let start = Instant::now();
+    let ws = white_scene(scene)?;
+    let wt = Tracer::new(&ws, opts.strategy);
+    let aim = patch_aim(&ws, 19)?;
+    let mut st = XyzStats::default();
+    let mut batch = opts.first_batch;
+    loop {
+        st.merge(&sample_cone(&wt, aim, opts.seed, 1000, st.n, batch));
+        let w = Xyz::from_array(st.mean());
+        if st.de_ci95(w) < opts.target_de / 3.0 || start.elapsed().as_secs_f64() > opts.max_seconds
+        {
+            return Ok(st.mean());
+        }
+        batch = st.n;
+    }
+}
+
 /// The 24 readings, refined until every ΔE*ab 95 % half-width is below the target.
 pub fn render_spots(scene: &Scene, opts: &SpotOptions) -> Result<SpotResult, SpotError> {
+    render_spots_with_progress(scene, opts, &|_| {})
+}
+
+/// [`render_spots`], reporting after every round of batches.
+pub fn render_spots_with_progress(
+    scene: &Scene,
+    opts: &SpotOptions,
+    progress: &dyn Fn(SpotProgress),
+) -> Result<SpotResult, SpotError> {
     let start = Instant::now();
     let aims: Vec<Aim> = (1..=24)
         .map(|k| patch_aim(scene, k))
@@ -242,25 +282,7 @@ pub fn render_spots(scene: &Scene, opts: &SpotOptions) -> Result<SpotResult, Spo
             }
             Xyz::from_array(w)
         }
-        None => {
-            let ws = white_scene(scene)?;
-            let wt = Tracer::new(&ws, opts.strategy);
-            let aim = patch_aim(&ws, 19)?;
-            // The white to a third of the target: its error is a shift common to every patch
-            // (not included in the patches' half-widths), so it must be smaller than theirs.
-            let mut st = XyzStats::default();
-            let mut batch = opts.first_batch;
-            loop {
-                st.merge(&sample_cone(&wt, aim, opts.seed, 1000, st.n, batch));
-                let w = Xyz::from_array(st.mean());
-                if st.de_ci95(w) < opts.target_de / 3.0
-                    || start.elapsed().as_secs_f64() > opts.max_seconds
-                {
-                    break Xyz::from_array(st.mean());
-                }
-                batch = st.n;
-            }
-        }
+        None => Xyz::from_array(reference_white(scene, opts)?),
     };
     let mut stats = vec![XyzStats::default(); 24];
     let mut batch = [opts.first_batch; 24];
@@ -282,6 +304,14 @@ pub fn render_spots(scene: &Scene, opts: &SpotOptions) -> Result<SpotResult, Spo
                 .saturating_sub(stats[k].n)
                 .clamp(1024, stats[k].n.max(1024));
         }
+        progress(SpotProgress {
+            converged: stats
+                .iter()
+                .filter(|st| st.de_ci95(white) < opts.target_de)
+                .count(),
+            worst_de: stats.iter().map(|st| st.de_ci95(white)).fold(0.0, f64::max),
+            seconds: start.elapsed().as_secs_f64(),
+        });
         if converged || start.elapsed().as_secs_f64() > opts.max_seconds {
             break;
         }
