@@ -193,6 +193,7 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
         .label("ΔE 0.1 target");
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()
