@@ -6,6 +6,7 @@
 //! one [`Instrument`] trait. Devices are chosen by one string (see [`open_instrument`]).
 
 pub mod cs100a;
+pub mod devices;
 
 mod error;
 pub mod instrument;
