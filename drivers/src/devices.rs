@@ -305,3 +305,26 @@ mod tests {
         assert_eq!(known(0x0765, 0x5020, "hid"), Some("X-Rite i1Display Pro"));
     }
 }
+
+#[cfg(test)]
+mod udev_tests {
+    use super::*;
+
+    /// Every device `metamer devices` knows is covered by the shipped udev rules, so the fix
+    /// it prints works.
+    #[test]
+    fn the_udev_rules_cover_every_known_device() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/udev/60-metamer.rules");
+        let rules = std::fs::read_to_string(path).unwrap();
+        let ids = KNOWN_INSTRUMENTS
+            .iter()
+            .map(|(v, p, _, _)| (*v, *p))
+            .chain(KNOWN_ADAPTERS.iter().map(|(v, p, _)| (*v, *p)));
+        for (vid, pid) in ids {
+            let rule =
+                format!(r#"ATTRS{{idVendor}}=="{vid:04x}", ATTRS{{idProduct}}=="{pid:04x}""#);
+            assert!(rules.contains(&rule), "no rule for {vid:04x}:{pid:04x}");
+        }
+        assert!(USB_PERMISSION_FIX.contains("data/udev/60-metamer.rules"));
+    }
+}

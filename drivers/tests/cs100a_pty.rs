@@ -98,6 +98,31 @@ fn a_recorded_session_replays_to_the_same_readings() {
 }
 
 #[test]
+fn the_real_backend_sets_4800_7e2_and_talks_to_the_meter() {
+    use metamer_drivers::cs100a::Cs100a;
+    use metamer_drivers::link::serial::PortLink;
+    use metamer_drivers::link::LineSettings;
+    let emu = start(Arc::new(SharedStimulus::new(RED)), 2);
+    let link = PortLink::open(emu.path(), LineSettings::CS100A).unwrap();
+    let os = link.os_settings().unwrap();
+    assert_eq!((os.baud, os.stop_bits), (4800, 2), "{os:?}");
+    // Linux's pty driver forces CS8 without parity whatever is asked (pty_set_termios in
+    // drivers/tty/pty.c), so 7E on a pty reads back as 8N there; a real port keeps 7E.
+    let seven_even = (os.data_bits, os.parity) == (7, metamer_drivers::link::Parity::Even);
+    let pty_forced = (os.data_bits, os.parity) == (8, metamer_drivers::link::Parity::None);
+    assert!(
+        seven_even || (cfg!(target_os = "linux") && pty_forced),
+        "{os:?}"
+    );
+    let mut meter = Cs100a::new(link);
+    meter.connect().unwrap();
+    meter.set_speed(Speed::Slow).unwrap();
+    let (status, value) = meter.measure_yxy().unwrap();
+    assert_eq!(status, metamer_protocols::cs100a::Status::Ok00);
+    assert!((value.luminance.unwrap() / 21.26 - 1.0).abs() < 0.0055);
+}
+
+#[test]
 fn a_command_without_terminator_gets_er00_like_the_ls100() {
     let emu = start(Arc::new(SharedStimulus::new(RED)), 1);
     let mut port = serialport::new(emu.path(), 4800)

@@ -635,4 +635,31 @@ mod tests {
             }
         }
     }
+
+    proptest::proptest! {
+        #[test]
+        fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..40)) {
+            let _ = parse_reply(&bytes);
+            let _ = parse_command(&bytes);
+        }
+
+        #[test]
+        fn any_reading_in_range_survives_the_wire(
+            lum in 0.001f64..299_000.0,
+            x in 0.0001f64..0.9,
+            y in 0.0001f64..0.9,
+        ) {
+            let v = Yxy { luminance: Some(lum), x: Some(x), y: Some(y) };
+            let line = encode_measurement(Status::Ok00, &v);
+            proptest::prop_assert_eq!(line.len(), MES_REPLY_LEN);
+            let Ok(Reply::Measurement { value, .. }) = parse_reply(&line) else {
+                return Err(proptest::test_runner::TestCaseError::fail("did not parse"));
+            };
+            // Four significant digits (≥ 1), three decimals below 10: half a unit of the last.
+            let tol = if lum >= 10.0 { lum * 5e-4 } else { 5e-4 } + 1e-9;
+            proptest::prop_assert!((value.luminance.unwrap() - lum).abs() <= tol);
+            proptest::prop_assert!((value.x.unwrap() - x).abs() <= 5e-5 + 1e-12);
+            proptest::prop_assert!((value.y.unwrap() - y).abs() <= 5e-5 + 1e-12);
+        }
+    }
 }

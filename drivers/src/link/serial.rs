@@ -48,6 +48,31 @@ impl PortLink {
         }
     }
 
+    /// The line settings as the OS reports them now (to check that a port took 7E2).
+    pub fn os_settings(&self) -> Result<LineSettings, LinkError> {
+        let read = || -> serialport::Result<LineSettings> {
+            Ok(LineSettings {
+                baud: self.port.baud_rate()?,
+                data_bits: match self.port.data_bits()? {
+                    serialport::DataBits::Five => 5,
+                    serialport::DataBits::Six => 6,
+                    serialport::DataBits::Seven => 7,
+                    serialport::DataBits::Eight => 8,
+                },
+                parity: match self.port.parity()? {
+                    serialport::Parity::None => Parity::None,
+                    serialport::Parity::Even => Parity::Even,
+                    serialport::Parity::Odd => Parity::Odd,
+                },
+                stop_bits: match self.port.stop_bits()? {
+                    serialport::StopBits::One => 1,
+                    serialport::StopBits::Two => 2,
+                },
+            })
+        };
+        read().map_err(|e| self.io(e.into()))
+    }
+
     /// An I/O failure as a link error: a hang-up (the adapter unplugged, the pty peer gone)
     /// is a disconnect, anything else an I/O error naming the port.
     fn io(&self, source: std::io::Error) -> LinkError {
