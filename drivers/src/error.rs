@@ -44,6 +44,18 @@ pub enum DriverError {
         command: String,
         timeout_ms: u64,
     },
+    /// The meter answered earlier in this session, then went silent: switched off (which
+    /// also ends remote mode), batteries out, or the cable came loose.
+    #[error(
+        "the CS-100A on {port} stopped answering: no reply to '{command}' within {timeout_ms} ms. \
+         If it was switched off or its batteries ran out, switch it on again while holding F \
+         until a 'C' shows at the bottom right of its display (remote mode); also check the cable"
+    )]
+    StoppedAnswering {
+        port: String,
+        command: String,
+        timeout_ms: u64,
+    },
     /// Part of a reply came, then silence.
     #[error(
         "the CS-100A on {port} stopped in the middle of its reply to '{command}': received {received} \

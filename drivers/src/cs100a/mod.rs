@@ -46,6 +46,9 @@ pub struct Cs100a<L: SerialLink> {
     speed: Option<Speed>,
     absolute: bool,
     timeout: Duration,
+    /// The meter has answered at least once on this link, so silence now means it went
+    /// away rather than that it was never in remote mode.
+    answered: bool,
 }
 
 impl<L: SerialLink> Cs100a<L> {
@@ -56,6 +59,7 @@ impl<L: SerialLink> Cs100a<L> {
             speed: None,
             absolute: false,
             timeout: REPLY_TIMEOUT,
+            answered: false,
         }
     }
 
@@ -165,12 +169,21 @@ impl<L: SerialLink> Cs100a<L> {
     fn transact(&mut self, command: Command) -> Result<Vec<u8>, DriverError> {
         let port = self.link.describe();
         let text = command.text();
+        let answered = self.answered;
         let r = self
             .link
             .discard_input()
             .and_then(|()| self.link.write_all(&command.encode()))
             .and_then(|()| self.link.read_until(cs100a::TERMINATOR, self.timeout));
         r.map_err(|e| match e {
+            LinkError::Timeout {
+                timeout_ms,
+                received,
+            } if received.is_empty() && answered => DriverError::StoppedAnswering {
+                port,
+                command: text,
+                timeout_ms,
+            },
             LinkError::Timeout {
                 timeout_ms,
                 received,
@@ -199,6 +212,7 @@ impl<L: SerialLink> Cs100a<L> {
             },
             other => DriverError::Link(other),
         })
+        .inspect(|_| self.answered = true)
     }
 }
 
