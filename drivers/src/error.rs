@@ -119,6 +119,18 @@ pub enum DriverError {
         #[source]
         source: std::io::Error,
     },
+    /// USB (or HID) cannot be used on this machine.
+    #[error("USB is not available: {message}")]
+    UsbUnavailable { message: String },
+    /// No such USB/HID device is plugged in.
+    #[error("no {device} is plugged in; `metamer devices` lists the instruments of this machine")]
+    UsbNotFound { device: String },
+    /// The user may not open the USB/HID device.
+    #[error(
+        "no permission to open {device}: {}",
+        crate::devices::USB_PERMISSION_FIX
+    )]
+    UsbPermission { device: String },
     /// The instrument cannot do what was asked.
     #[error("the {instrument} cannot do {what}")]
     Unsupported { instrument: String, what: String },

@@ -7,6 +7,7 @@ pub mod record;
 pub mod replay;
 pub mod serial;
 pub mod usb;
+pub mod usb_real;
 
 use std::time::Duration;
 
