@@ -302,3 +302,40 @@ fn a_recorded_sim_session_replays_identically() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The real-meter path end to end: `cs100a:PORT` through the `serialport` backend, with the
+/// emulator answering on a pseudo-terminal.
+#[cfg(unix)]
+#[test]
+fn a_meter_on_a_serial_port() {
+    use std::sync::Arc;
+
+    use metamer_drivers::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
+    use metamer_drivers::cs100a::pty::PtyEmulator;
+    use metamer_drivers::SharedStimulus;
+
+    // A display's blue primary: x = 0.15, y = 0.06, Y = 7.22 cd/m².
+    let (x, y, lum) = (0.15, 0.06, 7.22);
+    let light = SharedStimulus::new([x / y * lum, lum, (1.0 - x - y) / y * lum]);
+    let config = EmulatorConfig {
+        seed: 11,
+        time_scale: 0.01,
+        noise: false,
+    };
+    let emu = PtyEmulator::start(Cs100aEmulator::new(Arc::new(light), config)).unwrap();
+    let spec = format!("cs100a:{}", emu.path());
+    let o = metamer(&[
+        "spot",
+        "--instrument",
+        &spec,
+        "--json",
+        "--count",
+        "2",
+        "--speed",
+        "slow",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for v in json_lines(&o) {
+        assert_eq!(v["xyY"], serde_json::json!([0.15, 0.06, 7.22]), "{v}");
+    }
+}
