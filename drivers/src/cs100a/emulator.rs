@@ -174,7 +174,10 @@ impl Cs100aEmulator {
                     full.extend_from_slice(&line);
                     let (reply, delay) = self.respond(&full);
                     std::thread::sleep(delay);
-                    if link.write_all(&reply).is_err() {
+                    // The meter ignores requests that arrive while it measures (LS-100 manual
+                    // p.13 [C]; the CS-100A is assumed alike [I]).
+                    pending.clear();
+                    if link.discard_input().is_err() || link.write_all(&reply).is_err() {
                         return;
                     }
                 }
@@ -318,6 +321,31 @@ mod tests {
         assert_eq!(e.respond(b"MDS,08\r\n").0, b"ER00\r\n");
         assert_eq!(e.respond(b"FOO\r\n").0, b"ER00\r\n");
         assert_eq!(e.respond(b"CLE\r\n").0, b"OK00\r\n");
+    }
+
+    #[test]
+    fn commands_sent_while_measuring_are_ignored() {
+        use crate::link::pair::pair;
+        let (mut host, device) = pair(LineSettings::CS100A, "test");
+        let config = EmulatorConfig {
+            seed: 1,
+            time_scale: 1.0,
+            noise: false,
+        };
+        let light = Arc::new(crate::instrument::SharedStimulus::new(d65(123.4)));
+        Cs100aEmulator::new(light, config).spawn(device);
+        host.write_all(b"MES\r\n").unwrap();
+        std::thread::sleep(Duration::from_millis(5));
+        host.write_all(b"MES\r\n").unwrap();
+        let t = Duration::from_millis(600);
+        assert_eq!(
+            host.read_until(b"\r\n", t).unwrap(),
+            b"OK00,  123.4, .3127, .3290\r\n"
+        );
+        assert!(matches!(
+            host.read_until(b"\r\n", Duration::from_millis(300)),
+            Err(LinkError::Timeout { .. })
+        ));
     }
 
     #[test]

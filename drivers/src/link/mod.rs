@@ -84,7 +84,7 @@ pub enum LinkError {
 
 /// A serial byte pipe with line-oriented reads.
 pub trait SerialLink: Send {
-    /// Writes all bytes.
+    /// Writes all bytes and flushes them to the device.
     fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError>;
     /// Reads until `terminator` has arrived and returns everything up to and including it;
     /// bytes after the terminator stay buffered for the next read. On timeout or disconnect
