@@ -193,6 +193,24 @@ mod tests {
     }
 
     #[test]
+    fn info_capabilities_and_unsupported_requests() {
+        let mut m = open_instrument("sim:cs100a?time_scale=0", None).unwrap();
+        assert_eq!(m.info().model, "cs100a");
+        assert_eq!(m.info().connection, "sim:cs100a");
+        let caps = serde_json::to_value(m.capabilities()).unwrap();
+        assert_eq!(caps["speeds"], serde_json::json!(["fast", "slow"]));
+        assert_eq!(caps["emissive"], true);
+        assert_eq!(m.calibration_needed().unwrap(), None);
+        let e = m
+            .measure(&Request {
+                mode: crate::MeasureMode::Reflective,
+                ..Request::default()
+            })
+            .unwrap_err();
+        assert!(e.to_string().starts_with("the cs100a cannot do reflective"), "{e}");
+    }
+
+    #[test]
     fn default_stimulus_and_bad_specs() {
         let mut m = open_instrument("sim:cs100a?time_scale=0&noise=off", None).unwrap();
         let r = m.measure(&Request::default()).unwrap();
