@@ -207,7 +207,10 @@ mod tests {
                 ..Request::default()
             })
             .unwrap_err();
-        assert!(e.to_string().starts_with("the cs100a cannot do reflective"), "{e}");
+        assert!(
+            e.to_string().starts_with("the cs100a cannot do reflective"),
+            "{e}"
+        );
     }
 
     #[test]
