@@ -9,5 +9,6 @@
 pub mod color;
 pub mod display;
 pub mod numeric_csv;
+pub mod plot;
 pub mod render;
 pub mod validation;

@@ -1,6 +1,8 @@
 //! Display characterization (issue 5): display models (paper Eq. 9 and richer), fitting,
 //! reproduction of XYZ on a display, patch display backends and the `characterize` session.
 
+pub mod gamut;
+
 use serde::{Deserialize, Serialize};
 
 /// One measured patch: drive values 0–1 per channel and the XYZ measured, cd/m².

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use plotters::prelude::*;
+use crate::plot::{write_log_log, LogLogChart, Series};
 
 use super::integrator::{Strategy, Tracer, Wavelengths};
 use super::scene::Scene;
@@ -141,63 +141,24 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
     }
     std::fs::write(&csv, text).map_err(io(&csv))?;
     let svg = dir.join("convergence.svg");
-    let chart_err = |e: &dyn std::fmt::Display| ConvergenceError::Chart(e.to_string());
-    let root = SVGBackend::new(&svg, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| chart_err(&e))?;
-    let (xmin, xmax) = points.iter().fold((f64::MAX, 0.0f64), |a, p| {
-        (a.0.min(p.seconds), a.1.max(p.seconds))
-    });
-    let (ymin, ymax) = points.iter().fold((f64::MAX, 0.0f64), |a, p| {
-        (a.0.min(p.max_de), a.1.max(p.max_de))
-    });
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "max ΔE*ab over 24 patches vs render seconds (2 cores)",
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(
-            (xmin.max(1e-4) * 0.8..xmax * 1.2).log_scale(),
-            (ymin.clamp(1e-4, 0.05) * 0.8..ymax * 1.2).log_scale(),
-        )
-        .map_err(|e| chart_err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("seconds")
-        .y_desc("max ΔE*ab")
-        .draw()
-        .map_err(|e| chart_err(&e))?;
-    let colours = [BLACK, RED, BLUE, GREEN, MAGENTA, CYAN];
-    for (i, (name, _)) in strategies().iter().enumerate() {
-        let c = colours[i % colours.len()];
-        let series: Vec<(f64, f64)> = points
-            .iter()
-            .filter(|p| p.strategy == *name)
-            .map(|p| (p.seconds, p.max_de))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(series, c.stroke_width(2)))
-            .map_err(|e| chart_err(&e))?
-            .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
-    }
-    // The 0.1 target.
-    chart
-        .draw_series(LineSeries::new(
-            vec![(xmin.max(1e-4) * 0.8, 0.1), (xmax * 1.2, 0.1)],
-            BLACK.mix(0.4),
-        ))
-        .map_err(|e| chart_err(&e))?
-        .label("ΔE 0.1 target");
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| chart_err(&e))?;
-    root.present().map_err(|e| chart_err(&e))?;
-    Ok(())
+    let series: Vec<Series> = strategies()
+        .iter()
+        .map(|(name, _)| Series {
+            name: name.to_string(),
+            points: points
+                .iter()
+                .filter(|p| p.strategy == *name)
+                .map(|p| (p.seconds, p.max_de))
+                .collect(),
+        })
+        .collect();
+    let chart = LogLogChart {
+        title: "max ΔE*ab over 24 patches vs render seconds (2 cores)",
+        x_desc: "seconds",
+        y_desc: "max ΔE*ab",
+        series: &series,
+        target: Some((0.1, "ΔE 0.1 target")),
+        size: (900, 560),
+    };
+    write_log_log(&chart, &svg).map_err(ConvergenceError::Chart)
 }

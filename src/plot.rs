@@ -1,0 +1,156 @@
+//! Log–log line charts of error against cost, the one shape every "speed against accuracy"
+//! figure here shares (render convergence, display patch budget). SVG only: text stays SVG
+//! `<text>`, so no font files are needed at build or run time.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+/// One named curve.
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub name: String,
+    /// (x, y) points, both > 0; drawn in the order given.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A chart to draw.
+#[derive(Clone, Debug)]
+pub struct LogLogChart<'a> {
+    pub title: &'a str,
+    pub x_desc: &'a str,
+    pub y_desc: &'a str,
+    pub series: &'a [Series],
+    /// A horizontal reference line (value, label), e.g. a target ΔE.
+    pub target: Option<(f64, &'a str)>,
+    pub size: (u32, u32),
+}
+
+/// Draws `chart` to `file`; the error is plotters' message.
+pub fn write_log_log(chart: &LogLogChart, file: &Path) -> Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let points = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for &(x, y) in points {
+        xmin = xmin.min(x);
+        xmax = xmax.max(x);
+        ymin = ymin.min(y);
+        ymax = ymax.max(y);
+    }
+    if let Some((t, _)) = chart.target {
+        ymin = ymin.min(t);
+        ymax = ymax.max(t);
+    }
+    if xmax <= 0.0 || ymax <= 0.0 {
+        return Err("no positive points to draw".into());
+    }
+    let root = SVGBackend::new(file, chart.size).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut c = ChartBuilder::on(&root)
+        .caption(chart.title, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (xmin * 0.8..xmax * 1.25).log_scale(),
+            (ymin * 0.8..ymax * 1.25).log_scale(),
+        )
+        .map_err(|e| err(&e))?;
+    c.configure_mesh()
+        .x_desc(chart.x_desc)
+        .y_desc(chart.y_desc)
+        .draw()
+        .map_err(|e| err(&e))?;
+    let colours = [
+        BLACK,
+        RED,
+        BLUE,
+        GREEN,
+        MAGENTA,
+        CYAN,
+        RGBColor(230, 140, 0),
+    ];
+    for (i, s) in chart.series.iter().enumerate() {
+        let colour = colours[i % colours.len()];
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+            .collect();
+        c.draw_series(PointSeries::of_element(
+            pts.clone(),
+            3,
+            colour.filled(),
+            &|p, size, style| Circle::new(p, size, style),
+        ))
+        .map_err(|e| err(&e))?;
+        c.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+            .map_err(|e| err(&e))?
+            .label(s.name.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+    }
+    if let Some((t, label)) = chart.target {
+        c.draw_series(LineSeries::new(
+            vec![(xmin * 0.8, t), (xmax * 1.25, t)],
+            BLACK.mix(0.4),
+        ))
+        .map_err(|e| err(&e))?
+        .label(label)
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
+    }
+    c.configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draws_every_series_and_the_target() {
+        let dir = std::env::temp_dir().join(format!("metamer-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("c.svg");
+        let series = [
+            Series {
+                name: "alpha".into(),
+                points: vec![(1.0, 1.0), (10.0, 0.3)],
+            },
+            Series {
+                name: "beta".into(),
+                points: vec![(2.0, 2.0), (20.0, 0.1)],
+            },
+        ];
+        let chart = LogLogChart {
+            title: "t",
+            x_desc: "x",
+            y_desc: "y",
+            series: &series,
+            target: Some((0.5, "goal")),
+            size: (400, 300),
+        };
+        write_log_log(&chart, &file).unwrap();
+        let svg = std::fs::read_to_string(&file).unwrap();
+        for word in ["alpha", "beta", "goal"] {
+            assert!(svg.contains(word), "{word} missing");
+        }
+        let empty = LogLogChart {
+            series: &[],
+            target: None,
+            ..chart
+        };
+        assert!(write_log_log(&empty, &file).is_err());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
