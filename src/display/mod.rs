@@ -11,3 +11,10 @@ pub struct Patch {
     pub rgb: [f64; 3],
     pub xyz: [f64; 3],
 }
+
+pub mod patch_display;
+pub mod virtual_display;
+pub mod window;
+
+pub use patch_display::{DisplaySpec, PatchDisplay, PatchDisplayError};
+pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};

@@ -1,0 +1,147 @@
+//! The full-screen patch window on a real X server (Xvfb): a screenshot of the monitor
+//! must show exactly the requested 8-bit RGB, every pixel. Each test starts its own Xvfb,
+//! which picks a free display number itself (`-displayfd`), so tests and parallel runs do
+//! not collide. Without Xvfb the tests are skipped with a reason, except in CI (`CI` set),
+//! where `.ci/run` installs it and a missing Xvfb is a failure.
+
+use std::io::Read;
+use std::os::fd::FromRawFd;
+use std::process::{Child, Command, Stdio};
+
+use metamer::display::window::{list_monitors, WindowDisplay, WindowError};
+use metamer::display::PatchDisplay;
+
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Starts `Xvfb -screen 0 WxHx24`, or None (with the reason printed) when Xvfb is not
+/// installed outside CI.
+fn xvfb(width: u32, height: u32) -> Option<Xvfb> {
+    let installed = Command::new("Xvfb")
+        .arg("-help")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok();
+    if !installed {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "Xvfb is not installed but CI is set: .ci/run installs it (apt-get install xvfb)"
+        );
+        eprintln!("skipped: Xvfb is not installed (apt-get install xvfb); CI runs this test");
+        return None;
+    }
+    let mut fds = [0; 2];
+    // SAFETY: pipe writes two new descriptors into the array; without O_CLOEXEC the write
+    // end is inherited by Xvfb, which reports its display number on it when ready.
+    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+    let child = Command::new("Xvfb")
+        .args(["-displayfd", &fds[1].to_string()])
+        .args(["-screen", "0", &format!("{width}x{height}x24")])
+        .args(["-nolisten", "tcp"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("Xvfb starts");
+    // SAFETY: both descriptors came from pipe() above and are owned here alone.
+    let mut read_end = unsafe { std::fs::File::from_raw_fd(fds[0]) };
+    drop(unsafe { std::fs::File::from_raw_fd(fds[1]) });
+    let mut number = String::new();
+    read_end
+        .read_to_string(&mut number)
+        .expect("Xvfb reports its display number");
+    let number = number.trim();
+    assert!(
+        !number.is_empty(),
+        "Xvfb exited without reporting a display"
+    );
+    Some(Xvfb {
+        child,
+        display: format!(":{number}"),
+    })
+}
+
+#[test]
+fn screenshot_shows_exactly_the_requested_rgb() {
+    let Some(x) = xvfb(640, 480) else { return };
+    let mut window = WindowDisplay::open(Some(&x.display), 0).unwrap();
+    let m = window.monitor().clone();
+    assert_eq!((m.x, m.y, m.width, m.height), (0, 0, 640, 480), "{m}");
+    // Opens black.
+    assert!(window.screenshot().unwrap().iter().all(|&p| p == [0, 0, 0]));
+    for rgb in [
+        [255, 255, 255],
+        [255, 0, 0],
+        [0, 255, 0],
+        [0, 0, 255],
+        [1, 2, 3],
+        [128, 64, 200],
+        [254, 1, 127],
+        [0, 0, 0],
+    ] {
+        window.show(rgb).unwrap();
+        let pixels = window.screenshot().unwrap();
+        assert_eq!(pixels.len(), 640 * 480);
+        let wrong = pixels.iter().filter(|&&p| p != rgb).count();
+        assert_eq!(
+            wrong,
+            0,
+            "{rgb:?}: {wrong} pixels differ, e.g. {:?}",
+            pixels.iter().find(|&&p| p != rgb)
+        );
+    }
+    assert_eq!(window.spec(), "window:0");
+    assert!(window.describe().contains(&x.display));
+}
+
+#[test]
+fn monitors_errors_and_reopening() {
+    let Some(x) = xvfb(320, 200) else { return };
+    let monitors = list_monitors(Some(&x.display)).unwrap();
+    assert_eq!(monitors.len(), 1, "{monitors:?}");
+    assert_eq!((monitors[0].width, monitors[0].height), (320, 200));
+    let e = WindowDisplay::open(Some(&x.display), 3).err().unwrap();
+    assert!(
+        matches!(
+            e,
+            WindowError::NoSuchMonitor {
+                index: 3,
+                count: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("has no monitor 3; it has 1: 0: "),
+        "{e}"
+    );
+    {
+        let mut w = WindowDisplay::open(Some(&x.display), 0).unwrap();
+        w.show([9, 99, 199]).unwrap();
+        assert!(w.screenshot().unwrap().iter().all(|&p| p == [9, 99, 199]));
+    }
+    // A new session on the same server opens black again, on top of whatever was there.
+    let w = WindowDisplay::open(Some(&x.display), 0).unwrap();
+    assert!(w.screenshot().unwrap().iter().all(|&p| p == [0, 0, 0]));
+}
+
+#[test]
+fn a_display_nobody_serves_is_a_clear_error() {
+    // Display numbers are below 65536 on every server; this one has no socket.
+    let e = WindowDisplay::open(Some(":65000"), 0).err().unwrap();
+    let text = e.to_string();
+    assert!(
+        text.starts_with("cannot connect to X display ':65000': ") && text.contains("xhost"),
+        "{text}"
+    );
+}
