@@ -12,6 +12,7 @@ pub struct Patch {
     pub xyz: [f64; 3],
 }
 
+pub mod characterize;
 pub mod patch_display;
 pub mod virtual_display;
 pub mod window;

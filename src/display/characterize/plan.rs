@@ -1,0 +1,366 @@
+//! What a characterization measures (issue 5 item 5): black, the full-on primaries and
+//! white, per-channel and grey ramps for the fit, and a fixed set of verification patches
+//! the fit never sees, the whole list repeated `repeats` times (pass after pass, so slow
+//! drift of the display spreads over all patches rather than biasing a few).
+//!
+//! The verification set is 24 seeded pseudo-random drive triplets plus the 24 ColorChecker
+//! patches (BabelColor average, `data/colorchecker_babelcolor_average.csv`) under D65
+//! encoded as sRGB (IEC 61966-2-1:1999 matrix and transfer function): natural colours
+//! spread over the drive cube as a display would show them.
+
+use serde::{Deserialize, Serialize};
+
+use crate::color::{self, ColorCheckerSet, Illuminant, ObserverKind};
+
+/// Default number of levels per ramp, 0 and 255 included.
+pub const DEFAULT_RAMP_STEPS: usize = 9;
+/// Number of pseudo-random verification patches.
+pub const RANDOM_VERIFICATION: usize = 24;
+/// The seed of the random verification patches; fixed, so every session with the same
+/// options measures the same patches and logs stay comparable.
+pub const VERIFICATION_SEED: u64 = 0x6d65_7461_6d65_7231;
+
+/// What a patch is measured for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Purpose {
+    /// Input of the model fit.
+    Fit,
+    /// Held out to verify the fitted model.
+    Verify,
+}
+
+/// One patch of the plan.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PlannedPatch {
+    /// Position in the measuring order, 0-based over all repeats.
+    pub index: usize,
+    /// Which of the distinct patches this is (0-based; the same in every repeat).
+    pub patch: usize,
+    /// Pass, 0-based.
+    pub repeat: usize,
+    /// 8-bit drive values.
+    pub rgb: [u8; 3],
+    pub purpose: Purpose,
+    /// For people: `black`, `red ramp 64`, `ColorChecker dark skin`, `random 7`.
+    pub label: String,
+}
+
+/// The options a plan is made from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PlanOptions {
+    /// Levels per ramp including 0 and 255 (2–256).
+    pub ramp_steps: usize,
+    /// Passes over all patches (≥ 1).
+    pub repeats: usize,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions {
+            ramp_steps: DEFAULT_RAMP_STEPS,
+            repeats: 1,
+        }
+    }
+}
+
+/// Options that make no plan.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    #[error(
+        "--ramp-steps must be between 2 and 256 (levels per ramp, 0 and 255 included), got {0}"
+    )]
+    RampSteps(usize),
+    #[error("--repeats must be at least 1, got {0}")]
+    Repeats(usize),
+}
+
+/// The ordered list of patches to show and measure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    pub options: PlanOptions,
+    /// The distinct patches, in measuring order within a pass.
+    pub distinct: Vec<PlannedPatch>,
+    /// Every measurement: `distinct` × repeats.
+    pub patches: Vec<PlannedPatch>,
+}
+
+impl Plan {
+    pub fn new(options: PlanOptions) -> Result<Plan, PlanError> {
+        if !(2..=256).contains(&options.ramp_steps) {
+            return Err(PlanError::RampSteps(options.ramp_steps));
+        }
+        if options.repeats == 0 {
+            return Err(PlanError::Repeats(options.repeats));
+        }
+        let mut distinct: Vec<(String, [u8; 3], Purpose)> = vec![
+            ("black".into(), [0, 0, 0], Purpose::Fit),
+            ("red".into(), [255, 0, 0], Purpose::Fit),
+            ("green".into(), [0, 255, 0], Purpose::Fit),
+            ("blue".into(), [0, 0, 255], Purpose::Fit),
+            ("white".into(), [255, 255, 255], Purpose::Fit),
+        ];
+        // Interior levels only: 0 and 255 are black and the full-on patches above.
+        let levels: Vec<u8> = (1..options.ramp_steps - 1)
+            .map(|i| (255.0 * i as f64 / (options.ramp_steps - 1) as f64).round() as u8)
+            .collect();
+        for (name, mask) in [
+            ("red", [1, 0, 0]),
+            ("green", [0, 1, 0]),
+            ("blue", [0, 0, 1]),
+            ("grey", [1, 1, 1]),
+        ] {
+            for &v in &levels {
+                distinct.push((
+                    format!("{name} ramp {v}"),
+                    [mask[0] * v, mask[1] * v, mask[2] * v],
+                    Purpose::Fit,
+                ));
+            }
+        }
+        for (i, rgb) in random_patches(RANDOM_VERIFICATION, VERIFICATION_SEED)
+            .into_iter()
+            .enumerate()
+        {
+            distinct.push((format!("random {}", i + 1), rgb, Purpose::Verify));
+        }
+        for (name, rgb) in colorchecker_srgb() {
+            distinct.push((format!("ColorChecker {name}"), rgb, Purpose::Verify));
+        }
+        let distinct: Vec<PlannedPatch> = distinct
+            .into_iter()
+            .enumerate()
+            .map(|(i, (label, rgb, purpose))| PlannedPatch {
+                index: i,
+                patch: i,
+                repeat: 0,
+                rgb,
+                purpose,
+                label,
+            })
+            .collect();
+        let mut patches = Vec::with_capacity(options.repeats * distinct.len());
+        for repeat in 0..options.repeats {
+            for p in &distinct {
+                patches.push(PlannedPatch {
+                    index: repeat * distinct.len() + p.patch,
+                    repeat,
+                    ..p.clone()
+                });
+            }
+        }
+        Ok(Plan {
+            options,
+            distinct,
+            patches,
+        })
+    }
+
+    /// A fingerprint of everything measured and in which order (FNV-1a 64 of the patch
+    /// list): a log is resumed only by the plan that wrote it.
+    pub fn hash(&self) -> String {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |bytes: &[u8]| {
+            for &b in bytes {
+                h ^= u64::from(b);
+                h = h.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        };
+        eat(b"metamer characterize plan 1");
+        for p in &self.patches {
+            eat(&(p.index as u64).to_le_bytes());
+            eat(&(p.patch as u64).to_le_bytes());
+            eat(&p.rgb);
+            eat(&[p.purpose as u8]);
+        }
+        format!("{h:016x}")
+    }
+}
+
+/// `n` drive triplets from SplitMix64 (Steele, Lea, Flood 2014) seeded with `seed`.
+fn random_patches(n: usize, seed: u64) -> Vec<[u8; 3]> {
+    let mut state = seed;
+    let mut next = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    (0..n)
+        .map(|_| {
+            let r = next();
+            [(r >> 8) as u8, (r >> 24) as u8, (r >> 40) as u8]
+        })
+        .collect()
+}
+
+/// sRGB encoding of linear v (IEC 61966-2-1:1999 §5.2).
+fn srgb_encode(v: f64) -> f64 {
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The 24 ColorChecker patches under D65 as 8-bit sRGB (out-of-gamut channels clipped).
+pub fn colorchecker_srgb() -> Vec<(&'static str, [u8; 3])> {
+    // XYZ (D65, Y = 1 for white) → linear sRGB, IEC 61966-2-1:1999 §5.2.
+    const M: [[f64; 3]; 3] = [
+        [3.2406, -1.5372, -0.4986],
+        [-0.9689, 1.8758, 0.0415],
+        [0.0557, -0.2040, 1.0570],
+    ];
+    let d65 = Illuminant::D65.spectrum();
+    color::colorchecker(ColorCheckerSet::BabelColorAverage)
+        .iter()
+        .zip(color::COLORCHECKER_NAMES)
+        .map(|(reflectance, name)| {
+            let xyz = color::reflectance_to_xyz(reflectance, &d65, ObserverKind::Cie1931)
+                .scaled(0.01)
+                .to_array();
+            let rgb = M.map(|row| {
+                let linear: f64 = row.iter().zip(xyz).map(|(m, v)| m * v).sum();
+                (srgb_encode(linear.clamp(0.0, 1.0)) * 255.0).round() as u8
+            });
+            (name, rgb)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_plan_has_the_promised_patches() {
+        let plan = Plan::new(PlanOptions::default()).unwrap();
+        // 5 + 4 ramps × 7 interior levels + 24 random + 24 ColorChecker.
+        assert_eq!(plan.distinct.len(), 5 + 28 + 48);
+        assert_eq!(plan.patches, plan.distinct);
+        let fit: Vec<_> = plan
+            .distinct
+            .iter()
+            .filter(|p| p.purpose == Purpose::Fit)
+            .collect();
+        assert_eq!(fit.len(), 33);
+        assert_eq!(fit[0].rgb, [0, 0, 0]);
+        assert_eq!(fit[4].rgb, [255, 255, 255]);
+        // 9 steps: 255·i/8 rounded = 32, 64, 96, 128, 159, 191, 223.
+        let red: Vec<u8> = fit
+            .iter()
+            .filter(|p| p.label.starts_with("red ramp"))
+            .map(|p| p.rgb[0])
+            .collect();
+        assert_eq!(red, [32, 64, 96, 128, 159, 191, 223]);
+        let grey = fit.iter().find(|p| p.label == "grey ramp 128").unwrap();
+        assert_eq!(grey.rgb, [128, 128, 128]);
+    }
+
+    #[test]
+    fn repeats_are_whole_passes_and_the_hash_tracks_the_plan() {
+        let one = Plan::new(PlanOptions {
+            ramp_steps: 3,
+            repeats: 1,
+        })
+        .unwrap();
+        let three = Plan::new(PlanOptions {
+            ramp_steps: 3,
+            repeats: 3,
+        })
+        .unwrap();
+        let n = one.distinct.len();
+        assert_eq!(three.patches.len(), 3 * n);
+        for (i, p) in three.patches.iter().enumerate() {
+            assert_eq!(p.index, i);
+            assert_eq!((p.repeat, p.patch), (i / n, i % n));
+            assert_eq!(p.rgb, one.distinct[i % n].rgb);
+        }
+        assert_eq!(
+            one.hash(),
+            Plan::new(PlanOptions {
+                ramp_steps: 3,
+                repeats: 1
+            })
+            .unwrap()
+            .hash()
+        );
+        assert_ne!(one.hash(), three.hash());
+        assert_ne!(
+            one.hash(),
+            Plan::new(PlanOptions::default()).unwrap().hash()
+        );
+        assert!(matches!(
+            Plan::new(PlanOptions {
+                ramp_steps: 1,
+                repeats: 1
+            }),
+            Err(PlanError::RampSteps(1))
+        ));
+        assert!(matches!(
+            Plan::new(PlanOptions {
+                ramp_steps: 257,
+                repeats: 1
+            }),
+            Err(PlanError::RampSteps(257))
+        ));
+        assert!(matches!(
+            Plan::new(PlanOptions {
+                ramp_steps: 9,
+                repeats: 0
+            }),
+            Err(PlanError::Repeats(0))
+        ));
+        // Two steps: no interior levels, only black, primaries and white for the fit.
+        let two = Plan::new(PlanOptions {
+            ramp_steps: 2,
+            repeats: 1,
+        })
+        .unwrap();
+        assert_eq!(
+            two.distinct
+                .iter()
+                .filter(|p| p.purpose == Purpose::Fit)
+                .count(),
+            5
+        );
+    }
+
+    #[test]
+    fn colorchecker_patches_match_published_srgb() {
+        // The sRGB values of the table in Wikipedia's "ColorChecker" article (from X-Rite's
+        // data): dark skin #735244, light skin #c29682, white 9.5 #f3f3f2, neutral 5
+        // #7a7a79, black 2 #343434. Those are of one chart, the BabelColor average of thirty,
+        // so a few codes may differ (dark saturated patches more: blue's red is 14 apart).
+        let cc = colorchecker_srgb();
+        assert_eq!(cc.len(), 24);
+        for (i, published) in [
+            (0, [115, 82, 68]),
+            (1, [194, 150, 130]),
+            (18, [243, 243, 242]),
+            (21, [122, 122, 121]),
+            (23, [52, 52, 52]),
+        ] {
+            let got = cc[i].1;
+            for c in 0..3 {
+                assert!(
+                    (i32::from(got[c]) - published[c]).abs() <= 8,
+                    "{}: {got:?} vs {published:?}",
+                    cc[i].0
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn random_patches_are_seeded_and_spread() {
+        let a = random_patches(24, VERIFICATION_SEED);
+        assert_eq!(a, random_patches(24, VERIFICATION_SEED));
+        assert_ne!(a, random_patches(24, 1));
+        // Spread: every channel has codes in each half of the range.
+        for c in 0..3 {
+            assert!(a.iter().any(|p| p[c] < 128) && a.iter().any(|p| p[c] >= 128));
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! From readings to what the fit and the verification use: repeats averaged per planned
+//! patch, and the fitted model's forward prediction of each held-out verification patch
+//! compared with its measurement in CIEDE2000, CIELAB relative to the measured white (the
+//! paper's validation uses the display white as reference white).
+
+use metamer_drivers::{Flag, Reading};
+use serde::Serialize;
+
+use super::plan::{PlannedPatch, Purpose};
+use crate::color::{delta_e2000, Xyz};
+use crate::display::Patch;
+
+/// A planned patch with its readings averaged.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AveragedPatch {
+    /// [`PlannedPatch::patch`].
+    pub patch: usize,
+    pub label: String,
+    pub rgb8: [u8; 3],
+    pub purpose: Purpose,
+    /// Mean XYZ over the usable readings, cd/m².
+    pub xyz: [f64; 3],
+    /// Usable readings averaged.
+    pub readings: usize,
+}
+
+impl AveragedPatch {
+    /// As the display models take it: drive 0–1 and XYZ.
+    pub fn to_patch(&self) -> Patch {
+        Patch {
+            rgb: self.rgb8.map(|c| f64::from(c) / 255.0),
+            xyz: self.xyz,
+        }
+    }
+}
+
+/// A reading whose XYZ may be used: finite, and not flagged as beyond the instrument's
+/// range (a low-light flag only says the accuracy is lower, the value is still the best
+/// there is).
+pub fn usable(reading: &Reading) -> bool {
+    reading.xyz.iter().all(|v| v.is_finite())
+        && !reading.flags.iter().any(|f| {
+            matches!(
+                f,
+                Flag::OverRange | Flag::ChromaticityOverRange | Flag::Saturated
+            )
+        })
+}
+
+/// Averages the usable readings of each distinct patch; patches without any usable
+/// reading are listed in the error.
+pub fn average(readings: &[(&PlannedPatch, &Reading)]) -> Result<Vec<AveragedPatch>, Vec<String>> {
+    let n = readings.iter().map(|(p, _)| p.patch + 1).max().unwrap_or(0);
+    let mut sums: Vec<Option<AveragedPatch>> = vec![None; n];
+    for (p, r) in readings {
+        let slot = sums[p.patch].get_or_insert_with(|| AveragedPatch {
+            patch: p.patch,
+            label: p.label.clone(),
+            rgb8: p.rgb,
+            purpose: p.purpose,
+            xyz: [0.0; 3],
+            readings: 0,
+        });
+        if usable(r) {
+            for (s, v) in slot.xyz.iter_mut().zip(r.xyz) {
+                *s += v;
+            }
+            slot.readings += 1;
+        }
+    }
+    let mut out = Vec::new();
+    let mut unusable = Vec::new();
+    for mut a in sums.into_iter().flatten() {
+        if a.readings == 0 {
+            unusable.push(format!("{} (RGB {:?})", a.label, a.rgb8));
+            continue;
+        }
+        let k = a.readings as f64;
+        a.xyz = a.xyz.map(|v| v / k);
+        out.push(a);
+    }
+    if unusable.is_empty() {
+        Ok(out)
+    } else {
+        Err(unusable)
+    }
+}
+
+/// One verification patch: measured, predicted and their CIEDE2000.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VerifiedPatch {
+    pub label: String,
+    pub rgb8: [u8; 3],
+    pub measured_xyz: [f64; 3],
+    pub predicted_xyz: [f64; 3],
+    pub delta_e00: f64,
+}
+
+/// ΔE00 of the model over the verification patches.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verification {
+    /// The measured white CIELAB is taken relative to, cd/m².
+    pub white_xyz: [f64; 3],
+    pub patches: Vec<VerifiedPatch>,
+    pub mean: f64,
+    /// 95th percentile, linear between order statistics (rank 0.95·(n − 1)).
+    pub p95: f64,
+    pub max: f64,
+}
+
+/// Compares `predict` (the model's forward direction, drive 0–1 → XYZ) with the measured
+/// verification patches of `patches`. None if there are none.
+pub fn verify(
+    patches: &[AveragedPatch],
+    white_xyz: [f64; 3],
+    predict: &dyn Fn([f64; 3]) -> [f64; 3],
+) -> Option<Verification> {
+    let white = Xyz::from_array(white_xyz);
+    let verified: Vec<VerifiedPatch> = patches
+        .iter()
+        .filter(|p| p.purpose == Purpose::Verify)
+        .map(|p| {
+            let predicted = predict(p.to_patch().rgb);
+            let de = delta_e2000(
+                Xyz::from_array(p.xyz).to_lab(white),
+                Xyz::from_array(predicted).to_lab(white),
+            );
+            VerifiedPatch {
+                label: p.label.clone(),
+                rgb8: p.rgb8,
+                measured_xyz: p.xyz,
+                predicted_xyz: predicted,
+                delta_e00: de,
+            }
+        })
+        .collect();
+    if verified.is_empty() {
+        return None;
+    }
+    let mut sorted: Vec<f64> = verified.iter().map(|v| v.delta_e00).collect();
+    sorted.sort_by(f64::total_cmp);
+    let mean = sorted.iter().sum::<f64>() / sorted.len() as f64;
+    Some(Verification {
+        white_xyz,
+        mean,
+        p95: percentile(&sorted, 0.95),
+        max: *sorted.last().expect("not empty"),
+        patches: verified,
+    })
+}
+
+/// The `q` quantile of ascending `sorted`, linear between order statistics.
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    let rank = q * (sorted.len() - 1) as f64;
+    let lo = rank.floor() as usize;
+    let hi = rank.ceil() as usize;
+    sorted[lo] + (sorted[hi] - sorted[lo]) * (rank - lo as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn planned(patch: usize, rgb: [u8; 3], purpose: Purpose) -> PlannedPatch {
+        PlannedPatch {
+            index: patch,
+            patch,
+            repeat: 0,
+            rgb,
+            purpose,
+            label: format!("p{patch}"),
+        }
+    }
+
+    #[test]
+    fn repeats_are_averaged_and_out_of_range_readings_left_out() {
+        let a = planned(0, [0, 0, 0], Purpose::Fit);
+        let b = planned(1, [9, 9, 9], Purpose::Verify);
+        let r1 = Reading::from_yxy(1.0, 0.3, 0.3, "t");
+        let r2 = Reading::from_yxy(3.0, 0.3, 0.3, "t");
+        let mut over = Reading::from_yxy(1e6, 0.3, 0.3, "t");
+        over.flags.push(Flag::OverRange);
+        let mut low = Reading::from_yxy(0.005, 0.3, 0.3, "t");
+        low.flags.push(Flag::LowLight);
+        let avg = average(&[(&a, &r1), (&b, &low), (&a, &r2), (&a, &over)]).unwrap();
+        assert_eq!(avg.len(), 2);
+        assert_eq!(avg[0].readings, 2);
+        assert!((avg[0].xyz[1] - 2.0).abs() < 1e-15);
+        assert_eq!(avg[1].readings, 1, "low light is still a value");
+        assert_eq!(avg[1].to_patch().rgb, [9.0 / 255.0; 3]);
+        let e = average(&[(&a, &over)]).unwrap_err();
+        assert_eq!(e, vec!["p0 (RGB [0, 0, 0])".to_string()]);
+    }
+
+    #[test]
+    fn statistics_of_a_known_error() {
+        // A prediction that scales XYZ by k leaves a, b at 0 for a neutral patch and moves
+        // L* only: ΔE00 of a pure ΔL at L ≈ 50 is ΔL/S_L with S_L = 1 (CIEDE2000, Sharma
+        // et al. 2005 Eq. 13: S_L = 1 + 0.015(L̄−50)²/√(20+(L̄−50)²)).
+        let white = [95.047, 100.0, 108.883];
+        let grey_y = 18.418_651_851_244_416; // L* = 50 exactly: ((50+16)/116)³·100
+        let patches: Vec<AveragedPatch> = (0..21)
+            .map(|i| AveragedPatch {
+                patch: i,
+                label: format!("g{i}"),
+                rgb8: [i as u8; 3],
+                purpose: if i == 0 {
+                    Purpose::Fit
+                } else {
+                    Purpose::Verify
+                },
+                xyz: white.map(|w| w * grey_y / 100.0),
+                readings: 1,
+            })
+            .collect();
+        // Patch i is predicted with lightness off by i/10 (moving Y by the slope of L*).
+        let predict = |rgb: [f64; 3]| {
+            let i = (rgb[0] * 255.0).round();
+            let l = 50.0 + i / 10.0;
+            let y = ((l + 16.0) / 116.0).powi(3) * 100.0;
+            white.map(|w| w * y / 100.0)
+        };
+        let v = verify(&patches, white, &predict).unwrap();
+        assert_eq!(v.patches.len(), 20);
+        for (k, p) in v.patches.iter().enumerate() {
+            let dl = (k + 1) as f64 / 10.0;
+            let lbar: f64 = 50.0 + dl / 2.0;
+            let sl = 1.0 + 0.015 * (lbar - 50.0).powi(2) / (20.0 + (lbar - 50.0).powi(2)).sqrt();
+            assert!(
+                (p.delta_e00 - dl / sl).abs() < 1e-9,
+                "{}: {}",
+                p.label,
+                p.delta_e00
+            );
+        }
+        assert!((v.max - v.patches[19].delta_e00).abs() < 1e-15);
+        // Rank 0.95·19 = 18.05: between the 19th and 20th values.
+        let p95 =
+            v.patches[18].delta_e00 + 0.05 * (v.patches[19].delta_e00 - v.patches[18].delta_e00);
+        assert!((v.p95 - p95).abs() < 1e-12);
+        let mean = v.patches.iter().map(|p| p.delta_e00).sum::<f64>() / 20.0;
+        assert!((v.mean - mean).abs() < 1e-12);
+        assert!(verify(&patches[..1], white, &predict).is_none());
+    }
+}
