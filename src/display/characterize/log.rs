@@ -31,6 +31,7 @@ pub struct LogHeader {
     pub plan_hash: String,
     pub ramp_steps: usize,
     pub repeats: usize,
+    pub grid_steps: usize,
     /// Number of readings the plan takes.
     pub readings: usize,
     /// The display as given to `--display`, canonical (`virtual:ips-lcd`, `window:0`).
@@ -201,12 +202,12 @@ impl SessionLog {
             return Err(mismatch(
                 "plan",
                 format!(
-                    "{} (--ramp-steps {} --repeats {})",
-                    logged.plan_hash, logged.ramp_steps, logged.repeats
+                    "{} (--ramp-steps {} --repeats {} --grid-steps {})",
+                    logged.plan_hash, logged.ramp_steps, logged.repeats, logged.grid_steps
                 ),
                 format!(
-                    "{} (--ramp-steps {} --repeats {})",
-                    header.plan_hash, header.ramp_steps, header.repeats
+                    "{} (--ramp-steps {} --repeats {} --grid-steps {})",
+                    header.plan_hash, header.ramp_steps, header.repeats, header.grid_steps
                 ),
             ));
         }
@@ -303,6 +304,17 @@ impl SessionLog {
     }
 }
 
+/// The error [`SessionLog::create`] would give for `dir`, checked before anything is
+/// opened (a full-screen window, an instrument).
+pub fn refuse_existing(dir: &Path) -> Result<(), LogError> {
+    let path = dir.join(LOG_FILE);
+    if path.exists() {
+        let readings = count_readings(&path);
+        return Err(LogError::Exists { path, readings });
+    }
+    Ok(())
+}
+
 /// Reading lines in an existing log (for the "exists" message; 0 if unreadable).
 fn count_readings(path: &Path) -> usize {
     std::fs::read_to_string(path)
@@ -326,6 +338,7 @@ mod tests {
             plan_hash: plan.hash(),
             ramp_steps: plan.options.ramp_steps,
             repeats: plan.options.repeats,
+            grid_steps: plan.options.grid_steps,
             readings: plan.patches.len(),
             display: "virtual:ips-lcd".into(),
             instrument: "sim:cs100a".into(),
@@ -436,6 +449,7 @@ mod tests {
         let other = Plan::new(PlanOptions {
             ramp_steps: 5,
             repeats: 2,
+            grid_steps: 0,
         })
         .unwrap();
         let e = SessionLog::resume(&dir, &other, &header(&other))
@@ -443,7 +457,8 @@ mod tests {
             .unwrap();
         assert!(
             e.to_string().contains("its plan is")
-                && e.to_string().contains("--ramp-steps 9 --repeats 1"),
+                && e.to_string()
+                    .contains("--ramp-steps 9 --repeats 1 --grid-steps 0)"),
             "{e}"
         );
         let mut elsewhere = h.clone();

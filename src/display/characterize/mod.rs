@@ -4,10 +4,12 @@
 
 pub mod log;
 pub mod plan;
+pub mod report;
 pub mod session;
 pub mod verify;
 
 pub use log::{LogError, LOG_FILE};
-pub use plan::{Plan, PlanError, PlanOptions, PlannedPatch, Purpose};
+pub use plan::{Plan, PlanError, PlanOptions, PlannedPatch, Purpose, DEFAULT_RAMP_STEPS};
+pub use report::{write_report, Report, ReportError};
 pub use session::{MeasureOptions, Measured, Progress, Session, SessionError};
 pub use verify::{average, verify, AveragedPatch, Verification};

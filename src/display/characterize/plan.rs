@@ -1,5 +1,7 @@
 //! What a characterization measures (issue 5 item 5): black, the full-on primaries and
-//! white, per-channel and grey ramps for the fit, and a fixed set of verification patches
+//! white, per-channel and grey ramps for the fit, optionally an N×N×N grid of the drive
+//! cube (for models without PLCC's assumptions, such as a 3D LUT), and a fixed set of
+//! verification patches
 //! the fit never sees, the whole list repeated `repeats` times (pass after pass, so slow
 //! drift of the display spreads over all patches rather than biasing a few).
 //!
@@ -53,6 +55,9 @@ pub struct PlanOptions {
     pub ramp_steps: usize,
     /// Passes over all patches (≥ 1).
     pub repeats: usize,
+    /// Levels per channel of a fit grid over the drive cube, 0 and 255 included (0 = no
+    /// grid, else 2–64).
+    pub grid_steps: usize,
 }
 
 impl Default for PlanOptions {
@@ -60,6 +65,7 @@ impl Default for PlanOptions {
         PlanOptions {
             ramp_steps: DEFAULT_RAMP_STEPS,
             repeats: 1,
+            grid_steps: 0,
         }
     }
 }
@@ -73,6 +79,8 @@ pub enum PlanError {
     RampSteps(usize),
     #[error("--repeats must be at least 1, got {0}")]
     Repeats(usize),
+    #[error("--grid-steps must be 0 (no grid) or between 2 and 64, got {0}")]
+    GridSteps(usize),
 }
 
 /// The ordered list of patches to show and measure.
@@ -92,6 +100,9 @@ impl Plan {
         }
         if options.repeats == 0 {
             return Err(PlanError::Repeats(options.repeats));
+        }
+        if options.grid_steps == 1 || options.grid_steps > 64 {
+            return Err(PlanError::GridSteps(options.grid_steps));
         }
         let mut distinct: Vec<(String, [u8; 3], Purpose)> = vec![
             ("black".into(), [0, 0, 0], Purpose::Fit),
@@ -116,6 +127,21 @@ impl Plan {
                     [mask[0] * v, mask[1] * v, mask[2] * v],
                     Purpose::Fit,
                 ));
+            }
+        }
+        if options.grid_steps > 0 {
+            let n = options.grid_steps;
+            let level = |i: usize| (255.0 * i as f64 / (n - 1) as f64).round() as u8;
+            for r in 0..n {
+                for g in 0..n {
+                    for b in 0..n {
+                        let rgb = [level(r), level(g), level(b)];
+                        // Corners and axes the ramps already hold are not measured twice.
+                        if !distinct.iter().any(|d| d.1 == rgb) {
+                            distinct.push((format!("grid {rgb:?}"), rgb, Purpose::Fit));
+                        }
+                    }
+                }
             }
         }
         for (i, rgb) in random_patches(RANDOM_VERIFICATION, VERIFICATION_SEED)
@@ -263,11 +289,13 @@ mod tests {
         let one = Plan::new(PlanOptions {
             ramp_steps: 3,
             repeats: 1,
+            grid_steps: 0,
         })
         .unwrap();
         let three = Plan::new(PlanOptions {
             ramp_steps: 3,
             repeats: 3,
+            grid_steps: 0,
         })
         .unwrap();
         let n = one.distinct.len();
@@ -281,7 +309,8 @@ mod tests {
             one.hash(),
             Plan::new(PlanOptions {
                 ramp_steps: 3,
-                repeats: 1
+                repeats: 1,
+                grid_steps: 0,
             })
             .unwrap()
             .hash()
@@ -294,21 +323,24 @@ mod tests {
         assert!(matches!(
             Plan::new(PlanOptions {
                 ramp_steps: 1,
-                repeats: 1
+                repeats: 1,
+                grid_steps: 0,
             }),
             Err(PlanError::RampSteps(1))
         ));
         assert!(matches!(
             Plan::new(PlanOptions {
                 ramp_steps: 257,
-                repeats: 1
+                repeats: 1,
+                grid_steps: 0,
             }),
             Err(PlanError::RampSteps(257))
         ));
         assert!(matches!(
             Plan::new(PlanOptions {
                 ramp_steps: 9,
-                repeats: 0
+                repeats: 0,
+                grid_steps: 0,
             }),
             Err(PlanError::Repeats(0))
         ));
@@ -316,6 +348,7 @@ mod tests {
         let two = Plan::new(PlanOptions {
             ramp_steps: 2,
             repeats: 1,
+            grid_steps: 0,
         })
         .unwrap();
         assert_eq!(
@@ -325,6 +358,34 @@ mod tests {
                 .count(),
             5
         );
+    }
+
+    #[test]
+    fn a_grid_adds_the_cube_without_repeating_ramp_patches() {
+        let base = Plan::new(PlanOptions {
+            grid_steps: 0,
+            ..PlanOptions::default()
+        })
+        .unwrap();
+        let grid = Plan::new(PlanOptions {
+            grid_steps: 5,
+            ..PlanOptions::default()
+        })
+        .unwrap();
+        // 5³ = 125 grid points; 0, 64, 128, 191, 255 per channel. Already planned: black,
+        // white, 3 primaries, and the 64/128/191 levels of the four ramps (12): 17.
+        assert_eq!(grid.distinct.len(), base.distinct.len() + 125 - 17);
+        assert!(grid.distinct.iter().any(|p| p.rgb == [64, 191, 0]));
+        assert_ne!(grid.hash(), base.hash());
+        for bad in [1, 65] {
+            assert!(matches!(
+                Plan::new(PlanOptions {
+                    grid_steps: bad,
+                    ..PlanOptions::default()
+                }),
+                Err(PlanError::GridSteps(_))
+            ));
+        }
     }
 
     #[test]

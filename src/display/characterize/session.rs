@@ -105,6 +105,7 @@ impl Session {
             plan_hash: plan.hash(),
             ramp_steps: plan.options.ramp_steps,
             repeats: plan.options.repeats,
+            grid_steps: plan.options.grid_steps,
             readings: plan.patches.len(),
             display: display.into(),
             instrument: instrument.into(),
@@ -232,6 +233,7 @@ mod tests {
         let plan = Plan::new(PlanOptions {
             ramp_steps: 3,
             repeats: 2,
+            grid_steps: 0,
         })
         .unwrap();
         let mut display = VirtualDisplay::preset(Preset::IpsLcd);
