@@ -5,6 +5,19 @@ pub mod gamut;
 
 use serde::{Deserialize, Serialize};
 
+pub mod diagnostics;
+pub mod fit;
+pub mod measurements;
+pub mod model;
+pub mod patch_set;
+pub mod profile;
+
+pub use diagnostics::{Diagnostics, Residuals};
+pub use fit::{fit_profile, fit_profile_with, FitError, FitOptions};
+pub use measurements::{read_measurement_file, read_measurements, write_ti3, MeasurementsError};
+pub use model::{DisplayModel, Inverse, ModelKind};
+pub use profile::{Profile, ProfileError};
+
 /// One measured patch: drive values 0–1 per channel and the XYZ measured, cd/m².
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Patch {

@@ -1,0 +1,308 @@
+//! Checks of PLCC's assumptions (paper Eq. 9) on the measured patches, saved with every fit:
+//! each channel's chromaticity drift along its ramp, additivity (white against the sum of
+//! black and the three primaries), black level share, the TRC's deviation from a power law,
+//! the condition number of M, and a plain verdict. Differences are CIEDE2000 in CIELAB relative to the
+//! display white, the measure the paper validates with.
+
+use serde::{Deserialize, Serialize};
+
+use super::model::{condition_number, fit_power_gamma, ModelKind};
+use super::patch_set::{PatchSet, CHANNEL_NAMES};
+use crate::color::{delta_e2000, Xyz};
+
+/// Default tolerance of the verdict, ΔE00.
+pub const TOLERANCE_DE00: f64 = 0.5;
+
+/// How well the fitted model reproduces the measured patches.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Residuals {
+    pub patches: usize,
+    pub mean_de00: f64,
+    pub p95_de00: f64,
+    pub max_de00: f64,
+    /// Drive values of the worst patch.
+    pub worst_rgb: [f64; 3],
+    /// Root mean square of the XYZ differences, cd/m².
+    pub rms_xyz: f64,
+}
+
+/// One channel's ramp checks (absent values: not measured).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChannelDiagnostics {
+    pub channel: String,
+    /// Ramp levels strictly between 0 and 1.
+    pub levels: usize,
+    /// Largest xy distance of a ramp patch's black-corrected chromaticity from the full-on
+    /// primary's (patches above 5 % of the primary's luminance).
+    pub chromaticity_drift_xy: Option<f64>,
+    /// Largest ΔE00 between a ramp patch and the constant-chromaticity prediction.
+    pub chromaticity_drift_de00: Option<f64>,
+    pub drift_at_drive: Option<f64>,
+    /// Least-squares power-law exponent of the ramp.
+    pub gamma: Option<f64>,
+    /// Largest ΔE00 between the measured TRC and that power law along the ramp.
+    pub power_law_de00: Option<f64>,
+}
+
+/// White measured against black + the three primaries' contributions.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Additivity {
+    pub de00: f64,
+    /// (Y_white − Y_predicted) / Y_white, percent.
+    pub luminance_error_percent: f64,
+}
+
+/// Everything checked, and the verdict.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Diagnostics {
+    pub model: ModelKind,
+    pub tolerance_de00: f64,
+    pub channels: Vec<ChannelDiagnostics>,
+    pub additivity: Option<Additivity>,
+    /// Y_black / Y_white.
+    pub black_share: Option<f64>,
+    pub condition_number: Option<f64>,
+    pub residuals: Residuals,
+    /// Assumptions that fail, each in one sentence.
+    pub failures: Vec<String>,
+    pub verdict: String,
+}
+
+fn de(a: [f64; 3], b: [f64; 3], white: Xyz) -> f64 {
+    delta_e2000(
+        Xyz::from_array(a).to_lab(white),
+        Xyz::from_array(b).to_lab(white),
+    )
+}
+
+fn xy(v: [f64; 3]) -> (f64, f64) {
+    let s = v[0] + v[1] + v[2];
+    (v[0] / s, v[1] / s)
+}
+
+impl Diagnostics {
+    /// Checks the patch set; `white` is the Lab reference (the display white).
+    pub fn compute(
+        set: &PatchSet,
+        model: ModelKind,
+        white: [f64; 3],
+        residuals: Residuals,
+    ) -> Diagnostics {
+        let w = Xyz::from_array(white);
+        let mut channels = Vec::new();
+        let mut additivity = None;
+        let mut condition = None;
+        let black_share = set.black.map(|b| b[1] / white[1]);
+        let primaries: Option<Vec<[f64; 3]>> = set.primaries.iter().copied().collect();
+        if let (Some(black), Some(prims)) = (set.black, primaries) {
+            let col = |c: usize| -> [f64; 3] { std::array::from_fn(|k| prims[c][k] - black[k]) };
+            let m: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| col(c)[r]));
+            condition = Some(condition_number(&m));
+            if let Some(white_measured) = set.white {
+                let predicted: [f64; 3] =
+                    std::array::from_fn(|k| black[k] + (0..3).map(|c| col(c)[k]).sum::<f64>());
+                additivity = Some(Additivity {
+                    de00: de(white_measured, predicted, w),
+                    luminance_error_percent: 100.0 * (white_measured[1] - predicted[1])
+                        / white_measured[1],
+                });
+            }
+            for (c, name) in CHANNEL_NAMES.iter().enumerate() {
+                let p = col(c);
+                let norm2: f64 = p.iter().map(|v| v * v).sum();
+                let mut ch = ChannelDiagnostics {
+                    channel: name.to_string(),
+                    levels: set.intermediate_levels(c),
+                    chromaticity_drift_xy: None,
+                    chromaticity_drift_de00: None,
+                    drift_at_drive: None,
+                    gamma: None,
+                    power_law_de00: None,
+                };
+                let mut ramp = vec![(0.0, 0.0)];
+                let (px, py) = xy(p);
+                for (d, xyz) in &set.ramps[c] {
+                    let corrected: [f64; 3] = std::array::from_fn(|k| xyz[k] - black[k]);
+                    let s = (0..3).map(|k| corrected[k] * p[k]).sum::<f64>() / norm2;
+                    ramp.push((*d, s));
+                    let predicted: [f64; 3] = std::array::from_fn(|k| black[k] + s * p[k]);
+                    let e = de(*xyz, predicted, w);
+                    if ch.chromaticity_drift_de00.is_none_or(|m| e > m) {
+                        ch.chromaticity_drift_de00 = Some(e);
+                        ch.drift_at_drive = Some(*d);
+                    }
+                    if corrected[1] > 0.05 * p[1] {
+                        let (x, y) = xy(corrected);
+                        let dxy = ((x - px).powi(2) + (y - py).powi(2)).sqrt();
+                        ch.chromaticity_drift_xy =
+                            Some(ch.chromaticity_drift_xy.map_or(dxy, |m: f64| m.max(dxy)));
+                    }
+                }
+                if ch.levels > 0 {
+                    let g = fit_power_gamma(&ramp);
+                    ch.gamma = Some(g);
+                    let worst = ramp
+                        .iter()
+                        .map(|&(d, s)| {
+                            let a: [f64; 3] = std::array::from_fn(|k| black[k] + s * p[k]);
+                            let b: [f64; 3] = std::array::from_fn(|k| black[k] + d.powf(g) * p[k]);
+                            de(a, b, w)
+                        })
+                        .fold(0.0, f64::max);
+                    ch.power_law_de00 = Some(worst);
+                }
+                channels.push(ch);
+            }
+        }
+        let mut d = Diagnostics {
+            model,
+            tolerance_de00: TOLERANCE_DE00,
+            channels,
+            additivity,
+            black_share,
+            condition_number: condition,
+            residuals,
+            failures: Vec::new(),
+            verdict: String::new(),
+        };
+        d.judge();
+        d
+    }
+
+    fn judge(&mut self) {
+        let tol = self.tolerance_de00;
+        let mut failures = Vec::new();
+        let mut unchecked = Vec::new();
+        let mut largest: Vec<String> = Vec::new();
+        match &self.additivity {
+            Some(a) if a.de00 > tol => failures.push(format!(
+                "the channels are not additive: white differs from black + red + green + blue \
+                 by ΔE00 {:.2} (luminance {:+.1} %)",
+                a.de00, a.luminance_error_percent
+            )),
+            Some(a) => largest.push(format!("additivity {:.2}", a.de00)),
+            None => unchecked.push("additivity (needs black, the three primaries and white)"),
+        }
+        if self.channels.is_empty() {
+            unchecked.push("chromaticity constancy (needs black and the three primaries)");
+        }
+        let mut power_notes = Vec::new();
+        for ch in &self.channels {
+            match (ch.chromaticity_drift_de00, ch.levels) {
+                (Some(e), n) if n > 0 && e > tol => failures.push(format!(
+                    "the {} channel's chromaticity drifts along its ramp: ΔE00 {:.2} at drive \
+                     {:.3}{}",
+                    ch.channel,
+                    e,
+                    ch.drift_at_drive.unwrap_or(f64::NAN),
+                    ch.chromaticity_drift_xy
+                        .map(|v| format!(" (Δxy up to {v:.4})"))
+                        .unwrap_or_default()
+                )),
+                (Some(e), n) if n > 0 => {
+                    largest.push(format!("{} drift {:.2}", ch.channel, e));
+                }
+                _ => unchecked.push("chromaticity constancy of a channel without a ramp"),
+            }
+            if let (Some(e), Some(g)) = (ch.power_law_de00, ch.gamma) {
+                if e > tol {
+                    power_notes.push(format!(
+                        "the {} TRC is not a power law: it deviates from γ = {:.2} by up to \
+                         ΔE00 {:.2}",
+                        ch.channel, g, e
+                    ));
+                }
+            }
+        }
+        let power_law_model = matches!(self.model, ModelKind::PlccGamma);
+        if power_law_model {
+            failures.append(&mut power_notes);
+        }
+        unchecked.dedup();
+        let r = &self.residuals;
+        let fit = format!(
+            "The fitted {} reproduces the {} patches with mean ΔE00 {:.2}, 95th percentile \
+             {:.2}, max {:.2}.",
+            self.model, r.patches, r.mean_de00, r.p95_de00, r.max_de00
+        );
+        let mut verdict = if failures.is_empty() && unchecked.is_empty() {
+            format!(
+                "PLCC's assumptions hold within ΔE00 {tol} (largest: {}).",
+                largest.join(", ")
+            )
+        } else if failures.is_empty() {
+            format!(
+                "No PLCC assumption fails within ΔE00 {tol} among those checked; not checked: {}.",
+                unchecked.join("; ")
+            )
+        } else {
+            format!(
+                "PLCC's assumptions fail: {}. Models that do not assume them: lut (needs a full \
+                 grid of patches) or matrix-lsq (fits over all patches).",
+                failures.join("; ")
+            )
+        };
+        if !power_law_model && !power_notes.is_empty() {
+            verdict.push_str(&format!(
+                " Note: {} (plcc-gamma would not cope; measured-ramp TRCs do).",
+                power_notes.join("; ")
+            ));
+        }
+        verdict.push(' ');
+        verdict.push_str(&fit);
+        self.failures = failures;
+        self.verdict = verdict;
+    }
+}
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("–".into(), |v| format!("{v:.digits$}"))
+}
+
+impl std::fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "channel  levels  drift ΔE00  drift Δxy  γ (power law)  power-law ΔE00"
+        )?;
+        for ch in &self.channels {
+            writeln!(
+                f,
+                "{:<7}  {:>6}  {:>10}  {:>9}  {:>13}  {:>14}",
+                ch.channel,
+                ch.levels,
+                opt(ch.chromaticity_drift_de00, 2),
+                opt(ch.chromaticity_drift_xy, 4),
+                opt(ch.gamma, 3),
+                opt(ch.power_law_de00, 2)
+            )?;
+        }
+        match &self.additivity {
+            Some(a) => writeln!(
+                f,
+                "additivity: white vs black+R+G+B ΔE00 {:.2}, luminance {:+.2} %",
+                a.de00, a.luminance_error_percent
+            )?,
+            None => writeln!(f, "additivity: not measured")?,
+        }
+        writeln!(
+            f,
+            "black level: {} % of white; condition number of M: {}",
+            opt(self.black_share.map(|b| 100.0 * b), 3),
+            opt(self.condition_number, 2)
+        )?;
+        writeln!(
+            f,
+            "fit ({}): mean ΔE00 {:.3}, p95 {:.3}, max {:.3} at rgb {:.3},{:.3},{:.3}; rms XYZ {:.4} cd/m²",
+            self.model,
+            self.residuals.mean_de00,
+            self.residuals.p95_de00,
+            self.residuals.max_de00,
+            self.residuals.worst_rgb[0],
+            self.residuals.worst_rgb[1],
+            self.residuals.worst_rgb[2],
+            self.residuals.rms_xyz
+        )?;
+        write!(f, "verdict: {}", self.verdict)
+    }
+}

@@ -1,0 +1,160 @@
+//! Fitting a display model to measured patches: each model takes what it needs (black,
+//! primaries, ramps, a grid) and is judged on every patch; diagnostics go with the result.
+
+use std::path::{Path, PathBuf};
+
+use sha2::{Digest, Sha256};
+
+use super::diagnostics::{Diagnostics, Residuals};
+use super::model::{fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind, ModelParams};
+use super::patch_set::PatchSet;
+use super::profile::{InputFile, Profile, PROFILE_FORMAT};
+use super::Patch;
+use crate::color::{delta_e2000, Xyz};
+
+/// Why a model could not be fitted.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    #[error("no patches to fit")]
+    NoPatches,
+    #[error("patch {index} (r,g,b = {rgb:?}) has a value that is not a finite number in range")]
+    BadPatch { index: usize, rgb: [f64; 3] },
+    #[error("{model} needs {what}; the measurements have none")]
+    Missing { model: ModelKind, what: String },
+    #[error(
+        "the primaries are (nearly) linearly dependent: the condition number of M (columns: \
+         full-on red, green, blue minus black) is {condition:.3e}, above {limit:.0e}; check that \
+         the three primaries were measured on the right patches and are above the black level"
+    )]
+    SingularPrimaries { condition: f64, limit: f64 },
+    #[error("{model}: {message}")]
+    Failed { model: ModelKind, message: String },
+    #[error("{file}: cannot read for its hash: {source}")]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Choices beyond the model kind.
+#[derive(Clone, Debug, Default)]
+pub struct FitOptions {
+    /// plcc-gamma: use this exponent for every channel instead of fitting (the paper: 2.2).
+    pub gamma: Option<f64>,
+}
+
+/// Fits `kind` to `patches`; `source` is the measurement file whose hash the profile records.
+pub fn fit_profile(
+    kind: ModelKind,
+    patches: &[Patch],
+    source: Option<&Path>,
+) -> Result<Profile, FitError> {
+    fit_profile_with(kind, patches, source, &FitOptions::default())
+}
+
+/// [`fit_profile`] with options.
+pub fn fit_profile_with(
+    kind: ModelKind,
+    patches: &[Patch],
+    source: Option<&Path>,
+    options: &FitOptions,
+) -> Result<Profile, FitError> {
+    if patches.is_empty() {
+        return Err(FitError::NoPatches);
+    }
+    for (index, p) in patches.iter().enumerate() {
+        let ok =
+            p.rgb.iter().all(|d| (0.0..=1.0).contains(d)) && p.xyz.iter().all(|v| v.is_finite());
+        if !ok {
+            return Err(FitError::BadPatch {
+                index: index + 1,
+                rgb: p.rgb,
+            });
+        }
+    }
+    let set = PatchSet::new(patches);
+    let mut params = match kind {
+        ModelKind::Plcc => ModelParams::MatrixTrc(fit_plcc(&set)?),
+        ModelKind::PlccGamma => ModelParams::MatrixTrc(fit_plcc_gamma(&set, options.gamma)?),
+        other => {
+            return Err(FitError::Failed {
+                model: other,
+                message: "this model is not available in this build".into(),
+            })
+        }
+    };
+    params
+        .prepare(kind)
+        .map_err(|condition| FitError::SingularPrimaries {
+            condition,
+            limit: super::model::MAX_CONDITION,
+        })?;
+    let model = params.model();
+    let white = set.white.unwrap_or_else(|| model.forward([1.0; 3]));
+    let black = set.black.unwrap_or_else(|| model.forward([0.0; 3]));
+    if white[1].is_nan() || white[1] <= 0.0 {
+        return Err(FitError::Failed {
+            model: kind,
+            message: format!("the white has no positive luminance (Y = {})", white[1]),
+        });
+    }
+    let residuals = residuals(model, patches, white);
+    let diagnostics = Diagnostics::compute(&set, kind, white, residuals.clone());
+    let input = match source {
+        Some(path) => {
+            let bytes = std::fs::read(path).map_err(|e| FitError::Io {
+                file: path.to_path_buf(),
+                source: e,
+            })?;
+            Some(InputFile {
+                path: path.display().to_string(),
+                sha256: format!("{:x}", Sha256::digest(&bytes)),
+                patches: patches.len(),
+            })
+        }
+        None => None,
+    };
+    Ok(Profile {
+        format: PROFILE_FORMAT.into(),
+        model: kind,
+        parameters: params,
+        white_xyz: white,
+        black_xyz: black,
+        residuals,
+        diagnostics,
+        input,
+    })
+}
+
+/// ΔE00 (relative to `white`) and XYZ differences between the model and every patch.
+pub fn residuals(model: &dyn DisplayModel, patches: &[Patch], white: [f64; 3]) -> Residuals {
+    let w = Xyz::from_array(white);
+    let mut des = Vec::with_capacity(patches.len());
+    let mut sq = 0.0;
+    let mut worst = (0.0, [0.0; 3]);
+    for p in patches {
+        let f = model.forward(p.rgb);
+        let e = delta_e2000(
+            Xyz::from_array(f).to_lab(w),
+            Xyz::from_array(p.xyz).to_lab(w),
+        );
+        sq += (0..3).map(|k| (f[k] - p.xyz[k]).powi(2)).sum::<f64>();
+        if e > worst.0 || des.is_empty() {
+            worst = (e, p.rgb);
+        }
+        des.push(e);
+    }
+    let n = des.len() as f64;
+    let mut sorted = des.clone();
+    sorted.sort_by(f64::total_cmp);
+    let p95 = sorted[((0.95 * n).ceil() as usize).clamp(1, sorted.len()) - 1];
+    Residuals {
+        patches: des.len(),
+        mean_de00: des.iter().sum::<f64>() / n,
+        p95_de00: p95,
+        max_de00: worst.0,
+        worst_rgb: worst.1,
+        rms_xyz: (sq / (3.0 * n)).sqrt(),
+    }
+}

@@ -1,0 +1,600 @@
+//! Measured patch files: ArgyllCMS CGATS `.ti3` (as `dispread` writes them) and plain CSV
+//! `r,g,b,X,Y,Z` (drive values 0–1, XYZ in cd/m²).
+//!
+//! Facts about `.ti3` (ArgyllCMS documentation `doc/ti3_format.html`, and how `colprof`
+//! reads display data): the file starts with the identifier `CTI3`; device values
+//! `RGB_R RGB_G RGB_B` are percentages 0–100; for `DEVICE_CLASS "DISPLAY"` the XYZ values are
+//! normalised so that the white has Y = 100 unless the keyword `NORMALIZED_TO_Y_100` is
+//! `"NO"`, and the keyword `LUMINANCE_XYZ_CDM2 "X Y Z"` gives the white's absolute XYZ in
+//! cd/m², so absolute = value × LUMINANCE_Y / 100. Only the first table is read: dispread
+//! may append a second (`CAL`) table with the video LUT.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use super::Patch;
+use crate::numeric_csv::{CsvError, NumericCsv};
+
+/// What is wrong with a measurement file; every variant names the file, most the line.
+#[derive(Debug, thiserror::Error)]
+pub enum MeasurementsError {
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Csv(#[from] CsvError),
+    #[error("{file}:{line}: {message}")]
+    Cgats {
+        file: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{file}: {message}")]
+    File { file: PathBuf, message: String },
+}
+
+/// A measurement file as read: the patches (absolute cd/m² when `absolute`) and how the
+/// XYZ scale was established.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurements {
+    pub patches: Vec<Patch>,
+    /// False when a `.ti3` holds only white-relative XYZ (Y = 100 at white, no
+    /// `LUMINANCE_XYZ_CDM2`): the values are then taken as if the white had 100 cd/m².
+    pub absolute: bool,
+}
+
+/// Reads `.ti3` (CGATS) or `.csv` by extension; relative `.ti3` data are returned as if the
+/// white were 100 cd/m² (use [`read_measurement_file`] to know).
+pub fn read_measurements(path: &Path) -> Result<Vec<Patch>, MeasurementsError> {
+    read_measurement_file(path).map(|m| m.patches)
+}
+
+/// Reads `.ti3` (CGATS) or `.csv` by extension and tells whether the XYZ are absolute.
+pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext == "csv" {
+        let table = NumericCsv::read(path, &["r", "g", "b", "X", "Y", "Z"])?;
+        let mut patches = Vec::with_capacity(table.rows.len());
+        for (line, v) in &table.rows {
+            let rgb = [v[0], v[1], v[2]];
+            if rgb.iter().any(|d| !(0.0..=1.0).contains(d)) {
+                return Err(MeasurementsError::Cgats {
+                    file: path.to_path_buf(),
+                    line: *line,
+                    message: format!(
+                        "drive values must lie in 0–1, found r,g,b = {},{},{}",
+                        v[0], v[1], v[2]
+                    ),
+                });
+            }
+            patches.push(Patch {
+                rgb,
+                xyz: [v[3], v[4], v[5]],
+            });
+        }
+        return Ok(Measurements {
+            patches,
+            absolute: true,
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| MeasurementsError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    parse_ti3(&text, path)
+}
+
+/// Splits a CGATS line into tokens: whitespace separated, double quotes group.
+fn tokens(line: &str) -> Result<Vec<String>, String> {
+    let mut out = Vec::new();
+    let mut chars = line.chars().peekable();
+    while let Some(&c) = chars.peek() {
+        if c.is_whitespace() {
+            chars.next();
+        } else if c == '#' {
+            break;
+        } else if c == '"' {
+            chars.next();
+            let mut s = String::new();
+            loop {
+                match chars.next() {
+                    Some('"') => break,
+                    Some(ch) => s.push(ch),
+                    None => return Err("a quoted value is not closed".into()),
+                }
+            }
+            out.push(s);
+        } else {
+            let mut s = String::new();
+            while let Some(&ch) = chars.peek() {
+                if ch.is_whitespace() {
+                    break;
+                }
+                s.push(ch);
+                chars.next();
+            }
+            out.push(s);
+        }
+    }
+    Ok(out)
+}
+
+/// Parses the first table of a CGATS `.ti3` text; `path` names it in errors.
+pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsError> {
+    let file = path.to_path_buf();
+    let err = |line: usize, message: String| MeasurementsError::Cgats {
+        file: file.clone(),
+        line,
+        message,
+    };
+    enum State {
+        Header,
+        Format,
+        Data,
+    }
+    let mut state = State::Header;
+    let mut seen_identifier = false;
+    let mut keywords: Vec<(String, String, usize)> = Vec::new();
+    let mut fields: Vec<String> = Vec::new();
+    let mut declared_fields: Option<(usize, usize)> = None;
+    let mut declared_sets: Option<(usize, usize)> = None;
+    let mut columns: Option<[usize; 6]> = None;
+    let mut rows: Vec<(usize, [f64; 6])> = Vec::new();
+    let mut ended = false;
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        let toks = tokens(raw).map_err(|m| err(line, m))?;
+        if toks.is_empty() {
+            continue;
+        }
+        if !seen_identifier {
+            if toks[0] != "CTI3" {
+                return Err(err(
+                    line,
+                    format!(
+                        "not an ArgyllCMS .ti3 file: it must start with 'CTI3', found '{}'",
+                        toks[0]
+                    ),
+                ));
+            }
+            seen_identifier = true;
+            continue;
+        }
+        match state {
+            State::Header => match toks[0].as_str() {
+                "BEGIN_DATA_FORMAT" => {
+                    state = State::Format;
+                    fields.extend(toks[1..].iter().cloned());
+                }
+                "NUMBER_OF_FIELDS" | "NUMBER_OF_SETS" => {
+                    let n = toks
+                        .get(1)
+                        .and_then(|t| t.parse::<usize>().ok())
+                        .ok_or_else(|| err(line, format!("{} needs a whole number", toks[0])))?;
+                    if toks[0] == "NUMBER_OF_FIELDS" {
+                        declared_fields = Some((n, line));
+                    } else {
+                        declared_sets = Some((n, line));
+                    }
+                }
+                "BEGIN_DATA" => {
+                    let cols = find_columns(&fields).map_err(|m| err(line, m))?;
+                    if let Some((n, l)) = declared_fields {
+                        if n != fields.len() {
+                            return Err(err(
+                                l,
+                                format!(
+                                    "NUMBER_OF_FIELDS is {n} but the data format lists {} fields",
+                                    fields.len()
+                                ),
+                            ));
+                        }
+                    }
+                    columns = Some(cols);
+                    state = State::Data;
+                }
+                "KEYWORD" => {}
+                name => {
+                    let value = toks[1..].join(" ");
+                    keywords.push((name.to_string(), value, line));
+                }
+            },
+            State::Format => {
+                if toks[0] == "END_DATA_FORMAT" {
+                    state = State::Header;
+                } else {
+                    fields.extend(toks.iter().cloned());
+                }
+            }
+            State::Data => {
+                if toks[0] == "END_DATA" {
+                    ended = true;
+                    break;
+                }
+                let cols = columns.expect("set when the data began");
+                if toks.len() != fields.len() {
+                    return Err(err(
+                        line,
+                        format!(
+                            "expected {} values ({}), found {}",
+                            fields.len(),
+                            fields.join(" "),
+                            toks.len()
+                        ),
+                    ));
+                }
+                let mut v = [0.0; 6];
+                for (k, &c) in cols.iter().enumerate() {
+                    v[k] = toks[c]
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| {
+                            err(
+                                line,
+                                format!("field {} ('{}') is not a number", fields[c], toks[c]),
+                            )
+                        })?;
+                }
+                for (k, name) in ["RGB_R", "RGB_G", "RGB_B"].iter().enumerate() {
+                    if !(0.0..=100.0).contains(&v[k]) {
+                        return Err(err(line, format!("{name} = {} is outside 0–100", v[k])));
+                    }
+                }
+                rows.push((line, v));
+            }
+        }
+    }
+    let last = text.lines().count().max(1);
+    if !seen_identifier {
+        return Err(MeasurementsError::File {
+            file,
+            message: "the file is empty".into(),
+        });
+    }
+    if columns.is_none() {
+        return Err(err(
+            last,
+            "no BEGIN_DATA: the file holds no measurements".into(),
+        ));
+    }
+    if !ended {
+        return Err(err(
+            last,
+            "END_DATA is missing: the file is cut short".into(),
+        ));
+    }
+    if rows.is_empty() {
+        return Err(err(last, "the data table has no rows".into()));
+    }
+    if let Some((n, l)) = declared_sets {
+        if n != rows.len() {
+            return Err(err(
+                l,
+                format!(
+                    "NUMBER_OF_SETS is {n} but the data table has {} rows",
+                    rows.len()
+                ),
+            ));
+        }
+    }
+    let keyword = |name: &str| keywords.iter().find(|(k, _, _)| k == name);
+    if let Some((_, class, l)) = keyword("DEVICE_CLASS") {
+        if class != "DISPLAY" {
+            return Err(err(
+                *l,
+                format!("DEVICE_CLASS is \"{class}\"; display measurements need \"DISPLAY\""),
+            ));
+        }
+    }
+    let normalised = keyword("NORMALIZED_TO_Y_100").is_none_or(|(_, v, _)| v != "NO");
+    let (scale, absolute) = match (normalised, keyword("LUMINANCE_XYZ_CDM2")) {
+        (false, _) => (1.0, true),
+        (true, Some((_, value, l))) => {
+            let xyz: Vec<f64> = value
+                .split_whitespace()
+                .filter_map(|t| t.parse::<f64>().ok())
+                .collect();
+            if xyz.len() != 3 || !xyz[1].is_finite() || xyz[1] <= 0.0 {
+                return Err(err(
+                    *l,
+                    format!("LUMINANCE_XYZ_CDM2 must be three numbers X Y Z with Y > 0, found \"{value}\""),
+                ));
+            }
+            (xyz[1] / 100.0, true)
+        }
+        (true, None) => (1.0, false),
+    };
+    Ok(Measurements {
+        patches: rows
+            .into_iter()
+            .map(|(_, v)| Patch {
+                rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
+                xyz: [v[3] * scale, v[4] * scale, v[5] * scale],
+            })
+            .collect(),
+        absolute,
+    })
+}
+
+fn find_columns(fields: &[String]) -> Result<[usize; 6], String> {
+    let names = ["RGB_R", "RGB_G", "RGB_B", "XYZ_X", "XYZ_Y", "XYZ_Z"];
+    let mut out = [0; 6];
+    let missing: Vec<&str> = names
+        .iter()
+        .filter(|n| !fields.iter().any(|f| f == *n))
+        .copied()
+        .collect();
+    if !missing.is_empty() {
+        return Err(format!(
+            "the data format lacks the field(s) {} (found: {})",
+            missing.join(" "),
+            fields.join(" ")
+        ));
+    }
+    for (o, n) in out.iter_mut().zip(names) {
+        *o = fields.iter().position(|f| f == n).expect("checked above");
+    }
+    Ok(out)
+}
+
+/// The white used to normalise a `.ti3`: the brightest patch driven at full on all channels,
+/// or the brightest patch when none is.
+fn white_of(patches: &[Patch]) -> Option<[f64; 3]> {
+    let brightest = |it: &mut dyn Iterator<Item = &Patch>| {
+        it.max_by(|a, b| a.xyz[1].total_cmp(&b.xyz[1]))
+            .map(|p| p.xyz)
+    };
+    brightest(&mut patches.iter().filter(|p| p.rgb == [1.0, 1.0, 1.0]))
+        .or_else(|| brightest(&mut patches.iter()))
+}
+
+/// `ctime()`-style UTC date, as dispread writes in CREATED.
+fn created_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() as i64)
+        .unwrap_or(0);
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // Civil date from days since 1970-01-01 (H. Hinnant, "chrono-Compatible Low-Level Date
+    // Algorithms", days_from_civil inverse).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    const WEEKDAYS: [&str; 7] = ["Thu", "Fri", "Sat", "Sun", "Mon", "Tue", "Wed"];
+    const MONTHS: [&str; 12] = [
+        "Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec",
+    ];
+    format!(
+        "{} {} {:2} {:02}:{:02}:{:02} {}",
+        WEEKDAYS[days.rem_euclid(7) as usize],
+        MONTHS[(month - 1) as usize],
+        day,
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60,
+        year
+    )
+}
+
+/// Writes patches as ArgyllCMS dispread does: RGB in 0–100, XYZ normalised to the white's
+/// Y = 100 with the white's absolute XYZ in `LUMINANCE_XYZ_CDM2`. `description` goes into the
+/// DESCRIPTOR keyword.
+pub fn write_ti3(path: &Path, patches: &[Patch], description: &str) -> std::io::Result<()> {
+    let white = white_of(patches).filter(|w| w[1] > 0.0).ok_or_else(|| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "no patch with positive luminance to normalise the .ti3 to",
+        )
+    })?;
+    let k = 100.0 / white[1];
+    let mut s = String::new();
+    s.push_str("CTI3   \n\n");
+    s.push_str(&format!(
+        "DESCRIPTOR \"{}\"\n\n",
+        description.replace('"', "'")
+    ));
+    s.push_str("ORIGINATOR \"metamer\"\n\n");
+    s.push_str(&format!("CREATED \"{}\"\n", created_now()));
+    for (name, value) in [
+        ("DEVICE_CLASS", "DISPLAY".to_string()),
+        ("COLOR_REP", "RGB_XYZ".to_string()),
+        (
+            "LUMINANCE_XYZ_CDM2",
+            format!("{:.6} {:.6} {:.6}", white[0], white[1], white[2]),
+        ),
+        ("NORMALIZED_TO_Y_100", "YES".to_string()),
+    ] {
+        s.push_str(&format!("KEYWORD \"{name}\"\n{name} \"{value}\"\n"));
+    }
+    s.push_str("\nNUMBER_OF_FIELDS 7\nBEGIN_DATA_FORMAT\n");
+    s.push_str("SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z \nEND_DATA_FORMAT\n\n");
+    s.push_str(&format!("NUMBER_OF_SETS {}\nBEGIN_DATA\n", patches.len()));
+    for (i, p) in patches.iter().enumerate() {
+        s.push_str(&format!(
+            "{} {:.6} {:.6} {:.6} {:.6} {:.6} {:.6} \n",
+            i + 1,
+            p.rgb[0] * 100.0,
+            p.rgb[1] * 100.0,
+            p.rgb[2] * 100.0,
+            p.xyz[0] * k,
+            p.xyz[1] * k,
+            p.xyz[2] * k
+        ));
+    }
+    s.push_str("END_DATA\n");
+    // Write a sibling then rename: an interrupted write never leaves a half file in place.
+    let tmp = path.with_extension("ti3.partial");
+    let mut f = std::fs::File::create(&tmp)?;
+    f.write_all(s.as_bytes())?;
+    f.sync_all()?;
+    std::fs::rename(&tmp, path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DISPREAD: &str = r#"CTI3   
+
+DESCRIPTOR "Argyll Calibration Target chart information 3"
+
+ORIGINATOR "Argyll dispread"
+
+CREATED "Wed Jan 10 12:00:00 2024"
+KEYWORD "DEVICE_CLASS"
+DEVICE_CLASS "DISPLAY"
+KEYWORD "COLOR_REP"
+COLOR_REP "RGB_XYZ"
+KEYWORD "LUMINANCE_XYZ_CDM2"
+LUMINANCE_XYZ_CDM2 "190.10 200.00 217.76"
+KEYWORD "NORMALIZED_TO_Y_100"
+NORMALIZED_TO_Y_100 "YES"
+
+NUMBER_OF_FIELDS 7
+BEGIN_DATA_FORMAT
+SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z 
+END_DATA_FORMAT
+
+NUMBER_OF_SETS 2
+BEGIN_DATA
+1 100.00 100.00 100.00 95.05 100.00 108.88 
+2 50.000 0.0000 0.0000 10.000 5.0000 0.5000 
+END_DATA
+
+CAL    
+
+DESCRIPTOR "Argyll Device Calibration State"
+"#;
+
+    #[test]
+    fn dispread_layout_is_scaled_to_absolute_by_luminance_y() {
+        let m = parse_ti3(DISPREAD, Path::new("d.ti3")).unwrap();
+        assert!(m.absolute);
+        // absolute = value × 200 / 100
+        assert_eq!(m.patches[0].rgb, [1.0, 1.0, 1.0]);
+        assert!((m.patches[0].xyz[1] - 200.0).abs() < 1e-9);
+        assert!((m.patches[0].xyz[0] - 190.1).abs() < 1e-9);
+        assert_eq!(m.patches[1].rgb, [0.5, 0.0, 0.0]);
+        assert!((m.patches[1].xyz[0] - 20.0).abs() < 1e-9);
+        assert!((m.patches[1].xyz[2] - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn unnormalised_and_relative_files() {
+        let abs = DISPREAD.replace("NORMALIZED_TO_Y_100 \"YES\"", "NORMALIZED_TO_Y_100 \"NO\"");
+        let m = parse_ti3(&abs, Path::new("d.ti3")).unwrap();
+        assert!(m.absolute);
+        assert!((m.patches[0].xyz[1] - 100.0).abs() < 1e-12);
+        let rel = DISPREAD.replace("LUMINANCE_XYZ_CDM2 \"190.10 200.00 217.76\"", "");
+        let m = parse_ti3(&rel, Path::new("d.ti3")).unwrap();
+        assert!(!m.absolute);
+        assert!((m.patches[0].xyz[1] - 100.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_files_name_file_and_line() {
+        let p = Path::new("bad.ti3");
+        let msg = |t: &str| parse_ti3(t, p).unwrap_err().to_string();
+        assert_eq!(
+            msg(&DISPREAD.replace("2 50.000 0.0000", "2 50.000 x0.0")),
+            "bad.ti3:25: field RGB_G ('x0.0') is not a number"
+        );
+        assert_eq!(
+            msg(&DISPREAD.replace("2 50.000 0.0000 0.0000 10.000", "2 50.000 0.0000 10.000")),
+            "bad.ti3:25: expected 7 values (SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z), found 6"
+        );
+        assert_eq!(
+            msg(&DISPREAD.replace("NUMBER_OF_SETS 2", "NUMBER_OF_SETS 3")),
+            "bad.ti3:22: NUMBER_OF_SETS is 3 but the data table has 2 rows"
+        );
+        assert!(msg(&DISPREAD.replace("XYZ_Y", "LAB_L"))
+            .contains("bad.ti3:23: the data format lacks the field(s) XYZ_Y"));
+        assert!(msg(&DISPREAD.replace("CTI3", "CGATS.17"))
+            .starts_with("bad.ti3:1: not an ArgyllCMS .ti3"));
+        let cut: String = DISPREAD.lines().take(24).collect::<Vec<_>>().join("\n");
+        assert!(msg(&cut).contains("END_DATA is missing"));
+        assert!(
+            msg(&DISPREAD.replace("2 50.000", "2 150.00")).starts_with("bad.ti3:25: RGB_R = 150")
+        );
+        assert!(
+            msg(&DISPREAD.replace("\"190.10 200.00 217.76\"", "\"190.10\""))
+                .starts_with("bad.ti3:13: LUMINANCE_XYZ_CDM2")
+        );
+    }
+
+    #[test]
+    fn write_then_read_round_trips_absolute_values() {
+        let patches = vec![
+            Patch {
+                rgb: [0.0, 0.0, 0.0],
+                xyz: [0.2, 0.21, 0.3],
+            },
+            Patch {
+                rgb: [1.0, 1.0, 1.0],
+                xyz: [152.0, 160.0, 174.2],
+            },
+            Patch {
+                rgb: [128.0 / 255.0, 0.25, 1.0],
+                xyz: [30.5, 20.25, 90.125],
+            },
+        ];
+        let dir = std::env::temp_dir().join(format!("metamer-ti3-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("m.ti3");
+        write_ti3(&path, &patches, "test \"patches\"").unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("LUMINANCE_XYZ_CDM2 \"152.000000 160.000000 174.200000\""));
+        assert!(text.contains("2 100.000000 100.000000 100.000000 95.000000 100.000000 108.875000"));
+        let back = read_measurements(&path).unwrap();
+        for (a, b) in back.iter().zip(&patches) {
+            for c in 0..3 {
+                assert!((a.rgb[c] - b.rgb[c]).abs() < 1e-8);
+                assert!((a.xyz[c] - b.xyz[c]).abs() < 1e-5 * b.xyz[c].max(1.0));
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn csv_rows_and_errors() {
+        let dir = std::env::temp_dir().join(format!("metamer-mcsv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("m.csv");
+        std::fs::write(&path, "r,g,b,X,Y,Z\n1,1,1,95,100,108\n0.5,0,0,10,5,0.5\n").unwrap();
+        let p = read_measurements(&path).unwrap();
+        assert_eq!(
+            p[1],
+            Patch {
+                rgb: [0.5, 0.0, 0.0],
+                xyz: [10.0, 5.0, 0.5]
+            }
+        );
+        std::fs::write(&path, "r,g,b,X,Y,Z\n1,1,1,95,100,108\n2,0,0,10,5,0.5\n").unwrap();
+        let e = read_measurements(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("m.csv:3: drive values must lie in 0–1, found r,g,b = 2,0,0"),
+            "{e}"
+        );
+        std::fs::write(&path, "r,g,b,X,Y\n").unwrap();
+        let e = read_measurements(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("m.csv:1: expected the header 'r,g,b,X,Y,Z'"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

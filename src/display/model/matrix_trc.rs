@@ -1,0 +1,111 @@
+//! The matrix-plus-curves form of paper Eq. 9: XYZ − XYZ₀ = M·[R′ G′ B′]ᵀ with R′ = TRC_R(R)
+//! etc. PLCC, PLCC with a power law, GOG/GOGO and the all-patch matrix differ only in how M,
+//! XYZ₀ and the curves are fitted; they share this forward and inverse.
+
+use serde::{Deserialize, Serialize};
+
+use super::{DisplayModel, Inverse, ModelKind, Trc, GAMUT_TOLERANCE};
+
+/// Black offset, matrix and one curve per channel.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MatrixTrc {
+    /// XYZ₀, cd/m².
+    pub black: [f64; 3],
+    /// Rows X, Y, Z; columns R, G, B (cd/m² per unit R′, G′, B′).
+    pub matrix: [[f64; 3]; 3],
+    pub trc: [Trc; 3],
+    #[serde(skip)]
+    inverse_matrix: [[f64; 3]; 3],
+    #[serde(skip)]
+    kind: Option<ModelKind>,
+}
+
+/// 2-norm condition number of a 3×3 matrix (∞ when singular).
+pub fn condition_number(m: &[[f64; 3]; 3]) -> f64 {
+    let mat = nalgebra::Matrix3::from_fn(|r, c| m[r][c]);
+    let sv = mat.singular_values();
+    let (max, min) = (sv.max(), sv.min());
+    if min > 0.0 && max.is_finite() {
+        max / min
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Largest condition number accepted for M; real displays' primaries give 2–20, so beyond
+/// this the primaries are (nearly) linearly dependent and the inverse amplifies noise.
+pub const MAX_CONDITION: f64 = 1e4;
+
+impl MatrixTrc {
+    /// Builds the model; `Err(condition number)` when M cannot be inverted safely.
+    pub fn new(
+        kind: ModelKind,
+        black: [f64; 3],
+        matrix: [[f64; 3]; 3],
+        trc: [Trc; 3],
+    ) -> Result<Self, f64> {
+        let mut m = MatrixTrc {
+            black,
+            matrix,
+            trc,
+            inverse_matrix: [[0.0; 3]; 3],
+            kind: None,
+        };
+        m.prepare(kind)?;
+        Ok(m)
+    }
+
+    /// Computes the derived inverse after loading; `Err(condition number)` when singular.
+    pub fn prepare(&mut self, kind: ModelKind) -> Result<(), f64> {
+        let cond = condition_number(&self.matrix);
+        if cond > MAX_CONDITION {
+            return Err(cond);
+        }
+        let inv = nalgebra::Matrix3::from_fn(|r, c| self.matrix[r][c])
+            .try_inverse()
+            .ok_or(f64::INFINITY)?;
+        self.inverse_matrix = std::array::from_fn(|r| std::array::from_fn(|c| inv[(r, c)]));
+        self.kind = Some(kind);
+        Ok(())
+    }
+
+    /// R′, G′, B′ for a drive triple.
+    pub fn linear(&self, rgb: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|c| self.trc[c].eval(rgb[c]))
+    }
+}
+
+fn mul(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
+}
+
+impl DisplayModel for MatrixTrc {
+    fn name(&self) -> &'static str {
+        self.kind.map_or("matrix-trc", ModelKind::name)
+    }
+
+    fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+        let l = mul(&self.matrix, self.linear(rgb));
+        std::array::from_fn(|c| self.black[c] + l[c])
+    }
+
+    fn inverse(&self, xyz: [f64; 3]) -> Inverse {
+        let d = std::array::from_fn(|c| xyz[c] - self.black[c]);
+        let lin = mul(&self.inverse_matrix, d);
+        Inverse::from_unclipped(std::array::from_fn(|c| self.trc[c].inverse(lin[c])))
+    }
+}
+
+impl Inverse {
+    /// Clips to 0..=1 and flags targets whose drive leaves it by more than the tolerance.
+    pub fn from_unclipped(unclipped: [f64; 3]) -> Inverse {
+        let out_of_gamut = unclipped
+            .iter()
+            .any(|&v| !(-GAMUT_TOLERANCE..=1.0 + GAMUT_TOLERANCE).contains(&v) || v.is_nan());
+        Inverse {
+            rgb: unclipped.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }),
+            unclipped,
+            out_of_gamut,
+        }
+    }
+}

@@ -1,0 +1,141 @@
+//! Display models behind one trait: forward (drive RGB 0–1 → absolute XYZ cd/m²) and inverse
+//! (XYZ → drive RGB, reporting out-of-gamut targets instead of clipping silently).
+//!
+//! The paper's model is Eq. 9, inverse PLCC with black correction; [`ModelKind`] lists it and
+//! the richer models offered where its assumptions fail.
+
+mod matrix_trc;
+mod plcc;
+mod trc;
+
+pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
+pub use plcc::{fit_plcc, fit_plcc_gamma, fit_power_gamma};
+pub use trc::Trc;
+
+use serde::{Deserialize, Serialize};
+
+/// A drive value further than this outside 0–1 marks a target out of gamut.
+pub const GAMUT_TOLERANCE: f64 = 1e-6;
+
+/// A display's colorimetric behaviour.
+pub trait DisplayModel: Send + Sync {
+    fn name(&self) -> &'static str;
+    /// Drive values 0–1 → absolute XYZ, cd/m².
+    fn forward(&self, rgb: [f64; 3]) -> [f64; 3];
+    /// XYZ → drive values; never clips silently (see [`Inverse`]).
+    fn inverse(&self, xyz: [f64; 3]) -> Inverse;
+}
+
+/// The drive values for a target.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inverse {
+    /// Clipped to 0..=1.
+    pub rgb: [f64; 3],
+    /// The model's solution before clipping.
+    pub unclipped: [f64; 3],
+    /// The unclipped solution leaves 0..=1 by more than [`GAMUT_TOLERANCE`].
+    pub out_of_gamut: bool,
+}
+
+/// The models `fit` offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ModelKind {
+    /// Paper Eq. 9 with TRCs interpolated piecewise-linearly from measured ramps.
+    Plcc,
+    /// Paper Eq. 9 with a power-law TRC per channel (fitted, or given as the paper's 2.2).
+    PlccGamma,
+    /// Gain-offset-gamma per channel + primaries matrix, least squares.
+    Gog,
+    /// GOG with an extra additive offset per channel.
+    Gogo,
+    /// A 3D LUT over a measured grid, tetrahedral interpolation: no constant-chromaticity or
+    /// additivity assumption.
+    Lut,
+    /// Measured-ramp TRCs and a matrix + black offset fitted over all patches.
+    MatrixLsq,
+}
+
+impl ModelKind {
+    pub const ALL: [ModelKind; 6] = [
+        ModelKind::Plcc,
+        ModelKind::PlccGamma,
+        ModelKind::Gog,
+        ModelKind::Gogo,
+        ModelKind::Lut,
+        ModelKind::MatrixLsq,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Plcc => "plcc",
+            ModelKind::PlccGamma => "plcc-gamma",
+            ModelKind::Gog => "gog",
+            ModelKind::Gogo => "gogo",
+            ModelKind::Lut => "lut",
+            ModelKind::MatrixLsq => "matrix-lsq",
+        }
+    }
+}
+
+impl std::fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ModelKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                let names: Vec<&str> = ModelKind::ALL.iter().map(|k| k.name()).collect();
+                format!("unknown model '{s}' (known: {})", names.join(", "))
+            })
+    }
+}
+
+/// A fitted model's parameters, as saved in a profile.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "kebab-case")]
+pub enum ModelParams {
+    /// XYZ = XYZ₀ + M·TRC(rgb) (plcc, plcc-gamma, gog, gogo, matrix-lsq).
+    MatrixTrc(MatrixTrc),
+}
+
+impl ModelParams {
+    pub fn model(&self) -> &dyn DisplayModel {
+        match self {
+            ModelParams::MatrixTrc(m) => m,
+        }
+    }
+
+    /// Rebuilds derived data after loading; `Err(condition number)` when M is singular.
+    pub fn prepare(&mut self, kind: ModelKind) -> Result<(), f64> {
+        match self {
+            ModelParams::MatrixTrc(m) => m.prepare(kind),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kind_names_round_trip() {
+        for k in ModelKind::ALL {
+            assert_eq!(k.to_string().parse::<ModelKind>().unwrap(), k);
+            assert_eq!(
+                serde_json::to_string(&k).unwrap(),
+                format!("\"{}\"", k.name())
+            );
+        }
+        assert!("plc"
+            .parse::<ModelKind>()
+            .unwrap_err()
+            .contains("plcc-gamma"));
+    }
+}

@@ -1,0 +1,134 @@
+//! PLCC with black correction (paper Eq. 9; Post & Calhoun, "An evaluation of methods for
+//! producing desired colors on CRT monitors", Color Res. Appl. 14(4), 1989): the columns of M
+//! are the full-on primaries minus black, and each channel's TRC comes from its ramp —
+//! interpolated piecewise-linearly (true PLCC) or as a fitted or given power law (the paper
+//! used 2.2).
+//!
+//! A ramp patch's normalised output is its black-corrected XYZ projected on the primary's
+//! column (least squares), not its Y alone: blue has little Y, so Y alone would be noisy.
+
+use super::{MatrixTrc, ModelKind, Trc};
+use crate::display::fit::FitError;
+use crate::display::patch_set::{PatchSet, CHANNEL_NAMES};
+
+/// Black and the Eq. 9 matrix (columns: full-on primaries minus black).
+pub fn black_and_primaries(
+    set: &PatchSet,
+    kind: ModelKind,
+) -> Result<([f64; 3], [[f64; 3]; 3]), FitError> {
+    let black = set.black.ok_or_else(|| FitError::Missing {
+        model: kind,
+        what: "the black patch (r,g,b = 0,0,0)".into(),
+    })?;
+    let mut m = [[0.0; 3]; 3];
+    for c in 0..3 {
+        let p = set.primaries[c].ok_or_else(|| FitError::Missing {
+            model: kind,
+            what: format!("the full-on {} patch", CHANNEL_NAMES[c]),
+        })?;
+        for r in 0..3 {
+            m[r][c] = p[r] - black[r];
+        }
+    }
+    Ok((black, m))
+}
+
+/// The ramp of channel `c` as (drive, R′) points including (0, 0), R′ being the
+/// black-corrected XYZ projected on M's column `c`.
+pub fn ramp_points(
+    set: &PatchSet,
+    black: [f64; 3],
+    m: &[[f64; 3]; 3],
+    c: usize,
+) -> Vec<(f64, f64)> {
+    let col = [m[0][c], m[1][c], m[2][c]];
+    let norm2: f64 = col.iter().map(|v| v * v).sum();
+    let mut pts = vec![(0.0, 0.0)];
+    pts.extend(set.ramps[c].iter().map(|(d, xyz)| {
+        let dot: f64 = (0..3).map(|k| (xyz[k] - black[k]) * col[k]).sum();
+        (*d, dot / norm2)
+    }));
+    pts
+}
+
+pub(crate) fn singular(condition: f64) -> FitError {
+    FitError::SingularPrimaries {
+        condition,
+        limit: super::MAX_CONDITION,
+    }
+}
+
+/// Paper Eq. 9 with piecewise-linear TRCs through the measured ramps.
+pub fn fit_plcc(set: &PatchSet) -> Result<MatrixTrc, FitError> {
+    let kind = ModelKind::Plcc;
+    let (black, m) = black_and_primaries(set, kind)?;
+    let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });
+    for (c, t) in trc.iter_mut().enumerate() {
+        if set.intermediate_levels(c) == 0 {
+            return Err(FitError::Missing {
+                model: kind,
+                what: format!(
+                    "a {} ramp (patches with only {} on, between 0 and 1) to interpolate its \
+                     TRC; use plcc-gamma with --gamma to assume a power law instead",
+                    CHANNEL_NAMES[c], CHANNEL_NAMES[c]
+                ),
+            });
+        }
+        *t = Trc::table_from_ramp(&ramp_points(set, black, &m, c));
+    }
+    MatrixTrc::new(kind, black, m, trc).map_err(singular)
+}
+
+/// Least-squares exponent of `d^γ` through ramp points (golden-section search on ln γ;
+/// the sum of squares is unimodal in γ for a monotone ramp).
+pub fn fit_power_gamma(points: &[(f64, f64)]) -> f64 {
+    let cost = |g: f64| -> f64 { points.iter().map(|&(d, s)| (d.powf(g) - s).powi(2)).sum() };
+    let (mut a, mut b) = (0.1f64.ln(), 10.0f64.ln());
+    let phi = (5f64.sqrt() - 1.0) / 2.0;
+    let mut x1 = b - phi * (b - a);
+    let mut x2 = a + phi * (b - a);
+    let (mut f1, mut f2) = (cost(x1.exp()), cost(x2.exp()));
+    for _ in 0..100 {
+        if f1 <= f2 {
+            b = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = b - phi * (b - a);
+            f1 = cost(x1.exp());
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + phi * (b - a);
+            f2 = cost(x2.exp());
+        }
+    }
+    (0.5 * (a + b)).exp()
+}
+
+/// Paper Eq. 9 with a power-law TRC per channel: `gamma` given (the paper's 2.2) or fitted
+/// to each ramp.
+pub fn fit_plcc_gamma(set: &PatchSet, gamma: Option<f64>) -> Result<MatrixTrc, FitError> {
+    let kind = ModelKind::PlccGamma;
+    let (black, m) = black_and_primaries(set, kind)?;
+    let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });
+    for (c, t) in trc.iter_mut().enumerate() {
+        let g = match gamma {
+            Some(g) => g,
+            None => {
+                if set.intermediate_levels(c) == 0 {
+                    return Err(FitError::Missing {
+                        model: kind,
+                        what: format!(
+                            "a {} ramp to fit its exponent (or give one with --gamma)",
+                            CHANNEL_NAMES[c]
+                        ),
+                    });
+                }
+                fit_power_gamma(&ramp_points(set, black, &m, c))
+            }
+        };
+        *t = Trc::Power { gamma: g };
+    }
+    MatrixTrc::new(kind, black, m, trc).map_err(singular)
+}

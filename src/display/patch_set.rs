@@ -1,0 +1,114 @@
+//! Sorting a measured patch set into what the models need: black, full-on primaries, white,
+//! single-channel ramps. Repeated patches are averaged; everything else stays available for
+//! fitting and residuals.
+
+use super::Patch;
+
+/// Drive values closer than this count as equal (finer than a 16-bit step).
+pub const SAME_DRIVE: f64 = 1e-6;
+
+/// Black, white, primaries and ramps of a patch set, each averaged over repeats.
+#[derive(Clone, Debug, Default)]
+pub struct PatchSet {
+    pub black: Option<[f64; 3]>,
+    pub white: Option<[f64; 3]>,
+    /// Full-on red, green, blue alone.
+    pub primaries: [Option<[f64; 3]>; 3],
+    /// Per channel: (drive, XYZ) with only that channel on, drive in (0, 1], sorted, averaged.
+    pub ramps: [Vec<(f64, [f64; 3])>; 3],
+}
+
+fn is(v: f64, target: f64) -> bool {
+    (v - target).abs() < SAME_DRIVE
+}
+
+fn mean(xs: &[[f64; 3]]) -> Option<[f64; 3]> {
+    if xs.is_empty() {
+        return None;
+    }
+    let n = xs.len() as f64;
+    Some(std::array::from_fn(|c| {
+        xs.iter().map(|x| x[c]).sum::<f64>() / n
+    }))
+}
+
+impl PatchSet {
+    pub fn new(patches: &[Patch]) -> PatchSet {
+        let pick = |f: &dyn Fn(&Patch) -> bool| -> Vec<[f64; 3]> {
+            patches.iter().filter(|p| f(p)).map(|p| p.xyz).collect()
+        };
+        let black = mean(&pick(&|p| p.rgb.iter().all(|&d| is(d, 0.0))));
+        let white = mean(&pick(&|p| p.rgb.iter().all(|&d| is(d, 1.0))));
+        let mut ramps: [Vec<(f64, [f64; 3])>; 3] = Default::default();
+        for (c, ramp) in ramps.iter_mut().enumerate() {
+            let mut pts: Vec<(f64, [f64; 3])> = patches
+                .iter()
+                .filter(|p| {
+                    p.rgb[c] > SAME_DRIVE && (0..3).filter(|&o| o != c).all(|o| is(p.rgb[o], 0.0))
+                })
+                .map(|p| (p.rgb[c], p.xyz))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut i = 0;
+            while i < pts.len() {
+                let mut j = i;
+                while j < pts.len() && is(pts[j].0, pts[i].0) {
+                    j += 1;
+                }
+                let xyz: Vec<[f64; 3]> = pts[i..j].iter().map(|p| p.1).collect();
+                ramp.push((pts[i].0, mean(&xyz).expect("non-empty group")));
+                i = j;
+            }
+        }
+        let primaries = std::array::from_fn(|c| {
+            ramps[c]
+                .last()
+                .filter(|(d, _)| is(*d, 1.0))
+                .map(|(_, xyz)| *xyz)
+        });
+        PatchSet {
+            black,
+            white,
+            primaries,
+            ramps,
+        }
+    }
+
+    /// Ramp levels strictly between 0 and 1 for a channel.
+    pub fn intermediate_levels(&self, channel: usize) -> usize {
+        self.ramps[channel]
+            .iter()
+            .filter(|(d, _)| *d < 1.0 - SAME_DRIVE)
+            .count()
+    }
+}
+
+pub const CHANNEL_NAMES: [&str; 3] = ["red", "green", "blue"];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sorts_and_averages() {
+        let p = |rgb: [f64; 3], y: f64| Patch {
+            rgb,
+            xyz: [y, y, y],
+        };
+        let set = PatchSet::new(&[
+            p([0.0, 0.0, 0.0], 1.0),
+            p([0.0, 0.0, 0.0], 3.0),
+            p([1.0, 1.0, 1.0], 100.0),
+            p([1.0, 0.0, 0.0], 20.0),
+            p([0.5, 0.0, 0.0], 5.0),
+            p([0.5, 0.0, 0.0], 7.0),
+            p([0.5, 0.5, 0.0], 9.0),
+        ]);
+        assert_eq!(set.black, Some([2.0; 3]));
+        assert_eq!(set.white, Some([100.0; 3]));
+        assert_eq!(set.primaries, [Some([20.0; 3]), None, None]);
+        assert_eq!(set.ramps[0], vec![(0.5, [6.0; 3]), (1.0, [20.0; 3])]);
+        assert_eq!(set.intermediate_levels(0), 1);
+        assert!(set.ramps[1].is_empty());
+    }
+}

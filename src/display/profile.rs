@@ -1,0 +1,113 @@
+//! A fitted display profile as a JSON document: model name and parameters, white and black
+//! XYZ, residuals, diagnostics and the measurement file's SHA-256.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::diagnostics::{Diagnostics, Residuals};
+use super::model::{DisplayModel, Inverse, ModelKind, ModelParams};
+
+/// The `format` value of profiles this version writes and reads.
+pub const PROFILE_FORMAT: &str = "metamer-display-profile-1";
+
+/// Where the fitted patches came from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InputFile {
+    pub path: String,
+    pub sha256: String,
+    pub patches: usize,
+}
+
+/// A fitted model with everything needed to trust or reject it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Profile {
+    pub format: String,
+    pub model: ModelKind,
+    pub parameters: ModelParams,
+    /// The display white (measured when a white patch was), cd/m²; the CIELAB reference.
+    pub white_xyz: [f64; 3],
+    pub black_xyz: [f64; 3],
+    pub residuals: Residuals,
+    pub diagnostics: Diagnostics,
+    pub input: Option<InputFile>,
+}
+
+/// Why a profile could not be saved or loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum ProfileError {
+    #[error("{file}: {source}")]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{file}:{line}:{column}: not a display profile: {message}")]
+    Json {
+        file: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("{file}: format '{found}' is not '{PROFILE_FORMAT}'")]
+    Format { file: PathBuf, found: String },
+    #[error("{file}: the model's matrix cannot be inverted (condition number {condition:.3e})")]
+    Singular { file: PathBuf, condition: f64 },
+}
+
+impl Profile {
+    pub fn model(&self) -> &dyn DisplayModel {
+        self.parameters.model()
+    }
+
+    pub fn diagnostics(&self) -> &Diagnostics {
+        &self.diagnostics
+    }
+
+    /// Drive values 0–1 → absolute XYZ, cd/m².
+    pub fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+        self.model().forward(rgb)
+    }
+
+    /// XYZ → drive values, with out-of-gamut reported.
+    pub fn inverse(&self, xyz: [f64; 3]) -> Inverse {
+        self.model().inverse(xyz)
+    }
+
+    /// Writes pretty JSON through a sibling file and a rename, so an interrupted save never
+    /// leaves a truncated profile behind.
+    pub fn save(&self, path: &Path) -> Result<(), ProfileError> {
+        let io = |source| ProfileError::Io {
+            file: path.to_path_buf(),
+            source,
+        };
+        let text = serde_json::to_string_pretty(self).expect("a profile always serialises");
+        let tmp = path.with_extension("json.partial");
+        std::fs::write(&tmp, text + "\n").map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
+    }
+
+    pub fn load(path: &Path) -> Result<Profile, ProfileError> {
+        let file = path.to_path_buf();
+        let text = std::fs::read_to_string(path).map_err(|source| ProfileError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        let mut p: Profile = serde_json::from_str(&text).map_err(|e| ProfileError::Json {
+            file: file.clone(),
+            line: e.line(),
+            column: e.column(),
+            message: e.to_string(),
+        })?;
+        if p.format != PROFILE_FORMAT {
+            return Err(ProfileError::Format {
+                file,
+                found: p.format,
+            });
+        }
+        p.parameters
+            .prepare(p.model)
+            .map_err(|condition| ProfileError::Singular { file, condition })?;
+        Ok(p)
+    }
+}

@@ -1,0 +1,330 @@
+//! Display models fitted to patches from small analytic displays: round trips where PLCC's
+//! assumptions hold, diagnostics where they fail, singular primaries, out-of-gamut targets,
+//! and a `.ti3` in the exact layout ArgyllCMS dispread writes.
+
+use std::path::Path;
+
+use metamer::color::{delta_e2000, Xyz};
+use metamer::display::{
+    fit_profile, fit_profile_with, read_measurement_file, FitError, FitOptions, ModelKind, Patch,
+    Profile,
+};
+
+/// XYZ = black + Σ col_c · d_c^γ_c, optionally with a blue chromaticity drift along its ramp
+/// and a loss of additivity (channels driven together give less than their sum).
+#[derive(Clone)]
+struct Analytic {
+    black: [f64; 3],
+    cols: [[f64; 3]; 3],
+    gamma: [f64; 3],
+    /// XYZ added to blue at mid levels: drift · 4·b(1−b) · [8, 6, −8] (zero at 0 and 1).
+    blue_drift: f64,
+    /// Output scaled by 1 − k·(l_r l_g + l_g l_b + l_b l_r)/3.
+    interaction: f64,
+}
+
+/// The display of `tests/data/dispread_analytic.ti3` (sRGB-like primaries, 120.25 cd/m²).
+fn ideal() -> Analytic {
+    Analytic {
+        black: [0.25, 0.26, 0.30],
+        cols: [
+            [49.49, 25.51, 2.32],
+            [42.91, 85.82, 14.30],
+            [21.66, 8.66, 114.07],
+        ],
+        gamma: [2.2, 2.3, 2.1],
+        blue_drift: 0.0,
+        interaction: 0.0,
+    }
+}
+
+impl Analytic {
+    fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+        let l: [f64; 3] = std::array::from_fn(|c| rgb[c].powf(self.gamma[c]));
+        let k = 1.0 - self.interaction * (l[0] * l[1] + l[1] * l[2] + l[2] * l[0]) / 3.0;
+        let b = rgb[2];
+        let drift = [8.0, 6.0, -8.0].map(|v| v * self.blue_drift * 4.0 * b * (1.0 - b));
+        std::array::from_fn(|k2| {
+            self.black[k2] + k * (0..3).map(|c| self.cols[c][k2] * l[c]).sum::<f64>() + drift[k2]
+        })
+    }
+
+    /// Black, white, 17-level ramps per channel and a 5³ grid.
+    fn patches(&self, ramp_levels: usize) -> Vec<Patch> {
+        let mut rgbs = vec![[0.0; 3], [1.0; 3]];
+        for c in 0..3 {
+            for i in 1..=ramp_levels {
+                let mut v = [0.0; 3];
+                v[c] = i as f64 / ramp_levels as f64;
+                rgbs.push(v);
+            }
+        }
+        let lv = [0.0, 0.25, 0.5, 0.75, 1.0];
+        for r in lv {
+            for g in lv {
+                for b in lv {
+                    rgbs.push([r, g, b]);
+                }
+            }
+        }
+        rgbs.into_iter()
+            .map(|rgb| Patch {
+                rgb,
+                xyz: self.forward(rgb),
+            })
+            .collect()
+    }
+
+    fn white(&self) -> Xyz {
+        Xyz::from_array(self.forward([1.0; 3]))
+    }
+}
+
+/// Deterministic drive triples spread over the cube.
+fn drives(n: usize) -> Vec<[f64; 3]> {
+    let mut s: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n).map(|_| [next(), next(), next()]).collect()
+}
+
+fn de00(a: [f64; 3], b: [f64; 3], white: Xyz) -> f64 {
+    delta_e2000(
+        Xyz::from_array(a).to_lab(white),
+        Xyz::from_array(b).to_lab(white),
+    )
+}
+
+/// Largest ΔE00 between a target the display can show and what the display shows for the
+/// drive values the profile computes for it.
+fn round_trip(display: &Analytic, profile: &Profile, n: usize) -> f64 {
+    let w = display.white();
+    drives(n)
+        .into_iter()
+        .map(|rgb| {
+            let target = display.forward(rgb);
+            let inv = profile.inverse(target);
+            assert!(!inv.out_of_gamut, "{rgb:?} → {inv:?}");
+            de00(display.forward(inv.rgb), target, w)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn plcc_round_trip_where_its_assumptions_hold() {
+    let d = ideal();
+    let gamma = fit_profile(ModelKind::PlccGamma, &d.patches(16), None).unwrap();
+    let e = round_trip(&d, &gamma, 2000);
+    assert!(e < 0.01, "plcc-gamma round trip ΔE00 {e}");
+    // Piecewise-linear ramps are exact at their levels; between them the error shrinks with
+    // the level count: 255 levels (every 8-bit code) keep it far below 0.01.
+    let plcc = fit_profile(ModelKind::Plcc, &d.patches(255), None).unwrap();
+    let e = round_trip(&d, &plcc, 2000);
+    assert!(e < 0.01, "plcc round trip ΔE00 {e}");
+    let diag = plcc.diagnostics();
+    assert!(diag.failures.is_empty(), "{diag}");
+    assert!(
+        diag.verdict
+            .starts_with("PLCC's assumptions hold within ΔE00 0.5"),
+        "{}",
+        diag.verdict
+    );
+    assert!(plcc.residuals.max_de00 < 0.01, "{:?}", plcc.residuals);
+    // Eq. 9's matrix is the full-on primaries minus black: the analytic columns.
+    let cond = diag.condition_number.unwrap();
+    assert!(cond > 1.0 && cond < 20.0, "{cond}");
+}
+
+#[test]
+fn paper_gamma_is_used_when_given() {
+    let d = ideal();
+    let p = fit_profile_with(
+        ModelKind::PlccGamma,
+        &d.patches(4),
+        None,
+        &FitOptions { gamma: Some(2.2) },
+    )
+    .unwrap();
+    // Red has γ = 2.2 exactly, so its ramp is reproduced; green (γ 2.3) is not.
+    let mid_red = d.forward([0.5, 0.0, 0.0]);
+    assert!(de00(p.forward([0.5, 0.0, 0.0]), mid_red, d.white()) < 1e-9);
+    let mid_green = d.forward([0.0, 0.5, 0.0]);
+    assert!(de00(p.forward([0.0, 0.5, 0.0]), mid_green, d.white()) > 0.5);
+    assert!(
+        p.diagnostics().verdict.contains("PLCC's assumptions hold"),
+        "{}",
+        p.diagnostics().verdict
+    );
+}
+
+#[test]
+fn violated_assumptions_are_named() {
+    let mut d = ideal();
+    d.blue_drift = 1.0;
+    d.interaction = 0.08;
+    let p = fit_profile(ModelKind::Plcc, &d.patches(16), None).unwrap();
+    let diag = p.diagnostics();
+    assert!(
+        diag.verdict.starts_with("PLCC's assumptions fail"),
+        "{diag}"
+    );
+    let additivity = diag.additivity.as_ref().unwrap();
+    // white = black + 0.92 · Σ columns: luminance 8 % of the sum short of it
+    let sum_y: f64 = d.cols.iter().map(|c| c[1]).sum();
+    let expected = 100.0 * (-0.08 * sum_y) / (d.black[1] + 0.92 * sum_y);
+    assert!(
+        (additivity.luminance_error_percent - expected).abs() < 1e-9,
+        "{additivity:?} vs {expected}"
+    );
+    assert!(diag.failures.iter().any(|f| f.contains("not additive")));
+    assert!(diag
+        .failures
+        .iter()
+        .any(|f| f.contains("blue channel's chromaticity drifts")));
+    assert!(!diag
+        .failures
+        .iter()
+        .any(|f| f.contains("red channel's chromaticity")));
+    // the drift peaks mid-ramp, where 4·b(1−b) is largest
+    let blue = &diag.channels[2];
+    let at = blue.drift_at_drive.unwrap();
+    assert!((0.2..=0.6).contains(&at), "{at}");
+}
+
+#[test]
+fn singular_primaries_are_a_clear_error() {
+    let mut d = ideal();
+    // blue's column = red's + green's: M has rank 2
+    d.cols[2] = std::array::from_fn(|k| d.cols[0][k] + d.cols[1][k]);
+    for kind in [ModelKind::Plcc, ModelKind::PlccGamma] {
+        let e = fit_profile(kind, &d.patches(8), None).unwrap_err();
+        assert!(matches!(e, FitError::SingularPrimaries { .. }), "{e}");
+        let text = e.to_string();
+        assert!(text.contains("condition number"), "{text}");
+        assert!(!text.contains("NaN"), "{text}");
+    }
+    // nearly singular: blue barely differs from red + green
+    d.cols[2][2] += 1e-4;
+    let e = fit_profile(ModelKind::Plcc, &d.patches(8), None).unwrap_err();
+    assert!(matches!(e, FitError::SingularPrimaries { condition, .. } if condition > 1e4));
+}
+
+#[test]
+fn missing_patches_are_named() {
+    let d = ideal();
+    let no_black: Vec<Patch> = d
+        .patches(4)
+        .into_iter()
+        .filter(|p| p.rgb != [0.0; 3])
+        .collect();
+    let e = fit_profile(ModelKind::Plcc, &no_black, None).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "plcc needs the black patch (r,g,b = 0,0,0); the measurements have none"
+    );
+    let corners: Vec<Patch> = d
+        .patches(1)
+        .into_iter()
+        .filter(|p| p.rgb.iter().all(|&v| v == 0.0 || v == 1.0))
+        .collect();
+    let e = fit_profile(ModelKind::Plcc, &corners, None).unwrap_err();
+    assert!(e.to_string().contains("a red ramp"), "{e}");
+    assert!(fit_profile(ModelKind::Plcc, &[], None).is_err());
+}
+
+#[test]
+fn out_of_gamut_and_negative_targets_are_reported_not_hidden() {
+    let d = ideal();
+    let p = fit_profile(ModelKind::Plcc, &d.patches(16), None).unwrap();
+    let white = d.forward([1.0; 3]);
+    // twice the white: every channel beyond full drive
+    let inv = p.inverse(white.map(|v| 2.0 * v));
+    assert!(inv.out_of_gamut);
+    assert_eq!(inv.rgb, [1.0; 3]);
+    assert!(inv.unclipped.iter().all(|&v| v > 1.0));
+    // negative XYZ: below black, flagged, clipped into 0–1, never NaN
+    let inv = p.inverse([-1.0, -2.0, -3.0]);
+    assert!(inv.out_of_gamut);
+    assert!(inv.rgb.iter().all(|v| (0.0..=1.0).contains(v)), "{inv:?}");
+    assert!(inv.unclipped.iter().all(|v| v.is_finite()));
+    assert!(inv.unclipped.iter().any(|&v| v < 0.0));
+    // a saturated green beyond the primary's chromaticity: one channel negative
+    let g = d.forward([0.0, 0.6, 0.0]);
+    let beyond = [g[0] - 5.0, g[1], g[2] - 3.0];
+    let inv = p.inverse(beyond);
+    assert!(inv.out_of_gamut && inv.unclipped.iter().any(|&v| v < 0.0));
+    // black itself is in gamut
+    let inv = p.inverse(d.black);
+    assert!(
+        !inv.out_of_gamut && inv.rgb.iter().all(|&v| v.abs() < 1e-9),
+        "{inv:?}"
+    );
+}
+
+#[test]
+fn profile_saves_and_loads() {
+    let d = ideal();
+    let dir = std::env::temp_dir().join(format!("metamer-profile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("p.json");
+    for kind in [ModelKind::Plcc, ModelKind::PlccGamma] {
+        let p = fit_profile(kind, &d.patches(16), None).unwrap();
+        p.save(&path).unwrap();
+        let q = Profile::load(&path).unwrap();
+        assert_eq!(q.model().name(), kind.name());
+        for rgb in drives(20) {
+            let xyz = p.forward(rgb);
+            assert_eq!(q.forward(rgb), xyz);
+            assert_eq!(q.inverse(xyz), p.inverse(xyz));
+        }
+        assert_eq!(q.diagnostics(), p.diagnostics());
+    }
+    std::fs::write(&path, "{\"format\": 3}").unwrap();
+    let e = Profile::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("p.json:1:") && e.contains("not a display profile"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `tests/data/dispread_analytic.ti3` holds the display [`ideal`] in dispread's layout:
+/// XYZ normalised to white Y = 100 and LUMINANCE_XYZ_CDM2 the absolute white.
+#[test]
+fn dispread_ti3_fits_to_the_analytic_display() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/dispread_analytic.ti3");
+    let m = read_measurement_file(&path).unwrap();
+    assert!(m.absolute);
+    assert_eq!(m.patches.len(), 137);
+    let d = ideal();
+    for p in &m.patches {
+        let want = d.forward(p.rgb);
+        for k in 0..3 {
+            assert!(
+                (p.xyz[k] - want[k]).abs() < 2e-6 * 120.25,
+                "{p:?} vs {want:?}"
+            );
+        }
+    }
+    let p = fit_profile(ModelKind::PlccGamma, &m.patches, Some(&path)).unwrap();
+    let metamer::display::model::ModelParams::MatrixTrc(mt) = &p.parameters;
+    for c in 0..3 {
+        let metamer::display::model::Trc::Power { gamma } = mt.trc[c] else {
+            panic!("plcc-gamma has power laws")
+        };
+        assert!((gamma - d.gamma[c]).abs() < 1e-4, "{c}: {gamma}");
+        for k in 0..3 {
+            assert!((mt.matrix[k][c] - d.cols[c][k]).abs() < 1e-3, "{k},{c}");
+            assert!((mt.black[k] - d.black[k]).abs() < 1e-3);
+        }
+    }
+    assert!((p.white_xyz[1] - 120.25).abs() < 1e-9);
+    let input = p.input.as_ref().unwrap();
+    assert_eq!(input.sha256.len(), 64);
+    assert_eq!(input.patches, 137);
+    assert!(round_trip(&d, &p, 500) < 0.01);
+}
