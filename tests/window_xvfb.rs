@@ -145,3 +145,33 @@ fn a_display_nobody_serves_is_a_clear_error() {
         "{text}"
     );
 }
+
+#[test]
+fn characterize_runs_through_the_window_backend() {
+    let Some(x) = xvfb(320, 240) else { return };
+    let dir = std::env::temp_dir().join(format!("metamer-xvfb-char-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(["characterize", "--display", "window", "--instrument"])
+        .arg("sim:cs100a?time_scale=0")
+        .args(["--settle-ms", "0", "--stop-after", "5", "-o"])
+        .arg(&dir)
+        .env("DISPLAY", &x.display)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("a simulated instrument cannot see a real screen"),
+        "{err}"
+    );
+    let log = std::fs::read_to_string(dir.join("log.jsonl")).unwrap();
+    assert!(log
+        .lines()
+        .next()
+        .unwrap()
+        .contains("\"display\":\"window:0\""));
+    assert_eq!(log.lines().count(), 6);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

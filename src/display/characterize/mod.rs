@@ -2,6 +2,7 @@
 //! measure them with every reading appended to a durable log ([`log`], [`session`]),
 //! average repeats and verify a fitted display model on held-out patches ([`verify`]).
 
+pub mod finish;
 pub mod log;
 pub mod plan;
 pub mod report;

@@ -1,0 +1,171 @@
+//! The end of a characterization: average repeats, fit the chosen model on the fit patches,
+//! verify it on the held-out patches, and write the profile, the raw readings as CGATS
+//! `.ti3` (ArgyllCMS reads it too), the SVG report and a JSON summary next to the log.
+
+use std::path::{Path, PathBuf};
+
+use metamer_drivers::{InstrumentInfo, Reading};
+use serde::Serialize;
+
+use super::plan::{PlannedPatch, Purpose};
+use super::report::{write_report, Report, ReportError};
+use super::verify::{average, usable, verify, Verification};
+use crate::display::{fit_profile, write_ti3, FitError, ModelKind, Patch, ProfileError, Residuals};
+
+pub const PROFILE_FILE: &str = "profile.json";
+pub const TI3_FILE: &str = "readings.ti3";
+pub const REPORT_FILE: &str = "report.svg";
+pub const SUMMARY_FILE: &str = "summary.json";
+
+/// Finishing failed; the log is untouched, so fixing the cause and running again with
+/// `--resume` finishes without measuring anything.
+#[derive(Debug, thiserror::Error)]
+pub enum FinishError {
+    #[error("no usable reading of {}: every one was out of the instrument's range", .0.join(", "))]
+    Unusable(Vec<String>),
+    #[error("no white patch was measured: CIELAB needs the display white")]
+    NoWhite,
+    #[error("fitting {model}: {source}")]
+    Fit { model: ModelKind, source: FitError },
+    #[error("the plan has no verification patches")]
+    NoVerification,
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    #[error("writing {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Report(#[from] ReportError),
+}
+
+/// Who measured what, for the files' descriptions.
+pub struct Provenance<'a> {
+    pub display: &'a str,
+    pub display_description: &'a str,
+    pub instrument: &'a str,
+    pub instrument_info: &'a InstrumentInfo,
+}
+
+/// What a finished characterization found; also written as `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub display: String,
+    pub display_description: String,
+    pub instrument: String,
+    pub instrument_info: InstrumentInfo,
+    pub model: ModelKind,
+    pub verdict: String,
+    /// PLCC assumptions the fit patches contradict, one sentence each.
+    pub failures: Vec<String>,
+    pub readings: usize,
+    pub fit_patches: usize,
+    pub white_xyz: [f64; 3],
+    pub black_xyz: [f64; 3],
+    /// The model against the patches it was fitted to.
+    pub fit_residuals: Residuals,
+    /// The model against the held-out patches (ΔE00 relative to the measured white).
+    pub verification: Verification,
+    pub files: Files,
+}
+
+/// The files written.
+#[derive(Clone, Debug, Serialize)]
+pub struct Files {
+    pub log: PathBuf,
+    pub profile: PathBuf,
+    pub ti3: PathBuf,
+    pub report: PathBuf,
+    pub summary: PathBuf,
+}
+
+/// Fits, verifies and writes everything into `dir` from the complete `readings` of the
+/// log at `log`.
+pub fn finish(
+    dir: &Path,
+    log: &Path,
+    readings: &[(&PlannedPatch, &Reading)],
+    model: ModelKind,
+    who: &Provenance,
+) -> Result<Summary, FinishError> {
+    let averaged = average(readings).map_err(FinishError::Unusable)?;
+    let white = averaged
+        .iter()
+        .find(|p| p.rgb8 == [255; 3])
+        .ok_or(FinishError::NoWhite)?
+        .xyz;
+    let black = averaged
+        .iter()
+        .find(|p| p.rgb8 == [0; 3])
+        .map_or([0.0; 3], |p| p.xyz);
+    let training: Vec<Patch> = averaged
+        .iter()
+        .filter(|p| p.purpose == Purpose::Fit)
+        .map(|p| p.to_patch())
+        .collect();
+    let profile = fit_profile(model, &training, Some(log))
+        .map_err(|source| FinishError::Fit { model, source })?;
+    let forward = |rgb: [f64; 3]| profile.forward(rgb);
+    let verification = verify(&averaged, white, &forward).ok_or(FinishError::NoVerification)?;
+
+    let files = Files {
+        log: log.to_path_buf(),
+        profile: dir.join(PROFILE_FILE),
+        ti3: dir.join(TI3_FILE),
+        report: dir.join(REPORT_FILE),
+        summary: dir.join(SUMMARY_FILE),
+    };
+    profile.save(&files.profile)?;
+    let raw: Vec<Patch> = readings
+        .iter()
+        .filter(|(_, r)| usable(r))
+        .map(|(p, r)| Patch {
+            rgb: p.rgb.map(|c| f64::from(c) / 255.0),
+            xyz: r.xyz,
+        })
+        .collect();
+    let description = format!(
+        "metamer characterize: {} measured with {} ({})",
+        who.display, who.instrument_info.model, who.instrument
+    );
+    write_ti3(&files.ti3, &raw, &description).map_err(|source| FinishError::Io {
+        path: files.ti3.clone(),
+        source,
+    })?;
+    let diagnostics = profile.diagnostics();
+    write_report(
+        &Report {
+            title: format!(
+                "{} — {} — model {}",
+                who.display, who.instrument_info.model, model
+            ),
+            patches: &averaged,
+            forward: Some(&forward),
+            verification: Some(&verification),
+        },
+        &files.report,
+    )?;
+    let summary = Summary {
+        display: who.display.to_string(),
+        display_description: who.display_description.to_string(),
+        instrument: who.instrument.to_string(),
+        instrument_info: who.instrument_info.clone(),
+        model,
+        verdict: diagnostics.verdict.clone(),
+        failures: diagnostics.failures.clone(),
+        readings: readings.len(),
+        fit_patches: training.len(),
+        white_xyz: white,
+        black_xyz: black,
+        fit_residuals: diagnostics.residuals.clone(),
+        verification,
+        files: files.clone(),
+    };
+    let text = serde_json::to_string_pretty(&summary).expect("a summary serializes") + "\n";
+    std::fs::write(&files.summary, text).map_err(|source| FinishError::Io {
+        path: files.summary.clone(),
+        source,
+    })?;
+    Ok(summary)
+}
