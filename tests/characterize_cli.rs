@@ -260,6 +260,59 @@ fn a_killed_session_resumes_to_the_same_patches_as_an_uninterrupted_one() {
 }
 
 #[test]
+fn ctrl_c_stops_cleanly_and_the_session_resumes() {
+    let dir = temp_dir("ctrl-c");
+    let d = dir.to_str().unwrap();
+    let slow = [
+        "--display",
+        "virtual:ideal-crt",
+        "--instrument",
+        "sim:cs100a?time_scale=0.1",
+        "-o",
+        d,
+    ];
+    let child = command(&slow)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while std::fs::read_to_string(dir.join("log.jsonl")).map_or(0, |t| t.lines().count()) < 6 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no readings arrive"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // SAFETY: sending a signal to our own child process.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+        0
+    );
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("error: interrupted with ") && err.contains("continue with --resume"),
+        "{err}"
+    );
+    let partial = logged(&dir).len();
+    assert!(partial < 81, "{partial}");
+    let o = metamer(&[
+        "--display",
+        "virtual:ideal-crt",
+        "--instrument",
+        "sim:cs100a?time_scale=0",
+        "-o",
+        d,
+        "--resume",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(logged(&dir).len(), 81);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn usage_and_environment_errors() {
     let dir = temp_dir("usage");
     let d = dir.to_str().unwrap();

@@ -2,6 +2,8 @@
 
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use clap::ValueEnum;
@@ -137,6 +139,7 @@ pub fn run(args: Args) -> CliResult {
             ..Request::default()
         },
         stop_after: args.stop_after,
+        interrupt: Some(on_ctrl_c()),
     };
 
     let bar = indicatif::ProgressBar::new(total as u64);
@@ -166,6 +169,15 @@ pub fn run(args: Args) -> CliResult {
             );
             return Ok(());
         }
+        Measured::Interrupted { missing } => {
+            return Err(CliError::Failed(
+                format!(
+                    "interrupted with {missing} of {total} readings still to take; the others are safe in {}: continue with --resume",
+                    session.log_path().display()
+                )
+                .into(),
+            ));
+        }
         Measured::Complete => {}
     }
     let readings = session
@@ -185,6 +197,35 @@ pub fn run(args: Args) -> CliResult {
     )?;
     print_summary(&summary)?;
     Ok(())
+}
+
+/// Set by the first Ctrl-C; the session stops before its next patch (the readings are on
+/// disk already). A second Ctrl-C ends the process at once.
+static INTERRUPTED: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
+
+extern "C" fn ctrl_c(_: libc::c_int) {
+    if let Some(flag) = INTERRUPTED.get() {
+        flag.store(true, Ordering::SeqCst);
+    }
+    // SAFETY: signal() is async-signal-safe (POSIX.1-2008 §2.4.3); SIG_DFL is always valid.
+    unsafe {
+        libc::signal(libc::SIGINT, libc::SIG_DFL);
+    }
+}
+
+fn on_ctrl_c() -> Arc<AtomicBool> {
+    let flag = INTERRUPTED
+        .get_or_init(|| Arc::new(AtomicBool::new(false)))
+        .clone();
+    // SAFETY: the handler only stores to an atomic and resets the disposition, both
+    // async-signal-safe; the flag is initialised before the handler is installed.
+    unsafe {
+        libc::signal(
+            libc::SIGINT,
+            ctrl_c as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+    }
+    flag
 }
 
 /// Runs the instrument's calibration negotiation, asking the user for each condition.

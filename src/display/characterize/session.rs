@@ -3,6 +3,8 @@
 //! only what the log lacks.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use metamer_drivers::{DriverError, Instrument, InstrumentInfo, Reading, Request};
@@ -53,6 +55,8 @@ pub struct MeasureOptions {
     /// Stop after this many new readings (an interruption on purpose, for tests and for
     /// splitting a long session).
     pub stop_after: Option<usize>,
+    /// Set from elsewhere (a Ctrl-C handler) to stop before the next patch.
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// Where measuring ended.
@@ -62,6 +66,8 @@ pub enum Measured {
     Complete,
     /// Stopped by [`MeasureOptions::stop_after`] with this many readings still missing.
     Stopped { missing: usize },
+    /// Stopped by [`MeasureOptions::interrupt`] with this many readings still missing.
+    Interrupted { missing: usize },
 }
 
 /// One reading as it arrives, for progress displays.
@@ -160,6 +166,15 @@ impl Session {
         for patch in &self.plan.patches {
             if self.readings[patch.index].is_some() {
                 continue;
+            }
+            if options
+                .interrupt
+                .as_ref()
+                .is_some_and(|i| i.load(Ordering::SeqCst))
+            {
+                return Ok(Measured::Interrupted {
+                    missing: total - done,
+                });
             }
             if options.stop_after.is_some_and(|n| new >= n) {
                 return Ok(Measured::Stopped {
@@ -313,6 +328,41 @@ mod tests {
         assert_eq!((outcome, again.recovered), (Measured::Complete, n));
         std::fs::remove_dir_all(&whole).unwrap();
         std::fs::remove_dir_all(&split).unwrap();
+    }
+
+    #[test]
+    fn an_interrupt_stops_before_the_next_patch() {
+        let dir = tempdir("interrupt");
+        let plan = Plan::new(PlanOptions::default()).unwrap();
+        let n = plan.patches.len();
+        let mut display = VirtualDisplay::preset(Preset::IdealCrt);
+        let mut meter =
+            metamer_drivers::open_instrument("sim:cs100a?time_scale=0", display.stimulus())
+                .unwrap();
+        let mut session = Session::open(
+            &dir,
+            plan,
+            "virtual:ideal-crt",
+            "sim:cs100a",
+            meter.info(),
+            false,
+        )
+        .unwrap();
+        let flag = Arc::new(AtomicBool::new(false));
+        let options = MeasureOptions {
+            interrupt: Some(flag.clone()),
+            ..MeasureOptions::default()
+        };
+        let outcome = session
+            .measure(&mut display, meter.as_mut(), &options, &mut |p| {
+                if p.done == 5 {
+                    flag.store(true, Ordering::SeqCst);
+                }
+            })
+            .unwrap();
+        assert_eq!(outcome, Measured::Interrupted { missing: n - 5 });
+        assert_eq!(session.done(), 5);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
