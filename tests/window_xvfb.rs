@@ -48,6 +48,9 @@ fn xvfb(width: u32, height: u32) -> Option<Xvfb> {
         .args(["-displayfd", &fds[1].to_string()])
         .args(["-screen", "0", &format!("{width}x{height}x24")])
         .args(["-nolisten", "tcp"])
+        // Without -noreset the server resets when its last client leaves, and a client
+        // connecting just then is dropped ("failed to read whole buffer").
+        .arg("-noreset")
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
