@@ -6,7 +6,10 @@ use std::path::{Path, PathBuf};
 use sha2::{Digest, Sha256};
 
 use super::diagnostics::{Diagnostics, Residuals};
-use super::model::{fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind, ModelParams};
+use super::model::{
+    fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind,
+    ModelParams,
+};
 use super::patch_set::PatchSet;
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
 use super::Patch;
@@ -74,22 +77,13 @@ pub fn fit_profile_with(
         }
     }
     let set = PatchSet::new(patches);
-    let mut params = match kind {
+    let params = match kind {
         ModelKind::Plcc => ModelParams::MatrixTrc(fit_plcc(&set)?),
         ModelKind::PlccGamma => ModelParams::MatrixTrc(fit_plcc_gamma(&set, options.gamma)?),
-        other => {
-            return Err(FitError::Failed {
-                model: other,
-                message: "this model is not available in this build".into(),
-            })
-        }
+        ModelKind::Gog | ModelKind::Gogo => ModelParams::MatrixTrc(fit_gog(&set, kind)?),
+        ModelKind::MatrixLsq => ModelParams::MatrixTrc(fit_matrix_lsq(&set, patches)?),
+        ModelKind::Lut => ModelParams::Lut(fit_lut(&set, patches)?),
     };
-    params
-        .prepare(kind)
-        .map_err(|condition| FitError::SingularPrimaries {
-            condition,
-            limit: super::model::MAX_CONDITION,
-        })?;
     let model = params.model();
     let white = set.white.unwrap_or_else(|| model.forward([1.0; 3]));
     let black = set.black.unwrap_or_else(|| model.forward([0.0; 3]));

@@ -51,8 +51,8 @@ pub enum ProfileError {
     },
     #[error("{file}: format '{found}' is not '{PROFILE_FORMAT}'")]
     Format { file: PathBuf, found: String },
-    #[error("{file}: the model's matrix cannot be inverted (condition number {condition:.3e})")]
-    Singular { file: PathBuf, condition: f64 },
+    #[error("{file}: inconsistent parameters: {message}")]
+    Parameters { file: PathBuf, message: String },
 }
 
 impl Profile {
@@ -107,7 +107,7 @@ impl Profile {
         }
         p.parameters
             .prepare(p.model)
-            .map_err(|condition| ProfileError::Singular { file, condition })?;
+            .map_err(|message| ProfileError::Parameters { file, message })?;
         Ok(p)
     }
 }

@@ -4,10 +4,18 @@
 //! The paper's model is Eq. 9, inverse PLCC with black correction; [`ModelKind`] lists it and
 //! the richer models offered where its assumptions fail.
 
+mod gog;
+mod least_squares;
+mod lut;
+mod matrix_lsq;
 mod matrix_trc;
 mod plcc;
 mod trc;
 
+pub use gog::{fit_gog, fit_gog_curve};
+pub use least_squares::levenberg_marquardt;
+pub use lut::{fit_lut, Lut3d};
+pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma, fit_power_gamma};
 pub use trc::Trc;
@@ -103,19 +111,25 @@ impl std::str::FromStr for ModelKind {
 pub enum ModelParams {
     /// XYZ = XYZ₀ + M·TRC(rgb) (plcc, plcc-gamma, gog, gogo, matrix-lsq).
     MatrixTrc(MatrixTrc),
+    /// A 3D LUT with per-channel shapers (lut).
+    Lut(Lut3d),
 }
 
 impl ModelParams {
     pub fn model(&self) -> &dyn DisplayModel {
         match self {
             ModelParams::MatrixTrc(m) => m,
+            ModelParams::Lut(l) => l,
         }
     }
 
-    /// Rebuilds derived data after loading; `Err(condition number)` when M is singular.
-    pub fn prepare(&mut self, kind: ModelKind) -> Result<(), f64> {
+    /// Rebuilds derived data after loading; the error says what is inconsistent.
+    pub fn prepare(&mut self, kind: ModelKind) -> Result<(), String> {
         match self {
-            ModelParams::MatrixTrc(m) => m.prepare(kind),
+            ModelParams::MatrixTrc(m) => m.prepare(kind).map_err(|condition| {
+                format!("the model's matrix cannot be inverted (condition number {condition:.3e})")
+            }),
+            ModelParams::Lut(l) => l.prepare(),
         }
     }
 }

@@ -1,0 +1,117 @@
+//! GOG and GOGO (Berns, "Methods for characterizing CRT displays", Displays 16(4), 1996):
+//! the Eq. 9 matrix of full-on primaries minus black, with each channel's TRC a
+//! gain-offset-gamma curve `max(gain·d + offset, 0)^γ` (GOG, normalised so gain + offset =
+//! 1) or with an extra additive offset (GOGO), fitted by least squares to the channel's ramp.
+
+use super::least_squares::levenberg_marquardt;
+use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
+use super::{MatrixTrc, ModelKind, Trc};
+use crate::display::fit::FitError;
+use crate::display::patch_set::{PatchSet, CHANNEL_NAMES};
+
+/// Fits one channel's GOG (`flare` false) or GOGO curve to (drive, R′) points.
+pub fn fit_gog_curve(points: &[(f64, f64)], flare: bool) -> Trc {
+    let gamma0 = fit_power_gamma(points);
+    let curve = |p: &[f64]| -> Trc {
+        if flare {
+            Trc::Gog {
+                gain: p[0],
+                offset: p[1],
+                gamma: p[2],
+                flare: p[3],
+            }
+        } else {
+            Trc::Gog {
+                gain: 1.0 - p[0],
+                offset: p[0],
+                gamma: p[1],
+                flare: 0.0,
+            }
+        }
+    };
+    let residual = |p: &[f64]| -> Vec<f64> {
+        let t = curve(p);
+        points.iter().map(|&(d, s)| t.eval(d) - s).collect()
+    };
+    let p = if flare {
+        levenberg_marquardt(
+            &residual,
+            &[1.0, 0.0, gamma0, 0.0],
+            &[0.2, -0.5, 0.3, -0.2],
+            &[2.0, 0.8, 6.0, 0.2],
+        )
+    } else {
+        levenberg_marquardt(&residual, &[0.0, gamma0], &[-0.5, 0.3], &[0.8, 6.0])
+    };
+    curve(&p)
+}
+
+/// GOG (`kind` Gog) or GOGO (`kind` Gogo).
+pub fn fit_gog(set: &PatchSet, kind: ModelKind) -> Result<MatrixTrc, FitError> {
+    let flare = kind == ModelKind::Gogo;
+    let (black, m) = black_and_primaries(set, kind)?;
+    let need = if flare { 3 } else { 2 };
+    let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });
+    for (c, t) in trc.iter_mut().enumerate() {
+        if set.intermediate_levels(c) < need {
+            return Err(FitError::Missing {
+                model: kind,
+                what: format!(
+                    "a {} ramp with at least {need} levels between 0 and 1 to fit its curve",
+                    CHANNEL_NAMES[c]
+                ),
+            });
+        }
+        *t = fit_gog_curve(&ramp_points(set, black, &m, c), flare);
+    }
+    MatrixTrc::new(kind, black, m, trc).map_err(singular)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recovers_gain_offset_gamma() {
+        let truth = Trc::Gog {
+            gain: 1.1,
+            offset: -0.1,
+            gamma: 2.4,
+            flare: 0.0,
+        };
+        let pts: Vec<(f64, f64)> = (0..=16)
+            .map(|i| {
+                let d = i as f64 / 16.0;
+                (d, truth.eval(d))
+            })
+            .collect();
+        let Trc::Gog {
+            gain,
+            offset,
+            gamma,
+            ..
+        } = fit_gog_curve(&pts, false)
+        else {
+            panic!("a GOG curve")
+        };
+        assert!((gain - 1.1).abs() < 1e-5, "{gain}");
+        assert!((offset + 0.1).abs() < 1e-5, "{offset}");
+        assert!((gamma - 2.4).abs() < 1e-4, "{gamma}");
+        let with_flare = Trc::Gog {
+            gain: 0.9,
+            offset: 0.05,
+            gamma: 2.0,
+            flare: 0.02,
+        };
+        let pts: Vec<(f64, f64)> = (0..=16)
+            .map(|i| {
+                let d = i as f64 / 16.0;
+                (d, with_flare.eval(d))
+            })
+            .collect();
+        let fitted = fit_gog_curve(&pts, true);
+        for (d, s) in pts {
+            assert!((fitted.eval(d) - s).abs() < 1e-6, "{d}");
+        }
+    }
+}

@@ -1,0 +1,258 @@
+//! A 3D look-up table over a measured grid of drive values with tetrahedral interpolation
+//! (Kasson, Nin, Plouffe, Hafner, "Performing color space conversions with three-dimensional
+//! linear interpolation", J. Electronic Imaging 4(3), 1995). It assumes neither constant
+//! channel chromaticity nor additivity: every grid node is a measurement.
+//!
+//! The grid axes are first mapped through per-channel shaper curves (the channel's ramp, as
+//! in PLCC), so the interpolation runs in a space where an additive display is linear and
+//! tetrahedral interpolation is then exact; between nodes a non-additive display is
+//! approximated piecewise linearly. Outside the cube the boundary tetrahedra continue
+//! linearly, which lets the inverse (Newton on the piecewise-linear map) report how far a
+//! target lies out of gamut.
+
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
+use super::{condition_number, DisplayModel, Inverse, ModelKind, Trc, MAX_CONDITION};
+use crate::display::fit::FitError;
+use crate::display::patch_set::{PatchSet, CHANNEL_NAMES, SAME_DRIVE};
+use crate::display::Patch;
+
+/// Ramp levels from which the shaper interpolates the ramp instead of fitting a power law.
+const TABLE_SHAPER_LEVELS: usize = 8;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Lut3d {
+    /// Drive levels of the grid per channel, increasing from 0 to 1.
+    pub levels: [Vec<f64>; 3],
+    /// Drive → shaped coordinate per channel.
+    pub shaper: [Trc; 3],
+    /// XYZ (cd/m²) at node (i, j, k), index (i·n_g + j)·n_b + k.
+    pub nodes: Vec<[f64; 3]>,
+    #[serde(skip)]
+    shaped: [Vec<f64>; 3],
+}
+
+impl Lut3d {
+    pub fn prepare(&mut self) -> Result<(), String> {
+        for (c, name) in CHANNEL_NAMES.iter().enumerate() {
+            let n = self.levels[c].len();
+            if n < 2 {
+                return Err(format!("the {name} axis has fewer than 2 levels"));
+            }
+            self.shaped[c] = self.levels[c]
+                .iter()
+                .map(|&d| self.shaper[c].eval(d))
+                .collect();
+            if self.shaped[c]
+                .windows(2)
+                .any(|w| w[1] <= w[0] || !w[1].is_finite())
+            {
+                return Err(format!(
+                    "the {name} shaper is flat between grid levels; its ramp does not rise"
+                ));
+            }
+        }
+        let count: usize = self.levels.iter().map(Vec::len).product();
+        if self.nodes.len() != count {
+            return Err(format!(
+                "{} nodes for a {}×{}×{} grid",
+                self.nodes.len(),
+                self.levels[0].len(),
+                self.levels[1].len(),
+                self.levels[2].len()
+            ));
+        }
+        Ok(())
+    }
+
+    fn node(&self, i: [usize; 3]) -> Vector3<f64> {
+        let (ng, nb) = (self.levels[1].len(), self.levels[2].len());
+        Vector3::from(self.nodes[(i[0] * ng + i[1]) * nb + i[2]])
+    }
+
+    /// Cell and fractions of a shaped point (fractions outside 0–1 beyond the cube).
+    fn locate(&self, s: [f64; 3]) -> ([usize; 3], [f64; 3], [f64; 3]) {
+        let mut cell = [0; 3];
+        let mut frac = [0.0; 3];
+        let mut width = [0.0; 3];
+        for c in 0..3 {
+            let a = &self.shaped[c];
+            let i = a.partition_point(|&v| v <= s[c]).clamp(1, a.len() - 1) - 1;
+            cell[c] = i;
+            width[c] = a[i + 1] - a[i];
+            frac[c] = (s[c] - a[i]) / width[c];
+        }
+        (cell, frac, width)
+    }
+
+    /// Value and Jacobian (per shaped unit) of the interpolation at a shaped point.
+    fn eval_shaped(&self, s: [f64; 3]) -> (Vector3<f64>, Matrix3<f64>) {
+        let (cell, f, width) = self.locate(s);
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| f[b].total_cmp(&f[a]));
+        let mut corner = cell;
+        let mut prev = self.node(corner);
+        let mut value = prev;
+        let mut jac = Matrix3::zeros();
+        for &axis in &order {
+            corner[axis] += 1;
+            let next = self.node(corner);
+            let edge = next - prev;
+            value += edge * f[axis];
+            jac.set_column(axis, &(edge / width[axis]));
+            prev = next;
+        }
+        (value, jac)
+    }
+}
+
+impl DisplayModel for Lut3d {
+    fn name(&self) -> &'static str {
+        ModelKind::Lut.name()
+    }
+
+    fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+        let s = std::array::from_fn(|c| self.shaper[c].eval(rgb[c]));
+        self.eval_shaped(s).0.into()
+    }
+
+    fn inverse(&self, xyz: [f64; 3]) -> Inverse {
+        let target = Vector3::from(xyz);
+        let scale = self.nodes.iter().map(|n| n[1].abs()).fold(1e-12, f64::max);
+        // Start from the linear map through black and the three full-on primaries.
+        let black = self.node([0, 0, 0]);
+        let last = [
+            self.levels[0].len() - 1,
+            self.levels[1].len() - 1,
+            self.levels[2].len() - 1,
+        ];
+        let m = Matrix3::from_columns(&[
+            self.node([last[0], 0, 0]) - black,
+            self.node([0, last[1], 0]) - black,
+            self.node([0, 0, last[2]]) - black,
+        ]);
+        let mut s: Vector3<f64> = m
+            .try_inverse()
+            .map_or(Vector3::repeat(0.5), |inv| inv * (target - black));
+        let (mut value, mut jac) = self.eval_shaped(s.into());
+        let mut err = (value - target).norm();
+        for _ in 0..60 {
+            if err <= 1e-12 * scale {
+                break;
+            }
+            let Some(inv) = jac.try_inverse() else { break };
+            let step = inv * (target - value);
+            let mut t = 1.0;
+            let mut accepted = false;
+            for _ in 0..30 {
+                let trial = s + step * t;
+                let (v, j) = self.eval_shaped(trial.into());
+                let e = (v - target).norm();
+                if e < err {
+                    s = trial;
+                    value = v;
+                    jac = j;
+                    err = e;
+                    accepted = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+            if !accepted {
+                break;
+            }
+        }
+        Inverse::from_unclipped(std::array::from_fn(|c| self.shaper[c].inverse(s[c])))
+    }
+}
+
+/// Grid levels of channel `c`: drive values that occur together with another channel on
+/// (single-channel ramp levels do not), plus 0 and 1.
+fn grid_levels(patches: &[Patch], c: usize) -> Vec<f64> {
+    let mut v: Vec<f64> = patches
+        .iter()
+        .filter(|p| (0..3).any(|o| o != c && p.rgb[o] > SAME_DRIVE))
+        .map(|p| p.rgb[c])
+        .chain([0.0, 1.0])
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| (*a - *b).abs() < SAME_DRIVE);
+    v
+}
+
+pub fn fit_lut(set: &PatchSet, patches: &[Patch]) -> Result<Lut3d, FitError> {
+    let kind = ModelKind::Lut;
+    let (black, m) = black_and_primaries(set, kind)?;
+    let cond = condition_number(&m);
+    if cond > MAX_CONDITION {
+        return Err(singular(cond));
+    }
+    let levels: [Vec<f64>; 3] = std::array::from_fn(|c| grid_levels(patches, c));
+    let index = |c: usize, d: f64| levels[c].iter().position(|&l| (l - d).abs() < SAME_DRIVE);
+    let (nr, ng, nb) = (levels[0].len(), levels[1].len(), levels[2].len());
+    let mut sums = vec![([0.0; 3], 0usize); nr * ng * nb];
+    for p in patches {
+        if let (Some(i), Some(j), Some(k)) =
+            (index(0, p.rgb[0]), index(1, p.rgb[1]), index(2, p.rgb[2]))
+        {
+            let slot = &mut sums[(i * ng + j) * nb + k];
+            for q in 0..3 {
+                slot.0[q] += p.xyz[q];
+            }
+            slot.1 += 1;
+        }
+    }
+    let missing: Vec<usize> = (0..sums.len()).filter(|&i| sums[i].1 == 0).collect();
+    if let Some(&first) = missing.first() {
+        let (i, j, k) = (first / (ng * nb), first / nb % ng, first % nb);
+        let show = |v: &[f64]| {
+            v.iter()
+                .map(|d| format!("{d:.3}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        return Err(FitError::Missing {
+            model: kind,
+            what: format!(
+                "a full grid of patches: {} of the {}×{}×{} combinations of the levels r: {}, \
+                 g: {}, b: {} are not measured (first: r,g,b = {:.3},{:.3},{:.3})",
+                missing.len(),
+                nr,
+                ng,
+                nb,
+                show(&levels[0]),
+                show(&levels[1]),
+                show(&levels[2]),
+                levels[0][i],
+                levels[1][j],
+                levels[2][k]
+            ),
+        });
+    }
+    let shaper: [Trc; 3] = std::array::from_fn(|c| {
+        let pts = ramp_points(set, black, &m, c);
+        if set.intermediate_levels(c) >= TABLE_SHAPER_LEVELS {
+            Trc::table_from_ramp(&pts)
+        } else {
+            Trc::Power {
+                gamma: fit_power_gamma(&pts),
+            }
+        }
+    });
+    let mut lut = Lut3d {
+        levels,
+        shaper,
+        nodes: sums
+            .into_iter()
+            .map(|(s, n)| s.map(|v| v / n as f64))
+            .collect(),
+        shaped: Default::default(),
+    };
+    lut.prepare().map_err(|message| FitError::Failed {
+        model: kind,
+        message,
+    })?;
+    Ok(lut)
+}

@@ -1,0 +1,63 @@
+//! A matrix and black offset fitted over all measured patches, after per-channel TRCs from
+//! the measured ramps: XYZ = b + M·[R′ G′ B′]ᵀ in weighted least squares. Where PLCC takes
+//! M from three patches, this averages the noise of every patch, and where channels interact
+//! mildly it finds the best single matrix. Each patch is weighted by 1 / max(Y, 1 % of
+//! white) so that dark patches count by their relative (closer to perceptual) error.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::plcc::{black_and_primaries, ramp_points, singular};
+use super::{MatrixTrc, ModelKind, Trc};
+use crate::display::fit::FitError;
+use crate::display::patch_set::{PatchSet, CHANNEL_NAMES};
+use crate::display::Patch;
+
+pub fn fit_matrix_lsq(set: &PatchSet, patches: &[Patch]) -> Result<MatrixTrc, FitError> {
+    let kind = ModelKind::MatrixLsq;
+    let (black, m) = black_and_primaries(set, kind)?;
+    let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });
+    for (c, t) in trc.iter_mut().enumerate() {
+        if set.intermediate_levels(c) == 0 {
+            return Err(FitError::Missing {
+                model: kind,
+                what: format!("a {} ramp to interpolate its TRC", CHANNEL_NAMES[c]),
+            });
+        }
+        *t = Trc::table_from_ramp(&ramp_points(set, black, &m, c));
+    }
+    let white_y = set
+        .white
+        .map_or_else(|| black[1] + m[1].iter().sum::<f64>(), |w| w[1]);
+    let n = patches.len();
+    if n < 4 {
+        return Err(FitError::Missing {
+            model: kind,
+            what: "at least 4 patches for 12 unknowns in 3 equations each".into(),
+        });
+    }
+    let mut a = DMatrix::<f64>::zeros(n, 4);
+    let mut rhs = DMatrix::<f64>::zeros(n, 3);
+    for (i, p) in patches.iter().enumerate() {
+        let w = 1.0 / p.xyz[1].max(0.01 * white_y);
+        for c in 0..3 {
+            a[(i, c)] = w * trc[c].eval(p.rgb[c]);
+            rhs[(i, c)] = w * p.xyz[c];
+        }
+        a[(i, 3)] = w;
+    }
+    let svd = a.svd(true, true);
+    let mut fitted = [[0.0; 3]; 3];
+    let mut offset = [0.0; 3];
+    for k in 0..3 {
+        let col = DVector::from_iterator(n, rhs.column(k).iter().copied());
+        let x = svd.solve(&col, 1e-12).map_err(|e| FitError::Failed {
+            model: kind,
+            message: format!("least squares failed: {e}"),
+        })?;
+        for c in 0..3 {
+            fitted[k][c] = x[c];
+        }
+        offset[k] = x[3];
+    }
+    MatrixTrc::new(kind, offset, fitted, trc).map_err(singular)
+}
