@@ -168,6 +168,35 @@ fn an_exact_model_verifies_to_the_meter_resolution_and_a_faulty_display_does_not
 }
 
 #[test]
+fn a_lut_gets_a_grid_of_the_ramp_levels() {
+    // --ramp-steps 3: levels 0, 128, 255; the 3³ grid adds the 18 combinations that black,
+    // the primaries, white and the four ramps' 128 do not already hold: 9 + 18 fit patches.
+    let dir = temp_dir("lut");
+    let o = metamer(
+        &[
+            IPS,
+            &[
+                "--model",
+                "lut",
+                "--ramp-steps",
+                "3",
+                "-o",
+                dir.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let s = summary(&dir);
+    assert_eq!(
+        (s["model"].as_str(), s["fit_patches"].as_u64()),
+        (Some("lut"), Some(27))
+    );
+    assert_eq!(s["readings"], 27 + 48);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_stopped_session_resumes_and_measures_only_what_is_missing() {
     let dir = temp_dir("stop");
     let d = dir.to_str().unwrap();

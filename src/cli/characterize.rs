@@ -42,8 +42,8 @@ pub struct Args {
     /// Passes over all patches (readings of a patch are averaged).
     #[arg(long, default_value_t = 1, value_name = "K")]
     repeats: usize,
-    /// Add an N×N×N grid of the drive cube to the fit patches (default: 5 for --model lut,
-    /// else none).
+    /// Add an N×N×N grid of the drive cube to the fit patches (default: none; for --model lut
+    /// the ramp steps, so the grid holds the ramps' levels: 9³ = 729 patches by default).
     #[arg(long, value_name = "N")]
     grid_steps: Option<usize>,
     /// Wait between showing a patch and measuring it (default: 500 for a window, 0 for a
@@ -69,9 +69,13 @@ pub struct Args {
 pub fn run(args: Args) -> CliResult {
     let spec = DisplaySpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
-    let grid_steps = args
-        .grid_steps
-        .unwrap_or(if model == ModelKind::Lut { 5 } else { 0 });
+    // The LUT's grid is every combination of the levels measured on each axis, ramps
+    // included: a grid of the ramps' own levels is what completes it.
+    let grid_steps = args.grid_steps.unwrap_or(if model == ModelKind::Lut {
+        args.ramp_steps
+    } else {
+        0
+    });
     let plan = Plan::new(PlanOptions {
         ramp_steps: args.ramp_steps,
         repeats: args.repeats,
