@@ -178,3 +178,51 @@ fn characterize_runs_through_the_window_backend() {
     assert_eq!(log.lines().count(), 6);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_video_lut_that_is_not_identity_is_reported() {
+    use x11rb::connection::Connection;
+    use x11rb::protocol::randr::ConnectionExt as _;
+    let Some(x) = xvfb(320, 240) else { return };
+    let window = WindowDisplay::open(Some(&x.display), 0).unwrap();
+    // Xvfb applies no gamma and reports an all-zero ramp: that is "no LUT", not a warning.
+    assert_eq!(window.video_lut().unwrap(), None);
+    assert!(window.warnings().is_empty());
+    // A night-light filter sets blue to 70 %; Xvfb keeps the ramp it is given.
+    let (conn, screen) = x11rb::connect(Some(&x.display)).unwrap();
+    let root = conn.setup().roots[screen].root;
+    let res = conn
+        .randr_get_screen_resources_current(root)
+        .unwrap()
+        .reply()
+        .unwrap();
+    let crtc = res.crtcs[0];
+    let n = usize::from(
+        conn.randr_get_crtc_gamma_size(crtc)
+            .unwrap()
+            .reply()
+            .unwrap()
+            .size,
+    );
+    let ramp: Vec<u16> = (0..n).map(|i| (65535 * i / (n - 1)) as u16).collect();
+    let blue: Vec<u16> = ramp.iter().map(|&v| (f64::from(v) * 0.7) as u16).collect();
+    conn.randr_set_crtc_gamma(crtc, &ramp, &ramp, &blue)
+        .unwrap()
+        .check()
+        .unwrap();
+    let lut = window.video_lut().unwrap().expect("the ramp just set");
+    assert_eq!((lut.red, lut.blue), (ramp.clone(), blue));
+    let warnings = window.warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("departs from identity by up to 30.0 %"),
+        "{}",
+        warnings[0]
+    );
+    // Identity again: nothing to say.
+    conn.randr_set_crtc_gamma(crtc, &ramp, &ramp, &ramp)
+        .unwrap()
+        .check()
+        .unwrap();
+    assert!(window.warnings().is_empty());
+}

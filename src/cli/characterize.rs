@@ -88,6 +88,9 @@ pub fn run(args: Args) -> CliResult {
     }
 
     let mut display = spec.open()?;
+    for warning in display.warnings() {
+        eprintln!("warning: {warning}");
+    }
     let mut instrument =
         open_instrument(&args.instrument, display.stimulus()).map_err(|e| match e {
             DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {

@@ -24,6 +24,10 @@ pub trait PatchDisplay {
     fn show(&mut self, rgb: [u8; 3]) -> Result<(), PatchDisplayError>;
     /// The wait between showing a patch and measuring it when the user gives none.
     fn default_settle(&self) -> Duration;
+    /// Conditions the user should know before measuring (e.g. an active video LUT).
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// What a simulated instrument aimed at this display sees, for displays that are
     /// themselves simulated; `None` for real screens.
     fn stimulus(&self) -> Option<Arc<dyn Stimulus>>;

@@ -60,6 +60,8 @@ pub struct Monitor {
     pub width: u16,
     pub height: u16,
     pub primary: bool,
+    /// RandR outputs driving it (empty without RandR).
+    pub outputs: Vec<u32>,
 }
 
 impl std::fmt::Display for Monitor {
@@ -275,6 +277,71 @@ impl WindowDisplay {
     }
 }
 
+/// A CRTC's video LUT (RandR gamma ramp): what the graphics card does to the drive values
+/// on their way to the panel, 16-bit per entry.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct VideoLut {
+    pub red: Vec<u16>,
+    pub green: Vec<u16>,
+    pub blue: Vec<u16>,
+}
+
+impl VideoLut {
+    /// Largest departure from the identity ramp (entry i of n = i·65535/(n − 1)), as a
+    /// fraction of full scale.
+    pub fn max_deviation(&self) -> f64 {
+        [&self.red, &self.green, &self.blue]
+            .iter()
+            .flat_map(|ramp| {
+                let n = ramp.len().max(2) - 1;
+                ramp.iter().enumerate().map(move |(i, &v)| {
+                    (f64::from(v) - 65535.0 * i as f64 / n as f64).abs() / 65535.0
+                })
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// A video LUT departing from identity by more than this is reported: a 1 % change is
+/// about one 8-bit code, more than the meter's repeatability at mid grey.
+pub const VIDEO_LUT_TOLERANCE: f64 = 0.01;
+
+impl WindowDisplay {
+    /// The video LUT of the first CRTC showing this monitor, None when the server has no
+    /// RandR CRTC for it (no RandR 1.5, or a virtual output).
+    pub fn video_lut(&self) -> Result<Option<VideoLut>, WindowError> {
+        for &output in &self.monitor.outputs {
+            let info = self
+                .conn
+                .randr_get_output_info(output, x11rb::CURRENT_TIME)
+                .map_err(perr(&self.display, "RRGetOutputInfo"))?
+                .reply()
+                .map_err(perr(&self.display, "RRGetOutputInfo"))?;
+            if info.crtc == 0 {
+                continue;
+            }
+            let gamma = self
+                .conn
+                .randr_get_crtc_gamma(info.crtc)
+                .map_err(perr(&self.display, "RRGetCrtcGamma"))?
+                .reply()
+                .map_err(perr(&self.display, "RRGetCrtcGamma"))?;
+            // Servers without hardware gamma (Xvfb) answer with an all-zero ramp they do not
+            // apply; a real all-zero LUT would show nothing at all.
+            let all = gamma.red.iter().chain(&gamma.green).chain(&gamma.blue);
+            if gamma.red.is_empty() || all.clone().all(|&v| v == 0) {
+                continue;
+            }
+            return Ok(Some(VideoLut {
+                red: gamma.red,
+                green: gamma.green,
+                blue: gamma.blue,
+            }));
+        }
+        Ok(None)
+    }
+}
+
 impl Drop for WindowDisplay {
     fn drop(&mut self) {
         // Best effort: the server removes both when the connection closes anyway.
@@ -302,6 +369,19 @@ impl PatchDisplay for WindowDisplay {
 
     fn default_settle(&self) -> Duration {
         DEFAULT_SETTLE
+    }
+
+    fn warnings(&self) -> Vec<String> {
+        match self.video_lut() {
+            Ok(Some(lut)) if lut.max_deviation() > VIDEO_LUT_TOLERANCE => vec![format!(
+                "the video LUT of monitor {} departs from identity by up to {:.1} % of full scale \
+                 (a calibration loader or night-light filter is active); the profile will include it",
+                self.monitor_index,
+                100.0 * lut.max_deviation()
+            )],
+            // No LUT to read, or one we could not read: nothing to say.
+            _ => Vec::new(),
+        }
     }
 
     fn stimulus(&self) -> Option<std::sync::Arc<dyn metamer_drivers::Stimulus>> {
@@ -417,6 +497,7 @@ fn monitors_of(
                     width: m.width,
                     height: m.height,
                     primary: m.primary,
+                    outputs: m.outputs,
                 });
             }
         }
@@ -429,7 +510,34 @@ fn monitors_of(
             width: screen.width_in_pixels,
             height: screen.height_in_pixels,
             primary: true,
+            outputs: Vec::new(),
         });
     }
     Ok(monitors)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn video_lut_deviation_from_identity() {
+        let identity: Vec<u16> = (0..256u32).map(|i| (i * 65535 / 255) as u16).collect();
+        let lut = VideoLut {
+            red: identity.clone(),
+            green: identity.clone(),
+            blue: identity.clone(),
+        };
+        // Integer truncation leaves < 1/65535 of full scale.
+        assert!(lut.max_deviation() < 1.0 / 65535.0);
+        // Night light: blue at 80 % of full scale, the worst entry at the top.
+        let dimmed = VideoLut {
+            blue: identity
+                .iter()
+                .map(|&v| (f64::from(v) * 0.8) as u16)
+                .collect(),
+            ..lut
+        };
+        assert!((dimmed.max_deviation() - 0.2).abs() < 1e-4);
+    }
 }
