@@ -8,6 +8,7 @@
 
 pub mod color;
 pub mod display;
+pub mod lab;
 pub mod numeric_csv;
 pub mod plot;
 pub mod render;

@@ -5,10 +5,12 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod budget;
 mod characterize;
 mod color;
 mod devices;
 mod fit;
+mod lab;
 mod render;
 mod reproduce;
 mod spot;
@@ -37,6 +39,10 @@ enum Command {
     Reproduce(reproduce::Args),
     /// Show and measure patches on a display, fit and verify a profile.
     Characterize(characterize::Args),
+    /// Display models' reproduction error against the number of measured patches.
+    Budget(budget::Args),
+    /// The whole validation chain on the built-in simulated lab: box, simulation, display.
+    Lab(lab::Args),
 }
 
 /// A command's failure: usage errors exit 2, data and device errors exit 1.
@@ -63,6 +69,8 @@ pub fn main() -> ExitCode {
         Command::Fit(args) => fit::run(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Characterize(args) => characterize::run(args),
+        Command::Lab(args) => lab::run(args),
+        Command::Budget(args) => budget::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,7 @@
 //! Display characterization (issue 5): display models (paper Eq. 9 and richer), fitting,
 //! reproduction of XYZ on a display, patch display backends and the `characterize` session.
 
+pub mod budget;
 pub mod gamut;
 
 use serde::{Deserialize, Serialize};

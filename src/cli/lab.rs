@@ -1,0 +1,130 @@
+//! `metamer lab`: the whole validation chain on the built-in simulated lab.
+
+use std::path::PathBuf;
+
+use metamer::display::gamut::GamutMapping;
+use metamer::display::{ModelKind, Preset};
+use metamer::lab::{run_lab, LabOptions, LabProgress, LabResult, DISPLAY_DIR};
+
+use super::{CliError, CliResult};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output directory: lab.json, the three comparisons (CSV + SVG), display/ (the display
+    /// characterization: log, profile, .ti3, report).
+    #[arg(short = 'o', long = "out", value_name = "DIR")]
+    out: PathBuf,
+    /// The box scene.
+    #[arg(
+        long,
+        default_value = "data/scenes/validation-box.json",
+        value_name = "SCENE"
+    )]
+    scene: PathBuf,
+    /// The simulated monitor: ideal-crt, ips-lcd or wide-gamut-ccfl.
+    #[arg(long, default_value = "ips-lcd", value_name = "PRESET")]
+    display: String,
+    /// Display model: plcc (paper Eq. 9), plcc-gamma, gog, gogo, lut, matrix-lsq.
+    #[arg(long, default_value = "plcc", value_name = "MODEL")]
+    model: String,
+    /// Out-of-gamut colours: nearest-lab (least ΔE*ab the display can show) or clip.
+    #[arg(long, default_value = "nearest-lab", value_name = "MAPPING")]
+    gamut: String,
+    /// The simulation's accuracy: 95 % half-width of every patch's ΔE*ab.
+    #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
+    target_de: f64,
+    /// Meter readings averaged per patch.
+    #[arg(long, default_value_t = 3, value_name = "K")]
+    repeats: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The simulated meter's speed: 1 = the CS-100A's real ≈100 ms per reading.
+    #[arg(long, default_value_t = 0.05, value_name = "F")]
+    time_scale: f64,
+    /// Continue an interrupted run in DIR (the display characterization resumes from its log).
+    #[arg(long)]
+    resume: bool,
+}
+
+pub fn run(args: Args) -> CliResult {
+    let display: Preset = args.display.parse().map_err(CliError::Usage)?;
+    let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
+    let gamut: GamutMapping = args.gamut.parse().map_err(CliError::Usage)?;
+    if args.target_de.is_nan() || args.target_de <= 0.0 {
+        return Err(CliError::Usage("--target-de must be above 0".into()));
+    }
+    if args.repeats == 0 {
+        return Err(CliError::Usage("--repeats must be at least 1".into()));
+    }
+    if args.time_scale.is_nan() || args.time_scale < 0.0 {
+        return Err(CliError::Usage("--time-scale must be 0 or more".into()));
+    }
+    let options = LabOptions {
+        scene: args.scene,
+        display,
+        model,
+        gamut,
+        target_de: args.target_de,
+        repeats: args.repeats,
+        seed: args.seed,
+        time_scale: args.time_scale,
+    };
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {prefix}: {msg} ({elapsed})")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let result = run_lab(&args.out, &options, args.resume, &|p| match p {
+        LabProgress::Stage(name) => {
+            bar.set_prefix(name.to_string());
+            bar.set_message("");
+        }
+        LabProgress::Render(r) => bar.set_message(format!(
+            "{} of 24 patches at target, worst ±{:.3} ΔE*ab",
+            r.converged, r.worst_de
+        )),
+        LabProgress::Readings { done, total } => {
+            bar.set_message(format!("reading {done} of {total}"))
+        }
+    });
+    bar.finish_and_clear();
+    let result = result?;
+    let written = result.write(&args.out)?;
+    print_summary(&result);
+    println!(
+        "wrote {} and the display characterization in {}",
+        written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        args.out.join(DISPLAY_DIR).display()
+    );
+    Ok(())
+}
+
+fn print_summary(r: &LabResult) {
+    let v = &r.display_characterization.verification;
+    println!(
+        "box: {} readings per patch; simulation: {:.1} s of rendering to ΔE*ab ±{} (95 %)",
+        r.options.repeats, r.render_seconds, r.options.target_de
+    );
+    println!(
+        "display: virtual:{} at {:.1} cd/m² white, model {} (held-out ΔE00 mean {:.2}, max {:.2}); {}",
+        r.options.display.name(),
+        r.display_white_cd_m2,
+        r.options.model,
+        v.mean,
+        v.max,
+        r.display_characterization.verdict
+    );
+    println!(
+        "{} of 24 simulated colours out of the display's gamut ({} mapping)",
+        r.out_of_gamut, r.options.gamut
+    );
+    for (name, c) in r.comparisons() {
+        println!("{name}: {}", c.summary());
+    }
+    println!("total {:.1} s", r.seconds);
+}

@@ -1,0 +1,345 @@
+//! Speed against accuracy for display characterization (issue 5 item 6): how well each
+//! model reproduces colours on each simulated monitor as the number of measured patches
+//! grows.
+//!
+//! Every measured patch costs the user a reading (≈0.1–0.5 s with a CS-100A, more with
+//! settling), so the cost axis is the patch count. For each budget the patch set is the
+//! one `characterize` would measure with that many ramp steps, plus, from the larger budgets
+//! on, an evenly spaced RGB cube that the models which do not assume additivity need. The
+//! patches are read by the simulated CS-100A with its noise (±0.2 % in Y, ±0.001 in x, y),
+//! every model is fitted to the same readings, and the fit is judged as reproduction is
+//! used: for in-gamut targets (the noiseless XYZ of seeded random drive values) the model's
+//! inverse gives drive values, the monitor shows them (8-bit), and ΔE00 between what it
+//! shows and the target is the error (CIELAB relative to the monitor's true white).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use metamer_drivers::{open_instrument, Request, SharedStimulus};
+use serde::Serialize;
+
+use super::virtual_display::{quantize, Preset, VirtualPanel};
+use super::Patch;
+use super::{fit_profile, ModelKind};
+use crate::color::{delta_e2000, Xyz};
+use crate::plot::{write_log_log, LogLogChart, Series};
+
+/// One patch budget: ramp steps per channel (including 0 and full drive) and the points
+/// per axis of the RGB cube (0 for none).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Budget {
+    pub ramp_steps: usize,
+    pub cube: usize,
+}
+
+/// The budgets charted, smallest first: ramps only (what matrix models need), then ramps
+/// with growing cubes (what LUT and regression models need).
+pub const BUDGETS: [Budget; 9] = [
+    Budget {
+        ramp_steps: 2,
+        cube: 0,
+    },
+    Budget {
+        ramp_steps: 3,
+        cube: 0,
+    },
+    Budget {
+        ramp_steps: 5,
+        cube: 0,
+    },
+    Budget {
+        ramp_steps: 9,
+        cube: 0,
+    },
+    Budget {
+        ramp_steps: 5,
+        cube: 3,
+    },
+    Budget {
+        ramp_steps: 9,
+        cube: 4,
+    },
+    Budget {
+        ramp_steps: 9,
+        cube: 5,
+    },
+    Budget {
+        ramp_steps: 17,
+        cube: 6,
+    },
+    Budget {
+        ramp_steps: 17,
+        cube: 9,
+    },
+];
+
+/// The drive values of a budget: black, the red, green, blue and grey ramps, the cube;
+/// each distinct 8-bit colour once.
+pub fn budget_patches(b: Budget) -> Vec<[u8; 3]> {
+    let mut out: Vec<[u8; 3]> = vec![[0, 0, 0]];
+    let mut push = |rgb: [u8; 3]| {
+        if !out.contains(&rgb) {
+            out.push(rgb);
+        }
+    };
+    let steps = b.ramp_steps.max(2);
+    for i in 1..steps {
+        let v = quantize(i as f64 / (steps - 1) as f64);
+        for rgb in [[v, 0, 0], [0, v, 0], [0, 0, v], [v, v, v]] {
+            push(rgb);
+        }
+    }
+    if b.cube >= 2 {
+        let level = |i: usize| quantize(i as f64 / (b.cube - 1) as f64);
+        for r in 0..b.cube {
+            for g in 0..b.cube {
+                for bl in 0..b.cube {
+                    push([level(r), level(g), level(bl)]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// One point of the chart.
+#[derive(Clone, Debug, Serialize)]
+pub struct BudgetPoint {
+    pub preset: String,
+    pub model: String,
+    pub patches: usize,
+    pub ramp_steps: usize,
+    pub cube: usize,
+    /// ΔE00 of reproduced targets, pooled over the trials: mean, 95th percentile, maximum.
+    pub mean_de00: f64,
+    pub p95_de00: f64,
+    pub max_de00: f64,
+    /// Mean time of one fit, milliseconds.
+    pub fit_ms: f64,
+}
+
+/// What the study could not do.
+#[derive(Debug, thiserror::Error)]
+pub enum BudgetError {
+    #[error("the simulated meter failed: {0}")]
+    Meter(#[from] metamer_drivers::DriverError),
+    #[error("cannot write {file}: {source}")]
+    Write {
+        file: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot draw {file}: {message}")]
+    Chart {
+        file: std::path::PathBuf,
+        message: String,
+    },
+}
+
+/// Seeded uniform random 8-bit colours (SplitMix64, so the set never changes).
+fn verification_colours(n: usize, seed: u64) -> Vec<[u8; 3]> {
+    let mut s = seed;
+    let mut next = || {
+        s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 56) as u8
+    };
+    (0..n).map(|_| [next(), next(), next()]).collect()
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let i = ((sorted.len() - 1) as f64 * p).round() as usize;
+    sorted[i]
+}
+
+/// Runs the study on `presets` with `models`, each budget measured `trials` times;
+/// `progress` gets (done, total) as each model is finished at each budget.
+pub fn run_budget_study(
+    presets: &[Preset],
+    models: &[ModelKind],
+    trials: usize,
+    seed: u64,
+    progress: &dyn Fn(usize, usize),
+) -> Result<Vec<BudgetPoint>, BudgetError> {
+    let targets_rgb = verification_colours(200, seed ^ 0xB0D6E7);
+    let total = presets.len() * BUDGETS.len() * models.len();
+    let mut done = 0;
+    let mut points = Vec::new();
+    for &preset in presets {
+        let panel = VirtualPanel::preset(preset);
+        let white = Xyz::from_array(panel.xyz([255; 3]));
+        let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
+        let stimulus = Arc::new(SharedStimulus::new([0.0; 3]));
+        let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
+        let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
+        for budget in BUDGETS {
+            let drive = budget_patches(budget);
+            // Each trial is a fresh set of readings (new meter noise); errors are pooled over
+            // the trials so one lucky or unlucky reading of a primary does not make the curve.
+            let mut pooled: Vec<Option<(Vec<f64>, f64)>> =
+                vec![Some((Vec::new(), 0.0)); models.len()];
+            for _ in 0..trials.max(1) {
+                let mut patches = Vec::with_capacity(drive.len());
+                for rgb in &drive {
+                    stimulus.set(panel.xyz(*rgb));
+                    let reading = meter.measure(&Request::default())?;
+                    patches.push(Patch {
+                        rgb: rgb.map(|c| f64::from(c) / 255.0),
+                        xyz: reading.xyz,
+                    });
+                }
+                for (m, &kind) in models.iter().enumerate() {
+                    let Some((errors, fit_ms)) = pooled[m].as_mut() else {
+                        continue;
+                    };
+                    let start = Instant::now();
+                    // A model that needs more patches than the budget has is not charted at
+                    // that budget.
+                    let Ok(profile) = fit_profile(kind, &patches, None) else {
+                        pooled[m] = None;
+                        continue;
+                    };
+                    *fit_ms += start.elapsed().as_secs_f64() * 1e3;
+                    errors.extend(targets.iter().map(|&t| {
+                        let rgb = profile.inverse(t).rgb;
+                        let shown = Xyz::from_array(panel.xyz_of_drive(rgb));
+                        delta_e2000(shown.to_lab(white), Xyz::from_array(t).to_lab(white))
+                    }));
+                }
+            }
+            for (m, &kind) in models.iter().enumerate() {
+                done += 1;
+                progress(done, total);
+                let Some((mut errors, fit_ms)) = pooled[m].take() else {
+                    continue;
+                };
+                errors.sort_by(f64::total_cmp);
+                points.push(BudgetPoint {
+                    preset: preset.name().to_string(),
+                    model: kind.name().to_string(),
+                    patches: drive.len(),
+                    ramp_steps: budget.ramp_steps,
+                    cube: budget.cube,
+                    mean_de00: errors.iter().sum::<f64>() / errors.len() as f64,
+                    p95_de00: percentile(&errors, 0.95),
+                    max_de00: errors[errors.len() - 1],
+                    fit_ms: fit_ms / trials.max(1) as f64,
+                });
+            }
+        }
+    }
+    Ok(points)
+}
+
+/// Writes `budget.csv` and one SVG chart per preset (`budget-PRESET.svg`) into `dir`.
+pub fn write_budget(dir: &std::path::Path, points: &[BudgetPoint]) -> Result<(), BudgetError> {
+    let io = |file: &std::path::Path| {
+        let file = file.to_path_buf();
+        move |source| BudgetError::Write { file, source }
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let csv = dir.join("budget.csv");
+    let mut text =
+        String::from("preset,model,patches,ramp_steps,cube,mean_de00,p95_de00,max_de00,fit_ms\n");
+    for p in points {
+        text.push_str(&format!(
+            "{},{},{},{},{},{:.4},{:.4},{:.4},{:.3}\n",
+            p.preset,
+            p.model,
+            p.patches,
+            p.ramp_steps,
+            p.cube,
+            p.mean_de00,
+            p.p95_de00,
+            p.max_de00,
+            p.fit_ms
+        ));
+    }
+    std::fs::write(&csv, text).map_err(io(&csv))?;
+    let mut presets: Vec<&str> = points.iter().map(|p| p.preset.as_str()).collect();
+    presets.dedup();
+    for preset in presets {
+        let mut models: Vec<&str> = points
+            .iter()
+            .filter(|p| p.preset == preset)
+            .map(|p| p.model.as_str())
+            .collect();
+        models.dedup();
+        models.sort();
+        models.dedup();
+        let series: Vec<Series> = models
+            .iter()
+            .map(|m| {
+                let mut pts: Vec<(f64, f64)> = points
+                    .iter()
+                    .filter(|p| p.preset == preset && p.model == *m)
+                    .map(|p| (p.patches as f64, p.mean_de00))
+                    .collect();
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                Series {
+                    name: m.to_string(),
+                    points: pts,
+                }
+            })
+            .collect();
+        let title = format!("{preset}: mean ΔE00 of reproduced colours vs measured patches");
+        let file = dir.join(format!("budget-{preset}.svg"));
+        let chart = LogLogChart {
+            title: &title,
+            x_desc: "measured patches",
+            y_desc: "mean ΔE00 (200 in-gamut targets)",
+            series: &series,
+            target: Some((0.5, "ΔE00 0.5")),
+            size: (900, 520),
+        };
+        write_log_log(&chart, &file).map_err(|message| BudgetError::Chart {
+            file: file.clone(),
+            message,
+        })?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Patch counts by hand: ramps of s steps give black + 4 (s − 1); a cube of g points per
+    /// axis adds g³ minus what the ramps already hold.
+    #[test]
+    fn budget_patch_counts_match_a_hand_count() {
+        let count = |ramp_steps, cube| budget_patches(Budget { ramp_steps, cube }).len();
+        assert_eq!(count(2, 0), 5);
+        assert_eq!(count(3, 0), 9);
+        assert_eq!(count(9, 0), 33);
+        // Ramps of 3 hold black, the 3 primaries, white, the 3 half-level channels and the
+        // half grey: 9 of the 27 points of a 3-cube.
+        assert_eq!(count(3, 3), 27);
+        // Ramps of 2 hold black, 3 primaries and white: 5 of the 8 corners of a 2-cube.
+        assert_eq!(count(2, 2), 8);
+    }
+
+    #[test]
+    fn verification_colours_are_fixed_and_spread() {
+        let a = verification_colours(200, 7);
+        assert_eq!(a, verification_colours(200, 7));
+        let mean: f64 = a.iter().map(|c| f64::from(c[0])).sum::<f64>() / 200.0;
+        assert!((mean - 127.5).abs() < 15.0, "{mean}");
+    }
+
+    /// On the display that satisfies PLCC, PLCC reproduces colours within the error the
+    /// meter's noise and 8-bit quantisation allow once its ramps are dense enough.
+    #[test]
+    fn plcc_reproduces_the_ideal_crt_within_the_noise() {
+        let points =
+            run_budget_study(&[Preset::IdealCrt], &[ModelKind::Plcc], 2, 3, &|_, _| {}).unwrap();
+        let best = points
+            .iter()
+            .filter(|p| p.ramp_steps >= 9)
+            .map(|p| p.mean_de00)
+            .fold(f64::MAX, f64::min);
+        assert!(best < 0.5, "PLCC on ideal-crt: mean ΔE00 {best}");
+    }
+}

@@ -1,0 +1,186 @@
+//! The display side of the simulated lab: set the simulated monitor's peak luminance,
+//! characterize it with the `characterize` session, and show the simulation on it.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use metamer_drivers::{Instrument, Stimulus};
+use nalgebra::{Matrix3, Vector3};
+use serde::Serialize;
+
+use crate::color::Xyz;
+use crate::display::characterize::finish::{finish, Provenance, Summary};
+use crate::display::characterize::{MeasureOptions, Measured, Plan, PlanOptions, Session};
+use crate::display::gamut::{map_to_gamut, GamutMapping};
+use crate::display::virtual_display::quantize;
+use crate::display::{ModelKind, PatchDisplay, Profile, VirtualPanel};
+
+use super::scene_readings::mean_reading;
+use super::LabError;
+
+/// Headroom above the brightest in-gamut target, so no channel sits at its very end.
+const LUMINANCE_HEADROOM: f64 = 1.05;
+
+/// The full-white luminance (cd/m²) at which every target the panel's primaries can show
+/// fits below full drive: the paper sets the display's maximum luminance so that no tone
+/// mapping is needed. The panel's own primaries at its nominal setting give the linear
+/// drives (paper Eq. 9 without the TRC); targets outside the primaries' triangle need gamut
+/// mapping whatever the luminance, so they do not raise it.
+pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
+    let black = Vector3::from(panel.xyz([0; 3]));
+    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb)) - black;
+    let m = Matrix3::from_columns(&[
+        column([255, 0, 0]),
+        column([0, 255, 0]),
+        column([0, 0, 255]),
+    ]);
+    let nominal_white = panel.xyz([255; 3])[1];
+    let Some(inv) = m.try_inverse() else {
+        return nominal_white;
+    };
+    let needed = targets
+        .iter()
+        .map(|t| inv * Vector3::from(*t))
+        .filter(|lin| lin.iter().all(|&c| c >= 0.0))
+        .map(|lin| lin.max())
+        .fold(0.0, f64::max);
+    if needed > 0.0 {
+        nominal_white * needed * LUMINANCE_HEADROOM
+    } else {
+        nominal_white
+    }
+}
+
+/// Characterizes `display` with `meter` into `dir` (the `characterize` session: durable
+/// log, resume, fit, held-out verification, profile, `.ti3`, report).
+#[allow(clippy::too_many_arguments)]
+pub fn characterize(
+    dir: &Path,
+    display: &mut dyn PatchDisplay,
+    meter: &mut dyn Instrument,
+    instrument_spec: &str,
+    model: ModelKind,
+    repeats: usize,
+    resume: bool,
+    progress: &dyn Fn(usize, usize),
+) -> Result<(Profile, Summary), LabError> {
+    let plan = Plan::new(PlanOptions {
+        repeats,
+        // The models that do not assume additivity need the cube (as `characterize` does).
+        grid_steps: if model == ModelKind::Lut { 5 } else { 0 },
+        ..PlanOptions::default()
+    })?;
+    let info = meter.info();
+    let mut session = Session::open(
+        dir,
+        plan,
+        &display.spec(),
+        instrument_spec,
+        info.clone(),
+        resume,
+    )?;
+    let description = display.describe();
+    let outcome = session.measure(display, meter, &MeasureOptions::default(), &mut |p| {
+        progress(p.done, p.total)
+    })?;
+    if let Measured::Stopped { missing } | Measured::Interrupted { missing } = outcome {
+        return Err(LabError::Incomplete { missing });
+    }
+    let readings = session
+        .complete_readings()
+        .ok_or(LabError::Incomplete { missing: 0 })?;
+    let summary = finish(
+        dir,
+        session.log_path(),
+        &readings,
+        model,
+        &Provenance {
+            display: &display.spec(),
+            display_description: &description,
+            instrument: instrument_spec,
+            instrument_info: &info,
+        },
+    )?;
+    let profile = Profile::load(&summary.files.profile)?;
+    Ok((profile, summary))
+}
+
+/// One simulated reading reproduced on the display.
+#[derive(Clone, Debug, Serialize)]
+pub struct Reproduced {
+    /// What the display was asked to show, cd/m².
+    pub target_xyz: [f64; 3],
+    /// The inverse model's drive values before gamut mapping.
+    pub unclipped_rgb: [f64; 3],
+    pub out_of_gamut: bool,
+    /// The 8-bit drive values shown.
+    pub rgb8: [u8; 3],
+    /// The meter's mean reading of the display, cd/m².
+    pub measured_xyz: [f64; 3],
+}
+
+/// Shows each target through `profile` (with `mapping` where it is out of gamut) and reads
+/// it `repeats` times with `meter`.
+pub fn reproduce_and_measure(
+    display: &mut dyn PatchDisplay,
+    meter: &mut dyn Instrument,
+    profile: &Profile,
+    mapping: GamutMapping,
+    white: Xyz,
+    targets: &[[f64; 3]],
+    repeats: usize,
+) -> Result<Vec<Reproduced>, LabError> {
+    let forward = |rgb: [f64; 3]| profile.forward(rgb);
+    targets
+        .iter()
+        .map(|&t| {
+            let inverse = profile.inverse(t);
+            let rgb = map_to_gamut(
+                mapping,
+                &forward,
+                inverse.unclipped,
+                Xyz::from_array(t),
+                white,
+            );
+            let rgb8 = rgb.map(quantize);
+            display.show(rgb8)?;
+            let measured_xyz = mean_reading(meter, repeats)?;
+            Ok(Reproduced {
+                target_xyz: t,
+                unclipped_rgb: inverse.unclipped,
+                out_of_gamut: inverse.out_of_gamut,
+                rgb8,
+                measured_xyz,
+            })
+        })
+        .collect()
+}
+
+/// What a simulated meter aimed at `display` sees; the lab runs on simulated displays only.
+pub fn stimulus_of(display: &dyn PatchDisplay) -> Result<Arc<dyn Stimulus>, LabError> {
+    display.stimulus().ok_or(LabError::NotSimulated)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::display::Preset;
+
+    /// Doubling the luminance a target asks for doubles the white luminance chosen, and a
+    /// target on the nominal white needs the nominal white (plus headroom).
+    #[test]
+    fn white_luminance_scales_with_the_targets() {
+        let panel = VirtualPanel::preset(Preset::IdealCrt);
+        let white = panel.xyz([255; 3]);
+        let black = panel.xyz([0; 3]);
+        let w_minus_k = [0, 1, 2].map(|k| white[k] - black[k]);
+        let at = |s: f64| w_minus_k.map(|c| c * s);
+        let one = white_luminance_for(&panel, &[at(1.0)]);
+        assert!((one - white[1] * LUMINANCE_HEADROOM).abs() < 1e-9 * white[1]);
+        let two = white_luminance_for(&panel, &[at(1.0), at(2.0)]);
+        assert!((two / one - 2.0).abs() < 1e-9);
+        // Beyond the primaries: ignored.
+        let outside = white_luminance_for(&panel, &[at(1.0), [-5.0, 80.0, 0.0]]);
+        assert!((outside - one).abs() < 1e-9);
+    }
+}
