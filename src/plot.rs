@@ -61,6 +61,8 @@ pub fn write_log_log(chart: &LogLogChart, file: &Path) -> Result<(), String> {
         )
         .map_err(|e| err(&e))?;
     c.configure_mesh()
+        .x_label_formatter(&|x| tick(*x))
+        .y_label_formatter(&|y| tick(*y))
         .x_desc(chart.x_desc)
         .y_desc(chart.y_desc)
         .draw()
@@ -113,9 +115,27 @@ pub fn write_log_log(chart: &LogLogChart, file: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// A tick label without spurious decimals: 10, 0.5, 0.02.
+fn tick(v: f64) -> String {
+    if v >= 10.0 {
+        format!("{v:.0}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ticks_drop_spurious_decimals() {
+        assert_eq!(tick(1000.0), "1000");
+        assert_eq!(tick(1.0), "1");
+        assert_eq!(tick(0.5), "0.5");
+        assert_eq!(tick(0.02), "0.02");
+    }
 
     #[test]
     fn draws_every_series_and_the_target() {

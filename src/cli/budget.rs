@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use metamer::display::budget::{run_budget_study, write_budget, BUDGETS};
+use metamer::display::budget::{run_budget_study, write_budget, RAMP_STEPS};
 use metamer::display::{ModelKind, Preset};
 
 use super::{CliError, CliResult};
@@ -47,7 +47,7 @@ pub fn run(args: Args) -> CliResult {
             .collect::<Result<_, String>>()
             .map_err(CliError::Usage)?
     };
-    let total = presets.len() * models.len() * BUDGETS.len();
+    let total = presets.len() * models.len() * RAMP_STEPS.len();
     let bar = indicatif::ProgressBar::new(total as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:30} fit {pos}/{len} · about {eta} left")

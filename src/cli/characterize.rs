@@ -10,7 +10,7 @@ use clap::ValueEnum;
 use metamer::display::characterize::finish::{finish, Provenance, Summary};
 use metamer::display::characterize::log::refuse_existing;
 use metamer::display::characterize::{
-    MeasureOptions, Measured, Plan, PlanOptions, Session, DEFAULT_RAMP_STEPS,
+    default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::{DisplaySpec, ModelKind};
 use metamer_drivers::{
@@ -69,13 +69,9 @@ pub struct Args {
 pub fn run(args: Args) -> CliResult {
     let spec = DisplaySpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
-    // The LUT's grid is every combination of the levels measured on each axis, ramps
-    // included: a grid of the ramps' own levels is what completes it.
-    let grid_steps = args.grid_steps.unwrap_or(if model == ModelKind::Lut {
-        args.ramp_steps
-    } else {
-        0
-    });
+    let grid_steps = args
+        .grid_steps
+        .unwrap_or(default_grid_steps(model, args.ramp_steps));
     let plan = Plan::new(PlanOptions {
         ramp_steps: args.ramp_steps,
         repeats: args.repeats,

@@ -18,6 +18,7 @@ use std::time::Instant;
 use metamer_drivers::{open_instrument, Request, SharedStimulus};
 use serde::Serialize;
 
+use super::characterize::default_grid_steps;
 use super::virtual_display::{quantize, Preset, VirtualPanel};
 use super::Patch;
 use super::{fit_profile, ModelKind};
@@ -32,46 +33,18 @@ pub struct Budget {
     pub cube: usize,
 }
 
-/// The budgets charted, smallest first: ramps only (what matrix models need), then ramps
-/// with growing cubes (what LUT and regression models need).
-pub const BUDGETS: [Budget; 9] = [
+/// The ramp steps charted. Each model gets the plan `characterize` would measure for it
+/// with that many steps: the ramps, plus for the LUT the grid of the ramps' levels (see
+/// [`default_grid_steps`]), so a model's curve is what a user of that model pays.
+pub const RAMP_STEPS: [usize; 8] = [2, 3, 4, 5, 7, 9, 13, 17];
+
+/// The budget of `model` with `ramp_steps` steps.
+pub fn budget_for(model: ModelKind, ramp_steps: usize) -> Budget {
     Budget {
-        ramp_steps: 2,
-        cube: 0,
-    },
-    Budget {
-        ramp_steps: 3,
-        cube: 0,
-    },
-    Budget {
-        ramp_steps: 5,
-        cube: 0,
-    },
-    Budget {
-        ramp_steps: 9,
-        cube: 0,
-    },
-    Budget {
-        ramp_steps: 5,
-        cube: 3,
-    },
-    Budget {
-        ramp_steps: 9,
-        cube: 4,
-    },
-    Budget {
-        ramp_steps: 9,
-        cube: 5,
-    },
-    Budget {
-        ramp_steps: 17,
-        cube: 6,
-    },
-    Budget {
-        ramp_steps: 17,
-        cube: 9,
-    },
-];
+        ramp_steps,
+        cube: default_grid_steps(model, ramp_steps),
+    }
+}
 
 /// The drive values of a budget: black, the red, green, blue and grey ramps, the cube;
 /// each distinct 8-bit colour once.
@@ -164,7 +137,7 @@ pub fn run_budget_study(
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<BudgetPoint>, BudgetError> {
     let targets_rgb = verification_colours(200, seed ^ 0xB0D6E7);
-    let total = presets.len() * BUDGETS.len() * models.len();
+    let total = presets.len() * RAMP_STEPS.len() * models.len();
     let mut done = 0;
     let mut points = Vec::new();
     for &preset in presets {
@@ -174,47 +147,44 @@ pub fn run_budget_study(
         let stimulus = Arc::new(SharedStimulus::new([0.0; 3]));
         let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
         let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
-        for budget in BUDGETS {
-            let drive = budget_patches(budget);
-            // Each trial is a fresh set of readings (new meter noise); errors are pooled over
-            // the trials so one lucky or unlucky reading of a primary does not make the curve.
-            let mut pooled: Vec<Option<(Vec<f64>, f64)>> =
-                vec![Some((Vec::new(), 0.0)); models.len()];
-            for _ in 0..trials.max(1) {
-                let mut patches = Vec::with_capacity(drive.len());
-                for rgb in &drive {
-                    stimulus.set(panel.xyz(*rgb));
-                    let reading = meter.measure(&Request::default())?;
-                    patches.push(Patch {
-                        rgb: rgb.map(|c| f64::from(c) / 255.0),
-                        xyz: reading.xyz,
-                    });
-                }
-                for (m, &kind) in models.iter().enumerate() {
-                    let Some((errors, fit_ms)) = pooled[m].as_mut() else {
-                        continue;
-                    };
+        for &kind in models {
+            for steps in RAMP_STEPS {
+                done += 1;
+                let budget = budget_for(kind, steps);
+                let drive = budget_patches(budget);
+                let mut errors = Vec::with_capacity(targets.len() * trials.max(1));
+                let mut fit_ms = 0.0;
+                // Each trial is a fresh set of readings (new meter noise); errors are pooled
+                // so one lucky or unlucky reading of a primary does not make the curve.
+                let mut fitted = true;
+                for _ in 0..trials.max(1) {
+                    let mut patches = Vec::with_capacity(drive.len());
+                    for rgb in &drive {
+                        stimulus.set(panel.xyz(*rgb));
+                        let reading = meter.measure(&Request::default())?;
+                        patches.push(Patch {
+                            rgb: rgb.map(|c| f64::from(c) / 255.0),
+                            xyz: reading.xyz,
+                        });
+                    }
                     let start = Instant::now();
-                    // A model that needs more patches than the budget has is not charted at
-                    // that budget.
+                    // A model that needs more patches than the budget has is not charted
+                    // there.
                     let Ok(profile) = fit_profile(kind, &patches, None) else {
-                        pooled[m] = None;
-                        continue;
+                        fitted = false;
+                        break;
                     };
-                    *fit_ms += start.elapsed().as_secs_f64() * 1e3;
+                    fit_ms += start.elapsed().as_secs_f64() * 1e3;
                     errors.extend(targets.iter().map(|&t| {
                         let rgb = profile.inverse(t).rgb;
                         let shown = Xyz::from_array(panel.xyz_of_drive(rgb));
                         delta_e2000(shown.to_lab(white), Xyz::from_array(t).to_lab(white))
                     }));
                 }
-            }
-            for (m, &kind) in models.iter().enumerate() {
-                done += 1;
                 progress(done, total);
-                let Some((mut errors, fit_ms)) = pooled[m].take() else {
+                if !fitted {
                     continue;
-                };
+                }
                 errors.sort_by(f64::total_cmp);
                 points.push(BudgetPoint {
                     preset: preset.name().to_string(),

@@ -10,7 +10,9 @@ use serde::Serialize;
 
 use crate::color::Xyz;
 use crate::display::characterize::finish::{finish, Provenance, Summary};
-use crate::display::characterize::{MeasureOptions, Measured, Plan, PlanOptions, Session};
+use crate::display::characterize::{
+    default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session,
+};
 use crate::display::gamut::{map_to_gamut, GamutMapping};
 use crate::display::virtual_display::quantize;
 use crate::display::{ModelKind, PatchDisplay, Profile, VirtualPanel};
@@ -64,11 +66,11 @@ pub fn characterize(
     resume: bool,
     progress: &dyn Fn(usize, usize),
 ) -> Result<(Profile, Summary), LabError> {
+    let defaults = PlanOptions::default();
     let plan = Plan::new(PlanOptions {
         repeats,
-        // The models that do not assume additivity need the cube (as `characterize` does).
-        grid_steps: if model == ModelKind::Lut { 5 } else { 0 },
-        ..PlanOptions::default()
+        grid_steps: default_grid_steps(model, defaults.ramp_steps),
+        ..defaults
     })?;
     let info = meter.info();
     let mut session = Session::open(

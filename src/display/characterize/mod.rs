@@ -10,7 +10,9 @@ pub mod session;
 pub mod verify;
 
 pub use log::{LogError, LOG_FILE};
-pub use plan::{Plan, PlanError, PlanOptions, PlannedPatch, Purpose, DEFAULT_RAMP_STEPS};
+pub use plan::{
+    default_grid_steps, Plan, PlanError, PlanOptions, PlannedPatch, Purpose, DEFAULT_RAMP_STEPS,
+};
 pub use report::{write_report, Report, ReportError};
 pub use session::{MeasureOptions, Measured, Progress, Session, SessionError};
 pub use verify::{average, verify, AveragedPatch, Verification};

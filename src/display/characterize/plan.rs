@@ -13,6 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::color::{self, ColorCheckerSet, Illuminant, ObserverKind};
+use crate::display::ModelKind;
 
 /// Default number of levels per ramp, 0 and 255 included.
 pub const DEFAULT_RAMP_STEPS: usize = 9;
@@ -46,6 +47,17 @@ pub struct PlannedPatch {
     pub purpose: Purpose,
     /// For people: `black`, `red ramp 64`, `ColorChecker dark skin`, `random 7`.
     pub label: String,
+}
+
+/// The drive-cube grid a model needs by default: none for the matrix models; for the LUT,
+/// whose grid is every combination of the levels measured on each axis (ramps included), a
+/// grid of the ramps' own levels, which is what completes it.
+pub fn default_grid_steps(model: ModelKind, ramp_steps: usize) -> usize {
+    if model == ModelKind::Lut {
+        ramp_steps
+    } else {
+        0
+    }
 }
 
 /// The options a plan is made from.
