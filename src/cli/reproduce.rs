@@ -1,10 +1,97 @@
-//! `metamer reproduce` (placeholder until its issue's helper lands it).
+//! `metamer reproduce`: XYZ targets (CSV) or an XYZ image (.exr/.pfm) → display drive values
+//! through a profile's inverse model, with out-of-gamut values counted.
+
+use std::path::PathBuf;
+use std::time::Instant;
 
 use super::{CliError, CliResult};
+use metamer::display::gamut::GamutMapping;
+use metamer::display::reproduce::{
+    read_targets, reproduce_image, reproduce_targets, write_drive_csv, write_drive_png,
+};
+use metamer::display::Profile;
+use metamer::render::image_io::read_xyz_image;
 
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Display profile written by `metamer fit`.
+    #[arg(long, value_name = "PROFILE.json")]
+    profile: PathBuf,
+    /// Targets: CSV with the header X,Y,Z (cd/m²); writes r,g,b,out_of_gamut.
+    #[arg(long, value_name = "TARGETS.csv", conflicts_with = "image")]
+    xyz: Option<PathBuf>,
+    /// An absolute XYZ image (.exr or .pfm); writes a PNG of drive values.
+    #[arg(long, value_name = "XYZ.exr|XYZ.pfm")]
+    image: Option<PathBuf>,
+    /// Output: RGB.csv for --xyz, OUT.png for --image.
+    #[arg(short = 'o', long = "output")]
+    output: PathBuf,
+    /// PNG bits per channel (8 or 16).
+    #[arg(long, default_value_t = 8)]
+    bits: u8,
+    /// Flip the image left–right, for the paper's set-up where the display is seen in a
+    /// mirror.
+    #[arg(long)]
+    mirror: bool,
+    /// Out-of-gamut values: clip the drive values, or the nearest colour in CIELAB.
+    #[arg(long, default_value = "clip")]
+    gamut: GamutMapping,
+}
 
-pub fn run(_args: Args) -> CliResult {
-    Err(CliError::Usage("'reproduce' is being built".into()))
+pub fn run(args: Args) -> CliResult {
+    if args.bits != 8 && args.bits != 16 {
+        return Err(CliError::Usage(format!(
+            "--bits must be 8 or 16, got {}",
+            args.bits
+        )));
+    }
+    let profile = Profile::load(&args.profile)?;
+    match (&args.xyz, &args.image) {
+        (Some(targets), None) => {
+            if args.mirror {
+                return Err(CliError::Usage("--mirror applies to --image only".into()));
+            }
+            let xyz = read_targets(targets)?;
+            let drives = reproduce_targets(&profile, &xyz, args.gamut);
+            write_drive_csv(&args.output, &drives)
+                .map_err(|e| CliError::Failed(format!("{}: {e}", args.output.display()).into()))?;
+            let out = drives.iter().filter(|d| d.out_of_gamut).count();
+            eprintln!(
+                "{} targets, {out} out of gamut ({}); written to {}",
+                drives.len(),
+                if out > 0 && args.gamut == GamutMapping::Clip {
+                    "clipped"
+                } else if out > 0 {
+                    "mapped to the nearest CIELAB colour"
+                } else {
+                    "none to handle"
+                },
+                args.output.display()
+            );
+            Ok(())
+        }
+        (None, Some(image)) => {
+            let img = read_xyz_image(image)?;
+            let start = Instant::now();
+            let drive = reproduce_image(&profile, &img, args.mirror, args.gamut);
+            let elapsed = start.elapsed();
+            write_drive_png(&args.output, &drive, args.bits)?;
+            let total = img.width * img.height;
+            eprintln!(
+                "{}×{} pixels converted in {:.1} ms; {} out of gamut ({:.3} %); {}-bit PNG \
+                 written to {}",
+                img.width,
+                img.height,
+                elapsed.as_secs_f64() * 1e3,
+                drive.out_of_gamut,
+                100.0 * drive.out_of_gamut as f64 / total.max(1) as f64,
+                args.bits,
+                args.output.display()
+            );
+            Ok(())
+        }
+        _ => Err(CliError::Usage(
+            "give exactly one of --xyz TARGETS.csv or --image XYZ.exr|XYZ.pfm".into(),
+        )),
+    }
 }

@@ -12,6 +12,7 @@ pub mod measurements;
 pub mod model;
 pub mod patch_set;
 pub mod profile;
+pub mod reproduce;
 
 pub use diagnostics::{Diagnostics, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitError, FitOptions};

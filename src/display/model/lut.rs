@@ -14,7 +14,9 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
-use super::{condition_number, DisplayModel, Inverse, ModelKind, Trc, MAX_CONDITION};
+use super::{
+    condition_number, output_ranges, DisplayModel, Inverse, ModelKind, Trc, MAX_CONDITION,
+};
 use crate::display::fit::FitError;
 use crate::display::patch_set::{PatchSet, CHANNEL_NAMES, SAME_DRIVE};
 use crate::display::Patch;
@@ -32,6 +34,8 @@ pub struct Lut3d {
     pub nodes: Vec<[f64; 3]>,
     #[serde(skip)]
     shaped: [Vec<f64>; 3],
+    #[serde(skip)]
+    ranges: [(f64, f64); 3],
 }
 
 impl Lut3d {
@@ -54,6 +58,7 @@ impl Lut3d {
                 ));
             }
         }
+        self.ranges = output_ranges(&self.shaper);
         let count: usize = self.levels.iter().map(Vec::len).product();
         if self.nodes.len() != count {
             return Err(format!(
@@ -164,7 +169,7 @@ impl DisplayModel for Lut3d {
                 break;
             }
         }
-        Inverse::from_unclipped(std::array::from_fn(|c| self.shaper[c].inverse(s[c])))
+        Inverse::from_outputs(&self.shaper, &self.ranges, s.into())
     }
 }
 
@@ -249,6 +254,7 @@ pub fn fit_lut(set: &PatchSet, patches: &[Patch]) -> Result<Lut3d, FitError> {
             .map(|(s, n)| s.map(|v| v / n as f64))
             .collect(),
         shaped: Default::default(),
+        ranges: Default::default(),
     };
     lut.prepare().map_err(|message| FitError::Failed {
         model: kind,

@@ -17,6 +17,8 @@ pub struct MatrixTrc {
     #[serde(skip)]
     inverse_matrix: [[f64; 3]; 3],
     #[serde(skip)]
+    ranges: [(f64, f64); 3],
+    #[serde(skip)]
     kind: Option<ModelKind>,
 }
 
@@ -49,6 +51,7 @@ impl MatrixTrc {
             matrix,
             trc,
             inverse_matrix: [[0.0; 3]; 3],
+            ranges: [(0.0, 1.0); 3],
             kind: None,
         };
         m.prepare(kind)?;
@@ -65,6 +68,7 @@ impl MatrixTrc {
             .try_inverse()
             .ok_or(f64::INFINITY)?;
         self.inverse_matrix = std::array::from_fn(|r| std::array::from_fn(|c| inv[(r, c)]));
+        self.ranges = output_ranges(&self.trc);
         self.kind = Some(kind);
         Ok(())
     }
@@ -92,16 +96,26 @@ impl DisplayModel for MatrixTrc {
     fn inverse(&self, xyz: [f64; 3]) -> Inverse {
         let d = std::array::from_fn(|c| xyz[c] - self.black[c]);
         let lin = mul(&self.inverse_matrix, d);
-        Inverse::from_unclipped(std::array::from_fn(|c| self.trc[c].inverse(lin[c])))
+        Inverse::from_outputs(&self.trc, &self.ranges, lin)
     }
 }
 
+/// Each curve's output at drive 0 and 1.
+pub fn output_ranges(curves: &[Trc; 3]) -> [(f64, f64); 3] {
+    std::array::from_fn(|c| (curves[c].eval(0.0), curves[c].eval(1.0)))
+}
+
 impl Inverse {
-    /// Clips to 0..=1 and flags targets whose drive leaves it by more than the tolerance.
-    pub fn from_unclipped(unclipped: [f64; 3]) -> Inverse {
-        let out_of_gamut = unclipped
-            .iter()
-            .any(|&v| !(-GAMUT_TOLERANCE..=1.0 + GAMUT_TOLERANCE).contains(&v) || v.is_nan());
+    /// The inverse through per-channel curves for channel outputs `out`: out of gamut when
+    /// an output leaves the curve's range over drive 0–1 (`ranges`, from
+    /// [`output_ranges`]) by more than [`GAMUT_TOLERANCE`].
+    pub fn from_outputs(curves: &[Trc; 3], ranges: &[(f64, f64); 3], out: [f64; 3]) -> Inverse {
+        let unclipped: [f64; 3] = std::array::from_fn(|c| curves[c].inverse(out[c]));
+        let out_of_gamut = (0..3).any(|c| {
+            let (lo, hi) = ranges[c];
+            let tol = GAMUT_TOLERANCE * (hi - lo).abs();
+            out[c].is_nan() || out[c] < lo - tol || out[c] > hi + tol
+        });
         Inverse {
             rgb: unclipped.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }),
             unclipped,

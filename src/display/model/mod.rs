@@ -16,14 +16,19 @@ pub use gog::{fit_gog, fit_gog_curve};
 pub use least_squares::levenberg_marquardt;
 pub use lut::{fit_lut, Lut3d};
 pub use matrix_lsq::fit_matrix_lsq;
-pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
+pub use matrix_trc::{condition_number, output_ranges, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma, fit_power_gamma};
 pub use trc::Trc;
 
 use serde::{Deserialize, Serialize};
 
-/// A drive value further than this outside 0–1 marks a target out of gamut.
-pub const GAMUT_TOLERANCE: f64 = 1e-6;
+/// A target whose channel output (R′, G′, B′ in Eq. 9, normalised so full drive gives 1)
+/// lies further than this outside the range that drive values 0–1 produce is out of gamut.
+/// It is judged on the output, not on the drive value, because a TRC's inverse magnifies
+/// rounding near black (d = v^(1/γ) turns −10⁻⁷ into −7·10⁻⁴ for γ = 2.2); 10⁻⁵ of full
+/// output is above float32 image precision and measurement rounding, far below a visible
+/// difference.
+pub const GAMUT_TOLERANCE: f64 = 1e-5;
 
 /// A display's colorimetric behaviour.
 pub trait DisplayModel: Send + Sync {
@@ -41,7 +46,8 @@ pub struct Inverse {
     pub rgb: [f64; 3],
     /// The model's solution before clipping.
     pub unclipped: [f64; 3],
-    /// The unclipped solution leaves 0..=1 by more than [`GAMUT_TOLERANCE`].
+    /// The target needs a channel output outside what drive values 0–1 give, by more than
+    /// [`GAMUT_TOLERANCE`] of full output.
     pub out_of_gamut: bool,
 }
 
