@@ -236,6 +236,18 @@ pub fn fit_lut(set: &PatchSet, patches: &[Patch]) -> Result<Lut3d, FitError> {
             ),
         });
     }
+    // With only black and full drive on an axis nothing tells the shaper's curvature, and
+    // the tetrahedra would interpolate light linearly in drive (ΔE00 ≈ 46 on a γ 2.2
+    // display, `metamer budget`): refuse rather than mislead.
+    if let Some(c) = (0..3).find(|&c| set.intermediate_levels(c) == 0) {
+        return Err(FitError::Missing {
+            model: kind,
+            what: format!(
+                "a {} ramp with at least one level between 0 and 1 for the shaper curve",
+                CHANNEL_NAMES[c]
+            ),
+        });
+    }
     let shaper: [Trc; 3] = std::array::from_fn(|c| {
         let pts = ramp_points(set, black, &m, c);
         if set.intermediate_levels(c) >= TABLE_SHAPER_LEVELS {
