@@ -50,7 +50,19 @@ impl Analytic {
         })
     }
 
-    /// Black, white, ramps per channel and a 5³ grid.
+    /// Black, white, ramps per channel and a 5³ grid, each drive triple once.
+    fn unique_patches(&self, ramp_levels: usize) -> Vec<Patch> {
+        let mut out: Vec<Patch> = Vec::new();
+        for p in self.patches(ramp_levels) {
+            if !out.iter().any(|q| q.rgb == p.rgb) {
+                out.push(p);
+            }
+        }
+        out
+    }
+
+    /// Black, white, ramps per channel and a 5³ grid (black, white and grid levels of the
+    /// ramps appear twice, with identical readings).
     fn patches(&self, ramp_levels: usize) -> Vec<Patch> {
         self.patches_with_grid(ramp_levels, 5)
     }
@@ -152,7 +164,10 @@ fn paper_gamma_is_used_when_given() {
         ModelKind::PlccGamma,
         &d.patches(4),
         None,
-        &FitOptions { gamma: Some(2.2) },
+        &FitOptions {
+            gamma: Some(2.2),
+            ..FitOptions::default()
+        },
     )
     .unwrap();
     // Red has γ = 2.2 exactly, so its ramp is reproduced; green (γ 2.3) is not.
@@ -415,4 +430,69 @@ fn lut_names_the_missing_grid_patches() {
         e.contains("1 of the 5×5×5 combinations") && e.contains("r,g,b = 0.500,0.750,0.250"),
         "{e}"
     );
+}
+
+#[test]
+fn verdict_separates_measurement_noise_from_the_display() {
+    let mut d = ideal();
+    d.interaction = 0.03;
+    let patches = d.unique_patches(16);
+    let judged = |noise: Option<f64>| {
+        let options = FitOptions {
+            noise_de00: noise,
+            ..FitOptions::default()
+        };
+        fit_profile_with(ModelKind::Plcc, &patches, None, &options)
+            .unwrap()
+            .diagnostics()
+            .clone()
+    };
+    let exact = judged(None);
+    let a = exact.additivity.as_ref().unwrap().de00;
+    assert!(a > 0.5, "additivity {a}");
+    assert!(exact.failures.iter().any(|f| f.contains("not additive")));
+    assert!(
+        exact.verdict.contains("No patch was measured twice"),
+        "{}",
+        exact.verdict
+    );
+    // a meter whose single reading scatters by ΔE00 a/2 (1σ) cannot tell: 2σ√4 = 2a > a − 0.5
+    let noisy = judged(Some(a / 2.0));
+    assert!(noisy.failures.is_empty(), "{noisy}");
+    assert!(
+        noisy.verdict.contains("Within measurement noise"),
+        "{}",
+        noisy.verdict
+    );
+    assert!(noisy.verdict.contains("additivity"), "{}", noisy.verdict);
+    // a precise one can
+    let precise = judged(Some(0.01));
+    assert!(!precise.failures.is_empty(), "{precise}");
+}
+
+#[test]
+fn noise_is_estimated_from_repeated_patches() {
+    let d = ideal();
+    let mut patches = d.unique_patches(4);
+    let white = d.forward([1.0; 3]);
+    // grey 0.5 measured twice more, ±0.5 % in luminance: ΔE00 of each from the mean
+    let grey = d.forward([0.5; 3]);
+    patches.push(Patch {
+        rgb: [0.5; 3],
+        xyz: grey.map(|v| v * 1.005),
+    });
+    patches.push(Patch {
+        rgb: [0.5; 3],
+        xyz: grey.map(|v| v * 0.995),
+    });
+    let n = metamer::display::diagnostics::repeat_noise(&patches, white).unwrap();
+    assert_eq!(n.source, "1 repeated patches");
+    // three readings at 1, 1.005, 0.995: deviations 0, ±0.5 %; σ² = Σ ΔE² / (3 − 1)
+    let w = Xyz::from_array(white);
+    let e = de00(grey.map(|v| v * 1.005), grey, w);
+    let e2 = de00(grey.map(|v| v * 0.995), grey, w);
+    let want = ((e * e + e2 * e2) / 2.0).sqrt();
+    assert!((n.de00 - want).abs() < 1e-12, "{} vs {want}", n.de00);
+    let p = fit_profile(ModelKind::Plcc, &patches, None).unwrap();
+    assert_eq!(p.diagnostics().noise.as_ref().unwrap(), &n);
 }

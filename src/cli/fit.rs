@@ -18,6 +18,10 @@ pub struct Args {
     /// plcc-gamma only: this exponent for every channel instead of fitting (the paper: 2.2).
     #[arg(long)]
     gamma: Option<f64>,
+    /// The instrument's noise, ΔE00 (1σ) of one reading, so the verdict does not blame the
+    /// display for it; by default estimated from repeated patches, if any.
+    #[arg(long, value_name = "DE00")]
+    noise: Option<f64>,
     /// Where to write the profile (JSON).
     #[arg(short = 'o', long = "output", value_name = "PROFILE.json")]
     output: PathBuf,
@@ -44,7 +48,17 @@ pub fn run(args: Args) -> CliResult {
             args.measurements.display()
         );
     }
-    let options = FitOptions { gamma: args.gamma };
+    if let Some(n) = args.noise {
+        if !(n.is_finite() && n >= 0.0) {
+            return Err(CliError::Usage(format!(
+                "--noise must be a non-negative number, got {n}"
+            )));
+        }
+    }
+    let options = FitOptions {
+        gamma: args.gamma,
+        noise_de00: args.noise,
+    };
     let profile = fit_profile_with(args.model, &m.patches, Some(&args.measurements), &options)?;
     println!(
         "{} patches from {}; model {}",

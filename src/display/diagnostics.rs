@@ -63,9 +63,45 @@ pub struct Diagnostics {
     pub black_share: Option<f64>,
     pub condition_number: Option<f64>,
     pub residuals: Residuals,
-    /// Assumptions that fail, each in one sentence.
+    /// Measurement noise, ΔE00 of one reading (1σ): from repeated patches or given.
+    #[serde(default)]
+    pub noise: Option<Noise>,
+    /// Assumptions that fail beyond the tolerance and the measurement noise, each in one
+    /// sentence.
     pub failures: Vec<String>,
     pub verdict: String,
+}
+
+/// How noisy one reading is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Noise {
+    /// 1σ ΔE00 of a single reading around the mean of its repeats.
+    pub de00: f64,
+    /// Where the figure comes from ("7 repeated patches", "given").
+    pub source: String,
+}
+
+/// The scatter of repeated readings: RMS ΔE00 of each reading from its patch's mean, with
+/// n − 1 degrees of freedom per patch; None when no patch was measured twice.
+pub fn repeat_noise(patches: &[super::Patch], white: [f64; 3]) -> Option<Noise> {
+    let w = Xyz::from_array(white);
+    let key = |p: &super::Patch| p.rgb.map(|d| (d * 1e6).round() as i64);
+    let mut groups: std::collections::HashMap<[i64; 3], Vec<[f64; 3]>> = Default::default();
+    for p in patches {
+        groups.entry(key(p)).or_default().push(p.xyz);
+    }
+    let (mut sum, mut dof, mut repeated) = (0.0, 0usize, 0usize);
+    for xyzs in groups.values().filter(|g| g.len() > 1) {
+        let n = xyzs.len() as f64;
+        let mean: [f64; 3] = std::array::from_fn(|k| xyzs.iter().map(|x| x[k]).sum::<f64>() / n);
+        sum += xyzs.iter().map(|x| de(*x, mean, w).powi(2)).sum::<f64>();
+        dof += xyzs.len() - 1;
+        repeated += 1;
+    }
+    (dof > 0).then(|| Noise {
+        de00: (sum / dof as f64).sqrt(),
+        source: format!("{repeated} repeated patches"),
+    })
 }
 
 fn de(a: [f64; 3], b: [f64; 3], white: Xyz) -> f64 {
@@ -82,11 +118,13 @@ fn xy(v: [f64; 3]) -> (f64, f64) {
 
 impl Diagnostics {
     /// Checks the patch set; `white` is the Lab reference (the display white).
+    /// `noise`: the measurement noise, when known (see [`repeat_noise`]).
     pub fn compute(
         set: &PatchSet,
         model: ModelKind,
         white: [f64; 3],
         residuals: Residuals,
+        noise: Option<Noise>,
     ) -> Diagnostics {
         let w = Xyz::from_array(white);
         let mut channels = Vec::new();
@@ -154,6 +192,22 @@ impl Diagnostics {
                 channels.push(ch);
             }
         }
+        // Σ 1/n over the averaged patches each check combines (n readings each): the check's
+        // noise variance in units of one reading's.
+        let inv = |n: usize| 1.0 / n.max(1) as f64;
+        let primary_inv = |c: usize| set.ramp_readings[c].last().map_or(1.0, |&n| inv(n));
+        let additivity_weight = inv(set.white_readings) + (0..3).map(primary_inv).sum::<f64>();
+        let drift_weights: Vec<f64> = (0..channels.len())
+            .map(|c| {
+                let at = channels[c].drift_at_drive;
+                let n = set.ramps[c]
+                    .iter()
+                    .zip(&set.ramp_readings[c])
+                    .find(|((d, _), _)| Some(*d) == at)
+                    .map_or(1, |(_, &n)| n);
+                inv(n) + primary_inv(c)
+            })
+            .collect();
         let mut d = Diagnostics {
             model,
             tolerance_de00: TOLERANCE_DE00,
@@ -162,50 +216,71 @@ impl Diagnostics {
             black_share,
             condition_number: condition,
             residuals,
+            noise,
             failures: Vec::new(),
             verdict: String::new(),
         };
-        d.judge();
+        d.judge(additivity_weight, &drift_weights);
         d
     }
 
-    fn judge(&mut self) {
+    fn judge(&mut self, additivity_weight: f64, drift_weights: &[f64]) {
         let tol = self.tolerance_de00;
+        let sigma = self.noise.as_ref().map(|n| n.de00);
+        // A check combining patches averaged over n₁, n₂, … readings scatters by about
+        // σ·√(Σ 1/nᵢ); beyond tolerance + twice that the display, not the meter, is to blame.
+        let margin = |weight: f64| sigma.map_or(0.0, |s| 2.0 * s * weight.sqrt());
         let mut failures = Vec::new();
+        let mut in_noise = Vec::new();
         let mut unchecked = Vec::new();
         let mut largest: Vec<String> = Vec::new();
+        let mut judge = |value: f64, readings: f64, failure: String, short: String| {
+            if value <= tol {
+                largest.push(short);
+            } else if value <= tol + margin(readings) {
+                in_noise.push(short);
+            } else {
+                failures.push(failure);
+            }
+        };
         match &self.additivity {
-            Some(a) if a.de00 > tol => failures.push(format!(
-                "the channels are not additive: white differs from black + red + green + blue \
-                 by ΔE00 {:.2} (luminance {:+.1} %)",
-                a.de00, a.luminance_error_percent
-            )),
-            Some(a) => largest.push(format!("additivity {:.2}", a.de00)),
+            Some(a) => judge(
+                a.de00,
+                additivity_weight,
+                format!(
+                    "the channels are not additive: white differs from black + red + green + \
+                     blue by ΔE00 {:.2} (luminance {:+.1} %)",
+                    a.de00, a.luminance_error_percent
+                ),
+                format!("additivity {:.2}", a.de00),
+            ),
             None => unchecked.push("additivity (needs black, the three primaries and white)"),
         }
         if self.channels.is_empty() {
             unchecked.push("chromaticity constancy (needs black and the three primaries)");
         }
         let mut power_notes = Vec::new();
-        for ch in &self.channels {
+        for (c, ch) in self.channels.iter().enumerate() {
             match (ch.chromaticity_drift_de00, ch.levels) {
-                (Some(e), n) if n > 0 && e > tol => failures.push(format!(
-                    "the {} channel's chromaticity drifts along its ramp: ΔE00 {:.2} at drive \
-                     {:.3}{}",
-                    ch.channel,
+                (Some(e), n) if n > 0 => judge(
                     e,
-                    ch.drift_at_drive.unwrap_or(f64::NAN),
-                    ch.chromaticity_drift_xy
-                        .map(|v| format!(" (Δxy up to {v:.4})"))
-                        .unwrap_or_default()
-                )),
-                (Some(e), n) if n > 0 => {
-                    largest.push(format!("{} drift {:.2}", ch.channel, e));
-                }
+                    drift_weights.get(c).copied().unwrap_or(2.0),
+                    format!(
+                        "the {} channel's chromaticity drifts along its ramp: ΔE00 {:.2} at \
+                         drive {:.3}{}",
+                        ch.channel,
+                        e,
+                        ch.drift_at_drive.unwrap_or(f64::NAN),
+                        ch.chromaticity_drift_xy
+                            .map(|v| format!(" (Δxy up to {v:.4})"))
+                            .unwrap_or_default()
+                    ),
+                    format!("{} drift {:.2}", ch.channel, e),
+                ),
                 _ => unchecked.push("chromaticity constancy of a channel without a ramp"),
             }
             if let (Some(e), Some(g)) = (ch.power_law_de00, ch.gamma) {
-                if e > tol {
+                if e > tol + margin(1.0) {
                     power_notes.push(format!(
                         "the {} TRC is not a power law: it deviates from γ = {:.2} by up to \
                          ΔE00 {:.2}",
@@ -225,11 +300,29 @@ impl Diagnostics {
              {:.2}, max {:.2}.",
             self.model, r.patches, r.mean_de00, r.p95_de00, r.max_de00
         );
+        let noise_note = match &self.noise {
+            Some(n) if !in_noise.is_empty() => format!(
+                " Within measurement noise (one reading ±{:.2} ΔE00 1σ, from {}): {}.",
+                n.de00,
+                n.source,
+                in_noise.join(", ")
+            ),
+            Some(_) => String::new(),
+            None if !failures.is_empty() => " No patch was measured twice, so measurement \
+                noise is not separated from the display's behaviour: measure repeats to tell \
+                them apart."
+                .to_string(),
+            None => String::new(),
+        };
         let mut verdict = if failures.is_empty() && unchecked.is_empty() {
-            format!(
-                "PLCC's assumptions hold within ΔE00 {tol} (largest: {}).",
-                largest.join(", ")
-            )
+            if in_noise.is_empty() {
+                format!(
+                    "PLCC's assumptions hold within ΔE00 {tol} (largest: {}).",
+                    largest.join(", ")
+                )
+            } else {
+                format!("PLCC's assumptions hold within ΔE00 {tol} and the measurement noise.")
+            }
         } else if failures.is_empty() {
             format!(
                 "No PLCC assumption fails within ΔE00 {tol} among those checked; not checked: {}.",
@@ -242,6 +335,7 @@ impl Diagnostics {
                 failures.join("; ")
             )
         };
+        verdict.push_str(&noise_note);
         if !power_law_model && !power_notes.is_empty() {
             verdict.push_str(&format!(
                 " Note: {} (plcc-gamma would not cope; measured-ramp TRCs do).",
@@ -284,6 +378,13 @@ impl std::fmt::Display for Diagnostics {
                 a.de00, a.luminance_error_percent
             )?,
             None => writeln!(f, "additivity: not measured")?,
+        }
+        if let Some(n) = &self.noise {
+            writeln!(
+                f,
+                "measurement noise: ΔE00 {:.3} (1σ of one reading, {})",
+                n.de00, n.source
+            )?;
         }
         writeln!(
             f,

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
-use super::diagnostics::{Diagnostics, Residuals};
+use super::diagnostics::{repeat_noise, Diagnostics, Noise, Residuals};
 use super::model::{
     fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind,
     ModelParams,
@@ -45,6 +45,9 @@ pub enum FitError {
 pub struct FitOptions {
     /// plcc-gamma: use this exponent for every channel instead of fitting (the paper: 2.2).
     pub gamma: Option<f64>,
+    /// The instrument's noise, ΔE00 1σ of one reading, when known; otherwise it is estimated
+    /// from repeated patches, if any.
+    pub noise_de00: Option<f64>,
 }
 
 /// Fits `kind` to `patches`; `source` is the measurement file whose hash the profile records.
@@ -94,7 +97,14 @@ pub fn fit_profile_with(
         });
     }
     let residuals = residuals(model, patches, white);
-    let diagnostics = Diagnostics::compute(&set, kind, white, residuals.clone());
+    let noise = match options.noise_de00 {
+        Some(de00) => Some(Noise {
+            de00,
+            source: "given".into(),
+        }),
+        None => repeat_noise(patches, white),
+    };
+    let diagnostics = Diagnostics::compute(&set, kind, white, residuals.clone(), noise);
     let input = match source {
         Some(path) => {
             let bytes = std::fs::read(path).map_err(|e| FitError::Io {

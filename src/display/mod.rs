@@ -14,7 +14,7 @@ pub mod patch_set;
 pub mod profile;
 pub mod reproduce;
 
-pub use diagnostics::{Diagnostics, Residuals};
+pub use diagnostics::{Diagnostics, Noise, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitError, FitOptions};
 pub use measurements::{read_measurement_file, read_measurements, write_ti3, MeasurementsError};
 pub use model::{DisplayModel, Inverse, ModelKind};

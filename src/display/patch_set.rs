@@ -16,6 +16,10 @@ pub struct PatchSet {
     pub primaries: [Option<[f64; 3]>; 3],
     /// Per channel: (drive, XYZ) with only that channel on, drive in (0, 1], sorted, averaged.
     pub ramps: [Vec<(f64, [f64; 3])>; 3],
+    /// Readings averaged into each ramp entry (the last, at drive 1, is the primary).
+    pub ramp_readings: [Vec<usize>; 3],
+    /// Readings averaged into the white.
+    pub white_readings: usize,
 }
 
 fn is(v: f64, target: f64) -> bool {
@@ -38,8 +42,10 @@ impl PatchSet {
             patches.iter().filter(|p| f(p)).map(|p| p.xyz).collect()
         };
         let black = mean(&pick(&|p| p.rgb.iter().all(|&d| is(d, 0.0))));
-        let white = mean(&pick(&|p| p.rgb.iter().all(|&d| is(d, 1.0))));
+        let whites = pick(&|p| p.rgb.iter().all(|&d| is(d, 1.0)));
+        let white = mean(&whites);
         let mut ramps: [Vec<(f64, [f64; 3])>; 3] = Default::default();
+        let mut ramp_readings: [Vec<usize>; 3] = Default::default();
         for (c, ramp) in ramps.iter_mut().enumerate() {
             let mut pts: Vec<(f64, [f64; 3])> = patches
                 .iter()
@@ -57,6 +63,7 @@ impl PatchSet {
                 }
                 let xyz: Vec<[f64; 3]> = pts[i..j].iter().map(|p| p.1).collect();
                 ramp.push((pts[i].0, mean(&xyz).expect("non-empty group")));
+                ramp_readings[c].push(j - i);
                 i = j;
             }
         }
@@ -71,6 +78,8 @@ impl PatchSet {
             white,
             primaries,
             ramps,
+            ramp_readings,
+            white_readings: whites.len(),
         }
     }
 
@@ -108,6 +117,8 @@ mod tests {
         assert_eq!(set.white, Some([100.0; 3]));
         assert_eq!(set.primaries, [Some([20.0; 3]), None, None]);
         assert_eq!(set.ramps[0], vec![(0.5, [6.0; 3]), (1.0, [20.0; 3])]);
+        assert_eq!(set.ramp_readings[0], vec![2, 1]);
+        assert_eq!(set.white_readings, 1);
         assert_eq!(set.intermediate_levels(0), 1);
         assert!(set.ramps[1].is_empty());
     }
