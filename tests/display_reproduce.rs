@@ -239,3 +239,71 @@ fn image_is_mirrored_counted_and_written_at_both_depths() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn reproduce_an_exr_image_from_the_command_line() {
+    let dir = temp_dir("repro-exr");
+    let profile_path = dir.join("p.json");
+    profile().save(&profile_path).unwrap();
+    // 4×3: drive (x/3, y/2, 0.5) per pixel, and one pixel twice as bright as white
+    let (w, h) = (4usize, 3usize);
+    let drive = |x: usize, y: usize| [x as f64 / 3.0, y as f64 / 2.0, 0.5];
+    let mut pixels: Vec<[f32; 3]> = (0..w * h)
+        .map(|i| analytic(drive(i % w, i / w)).map(|v| v as f32))
+        .collect();
+    pixels[w * h - 1] = analytic([1.0; 3]).map(|v| 2.0 * v as f32);
+    let exr = dir.join("i.exr");
+    metamer::render::image_io::write_xyz_image(
+        &exr,
+        &XyzImage {
+            width: w,
+            height: h,
+            pixels,
+        },
+    )
+    .unwrap();
+    let png_path = dir.join("o.png");
+    let out = metamer(&[
+        "reproduce",
+        "--profile",
+        profile_path.to_str().unwrap(),
+        "--image",
+        exr.to_str().unwrap(),
+        "-o",
+        png_path.to_str().unwrap(),
+        "--bits",
+        "16",
+        "--mirror",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("4×3 pixels converted") && stderr.contains("1 out of gamut"),
+        "{stderr}"
+    );
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&png_path).unwrap(),
+    ));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    reader.next_frame(&mut buf).unwrap();
+    let code = |x: usize, y: usize, c: usize| {
+        let i = 2 * (3 * (y * w + x) + c);
+        f64::from(u16::from_be_bytes([buf[i], buf[i + 1]])) / 65535.0
+    };
+    // mirrored: output column x shows input column w − 1 − x
+    for y in 0..h {
+        for x in 0..w {
+            if (w - 1 - x, y) == (w - 1, h - 1) {
+                assert_eq!([code(x, y, 0), code(x, y, 1), code(x, y, 2)], [1.0; 3]);
+                continue;
+            }
+            let want = drive(w - 1 - x, y);
+            for (c, want) in want.iter().enumerate() {
+                let got = code(x, y, c);
+                assert!((got - want).abs() < 2e-3, "({x},{y}) c{c}: {got} vs {want}");
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
