@@ -24,8 +24,9 @@ pub struct Args {
     /// The simulated monitor: ideal-crt, ips-lcd or wide-gamut-ccfl.
     #[arg(long, default_value = "ips-lcd", value_name = "PRESET")]
     display: String,
-    /// Display model: plcc (paper Eq. 9), plcc-gamma, gog, gogo, lut, matrix-lsq.
-    #[arg(long, default_value = "plcc", value_name = "MODEL")]
+    /// Display model: lut (3D LUT, for displays where PLCC's assumptions fail, as the
+    /// simulated LCDs'), plcc (paper Eq. 9), plcc-gamma, gog, gogo, matrix-lsq.
+    #[arg(long, default_value = "lut", value_name = "MODEL")]
     model: String,
     /// Out-of-gamut colours: nearest-lab (least ΔE*ab the display can show) or clip.
     #[arg(long, default_value = "nearest-lab", value_name = "MAPPING")]

@@ -62,13 +62,11 @@ pub fn characterize(
     meter: &mut dyn Instrument,
     instrument_spec: &str,
     model: ModelKind,
-    repeats: usize,
     resume: bool,
     progress: &dyn Fn(usize, usize),
 ) -> Result<(Profile, Summary), LabError> {
     let defaults = PlanOptions::default();
     let plan = Plan::new(PlanOptions {
-        repeats,
         grid_steps: default_grid_steps(model, defaults.ramp_steps),
         ..defaults
     })?;

@@ -50,7 +50,8 @@ pub struct LabOptions {
     pub gamut: GamutMapping,
     /// The simulation's target: 95 % half-width of every patch's ΔE*ab.
     pub target_de: f64,
-    /// Meter readings averaged per patch (box, display characterization, display).
+    /// Meter readings averaged per ColorChecker patch, in the box and on the display (the
+    /// display characterization reads each of its patches once, as `characterize` does).
     pub repeats: usize,
     pub seed: u64,
     /// The simulated meter's time scale (1 = the CS-100A's real ≈100 ms per reading).
@@ -215,7 +216,6 @@ pub fn run_lab(
         display_meter.as_mut(),
         &display_spec,
         opts.model,
-        opts.repeats,
         resume,
         &|done, total| progress(LabProgress::Readings { done, total }),
     )?;
