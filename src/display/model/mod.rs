@@ -55,7 +55,7 @@ pub struct Inverse {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ModelKind {
-    /// Paper Eq. 9 with TRCs interpolated piecewise-linearly from measured ramps.
+    /// Paper Eq. 9 with TRCs interpolated through the measured ramps.
     Plcc,
     /// Paper Eq. 9 with a power-law TRC per channel (fitted, or given as the paper's 2.2).
     PlccGamma,

@@ -1,7 +1,8 @@
 //! PLCC with black correction (paper Eq. 9; Post & Calhoun, "An evaluation of methods for
 //! producing desired colors on CRT monitors", Color Res. Appl. 14(4), 1989): the columns of M
 //! are the full-on primaries minus black, and each channel's TRC comes from its ramp —
-//! interpolated piecewise-linearly (true PLCC) or as a fitted or given power law (the paper
+//! interpolated through every measured level (true PLCC; piecewise linear in the ramp's
+//! power-law domain, see [`super::Trc::Table`]) or as a fitted or given power law (the paper
 //! used 2.2).
 //!
 //! A ramp patch's normalised output is its black-corrected XYZ projected on the primary's
@@ -58,7 +59,7 @@ pub(crate) fn singular(condition: f64) -> FitError {
     }
 }
 
-/// Paper Eq. 9 with piecewise-linear TRCs through the measured ramps.
+/// Paper Eq. 9 with TRCs interpolated through the measured ramps (see [`Trc::Table`]).
 pub fn fit_plcc(set: &PatchSet) -> Result<MatrixTrc, FitError> {
     let kind = ModelKind::Plcc;
     let (black, m) = black_and_primaries(set, kind)?;
