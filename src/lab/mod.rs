@@ -36,7 +36,7 @@ use crate::display::{
 };
 use crate::render::spot::SpotError;
 use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
-use crate::validation::{compare, write_delta_e_chart, Comparison, ValidationError};
+use crate::validation::{compare, write_delta_e_chart_shaded, Comparison, ValidationError};
 
 /// What a lab run is made of.
 #[derive(Clone, Debug, Serialize)]
@@ -289,7 +289,17 @@ impl LabResult {
             let csv = dir.join(format!("{stem}.csv"));
             std::fs::write(&csv, c.to_csv()).map_err(io(&csv))?;
             let svg = dir.join(format!("{stem}.svg"));
-            write_delta_e_chart(c, &svg)?;
+            // Simulation vs box involves no display: nothing to shade there.
+            let shaded: Vec<usize> = if stem == "simulation_vs_box" {
+                Vec::new()
+            } else {
+                self.patches
+                    .iter()
+                    .filter(|p| p.display.out_of_gamut)
+                    .map(|p| p.patch)
+                    .collect()
+            };
+            write_delta_e_chart_shaded(c, &shaded, "outside the display's gamut", &svg)?;
             written.extend([csv, svg]);
         }
         let json = dir.join(LAB_FILE);

@@ -9,6 +9,18 @@ use super::{Comparison, ValidationError, JND_DE76};
 
 /// Writes the per-patch ΔE chart of `comparison` to `file` (SVG).
 pub fn write_delta_e_chart(comparison: &Comparison, file: &Path) -> Result<(), ValidationError> {
+    write_delta_e_chart_shaded(comparison, &[], "", file)
+}
+
+/// [`write_delta_e_chart`] with the 1-based patches in `shaded` on a grey band labelled
+/// `shaded_label` in the legend (the lab marks the colours the display cannot show, so a
+/// reader sees at once which errors no display model could remove).
+pub fn write_delta_e_chart_shaded(
+    comparison: &Comparison,
+    shaded: &[usize],
+    shaded_label: &str,
+    file: &Path,
+) -> Result<(), ValidationError> {
     let chart_err = |e: &dyn std::fmt::Display| ValidationError::Chart {
         file: file.to_path_buf(),
         message: e.to_string(),
@@ -42,6 +54,17 @@ pub fn write_delta_e_chart(comparison: &Comparison, file: &Path) -> Result<(), V
         .disable_x_mesh()
         .draw()
         .map_err(|e| chart_err(&e))?;
+    if !shaded.is_empty() {
+        let band = RGBColor(200, 200, 200).mix(0.6).filled();
+        chart
+            .draw_series(shaded.iter().map(|&k| {
+                let x = k as f64;
+                Rectangle::new([(x - 0.45, 0.0), (x + 0.45, top)], band)
+            }))
+            .map_err(|e| chart_err(&e))?
+            .label(shaded_label)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], band));
+    }
     let bars = |offset: f64, pick: fn(&super::PatchComparison) -> f64, style: ShapeStyle| {
         comparison.patches.iter().map(move |p| {
             let x = p.patch as f64 + offset;

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz, COLORCHECKER_NAMES};
 
-pub use chart::write_delta_e_chart;
+pub use chart::{write_delta_e_chart, write_delta_e_chart_shaded};
 
 /// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
 pub const JND_DE76: f64 = 2.3;
@@ -212,6 +212,14 @@ mod chart_tests {
         let file = std::env::temp_dir().join(format!("metamer-chart-{}.svg", std::process::id()));
         write_delta_e_chart(&c, &file).unwrap();
         let svg = std::fs::read_to_string(&file).unwrap();
+        write_delta_e_chart_shaded(&c, &[7, 16], "out of gamut", &file).unwrap();
+        let shaded = std::fs::read_to_string(&file).unwrap();
+        assert!(shaded.contains("out of gamut") && !svg.contains("out of gamut"));
+        assert_eq!(
+            shaded.matches("<rect").count(),
+            svg.matches("<rect").count() + 3,
+            "two bands and their legend key"
+        );
         if let Ok(dir) = std::env::var("METAMER_KEEP_CHART") {
             std::fs::copy(&file, std::path::Path::new(&dir).join("chart.svg")).unwrap();
         }
