@@ -14,9 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
-use super::{
-    condition_number, output_ranges, DisplayModel, Inverse, ModelKind, Trc, MAX_CONDITION,
-};
+use super::{condition_number, DisplayModel, FastInverse, Inverse, ModelKind, Trc, MAX_CONDITION};
 use crate::display::fit::FitError;
 use crate::display::patch_set::{PatchSet, CHANNEL_NAMES, SAME_DRIVE};
 use crate::display::Patch;
@@ -35,7 +33,7 @@ pub struct Lut3d {
     #[serde(skip)]
     shaped: [Vec<f64>; 3],
     #[serde(skip)]
-    ranges: [(f64, f64); 3],
+    fast: [FastInverse; 3],
 }
 
 impl Lut3d {
@@ -58,7 +56,7 @@ impl Lut3d {
                 ));
             }
         }
-        self.ranges = output_ranges(&self.shaper);
+        self.fast = std::array::from_fn(|c| FastInverse::new(&self.shaper[c]));
         let count: usize = self.levels.iter().map(Vec::len).product();
         if self.nodes.len() != count {
             return Err(format!(
@@ -169,7 +167,7 @@ impl DisplayModel for Lut3d {
                 break;
             }
         }
-        Inverse::from_outputs(&self.shaper, &self.ranges, s.into())
+        Inverse::from_outputs(&self.fast, s.into())
     }
 }
 
@@ -266,7 +264,7 @@ pub fn fit_lut(set: &PatchSet, patches: &[Patch]) -> Result<Lut3d, FitError> {
             .map(|(s, n)| s.map(|v| v / n as f64))
             .collect(),
         shaped: Default::default(),
-        ranges: Default::default(),
+        fast: Default::default(),
     };
     lut.prepare().map_err(|message| FitError::Failed {
         model: kind,

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{DisplayModel, Inverse, ModelKind, Trc, GAMUT_TOLERANCE};
+use super::{DisplayModel, FastInverse, Inverse, ModelKind, Trc, GAMUT_TOLERANCE};
 
 /// Black offset, matrix and one curve per channel.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -17,7 +17,7 @@ pub struct MatrixTrc {
     #[serde(skip)]
     inverse_matrix: [[f64; 3]; 3],
     #[serde(skip)]
-    ranges: [(f64, f64); 3],
+    fast: [FastInverse; 3],
     #[serde(skip)]
     kind: Option<ModelKind>,
 }
@@ -51,7 +51,7 @@ impl MatrixTrc {
             matrix,
             trc,
             inverse_matrix: [[0.0; 3]; 3],
-            ranges: [(0.0, 1.0); 3],
+            fast: Default::default(),
             kind: None,
         };
         m.prepare(kind)?;
@@ -68,7 +68,7 @@ impl MatrixTrc {
             .try_inverse()
             .ok_or(f64::INFINITY)?;
         self.inverse_matrix = std::array::from_fn(|r| std::array::from_fn(|c| inv[(r, c)]));
-        self.ranges = output_ranges(&self.trc);
+        self.fast = std::array::from_fn(|c| FastInverse::new(&self.trc[c]));
         self.kind = Some(kind);
         Ok(())
     }
@@ -96,23 +96,17 @@ impl DisplayModel for MatrixTrc {
     fn inverse(&self, xyz: [f64; 3]) -> Inverse {
         let d = std::array::from_fn(|c| xyz[c] - self.black[c]);
         let lin = mul(&self.inverse_matrix, d);
-        Inverse::from_outputs(&self.trc, &self.ranges, lin)
+        Inverse::from_outputs(&self.fast, lin)
     }
-}
-
-/// Each curve's output at drive 0 and 1.
-pub fn output_ranges(curves: &[Trc; 3]) -> [(f64, f64); 3] {
-    std::array::from_fn(|c| (curves[c].eval(0.0), curves[c].eval(1.0)))
 }
 
 impl Inverse {
     /// The inverse through per-channel curves for channel outputs `out`: out of gamut when
-    /// an output leaves the curve's range over drive 0–1 (`ranges`, from
-    /// [`output_ranges`]) by more than [`GAMUT_TOLERANCE`].
-    pub fn from_outputs(curves: &[Trc; 3], ranges: &[(f64, f64); 3], out: [f64; 3]) -> Inverse {
+    /// an output leaves the curve's range over drive 0–1 by more than [`GAMUT_TOLERANCE`].
+    pub fn from_outputs(curves: &[FastInverse; 3], out: [f64; 3]) -> Inverse {
         let unclipped: [f64; 3] = std::array::from_fn(|c| curves[c].inverse(out[c]));
         let out_of_gamut = (0..3).any(|c| {
-            let (lo, hi) = ranges[c];
+            let (lo, hi) = curves[c].range;
             let tol = GAMUT_TOLERANCE * (hi - lo).abs();
             out[c].is_nan() || out[c] < lo - tol || out[c] > hi + tol
         });

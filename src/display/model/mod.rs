@@ -16,9 +16,9 @@ pub use gog::{fit_gog, fit_gog_curve};
 pub use least_squares::levenberg_marquardt;
 pub use lut::{fit_lut, Lut3d};
 pub use matrix_lsq::fit_matrix_lsq;
-pub use matrix_trc::{condition_number, output_ranges, MatrixTrc, MAX_CONDITION};
+pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma, fit_power_gamma};
-pub use trc::Trc;
+pub use trc::{FastInverse, Trc};
 
 use serde::{Deserialize, Serialize};
 

@@ -103,6 +103,49 @@ impl Trc {
     }
 }
 
+/// A curve's inverse with its constants precomputed, for per-pixel use: a ramp table's
+/// nodes are raised to 1/exponent once here instead of inside every binary search. Gives
+/// the same values as [`Trc::inverse`]; also holds the curve's outputs at drive 0 and 1.
+#[derive(Clone, Debug)]
+pub struct FastInverse {
+    curve: Trc,
+    /// Table nodes as `value^(1/exponent)`; empty for the other curves.
+    root: Vec<f64>,
+    /// Output at drive 0 and at drive 1.
+    pub range: (f64, f64),
+}
+
+impl Default for FastInverse {
+    fn default() -> Self {
+        FastInverse::new(&Trc::Power { gamma: 1.0 })
+    }
+}
+
+impl FastInverse {
+    pub fn new(curve: &Trc) -> FastInverse {
+        let root = match curve {
+            Trc::Table {
+                value, exponent, ..
+            } => value.iter().map(|&v| spow(v, 1.0 / exponent)).collect(),
+            _ => Vec::new(),
+        };
+        FastInverse {
+            curve: curve.clone(),
+            root,
+            range: (curve.eval(0.0), curve.eval(1.0)),
+        }
+    }
+
+    pub fn inverse(&self, v: f64) -> f64 {
+        match &self.curve {
+            Trc::Table {
+                drive, exponent, ..
+            } => interpolate_inverse_root(drive, &self.root, spow(v, 1.0 / exponent)),
+            other => other.inverse(v),
+        }
+    }
+}
+
 fn linear_exponent() -> f64 {
     1.0
 }
@@ -127,19 +170,24 @@ fn interpolate(x: &[f64], y: &[f64], e: f64, t: f64) -> f64 {
 
 /// The drive at which the interpolated `y^(1/e)` reaches `u`.
 fn interpolate_inverse(x: &[f64], y: &[f64], e: f64, u: f64) -> f64 {
-    let n = y.len();
+    let root: Vec<f64> = y.iter().map(|&w| spow(w, 1.0 / e)).collect();
+    interpolate_inverse_root(x, &root, u)
+}
+
+/// The drive at which the straight lines through (x, root) reach `u`.
+fn interpolate_inverse_root(x: &[f64], root: &[f64], u: f64) -> f64 {
+    let n = root.len();
     // First segment whose end reaches u; flat segments resolve to their first drive.
-    let i = match y.partition_point(|&w| spow(w, 1.0 / e) < u) {
+    let i = match root.partition_point(|&w| w < u) {
         0 => 0,
         k if k >= n => n - 2,
         k => k - 1,
     };
-    let (x0, x1) = (x[i], x[i + 1]);
-    let (y0, y1, v) = (spow(y[i], 1.0 / e), spow(y[i + 1], 1.0 / e), u);
+    let (x0, x1, y0, y1) = (x[i], x[i + 1], root[i], root[i + 1]);
     if y1 == y0 {
-        return if v <= y0 { x0 } else { x1 };
+        return if u <= y0 { x0 } else { x1 };
     }
-    x0 + (x1 - x0) * (v - y0) / (y1 - y0)
+    x0 + (x1 - x0) * (u - y0) / (y1 - y0)
 }
 
 /// Sorts by drive, averages repeated drives and fits the closest non-decreasing sequence in
@@ -257,6 +305,34 @@ mod tests {
         assert!((t.eval(1.0) - 1.0).abs() < 1e-12);
         for d in [0.0, 0.1, 0.7, 1.0, 1.2] {
             assert!((t.inverse(t.eval(d)) - d).abs() < 1e-10, "{d}");
+        }
+    }
+
+    #[test]
+    fn fast_inverse_matches_the_curve() {
+        let ramp: Vec<(f64, f64)> = (0..=8)
+            .map(|i| {
+                let d = i as f64 / 8.0;
+                (d, d.powf(2.3) + 0.002 * (d * 9.0).sin())
+            })
+            .collect();
+        let curves = [
+            Trc::table_from_ramp(&ramp),
+            Trc::Power { gamma: 2.2 },
+            Trc::Gog {
+                gain: 1.1,
+                offset: -0.1,
+                gamma: 2.4,
+                flare: 0.01,
+            },
+        ];
+        for t in &curves {
+            let f = FastInverse::new(t);
+            assert_eq!(f.range, (t.eval(0.0), t.eval(1.0)));
+            for i in -20..=140 {
+                let v = i as f64 / 100.0;
+                assert_eq!(f.inverse(v), t.inverse(v), "{t:?} at {v}");
+            }
         }
     }
 }
