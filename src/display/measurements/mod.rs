@@ -9,8 +9,11 @@
 //! cd/m², so absolute = value × LUMINANCE_Y / 100. Only the first table is read: dispread
 //! may append a second (`CAL`) table with the video LUT.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
+
+mod write;
+
+pub use write::write_ti3;
 
 use super::Patch;
 use crate::numeric_csv::{CsvError, NumericCsv};
@@ -345,105 +348,6 @@ fn find_columns(fields: &[String]) -> Result<[usize; 6], String> {
     Ok(out)
 }
 
-/// The white used to normalise a `.ti3`: the brightest patch driven at full on all channels,
-/// or the brightest patch when none is.
-fn white_of(patches: &[Patch]) -> Option<[f64; 3]> {
-    let brightest = |it: &mut dyn Iterator<Item = &Patch>| {
-        it.max_by(|a, b| a.xyz[1].total_cmp(&b.xyz[1]))
-            .map(|p| p.xyz)
-    };
-    brightest(&mut patches.iter().filter(|p| p.rgb == [1.0, 1.0, 1.0]))
-        .or_else(|| brightest(&mut patches.iter()))
-}
-
-/// `ctime()`-style UTC date, as dispread writes in CREATED.
-fn created_now() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs() as i64)
-        .unwrap_or(0);
-    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
-    // Civil date from days since 1970-01-01 (H. Hinnant, "chrono-Compatible Low-Level Date
-    // Algorithms", days_from_civil inverse).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
-    const WEEKDAYS: [&str; 7] = ["Thu", "Fri", "Sat", "Sun", "Mon", "Tue", "Wed"];
-    const MONTHS: [&str; 12] = [
-        "Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec",
-    ];
-    format!(
-        "{} {} {:2} {:02}:{:02}:{:02} {}",
-        WEEKDAYS[days.rem_euclid(7) as usize],
-        MONTHS[(month - 1) as usize],
-        day,
-        rem / 3600,
-        rem % 3600 / 60,
-        rem % 60,
-        year
-    )
-}
-
-/// Writes patches as ArgyllCMS dispread does: RGB in 0–100, XYZ normalised to the white's
-/// Y = 100 with the white's absolute XYZ in `LUMINANCE_XYZ_CDM2`. `description` goes into the
-/// DESCRIPTOR keyword.
-pub fn write_ti3(path: &Path, patches: &[Patch], description: &str) -> std::io::Result<()> {
-    let white = white_of(patches).filter(|w| w[1] > 0.0).ok_or_else(|| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "no patch with positive luminance to normalise the .ti3 to",
-        )
-    })?;
-    let k = 100.0 / white[1];
-    let mut s = String::new();
-    s.push_str("CTI3   \n\n");
-    s.push_str(&format!(
-        "DESCRIPTOR \"{}\"\n\n",
-        description.replace('"', "'")
-    ));
-    s.push_str("ORIGINATOR \"metamer\"\n\n");
-    s.push_str(&format!("CREATED \"{}\"\n", created_now()));
-    for (name, value) in [
-        ("DEVICE_CLASS", "DISPLAY".to_string()),
-        ("COLOR_REP", "RGB_XYZ".to_string()),
-        (
-            "LUMINANCE_XYZ_CDM2",
-            format!("{:.6} {:.6} {:.6}", white[0], white[1], white[2]),
-        ),
-        ("NORMALIZED_TO_Y_100", "YES".to_string()),
-    ] {
-        s.push_str(&format!("KEYWORD \"{name}\"\n{name} \"{value}\"\n"));
-    }
-    s.push_str("\nNUMBER_OF_FIELDS 7\nBEGIN_DATA_FORMAT\n");
-    s.push_str("SAMPLE_ID RGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z \nEND_DATA_FORMAT\n\n");
-    s.push_str(&format!("NUMBER_OF_SETS {}\nBEGIN_DATA\n", patches.len()));
-    for (i, p) in patches.iter().enumerate() {
-        s.push_str(&format!(
-            "{} {:.6} {:.6} {:.6} {:.6} {:.6} {:.6} \n",
-            i + 1,
-            p.rgb[0] * 100.0,
-            p.rgb[1] * 100.0,
-            p.rgb[2] * 100.0,
-            p.xyz[0] * k,
-            p.xyz[1] * k,
-            p.xyz[2] * k
-        ));
-    }
-    s.push_str("END_DATA\n");
-    // Write a sibling then rename: an interrupted write never leaves a half file in place.
-    let tmp = path.with_extension("ti3.partial");
-    let mut f = std::fs::File::create(&tmp)?;
-    f.write_all(s.as_bytes())?;
-    f.sync_all()?;
-    std::fs::rename(&tmp, path)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -534,39 +438,6 @@ DESCRIPTOR "Argyll Device Calibration State"
             msg(&DISPREAD.replace("\"190.10 200.00 217.76\"", "\"190.10\""))
                 .starts_with("bad.ti3:13: LUMINANCE_XYZ_CDM2")
         );
-    }
-
-    #[test]
-    fn write_then_read_round_trips_absolute_values() {
-        let patches = vec![
-            Patch {
-                rgb: [0.0, 0.0, 0.0],
-                xyz: [0.2, 0.21, 0.3],
-            },
-            Patch {
-                rgb: [1.0, 1.0, 1.0],
-                xyz: [152.0, 160.0, 174.2],
-            },
-            Patch {
-                rgb: [128.0 / 255.0, 0.25, 1.0],
-                xyz: [30.5, 20.25, 90.125],
-            },
-        ];
-        let dir = std::env::temp_dir().join(format!("metamer-ti3-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("m.ti3");
-        write_ti3(&path, &patches, "test \"patches\"").unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.contains("LUMINANCE_XYZ_CDM2 \"152.000000 160.000000 174.200000\""));
-        assert!(text.contains("2 100.000000 100.000000 100.000000 95.000000 100.000000 108.875000"));
-        let back = read_measurements(&path).unwrap();
-        for (a, b) in back.iter().zip(&patches) {
-            for c in 0..3 {
-                assert!((a.rgb[c] - b.rgb[c]).abs() < 1e-8);
-                assert!((a.xyz[c] - b.xyz[c]).abs() < 1e-5 * b.xyz[c].max(1.0));
-            }
-        }
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
