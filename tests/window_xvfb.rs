@@ -4,7 +4,7 @@
 //! not collide. Without Xvfb the tests are skipped with a reason, except in CI (`CI` set),
 //! where `.ci/run` installs it and a missing Xvfb is a failure.
 
-use std::io::Read;
+use std::io::BufRead;
 use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
@@ -58,9 +58,12 @@ fn xvfb(width: u32, height: u32) -> Option<Xvfb> {
     // SAFETY: both descriptors came from pipe() above and are owned here alone.
     let mut read_end = unsafe { std::fs::File::from_raw_fd(fds[0]) };
     drop(unsafe { std::fs::File::from_raw_fd(fds[1]) });
+    // Read one line, not to EOF: an Xvfb that another test thread spawns meanwhile inherits
+    // this pipe's write end too and keeps it open, so EOF may never come (seen as a hang).
+    // Xvfb writes the number followed by a newline.
     let mut number = String::new();
-    read_end
-        .read_to_string(&mut number)
+    std::io::BufReader::new(&mut read_end)
+        .read_line(&mut number)
         .expect("Xvfb reports its display number");
     let number = number.trim();
     assert!(
