@@ -69,7 +69,7 @@ fn writes_profile_ti3_log_report_and_summary() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     let out = text(&o.stdout);
     assert!(
-        out.contains("measured 81 readings of virtual:ips-lcd with cs100a"),
+        out.contains("measured 86 readings of virtual:ips-lcd with cs100a"),
         "{out}"
     );
     assert!(
@@ -82,9 +82,9 @@ fn writes_profile_ti3_log_report_and_summary() {
     // The .ti3 holds every raw reading and reads back through the .ti3 reader, white
     // normalised to Y = 100 as ArgyllCMS writes it.
     let ti3 = read_measurements(&dir.join("readings.ti3")).unwrap();
-    assert_eq!(ti3.len(), 81);
+    assert_eq!(ti3.len(), 86);
     let log = logged(&dir);
-    assert_eq!(log.len(), 81);
+    assert_eq!(log.len(), 86);
     for (patch, (_, rgb)) in ti3.iter().zip(&log) {
         let drive: Vec<u64> = patch
             .rgb
@@ -95,7 +95,7 @@ fn writes_profile_ti3_log_report_and_summary() {
     }
     let s = summary(&dir);
     assert_eq!(s["model"], "plcc");
-    assert_eq!(s["readings"], 81);
+    assert_eq!(s["readings"], 86);
     assert_eq!(s["fit_patches"], 33);
     let v = &s["verification"];
     assert_eq!(v["patches"].as_array().unwrap().len(), 48);
@@ -124,7 +124,7 @@ fn writes_profile_ti3_log_report_and_summary() {
     assert_eq!(o.status.code(), Some(1));
     let err = text(&o.stderr);
     assert!(
-        err.contains("log.jsonl exists with 81 reading(s)") && err.contains("--resume"),
+        err.contains("log.jsonl exists with 86 reading(s)") && err.contains("--resume"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
@@ -192,7 +192,8 @@ fn a_lut_gets_a_grid_of_the_ramp_levels() {
         (s["model"].as_str(), s["fit_patches"].as_u64()),
         (Some("lut"), Some(27))
     );
-    assert_eq!(s["readings"], 27 + 48);
+    // The 3³ grid holds the ramps; 48 verification patches; black, primaries, white twice.
+    assert_eq!(s["readings"], 27 + 48 + 5);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -270,7 +271,7 @@ fn a_killed_session_resumes_to_the_same_patches_as_an_uninterrupted_one() {
     child.wait().unwrap();
     let partial = logged(&dir).len();
     assert!(
-        (10..81).contains(&partial),
+        (10..86).contains(&partial),
         "{partial} readings before the kill"
     );
 
@@ -326,7 +327,7 @@ fn ctrl_c_stops_cleanly_and_the_session_resumes() {
         "{err}"
     );
     let partial = logged(&dir).len();
-    assert!(partial < 81, "{partial}");
+    assert!(partial < 86, "{partial}");
     let o = metamer(&[
         "--display",
         "virtual:ideal-crt",
@@ -337,7 +338,7 @@ fn ctrl_c_stops_cleanly_and_the_session_resumes() {
         "--resume",
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    assert_eq!(logged(&dir).len(), 81);
+    assert_eq!(logged(&dir).len(), 86);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -99,10 +99,15 @@ pub fn finish(
         .iter()
         .find(|p| p.rgb8 == [0; 3])
         .map_or([0.0; 3], |p| p.xyz);
-    let training: Vec<Patch> = averaged
+    // Every usable reading, not the averages: the fit averages repeats itself and needs them
+    // to estimate the meter's noise for its verdict.
+    let training: Vec<Patch> = readings
         .iter()
-        .filter(|p| p.purpose == Purpose::Fit)
-        .map(|p| p.to_patch())
+        .filter(|(p, r)| p.purpose == Purpose::Fit && usable(r))
+        .map(|(p, r)| Patch {
+            rgb: p.rgb.map(|c| f64::from(c) / 255.0),
+            xyz: r.xyz,
+        })
         .collect();
     let profile = fit_profile(model, &training, Some(log))
         .map_err(|source| FinishError::Fit { model, source })?;
@@ -155,7 +160,10 @@ pub fn finish(
         verdict: diagnostics.verdict.clone(),
         failures: diagnostics.failures.clone(),
         readings: readings.len(),
-        fit_patches: training.len(),
+        fit_patches: averaged
+            .iter()
+            .filter(|p| p.purpose == Purpose::Fit)
+            .count(),
         white_xyz: white,
         black_xyz: black,
         fit_residuals: diagnostics.residuals.clone(),

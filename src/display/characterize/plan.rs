@@ -95,13 +95,17 @@ pub enum PlanError {
     GridSteps(usize),
 }
 
+/// Black, red, green, blue and white: the first patches of every plan.
+const KEY_PATCHES: usize = 5;
+
 /// The ordered list of patches to show and measure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Plan {
     pub options: PlanOptions,
     /// The distinct patches, in measuring order within a pass.
     pub distinct: Vec<PlannedPatch>,
-    /// Every measurement: `distinct` × repeats.
+    /// Every measurement: `distinct` × repeats, and with one repeat a second reading of
+    /// black, the primaries and white at the end.
     pub patches: Vec<PlannedPatch>,
 }
 
@@ -183,6 +187,19 @@ impl Plan {
                 patches.push(PlannedPatch {
                     index: repeat * distinct.len() + p.patch,
                     repeat,
+                    ..p.clone()
+                });
+            }
+        }
+        if options.repeats == 1 {
+            // Black, the primaries and white once more at the end: the fit needs repeated
+            // patches to tell the meter's noise from the display's faults (the additivity
+            // check combines five readings; the CS-100A's ±0.001 in xy alone is ΔE00 ≈ 1 on
+            // it), and a change between the two readings shows drift during the session.
+            for p in &distinct[..KEY_PATCHES] {
+                patches.push(PlannedPatch {
+                    index: patches.len(),
+                    repeat: 1,
                     ..p.clone()
                 });
             }
@@ -276,7 +293,19 @@ mod tests {
         let plan = Plan::new(PlanOptions::default()).unwrap();
         // 5 + 4 ramps × 7 interior levels + 24 random + 24 ColorChecker.
         assert_eq!(plan.distinct.len(), 5 + 28 + 48);
-        assert_eq!(plan.patches, plan.distinct);
+        assert_eq!(plan.patches[..81], plan.distinct[..]);
+        // With one repeat, black, the primaries and white are read again at the end.
+        assert_eq!(plan.patches.len(), 86);
+        for (i, p) in plan.patches[81..].iter().enumerate() {
+            assert_eq!((p.index, p.patch, p.repeat), (81 + i, i, 1));
+            assert_eq!(p.rgb, plan.distinct[i].rgb);
+        }
+        let twice = Plan::new(PlanOptions {
+            repeats: 2,
+            ..PlanOptions::default()
+        })
+        .unwrap();
+        assert_eq!(twice.patches.len(), 2 * 81);
         let fit: Vec<_> = plan
             .distinct
             .iter()

@@ -394,11 +394,11 @@ mod tests {
             .unwrap_err();
         let text = e.to_string();
         assert!(
-            text.starts_with("patch 1 of 81 (black, RGB [0, 0, 0]): "),
+            text.starts_with("patch 1 of 86 (black, RGB [0, 0, 0]): "),
             "{text}"
         );
         assert!(
-            text.contains("0 of 81 readings are safe in") && text.contains("--resume"),
+            text.contains("0 of 86 readings are safe in") && text.contains("--resume"),
             "{text}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
