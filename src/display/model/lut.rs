@@ -34,6 +34,13 @@ pub struct Lut3d {
     shaped: [Vec<f64>; 3],
     #[serde(skip)]
     fast: [FastInverse; 3],
+    /// Largest |Y| of the nodes: the scale of the inverse's convergence test.
+    #[serde(skip)]
+    scale: f64,
+    /// The inverse's start: black and the inverse of the matrix of the full-on primaries
+    /// minus black (None when singular).
+    #[serde(skip)]
+    start: ([f64; 3], Option<Matrix3<f64>>),
 }
 
 impl Lut3d {
@@ -67,6 +74,15 @@ impl Lut3d {
                 self.levels[2].len()
             ));
         }
+        self.scale = self.nodes.iter().map(|n| n[1].abs()).fold(1e-12, f64::max);
+        let black = self.node([0, 0, 0]);
+        let last = self.levels.clone().map(|l| l.len() - 1);
+        let m = Matrix3::from_columns(&[
+            self.node([last[0], 0, 0]) - black,
+            self.node([0, last[1], 0]) - black,
+            self.node([0, 0, last[2]]) - black,
+        ]);
+        self.start = (black.into(), m.try_inverse());
         Ok(())
     }
 
@@ -123,22 +139,12 @@ impl DisplayModel for Lut3d {
 
     fn inverse(&self, xyz: [f64; 3]) -> Inverse {
         let target = Vector3::from(xyz);
-        let scale = self.nodes.iter().map(|n| n[1].abs()).fold(1e-12, f64::max);
+        let scale = self.scale;
         // Start from the linear map through black and the three full-on primaries.
-        let black = self.node([0, 0, 0]);
-        let last = [
-            self.levels[0].len() - 1,
-            self.levels[1].len() - 1,
-            self.levels[2].len() - 1,
-        ];
-        let m = Matrix3::from_columns(&[
-            self.node([last[0], 0, 0]) - black,
-            self.node([0, last[1], 0]) - black,
-            self.node([0, 0, last[2]]) - black,
-        ]);
-        let mut s: Vector3<f64> = m
-            .try_inverse()
-            .map_or(Vector3::repeat(0.5), |inv| inv * (target - black));
+        let (black, start) = &self.start;
+        let mut s: Vector3<f64> = start.map_or(Vector3::repeat(0.5), |inv| {
+            inv * (target - Vector3::from(*black))
+        });
         let (mut value, mut jac) = self.eval_shaped(s.into());
         let mut err = (value - target).norm();
         for _ in 0..60 {
@@ -265,6 +271,8 @@ pub fn fit_lut(set: &PatchSet, patches: &[Patch]) -> Result<Lut3d, FitError> {
             .collect(),
         shaped: Default::default(),
         fast: Default::default(),
+        scale: 1.0,
+        start: ([0.0; 3], None),
     };
     lut.prepare().map_err(|message| FitError::Failed {
         model: kind,
