@@ -43,6 +43,30 @@ pub struct LogHeader {
     pub started_s: f64,
 }
 
+impl LogHeader {
+    /// The header of a log of `plan` starting now.
+    pub fn new(
+        plan: &Plan,
+        display: &str,
+        instrument: &str,
+        instrument_info: InstrumentInfo,
+    ) -> LogHeader {
+        LogHeader {
+            format: LOG_FORMAT.into(),
+            version: LOG_VERSION,
+            plan_hash: plan.hash(),
+            ramp_steps: plan.options.ramp_steps,
+            repeats: plan.options.repeats,
+            grid_steps: plan.options.grid_steps,
+            readings: plan.patches.len(),
+            display: display.into(),
+            instrument: instrument.into(),
+            instrument_info,
+            started_s: metamer_drivers::instrument::now_s(),
+        }
+    }
+}
+
 /// One reading line.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LogReading {
@@ -333,22 +357,18 @@ mod tests {
 
     fn header(plan: &Plan) -> LogHeader {
         LogHeader {
-            format: LOG_FORMAT.into(),
-            version: LOG_VERSION,
-            plan_hash: plan.hash(),
-            ramp_steps: plan.options.ramp_steps,
-            repeats: plan.options.repeats,
-            grid_steps: plan.options.grid_steps,
-            readings: plan.patches.len(),
-            display: "virtual:ips-lcd".into(),
-            instrument: "sim:cs100a".into(),
-            instrument_info: InstrumentInfo {
-                model: "cs100a".into(),
-                serial: None,
-                firmware: None,
-                connection: "sim:cs100a".into(),
-            },
             started_s: 1.0,
+            ..LogHeader::new(
+                plan,
+                "virtual:ips-lcd",
+                "sim:cs100a",
+                InstrumentInfo {
+                    model: "cs100a".into(),
+                    serial: None,
+                    firmware: None,
+                    connection: "sim:cs100a".into(),
+                },
+            )
         }
     }
 

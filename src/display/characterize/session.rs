@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use metamer_drivers::{DriverError, Instrument, InstrumentInfo, Reading, Request};
 
-use super::log::{LogError, LogHeader, LogReading, SessionLog, LOG_FILE, LOG_FORMAT, LOG_VERSION};
+use super::log::{LogError, LogHeader, LogReading, SessionLog, LOG_FILE};
 use super::plan::{Plan, PlannedPatch};
 use crate::display::patch_display::{PatchDisplay, PatchDisplayError};
 
@@ -105,19 +105,7 @@ impl Session {
             dir: dir.to_path_buf(),
             source,
         })?;
-        let header = LogHeader {
-            format: LOG_FORMAT.into(),
-            version: LOG_VERSION,
-            plan_hash: plan.hash(),
-            ramp_steps: plan.options.ramp_steps,
-            repeats: plan.options.repeats,
-            grid_steps: plan.options.grid_steps,
-            readings: plan.patches.len(),
-            display: display.into(),
-            instrument: instrument.into(),
-            instrument_info,
-            started_s: metamer_drivers::instrument::now_s(),
-        };
+        let header = LogHeader::new(&plan, display, instrument, instrument_info);
         let mut readings = vec![None; plan.patches.len()];
         let (log, recovered, torn_bytes) = if resume && dir.join(LOG_FILE).exists() {
             let (log, rec) = SessionLog::resume(dir, &plan, &header)?;

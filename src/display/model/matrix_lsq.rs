@@ -6,25 +6,16 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::plcc::{black_and_primaries, ramp_points, singular};
-use super::{MatrixTrc, ModelKind, Trc};
+use super::plcc::{black_and_primaries, ramp_tables, singular};
+use super::{MatrixTrc, ModelKind};
 use crate::display::fit::FitError;
-use crate::display::patch_set::{PatchSet, CHANNEL_NAMES};
+use crate::display::patch_set::PatchSet;
 use crate::display::Patch;
 
 pub fn fit_matrix_lsq(set: &PatchSet, patches: &[Patch]) -> Result<MatrixTrc, FitError> {
     let kind = ModelKind::MatrixLsq;
     let (black, m) = black_and_primaries(set, kind)?;
-    let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });
-    for (c, t) in trc.iter_mut().enumerate() {
-        if set.intermediate_levels(c) == 0 {
-            return Err(FitError::Missing {
-                model: kind,
-                what: format!("a {} ramp to interpolate its TRC", CHANNEL_NAMES[c]),
-            });
-        }
-        *t = Trc::table_from_ramp(&ramp_points(set, black, &m, c));
-    }
+    let trc = ramp_tables(set, kind, black, &m)?;
     let white_y = set
         .white
         .map_or_else(|| black[1] + m[1].iter().sum::<f64>(), |w| w[1]);

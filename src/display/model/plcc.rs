@@ -63,21 +63,36 @@ pub(crate) fn singular(condition: f64) -> FitError {
 pub fn fit_plcc(set: &PatchSet) -> Result<MatrixTrc, FitError> {
     let kind = ModelKind::Plcc;
     let (black, m) = black_and_primaries(set, kind)?;
-    let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });
-    for (c, t) in trc.iter_mut().enumerate() {
-        if set.intermediate_levels(c) == 0 {
-            return Err(FitError::Missing {
-                model: kind,
-                what: format!(
-                    "a {} ramp (patches with only {} on, between 0 and 1) to interpolate its \
-                     TRC; use plcc-gamma with --gamma to assume a power law instead",
-                    CHANNEL_NAMES[c], CHANNEL_NAMES[c]
-                ),
-            });
-        }
-        *t = Trc::table_from_ramp(&ramp_points(set, black, &m, c));
-    }
+    let trc = ramp_tables(set, kind, black, &m)?;
     MatrixTrc::new(kind, black, m, trc).map_err(singular)
+}
+
+/// Each channel's TRC interpolated through its measured ramp (black-corrected against
+/// `black` and the primaries' matrix `m`); a channel without a ramp is an error for `kind`.
+pub fn ramp_tables(
+    set: &PatchSet,
+    kind: ModelKind,
+    black: [f64; 3],
+    m: &[[f64; 3]; 3],
+) -> Result<[Trc; 3], FitError> {
+    if let Some(c) = (0..3).find(|&c| set.intermediate_levels(c) == 0) {
+        let hint = if kind == ModelKind::Plcc {
+            "; use plcc-gamma with --gamma to assume a power law instead"
+        } else {
+            ""
+        };
+        return Err(FitError::Missing {
+            model: kind,
+            what: format!(
+                "a {} ramp (patches with only {} on, between 0 and 1) to interpolate its \
+                 TRC{hint}",
+                CHANNEL_NAMES[c], CHANNEL_NAMES[c]
+            ),
+        });
+    }
+    Ok(std::array::from_fn(|c| {
+        Trc::table_from_ramp(&ramp_points(set, black, m, c))
+    }))
 }
 
 /// Least-squares exponent of `d^γ` through ramp points (golden-section search on ln γ;
