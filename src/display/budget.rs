@@ -18,8 +18,8 @@ use std::time::Instant;
 use metamer_drivers::{open_instrument, Request, SharedStimulus};
 use serde::Serialize;
 
-use super::characterize::default_grid_steps;
-use super::virtual_display::{quantize, Preset, VirtualPanel};
+use super::characterize::{default_grid_steps, Plan, PlanOptions, PlannedPatch, Purpose};
+use super::virtual_display::{Preset, VirtualPanel};
 use super::Patch;
 use super::{fit_profile, ModelKind};
 use crate::color::{delta_e2000, Xyz};
@@ -46,33 +46,22 @@ pub fn budget_for(model: ModelKind, ramp_steps: usize) -> Budget {
     }
 }
 
-/// The drive values of a budget: black, the red, green, blue and grey ramps, the cube;
-/// each distinct 8-bit colour once.
-pub fn budget_patches(b: Budget) -> Vec<[u8; 3]> {
-    let mut out: Vec<[u8; 3]> = vec![[0, 0, 0]];
-    let mut push = |rgb: [u8; 3]| {
-        if !out.contains(&rgb) {
-            out.push(rgb);
-        }
-    };
-    let steps = b.ramp_steps.max(2);
-    for i in 1..steps {
-        let v = quantize(i as f64 / (steps - 1) as f64);
-        for rgb in [[v, 0, 0], [0, v, 0], [0, 0, v], [v, v, v]] {
-            push(rgb);
-        }
-    }
-    if b.cube >= 2 {
-        let level = |i: usize| quantize(i as f64 / (b.cube - 1) as f64);
-        for r in 0..b.cube {
-            for g in 0..b.cube {
-                for bl in 0..b.cube {
-                    push([level(r), level(g), level(bl)]);
-                }
-            }
-        }
-    }
-    out
+/// The drive values `characterize` measures for a budget, in order (the fit patches of its
+/// plan: black, primaries, white, ramps, grid, and black, primaries and white once more),
+/// and how many distinct patches they are.
+pub fn budget_patches(b: Budget) -> (Vec<[u8; 3]>, usize) {
+    let plan = Plan::new(PlanOptions {
+        ramp_steps: b.ramp_steps,
+        repeats: 1,
+        grid_steps: b.cube,
+    })
+    .expect("budgets are valid plans");
+    let fit = |p: &&PlannedPatch| p.purpose == Purpose::Fit;
+    let distinct = plan.distinct.iter().filter(fit).count();
+    (
+        plan.patches.iter().filter(fit).map(|p| p.rgb).collect(),
+        distinct,
+    )
 }
 
 /// One point of the chart.
@@ -151,7 +140,7 @@ pub fn run_budget_study(
             for steps in RAMP_STEPS {
                 done += 1;
                 let budget = budget_for(kind, steps);
-                let drive = budget_patches(budget);
+                let (drive, distinct) = budget_patches(budget);
                 let mut errors = Vec::with_capacity(targets.len() * trials.max(1));
                 let mut fit_ms = 0.0;
                 // Each trial is a fresh set of readings (new meter noise); errors are pooled
@@ -189,7 +178,7 @@ pub fn run_budget_study(
                 points.push(BudgetPoint {
                     preset: preset.name().to_string(),
                     model: kind.name().to_string(),
-                    patches: drive.len(),
+                    patches: distinct,
                     ramp_steps: budget.ramp_steps,
                     cube: budget.cube,
                     mean_de00: errors.iter().sum::<f64>() / errors.len() as f64,
@@ -277,10 +266,14 @@ mod tests {
     use super::*;
 
     /// Patch counts by hand: ramps of s steps give black + 4 (s − 1); a cube of g points per
-    /// axis adds g³ minus what the ramps already hold.
+    /// axis adds g³ minus what the ramps already hold; five of them are read twice.
     #[test]
     fn budget_patch_counts_match_a_hand_count() {
-        let count = |ramp_steps, cube| budget_patches(Budget { ramp_steps, cube }).len();
+        let count = |ramp_steps, cube| {
+            let (drive, distinct) = budget_patches(Budget { ramp_steps, cube });
+            assert_eq!(drive.len(), distinct + 5);
+            distinct
+        };
         assert_eq!(count(2, 0), 5);
         assert_eq!(count(3, 0), 9);
         assert_eq!(count(9, 0), 33);
