@@ -18,7 +18,9 @@ use std::time::Instant;
 use metamer_drivers::{open_instrument, Request, SharedStimulus};
 use serde::Serialize;
 
+use super::characterize::plan::random_patches;
 use super::characterize::{default_grid_steps, Plan, PlanOptions, PlannedPatch, Purpose};
+use super::diagnostics::percentile;
 use super::virtual_display::{Preset, VirtualPanel};
 use super::Patch;
 use super::{fit_profile, ModelKind};
@@ -98,24 +100,6 @@ pub enum BudgetError {
     },
 }
 
-/// Seeded uniform random 8-bit colours (SplitMix64, so the set never changes).
-fn verification_colours(n: usize, seed: u64) -> Vec<[u8; 3]> {
-    let mut s = seed;
-    let mut next = || {
-        s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = s;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 56) as u8
-    };
-    (0..n).map(|_| [next(), next(), next()]).collect()
-}
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    let i = ((sorted.len() - 1) as f64 * p).round() as usize;
-    sorted[i]
-}
-
 /// Runs the study on `presets` with `models`, each budget measured `trials` times;
 /// `progress` gets (done, total) as each model is finished at each budget.
 pub fn run_budget_study(
@@ -125,7 +109,7 @@ pub fn run_budget_study(
     seed: u64,
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<BudgetPoint>, BudgetError> {
-    let targets_rgb = verification_colours(200, seed ^ 0xB0D6E7);
+    let targets_rgb = random_patches(200, seed ^ 0xB0D6E7);
     let total = presets.len() * RAMP_STEPS.len() * models.len();
     let mut done = 0;
     let mut points = Vec::new();
@@ -285,9 +269,9 @@ mod tests {
     }
 
     #[test]
-    fn verification_colours_are_fixed_and_spread() {
-        let a = verification_colours(200, 7);
-        assert_eq!(a, verification_colours(200, 7));
+    fn targets_are_fixed_and_spread() {
+        let a = random_patches(200, 7);
+        assert_eq!(a, random_patches(200, 7));
         let mean: f64 = a.iter().map(|c| f64::from(c[0])).sum::<f64>() / 200.0;
         assert!((mean - 127.5).abs() < 15.0, "{mean}");
     }

@@ -407,3 +407,12 @@ impl std::fmt::Display for Diagnostics {
         write!(f, "verdict: {}", self.verdict)
     }
 }
+
+/// The `q` quantile of ascending, non-empty `sorted`, linear between order statistics (the
+/// one definition of p95 used in fits, verifications and the budget study).
+pub fn percentile(sorted: &[f64], q: f64) -> f64 {
+    let rank = q * (sorted.len() - 1) as f64;
+    let lo = rank.floor() as usize;
+    let hi = rank.ceil() as usize;
+    sorted[lo] + (sorted[hi] - sorted[lo]) * (rank - lo as f64)
+}

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
-use super::diagnostics::{repeat_noise, Diagnostics, Noise, Residuals};
+use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals};
 use super::model::{
     fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind,
     ModelParams,
@@ -152,7 +152,7 @@ pub fn residuals(model: &dyn DisplayModel, patches: &[Patch], white: [f64; 3]) -
     let n = des.len() as f64;
     let mut sorted = des.clone();
     sorted.sort_by(f64::total_cmp);
-    let p95 = sorted[((0.95 * n).ceil() as usize).clamp(1, sorted.len()) - 1];
+    let p95 = percentile(&sorted, 0.95);
     Residuals {
         patches: des.len(),
         mean_de00: des.iter().sum::<f64>() / n,

@@ -233,7 +233,7 @@ impl Plan {
 }
 
 /// `n` drive triplets from SplitMix64 (Steele, Lea, Flood 2014) seeded with `seed`.
-fn random_patches(n: usize, seed: u64) -> Vec<[u8; 3]> {
+pub fn random_patches(n: usize, seed: u64) -> Vec<[u8; 3]> {
     let mut state = seed;
     let mut next = move || {
         state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);

@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use super::plan::{PlannedPatch, Purpose};
 use crate::color::{delta_e2000, Xyz};
+use crate::display::diagnostics::percentile;
 use crate::display::Patch;
 
 /// A planned patch with its readings averaged.
@@ -147,14 +148,6 @@ pub fn verify(
         max: *sorted.last().expect("not empty"),
         patches: verified,
     })
-}
-
-/// The `q` quantile of ascending `sorted`, linear between order statistics.
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    let rank = q * (sorted.len() - 1) as f64;
-    let lo = rank.floor() as usize;
-    let hi = rank.ceil() as usize;
-    sorted[lo] + (sorted[hi] - sorted[lo]) * (rank - lo as f64)
 }
 
 #[cfg(test)]
