@@ -55,7 +55,6 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
 
 /// Characterizes `display` with `meter` into `dir` (the `characterize` session: durable
 /// log, resume, fit, held-out verification, profile, `.ti3`, report).
-#[allow(clippy::too_many_arguments)]
 pub fn characterize(
     dir: &Path,
     display: &mut dyn PatchDisplay,

@@ -32,7 +32,7 @@ use crate::display::characterize::finish::{FinishError, Summary};
 use crate::display::characterize::{LogError, PlanError, SessionError};
 use crate::display::gamut::GamutMapping;
 use crate::display::{
-    ModelKind, PatchDisplay, PatchDisplayError, Preset, ProfileError, VirtualDisplay,
+    ModelKind, PatchDisplay, PatchDisplayError, Preset, ProfileError, VirtualDisplay, VirtualPanel,
 };
 use crate::render::spot::SpotError;
 use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
@@ -203,10 +203,9 @@ pub fn run_lab(
         .collect();
 
     // 3: the display, bright enough for the rendering, characterized.
-    let panel = crate::display::VirtualPanel::preset(opts.display);
+    let panel = VirtualPanel::preset(opts.display);
     let display_white_cd_m2 = white_luminance_for(&panel, &simulated);
-    let mut display =
-        VirtualDisplay::preset(opts.display).with_white_luminance(display_white_cd_m2);
+    let mut display = VirtualDisplay::new(panel.with_white_luminance(display_white_cd_m2));
     let display_spec = meter_spec(opts.seed.wrapping_add(1));
     let mut display_meter = open_instrument(&display_spec, Some(stimulus_of(&display)?))?;
     progress(LabProgress::Stage("characterizing the display"));
