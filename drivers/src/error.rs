@@ -134,6 +134,30 @@ pub enum DriverError {
     /// The instrument cannot do what was asked.
     #[error("the {instrument} cannot do {what}")]
     Unsupported { instrument: String, what: String },
+    /// A model-specific setting the instrument does not have.
+    #[error("the {instrument} has no option '{option}' (known: {known})")]
+    UnknownOption {
+        instrument: String,
+        option: String,
+        known: String,
+    },
+    /// A model-specific setting given a value it does not take.
+    #[error("the {instrument}'s option {option}={value:?}: {message}")]
+    BadOption {
+        instrument: String,
+        option: String,
+        value: String,
+        message: String,
+    },
+    /// A calibration is due (never done, or expired) before the instrument can measure in
+    /// this mode; negotiate it with `calibration_needed`/`calibrate` and measure again.
+    #[error("the {instrument} must be calibrated for {mode} measurements first ({reason}): {}", condition.prompt())]
+    NeedsCalibration {
+        instrument: String,
+        mode: crate::instrument::MeasureMode,
+        condition: crate::instrument::CalibrationCondition,
+        reason: String,
+    },
     /// The simulated instrument could not be started.
     #[error("simulated instrument: {0}")]
     Simulation(String),

@@ -23,40 +23,91 @@ pub struct InstrumentInfo {
 /// What an instrument can do, as data (so the CLI, reports and sessions can decide).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Capabilities {
-    /// Measures light sources (displays, the box's light) in absolute units.
-    pub emissive: bool,
-    /// Measures reflectance of surfaces (with its own lamp).
-    pub reflective: bool,
+    /// The measurement modes it offers, each with the calibrations it needs.
+    pub modes: Vec<ModeInfo>,
     /// Returns a spectrum (not only XYZ).
     pub spectral: bool,
     /// Acceptance angle of a spot meter, degrees (full cone); None for contact devices.
     pub acceptance_angle_deg: Option<f64>,
-    /// Response speeds it offers.
-    pub speeds: Vec<Speed>,
     /// Luminance range it measures, cd/m².
     pub luminance_range_cd_m2: Option<(f64, f64)>,
+    /// Settings particular to this model (CS-100A response speed, an i1Pro's integration
+    /// time), changed with [`Instrument::set_option`]; not part of [`Request`] because no
+    /// other instrument understands them.
+    pub options: Vec<OptionInfo>,
 }
 
-/// Response speed (integration time class) of a measurement.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+impl Capabilities {
+    /// The description of `mode`, if the instrument offers it.
+    pub fn mode(&self, mode: MeasureMode) -> Option<&ModeInfo> {
+        self.modes.iter().find(|m| m.mode == mode)
+    }
+
+    /// Whether the instrument offers `mode`.
+    pub fn supports(&self, mode: MeasureMode) -> bool {
+        self.mode(mode).is_some()
+    }
+}
+
+/// One measurement mode an instrument offers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModeInfo {
+    pub mode: MeasureMode,
+    /// Aimed from a distance through optics with an acceptance angle (a spot meter), rather
+    /// than placed on the target.
+    pub spot: bool,
+    /// The calibrations this mode needs, in the order they are done.
+    pub calibrations: Vec<CalibrationNeed>,
+}
+
+/// A calibration a mode needs and how long it stays valid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationNeed {
+    /// Short stable name (`dark`, `white`).
+    pub name: String,
+    /// What the user must set up for it.
+    pub condition: CalibrationCondition,
+    /// Seconds after which it expires and a measurement answers
+    /// [`DriverError::NeedsCalibration`](crate::DriverError::NeedsCalibration); None when it
+    /// never expires within a session.
+    pub valid_for_s: Option<f64>,
+}
+
+/// A model-specific setting, described as data so a CLI or a log can list and record it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OptionInfo {
+    /// Short stable name (`speed`, `integration_s`).
+    pub name: String,
+    pub description: String,
+    pub values: OptionValues,
+    /// The value in force when the instrument is opened, as text.
+    pub default: String,
+}
+
+/// What values a model-specific setting takes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Speed {
-    /// The instrument's short integration (CS-100A FAST ≈ 100 ms).
-    #[default]
-    Fast,
-    /// The long integration for dark or flickering targets (CS-100A SLOW ≈ 400 ms).
-    Slow,
+pub enum OptionValues {
+    /// One of these words.
+    Choice(Vec<String>),
+    /// A number in `min..=max`, in `unit`; `auto` is allowed where `auto` is true.
+    Number {
+        min: f64,
+        max: f64,
+        unit: String,
+        auto: bool,
+    },
 }
 
-/// What a measurement should be.
+/// What a measurement should be. Model-specific settings are not here but in
+/// [`Instrument::set_option`], so one request means the same to every instrument.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Request {
     pub mode: MeasureMode,
-    pub speed: Speed,
 }
 
 /// Kind of measurement.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MeasureMode {
     /// A light source seen by the instrument: absolute XYZ in cd/m².
@@ -64,6 +115,41 @@ pub enum MeasureMode {
     Emissive,
     /// A surface lit by the instrument's lamp: relative XYZ (Y = 100 for white).
     Reflective,
+    /// The light falling on the instrument through a diffuser: illuminance XYZ in lux.
+    Ambient,
+}
+
+impl MeasureMode {
+    pub const ALL: [MeasureMode; 3] = [
+        MeasureMode::Emissive,
+        MeasureMode::Reflective,
+        MeasureMode::Ambient,
+    ];
+
+    /// The stable short name used in JSON, logs and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            MeasureMode::Emissive => "emissive",
+            MeasureMode::Reflective => "reflective",
+            MeasureMode::Ambient => "ambient",
+        }
+    }
+}
+
+impl std::fmt::Display for MeasureMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for MeasureMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        MeasureMode::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown mode '{s}' (known: emissive, reflective, ambient)"))
+    }
 }
 
 /// Conditions a reading is flagged with; the values may still be usable.
@@ -185,18 +271,49 @@ pub enum CalibrationOutcome {
 }
 
 /// Every instrument, whatever its link.
+///
+/// Calibration is negotiated per mode: before measuring in a mode the caller asks
+/// [`Instrument::calibration_needed`], has the user set up the condition, and calls
+/// [`Instrument::calibrate`] until it answers [`CalibrationOutcome::Done`]. A calibration
+/// can expire during a session; [`Instrument::measure`] then answers
+/// [`DriverError::NeedsCalibration`](crate::DriverError::NeedsCalibration) and the caller
+/// negotiates again and repeats the measurement.
 pub trait Instrument: Send {
     fn info(&self) -> InstrumentInfo;
     fn capabilities(&self) -> Capabilities;
-    /// The condition the next calibration needs, or None when none is due.
-    fn calibration_needed(&mut self) -> Result<Option<CalibrationCondition>, crate::DriverError>;
-    /// Calibrates, the user having set up `condition`.
+    /// The condition the next calibration for `mode` needs, or None when none is due.
+    fn calibration_needed(
+        &mut self,
+        mode: MeasureMode,
+    ) -> Result<Option<CalibrationCondition>, crate::DriverError>;
+    /// Calibrates for `mode`, the user having set up `condition`.
     fn calibrate(
         &mut self,
+        mode: MeasureMode,
         condition: &CalibrationCondition,
     ) -> Result<CalibrationOutcome, crate::DriverError>;
     /// Takes one reading.
     fn measure(&mut self, request: &Request) -> Result<Reading, crate::DriverError>;
+    /// Changes a model-specific setting named in [`Capabilities::options`].
+    fn set_option(&mut self, name: &str, value: &str) -> Result<(), crate::DriverError> {
+        let _ = value;
+        Err(crate::DriverError::UnknownOption {
+            instrument: self.info().model,
+            option: name.to_string(),
+            known: self
+                .capabilities()
+                .options
+                .iter()
+                .map(|o| o.name.clone())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+    }
+    /// The model-specific settings in force, as (name, value) text, for logs and resume
+    /// checks.
+    fn option_values(&self) -> Vec<(String, String)> {
+        Vec::new()
+    }
 }
 
 /// What a simulated instrument sees: the light in front of it. A simulated display sets it

@@ -13,10 +13,12 @@ pub mod instrument;
 pub mod link;
 mod spec;
 
+pub use cs100a::Speed;
 pub use error::{DriverError, SERIAL_PERMISSION_FIX};
 pub use instrument::{
-    CalibrationCondition, CalibrationOutcome, Capabilities, Flag, Instrument, InstrumentInfo,
-    MeasureMode, Reading, ReadingSpectrum, Request, SharedStimulus, Speed, Stimulus,
+    CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,
+    InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, ReadingSpectrum,
+    Request, SharedStimulus, Stimulus,
 };
 pub use spec::{
     open_instrument, open_instrument_with, OpenOptions, DEFAULT_STIMULUS_XYZ, TIME_SCALE_ENV,

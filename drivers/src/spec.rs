@@ -170,7 +170,7 @@ fn parse_scale(v: &str) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::instrument::Request;
+    use crate::instrument::{MeasureMode, Request};
 
     #[test]
     fn sim_measures_the_given_stimulus() {
@@ -198,9 +198,12 @@ mod tests {
         assert_eq!(m.info().model, "cs100a");
         assert_eq!(m.info().connection, "sim:cs100a");
         let caps = serde_json::to_value(m.capabilities()).unwrap();
-        assert_eq!(caps["speeds"], serde_json::json!(["fast", "slow"]));
-        assert_eq!(caps["emissive"], true);
-        assert_eq!(m.calibration_needed().unwrap(), None);
+        assert_eq!(
+            caps["options"][0]["values"]["choice"],
+            serde_json::json!(["fast", "slow"])
+        );
+        assert_eq!(caps["modes"][0]["mode"], "emissive");
+        assert_eq!(m.calibration_needed(MeasureMode::Emissive).unwrap(), None);
         let e = m
             .measure(&Request {
                 mode: crate::MeasureMode::Reflective,

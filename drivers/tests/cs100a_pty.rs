@@ -33,12 +33,8 @@ fn readings_through_the_real_serial_backend() {
     let mut meter = open_instrument(&spec, None).unwrap();
     assert_eq!(meter.info().connection, emu.path());
     for speed in [Speed::Fast, Speed::Slow, Speed::Fast] {
-        let r = meter
-            .measure(&Request {
-                speed,
-                ..Request::default()
-            })
-            .unwrap();
+        meter.set_option("speed", speed.name()).unwrap();
+        let r = meter.measure(&Request::default()).unwrap();
         // Repeatability ±0.2 % (2σ) in Y and ±0.001 in x, y; 5σ bounds plus the meter's
         // rounding to 4 significant digits / 4 decimals.
         assert!((r.xyy[2] / 21.26 - 1.0).abs() < 0.005 + 5e-4, "{r:?}");
@@ -70,20 +66,16 @@ fn a_recorded_session_replays_to_the_same_readings() {
         record: Some(path.clone()),
     };
     let mut live = open_instrument_with(&format!("cs100a:{}", emu.path()), &options).unwrap();
-    let slow = Request {
-        speed: Speed::Slow,
-        ..Request::default()
-    };
-    let a = [
-        live.measure(&Request::default()).unwrap(),
-        live.measure(&slow).unwrap(),
-    ];
+    let a = [live.measure(&Request::default()).unwrap(), {
+        live.set_option("speed", "slow").unwrap();
+        live.measure(&Request::default()).unwrap()
+    }];
     drop(live);
     let mut replayed = open_instrument(&format!("replay:{}", path.display()), None).unwrap();
-    let b = [
-        replayed.measure(&Request::default()).unwrap(),
-        replayed.measure(&slow).unwrap(),
-    ];
+    let b = [replayed.measure(&Request::default()).unwrap(), {
+        replayed.set_option("speed", "slow").unwrap();
+        replayed.measure(&Request::default()).unwrap()
+    }];
     for (a, b) in a.iter().zip(&b) {
         assert_eq!(a.xyy, b.xyy);
         assert_eq!(a.xyz, b.xyz);

@@ -8,7 +8,7 @@ use std::path::Path;
 use metamer_drivers::cs100a::Cs100a;
 use metamer_drivers::link::replay::ReplaySerial;
 use metamer_drivers::link::LineSettings;
-use metamer_drivers::{Instrument, MeasureMode, Request, Speed};
+use metamer_drivers::{Instrument, MeasureMode, Request};
 use serde_json::Value;
 
 include!(concat!(env!("OUT_DIR"), "/cs100a_transcript_tests.rs"));
@@ -46,13 +46,12 @@ fn replay_transcript(path: &str) {
                 _ => check_error(r.err(), step, &at),
             }
         } else if let Some(speed) = step.get("measure").and_then(Value::as_str) {
+            if speed != "fast" && speed != "slow" {
+                panic!("{at}: unknown speed {speed}");
+            }
+            meter.set_option("speed", speed).unwrap();
             let request = Request {
                 mode: MeasureMode::Emissive,
-                speed: match speed {
-                    "fast" => Speed::Fast,
-                    "slow" => Speed::Slow,
-                    other => panic!("{at}: unknown speed {other}"),
-                },
             };
             let r = meter.measure(&request);
             if step.get("error").is_some() {

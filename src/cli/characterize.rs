@@ -14,7 +14,7 @@ use metamer::display::characterize::{
 };
 use metamer::display::{DisplaySpec, ModelKind};
 use metamer_drivers::{
-    open_instrument, CalibrationOutcome, DriverError, Instrument, Request, Speed,
+    open_instrument, CalibrationOutcome, DriverError, Instrument, MeasureMode, Request, Speed,
 };
 
 use super::{CliError, CliResult};
@@ -53,8 +53,10 @@ pub struct Args {
     /// plcc (paper Eq. 9), plcc-gamma, gog, gogo, lut or matrix-lsq.
     #[arg(long, default_value = "plcc", value_name = "MODEL")]
     model: String,
-    #[arg(long, value_enum, default_value = "fast")]
-    speed: SpeedArg,
+    /// Response speed of instruments that have one (the CS-100A); default: the
+    /// instrument's (fast).
+    #[arg(long, value_enum)]
+    speed: Option<SpeedArg>,
     /// Continue the session whose log is in DIR (after a crash, Ctrl-C or a pulled cable).
     #[arg(long)]
     resume: bool,
@@ -99,6 +101,13 @@ pub fn run(args: Args) -> CliResult {
             "warning: a simulated instrument cannot see a real screen; it measures its own fixed light"
         );
     }
+    if let Some(speed) = args.speed {
+        let speed = match speed {
+            SpeedArg::Fast => Speed::Fast,
+            SpeedArg::Slow => Speed::Slow,
+        };
+        instrument.set_option("speed", speed.name())?;
+    }
     calibrate(instrument.as_mut())?;
     let info = instrument.info();
     let mut session = Session::open(
@@ -134,13 +143,7 @@ pub fn run(args: Args) -> CliResult {
         settle: args
             .settle_ms
             .map_or(display.default_settle(), Duration::from_millis),
-        request: Request {
-            speed: match args.speed {
-                SpeedArg::Fast => Speed::Fast,
-                SpeedArg::Slow => Speed::Slow,
-            },
-            ..Request::default()
-        },
+        request: Request::default(),
         stop_after: args.stop_after,
         interrupt: Some(on_ctrl_c()),
     };
@@ -236,14 +239,14 @@ fn calibrate(instrument: &mut dyn Instrument) -> Result<(), CliError> {
     // Instruments ask for at most a few conditions in a row (dark, then white tile); more
     // means the user's action did not satisfy it.
     for _ in 0..5 {
-        let Some(condition) = instrument.calibration_needed()? else {
+        let Some(condition) = instrument.calibration_needed(MeasureMode::Emissive)? else {
             return Ok(());
         };
         prompt(&format!(
             "calibration: {}, then press Enter",
             condition.prompt()
         ))?;
-        if instrument.calibrate(&condition)? == CalibrationOutcome::Done {
+        if instrument.calibrate(MeasureMode::Emissive, &condition)? == CalibrationOutcome::Done {
             return Ok(());
         }
     }

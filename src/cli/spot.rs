@@ -22,8 +22,10 @@ pub struct Args {
     /// (options: sim:cs100a?time_scale=0.01&seed=N&noise=off).
     #[arg(long, value_name = "SPEC")]
     instrument: String,
-    #[arg(long, value_enum, default_value = "fast")]
-    speed: SpeedArg,
+    /// Response speed of instruments that have one (the CS-100A); default: the
+    /// instrument's (fast).
+    #[arg(long, value_enum)]
+    speed: Option<SpeedArg>,
     /// Number of readings.
     #[arg(long, default_value_t = 1, value_name = "N")]
     count: u32,
@@ -57,13 +59,14 @@ pub fn run(args: Args) -> CliResult {
         }
         e => CliError::from(e),
     })?;
-    let request = Request {
-        speed: match args.speed {
+    if let Some(speed) = args.speed {
+        let speed = match speed {
             SpeedArg::Fast => Speed::Fast,
             SpeedArg::Slow => Speed::Slow,
-        },
-        ..Request::default()
-    };
+        };
+        instrument.set_option("speed", speed.name())?;
+    }
+    let request = Request::default();
     let info = instrument.info();
     let mut out = std::io::stdout().lock();
     if !args.json {

@@ -17,7 +17,8 @@ use std::time::{Duration, Instant};
 
 use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
 
-use crate::instrument::{Speed, Stimulus};
+use super::Speed;
+use crate::instrument::Stimulus;
 use crate::link::{LineSettings, LinkError, SerialLink};
 
 /// Upper end of the display range, cd/m² (fact sheet §5, unconfirmed).

@@ -15,9 +15,11 @@ use std::time::Duration;
 use metamer_protocols::cs100a::{self, Command, Mode, Reply, Status, Yxy};
 use metamer_protocols::transcript::show_bytes;
 
+use serde::{Deserialize, Serialize};
+
 use crate::instrument::{
     CalibrationCondition, CalibrationOutcome, Capabilities, Flag, Instrument, InstrumentInfo,
-    MeasureMode, Reading, Request, Speed,
+    MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,
 };
 use crate::link::{LinkError, SerialLink};
 use crate::DriverError;
@@ -29,6 +31,30 @@ pub const MODEL: &str = "cs100a";
 /// up on a half-sent command after 5 s (KM-LS p.13, [C]); SLOW takes ≈0.4 s plus ≈64 ms of
 /// wire time, so 5 s never cuts off a meter that is answering.
 pub const REPLY_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// The meter's response speed (its `MDS,06`/`MDS,07` modes), the CS-100A's one
+/// model-specific option (`speed=fast|slow`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Speed {
+    /// FAST, ≈100 ms.
+    #[default]
+    Fast,
+    /// SLOW, ≈400 ms, for dark or flickering targets.
+    Slow,
+}
+
+impl Speed {
+    pub fn name(self) -> &'static str {
+        match self {
+            Speed::Fast => "fast",
+            Speed::Slow => "slow",
+        }
+    }
+}
+
+/// The name of the speed option.
+pub const SPEED_OPTION: &str = "speed";
 
 /// The response time of a speed setting, seconds (MC2, VB, VCC comments; [C2]).
 pub fn response_time_s(speed: Speed) -> f64 {
@@ -44,6 +70,8 @@ pub struct Cs100a<L: SerialLink> {
     /// Speed last acknowledged by the meter; None until set (the meter keeps whatever its
     /// front panel or an earlier session chose).
     speed: Option<Speed>,
+    /// Speed the next measurement uses (the `speed` option).
+    wanted_speed: Speed,
     absolute: bool,
     timeout: Duration,
     /// The meter has answered at least once on this link, so silence now means it went
@@ -57,6 +85,7 @@ impl<L: SerialLink> Cs100a<L> {
         Cs100a {
             link,
             speed: None,
+            wanted_speed: Speed::Fast,
             absolute: false,
             timeout: REPLY_TIMEOUT,
             answered: false,
@@ -252,43 +281,88 @@ impl<L: SerialLink + 'static> Instrument for Cs100a<L> {
 
     fn capabilities(&self) -> Capabilities {
         Capabilities {
-            emissive: true,
-            reflective: false,
+            // A spot meter for light sources only: no lamp, no diffuser.
+            modes: vec![ModeInfo {
+                mode: MeasureMode::Emissive,
+                spot: true,
+                // The meter measures with Minolta's factory calibration (MDS,00 PRESET, the
+                // power-on default [I]); it has no dark or white step the host must drive.
+                calibrations: Vec::new(),
+            }],
             spectral: false,
             // 1° and 0.01–299,000 cd/m² are general knowledge, unconfirmed by a KM source
             // (fact sheet §5).
             acceptance_angle_deg: Some(1.0),
-            speeds: vec![Speed::Fast, Speed::Slow],
             luminance_range_cd_m2: Some((0.01, 299_000.0)),
+            options: vec![OptionInfo {
+                name: SPEED_OPTION.into(),
+                description: "response speed: fast ≈100 ms, slow ≈400 ms for dark or \
+                              flickering targets"
+                    .into(),
+                values: OptionValues::Choice(vec!["fast".into(), "slow".into()]),
+                default: Speed::Fast.name().into(),
+            }],
         }
     }
 
-    fn calibration_needed(&mut self) -> Result<Option<CalibrationCondition>, DriverError> {
-        // The meter measures with Minolta's factory calibration (MDS,00 PRESET, the power-on
-        // default [I]); it has no dark or white calibration step the host must drive.
+    fn calibration_needed(
+        &mut self,
+        _mode: MeasureMode,
+    ) -> Result<Option<CalibrationCondition>, DriverError> {
         Ok(None)
     }
 
     fn calibrate(
         &mut self,
+        _mode: MeasureMode,
         _condition: &CalibrationCondition,
     ) -> Result<CalibrationOutcome, DriverError> {
         Ok(CalibrationOutcome::Done)
     }
 
+    fn set_option(&mut self, name: &str, value: &str) -> Result<(), DriverError> {
+        if name != SPEED_OPTION {
+            return Err(DriverError::UnknownOption {
+                instrument: MODEL.into(),
+                option: name.into(),
+                known: SPEED_OPTION.into(),
+            });
+        }
+        self.wanted_speed = match value {
+            "fast" => Speed::Fast,
+            "slow" => Speed::Slow,
+            _ => {
+                return Err(DriverError::BadOption {
+                    instrument: MODEL.into(),
+                    option: name.into(),
+                    value: value.into(),
+                    message: "expected fast or slow".into(),
+                })
+            }
+        };
+        Ok(())
+    }
+
+    fn option_values(&self) -> Vec<(String, String)> {
+        vec![(SPEED_OPTION.into(), self.wanted_speed.name().into())]
+    }
+
     fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
-        if request.mode == MeasureMode::Reflective {
+        if request.mode != MeasureMode::Emissive {
             return Err(DriverError::Unsupported {
                 instrument: MODEL.into(),
-                what: "reflective measurements (it has no lamp; measure a lit surface emissively)"
-                    .into(),
+                what: format!(
+                    "{} measurements (it has no lamp and no diffuser; measure a lit surface \
+                     emissively)",
+                    request.mode
+                ),
             });
         }
         if !self.absolute {
             self.connect()?;
         }
-        if self.speed != Some(request.speed) {
-            self.set_speed(request.speed)?;
+        if self.speed != Some(self.wanted_speed) {
+            self.set_speed(self.wanted_speed)?;
         }
         let (status, value) = self.measure_yxy()?;
         Ok(reading_from(status, &value, self.speed))
