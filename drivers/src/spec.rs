@@ -207,7 +207,6 @@ mod tests {
         let e = m
             .measure(&Request {
                 mode: crate::MeasureMode::Reflective,
-                ..Request::default()
             })
             .unwrap_err();
         assert!(
