@@ -1,7 +1,7 @@
 //! Konica Minolta CS-100A chroma meter, RS-232C command set: host-side encoding of commands
 //! and parsing of replies, and the device side (parsing commands, encoding replies) for the
-//! emulator. Facts and their confidence tags are in `shared/protocols/cs100a.md`; the byte
-//! layout is described in `protocols/README.md`.
+//! emulator. The facts, their sources and confidence tags ([C], [C2], [I]; KM-CS, PP, MC2, …)
+//! are in `protocols/cs100a/README.md`, which also draws the reply's byte layout.
 //!
 //! Where a fact is only inferred ([I]) the parser accepts both readings of it and a comment
 //! says so.
