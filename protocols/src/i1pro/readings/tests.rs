@@ -94,7 +94,7 @@ fn encoding_checks_shape_and_range() {
         shielded: None,
     };
     assert!(matches!(
-        encode(&[r.clone()], Revision::E, 0),
+        encode(std::slice::from_ref(&r), Revision::E, 0),
         Err(ReadingError::Shape { .. })
     ));
     let mut neg = r.clone();
