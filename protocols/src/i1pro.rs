@@ -14,6 +14,8 @@ pub mod inverse;
 mod linalg;
 pub mod pipeline;
 pub mod readings;
+pub mod replies;
+pub mod timing;
 
 pub use calibration::{Calibration, CalibrationError, Filter, RevECalibration};
 pub use commands::{Request, Transfer};
@@ -71,7 +73,38 @@ pub enum Model {
     I1Pro2,
 }
 
+/// USB vendor id of the i1Pro family.
+pub const VENDOR_ID: u16 = 0x0971;
+/// Product id of the i1Pro and i1Pro 2.
+pub const PRODUCT_I1PRO: u16 = 0x2000;
+/// Product id of the i1Monitor.
+pub const PRODUCT_I1MONITOR: u16 = 0x2001;
+/// Endpoint descriptors in configuration 1 from which a unit is a Rev E.
+const REV_E_ENDPOINTS: usize = 5;
+/// Firmware below this is not a Rev E, whatever its endpoints say.
+const REV_E_MIN_FIRMWARE: u16 = 600;
+
 impl Model {
+    /// The model behind USB ids, the number of endpoint descriptors in configuration 1, and
+    /// the firmware revision once GetMisc has answered (`None` before); `None` for ids that
+    /// are not an i1Pro.
+    pub fn detect(
+        vendor: u16,
+        product: u16,
+        endpoints: usize,
+        firmware: Option<u16>,
+    ) -> Option<Model> {
+        match (vendor, product) {
+            (VENDOR_ID, PRODUCT_I1MONITOR) => Some(Model::I1Monitor),
+            (VENDOR_ID, PRODUCT_I1PRO) => {
+                let rev_e = endpoints >= REV_E_ENDPOINTS
+                    && firmware.is_none_or(|f| f >= REV_E_MIN_FIRMWARE);
+                Some(if rev_e { Model::I1Pro2 } else { Model::I1Pro })
+            }
+            _ => None,
+        }
+    }
+
     pub fn revision(self) -> Revision {
         match self {
             Model::I1Pro | Model::I1Monitor => Revision::AToD,
@@ -85,5 +118,33 @@ impl Model {
             Model::I1Monitor => "i1Monitor",
             Model::I1Pro2 => "i1Pro 2",
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn models_from_usb_ids_endpoints_and_firmware() {
+        assert_eq!(Model::detect(0x0971, 0x2000, 4, None), Some(Model::I1Pro));
+        assert_eq!(Model::detect(0x0971, 0x2000, 5, None), Some(Model::I1Pro2));
+        assert_eq!(
+            Model::detect(0x0971, 0x2000, 5, Some(629)),
+            Some(Model::I1Pro2)
+        );
+        // Five endpoints but Rev D firmware: an i1Pro.
+        assert_eq!(
+            Model::detect(0x0971, 0x2000, 5, Some(505)),
+            Some(Model::I1Pro)
+        );
+        assert_eq!(
+            Model::detect(0x0971, 0x2001, 4, None),
+            Some(Model::I1Monitor)
+        );
+        assert_eq!(Model::detect(0x0971, 0x2003, 4, None), None);
+        assert_eq!(Model::detect(0x0765, 0x5020, 2, None), None);
+        assert_eq!(Revision::E.bytes_per_reading(), 268);
+        assert_eq!(Revision::AToD.bytes_per_reading(), 256);
     }
 }

@@ -42,6 +42,8 @@ pub enum PipelineError {
         revision: Revision,
         problem: &'static str,
     },
+    #[error("two darks at the same integration time {0} s cannot be interpolated")]
+    SameDarkTimes(f64),
     #[error("nothing to average: no readings")]
     NoReadings,
     #[error("this unit has no ambient calibration (no diffuser)")]
@@ -161,6 +163,40 @@ pub fn subtract_dark(
         }
     }
     Ok(())
+}
+
+/// The dark for any integration time `t` from darks taken at two, `t1` and `t2` (emissive
+/// spot measurements take them at the shortest time and at 4 s): per cell the dark count
+/// grows linearly with time, `count(t) = a + b·t`, through the two measured points, and the
+/// dark absraw at `t` is `count(t) / t` (gain cancels: all three share it).
+pub fn interpolate_dark(
+    d1: &AbsRaw,
+    t1: f64,
+    d2: &AbsRaw,
+    t2: f64,
+    t: f64,
+) -> Result<AbsRaw, PipelineError> {
+    for x in [t1, t2, t] {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(PipelineError::IntegrationTime(x));
+        }
+    }
+    if t1 == t2 {
+        return Err(PipelineError::SameDarkTimes(t1));
+    }
+    let at = |v1: f64, v2: f64| {
+        let (c1, c2) = (v1 * t1, v2 * t2);
+        let b = (c2 - c1) / (t2 - t1);
+        (c1 + b * (t - t1)) / t
+    };
+    let mut cells = [0.0; CELLS];
+    for ((o, a), b) in cells.iter_mut().zip(&d1.cells).zip(&d2.cells) {
+        *o = at(*a, *b);
+    }
+    Ok(AbsRaw {
+        cells,
+        shielded: at(d1.shielded, d2.shielded),
+    })
 }
 
 /// The dark threshold in counts for an integration time: the EEPROM value plus 900 counts per

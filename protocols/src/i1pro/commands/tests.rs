@@ -2,6 +2,7 @@
 //! layouts (the README's table and example exchanges).
 
 use super::*;
+use crate::i1pro::timing::clocks;
 
 fn out(request: u8, data: &[u8]) -> Transfer {
     Transfer::Out {
@@ -206,102 +207,7 @@ fn malformed_transfers_are_errors() {
     ));
 }
 
-#[test]
-fn misc_reply_of_a_rev_b_in_high_power() {
-    let m = Misc::parse(&[0x01, 0x2E, 0x00, 0x00, 0xFF, 0xFF, 0x01, 0x00]).unwrap();
-    assert_eq!(m.firmware, 302);
-    assert_eq!(m.max_positive, 0xFFFF);
-    assert_eq!(m.unknown3, 1);
-    assert!(m.high_power());
-    assert!(m.has_clock_modes());
-    let low = Misc { power: 8, ..m };
-    assert!(!low.high_power());
-    assert_eq!(Misc::parse(&low.encode()).unwrap(), low);
-    assert_eq!(
-        Misc::parse(&[1, 2, 3]).unwrap_err(),
-        ReplyError::Length {
-            reply: "get misc (0xC9)",
-            expected: 8,
-            got: 3
-        }
-    );
-}
-
-#[test]
-fn clock_mode_1_is_68_us_by_130() {
-    let c = ClockMode::parse(&[0x03, 0x01, 0x00, 0x82, 0x44, 0x00]).unwrap();
-    assert_eq!(
-        (c.max, c.current, c.sub_clock_divider, c.clock_us),
-        (3, 1, 130, 68)
-    );
-    // 68 µs × 130 = 8.84 ms.
-    assert!((c.sub_clock_s() - 8.84e-3).abs() < 1e-15);
-    assert!(!c.subtract_mode());
-    assert_eq!(ClockMode::parse(&c.encode()).unwrap(), c);
-}
-
-#[test]
-fn rev_e_characteristics() {
-    let b = [0, 0, 0, 0x24, 0, 0, 0, 6, 0, 0, 0, 0x80, 0, 0, 0, 0x88];
-    let m = MeasChar::parse(&b).unwrap();
-    assert_eq!(m, MeasChar::KNOWN);
-    assert_eq!(m.encode(), b);
-    let mut odd = b;
-    odd[11] = 0x40;
-    assert_eq!(
-        MeasChar::parse(&odd).unwrap_err(),
-        ReplyError::UnexpectedMeasChar {
-            clock_us: 36,
-            shielded: 6,
-            cells: 64,
-            divider: 136
-        }
-    );
-}
-
-#[test]
-fn small_replies() {
-    assert_eq!(parse_eeprom_size(&[0, 0, 0x40, 0]).unwrap(), 16384);
-    assert_eq!(
-        parse_chip_id(&[1, 2, 3, 4, 5, 6, 7, 8]).unwrap(),
-        [1, 2, 3, 4, 5, 6, 7, 8]
-    );
-    assert_eq!(
-        parse_uv_volts(&[0x01, 0x00, 0x00, 0xFF]).unwrap(),
-        (256, 255)
-    );
-    assert!(parse_eeprom_size(&[0; 5]).is_err());
-}
-
-#[test]
-fn clock_counts_round_and_refuse_what_does_not_fit() {
-    // 4.896 ms / 36 µs = 136 exactly.
-    assert_eq!(clocks("t", 4.896e-3, 36e-6, u32::MAX as u64).unwrap(), 136);
-    // 5 s / 68 µs = 73529 > 65535.
-    assert!(matches!(
-        clocks("integration time", 5.0, 68e-6, 0xFFFF),
-        Err(RequestError::TooManyClocks { clocks: 73529, .. })
-    ));
-    assert!(clocks("t", f64::NAN, 68e-6, 0xFFFF).is_err());
-    assert!(clocks("t", -1.0, 68e-6, 0xFFFF).is_err());
-    // 0.25 s lamp / 8.84 ms = 28.3 → 28; 3 s would be 339 → capped at 256.
-    assert_eq!(lamp_clocks(0.25, 8.84e-3).unwrap(), 28);
-    assert_eq!(lamp_clocks(3.0, 8.84e-3).unwrap(), 256);
-}
-
 proptest::proptest! {
-    #[test]
-    fn arbitrary_replies_never_panic(bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..24)) {
-        let _ = Misc::parse(&bytes);
-        let _ = MeasParams::parse(&bytes);
-        let _ = MeasParamsE::parse(&bytes);
-        let _ = ClockMode::parse(&bytes);
-        let _ = MeasChar::parse(&bytes);
-        let _ = parse_eeprom_size(&bytes);
-        let _ = parse_chip_id(&bytes);
-        let _ = parse_uv_volts(&bytes);
-    }
-
     #[test]
     fn arbitrary_transfers_never_panic(
         request_type in proptest::prelude::any::<u8>(),

@@ -254,3 +254,32 @@ fn whole_chain_by_hand() {
     }
     assert_eq!(emissive(&cal, &s)[0], 2052.0 / 512.0);
 }
+
+#[test]
+fn dark_interpolates_linearly_in_counts() {
+    // 1000 /s at 0.1 s is 100 counts; 50 /s at 4 s is 200 counts: b = 100/3.9 counts/s.
+    // At 1 s: 100 + 0.9·100/3.9 = 123.076 923… counts, /1 s.
+    let d1 = abs(|_| 1000.0, 20.0);
+    let d2 = abs(|_| 50.0, 1.0);
+    let d = interpolate_dark(&d1, 0.1, &d2, 4.0, 1.0).unwrap();
+    close(d.cells[3], 100.0 + 90.0 / 3.9, 1e-12);
+    close(d.cells[3], 123.076_923_076_9, 1e-9);
+    // shielded: 2 counts and 4 counts → 2 + 0.9·2/3.9 at 1 s.
+    close(d.shielded, 2.0 + 1.8 / 3.9, 1e-12);
+    // At the measured times it gives the measured darks back.
+    close(
+        interpolate_dark(&d1, 0.1, &d2, 4.0, 0.1).unwrap().cells[0],
+        1000.0,
+        1e-9,
+    );
+    close(
+        interpolate_dark(&d1, 0.1, &d2, 4.0, 4.0).unwrap().cells[0],
+        50.0,
+        1e-12,
+    );
+    assert_eq!(
+        interpolate_dark(&d1, 1.0, &d2, 1.0, 2.0).unwrap_err(),
+        PipelineError::SameDarkTimes(1.0)
+    );
+    assert!(interpolate_dark(&d1, 0.1, &d2, 4.0, -1.0).is_err());
+}
