@@ -199,10 +199,20 @@ pub fn interpolate_dark(
     })
 }
 
-/// The dark threshold in counts for an integration time: the EEPROM value plus 900 counts per
-/// second of integration.
-pub fn dark_threshold_counts(cal: &Calibration, integration_s: f64) -> f64 {
-    f64::from(cal.dark_threshold) + 900.0 * integration_s
+/// The dark threshold in counts. Rev A–D: the EEPROM value plus 900 counts per second of
+/// integration, times the gain factor in high gain (so on the absraw scale it does not
+/// depend on the gain). Rev E: the mean raw count of the readings' shielded cells, which sit
+/// in the dark whatever the light.
+pub fn dark_threshold_counts(cal: &Calibration, e: &Exposure, readings: &[RawReading]) -> f64 {
+    let shielded: Vec<f64> = readings
+        .iter()
+        .filter_map(|r| r.shielded)
+        .flat_map(|s| s.map(f64::from))
+        .collect();
+    if cal.revision() == Revision::E && !shielded.is_empty() {
+        return shielded.iter().sum::<f64>() / shielded.len() as f64;
+    }
+    (f64::from(cal.dark_threshold) + 900.0 * e.integration_s) * cal.gain_factor(e.gain)
 }
 
 /// The averaged readings and what was seen while averaging.
@@ -279,12 +289,16 @@ impl Averaged {
     }
 }
 
-/// Saturation and dark thresholds of `cal` on the absraw scale of an exposure.
-pub fn thresholds(cal: &Calibration, e: &Exposure) -> Result<(f64, f64), PipelineError> {
+/// Saturation and dark thresholds on the absraw scale of an exposure, for its `readings`.
+pub fn thresholds(
+    cal: &Calibration,
+    e: &Exposure,
+    readings: &[RawReading],
+) -> Result<(f64, f64), PipelineError> {
     let k = scale(cal, e)?;
     Ok((
         f64::from(cal.saturation(e.gain)) * k,
-        dark_threshold_counts(cal, e.integration_s) * k,
+        dark_threshold_counts(cal, e, readings) * k,
     ))
 }
 
@@ -377,7 +391,7 @@ pub fn measure(
         .map(|r| to_absraw(cal, r, e))
         .collect::<Result<Vec<_>, _>>()?;
     subtract_dark(cal, &mut abs, dark, e)?;
-    let (sat, dark_t) = thresholds(cal, e)?;
+    let (sat, dark_t) = thresholds(cal, e, readings)?;
     let avg = average(cal.revision(), &abs, Some(sat), dark_t)?;
     Ok((resample(cal, &avg.mean.cells), avg))
 }
@@ -392,7 +406,7 @@ pub fn dark(
         .iter()
         .map(|r| to_absraw(cal, r, e))
         .collect::<Result<Vec<_>, _>>()?;
-    let (sat, dark_t) = thresholds(cal, e)?;
+    let (sat, dark_t) = thresholds(cal, e, readings)?;
     average(cal.revision(), &abs, Some(sat), dark_t)
 }
 

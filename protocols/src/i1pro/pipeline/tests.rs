@@ -174,13 +174,32 @@ fn averaging_flags_saturation_and_inconsistency() {
 #[test]
 fn thresholds_by_hand() {
     let cal = calibration_a_to_d();
+    let none: [RawReading; 0] = [];
     // 150 + 900·0.5 = 600 counts.
-    assert_eq!(dark_threshold_counts(&cal, 0.5), 600.0);
+    assert_eq!(dark_threshold_counts(&cal, &exposure(0.5), &none), 600.0);
     // ×2 per second: saturation 90000, dark 1200.
     assert_eq!(
-        thresholds(&cal, &exposure(0.5)).unwrap(),
+        thresholds(&cal, &exposure(0.5), &none).unwrap(),
         (90_000.0, 1200.0)
     );
+    // High gain: 600 × 9.5 = 5700 counts, ÷ (0.5 · 9.5): the same 1200; saturation
+    // 45000 ÷ 4.75 = 9473.68….
+    let high = Exposure {
+        integration_s: 0.5,
+        gain: Gain::High,
+    };
+    assert_eq!(dark_threshold_counts(&cal, &high, &none), 5700.0);
+    let (sat, dark) = thresholds(&cal, &high, &none).unwrap();
+    close(dark, 1200.0, 1e-9);
+    close(sat, 45_000.0 / 4.75, 1e-9);
+    // Rev E: the mean of the shielded cells, (10 + … + 60)/6 = 35 and (20 + … + 70)/6 = 45.
+    let cal_e = calibration_e();
+    let mut a = reading(|_| 0);
+    a.shielded = Some([10, 20, 30, 40, 50, 60]);
+    let mut b = a.clone();
+    b.shielded = Some([20, 30, 40, 50, 60, 70]);
+    assert_eq!(dark_threshold_counts(&cal_e, &exposure(0.5), &[a, b]), 40.0);
+
     let dark = average(Revision::AToD, &[abs(|_| 2401.0, 0.0)], None, 1200.0).unwrap();
     assert!(dark.too_bright_for_dark(1200.0));
     assert!(!dark.too_bright_for_dark(1200.5));
