@@ -264,7 +264,7 @@ impl Eeprom {
     }
 
     /// Parses the directory at 0x1000 and, on Rev E, the one at 0x2000. Items of keys this
-    /// codec does not know are kept as bytes; a key listed twice keeps its first item.
+    /// codec does not know are kept as bytes; a key listed twice keeps its last item.
     pub fn parse(image: &[u8], revision: Revision) -> Result<Eeprom, EepromError> {
         let mut e = Eeprom::new();
         e.parse_table(image, 1)?;
@@ -334,9 +334,7 @@ impl Eeprom {
                     width: kind.width(),
                 });
             }
-            self.items
-                .entry(key)
-                .or_insert_with(|| Value::decode(kind, b));
+            self.items.insert(key, Value::decode(kind, b));
         }
         Ok(())
     }

@@ -49,6 +49,16 @@ fn hand_made_image_parses_to_its_items() {
 }
 
 #[test]
+fn a_key_listed_twice_keeps_its_last_item() {
+    let mut im = hand_image();
+    // Entry 2 (bytes FF FE 00 03) now also claims the serial: 0xFFFE0003 as i32 = −131069.
+    set_entry(&mut im, 2, 0x04BB, 0x120C);
+    let e = Eeprom::parse(&im, Revision::AToD).unwrap();
+    assert_eq!(e.get(0x04BB), Some(&Value::Ints(vec![-131_069])));
+    assert!(e.get(0x2F58).is_none());
+}
+
+#[test]
 fn broken_directories_are_named() {
     let mut im = hand_image();
     im[0x1001] = 7;
