@@ -15,11 +15,14 @@ mod linalg;
 pub mod pipeline;
 pub mod readings;
 pub mod replies;
+#[cfg(test)]
+mod session_tests;
 pub mod timing;
 
-pub use calibration::{Calibration, CalibrationError, Filter, RevECalibration};
+pub use calibration::{Calibration, CalibrationError, Filter, Gain, RevECalibration};
 pub use commands::{Request, Transfer};
 pub use eeprom::{Eeprom, EepromError, Value};
+pub use pipeline::{AbsRaw, Exposure, PipelineError};
 pub use readings::{RawReading, ReadingError};
 
 /// Output bands of every spectrum: 380–730 nm in 10 nm steps.

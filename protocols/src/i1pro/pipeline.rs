@@ -329,7 +329,7 @@ fn times(s: &Spectrum, f: &Spectrum) -> Spectrum {
     out
 }
 
-/// Step 6, emissive: spectral radiance, `S · emissive factor`.
+/// Step 6, emissive: spectral radiance in mW·m⁻²·sr⁻¹·nm⁻¹, `S · emissive factor`.
 pub fn emissive(cal: &Calibration, s: &Spectrum) -> Spectrum {
     times(s, &cal.emissive)
 }
