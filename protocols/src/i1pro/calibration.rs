@@ -75,7 +75,7 @@ pub enum CalibrationError {
     FilterBands { found: usize },
     #[error("the {what} must be a polynomial with at least one coefficient")]
     EmptyPolynomial { what: &'static str },
-    #[error("a {model} calibration {problem}")]
+    #[error("the {model} calibration {problem}")]
     Model {
         model: &'static str,
         problem: &'static str,
@@ -119,8 +119,18 @@ impl Filter {
         })
     }
 
-    /// First cell and weights of band `w`.
-    pub fn band(&self, w: usize) -> (usize, &[f64]) {
+    /// First cell of each band.
+    pub fn starts(&self) -> &[usize] {
+        &self.starts
+    }
+
+    /// Weights of each band.
+    pub fn coefficients(&self) -> &[Vec<f64>] {
+        &self.coefficients
+    }
+
+    /// First cell and weights of band `w` (< 36).
+    pub(super) fn band(&self, w: usize) -> (usize, &[f64]) {
         (self.starts[w], &self.coefficients[w])
     }
 
@@ -140,8 +150,8 @@ impl Filter {
 pub struct RevECalibration {
     /// [`caps_e`] bits.
     pub capabilities: i32,
-    /// Stray-light table, row-major 36×36, signed; see [`RevECalibration::stray_light_matrix`].
-    pub stray_light: Vec<i16>,
+    /// Stray-light table, signed; see [`RevECalibration::stray_light_matrix`].
+    pub stray_light: [[i16; BANDS]; BANDS],
     pub stray_light_scale: f64,
     /// Raw cell → wavelength cubic for emissive measurements.
     pub wavelength_poly_emissive: [f64; 4],
@@ -155,7 +165,7 @@ impl RevECalibration {
         let mut m = [[0.0; BANDS]; BANDS];
         for (i, row) in m.iter_mut().enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
-                *v = self.stray_light_scale * f64::from(self.stray_light[i * BANDS + j]) / 32767.0;
+                *v = self.stray_light_scale * f64::from(self.stray_light[i][j]) / 32767.0;
                 if i == j {
                     *v += 1.0;
                 }
@@ -302,7 +312,7 @@ impl Calibration {
                 };
                 Some(RevECalibration {
                     capabilities: r.int(key::CAPABILITIES_E)?,
-                    stray_light: r.shorts(key::STRAY_LIGHT, BANDS * BANDS)?,
+                    stray_light: r.square(key::STRAY_LIGHT)?,
                     stray_light_scale: r.float(key::STRAY_LIGHT_SCALE)?,
                     wavelength_poly_emissive: emissive,
                     wavelength_poly_reflective: reflective,
@@ -359,7 +369,7 @@ impl Calibration {
         if self.rev_e.is_some() != (self.revision() == Revision::E) {
             return Err(CalibrationError::Model {
                 model,
-                problem: "has Rev E data exactly when it is an i1Pro 2",
+                problem: "must carry Rev E data (stray light, wavelength polynomials) exactly when the model is the i1Pro 2",
             });
         }
         if self.white_reference.is_none() && self.model != Model::I1Monitor {
@@ -368,16 +378,6 @@ impl Calibration {
                 name: key_name(key::WHITE_REF),
                 model,
             });
-        }
-        if let Some(e) = &self.rev_e {
-            if e.stray_light.len() != BANDS * BANDS {
-                return Err(CalibrationError::Length {
-                    key: key::STRAY_LIGHT,
-                    name: key_name(key::STRAY_LIGHT),
-                    expected: (BANDS * BANDS).to_string(),
-                    found: e.stray_light.len(),
-                });
-            }
         }
         Ok(())
     }
@@ -425,7 +425,8 @@ impl Calibration {
         e.insert(key::PHYSICAL_FILTER, int(self.physical_filter))?;
         if let Some(r) = &self.rev_e {
             e.insert(key::CAPABILITIES_E, int(r.capabilities))?;
-            e.insert(key::STRAY_LIGHT, Value::Shorts(r.stray_light.clone()))?;
+            let table = r.stray_light.iter().flatten().copied().collect();
+            e.insert(key::STRAY_LIGHT, Value::Shorts(table))?;
             e.insert(key::STRAY_LIGHT_SCALE, floats(&[r.stray_light_scale]))?;
             e.insert(
                 key::WAVELENGTH_POLY_EMISSIVE,
@@ -515,6 +516,15 @@ impl Reader<'_> {
             Value::Shorts(v) => self.length(key, v, Some(n)),
             _ => Err(Self::type_error(key)),
         }
+    }
+
+    fn square(&self, key: u16) -> Result<[[i16; BANDS]; BANDS], CalibrationError> {
+        let v = self.shorts(key, BANDS * BANDS)?;
+        let mut m = [[0i16; BANDS]; BANDS];
+        for (row, chunk) in m.iter_mut().zip(v.chunks_exact(BANDS)) {
+            row.copy_from_slice(chunk);
+        }
+        Ok(m)
     }
 
     fn int(&self, key: u16) -> Result<i32, CalibrationError> {

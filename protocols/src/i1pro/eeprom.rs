@@ -375,6 +375,17 @@ impl Eeprom {
     /// directory at 0x2000. Directories too short to pass the parser's sanity check are
     /// padded with extra closing markers. Unused bytes are 0xFF, as in an erased EEPROM.
     pub fn build(&self, revision: Revision, size: usize) -> Result<Vec<u8>, EepromError> {
+        let (table, dir) = match revision {
+            Revision::AToD => (1, DIRECTORY),
+            Revision::E => (2, DIRECTORY_E),
+        };
+        if size < dir + DIRECTORY_BYTES[table - 1].1 {
+            return Err(EepromError::TooSmall {
+                table,
+                address: dir,
+                len: size,
+            });
+        }
         let mut image = vec![0xFFu8; size];
         let in_table_2 = |k: u16| revision == Revision::E && TABLE_2_KEYS.contains(&k);
         let is_log = |k: u16| {

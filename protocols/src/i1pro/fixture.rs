@@ -46,11 +46,11 @@ pub fn calibration_a_to_d() -> Calibration {
 }
 
 pub fn calibration_e() -> Calibration {
-    let mut stray = vec![0i16; BANDS * BANDS];
-    for i in 0..BANDS {
-        for j in 0..BANDS {
+    let mut stray = [[0i16; BANDS]; BANDS];
+    for (i, row) in stray.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
             if i.abs_diff(j) == 1 {
-                stray[i * BANDS + j] = -3277;
+                *v = -3277;
             }
         }
     }

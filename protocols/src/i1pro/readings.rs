@@ -59,7 +59,7 @@ pub fn parse(
     max_positive: u16,
 ) -> Result<Vec<RawReading>, ReadingError> {
     let per_reading = revision.bytes_per_reading();
-    let expected = readings * per_reading;
+    let expected = readings.saturating_mul(per_reading);
     if bytes.len() != expected {
         let (got, readings) = (bytes.len(), readings);
         return Err(if got < expected {

@@ -152,6 +152,18 @@ fn built_images_parse_back() {
 
 #[test]
 fn building_refuses_what_does_not_fit() {
+    assert_eq!(
+        Eeprom::new().build(Revision::AToD, 0x1000).unwrap_err(),
+        EepromError::TooSmall {
+            table: 1,
+            address: 0x1000,
+            len: 0x1000
+        }
+    );
+    assert!(matches!(
+        sample().build(Revision::E, SIZE_A_TO_D),
+        Err(EepromError::TooSmall { table: 2, .. })
+    ));
     let mut e = Eeprom::new();
     e.insert(0x03EC, Value::Floats(vec![0.0; 2000])).unwrap();
     assert!(matches!(

@@ -68,6 +68,11 @@ fn wrong_byte_counts_are_errors() {
         })
     ));
     assert_eq!(parse(&[], Revision::AToD, 0, 0xFFFF).unwrap(), vec![]);
+    // An absurd count is a short read, not an overflow.
+    assert!(matches!(
+        parse(&[0; 256], Revision::AToD, usize::MAX, 0xFFFF),
+        Err(ReadingError::Short { .. })
+    ));
     assert_eq!(
         parse_scan(&[0; 3 * 256], Revision::AToD, 0xFFFF)
             .unwrap()
