@@ -191,3 +191,26 @@ fn stray_light_matrix_by_hand() {
     assert!((m[5][4] + 0.050_004_577_776).abs() < 1e-12);
     assert_eq!(m[0][2], 0.0);
 }
+
+proptest::proptest! {
+    /// Corrupting any bytes of a good image (directory, counts, filter tables) gives an error
+    /// or a calibration, never a panic.
+    #[test]
+    fn corrupted_images_never_panic(
+        hits in proptest::collection::vec((0usize..0x4000, proptest::prelude::any::<u8>()), 1..40),
+        rev_e in proptest::prelude::any::<bool>(),
+    ) {
+        let (cal, model) = if rev_e {
+            (calibration_e(), Model::I1Pro2)
+        } else {
+            (calibration_a_to_d(), Model::I1Pro)
+        };
+        let mut image = cal.to_image().unwrap();
+        // Aim half the hits at the directories and the first items, where damage matters.
+        for (i, (at, byte)) in hits.into_iter().enumerate() {
+            let at = if i % 2 == 0 { 0x1000 + at % 0x400 } else { at % image.len() };
+            image[at] = byte;
+        }
+        let _ = Calibration::from_image(&image, model);
+    }
+}
