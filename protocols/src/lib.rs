@@ -3,4 +3,5 @@
 //! byte strings and shared by real, replayed and emulated devices alike.
 
 pub mod cs100a;
+pub mod i1pro;
 pub mod transcript;
