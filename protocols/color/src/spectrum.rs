@@ -2,7 +2,7 @@
 //! interpolated between them (the convention of the validation-box contract and CIE 15:2018
 //! §7.2.2 for tables at 1 nm), zero outside unless the caller asks to hold the end values.
 
-use super::ColorError;
+use crate::ColorError;
 
 /// What a spectrum is worth outside its first and last sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

@@ -1,7 +1,7 @@
 //! One call from a spectrum to its XYZ, xyY and (when a white is known) CIELAB: what
 //! `metamer color xyz` prints.
 
-use super::{
+use crate::{
     illuminant_white, radiance_to_xyz, reflectance_to_xyz, Lab, ObserverKind, Spectrum, XyY, Xyz,
 };
 
