@@ -12,14 +12,15 @@ mod error;
 pub mod instrument;
 pub mod link;
 mod spec;
+pub mod world;
 
 pub use cs100a::Speed;
 pub use error::{DriverError, SERIAL_PERMISSION_FIX};
 pub use instrument::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,
-    InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, ReadingSpectrum,
-    Request, SharedStimulus, Stimulus,
+    InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,
 };
 pub use spec::{
     open_instrument, open_instrument_with, OpenOptions, DEFAULT_STIMULUS_XYZ, TIME_SCALE_ENV,
 };
+pub use world::{Light, SharedWorld, View, World};

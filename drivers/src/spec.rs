@@ -13,12 +13,13 @@ use std::sync::Arc;
 
 use crate::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
 use crate::cs100a::{self, Cs100a};
-use crate::instrument::{Instrument, SharedStimulus, Stimulus};
+use crate::instrument::Instrument;
 use crate::link::pair::pair;
 use crate::link::record::RecordSerial;
 use crate::link::replay::ReplaySerial;
 use crate::link::serial::PortLink;
 use crate::link::{LineSettings, SerialLink};
+use crate::world::{SharedWorld, World};
 use crate::DriverError;
 
 /// The environment variable that sets the simulated meters' time scale.
@@ -34,7 +35,7 @@ pub const DEFAULT_STIMULUS_XYZ: [f64; 3] = [108.229_360_132_203_85, 100.0, 29.24
 #[derive(Clone, Default)]
 pub struct OpenOptions {
     /// What a simulated instrument sees (default: [`DEFAULT_STIMULUS_XYZ`]).
-    pub stimulus: Option<Arc<dyn Stimulus>>,
+    pub stimulus: Option<Arc<dyn World>>,
     /// Record the session to this new transcript file (serial instruments).
     pub record: Option<PathBuf>,
 }
@@ -42,7 +43,7 @@ pub struct OpenOptions {
 /// Opens the instrument `spec` names; `stimulus` is what a simulated one sees.
 pub fn open_instrument(
     spec: &str,
-    stimulus: Option<Arc<dyn Stimulus>>,
+    stimulus: Option<Arc<dyn World>>,
 ) -> Result<Box<dyn Instrument>, DriverError> {
     open_instrument_with(
         spec,
@@ -91,7 +92,7 @@ pub fn open_instrument_with(
             let stimulus = options
                 .stimulus
                 .clone()
-                .unwrap_or_else(|| Arc::new(SharedStimulus::new(DEFAULT_STIMULUS_XYZ)));
+                .unwrap_or_else(|| Arc::new(SharedWorld::new(DEFAULT_STIMULUS_XYZ)));
             let (host, device) = pair(LineSettings::CS100A, "sim:cs100a");
             Cs100aEmulator::new(stimulus, config).spawn(device);
             connect_cs100a(host, options)
@@ -174,10 +175,10 @@ mod tests {
 
     #[test]
     fn sim_measures_the_given_stimulus() {
-        let light = Arc::new(SharedStimulus::new([0.0; 3]));
+        let light = Arc::new(SharedWorld::new([0.0; 3]));
         let mut m = open_instrument(
             "sim:cs100a?time_scale=0&noise=off",
-            Some(light.clone() as Arc<dyn Stimulus>),
+            Some(light.clone() as Arc<dyn World>),
         )
         .unwrap();
         light.set([95.047, 100.0, 108.883]);

@@ -245,7 +245,7 @@ impl<L: SerialLink> Cs100a<L> {
     }
 }
 
-/// A reading from what the meter sent: Yxy → XYZ (X = xY/y, Z = (1−x−y)Y/y). Values the
+/// A reading from what the meter sent: Yxy → XYZ by the colour core. Values the
 /// meter did not measure (OK11 chromaticity, OK12 placeholder luminance) are NaN, and the
 /// flags say why; JSON writes them as null.
 pub fn reading_from(status: Status, value: &Yxy, speed: Option<Speed>) -> Reading {
@@ -255,9 +255,6 @@ pub fn reading_from(status: Status, value: &Yxy, speed: Option<Speed>) -> Readin
         _ => (f64::NAN, f64::NAN),
     };
     let mut reading = Reading::from_yxy(lum, x, y, MODEL);
-    if y.is_nan() || y <= 0.0 {
-        reading.xyz = [f64::NAN, lum, f64::NAN];
-    }
     reading.flags = match status {
         Status::Ok11 => vec![Flag::ChromaticityOverRange],
         Status::Ok12 => vec![Flag::OverRange],
