@@ -10,6 +10,12 @@ use metamer_color::{radiance_to_xyz, ObserverKind, Quantity, Spectrum};
 
 use crate::DriverError;
 
+/// The light a simulated meter sees when no world is given: 100 cd/m² at the chromaticity
+/// of CIE illuminant LED-RGB1 (x, y) = (0.45576, 0.42110), computed from
+/// `data/illuminant_led_rgb1.csv` with the CIE 1931 2° observer by `metamer color xyz`
+/// (checked by `tests/cs100a_sim.rs`).
+pub const DEFAULT_STIMULUS_XYZ: [f64; 3] = [108.229_360_132_203_85, 100.0, 29.242_246_576_178_09];
+
 /// Light arriving from a source.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
