@@ -193,4 +193,50 @@ mod tests {
             .unwrap();
         assert!(e.to_string().contains("time_scale=\"-1\""), "{e}");
     }
+
+    #[test]
+    fn a_transcript_of_a_model_without_a_driver_names_those_with_one() {
+        let dir = std::env::temp_dir().join(format!("metamer-spec-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("i1pro.jsonl");
+        std::fs::write(
+            &path,
+            "{\"format\":\"metamer-transcript/1\",\"instrument\":\"i1pro\",\"transport\":\"usb\",\
+             \"origin\":\"synthesized from the protocol documentation\"}\n",
+        )
+        .unwrap();
+        let e = open_instrument(&format!("replay:{}", path.display()), None)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.ends_with("line 1: the transcript is of instrument 'i1pro', which has no driver yet (known: cs100a)"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_world_given_as_a_spectrum_is_read_through_the_colour_core() {
+        use crate::world::View;
+        use metamer_color::Spectrum;
+        // 0.1 W·sr⁻¹·m⁻²·nm⁻¹ flat over 380–780 nm: Y = 68.3 · Σȳ. Summed with awk over
+        // the 380–780 nm rows of data/cie1931_2deg_cmf_1nm.csv: Σx̄ 106.855085, Σȳ 106.856426,
+        // Σz̄ 106.846082, so Y = 7298.294 cd/m² and (x, y) = (0.333341, 0.333345); the meter
+        // sends four significant digits of Y here and four decimals of x, y.
+        let flat = Spectrum::constant(380.0, 780.0, 0.1);
+        let light = Arc::new(SharedWorld::new(View::radiance(flat).unwrap()));
+        let mut m = open_instrument(
+            "sim:cs100a?time_scale=0&noise=off",
+            Some(light as Arc<dyn World>),
+        )
+        .unwrap();
+        let r = m.measure(&Request::default()).unwrap();
+        assert_eq!(r.xyy[2], 7298.0, "{:?}", r.xyy);
+        assert!(
+            (r.xyy[0] - 0.3333).abs() < 1e-9 && (r.xyy[1] - 0.3333).abs() < 1e-9,
+            "{:?}",
+            r.xyy
+        );
+    }
 }
