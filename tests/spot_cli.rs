@@ -312,11 +312,11 @@ fn a_meter_on_a_serial_port() {
 
     use metamer_drivers::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
     use metamer_drivers::cs100a::pty::PtyEmulator;
-    use metamer_drivers::SharedStimulus;
+    use metamer_drivers::SharedWorld;
 
     // A display's blue primary: x = 0.15, y = 0.06, Y = 7.22 cd/m².
     let (x, y, lum) = (0.15, 0.06, 7.22);
-    let light = SharedStimulus::new([x / y * lum, lum, (1.0 - x - y) / y * lum]);
+    let light = SharedWorld::new([x / y * lum, lum, (1.0 - x - y) / y * lum]);
     let config = EmulatorConfig {
         seed: 11,
         time_scale: 0.01,

@@ -4,12 +4,9 @@
 
 use serde::Serialize;
 
-use crate::error::SERIAL_PERMISSION_FIX;
-
-/// How to get access to a USB or HID instrument on Linux.
-pub const USB_PERMISSION_FIX: &str = "install the udev rules: sudo cp data/udev/60-metamer.rules \
-     /etc/udev/rules.d/ && sudo udevadm control --reload && sudo udevadm trigger, then unplug \
-     and replug the instrument (see README, 'Linux permissions')";
+use crate::permissions::SERIAL_PERMISSION_FIX;
+pub use crate::permissions::USB_PERMISSION_FIX;
+use crate::registry::{self, Bus};
 
 /// Whether the current user may open a device.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -69,15 +66,6 @@ pub struct DeviceList {
     /// Things that could not be looked at (no USB on this machine, …).
     pub notes: Vec<String>,
 }
-
-/// Known USB instruments: (VID, PID, name, bus). IDs from ArgyllCMS `usb/55-Argyll.rules`
-/// (facts only).
-pub const KNOWN_INSTRUMENTS: &[(u16, u16, &str, &str)] = &[
-    (0x0971, 0x2000, "X-Rite i1Pro / i1Pro 2", "usb"),
-    (0x0765, 0x6009, "X-Rite i1Pro 3", "usb"),
-    (0x0971, 0x2007, "X-Rite ColorMunki", "usb"),
-    (0x0765, 0x5020, "X-Rite i1Display Pro", "hid"),
-];
 
 /// Common USB-serial converters a CS-100A cable is plugged into (vendor datasheets).
 pub const KNOWN_ADAPTERS: &[(u16, u16, &str)] = &[
@@ -171,11 +159,9 @@ pub fn access_from_error(e: &std::io::Error, fix: &str) -> Access {
     }
 }
 
-fn known(vid: u16, pid: u16, bus: &str) -> Option<&'static str> {
-    KNOWN_INSTRUMENTS
-        .iter()
-        .find(|(v, p, _, b)| *v == vid && *p == pid && *b == bus)
-        .map(|(_, _, name, _)| *name)
+/// The title of the model with this ID on this bus, from the driver registry.
+fn known(vid: u16, pid: u16, bus: Bus) -> Option<&'static str> {
+    registry::by_usb(vid, pid, bus).map(|m| m.title)
 }
 
 fn usb_instruments(list: &mut DeviceList) {
@@ -202,7 +188,7 @@ fn usb_instruments(list: &mut DeviceList) {
         let Ok(desc) = device.device_descriptor() else {
             continue;
         };
-        let Some(name) = known(desc.vendor_id(), desc.product_id(), "usb") else {
+        let Some(name) = known(desc.vendor_id(), desc.product_id(), Bus::Usb) else {
             continue;
         };
         let (access, serial) = match device.open() {
@@ -220,7 +206,7 @@ fn usb_instruments(list: &mut DeviceList) {
         };
         list.instruments.push(InstrumentEntry {
             name,
-            bus: "usb",
+            bus: Bus::Usb.name(),
             vid: desc.vendor_id(),
             pid: desc.product_id(),
             location: format!(
@@ -244,13 +230,13 @@ fn hid_instruments(list: &mut DeviceList) {
         }
     };
     for info in api.device_list() {
-        let Some(name) = known(info.vendor_id(), info.product_id(), "hid") else {
+        let Some(name) = known(info.vendor_id(), info.product_id(), Bus::Hid) else {
             continue;
         };
         let path = info.path().to_string_lossy().into_owned();
         list.instruments.push(InstrumentEntry {
             name,
-            bus: "hid",
+            bus: Bus::Hid.name(),
             vid: info.vendor_id(),
             pid: info.product_id(),
             access: path_access(&path, USB_PERMISSION_FIX),
@@ -300,9 +286,15 @@ mod tests {
 
     #[test]
     fn known_ids_are_matched_on_their_bus() {
-        assert_eq!(known(0x0971, 0x2000, "usb"), Some("X-Rite i1Pro / i1Pro 2"));
-        assert_eq!(known(0x0971, 0x2000, "hid"), None);
-        assert_eq!(known(0x0765, 0x5020, "hid"), Some("X-Rite i1Display Pro"));
+        assert_eq!(
+            known(0x0971, 0x2000, Bus::Usb),
+            Some("X-Rite i1Pro / i1Pro 2")
+        );
+        assert_eq!(known(0x0971, 0x2000, Bus::Hid), None);
+        assert_eq!(
+            known(0x0765, 0x5020, Bus::Hid),
+            Some("X-Rite i1Display Pro")
+        );
     }
 }
 
@@ -316,9 +308,8 @@ mod udev_tests {
     fn the_udev_rules_cover_every_known_device() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/udev/60-metamer.rules");
         let rules = std::fs::read_to_string(path).unwrap();
-        let ids = KNOWN_INSTRUMENTS
-            .iter()
-            .map(|(v, p, _, _)| (*v, *p))
+        let ids = registry::usb_ids()
+            .map(|(_, id)| (id.vid, id.pid))
             .chain(KNOWN_ADAPTERS.iter().map(|(v, p, _)| (*v, *p)));
         for (vid, pid) in ids {
             let rule =

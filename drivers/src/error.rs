@@ -1,20 +1,16 @@
 //! Errors of links and drivers, each with the context a user needs to act on it.
 
-use metamer_protocols::cs100a::{ReplyError, Status};
-
 use crate::link::LinkError;
-
-/// How to get access to a serial port on Linux, said wherever access is denied.
-pub const SERIAL_PERMISSION_FIX: &str = "add yourself to the group that owns the port \
-     (usually 'dialout': sudo usermod -aG dialout $USER, then log out and in again) or install \
-     data/udev/60-metamer.rules (see README, 'Linux permissions')";
+use crate::permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};
 
 /// What went wrong talking to an instrument.
 #[derive(Debug, thiserror::Error)]
 pub enum DriverError {
-    /// The instrument spec string is not understood.
-    #[error("unknown instrument '{spec}': expected cs100a:PORT, replay:FILE.jsonl or sim:cs100a")]
-    UnknownSpec { spec: String },
+    /// The instrument spec string is not understood; `expected` lists the forms the driver
+    /// registry knows.
+    #[error("unknown instrument '{spec}': expected {expected}")]
+    UnknownSpec { spec: String, expected: String },
+
     /// An option of a spec (`sim:cs100a?time_scale=…`) is not understood.
     #[error("instrument '{spec}': {message}")]
     BadSpecOption { spec: String, message: String },
@@ -32,41 +28,6 @@ pub enum DriverError {
     /// Any other failure to open or configure the port.
     #[error("cannot open serial port {port}: {message}")]
     PortOpen { port: String, message: String },
-    /// The CS-100A sent nothing: it is not in remote mode (PP docstring; [C2]).
-    #[error(
-        "the CS-100A on {port} did not answer '{command}' within {timeout_ms} ms: it is not in \
-         remote mode. Switch the meter off, then hold F while switching it on until a 'C' shows \
-         at the bottom right of its display (this is needed after every power cycle); also check \
-         the cable and that the meter is on"
-    )]
-    NotInRemoteMode {
-        port: String,
-        command: String,
-        timeout_ms: u64,
-    },
-    /// The meter answered earlier in this session, then went silent: switched off (which
-    /// also ends remote mode), batteries out, or the cable came loose.
-    #[error(
-        "the CS-100A on {port} stopped answering: no reply to '{command}' within {timeout_ms} ms. \
-         If it was switched off or its batteries ran out, switch it on again while holding F \
-         until a 'C' shows at the bottom right of its display (remote mode); also check the cable"
-    )]
-    StoppedAnswering {
-        port: String,
-        command: String,
-        timeout_ms: u64,
-    },
-    /// Part of a reply came, then silence.
-    #[error(
-        "the CS-100A on {port} stopped in the middle of its reply to '{command}': received {received} \
-         and then nothing for {timeout_ms} ms; check the cable and the meter's batteries"
-    )]
-    PartialReply {
-        port: String,
-        command: String,
-        received: String,
-        timeout_ms: u64,
-    },
     /// The device went away during an exchange.
     #[error(
         "the instrument on {port} disconnected during '{command}' (received {received}); \
@@ -77,31 +38,9 @@ pub enum DriverError {
         command: String,
         received: String,
     },
-    /// A reply that is not CS-100A protocol.
-    #[error("the CS-100A on {port} answered '{command}' with {received}, which is not a valid reply: {reason}")]
-    BadReply {
-        port: String,
-        command: String,
-        received: String,
-        #[source]
-        reason: ReplyError,
-    },
-    /// A reply that is valid protocol but not an answer to the command sent (e.g. bare OK00
-    /// to MES).
-    #[error("the CS-100A on {port} answered '{command}' with {received}: {reason}")]
-    UnexpectedReply {
-        port: String,
-        command: String,
-        received: String,
-        reason: String,
-    },
-    /// The meter reported an error code.
-    #[error("the CS-100A on {port} answered '{command}' with {status}")]
-    Instrument {
-        port: String,
-        command: String,
-        status: Status,
-    },
+    /// A CS-100A failure (not in remote mode, silent, garbled or refusing).
+    #[error(transparent)]
+    Cs100a(#[from] crate::cs100a::error::Cs100aError),
     /// A link failure not covered above (I/O error, replay mismatch).
     #[error("{0}")]
     Link(#[from] LinkError),
@@ -126,10 +65,7 @@ pub enum DriverError {
     #[error("no {device} is plugged in; `metamer devices` lists the instruments of this machine")]
     UsbNotFound { device: String },
     /// The user may not open the USB/HID device.
-    #[error(
-        "no permission to open {device}: {}",
-        crate::devices::USB_PERMISSION_FIX
-    )]
+    #[error("no permission to open {device}: {USB_PERMISSION_FIX}")]
     UsbPermission { device: String },
     /// The instrument cannot do what was asked.
     #[error("the {instrument} cannot do {what}")]

@@ -5,6 +5,7 @@
 //! [`CalibrationCondition`] asks for ("put the meter on its white tile"), then calls
 //! [`Instrument::calibrate`] with that condition; the instrument may answer with another.
 
+use metamer_color::{Spectrum, XyY};
 use serde::{Deserialize, Serialize};
 
 /// Who the instrument is.
@@ -178,16 +179,6 @@ impl Flag {
     }
 }
 
-/// A sampled spectrum carried with a reading.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ReadingSpectrum {
-    pub start_nm: f64,
-    pub step_nm: f64,
-    pub values: Vec<f64>,
-    /// e.g. `W/(sr·m²·nm)` or `reflectance`.
-    pub unit: String,
-}
-
 /// One measurement.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Reading {
@@ -195,7 +186,9 @@ pub struct Reading {
     pub xyz: [f64; 3],
     /// Chromaticity and luminance as the instrument reports them (x, y, Y).
     pub xyy: [f64; 3],
-    pub spectrum: Option<ReadingSpectrum>,
+    /// The spectrum where the instrument measures one, tagged with its quantity (radiance,
+    /// irradiance or reflectance).
+    pub spectrum: Option<Spectrum>,
     pub flags: Vec<Flag>,
     /// Integration or response time the instrument used, seconds.
     pub integration_s: Option<f64>,
@@ -206,13 +199,10 @@ pub struct Reading {
 }
 
 impl Reading {
-    /// Builds a reading from Yxy as colorimeters report it (X = xY/y, Z = (1−x−y)Y/y).
+    /// Builds a reading from Yxy as colorimeters report it, converted by the colour core's
+    /// [`XyY::to_xyz`] (no chromaticity: X and Z are NaN).
     pub fn from_yxy(luminance: f64, x: f64, y: f64, instrument: &str) -> Reading {
-        let xyz = if y > 0.0 {
-            [x * luminance / y, luminance, (1.0 - x - y) * luminance / y]
-        } else {
-            [0.0, luminance, 0.0]
-        };
+        let xyz = XyY { x, y, luminance }.to_xyz().to_array();
         Reading {
             xyz,
             xyy: [x, y, luminance],
@@ -313,39 +303,5 @@ pub trait Instrument: Send {
     /// checks.
     fn option_values(&self) -> Vec<(String, String)> {
         Vec::new()
-    }
-}
-
-/// What a simulated instrument sees: the light in front of it. A simulated display sets it
-/// when it shows a patch; the simulated meter reads it when asked to measure.
-pub trait Stimulus: Send + Sync {
-    /// CIE 1931 XYZ in cd/m² of what the instrument is aimed at now.
-    fn xyz(&self) -> [f64; 3];
-    /// The spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹) where the simulation knows it.
-    fn spectrum(&self) -> Option<ReadingSpectrum> {
-        None
-    }
-}
-
-/// A stimulus that can be changed from another thread (the simulated display's screen).
-#[derive(Debug, Default)]
-pub struct SharedStimulus {
-    xyz: std::sync::RwLock<[f64; 3]>,
-}
-
-impl SharedStimulus {
-    pub fn new(xyz: [f64; 3]) -> Self {
-        SharedStimulus {
-            xyz: std::sync::RwLock::new(xyz),
-        }
-    }
-    pub fn set(&self, xyz: [f64; 3]) {
-        *self.xyz.write().unwrap_or_else(|e| e.into_inner()) = xyz;
-    }
-}
-
-impl Stimulus for SharedStimulus {
-    fn xyz(&self) -> [f64; 3] {
-        *self.xyz.read().unwrap_or_else(|e| e.into_inner())
     }
 }

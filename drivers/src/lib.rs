@@ -3,7 +3,8 @@
 //! A driver is generic over its link (serial, USB, HID), and every link has a real backend,
 //! a replay backend that feeds recorded transcripts through the same driver code byte for
 //! byte, a record backend, and in-process pairs for emulated devices. Above the drivers sits
-//! one [`Instrument`] trait. Devices are chosen by one string (see [`open_instrument`]).
+//! one [`Instrument`] trait. Devices are chosen by one string (see [`open_instrument`]);
+//! the models and how each is opened are rows of the [`registry`].
 
 pub mod cs100a;
 pub mod devices;
@@ -11,15 +12,20 @@ pub mod devices;
 mod error;
 pub mod instrument;
 pub mod link;
+mod open;
+mod permissions;
+pub mod registry;
 mod spec;
+pub mod world;
 
+pub use cs100a::Cs100aError;
 pub use cs100a::Speed;
-pub use error::{DriverError, SERIAL_PERMISSION_FIX};
+pub use error::DriverError;
 pub use instrument::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,
-    InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, ReadingSpectrum,
-    Request, SharedStimulus, Stimulus,
+    InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,
 };
-pub use spec::{
-    open_instrument, open_instrument_with, OpenOptions, DEFAULT_STIMULUS_XYZ, TIME_SCALE_ENV,
-};
+pub use open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
+pub use permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};
+pub use spec::{open_instrument, open_instrument_with};
+pub use world::{Light, SharedWorld, View, World, DEFAULT_STIMULUS_XYZ};

@@ -3,46 +3,28 @@
 //!
 //! - `cs100a:PORT` — a CS-100A on a serial port (`cs100a:/dev/ttyUSB0`, `cs100a:COM3`);
 //! - `replay:FILE.jsonl` — a transcript played through the real driver;
-//! - `sim:cs100a` — the emulated CS-100A, answering from a stimulus. Options after `?`,
+//! - `sim:cs100a` — the emulated CS-100A, answering from a world. Options after `?`,
 //!   separated by `&`: `time_scale=F` (1 = the real meter's ≈100/400 ms per reading,
 //!   0.01 a hundred times faster, 0 instant; default 1, or the environment variable
 //!   `METAMER_SIM_TIME_SCALE`), `seed=N` (noise seed, default 1), `noise=off`.
+//!
+//! Which models exist and how each is opened is the driver registry's; this file only reads
+//! the spec.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
-use crate::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
-use crate::cs100a::{self, Cs100a};
-use crate::instrument::{Instrument, SharedStimulus, Stimulus};
-use crate::link::pair::pair;
-use crate::link::record::RecordSerial;
-use crate::link::replay::ReplaySerial;
-use crate::link::serial::PortLink;
-use crate::link::{LineSettings, SerialLink};
+use crate::instrument::Instrument;
+use crate::link::replay::Transcript;
+use crate::open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
+use crate::registry::{self, REPLAY_PREFIX, SIM_PREFIX};
+use crate::world::World;
 use crate::DriverError;
-
-/// The environment variable that sets the simulated meters' time scale.
-pub const TIME_SCALE_ENV: &str = "METAMER_SIM_TIME_SCALE";
-
-/// The light a simulated meter sees when no stimulus is given: 100 cd/m² at the
-/// chromaticity of CIE illuminant LED-RGB1 (x, y) = (0.45576, 0.42110), computed from
-/// `data/illuminant_led_rgb1.csv` with the CIE 1931 2° observer by `metamer color xyz`
-/// (checked by `tests/cs100a_sim.rs`).
-pub const DEFAULT_STIMULUS_XYZ: [f64; 3] = [108.229_360_132_203_85, 100.0, 29.242_246_576_178_09];
-
-/// Extra choices when opening an instrument.
-#[derive(Clone, Default)]
-pub struct OpenOptions {
-    /// What a simulated instrument sees (default: [`DEFAULT_STIMULUS_XYZ`]).
-    pub stimulus: Option<Arc<dyn Stimulus>>,
-    /// Record the session to this new transcript file (serial instruments).
-    pub record: Option<PathBuf>,
-}
 
 /// Opens the instrument `spec` names; `stimulus` is what a simulated one sees.
 pub fn open_instrument(
     spec: &str,
-    stimulus: Option<Arc<dyn Stimulus>>,
+    stimulus: Option<Arc<dyn World>>,
 ) -> Result<Box<dyn Instrument>, DriverError> {
     open_instrument_with(
         spec,
@@ -60,73 +42,47 @@ pub fn open_instrument_with(
 ) -> Result<Box<dyn Instrument>, DriverError> {
     let unknown = || DriverError::UnknownSpec {
         spec: spec.to_string(),
+        expected: registry::spec_forms(),
     };
     let (kind, rest) = spec.split_once(':').ok_or_else(unknown)?;
     match kind {
-        "cs100a" if !rest.is_empty() => {
-            let link = PortLink::open(rest, LineSettings::CS100A)?;
-            connect_cs100a(link, options)
-        }
-        "replay" if !rest.is_empty() => {
-            let link = ReplaySerial::open(Path::new(rest))?;
-            let instrument = link.transcript().header.instrument.clone();
-            if instrument != cs100a::MODEL {
-                return Err(DriverError::Transcript {
+        REPLAY_PREFIX if !rest.is_empty() => {
+            let transcript = Transcript::load(Path::new(rest))?;
+            let instrument = transcript.header.instrument.clone();
+            let open = registry::by_name(&instrument)
+                .and_then(|m| m.replay)
+                .ok_or_else(|| DriverError::Transcript {
                     file: rest.to_string(),
                     line: 1,
                     message: format!(
                         "the transcript is of instrument '{instrument}', which has no driver yet \
-                         (known: cs100a)"
+                         (known: {})",
+                        registry::replayable().join(", ")
                     ),
-                });
-            }
-            connect_cs100a(link, options)
+                })?;
+            open(transcript, options)
         }
-        "sim" => {
+        SIM_PREFIX => {
             let (model, query) = rest.split_once('?').unwrap_or((rest, ""));
-            if model != cs100a::MODEL {
-                return Err(unknown());
-            }
-            let config = sim_config(spec, query)?;
-            let stimulus = options
-                .stimulus
-                .clone()
-                .unwrap_or_else(|| Arc::new(SharedStimulus::new(DEFAULT_STIMULUS_XYZ)));
-            let (host, device) = pair(LineSettings::CS100A, "sim:cs100a");
-            Cs100aEmulator::new(stimulus, config).spawn(device);
-            connect_cs100a(host, options)
+            let open = registry::by_name(model)
+                .and_then(|m| m.sim)
+                .ok_or_else(unknown)?;
+            open(&sim_settings(spec, query)?, options)
         }
-        _ => Err(unknown()),
-    }
-}
-
-fn connect_cs100a<L: SerialLink + 'static>(
-    link: L,
-    options: &OpenOptions,
-) -> Result<Box<dyn Instrument>, DriverError> {
-    match &options.record {
-        Some(path) => {
-            let description = format!("metamer session with the CS-100A on {}", link.describe());
-            let rec = RecordSerial::create(link, path, cs100a::MODEL, &description)?;
-            let mut meter = Cs100a::new(rec);
-            meter.connect()?;
-            Ok(Box::new(meter))
-        }
-        None => {
-            let mut meter = Cs100a::new(link);
-            meter.connect()?;
-            Ok(Box::new(meter))
-        }
+        prefix => match registry::by_prefix(prefix).and_then(|m| m.real) {
+            Some(real) if !rest.is_empty() => (real.open)(rest, options),
+            _ => Err(unknown()),
+        },
     }
 }
 
 /// Parses `time_scale=…&seed=…&noise=off`.
-fn sim_config(spec: &str, query: &str) -> Result<EmulatorConfig, DriverError> {
+fn sim_settings(spec: &str, query: &str) -> Result<SimSettings, DriverError> {
     let bad = |message: String| DriverError::BadSpecOption {
         spec: spec.to_string(),
         message,
     };
-    let mut config = EmulatorConfig::default();
+    let mut config = SimSettings::default();
     if let Ok(v) = std::env::var(TIME_SCALE_ENV) {
         config.time_scale = parse_scale(&v)
             .ok_or_else(|| bad(format!("{TIME_SCALE_ENV}={v:?} is not a number ≥ 0")))?;
@@ -171,13 +127,14 @@ fn parse_scale(v: &str) -> Option<f64> {
 mod tests {
     use super::*;
     use crate::instrument::{MeasureMode, Request};
+    use crate::world::SharedWorld;
 
     #[test]
     fn sim_measures_the_given_stimulus() {
-        let light = Arc::new(SharedStimulus::new([0.0; 3]));
+        let light = Arc::new(SharedWorld::new([0.0; 3]));
         let mut m = open_instrument(
             "sim:cs100a?time_scale=0&noise=off",
-            Some(light.clone() as Arc<dyn Stimulus>),
+            Some(light.clone() as Arc<dyn World>),
         )
         .unwrap();
         light.set([95.047, 100.0, 108.883]);
@@ -235,5 +192,51 @@ mod tests {
             .err()
             .unwrap();
         assert!(e.to_string().contains("time_scale=\"-1\""), "{e}");
+    }
+
+    #[test]
+    fn a_transcript_of_a_model_without_a_driver_names_those_with_one() {
+        let dir = std::env::temp_dir().join(format!("metamer-spec-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("i1pro.jsonl");
+        std::fs::write(
+            &path,
+            "{\"format\":\"metamer-transcript/1\",\"instrument\":\"i1pro\",\"transport\":\"usb\",\
+             \"origin\":\"synthesized from the protocol documentation\"}\n",
+        )
+        .unwrap();
+        let e = open_instrument(&format!("replay:{}", path.display()), None)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.ends_with("line 1: the transcript is of instrument 'i1pro', which has no driver yet (known: cs100a)"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_world_given_as_a_spectrum_is_read_through_the_colour_core() {
+        use crate::world::View;
+        use metamer_color::Spectrum;
+        // 0.1 W·sr⁻¹·m⁻²·nm⁻¹ flat over 380–780 nm: Y = 68.3 · Σȳ. Summed with awk over
+        // the 380–780 nm rows of data/cie1931_2deg_cmf_1nm.csv: Σx̄ 106.855085, Σȳ 106.856426,
+        // Σz̄ 106.846082, so Y = 7298.294 cd/m² and (x, y) = (0.333341, 0.333345); the meter
+        // sends four significant digits of Y here and four decimals of x, y.
+        let flat = Spectrum::constant(380.0, 780.0, 0.1);
+        let light = Arc::new(SharedWorld::new(View::radiance(flat).unwrap()));
+        let mut m = open_instrument(
+            "sim:cs100a?time_scale=0&noise=off",
+            Some(light as Arc<dyn World>),
+        )
+        .unwrap();
+        let r = m.measure(&Request::default()).unwrap();
+        assert_eq!(r.xyy[2], 7298.0, "{:?}", r.xyy);
+        assert!(
+            (r.xyy[0] - 0.3333).abs() < 1e-9 && (r.xyy[1] - 0.3333).abs() < 1e-9,
+            "{:?}",
+            r.xyy
+        );
     }
 }

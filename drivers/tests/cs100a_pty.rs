@@ -9,13 +9,13 @@ use std::time::Duration;
 use metamer_drivers::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
 use metamer_drivers::cs100a::pty::PtyEmulator;
 use metamer_drivers::{
-    open_instrument, open_instrument_with, OpenOptions, Request, SharedStimulus, Speed, Stimulus,
+    open_instrument, open_instrument_with, OpenOptions, Request, SharedWorld, Speed, World,
 };
 
 /// XYZ of an sRGB-red-like patch: x = 0.64, y = 0.33, Y = 21.26 cd/m².
 const RED: [f64; 3] = [0.64 / 0.33 * 21.26, 21.26, 0.03 / 0.33 * 21.26];
 
-fn start(light: Arc<SharedStimulus>, seed: u64) -> PtyEmulator {
+fn start(light: Arc<SharedWorld>, seed: u64) -> PtyEmulator {
     let config = EmulatorConfig {
         seed,
         // A hundredth of the meter's pace: FAST ≈ 1.6 ms, SLOW ≈ 4.6 ms per reading.
@@ -27,7 +27,7 @@ fn start(light: Arc<SharedStimulus>, seed: u64) -> PtyEmulator {
 
 #[test]
 fn readings_through_the_real_serial_backend() {
-    let light = Arc::new(SharedStimulus::new(RED));
+    let light = Arc::new(SharedWorld::new(RED));
     let emu = start(light.clone(), 3);
     let spec = format!("cs100a:{}", emu.path());
     let mut meter = open_instrument(&spec, None).unwrap();
@@ -60,7 +60,7 @@ fn a_recorded_session_replays_to_the_same_readings() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("session.jsonl");
     let _ = std::fs::remove_file(&path);
-    let emu = start(Arc::new(SharedStimulus::new(RED)), 9);
+    let emu = start(Arc::new(SharedWorld::new(RED)), 9);
     let options = OpenOptions {
         stimulus: None,
         record: Some(path.clone()),
@@ -94,7 +94,7 @@ fn the_real_backend_sets_4800_7e2_and_talks_to_the_meter() {
     use metamer_drivers::cs100a::Cs100a;
     use metamer_drivers::link::serial::PortLink;
     use metamer_drivers::link::LineSettings;
-    let emu = start(Arc::new(SharedStimulus::new(RED)), 2);
+    let emu = start(Arc::new(SharedWorld::new(RED)), 2);
     let link = PortLink::open(emu.path(), LineSettings::CS100A).unwrap();
     let os = link.os_settings().unwrap();
     assert_eq!((os.baud, os.stop_bits), (4800, 2), "{os:?}");
@@ -116,7 +116,7 @@ fn the_real_backend_sets_4800_7e2_and_talks_to_the_meter() {
 
 #[test]
 fn a_command_without_terminator_gets_er00_like_the_ls100() {
-    let emu = start(Arc::new(SharedStimulus::new(RED)), 1);
+    let emu = start(Arc::new(SharedWorld::new(RED)), 1);
     let mut port = serialport::new(emu.path(), 4800)
         .timeout(Duration::from_secs(2))
         .open()
@@ -133,7 +133,7 @@ fn a_command_without_terminator_gets_er00_like_the_ls100() {
 
 #[test]
 fn the_meter_going_away_is_a_disconnect() {
-    let emu = start(Arc::new(SharedStimulus::new(RED)), 1);
+    let emu = start(Arc::new(SharedWorld::new(RED)), 1);
     let mut meter = open_instrument(&format!("cs100a:{}", emu.path()), None).unwrap();
     meter.measure(&Request::default()).unwrap();
     drop(emu);
@@ -143,8 +143,8 @@ fn the_meter_going_away_is_a_disconnect() {
 
 #[test]
 fn stimulus_trait_objects_are_accepted() {
-    // A session passes its own Arc<SharedStimulus> as Arc<dyn Stimulus>.
-    let light: Arc<dyn Stimulus> = Arc::new(SharedStimulus::new(RED));
+    // A session passes its own Arc<SharedWorld> as Arc<dyn World>.
+    let light: Arc<dyn World> = Arc::new(SharedWorld::new(RED));
     let mut m = open_instrument("sim:cs100a?time_scale=0.01&seed=5", Some(light)).unwrap();
     let r = m.measure(&Request::default()).unwrap();
     assert!((r.xyy[2] / 21.26 - 1.0).abs() < 0.0055, "{r:?}");

@@ -4,6 +4,7 @@
 use std::io::Write;
 
 use metamer_drivers::devices::{list_devices, Access, DeviceList};
+use metamer_drivers::registry;
 
 use super::CliResult;
 
@@ -77,6 +78,9 @@ fn human(list: &DeviceList) -> String {
     for note in &list.notes {
         s.push_str(&format!("note: {note}\n"));
     }
-    s.push_str("Simulated: sim:cs100a (always available)\n");
+    s.push_str(&format!(
+        "Simulated: {} (always available)\n",
+        registry::simulated_specs().join(", ")
+    ));
     s
 }

@@ -15,7 +15,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use metamer_drivers::{open_instrument, Request, SharedStimulus};
+use metamer_drivers::{open_instrument, Request, SharedWorld};
 use serde::Serialize;
 
 use super::characterize::plan::random_patches;
@@ -117,7 +117,7 @@ pub fn run_budget_study(
         let panel = VirtualPanel::preset(preset);
         let white = Xyz::from_array(panel.xyz([255; 3]));
         let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
-        let stimulus = Arc::new(SharedStimulus::new([0.0; 3]));
+        let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
         let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
         let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
         for &kind in models {

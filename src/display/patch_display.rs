@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use metamer_drivers::Stimulus;
+use metamer_drivers::World;
 
 use super::virtual_display::{Preset, VirtualDisplay};
 use super::window::{WindowDisplay, WindowError};
@@ -30,7 +30,7 @@ pub trait PatchDisplay {
     }
     /// What a simulated instrument aimed at this display sees, for displays that are
     /// themselves simulated; `None` for real screens.
-    fn stimulus(&self) -> Option<Arc<dyn Stimulus>>;
+    fn stimulus(&self) -> Option<Arc<dyn World>>;
 }
 
 /// A patch display could not be opened or could not show a patch.

@@ -1,6 +1,6 @@
 //! A simulated monitor (issue 5 item 4) for characterizing without hardware: it shows 8-bit
 //! drive values and the simulated instruments measure what it emits through the drivers'
-//! [`Stimulus`] trait (`open_instrument("sim:cs100a", Some(display.stimulus()))`).
+//! [`World`](metamer_drivers::World) trait (`open_instrument("sim:cs100a", Some(display.stimulus()))`).
 //!
 //! The light model is built to break the PLCC model of the paper (Eq. 9) the way real
 //! panels do, one fault at a time:
@@ -28,7 +28,7 @@ use std::str::FromStr;
 use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
-use metamer_drivers::Stimulus;
+use metamer_drivers::{View, World};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
@@ -292,10 +292,10 @@ struct Screen {
     shown: RwLock<[u8; 3]>,
 }
 
-impl Stimulus for Screen {
-    fn xyz(&self) -> [f64; 3] {
+impl World for Screen {
+    fn view(&self) -> View {
         let shown = *self.shown.read().unwrap_or_else(|e| e.into_inner());
-        self.panel.xyz(shown)
+        View::xyz(self.panel.xyz(shown))
     }
 }
 
@@ -356,7 +356,7 @@ impl PatchDisplay for VirtualDisplay {
         Duration::ZERO
     }
 
-    fn stimulus(&self) -> Option<Arc<dyn Stimulus>> {
+    fn stimulus(&self) -> Option<Arc<dyn World>> {
         Some(self.screen.clone())
     }
 }

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use metamer_drivers::{Instrument, Stimulus};
+use metamer_drivers::{Instrument, World};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
@@ -156,7 +156,7 @@ pub fn reproduce_and_measure(
 }
 
 /// What a simulated meter aimed at `display` sees; the lab runs on simulated displays only.
-pub fn stimulus_of(display: &dyn PatchDisplay) -> Result<Arc<dyn Stimulus>, LabError> {
+pub fn stimulus_of(display: &dyn PatchDisplay) -> Result<Arc<dyn World>, LabError> {
     display.stimulus().ok_or(LabError::NotSimulated)
 }
 

@@ -20,7 +20,7 @@ mod display_side;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use metamer_drivers::{open_instrument, DriverError, SharedStimulus};
+use metamer_drivers::{open_instrument, DriverError, SharedWorld};
 use serde::Serialize;
 
 pub use display_side::{
@@ -174,7 +174,7 @@ pub fn run_lab(
     let meter_spec = |seed: u64| format!("sim:cs100a?time_scale={}&seed={seed}", opts.time_scale);
 
     // 1–2: the box and the simulation.
-    let box_light = Arc::new(SharedStimulus::new([0.0; 3]));
+    let box_light = Arc::new(SharedWorld::new([0.0; 3]));
     let mut box_meter = open_instrument(&meter_spec(opts.seed), Some(box_light.clone()))?;
     let stage = std::cell::Cell::new("");
     let scene_readings = read_box_and_simulate(

@@ -10,7 +10,7 @@
 
 use std::sync::Arc;
 
-use metamer_drivers::{Instrument, Request, SharedStimulus};
+use metamer_drivers::{Instrument, Request, SharedWorld};
 
 use crate::render::{render_spots_with_progress, Scene, SpotOptions, SpotProgress, SpotResult};
 
@@ -33,7 +33,7 @@ pub fn read_box_and_simulate(
     scene: &Scene,
     opts: &SpotOptions,
     meter: &mut dyn Instrument,
-    stimulus: &Arc<SharedStimulus>,
+    stimulus: &Arc<SharedWorld>,
     repeats: usize,
     progress: &dyn Fn(&'static str, Option<SpotProgress>),
 ) -> Result<SceneReadings, LabError> {
@@ -66,7 +66,7 @@ pub fn read_box_and_simulate(
 /// Puts each light in front of the meter and averages `repeats` readings of it.
 pub fn measure_each(
     meter: &mut dyn Instrument,
-    stimulus: &SharedStimulus,
+    stimulus: &SharedWorld,
     lights: &[[f64; 3]],
     repeats: usize,
 ) -> Result<Vec<[f64; 3]>, LabError> {
@@ -99,7 +99,7 @@ mod tests {
     /// precision (4 significant digits of Y, 4 decimals of x and y).
     #[test]
     fn a_noiseless_meter_reads_back_each_light() {
-        let stimulus = Arc::new(SharedStimulus::new([0.0; 3]));
+        let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
         let mut meter =
             open_instrument("sim:cs100a?time_scale=0&noise=off", Some(stimulus.clone())).unwrap();
         let lights = [[20.0, 21.0, 22.0], [41.2, 35.0, 5.5]];

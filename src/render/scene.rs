@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::geometry::{Rect, Vec3};
-use super::spectral::{bin, cmf_bins, Binned};
+use super::spectral::{bins, cmf_bins, constant_bins};
 use crate::color::{luminance, ObserverKind, Outside, SpectralTable, Spectrum};
 
 /// Why a scene could not be loaded.
@@ -144,7 +144,7 @@ pub struct SceneFile {
 pub struct Surface {
     pub name: String,
     pub rect: Rect,
-    pub reflectance: Binned,
+    pub reflectance: Vec<f64>,
     pub patch: Option<usize>,
 }
 
@@ -175,11 +175,11 @@ pub struct Emitter {
     /// gains[row * cols + col]
     pub gains: Vec<f64>,
     /// s·S(λ) in W·sr⁻¹·m⁻²·nm⁻¹ on the grid.
-    pub radiance: Binned,
+    pub radiance: Vec<f64>,
     /// The scale s (paper: 683·Σ s·S·ȳ = luminance).
     pub scale: f64,
     pub distribution: Distribution,
-    pub reflectance: Binned,
+    pub reflectance: Vec<f64>,
 }
 
 impl Emitter {
@@ -211,7 +211,7 @@ pub struct Scene {
     pub camera: Camera,
     pub meter_acceptance_deg: f64,
     /// x̄, ȳ, z̄ on the grid (CIE 1931 2°).
-    pub cmf: [Binned; 3],
+    pub cmf: [Vec<f64>; 3],
 }
 
 impl Scene {
@@ -331,7 +331,7 @@ fn rect(p: &str, c: [f64; 3], u: [f64; 3], v: [f64; 3]) -> Result<Rect, (String,
     Ok(Rect::new(c, u, v))
 }
 
-fn check_reflectance(p: &str, r: &Binned) -> Result<(), (String, String)> {
+fn check_reflectance(p: &str, r: &[f64]) -> Result<(), (String, String)> {
     match r.iter().find(|x| !(0.0..=1.0).contains(*x)) {
         Some(x) => Err((
             p.into(),
@@ -341,14 +341,14 @@ fn check_reflectance(p: &str, r: &Binned) -> Result<(), (String, String)> {
     }
 }
 
-fn spectrum(p: &str, s: &SpectrumRef, dir: &Path) -> Result<Binned, (String, String)> {
+fn spectrum(p: &str, s: &SpectrumRef, dir: &Path) -> Result<Vec<f64>, (String, String)> {
     let sp = match s {
         SpectrumRef::Constant(v) => {
             if !v.is_finite() {
                 return Err((p.into(), "must be finite".into()));
             }
             let v = *v;
-            return Ok(bin(|_| v));
+            return Ok(constant_bins(v));
         }
         SpectrumRef::File {
             file,
@@ -377,7 +377,7 @@ fn spectrum(p: &str, s: &SpectrumRef, dir: &Path) -> Result<Binned, (String, Str
             .map_err(|e| (p.into(), e.to_string()))?
             .with_outside(outside.unwrap_or(Outside::Zero)),
     };
-    Ok(bin(|nm| sp.value_at(nm)))
+    Ok(bins(&sp))
 }
 
 fn emitter(p: &str, e: &EmitterFile, dir: &Path) -> Result<Emitter, (String, String)> {
@@ -444,7 +444,7 @@ fn emitter(p: &str, e: &EmitterFile, dir: &Path) -> Result<Emitter, (String, Str
             check_reflectance(&rp, &r)?;
             r
         }
-        None => bin(|_| 0.0),
+        None => constant_bins(0.0),
     };
     Ok(Emitter {
         rect,

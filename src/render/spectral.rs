@@ -7,25 +7,26 @@
 //! several wavelengths per path: one uniform offset u, the others at u + j/n (mod 1),
 //! each mapped through the inverse CDF so every one is marginally distributed by the pdf.
 
-use crate::color::{observer, ObserverKind, END_NM, START_NM};
+use crate::color::{observer, ObserverKind, Spectrum, END_NM, START_NM};
 
 /// Number of wavelength bins (380..=780 nm at 1 nm).
 pub const N_BINS: usize = (END_NM - START_NM + 1) as usize;
 
-/// A spectrum on the integer-nm grid of paper Eq. 8.
-pub type Binned = Vec<f64>;
+/// A spectrum's values on the integer-nm grid of paper Eq. 8, one per bin: the flat array
+/// the tracer indexes in its inner loop.
+pub fn bins(spectrum: &Spectrum) -> Vec<f64> {
+    spectrum.on_grid(START_NM as f64, 1.0, N_BINS)
+}
 
-/// Samples a spectrum on the grid.
-pub fn bin(f: impl Fn(f64) -> f64) -> Binned {
-    (0..N_BINS)
-        .map(|i| f((START_NM + i as i32) as f64))
-        .collect()
+/// The same value in every bin.
+pub fn constant_bins(value: f64) -> Vec<f64> {
+    vec![value; N_BINS]
 }
 
 /// x̄, ȳ, z̄ on the grid.
-pub fn cmf_bins(kind: ObserverKind) -> [Binned; 3] {
+pub fn cmf_bins(kind: ObserverKind) -> [Vec<f64>; 3] {
     let o = observer(kind);
-    let at = |k: usize| bin(|nm| o.at_nm(nm as i32)[k]);
+    let at = |k: usize| (START_NM..=END_NM).map(|nm| o.at_nm(nm)[k]).collect();
     [at(0), at(1), at(2)]
 }
 
@@ -147,6 +148,21 @@ mod tests {
         }
         // Stratified: exactly one of four lands on bin 10 each time (pmf 1/4).
         assert_eq!(count[0], 10_000);
+    }
+
+    #[test]
+    fn bins_hold_the_spectrum_at_each_integer_wavelength() {
+        // A ramp of 1 per nm from 0 at 380 nm: bin i holds i, and 780 nm holds 400.
+        let ramp = Spectrum::new(vec![380.0, 780.0], vec![0.0, 400.0]).unwrap();
+        let b = bins(&ramp);
+        assert_eq!(b.len(), 401);
+        assert!(b
+            .iter()
+            .enumerate()
+            .all(|(i, &v)| (v - i as f64).abs() < 1e-9));
+        let [_, ybar, _] = cmf_bins(ObserverKind::Cie1931);
+        // ȳ(555 nm) = 1 in the CIE 1931 table.
+        assert_eq!(ybar[555 - 380], 1.0);
     }
 
     #[test]

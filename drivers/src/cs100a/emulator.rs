@@ -1,10 +1,12 @@
-//! A simulated CS-100A: answers the protocol from a light model (the [`Stimulus`] in front
+//! A simulated CS-100A: answers the protocol from a light model (the [`World`] in front
 //! of it), with the meter's repeatability as seeded noise, its range codes and its
 //! measuring time. It serves any [`SerialLink`]: an in-process pair, or the master side of a
 //! pseudo-terminal so the real `serialport` backend is exercised (see `pty`).
 //!
 //! The light model, ours and only as good as the unconfirmed figures it rests on (fact
 //! sheet §5: repeatability ±0.2 % in Y and ±0.001 in x, y; range 0.01–299,000 cd/m²):
+//! - the meter has no lamp: it sees emitted light (XYZ, or computed from a spectral
+//!   radiance) and nothing from a surface, its tile or a cap (0 cd/m²);
 //! - Y < 0.01 cd/m² → OK13 (low light), values still sent;
 //! - 299,000 < Y ≤ 598,000 → OK12 with the `-999999` placeholder (MC2 template);
 //! - Y > 598,000 (twice the range) → ER10;
@@ -18,8 +20,8 @@ use std::time::{Duration, Instant};
 use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
 
 use super::Speed;
-use crate::instrument::Stimulus;
 use crate::link::{LineSettings, LinkError, SerialLink};
+use crate::world::World;
 
 /// Upper end of the display range, cd/m² (fact sheet §5, unconfirmed).
 pub const MAX_LUMINANCE: f64 = 299_000.0;
@@ -57,16 +59,16 @@ impl Default for EmulatorConfig {
 
 /// The simulated meter's state.
 pub struct Cs100aEmulator {
-    stimulus: Arc<dyn Stimulus>,
+    world: Arc<dyn World>,
     config: EmulatorConfig,
     rng: SplitMix64,
     speed: Speed,
 }
 
 impl Cs100aEmulator {
-    pub fn new(stimulus: Arc<dyn Stimulus>, config: EmulatorConfig) -> Cs100aEmulator {
+    pub fn new(world: Arc<dyn World>, config: EmulatorConfig) -> Cs100aEmulator {
         Cs100aEmulator {
-            stimulus,
+            world,
             rng: SplitMix64(config.seed),
             config,
             // The power-on speed is not documented; FAST is assumed [I].
@@ -117,9 +119,9 @@ impl Cs100aEmulator {
         }
     }
 
-    /// One measurement of the current stimulus by the light model in the module doc.
+    /// One measurement of what the meter sees now, by the light model in the module doc.
     pub fn measure(&mut self) -> (Status, Option<Yxy>) {
-        let [x_, y_, z_] = self.stimulus.xyz();
+        let [x_, y_, z_] = self.world.view().light().map_or([0.0; 3], |l| l.xyz());
         let lum = if y_.is_finite() { y_.max(0.0) } else { 0.0 };
         if lum > 2.0 * MAX_LUMINANCE {
             return (Status::Er10, None);
@@ -237,11 +239,11 @@ impl SplitMix64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::instrument::SharedStimulus;
+    use crate::world::SharedWorld;
 
     fn emu(xyz: [f64; 3], noise: bool, seed: u64) -> Cs100aEmulator {
         Cs100aEmulator::new(
-            Arc::new(SharedStimulus::new(xyz)),
+            Arc::new(SharedWorld::new(xyz)),
             EmulatorConfig {
                 seed,
                 time_scale: 0.0,
@@ -254,6 +256,40 @@ mod tests {
     fn d65(lum: f64) -> [f64; 3] {
         let (x, y) = (0.3127, 0.3290);
         [x / y * lum, lum, (1.0 - x - y) / y * lum]
+    }
+
+    #[test]
+    fn the_meter_sees_spectral_light_and_nothing_from_surfaces_or_a_cap() {
+        use crate::world::View;
+        use metamer_color::{Quantity, Spectrum};
+        let world = Arc::new(SharedWorld::new(View::Capped));
+        let config = EmulatorConfig {
+            seed: 1,
+            time_scale: 0.0,
+            noise: false,
+        };
+        let mut e = Cs100aEmulator::new(world.clone(), config);
+        // 0.1 W·sr⁻¹·m⁻²·nm⁻¹ in a 1 nm line at 555 nm (ȳ = 1): Y = 68.3 cd/m², and the
+        // chromaticity of 555 nm from the CIE 1931 table, x̄ 0.512050, ȳ 1, z̄ 0.005750:
+        // x = 0.512050 / 1.517800 = 0.33736, y = 1 / 1.517800 = 0.65885.
+        let line = Spectrum::new(vec![554.0, 555.0, 556.0], vec![0.0, 0.1, 0.0]).unwrap();
+        world.set(View::radiance(line).unwrap());
+        let (status, v) = e.measure();
+        assert_eq!(status, Status::Ok00);
+        let v = v.unwrap();
+        assert!((v.luminance.unwrap() - 68.3).abs() < 1e-9, "{v:?}");
+        assert!((v.x.unwrap() - 0.33736).abs() < 1e-5, "{v:?}");
+        assert!((v.y.unwrap() - 0.65885).abs() < 1e-5, "{v:?}");
+        let white = Spectrum::constant(380.0, 780.0, 1.0).with_quantity(Quantity::Reflectance);
+        for dark in [View::Capped, View::WhiteTile, View::surface(white).unwrap()] {
+            world.set(dark.clone());
+            let (status, v) = e.measure();
+            assert_eq!(
+                (status, v.unwrap().luminance),
+                (Status::Ok11, Some(0.0)),
+                "{dark:?}"
+            );
+        }
     }
 
     #[test]
@@ -333,7 +369,7 @@ mod tests {
             time_scale: 1.0,
             noise: false,
         };
-        let light = Arc::new(crate::instrument::SharedStimulus::new(d65(123.4)));
+        let light = Arc::new(SharedWorld::new(d65(123.4)));
         Cs100aEmulator::new(light, config).spawn(device);
         host.write_all(b"MES\r\n").unwrap();
         std::thread::sleep(Duration::from_millis(5));
@@ -352,7 +388,7 @@ mod tests {
     #[test]
     fn measuring_time_follows_speed_and_scale() {
         let mut e = Cs100aEmulator::new(
-            Arc::new(SharedStimulus::new(d65(10.0))),
+            Arc::new(SharedWorld::new(d65(10.0))),
             EmulatorConfig {
                 seed: 1,
                 time_scale: 1.0,

@@ -7,6 +7,8 @@
 //! discards stale input first (PP and VCC do the same, [C2]).
 
 pub mod emulator;
+pub mod error;
+pub mod open;
 #[cfg(unix)]
 pub mod pty;
 
@@ -23,6 +25,7 @@ use crate::instrument::{
 };
 use crate::link::{LinkError, SerialLink};
 use crate::DriverError;
+pub use error::Cs100aError;
 
 /// Model name used in readings, transcripts and specs.
 pub const MODEL: &str = "cs100a";
@@ -124,12 +127,13 @@ impl<L: SerialLink> Cs100a<L> {
             Reply::Code(status) if !status.is_ok() => {
                 Err(self.instrument_error(Command::Measure, status))
             }
-            Reply::Code(status) => Err(DriverError::UnexpectedReply {
+            Reply::Code(status) => Err(Cs100aError::UnexpectedReply {
                 port: self.link.describe(),
                 command: Command::Measure.text(),
                 received: status.code().to_string(),
                 reason: "a measurement must carry Y, x and y".into(),
-            }),
+            }
+            .into()),
         }
     }
 
@@ -147,21 +151,23 @@ impl<L: SerialLink> Cs100a<L> {
         match self.exchange(command)? {
             Reply::Code(Status::Ok00) => Ok(()),
             Reply::Code(status) if !status.is_ok() => Err(self.instrument_error(command, status)),
-            other => Err(DriverError::UnexpectedReply {
+            other => Err(Cs100aError::UnexpectedReply {
                 port: self.link.describe(),
                 command: command.text(),
                 received: format!("{other:?}"),
                 reason: "expected the acknowledgement OK00".into(),
-            }),
+            }
+            .into()),
         }
     }
 
     fn instrument_error(&self, command: Command, status: Status) -> DriverError {
-        DriverError::Instrument {
+        Cs100aError::Instrument {
             port: self.link.describe(),
             command: command.text(),
             status,
         }
+        .into()
     }
 
     /// Sends a command and parses its reply.
@@ -183,12 +189,13 @@ impl<L: SerialLink> Cs100a<L> {
                 Ok(reply) => return Ok(reply),
                 Err(reason) if attempt < ATTEMPTS => drop(reason),
                 Err(reason) => {
-                    return Err(DriverError::BadReply {
+                    return Err(Cs100aError::BadReply {
                         port: self.link.describe(),
                         command: command.text(),
                         received: show_bytes(&line),
                         reason,
-                    })
+                    }
+                    .into())
                 }
             }
         }
@@ -208,28 +215,31 @@ impl<L: SerialLink> Cs100a<L> {
             LinkError::Timeout {
                 timeout_ms,
                 received,
-            } if received.is_empty() && answered => DriverError::StoppedAnswering {
+            } if received.is_empty() && answered => Cs100aError::StoppedAnswering {
                 port,
                 command: text,
                 timeout_ms,
-            },
+            }
+            .into(),
             LinkError::Timeout {
                 timeout_ms,
                 received,
-            } if received.is_empty() => DriverError::NotInRemoteMode {
+            } if received.is_empty() => Cs100aError::NotInRemoteMode {
                 port,
                 command: text,
                 timeout_ms,
-            },
+            }
+            .into(),
             LinkError::Timeout {
                 timeout_ms,
                 received,
-            } => DriverError::PartialReply {
+            } => Cs100aError::PartialReply {
                 port,
                 command: text,
                 received: show_bytes(&received),
                 timeout_ms,
-            },
+            }
+            .into(),
             LinkError::Disconnected { received } => DriverError::Disconnected {
                 port,
                 command: text,
@@ -245,7 +255,7 @@ impl<L: SerialLink> Cs100a<L> {
     }
 }
 
-/// A reading from what the meter sent: Yxy → XYZ (X = xY/y, Z = (1−x−y)Y/y). Values the
+/// A reading from what the meter sent: Yxy → XYZ by the colour core. Values the
 /// meter did not measure (OK11 chromaticity, OK12 placeholder luminance) are NaN, and the
 /// flags say why; JSON writes them as null.
 pub fn reading_from(status: Status, value: &Yxy, speed: Option<Speed>) -> Reading {
@@ -255,9 +265,6 @@ pub fn reading_from(status: Status, value: &Yxy, speed: Option<Speed>) -> Readin
         _ => (f64::NAN, f64::NAN),
     };
     let mut reading = Reading::from_yxy(lum, x, y, MODEL);
-    if y.is_nan() || y <= 0.0 {
-        reading.xyz = [f64::NAN, lum, f64::NAN];
-    }
     reading.flags = match status {
         Status::Ok11 => vec![Flag::ChromaticityOverRange],
         Status::Ok12 => vec![Flag::OverRange],

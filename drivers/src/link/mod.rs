@@ -7,6 +7,7 @@ pub mod record;
 pub mod replay;
 pub mod serial;
 pub mod usb;
+pub mod usb_pair;
 pub mod usb_real;
 
 use std::time::Duration;
@@ -64,6 +65,10 @@ pub enum LinkError {
         metamer_protocols::transcript::show_bytes(received)
     )]
     Disconnected { received: Vec<u8> },
+    /// The device refused a USB transfer by stalling the endpoint (0x00 for control
+    /// transfers): a request it does not support, or one it cannot take in its state.
+    #[error("the device stalled endpoint 0x{endpoint:02x} (it refused the request)")]
+    Stalled { endpoint: u8 },
     #[error("I/O error on {port}: {source}")]
     Io {
         port: String,

@@ -75,8 +75,8 @@ impl RusbLink {
         })
     }
 
-    fn err(&self, e: rusb::Error) -> LinkError {
-        usb_link_error(&self.name, e)
+    fn err(&self, endpoint: u8, e: rusb::Error) -> LinkError {
+        usb_link_error(&self.name, endpoint, e)
     }
 }
 
@@ -94,8 +94,9 @@ fn usb_open_error(name: &str, e: rusb::Error) -> DriverError {
     }
 }
 
-fn usb_link_error(name: &str, e: rusb::Error) -> LinkError {
+fn usb_link_error(name: &str, endpoint: u8, e: rusb::Error) -> LinkError {
     match e {
+        rusb::Error::Pipe => LinkError::Stalled { endpoint },
         rusb::Error::Timeout => LinkError::Timeout {
             timeout_ms: 0,
             received: Vec::new(),
@@ -128,7 +129,7 @@ impl UsbLink for RusbLink {
                 &mut buf,
                 timeout,
             )
-            .map_err(|e| self.err(e))?;
+            .map_err(|e| self.err(0, e))?;
         buf.truncate(n);
         Ok(buf)
     }
@@ -142,7 +143,7 @@ impl UsbLink for RusbLink {
         self.handle
             .write_control(s.request_type, s.request, s.value, s.index, data, timeout)
             .map(drop)
-            .map_err(|e| self.err(e))
+            .map_err(|e| self.err(0, e))
     }
 
     fn read(
@@ -157,7 +158,7 @@ impl UsbLink for RusbLink {
             TransferKind::Bulk => self.handle.read_bulk(endpoint, &mut buf, timeout),
             TransferKind::Interrupt => self.handle.read_interrupt(endpoint, &mut buf, timeout),
         };
-        let n = r.map_err(|e| self.err(e))?;
+        let n = r.map_err(|e| self.err(endpoint, e))?;
         buf.truncate(n);
         Ok(buf)
     }
@@ -173,7 +174,7 @@ impl UsbLink for RusbLink {
             TransferKind::Bulk => self.handle.write_bulk(endpoint, data, timeout),
             TransferKind::Interrupt => self.handle.write_interrupt(endpoint, data, timeout),
         };
-        match r.map_err(|e| self.err(e))? {
+        match r.map_err(|e| self.err(endpoint, e))? {
             n if n == data.len() => Ok(()),
             n => Err(LinkError::Io {
                 port: self.name.clone(),
@@ -292,12 +293,16 @@ mod tests {
             "{msg}"
         );
         assert!(matches!(
-            usb_link_error("x", rusb::Error::NoDevice),
+            usb_link_error("x", 0, rusb::Error::NoDevice),
             LinkError::Disconnected { .. }
         ));
         assert!(matches!(
-            usb_link_error("x", rusb::Error::Timeout),
+            usb_link_error("x", 0, rusb::Error::Timeout),
             LinkError::Timeout { .. }
+        ));
+        assert!(matches!(
+            usb_link_error("x", 0x82, rusb::Error::Pipe),
+            LinkError::Stalled { endpoint: 0x82 }
         ));
     }
 }

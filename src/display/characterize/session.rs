@@ -360,7 +360,7 @@ mod tests {
         let mut display = VirtualDisplay::preset(Preset::IdealCrt);
         // A replay of nothing: the driver cannot talk to it at all, so use a meter that
         // measures light far beyond its range instead: ER10 is an instrument error.
-        let blinding = std::sync::Arc::new(metamer_drivers::SharedStimulus::new([1e7; 3]));
+        let blinding = std::sync::Arc::new(metamer_drivers::SharedWorld::new([1e7; 3]));
         let mut meter =
             metamer_drivers::open_instrument("sim:cs100a?time_scale=0", Some(blinding)).unwrap();
         let mut session = Session::open(

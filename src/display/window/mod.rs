@@ -384,7 +384,7 @@ impl PatchDisplay for WindowDisplay {
         }
     }
 
-    fn stimulus(&self) -> Option<std::sync::Arc<dyn metamer_drivers::Stimulus>> {
+    fn stimulus(&self) -> Option<std::sync::Arc<dyn metamer_drivers::World>> {
         None
     }
 }

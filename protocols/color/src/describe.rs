@@ -1,18 +1,10 @@
 //! One call from a spectrum to its XYZ, xyY and (when a white is known) CIELAB: what
 //! `metamer color xyz` prints.
 
-use super::{
-    illuminant_white, radiance_to_xyz, reflectance_to_xyz, Lab, ObserverKind, Spectrum, XyY, Xyz,
+use crate::{
+    illuminant_white, radiance_to_xyz, reflectance_to_xyz, Lab, ObserverKind, Quantity, Spectrum,
+    XyY, Xyz,
 };
-
-/// What a spectrum is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Quantity {
-    /// Spectral radiance in W·sr⁻¹·m⁻²·nm⁻¹ → absolute XYZ in cd/m².
-    Radiance,
-    /// Reflectance factor 0–1 under an illuminant → relative XYZ, Y = 100 for white.
-    Reflectance,
-}
 
 /// The colorimetry of one spectrum.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,7 +27,8 @@ pub fn describe(
     white: Option<Xyz>,
 ) -> Description {
     let (xyz, default_white) = match quantity {
-        Quantity::Radiance => (radiance_to_xyz(spectrum, observer), None),
+        // Eq. 8 with K_m holds for irradiance too: W·m⁻²·nm⁻¹ gives illuminance in lux.
+        Quantity::Radiance | Quantity::Irradiance => (radiance_to_xyz(spectrum, observer), None),
         Quantity::Reflectance => (
             reflectance_to_xyz(spectrum, illuminant, observer),
             Some(illuminant_white(illuminant, observer)),

@@ -6,7 +6,7 @@
 //! Objects: X = k Σ S(λ) R(λ) x̄(λ) Δλ with k = 100 / Σ S(λ) ȳ(λ) Δλ (CIE 15:2018 §7.1, Eq. 7.2),
 //! so the perfect diffuser has Y = 100.
 
-use super::{observer, ObserverKind, Spectrum, Xyz};
+use crate::{observer, ObserverKind, Spectrum, Xyz};
 
 /// Maximum luminous efficacy for photopic vision, lm/W (paper Eq. 8).
 pub const K_M: f64 = 683.0;
@@ -64,7 +64,7 @@ pub fn illuminant_white(illuminant: &Spectrum, kind: ObserverKind) -> Xyz {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::color::Illuminant;
+    use crate::Illuminant;
 
     #[test]
     fn d65_white_matches_cie_published_white_point() {

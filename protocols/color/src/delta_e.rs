@@ -4,7 +4,7 @@
 //! eqs. (1)–(22), with kL = kC = kH = 1. The hue conventions of their notes are followed:
 //! h' = 0 when a' = b' = 0, and the mean hue and Δh' rules for |h1' − h2'| > 180°.
 
-use super::Lab;
+use crate::Lab;
 
 /// CIE 1976 ΔE*ab.
 pub fn delta_e76(a: Lab, b: Lab) -> f64 {

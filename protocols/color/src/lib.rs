@@ -7,6 +7,7 @@ mod delta_e;
 mod describe;
 mod error;
 mod spectrum;
+mod spectrum_json;
 mod table;
 mod tables;
 
@@ -15,9 +16,9 @@ pub use colorimetry::{
 };
 pub use coords::{Lab, Lch, XyY, Xyz, D65_XY};
 pub use delta_e::{delta_e2000, delta_e76};
-pub use describe::{describe, Description, Quantity};
+pub use describe::{describe, Description};
 pub use error::ColorError;
-pub use spectrum::{Outside, Spectrum};
+pub use spectrum::{Outside, Quantity, Spectrum};
 pub use table::SpectralTable;
 pub use tables::{
     colorchecker, observer, paper_white, ColorCheckerSet, Illuminant, Observer, ObserverKind,

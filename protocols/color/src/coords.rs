@@ -112,10 +112,16 @@ impl std::ops::Sub for Xyz {
 }
 
 impl XyY {
-    /// XYZ from xyY; y = 0 (no light on the spectrum locus' purple line) gives black.
+    /// XYZ from xyY (X = xY/y, Z = (1−x−y)Y/y), the one conversion the colour core and the
+    /// instruments share. No light (Y = 0) is black whatever x, y say. Light without a
+    /// usable chromaticity (y ≤ 0 or not a number, as a colorimeter reports when it could
+    /// not measure one) keeps its Y, and X and Z are NaN: unknown, not zero.
     pub fn to_xyz(self) -> Xyz {
-        if self.y == 0.0 {
+        if self.luminance == 0.0 {
             return Xyz::default();
+        }
+        if self.y.is_nan() || self.y <= 0.0 {
+            return Xyz::new(f64::NAN, self.luminance, f64::NAN);
         }
         let k = self.luminance / self.y;
         Xyz::new(self.x * k, self.luminance, (1.0 - self.x - self.y) * k)
@@ -199,6 +205,34 @@ mod tests {
         let black = Xyz::default().to_xyy();
         assert_eq!(black.luminance, 0.0);
         assert_eq!(black.to_xyz(), Xyz::default());
+    }
+
+    #[test]
+    fn xyy_to_xyz_by_hand_and_without_chromaticity() {
+        // x = 0.3, y = 0.6, Y = 30: X = 0.3·30/0.6 = 15, Z = 0.1·30/0.6 = 5.
+        let c = XyY {
+            x: 0.3,
+            y: 0.6,
+            luminance: 30.0,
+        }
+        .to_xyz();
+        assert!((c.x - 15.0).abs() < 1e-12 && c.y == 30.0 && (c.z - 5.0).abs() < 1e-12);
+        for y in [0.0, -0.1, f64::NAN] {
+            let u = XyY {
+                x: 0.3,
+                y,
+                luminance: 52.31,
+            }
+            .to_xyz();
+            assert!(u.x.is_nan() && u.y == 52.31 && u.z.is_nan(), "{y}: {u:?}");
+            let dark = XyY {
+                x: f64::NAN,
+                y,
+                luminance: 0.0,
+            }
+            .to_xyz();
+            assert_eq!(dark, Xyz::default());
+        }
     }
 
     fn xyz_strategy() -> impl Strategy<Value = Xyz> {

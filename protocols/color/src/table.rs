@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{ColorError, Outside, Spectrum};
+use crate::{ColorError, Outside, Spectrum};
 
 /// A parsed spectral table: a shared wavelength column and named value columns.
 #[derive(Clone, Debug, PartialEq)]

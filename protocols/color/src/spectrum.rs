@@ -1,14 +1,42 @@
 //! Sampled spectra: a function of wavelength given at increasing sample points, linearly
 //! interpolated between them (the convention of the validation-box contract and CIE 15:2018
 //! §7.2.2 for tables at 1 nm), zero outside unless the caller asks to hold the end values.
+//! A spectrum may say what it measures ([`Quantity`]), so a reading's spectrum carries its
+//! unit with it.
 
-use super::ColorError;
+use serde::{Deserialize, Serialize};
+
+use crate::ColorError;
+
+/// What a spectrum's values are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// Spectral radiance in W·sr⁻¹·m⁻²·nm⁻¹ → absolute XYZ in cd/m².
+    Radiance,
+    /// Spectral irradiance in W·m⁻²·nm⁻¹ → illuminance XYZ in lux.
+    Irradiance,
+    /// Reflectance factor 0–1 under an illuminant → relative XYZ, Y = 100 for white.
+    Reflectance,
+}
+
+impl Quantity {
+    /// The unit of the values, for messages and file headers.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Quantity::Radiance => "W·sr⁻¹·m⁻²·nm⁻¹",
+            Quantity::Irradiance => "W·m⁻²·nm⁻¹",
+            Quantity::Reflectance => "1",
+        }
+    }
+}
 
 /// What a spectrum is worth outside its first and last sample.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outside {
     /// Zero outside the table (the default for emission and observer tables).
+    #[default]
     Zero,
     /// The first value below the table, the last above it (used for reflectances measured
     /// over a shorter range, e.g. the ColorChecker's 380–730 nm).
@@ -16,11 +44,17 @@ pub enum Outside {
 }
 
 /// A sampled spectrum with strictly increasing wavelengths in nm.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+///
+/// In JSON a spectrum on an even grid is `{"start_nm":380,"step_nm":10,"values":[…]}`, any
+/// other `{"wavelengths_nm":[…],"values":[…]}`; `quantity` and `outside` follow when set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "crate::spectrum_json::SpectrumJson")]
+#[serde(into = "crate::spectrum_json::SpectrumJson")]
 pub struct Spectrum {
     wavelengths_nm: Vec<f64>,
     values: Vec<f64>,
     outside: Outside,
+    quantity: Option<Quantity>,
 }
 
 impl Spectrum {
@@ -55,6 +89,7 @@ impl Spectrum {
             wavelengths_nm,
             values,
             outside: Outside::Zero,
+            quantity: None,
         })
     }
 
@@ -80,6 +115,32 @@ impl Spectrum {
 
     pub fn outside(&self) -> Outside {
         self.outside
+    }
+
+    /// The same samples marked as measuring `quantity`.
+    pub fn with_quantity(mut self, quantity: Quantity) -> Self {
+        self.quantity = Some(quantity);
+        self
+    }
+
+    /// What the values are, when the spectrum says.
+    pub fn quantity(&self) -> Option<Quantity> {
+        self.quantity
+    }
+
+    /// `(start, step)` when the samples lie exactly on `start + step·i` (two samples or
+    /// more); the exact test keeps a spectrum built with [`Spectrum::from_grid`] on its grid
+    /// through a JSON round trip.
+    pub fn grid(&self) -> Option<(f64, f64)> {
+        let w = &self.wavelengths_nm;
+        if w.len() < 2 {
+            return None;
+        }
+        let (start, step) = (w[0], w[1] - w[0]);
+        w.iter()
+            .enumerate()
+            .all(|(i, &nm)| nm == start + step * i as f64)
+            .then_some((start, step))
     }
 
     pub fn wavelengths_nm(&self) -> &[f64] {
@@ -121,6 +182,14 @@ impl Spectrum {
         self.values[i - 1] + t * (self.values[i] - self.values[i - 1])
     }
 
+    /// The values at `start, start+step, …` (`n` of them) as a flat array, for code that
+    /// works on a fixed grid (the path tracer's 1 nm bins).
+    pub fn on_grid(&self, start_nm: f64, step_nm: f64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| self.value_at(start_nm + step_nm * i as f64))
+            .collect()
+    }
+
     /// Samples this spectrum on `start, start+step, …, end` (inclusive).
     pub fn resample(&self, start_nm: f64, end_nm: f64, step_nm: f64) -> Spectrum {
         assert!(step_nm > 0.0 && end_nm >= start_nm, "bad resampling grid");
@@ -131,6 +200,7 @@ impl Spectrum {
             wavelengths_nm: nm,
             values,
             outside: self.outside,
+            quantity: self.quantity,
         }
     }
 
@@ -140,11 +210,13 @@ impl Spectrum {
             wavelengths_nm: self.wavelengths_nm.clone(),
             values: self.values.iter().map(|v| v * k).collect(),
             outside: self.outside,
+            quantity: self.quantity,
         }
     }
 
     /// The product of two spectra, sampled on the union of both grids so no sample of
-    /// either is lost. Outside both tables the product follows each factor's own rule.
+    /// either is lost. Outside both tables the product follows each factor's own rule. A
+    /// reflectance times anything is what the other factor is (light reflected is light).
     pub fn product(&self, other: &Spectrum) -> Spectrum {
         let mut nm: Vec<f64> = self
             .wavelengths_nm
@@ -163,10 +235,15 @@ impl Spectrum {
         } else {
             Outside::Zero
         };
+        let quantity = match (self.quantity, other.quantity) {
+            (Some(Quantity::Reflectance), q) | (q, Some(Quantity::Reflectance)) => q,
+            _ => None,
+        };
         Spectrum {
             wavelengths_nm: nm,
             values,
             outside,
+            quantity,
         }
     }
 }
@@ -207,6 +284,33 @@ mod tests {
         assert_eq!(p.value_at(500.0), 2.0);
         assert_eq!(p.value_at(390.0), 0.0);
         assert_eq!(ramp().scaled(2.0).value_at(600.0), 6.0);
+        assert_eq!(
+            ramp().on_grid(400.0, 25.0, 5),
+            vec![0.0, 0.25, 0.5, 0.75, 1.0]
+        );
+        assert_eq!(ramp().on_grid(350.0, 300.0, 2), vec![0.0, 0.0]);
+    }
+
+    #[test]
+    fn quantity_follows_scaling_resampling_and_reflection() {
+        let light = ramp().with_quantity(Quantity::Radiance);
+        let surface = Spectrum::constant(380.0, 780.0, 0.5).with_quantity(Quantity::Reflectance);
+        assert_eq!(light.scaled(2.0).quantity(), Some(Quantity::Radiance));
+        assert_eq!(
+            light.resample(400.0, 600.0, 10.0).quantity(),
+            Some(Quantity::Radiance)
+        );
+        assert_eq!(surface.product(&light).quantity(), Some(Quantity::Radiance));
+        assert_eq!(light.product(&light).quantity(), None);
+        assert_eq!(ramp().quantity(), None);
+    }
+
+    #[test]
+    fn grid_is_found_only_when_every_sample_is_on_it() {
+        assert_eq!(ramp().grid(), Some((400.0, 100.0)));
+        let odd = Spectrum::new(vec![400.0, 500.0, 650.0], vec![0.0; 3]).unwrap();
+        assert_eq!(odd.grid(), None);
+        assert_eq!(Spectrum::new(vec![500.0], vec![1.0]).unwrap().grid(), None);
     }
 
     #[test]

@@ -5,7 +5,7 @@
 
 use std::sync::OnceLock;
 
-use super::{ColorError, Outside, SpectralTable, Spectrum};
+use crate::{ColorError, Outside, SpectralTable, Spectrum};
 
 /// The CIE standard colorimetric observers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -93,14 +93,14 @@ pub fn observer(kind: ObserverKind) -> &'static Observer {
             build_observer(
                 kind,
                 "data/cie1931_2deg_cmf_1nm.csv",
-                include_str!("../../data/cie1931_2deg_cmf_1nm.csv"),
+                include_str!("../../../data/cie1931_2deg_cmf_1nm.csv"),
             )
         }),
         ObserverKind::Cie1964 => CIE1964.get_or_init(|| {
             build_observer(
                 kind,
                 "data/cie1964_10deg_cmf_1nm.csv",
-                include_str!("../../data/cie1964_10deg_cmf_1nm.csv"),
+                include_str!("../../../data/cie1964_10deg_cmf_1nm.csv"),
             )
         }),
     }
@@ -144,27 +144,27 @@ impl Illuminant {
         let (name, text) = match self {
             Illuminant::A => (
                 "data/illuminant_a.csv",
-                include_str!("../../data/illuminant_a.csv"),
+                include_str!("../../../data/illuminant_a.csv"),
             ),
             Illuminant::D50 => (
                 "data/illuminant_d50.csv",
-                include_str!("../../data/illuminant_d50.csv"),
+                include_str!("../../../data/illuminant_d50.csv"),
             ),
             Illuminant::D65 => (
                 "data/illuminant_d65.csv",
-                include_str!("../../data/illuminant_d65.csv"),
+                include_str!("../../../data/illuminant_d65.csv"),
             ),
             Illuminant::Fl11 => (
                 "data/illuminant_fl11.csv",
-                include_str!("../../data/illuminant_fl11.csv"),
+                include_str!("../../../data/illuminant_fl11.csv"),
             ),
             Illuminant::LedRgb1 => (
                 "data/illuminant_led_rgb1.csv",
-                include_str!("../../data/illuminant_led_rgb1.csv"),
+                include_str!("../../../data/illuminant_led_rgb1.csv"),
             ),
             Illuminant::LedB3 => (
                 "data/illuminant_led_b3.csv",
-                include_str!("../../data/illuminant_led_b3.csv"),
+                include_str!("../../../data/illuminant_led_b3.csv"),
             ),
         };
         parse_embedded(name, text).first()
@@ -229,11 +229,11 @@ pub fn colorchecker(set: ColorCheckerSet) -> Vec<Spectrum> {
     let (name, text) = match set {
         ColorCheckerSet::BabelColorAverage => (
             "data/colorchecker_babelcolor_average.csv",
-            include_str!("../../data/colorchecker_babelcolor_average.csv"),
+            include_str!("../../../data/colorchecker_babelcolor_average.csv"),
         ),
         ColorCheckerSet::Ohta => (
             "data/colorchecker_ohta.csv",
-            include_str!("../../data/colorchecker_ohta.csv"),
+            include_str!("../../../data/colorchecker_ohta.csv"),
         ),
     };
     parse_embedded(name, text).all(Outside::HoldEnds)
@@ -243,7 +243,7 @@ pub fn colorchecker(set: ColorCheckerSet) -> Vec<Spectrum> {
 pub fn paper_white() -> Spectrum {
     parse_embedded(
         "data/paper_white_reflectance.csv",
-        include_str!("../../data/paper_white_reflectance.csv"),
+        include_str!("../../../data/paper_white_reflectance.csv"),
     )
     .first()
 }
