@@ -12,7 +12,8 @@ use metamer::display::characterize::log::refuse_existing;
 use metamer::display::characterize::{
     default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session, DEFAULT_RAMP_STEPS,
 };
-use metamer::display::{DisplaySpec, ModelKind};
+use metamer::display::ModelKind;
+use metamer::rig::DisplaySpec;
 use metamer_drivers::{
     open_instrument, CalibrationOutcome, DriverError, Instrument, MeasureMode, Request, Speed,
 };
@@ -256,7 +257,7 @@ fn calibrate(instrument: &mut dyn Instrument) -> Result<(), CliError> {
 }
 
 /// Shows white and lets the user aim the instrument (on a real screen only).
-fn aim(display: &mut dyn metamer::display::PatchDisplay) -> Result<(), CliError> {
+fn aim(display: &mut dyn metamer::rig::PatchDisplay) -> Result<(), CliError> {
     display.show([255; 3])?;
     prompt(&format!(
         "aim the instrument at the middle of the white {} and press Enter",

@@ -14,8 +14,9 @@ use crate::display::characterize::{
     default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session,
 };
 use crate::display::gamut::{map_to_gamut, GamutMapping};
-use crate::display::virtual_display::quantize;
-use crate::display::{ModelKind, PatchDisplay, Profile, VirtualPanel};
+use crate::display::{ModelKind, Profile};
+use crate::rig::virtual_display::quantize;
+use crate::rig::{PatchDisplay, VirtualPanel};
 
 use super::scene_readings::mean_reading;
 use super::LabError;
@@ -163,7 +164,7 @@ pub fn stimulus_of(display: &dyn PatchDisplay) -> Result<Arc<dyn Stimulus>, LabE
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::display::Preset;
+    use crate::rig::Preset;
 
     /// Doubling the luminance a target asks for doubles the white luminance chosen, and a
     /// target on the nominal white needs the nominal white (plus headroom).

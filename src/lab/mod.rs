@@ -31,11 +31,10 @@ use crate::color::Xyz;
 use crate::display::characterize::finish::{FinishError, Summary};
 use crate::display::characterize::{LogError, PlanError, SessionError};
 use crate::display::gamut::GamutMapping;
-use crate::display::{
-    ModelKind, PatchDisplay, PatchDisplayError, Preset, ProfileError, VirtualDisplay, VirtualPanel,
-};
+use crate::display::{ModelKind, ProfileError};
 use crate::render::spot::SpotError;
 use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
+use crate::rig::{PatchDisplay, PatchDisplayError, Preset, VirtualDisplay, VirtualPanel};
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison, ValidationError};
 
 /// What a lab run is made of.

@@ -11,7 +11,7 @@ use metamer_drivers::{DriverError, Instrument, InstrumentInfo, Reading, Request}
 
 use super::log::{LogError, LogHeader, LogReading, SessionLog, LOG_FILE};
 use super::plan::{Plan, PlannedPatch};
-use crate::display::patch_display::{PatchDisplay, PatchDisplayError};
+use crate::rig::screen::{PatchDisplay, PatchDisplayError};
 
 /// A measurement could not be taken.
 #[derive(Debug, thiserror::Error)]
@@ -223,7 +223,7 @@ impl Session {
 mod tests {
     use super::*;
     use crate::display::characterize::plan::PlanOptions;
-    use crate::display::virtual_display::{Preset, VirtualDisplay};
+    use crate::rig::virtual_display::{Preset, VirtualDisplay};
 
     fn tempdir(name: &str) -> PathBuf {
         let dir =

@@ -24,7 +24,7 @@ use x11rb::wrapper::ConnectionExt as _;
 
 pub use pixels::PixelFormat;
 
-use super::patch_display::{PatchDisplay, PatchDisplayError};
+use super::screen::{PatchDisplay, PatchDisplayError};
 
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]

@@ -32,7 +32,7 @@ use metamer_drivers::Stimulus;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
-use super::patch_display::{PatchDisplay, PatchDisplayError};
+use super::screen::{PatchDisplay, PatchDisplayError};
 
 /// The named simulated monitors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
