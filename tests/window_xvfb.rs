@@ -9,7 +9,7 @@ use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
 use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
-use metamer::rig::PatchDisplay;
+use metamer::rig::Screen;
 
 struct Xvfb {
     child: Child,

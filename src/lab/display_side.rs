@@ -16,7 +16,7 @@ use crate::display::characterize::{
 use crate::display::gamut::{map_to_gamut, GamutMapping};
 use crate::display::{ModelKind, Profile};
 use crate::rig::virtual_display::quantize;
-use crate::rig::{PatchDisplay, VirtualPanel};
+use crate::rig::{Screen, VirtualPanel};
 
 use super::scene_readings::mean_reading;
 use super::LabError;
@@ -58,7 +58,7 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
 /// log, resume, fit, held-out verification, profile, `.ti3`, report).
 pub fn characterize(
     dir: &Path,
-    display: &mut dyn PatchDisplay,
+    display: &mut dyn Screen,
     meter: &mut dyn Instrument,
     instrument_spec: &str,
     model: ModelKind,
@@ -122,7 +122,7 @@ pub struct Reproduced {
 /// Shows each target through `profile` (with `mapping` where it is out of gamut) and reads
 /// it `repeats` times with `meter`.
 pub fn reproduce_and_measure(
-    display: &mut dyn PatchDisplay,
+    display: &mut dyn Screen,
     meter: &mut dyn Instrument,
     profile: &Profile,
     mapping: GamutMapping,
@@ -157,7 +157,7 @@ pub fn reproduce_and_measure(
 }
 
 /// What a simulated meter aimed at `display` sees; the lab runs on simulated displays only.
-pub fn stimulus_of(display: &dyn PatchDisplay) -> Result<Arc<dyn Stimulus>, LabError> {
+pub fn stimulus_of(display: &dyn Screen) -> Result<Arc<dyn Stimulus>, LabError> {
     display.stimulus().ok_or(LabError::NotSimulated)
 }
 

@@ -3,8 +3,10 @@
 //! monitor); display mathematics (models, fitting, reproduction) stays in `display`.
 
 pub mod screen;
+pub mod spec;
 pub mod virtual_display;
 pub mod window;
 
-pub use screen::{DisplaySpec, PatchDisplay, PatchDisplayError};
+pub use screen::{Screen, ScreenError};
+pub use spec::{OpenError, ScreenSpec};
 pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};
