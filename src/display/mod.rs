@@ -9,7 +9,6 @@ pub mod diagnostics;
 pub mod fit;
 pub mod measurements;
 pub mod model;
-pub mod patch_set;
 pub mod profile;
 
 // Using a profile.
