@@ -8,8 +8,8 @@ use std::io::BufRead;
 use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
-use metamer::display::window::{list_monitors, WindowDisplay, WindowError};
-use metamer::display::PatchDisplay;
+use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
+use metamer::rig::Screen;
 
 struct Xvfb {
     child: Child,

@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 
 use metamer::display::budget::{run_budget_study, write_budget, RAMP_STEPS};
-use metamer::display::{ModelKind, Preset};
+use metamer::display::ModelKind;
+use metamer::rig::Preset;
 
 use super::{CliError, CliResult};
 

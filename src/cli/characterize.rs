@@ -12,7 +12,8 @@ use metamer::display::characterize::log::refuse_existing;
 use metamer::display::characterize::{
     default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session, DEFAULT_RAMP_STEPS,
 };
-use metamer::display::{DisplaySpec, ModelKind};
+use metamer::display::ModelKind;
+use metamer::rig::ScreenSpec;
 use metamer_drivers::{
     open_instrument, CalibrationOutcome, DriverError, Instrument, MeasureMode, Request, Speed,
 };
@@ -69,7 +70,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let spec = DisplaySpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
+    let spec = ScreenSpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
     let grid_steps = args
         .grid_steps
@@ -256,7 +257,7 @@ fn calibrate(instrument: &mut dyn Instrument) -> Result<(), CliError> {
 }
 
 /// Shows white and lets the user aim the instrument (on a real screen only).
-fn aim(display: &mut dyn metamer::display::PatchDisplay) -> Result<(), CliError> {
+fn aim(display: &mut dyn metamer::rig::Screen) -> Result<(), CliError> {
     display.show([255; 3])?;
     prompt(&format!(
         "aim the instrument at the middle of the white {} and press Enter",

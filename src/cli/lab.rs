@@ -3,8 +3,9 @@
 use std::path::PathBuf;
 
 use metamer::display::gamut::GamutMapping;
-use metamer::display::{ModelKind, Preset};
+use metamer::display::ModelKind;
 use metamer::lab::{run_lab, LabOptions, LabProgress, LabResult, DISPLAY_DIR};
+use metamer::rig::Preset;
 
 use super::{CliError, CliResult};
 

@@ -13,6 +13,7 @@ mod fit;
 mod lab;
 mod render;
 mod reproduce;
+mod simulate;
 mod spot;
 
 /// metamer: prove a rendering is colour-true.
@@ -43,6 +44,8 @@ enum Command {
     Budget(budget::Args),
     /// The whole validation chain on the built-in simulated lab: box, simulation, display.
     Lab(lab::Args),
+    /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
+    Simulate(simulate::Args),
 }
 
 /// A command's failure: usage errors exit 2, data and device errors exit 1.
@@ -71,6 +74,7 @@ pub fn main() -> ExitCode {
         Command::Characterize(args) => characterize::run(args),
         Command::Lab(args) => lab::run(args),
         Command::Budget(args) => budget::run(args),
+        Command::Simulate(args) => simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,11 +21,11 @@ use serde::Serialize;
 use super::characterize::plan::random_patches;
 use super::characterize::{default_grid_steps, Plan, PlanOptions, PlannedPatch, Purpose};
 use super::diagnostics::percentile;
-use super::virtual_display::{Preset, VirtualPanel};
 use super::Patch;
 use super::{fit_profile, ModelKind};
 use crate::color::{delta_e2000, Xyz};
 use crate::plot::{write_log_log, LogLogChart, Series};
+use crate::rig::virtual_display::{Preset, VirtualPanel};
 
 /// One patch budget: ramp steps per channel (including 0 and full drive) and the points
 /// per axis of the RGB cube (0 for none).

@@ -6,8 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::model::samples::{PatchSet, CHANNEL_NAMES};
 use super::model::{condition_number, fit_power_gamma, ModelKind};
-use super::patch_set::{PatchSet, CHANNEL_NAMES};
 use crate::color::{delta_e2000, Xyz};
 
 /// Default tolerance of the verdict, ΔE00.

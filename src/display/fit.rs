@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use sha2::{Digest, Sha256};
 
 use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals};
+use super::model::samples::PatchSet;
 use super::model::{
     fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind,
     ModelParams,
 };
-use super::patch_set::PatchSet;
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
 use super::Patch;
 use crate::color::{delta_e2000, Xyz};

@@ -9,7 +9,6 @@ pub mod diagnostics;
 pub mod fit;
 pub mod measurements;
 pub mod model;
-pub mod patch_set;
 pub mod profile;
 
 // Using a profile.
@@ -18,9 +17,6 @@ pub mod reproduce;
 
 // Showing and measuring patches.
 pub mod characterize;
-pub mod patch_display;
-pub mod virtual_display;
-pub mod window;
 
 // Speed against accuracy.
 pub mod budget;
@@ -29,9 +25,7 @@ pub use diagnostics::{Diagnostics, Noise, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitError, FitOptions};
 pub use measurements::{read_measurement_file, read_measurements, write_ti3, MeasurementsError};
 pub use model::{DisplayModel, Inverse, ModelKind};
-pub use patch_display::{DisplaySpec, PatchDisplay, PatchDisplayError};
 pub use profile::{Profile, ProfileError};
-pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};
 
 /// One measured patch: drive values 0–1 per channel and the XYZ measured, cd/m².
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -14,8 +14,9 @@ use crate::display::characterize::{
     default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session,
 };
 use crate::display::gamut::{map_to_gamut, GamutMapping};
-use crate::display::virtual_display::quantize;
-use crate::display::{ModelKind, PatchDisplay, Profile, VirtualPanel};
+use crate::display::{ModelKind, Profile};
+use crate::rig::virtual_display::quantize;
+use crate::rig::{Screen, VirtualPanel};
 
 use super::scene_readings::mean_reading;
 use super::LabError;
@@ -57,7 +58,7 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
 /// log, resume, fit, held-out verification, profile, `.ti3`, report).
 pub fn characterize(
     dir: &Path,
-    display: &mut dyn PatchDisplay,
+    display: &mut dyn Screen,
     meter: &mut dyn Instrument,
     instrument_spec: &str,
     model: ModelKind,
@@ -121,7 +122,7 @@ pub struct Reproduced {
 /// Shows each target through `profile` (with `mapping` where it is out of gamut) and reads
 /// it `repeats` times with `meter`.
 pub fn reproduce_and_measure(
-    display: &mut dyn PatchDisplay,
+    display: &mut dyn Screen,
     meter: &mut dyn Instrument,
     profile: &Profile,
     mapping: GamutMapping,
@@ -156,14 +157,14 @@ pub fn reproduce_and_measure(
 }
 
 /// What a simulated meter aimed at `display` sees; the lab runs on simulated displays only.
-pub fn stimulus_of(display: &dyn PatchDisplay) -> Result<Arc<dyn World>, LabError> {
+pub fn stimulus_of(display: &dyn Screen) -> Result<Arc<dyn World>, LabError> {
     display.stimulus().ok_or(LabError::NotSimulated)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::display::Preset;
+    use crate::rig::Preset;
 
     /// Doubling the luminance a target asks for doubles the white luminance chosen, and a
     /// target on the nominal white needs the nominal white (plus headroom).

@@ -31,11 +31,10 @@ use crate::color::Xyz;
 use crate::display::characterize::finish::{FinishError, Summary};
 use crate::display::characterize::{LogError, PlanError, SessionError};
 use crate::display::gamut::GamutMapping;
-use crate::display::{
-    ModelKind, PatchDisplay, PatchDisplayError, Preset, ProfileError, VirtualDisplay, VirtualPanel,
-};
+use crate::display::{ModelKind, ProfileError};
 use crate::render::spot::SpotError;
 use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
+use crate::rig::{Preset, Screen, ScreenError, VirtualDisplay, VirtualPanel};
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison, ValidationError};
 
 /// What a lab run is made of.
@@ -90,7 +89,7 @@ pub enum LabError {
     #[error("the simulated meter: {0}")]
     Meter(#[from] DriverError),
     #[error(transparent)]
-    Display(#[from] PatchDisplayError),
+    Display(#[from] ScreenError),
     #[error(transparent)]
     Plan(#[from] PlanError),
     #[error(transparent)]
@@ -222,7 +221,7 @@ pub fn run_lab(
     // 4: the simulation shown and read.
     progress(LabProgress::Stage("showing the simulation on the display"));
     let reproduced = reproduce_and_measure(
-        &mut display as &mut dyn PatchDisplay,
+        &mut display as &mut dyn Screen,
         display_meter.as_mut(),
         &profile,
         opts.gamut,

@@ -283,7 +283,7 @@ mod tests {
     fn a_report_of_a_simulated_panel_draws_every_panel() {
         use crate::display::characterize::plan::{Plan, PlanOptions};
         use crate::display::characterize::verify::verify;
-        use crate::display::virtual_display::{Preset, VirtualPanel};
+        use crate::rig::virtual_display::{Preset, VirtualPanel};
         let panel = VirtualPanel::preset(Preset::IpsLcd);
         let plan = Plan::new(PlanOptions::default()).unwrap();
         let patches: Vec<AveragedPatch> = plan

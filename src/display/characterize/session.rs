@@ -11,13 +11,13 @@ use metamer_drivers::{DriverError, Instrument, InstrumentInfo, Reading, Request}
 
 use super::log::{LogError, LogHeader, LogReading, SessionLog, LOG_FILE};
 use super::plan::{Plan, PlannedPatch};
-use crate::display::patch_display::{PatchDisplay, PatchDisplayError};
+use crate::rig::screen::{Screen, ScreenError};
 
 /// A measurement could not be taken.
 #[derive(Debug, thiserror::Error)]
 pub enum MeasureFailure {
     #[error(transparent)]
-    Display(#[from] PatchDisplayError),
+    Display(#[from] ScreenError),
     #[error(transparent)]
     Instrument(#[from] DriverError),
     #[error(transparent)]
@@ -143,7 +143,7 @@ impl Session {
     /// Shows and measures every planned patch the log lacks, in plan order.
     pub fn measure(
         &mut self,
-        display: &mut dyn PatchDisplay,
+        display: &mut dyn Screen,
         instrument: &mut dyn Instrument,
         options: &MeasureOptions,
         progress: &mut dyn FnMut(Progress<'_>),
@@ -223,7 +223,7 @@ impl Session {
 mod tests {
     use super::*;
     use crate::display::characterize::plan::PlanOptions;
-    use crate::display::virtual_display::{Preset, VirtualDisplay};
+    use crate::rig::virtual_display::{Preset, VirtualDisplay};
 
     fn tempdir(name: &str) -> PathBuf {
         let dir =

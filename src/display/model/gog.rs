@@ -5,9 +5,9 @@
 
 use super::least_squares::levenberg_marquardt;
 use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
+use super::samples::{PatchSet, CHANNEL_NAMES};
 use super::{MatrixTrc, ModelKind, Trc};
 use crate::display::fit::FitError;
-use crate::display::patch_set::{PatchSet, CHANNEL_NAMES};
 
 /// Fits one channel's GOG (`flare` false) or GOGO curve to (drive, R′) points.
 pub fn fit_gog_curve(points: &[(f64, f64)], flare: bool) -> Trc {

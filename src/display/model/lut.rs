@@ -14,9 +14,9 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
+use super::samples::{PatchSet, CHANNEL_NAMES, SAME_DRIVE};
 use super::{condition_number, DisplayModel, FastInverse, Inverse, ModelKind, Trc, MAX_CONDITION};
 use crate::display::fit::FitError;
-use crate::display::patch_set::{PatchSet, CHANNEL_NAMES, SAME_DRIVE};
 use crate::display::Patch;
 
 /// Ramp levels from which the shaper interpolates the ramp instead of fitting a power law.

@@ -7,9 +7,9 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::plcc::{black_and_primaries, ramp_tables, singular};
+use super::samples::PatchSet;
 use super::{MatrixTrc, ModelKind};
 use crate::display::fit::FitError;
-use crate::display::patch_set::PatchSet;
 use crate::display::Patch;
 
 pub fn fit_matrix_lsq(set: &PatchSet, patches: &[Patch]) -> Result<MatrixTrc, FitError> {

@@ -10,6 +10,7 @@ mod lut;
 mod matrix_lsq;
 mod matrix_trc;
 mod plcc;
+pub mod samples;
 mod trc;
 
 pub use gog::{fit_gog, fit_gog_curve};

@@ -8,9 +8,9 @@
 //! A ramp patch's normalised output is its black-corrected XYZ projected on the primary's
 //! column (least squares), not its Y alone: blue has little Y, so Y alone would be noisy.
 
+use super::samples::{PatchSet, CHANNEL_NAMES};
 use super::{MatrixTrc, ModelKind, Trc};
 use crate::display::fit::FitError;
-use crate::display::patch_set::{PatchSet, CHANNEL_NAMES};
 
 /// Black and the Eq. 9 matrix (columns: full-on primaries minus black).
 pub fn black_and_primaries(

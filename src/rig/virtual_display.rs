@@ -32,7 +32,7 @@ use metamer_drivers::{View, World};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
-use super::patch_display::{PatchDisplay, PatchDisplayError};
+use super::screen::{Screen, ScreenError};
 
 /// The named simulated monitors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -287,27 +287,27 @@ pub fn quantize(v: f64) -> u8 {
 }
 
 /// The panel plus what it shows now; this is what a simulated meter looks at.
-struct Screen {
+struct LitPanel {
     panel: VirtualPanel,
     shown: RwLock<[u8; 3]>,
 }
 
-impl World for Screen {
+impl World for LitPanel {
     fn view(&self) -> View {
         let shown = *self.shown.read().unwrap_or_else(|e| e.into_inner());
         View::xyz(self.panel.xyz(shown))
     }
 }
 
-/// A simulated monitor as a [`PatchDisplay`]; it starts black.
+/// A simulated monitor as a [`Screen`]; it starts black.
 pub struct VirtualDisplay {
-    screen: Arc<Screen>,
+    lit: Arc<LitPanel>,
 }
 
 impl VirtualDisplay {
     pub fn new(panel: VirtualPanel) -> VirtualDisplay {
         VirtualDisplay {
-            screen: Arc::new(Screen {
+            lit: Arc::new(LitPanel {
                 panel,
                 shown: RwLock::new([0; 3]),
             }),
@@ -320,34 +320,34 @@ impl VirtualDisplay {
 
     /// The same display with full white at `cd_m2` (see [`VirtualPanel::with_white_luminance`]).
     pub fn with_white_luminance(self, cd_m2: f64) -> VirtualDisplay {
-        VirtualDisplay::new(self.screen.panel.with_white_luminance(cd_m2))
+        VirtualDisplay::new(self.lit.panel.with_white_luminance(cd_m2))
     }
 
     pub fn panel(&self) -> &VirtualPanel {
-        &self.screen.panel
+        &self.lit.panel
     }
 
     /// The drive values shown now.
     pub fn shown(&self) -> [u8; 3] {
-        *self.screen.shown.read().unwrap_or_else(|e| e.into_inner())
+        *self.lit.shown.read().unwrap_or_else(|e| e.into_inner())
     }
 }
 
-impl PatchDisplay for VirtualDisplay {
+impl Screen for VirtualDisplay {
     fn spec(&self) -> String {
-        format!("virtual:{}", self.screen.panel.name)
+        format!("virtual:{}", self.lit.panel.name)
     }
 
     fn describe(&self) -> String {
-        let p = &self.screen.panel.params;
+        let p = &self.lit.panel.params;
         format!(
             "simulated monitor '{}': white {:.1} cd/m² at x {:.4} y {:.4}, black {:.3} cd/m²",
-            self.screen.panel.name, p.white_cd_m2, p.white_xy[0], p.white_xy[1], p.black_cd_m2
+            self.lit.panel.name, p.white_cd_m2, p.white_xy[0], p.white_xy[1], p.black_cd_m2
         )
     }
 
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), PatchDisplayError> {
-        *self.screen.shown.write().unwrap_or_else(|e| e.into_inner()) = rgb;
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = rgb;
         Ok(())
     }
 
@@ -357,7 +357,7 @@ impl PatchDisplay for VirtualDisplay {
     }
 
     fn stimulus(&self) -> Option<Arc<dyn World>> {
-        Some(self.screen.clone())
+        Some(self.lit.clone())
     }
 }
 

@@ -2,7 +2,7 @@
 //! single-channel ramps. Repeated patches are averaged; everything else stays available for
 //! fitting and residuals.
 
-use super::Patch;
+use crate::display::Patch;
 
 /// Drive values closer than this count as equal (finer than a 16-bit step).
 pub const SAME_DRIVE: f64 = 1e-6;

@@ -24,7 +24,7 @@ use x11rb::wrapper::ConnectionExt as _;
 
 pub use pixels::PixelFormat;
 
-use super::patch_display::{PatchDisplay, PatchDisplayError};
+use super::screen::{Screen, ScreenError};
 
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]
@@ -351,7 +351,7 @@ impl Drop for WindowDisplay {
     }
 }
 
-impl PatchDisplay for WindowDisplay {
+impl Screen for WindowDisplay {
     fn spec(&self) -> String {
         format!("window:{}", self.monitor_index)
     }
@@ -363,8 +363,11 @@ impl PatchDisplay for WindowDisplay {
         )
     }
 
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), PatchDisplayError> {
-        Ok(self.show_rgb(rgb)?)
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
+        self.show_rgb(rgb).map_err(|e| ScreenError::Backend {
+            screen: self.spec(),
+            source: Box::new(e),
+        })
     }
 
     fn default_settle(&self) -> Duration {

@@ -1,0 +1,149 @@
+//! The simulated CS-100A served on a pseudo-terminal, for programs other than this one: any
+//! serial client (a terminal program, a script, another colour tool) opens the device path
+//! and talks to the emulated meter as to one on an RS-232C port. The meter sees a constant
+//! light, or whatever the owner of [`PtyMeter::light`] puts in front of it.
+
+use std::sync::Arc;
+
+use metamer_drivers::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
+use metamer_drivers::cs100a::pty::PtyEmulator;
+use metamer_drivers::{DriverError, SharedWorld, DEFAULT_STIMULUS_XYZ};
+
+/// How the served meter behaves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PtyMeterOptions {
+    /// The light in front of the meter, XYZ in cd/m².
+    pub xyz: [f64; 3],
+    /// Add the meter's repeatability noise to each reading.
+    pub noise: bool,
+    /// Seed of the noise; the same seed gives the same readings.
+    pub seed: u64,
+    /// Multiplies the meter's delays: 1 is the real pace, 0 answers at once.
+    pub time_scale: f64,
+}
+
+impl Default for PtyMeterOptions {
+    fn default() -> Self {
+        let meter = EmulatorConfig::default();
+        PtyMeterOptions {
+            xyz: DEFAULT_STIMULUS_XYZ,
+            noise: meter.noise,
+            seed: meter.seed,
+            time_scale: meter.time_scale,
+        }
+    }
+}
+
+/// The simulated meter could not be served.
+#[derive(Debug, thiserror::Error)]
+pub enum PtyMeterError {
+    #[error("the light X, Y, Z = {xyz:?} is not a light: each must be a finite number ≥ 0")]
+    NotALight { xyz: [f64; 3] },
+    #[error("the time scale {0} is not a finite number ≥ 0")]
+    BadTimeScale(f64),
+    #[error("cannot serve the simulated CS-100A: {0}")]
+    Start(#[from] DriverError),
+}
+
+/// A simulated CS-100A answering on a pseudo-terminal until dropped.
+pub struct PtyMeter {
+    light: Arc<SharedWorld>,
+    // Dropping it stops the emulator's thread and closes the pty.
+    emulator: PtyEmulator,
+}
+
+impl PtyMeter {
+    /// Starts the meter on a new pseudo-terminal; it answers from another thread.
+    pub fn start(options: &PtyMeterOptions) -> Result<PtyMeter, PtyMeterError> {
+        check_light(options.xyz)?;
+        if !(options.time_scale.is_finite() && options.time_scale >= 0.0) {
+            return Err(PtyMeterError::BadTimeScale(options.time_scale));
+        }
+        let light = Arc::new(SharedWorld::new(options.xyz));
+        let config = EmulatorConfig {
+            seed: options.seed,
+            time_scale: options.time_scale,
+            noise: options.noise,
+        };
+        let emulator = PtyEmulator::start(Cs100aEmulator::new(light.clone(), config))?;
+        Ok(PtyMeter { light, emulator })
+    }
+
+    /// The device path a client opens (`/dev/pts/N`).
+    pub fn path(&self) -> &str {
+        self.emulator.path()
+    }
+
+    /// What the meter sees; setting it changes the next reading.
+    pub fn light(&self) -> &Arc<SharedWorld> {
+        &self.light
+    }
+}
+
+fn check_light(xyz: [f64; 3]) -> Result<(), PtyMeterError> {
+    if xyz.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        Ok(())
+    } else {
+        Err(PtyMeterError::NotALight { xyz })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::io::{BufRead, BufReader, Write};
+
+    use super::*;
+
+    #[test]
+    fn bad_lights_and_time_scales_are_errors() {
+        for xyz in [
+            [-1.0, 1.0, 1.0],
+            [1.0, f64::NAN, 1.0],
+            [1.0, 1.0, f64::INFINITY],
+        ] {
+            let options = PtyMeterOptions {
+                xyz,
+                ..PtyMeterOptions::default()
+            };
+            let e = PtyMeter::start(&options).err().unwrap();
+            assert!(e.to_string().contains("is not a light"), "{e}");
+        }
+        let options = PtyMeterOptions {
+            time_scale: -0.5,
+            ..PtyMeterOptions::default()
+        };
+        let e = PtyMeter::start(&options).err().unwrap();
+        assert!(e.to_string().contains("time scale -0.5"), "{e}");
+    }
+
+    /// Raw reads and writes on the device path, as any program would make them: a light of
+    /// chromaticity (0.3127, 0.3290) at 50 cd/m² reads back as those numbers.
+    #[test]
+    fn a_plain_file_client_reads_the_light() {
+        let (x, y, lum) = (0.3127, 0.3290, 50.0);
+        let options = PtyMeterOptions {
+            xyz: [x / y * lum, lum, (1.0 - x - y) / y * lum],
+            noise: false,
+            seed: 1,
+            time_scale: 0.0,
+        };
+        let meter = PtyMeter::start(&options).unwrap();
+        let port = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(meter.path())
+            .unwrap();
+        let mut reader = BufReader::new(port.try_clone().unwrap());
+        let mut ask = |command: &str| {
+            (&port).write_all(command.as_bytes()).unwrap();
+            let mut reply = String::new();
+            reader.read_line(&mut reply).unwrap();
+            reply
+        };
+        assert_eq!(ask("MDS,04\r\n"), "OK00\r\n");
+        // The meter pads Y to seven characters and sends x, y without the leading zero.
+        assert_eq!(ask("MES\r\n"), "OK00,  50.00, .3127, .3290\r\n");
+        meter.light().set([0.0, 0.0, 0.0]);
+        assert_eq!(ask("MES\r\n").get(..5), Some("OK11,"));
+    }
+}
