@@ -12,4 +12,5 @@ pub mod lab;
 pub mod numeric_csv;
 pub mod plot;
 pub mod render;
+pub mod session;
 pub mod validation;
