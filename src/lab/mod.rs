@@ -28,8 +28,8 @@ pub use display_side::{
 };
 
 use crate::color::Xyz;
-use crate::display::characterize::finish::{FinishError, Summary};
-use crate::display::characterize::{LogError, PlanError, SessionError};
+use crate::display::characterize::finish::Summary;
+use crate::display::characterize::CharacterizeError;
 use crate::display::gamut::GamutMapping;
 use crate::display::{
     ModelKind, PatchDisplay, PatchDisplayError, Preset, ProfileError, VirtualDisplay, VirtualPanel,
@@ -92,13 +92,7 @@ pub enum LabError {
     #[error(transparent)]
     Display(#[from] PatchDisplayError),
     #[error(transparent)]
-    Plan(#[from] PlanError),
-    #[error(transparent)]
-    Session(#[from] SessionError),
-    #[error(transparent)]
-    Log(#[from] LogError),
-    #[error(transparent)]
-    Finish(#[from] FinishError),
+    Characterize(#[from] CharacterizeError),
     #[error(transparent)]
     Profile(#[from] ProfileError),
     #[error(transparent)]
