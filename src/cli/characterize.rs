@@ -82,7 +82,8 @@ pub fn run(args: Args) -> CliResult {
     Plan::new(plan).map_err(|e| CliError::Usage(plan_usage(&e)))?;
     if !args.resume {
         // Before a full-screen window or an instrument is opened for nothing.
-        refuse_existing(&log_path(&args.out)).map_err(|e| translate(CharacterizeError::Session(SessionError::Journal(e))))?;
+        refuse_existing(&log_path(&args.out))
+            .map_err(|e| translate(CharacterizeError::Session(SessionError::Journal(e))))?;
     }
 
     let mut display = spec.open()?;

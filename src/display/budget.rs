@@ -19,7 +19,7 @@ use metamer_drivers::{open_instrument, Request, SharedStimulus};
 use serde::Serialize;
 
 use super::characterize::plan::random_patches;
-use super::characterize::{default_grid_steps, Plan, PlanOptions, DriveStep, Purpose};
+use super::characterize::{default_grid_steps, DriveStep, Plan, PlanOptions, Purpose};
 use super::diagnostics::percentile;
 use super::virtual_display::{Preset, VirtualPanel};
 use super::Patch;

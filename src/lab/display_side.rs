@@ -12,10 +12,10 @@ use serde::Serialize;
 use crate::color::Xyz;
 use crate::display::characterize::finish::Summary;
 use crate::display::characterize::{self, default_grid_steps, PlanOptions};
-use crate::session::{RunOptions, ScriptedOperator, StepProgress};
 use crate::display::gamut::{map_to_gamut, GamutMapping};
 use crate::display::virtual_display::quantize;
 use crate::display::{ModelKind, PatchDisplay, Profile, VirtualPanel};
+use crate::session::{RunOptions, ScriptedOperator, StepProgress};
 
 use super::scene_readings::mean_reading;
 use super::LabError;

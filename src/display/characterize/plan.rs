@@ -387,10 +387,7 @@ mod tests {
         assert_ne!(elsewhere.fingerprint().unwrap(), fp(&one));
         assert_eq!(elsewhere.options["display"], "window:0");
         assert_ne!(fp(&one), fp(&three));
-        assert_ne!(
-            fp(&one),
-            fp(&Plan::new(PlanOptions::default()).unwrap())
-        );
+        assert_ne!(fp(&one), fp(&Plan::new(PlanOptions::default()).unwrap()));
         assert!(matches!(
             Plan::new(PlanOptions {
                 ramp_steps: 1,
