@@ -173,3 +173,139 @@ pub fn run(
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::display::virtual_display::{Preset, VirtualDisplay};
+    use crate::session::{NoProgress, ScriptedOperator, StepProgress};
+
+    fn options(tag: &str, resume: bool, run: RunOptions) -> Options {
+        let dir =
+            std::env::temp_dir().join(format!("metamer-charrun-{tag}-{}", std::process::id()));
+        if !resume {
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+        Options {
+            dir,
+            plan: PlanOptions {
+                ramp_steps: 3,
+                repeats: 2,
+                grid_steps: 0,
+            },
+            model: ModelKind::Plcc,
+            instrument: "sim:cs100a".into(),
+            settle: None,
+            resume,
+            run,
+        }
+    }
+
+    fn characterize(o: &Options, progress: &mut dyn ProgressSink) -> Outcome {
+        let mut display = VirtualDisplay::preset(Preset::IdealCrt);
+        let mut meter = metamer_drivers::open_instrument(
+            "sim:cs100a?time_scale=0&noise=off",
+            display.stimulus(),
+        )
+        .unwrap();
+        run(
+            o,
+            &mut display,
+            meter.as_mut(),
+            &mut ScriptedOperator::confirming(),
+            progress,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_split_session_finishes_with_the_straight_one_s_numbers() {
+        let straight = options("straight", false, RunOptions::default());
+        let Outcome::Finished(a) = characterize(&straight, &mut NoProgress) else {
+            panic!("a straight run finishes")
+        };
+        let stop = |n| RunOptions {
+            stop_after: Some(n),
+            ..RunOptions::default()
+        };
+        let first = options("split", false, stop(10));
+        let n = 2 * (5 + 4 + 48);
+        match characterize(&first, &mut NoProgress) {
+            Outcome::Incomplete {
+                end, done, total, ..
+            } => assert_eq!(
+                (end, done, total),
+                (RunEnd::Stopped { missing: n - 10 }, 10, n)
+            ),
+            Outcome::Finished(_) => panic!("stopped after 10"),
+        }
+        let Outcome::Finished(b) = characterize(
+            &options("split", true, RunOptions::default()),
+            &mut NoProgress,
+        ) else {
+            panic!("the resumed run finishes")
+        };
+        // Noise is off: the same readings, so the same fit and verification.
+        assert_eq!(a.readings, b.readings);
+        assert_eq!(a.verification.mean, b.verification.mean);
+        assert_eq!(a.verification.max, b.verification.max);
+        std::fs::remove_dir_all(&straight.dir).unwrap();
+        std::fs::remove_dir_all(&first.dir).unwrap();
+    }
+
+    #[test]
+    fn an_interrupt_stops_before_the_next_colour() {
+        let flag = Arc::new(AtomicBool::new(false));
+        let o = options(
+            "interrupt",
+            false,
+            RunOptions {
+                interrupt: Some(flag.clone()),
+                ..RunOptions::default()
+            },
+        );
+        let mut sink = |p: &StepProgress<'_>| {
+            if p.done == 5 {
+                flag.store(true, Ordering::SeqCst);
+            }
+        };
+        match characterize(&o, &mut sink) {
+            Outcome::Incomplete { end, done, .. } => {
+                assert_eq!((end, done), (RunEnd::Interrupted { missing: 114 - 5 }, 5))
+            }
+            Outcome::Finished(_) => panic!("interrupted"),
+        }
+        std::fs::remove_dir_all(&o.dir).unwrap();
+    }
+
+    #[test]
+    fn a_failing_instrument_says_what_is_safe() {
+        let o = options("fail", false, RunOptions::default());
+        let mut display = VirtualDisplay::preset(Preset::IdealCrt);
+        // Light far beyond the meter's range: the CS-100A answers ER10, an instrument error.
+        let blinding = Arc::new(metamer_drivers::SharedStimulus::new([1e7; 3]));
+        let mut meter =
+            metamer_drivers::open_instrument("sim:cs100a?time_scale=0", Some(blinding)).unwrap();
+        let e = run(
+            &o,
+            &mut display,
+            meter.as_mut(),
+            &mut ScriptedOperator::confirming(),
+            &mut NoProgress,
+        )
+        .unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.starts_with("step 1 of 114 (black, RGB [0, 0, 0]): "),
+            "{text}"
+        );
+        assert!(
+            text.contains("0 of 114 steps are safe in") && text.contains("resume the session"),
+            "{text}"
+        );
+        std::fs::remove_dir_all(&o.dir).unwrap();
+    }
+}
