@@ -643,7 +643,7 @@ fn an_operator_abort_keeps_what_is_measured() {
 }
 
 #[test]
-fn a_step_for_a_missing_instrument_says_what_is_safe() {
+fn a_rig_that_lacks_what_a_step_needs_is_refused_before_measuring() {
     let path = temp("missing");
     let mut session = open(&path, plan(TILES, Duration::ZERO), false);
     let world = Shared::default();
@@ -660,25 +660,43 @@ fn a_step_for_a_missing_instrument_says_what_is_safe() {
             '_,
         >| {})
         .unwrap_err();
-    assert!(
-        matches!(
-            e,
-            SessionError::Step {
-                index: 1,
-                done: 1,
-                ..
-            }
-        ),
-        "{e}"
+    assert_eq!(
+        e.to_string(),
+        "step 2 (tile 1) needs a 'spectral' instrument and the rig has none; nothing was measured"
     );
-    let text = e.to_string();
-    assert!(
-        text.starts_with("step 2 of 8 (tile 1, place the spectrometer on tile 1): the plan names instrument role 'spectral'"),
-        "{text}"
+    assert_eq!(session.done(), 0);
+    // An instrument that lacks the step's mode: the spot meter in the spectral role.
+    let world = Shared::default();
+    let mut spot = SpotMeter(world.clone());
+    let mut not_spectral = SpotMeter(world);
+    let mut rig = Rig {
+        screen: None,
+        instruments: vec![
+            ("spot".to_string(), &mut spot as &mut dyn Instrument),
+            ("spectral".to_string(), &mut not_spectral),
+        ],
+        operator: &mut operator,
+    };
+    let e = session
+        .run(&mut rig, &RunOptions::default(), &mut |_: &StepProgress<
+            '_,
+        >| {})
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "step 1 (white) shows a colour and the rig has no screen; nothing was measured"
     );
-    assert!(
-        text.contains("1 of 8 steps are safe in") && text.contains("resume the session"),
-        "{text}"
+    assert!(matches!(e, SessionError::RigLacks { index: 0, .. }));
+    let mut screen = FakeScreen(Shared::default());
+    rig.screen = Some(&mut screen);
+    let e = session
+        .run(&mut rig, &RunOptions::default(), &mut |_: &StepProgress<
+            '_,
+        >| {})
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "step 2 (tile 1) measures reflective with the 'spectral' instrument, a fake-spot that offers only emissive; nothing was measured"
     );
     std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
 }

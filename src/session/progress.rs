@@ -32,6 +32,10 @@ pub trait ProgressSink {
     fn note(&mut self, text: &str) {
         let _ = text;
     }
+    /// Runs `ask` (a question to the operator) with the progress display out of its way.
+    fn suspend(&mut self, ask: &mut dyn FnMut()) {
+        ask()
+    }
     /// The run ended, for whatever reason.
     fn finish(&mut self) {}
 }
@@ -92,6 +96,10 @@ impl ProgressSink for BarProgress {
         } else {
             self.bar.println(text);
         }
+    }
+
+    fn suspend(&mut self, ask: &mut dyn FnMut()) {
+        self.bar.suspend(ask)
     }
 
     fn finish(&mut self) {

@@ -128,6 +128,13 @@ pub enum SessionError {
         logged: String,
         now: String,
     },
+    /// The rig cannot take a step of the plan; found before anything is measured.
+    #[error("step {} ({label}) {need}; nothing was measured", index + 1)]
+    RigLacks {
+        index: usize,
+        label: String,
+        need: String,
+    },
     #[error("step {} of {total} ({label}, {prepare}): {source}\n  {done} of {total} steps are safe in {}; fix the cause and resume the session", index + 1, journal.display())]
     Step {
         index: usize,
@@ -326,11 +333,49 @@ where
         options: &RunOptions,
         progress: &mut dyn ProgressSink,
     ) -> Result<RunEnd, SessionError> {
+        self.check_rig(rig)?;
         let total = self.plan.steps.len();
         progress.start(self.done(), total);
         let result = self.run_steps(rig, options, progress);
         progress.finish();
         result
+    }
+
+    /// Whether the rig has what every step still to take needs: its instrument in a mode it
+    /// offers, and a screen for the steps that show colours.
+    fn check_rig(&self, rig: &mut Rig<'_>) -> Result<(), SessionError> {
+        let has_screen = rig.screen.is_some();
+        for (index, step) in self.plan.steps.iter().enumerate() {
+            if self.entries[index].is_some() {
+                continue;
+            }
+            let lacks = |need: String| SessionError::RigLacks {
+                index,
+                label: step.label.clone(),
+                need,
+            };
+            let Some(instrument) = rig.instrument(&step.role) else {
+                return Err(lacks(format!(
+                    "needs a '{}' instrument and the rig has none",
+                    step.role
+                )));
+            };
+            let capabilities = instrument.capabilities();
+            if !capabilities.supports(step.mode) {
+                let offered: Vec<&str> = capabilities.modes.iter().map(|m| m.mode.name()).collect();
+                return Err(lacks(format!(
+                    "measures {} with the '{}' instrument, a {} that offers only {}",
+                    step.mode,
+                    step.role,
+                    instrument.info().model,
+                    offered.join(", ")
+                )));
+            }
+            if matches!(step.prepare, Prepare::Show { .. }) && !has_screen {
+                return Err(lacks("shows a colour and the rig has no screen".into()));
+            }
+        }
+        Ok(())
     }
 
     fn run_steps(
@@ -473,7 +518,7 @@ where
                 "{role} instrument ({model}), {mode} calibration: {}",
                 condition.prompt()
             );
-            if self.rig.operator.ask(&prompt)? == Answer::Abort {
+            if self.ask(&prompt)? == Answer::Abort {
                 return Ok(false);
             }
             let outcome = self.instrument()?.calibrate(mode, &condition)?;
@@ -504,6 +549,14 @@ where
         })
     }
 
+    /// Asks the operator with the progress display out of the way.
+    fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
+        let operator = &mut *self.rig.operator;
+        let mut answer = Ok(Answer::Abort);
+        self.progress.suspend(&mut || answer = operator.ask(prompt));
+        answer
+    }
+
     /// Sets the rig up for the step; false when the operator aborted.
     fn prepare(&mut self) -> Result<bool, StepFailure> {
         match &self.step.prepare {
@@ -512,7 +565,7 @@ where
                 screen.show(*rgb).map_err(StepFailure::Screen)?;
                 Ok(true)
             }
-            Prepare::Operator { prompt } => Ok(self.rig.operator.ask(prompt)? == Answer::Confirmed),
+            Prepare::Operator { prompt } => Ok(self.ask(prompt)? == Answer::Confirmed),
             Prepare::None => Ok(true),
         }
     }
