@@ -13,4 +13,5 @@ pub mod numeric_csv;
 pub mod plot;
 pub mod render;
 pub mod rig;
+pub mod session;
 pub mod validation;

@@ -35,16 +35,17 @@ fn summary(dir: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 
-/// (index, rgb) of every reading line of a log, in file order.
+/// (index, rgb) of every reading entry of a journal, in file order.
 fn logged(dir: &Path) -> Vec<(u64, Vec<u64>)> {
     let log = std::fs::read_to_string(dir.join("log.jsonl")).unwrap();
     let mut lines = log.lines();
     let header: Value = serde_json::from_str(lines.next().unwrap()).unwrap();
     assert_eq!(header["type"], "header");
     lines
-        .map(|l| {
-            let v: Value = serde_json::from_str(l).unwrap();
-            let rgb = v["rgb"]
+        .map(|l| serde_json::from_str::<Value>(l).unwrap())
+        .filter(|v| v["type"] == "entry")
+        .map(|v| {
+            let rgb = v["data"]["rgb"]
                 .as_array()
                 .unwrap()
                 .iter()
@@ -213,7 +214,7 @@ fn a_stopped_session_resumes_and_measures_only_what_is_missing() {
     assert_eq!(o.status.code(), Some(1));
     let err = text(&o.stderr);
     assert!(
-        err.contains("was written by another session: its plan is") && err.contains("--repeats 2"),
+        err.contains("was written by another session: its --repeats is 2, this one's is 3"),
         "{err}"
     );
     assert_eq!(std::fs::read(dir.join("log.jsonl")).unwrap(), before);

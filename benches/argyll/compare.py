@@ -101,7 +101,7 @@ def one_set(out, display, model, steps, seed, algos, clut):
     t_metamer = time.time() - t0
     summary = json.load(open(os.path.join(d, "summary.json")))
     log = [json.loads(l) for l in open(os.path.join(d, "log.jsonl"))]
-    labels = [r["label"] for r in log if r["type"] == "reading"]
+    labels = [r["label"] for r in log if r["type"] == "entry"]
     white = summary["white_xyz"]
     ver = summary["verification"]["patches"]
     measured = [p["measured_xyz"] for p in ver]

@@ -1,22 +1,22 @@
 //! `metamer characterize`: show and measure patches on a display, fit and verify a profile.
 
-use std::io::{BufRead, IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::Duration;
 
 use clap::ValueEnum;
-use metamer::display::characterize::finish::{finish, Provenance, Summary};
-use metamer::display::characterize::log::refuse_existing;
+use metamer::display::characterize::finish::Summary;
 use metamer::display::characterize::{
-    default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session, DEFAULT_RAMP_STEPS,
+    self, default_grid_steps, log_path, CharacterizeError, Options, Outcome, Plan, PlanError,
+    PlanOptions, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::ModelKind;
 use metamer::rig::ScreenSpec;
-use metamer_drivers::{
-    open_instrument, CalibrationOutcome, DriverError, Instrument, MeasureMode, Request, Speed,
+use metamer::session::{
+    on_ctrl_c, refuse_existing, BarProgress, JournalError, RunEnd, RunOptions, SessionError,
+    TerminalOperator,
 };
+use metamer_drivers::{open_instrument, DriverError, Speed};
 
 use super::{CliError, CliResult};
 
@@ -75,15 +75,16 @@ pub fn run(args: Args) -> CliResult {
     let grid_steps = args
         .grid_steps
         .unwrap_or(default_grid_steps(model, args.ramp_steps));
-    let plan = Plan::new(PlanOptions {
+    let plan = PlanOptions {
         ramp_steps: args.ramp_steps,
         repeats: args.repeats,
         grid_steps,
-    })
-    .map_err(|e| CliError::Usage(e.to_string()))?;
+    };
+    Plan::new(plan).map_err(|e| CliError::Usage(plan_usage(&e)))?;
     if !args.resume {
         // Before a full-screen window or an instrument is opened for nothing.
-        refuse_existing(&args.out)?;
+        refuse_existing(&log_path(&args.out))
+            .map_err(|e| translate(CharacterizeError::Session(SessionError::Journal(e))))?;
     }
 
     let mut display = spec.open()?;
@@ -109,172 +110,122 @@ pub fn run(args: Args) -> CliResult {
         };
         instrument.set_option("speed", speed.name())?;
     }
-    calibrate(instrument.as_mut())?;
-    let info = instrument.info();
-    let mut session = Session::open(
-        &args.out,
+    let options = Options {
+        dir: args.out.clone(),
         plan,
-        &spec.canonical(),
-        &args.instrument,
-        info.clone(),
-        args.resume,
-    )?;
-    let total = session.plan().patches.len();
-    if session.recovered > 0 || session.torn_bytes > 0 {
-        eprintln!(
-            "resuming: {} of {total} readings in {}{}",
-            session.recovered,
-            session.log_path().display(),
-            if session.torn_bytes > 0 {
-                format!(
-                    " ({} bytes of a reading cut off by the interruption were set aside in log.torn.txt)",
-                    session.torn_bytes
-                )
-            } else {
-                String::new()
-            }
-        );
-    }
-    let display_description = display.describe();
-    let missing = total - session.done();
-    if missing > 0 && display.stimulus().is_none() {
-        aim(display.as_mut())?;
-    }
-    let options = MeasureOptions {
-        settle: args
-            .settle_ms
-            .map_or(display.default_settle(), Duration::from_millis),
-        request: Request::default(),
-        stop_after: args.stop_after,
-        interrupt: Some(on_ctrl_c()),
-    };
-
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:30} patch {pos}/{len} · {msg} · {elapsed} elapsed, about {eta} left",
-        )
-        .expect("valid template"),
-    );
-    bar.set_position(session.done() as u64);
-    bar.reset_eta();
-    let outcome = session.measure(display.as_mut(), instrument.as_mut(), &options, &mut |p| {
-        bar.set_message(format!(
-            "{} → Y {:.3} cd/m²",
-            p.patch.label, p.reading.xyz[1]
-        ));
-        bar.set_position(p.done as u64);
-    });
-    bar.finish_and_clear();
-    // The window goes before the (possibly slow) fit, so the user gets their screen back.
-    drop(display);
-    match outcome? {
-        Measured::Stopped { missing } => {
-            println!(
-                "stopped with {missing} of {total} readings still to take; continue with --resume (log: {})",
-                session.log_path().display()
-            );
-            return Ok(());
-        }
-        Measured::Interrupted { missing } => {
-            return Err(CliError::Failed(
-                format!(
-                    "interrupted with {missing} of {total} readings still to take; the others are safe in {}: continue with --resume",
-                    session.log_path().display()
-                )
-                .into(),
-            ));
-        }
-        Measured::Complete => {}
-    }
-    let readings = session
-        .complete_readings()
-        .expect("a complete session has every reading");
-    let summary = finish(
-        &args.out,
-        session.log_path(),
-        &readings,
         model,
-        &Provenance {
-            display: &spec.canonical(),
-            display_description: &display_description,
-            instrument: &args.instrument,
-            instrument_info: &info,
+        instrument: args.instrument.clone(),
+        settle: args.settle_ms.map(Duration::from_millis),
+        resume: args.resume,
+        run: RunOptions {
+            stop_after: args.stop_after,
+            interrupt: Some(on_ctrl_c()),
         },
-    )?;
-    print_summary(&summary)?;
-    Ok(())
-}
-
-/// Set by the first Ctrl-C; the session stops before its next patch (the readings are on
-/// disk already). A second Ctrl-C ends the process at once.
-static INTERRUPTED: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
-
-extern "C" fn ctrl_c(_: libc::c_int) {
-    if let Some(flag) = INTERRUPTED.get() {
-        flag.store(true, Ordering::SeqCst);
-    }
-    // SAFETY: signal() is async-signal-safe (POSIX.1-2008 §2.4.3); SIG_DFL is always valid.
-    unsafe {
-        libc::signal(libc::SIGINT, libc::SIG_DFL);
-    }
-}
-
-fn on_ctrl_c() -> Arc<AtomicBool> {
-    let flag = INTERRUPTED
-        .get_or_init(|| Arc::new(AtomicBool::new(false)))
-        .clone();
-    // SAFETY: the handler only stores to an atomic and resets the disposition, both
-    // async-signal-safe; the flag is initialised before the handler is installed.
-    unsafe {
-        libc::signal(
-            libc::SIGINT,
-            ctrl_c as extern "C" fn(libc::c_int) as libc::sighandler_t,
-        );
-    }
-    flag
-}
-
-/// Runs the instrument's calibration negotiation, asking the user for each condition.
-fn calibrate(instrument: &mut dyn Instrument) -> Result<(), CliError> {
-    // Instruments ask for at most a few conditions in a row (dark, then white tile); more
-    // means the user's action did not satisfy it.
-    for _ in 0..5 {
-        let Some(condition) = instrument.calibration_needed(MeasureMode::Emissive)? else {
-            return Ok(());
-        };
-        prompt(&format!(
-            "calibration: {}, then press Enter",
-            condition.prompt()
-        ))?;
-        if instrument.calibrate(MeasureMode::Emissive, &condition)? == CalibrationOutcome::Done {
-            return Ok(());
+    };
+    let outcome = characterize::run(
+        &options,
+        display.as_mut(),
+        instrument.as_mut(),
+        &mut TerminalOperator,
+        &mut BarProgress::new("patch"),
+    )
+    .map_err(translate)?;
+    match outcome {
+        Outcome::Finished(summary) => print_summary(&summary),
+        Outcome::Incomplete {
+            end,
+            done,
+            total,
+            log,
+        } => {
+            let missing = total - done;
+            let log = log.display();
+            match end {
+                RunEnd::Stopped { .. } | RunEnd::Complete => {
+                    println!(
+                        "stopped with {missing} of {total} readings still to take; continue with --resume (log: {log})"
+                    );
+                    Ok(())
+                }
+                RunEnd::Interrupted { .. } => Err(CliError::Failed(
+                    format!(
+                        "interrupted with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
+                    )
+                    .into(),
+                )),
+                RunEnd::Aborted { .. } => Err(CliError::Failed(
+                    format!(
+                        "stopped at the operator's request with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
+                    )
+                    .into(),
+                )),
+            }
         }
     }
-    Err(CliError::Failed(
-        "the instrument still asks for calibration after five attempts".into(),
-    ))
 }
 
-/// Shows white and lets the user aim the instrument (on a real screen only).
-fn aim(display: &mut dyn metamer::rig::Screen) -> Result<(), CliError> {
-    display.show([255; 3])?;
-    prompt(&format!(
-        "aim the instrument at the middle of the white {} and press Enter",
-        display.describe()
-    ))
-}
-
-fn prompt(text: &str) -> Result<(), CliError> {
-    if !std::io::stdin().is_terminal() {
-        // Unattended (scripts, CI): nobody can act on a prompt, go on.
-        return Ok(());
+/// A plan option's error in the words of this command's flags.
+fn plan_usage(e: &PlanError) -> String {
+    match e {
+        PlanError::RampSteps(n) => format!(
+            "--ramp-steps must be between 2 and 256 (levels per ramp, 0 and 255 included), got {n}"
+        ),
+        PlanError::Repeats(n) => format!("--repeats must be at least 1, got {n}"),
+        PlanError::GridSteps(n) => {
+            format!("--grid-steps must be 0 (no grid) or between 2 and 64, got {n}")
+        }
     }
-    eprint!("{text} ");
-    std::io::stderr().flush()?;
-    let mut line = String::new();
-    std::io::stdin().lock().read_line(&mut line)?;
-    Ok(())
+}
+
+/// The library's "resume the session" and option names said as this command's flags.
+fn translate(e: CharacterizeError) -> CliError {
+    let text = match &e {
+        CharacterizeError::Session(SessionError::Journal(j)) => journal_text(j),
+        CharacterizeError::Session(SessionError::InstrumentDiffers {
+            path, logged, now, ..
+        }) => Some(format!(
+            "{} was measured with a {logged}, this session has a {now}: resume with the instrument it was started with (--instrument), or choose another output directory",
+            path.display()
+        )),
+        CharacterizeError::Session(SessionError::Step {
+            index,
+            total,
+            label,
+            prepare,
+            done,
+            journal,
+            source,
+        }) => Some(format!(
+            "patch {} of {total} ({label}, {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+            index + 1,
+            journal.display()
+        )),
+        _ => None,
+    };
+    match text {
+        Some(t) => CliError::Failed(t.into()),
+        None => CliError::from(e),
+    }
+}
+
+fn journal_text(e: &JournalError) -> Option<String> {
+    Some(match e {
+        JournalError::Exists { path, entries } => format!(
+            "{} exists with {entries} reading(s) of an earlier session: continue it with --resume, or choose another output directory",
+            path.display()
+        ),
+        JournalError::OptionDiffers {
+            path,
+            option,
+            logged,
+            now,
+        } => format!(
+            "{} was written by another session: its --{} is {logged}, this one's is {now}; run with the options it was started with and --resume, or choose another output directory",
+            path.display(),
+            option.replace('_', "-")
+        ),
+        _ => return None,
+    })
 }
 
 fn print_summary(s: &Summary) -> Result<(), CliError> {

@@ -19,7 +19,7 @@ use metamer_drivers::{open_instrument, Request, SharedWorld};
 use serde::Serialize;
 
 use super::characterize::plan::random_patches;
-use super::characterize::{default_grid_steps, Plan, PlanOptions, PlannedPatch, Purpose};
+use super::characterize::{default_grid_steps, DriveStep, Plan, PlanOptions, Purpose};
 use super::diagnostics::percentile;
 use super::Patch;
 use super::{fit_profile, ModelKind};
@@ -58,7 +58,7 @@ pub fn budget_patches(b: Budget) -> (Vec<[u8; 3]>, usize) {
         grid_steps: b.cube,
     })
     .expect("budgets are valid plans");
-    let fit = |p: &&PlannedPatch| p.purpose == Purpose::Fit;
+    let fit = |p: &&DriveStep| p.purpose == Purpose::Fit;
     let distinct = plan.distinct.iter().filter(fit).count();
     (
         plan.patches.iter().filter(fit).map(|p| p.rgb).collect(),

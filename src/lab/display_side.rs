@@ -3,20 +3,20 @@
 
 use std::path::Path;
 use std::sync::Arc;
+use std::time::Duration;
 
 use metamer_drivers::{Instrument, World};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
 use crate::color::Xyz;
-use crate::display::characterize::finish::{finish, Provenance, Summary};
-use crate::display::characterize::{
-    default_grid_steps, MeasureOptions, Measured, Plan, PlanOptions, Session,
-};
+use crate::display::characterize::finish::Summary;
+use crate::display::characterize::{self, default_grid_steps, PlanOptions};
 use crate::display::gamut::{map_to_gamut, GamutMapping};
 use crate::display::{ModelKind, Profile};
 use crate::rig::virtual_display::quantize;
 use crate::rig::{Screen, VirtualPanel};
+use crate::session::{RunOptions, ScriptedOperator, StepProgress};
 
 use super::scene_readings::mean_reading;
 use super::LabError;
@@ -55,7 +55,7 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
 }
 
 /// Characterizes `display` with `meter` into `dir` (the `characterize` session: durable
-/// log, resume, fit, held-out verification, profile, `.ti3`, report).
+/// journal, resume, fit, held-out verification, profile, `.ti3`, report).
 pub fn characterize(
     dir: &Path,
     display: &mut dyn Screen,
@@ -66,43 +66,30 @@ pub fn characterize(
     progress: &dyn Fn(usize, usize),
 ) -> Result<(Profile, Summary), LabError> {
     let defaults = PlanOptions::default();
-    let plan = Plan::new(PlanOptions {
-        grid_steps: default_grid_steps(model, defaults.ramp_steps),
-        ..defaults
-    })?;
-    let info = meter.info();
-    let mut session = Session::open(
-        dir,
-        plan,
-        &display.spec(),
-        instrument_spec,
-        info.clone(),
-        resume,
-    )?;
-    let description = display.describe();
-    let outcome = session.measure(display, meter, &MeasureOptions::default(), &mut |p| {
-        progress(p.done, p.total)
-    })?;
-    if let Measured::Stopped { missing } | Measured::Interrupted { missing } = outcome {
-        return Err(LabError::Incomplete { missing });
-    }
-    let readings = session
-        .complete_readings()
-        .ok_or(LabError::Incomplete { missing: 0 })?;
-    let summary = finish(
-        dir,
-        session.log_path(),
-        &readings,
-        model,
-        &Provenance {
-            display: &display.spec(),
-            display_description: &description,
-            instrument: instrument_spec,
-            instrument_info: &info,
+    let options = characterize::Options {
+        dir: dir.to_path_buf(),
+        plan: PlanOptions {
+            grid_steps: default_grid_steps(model, defaults.ramp_steps),
+            ..defaults
         },
-    )?;
-    let profile = Profile::load(&summary.files.profile)?;
-    Ok((profile, summary))
+        model,
+        instrument: instrument_spec.to_string(),
+        settle: Some(Duration::ZERO),
+        resume,
+        run: RunOptions::default(),
+    };
+    // A simulated rig: nothing to do by hand, every request is done.
+    let mut operator = ScriptedOperator::confirming();
+    let mut sink = |p: &StepProgress<'_>| progress(p.done, p.total);
+    match characterize::run(&options, display, meter, &mut operator, &mut sink)? {
+        characterize::Outcome::Finished(summary) => {
+            let profile = Profile::load(&summary.files.profile)?;
+            Ok((profile, *summary))
+        }
+        characterize::Outcome::Incomplete { done, total, .. } => Err(LabError::Incomplete {
+            missing: total - done,
+        }),
+    }
 }
 
 /// One simulated reading reproduced on the display.

@@ -28,8 +28,8 @@ pub use display_side::{
 };
 
 use crate::color::Xyz;
-use crate::display::characterize::finish::{FinishError, Summary};
-use crate::display::characterize::{LogError, PlanError, SessionError};
+use crate::display::characterize::finish::Summary;
+use crate::display::characterize::CharacterizeError;
 use crate::display::gamut::GamutMapping;
 use crate::display::{ModelKind, ProfileError};
 use crate::render::spot::SpotError;
@@ -91,13 +91,7 @@ pub enum LabError {
     #[error(transparent)]
     Display(#[from] ScreenError),
     #[error(transparent)]
-    Plan(#[from] PlanError),
-    #[error(transparent)]
-    Session(#[from] SessionError),
-    #[error(transparent)]
-    Log(#[from] LogError),
-    #[error(transparent)]
-    Finish(#[from] FinishError),
+    Characterize(#[from] CharacterizeError),
     #[error(transparent)]
     Profile(#[from] ProfileError),
     #[error(transparent)]

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::{InstrumentInfo, Reading};
 use serde::Serialize;
 
-use super::plan::{PlannedPatch, Purpose};
+use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
 use super::verify::{average, usable, verify, Verification};
 use crate::display::{fit_profile, write_ti3, FitError, ModelKind, Patch, ProfileError, Residuals};
@@ -17,8 +17,8 @@ pub const TI3_FILE: &str = "readings.ti3";
 pub const REPORT_FILE: &str = "report.svg";
 pub const SUMMARY_FILE: &str = "summary.json";
 
-/// Finishing failed; the log is untouched, so fixing the cause and running again with
-/// `--resume` finishes without measuring anything.
+/// Finishing failed; the journal is untouched, so fixing the cause and resuming the session
+/// finishes without measuring anything.
 #[derive(Debug, thiserror::Error)]
 pub enum FinishError {
     #[error("no usable reading of {}: every one was out of the instrument's range", .0.join(", "))]
@@ -85,7 +85,7 @@ pub struct Files {
 pub fn finish(
     dir: &Path,
     log: &Path,
-    readings: &[(&PlannedPatch, &Reading)],
+    readings: &[(&DriveStep, &Reading)],
     model: ModelKind,
     who: &Provenance,
 ) -> Result<Summary, FinishError> {

@@ -1,18 +1,16 @@
-//! The `characterize` session (issue 5 item 5): plan the patches ([`plan`]), show and
-//! measure them with every reading appended to a durable log ([`log`], [`session`]),
-//! average repeats and verify a fitted display model on held-out patches ([`verify`]).
+//! The `characterize` session: plan the drive colours ([`plan`]), show and measure them on
+//! the session engine with every reading journalled ([`run`]), average repeats and verify a
+//! fitted display model on held-out colours ([`verify`], [`finish`]).
 
 pub mod finish;
-pub mod log;
 pub mod plan;
 pub mod report;
-pub mod session;
+pub mod run;
 pub mod verify;
 
-pub use log::{LogError, LOG_FILE};
 pub use plan::{
-    default_grid_steps, Plan, PlanError, PlanOptions, PlannedPatch, Purpose, DEFAULT_RAMP_STEPS,
+    default_grid_steps, DriveStep, Plan, PlanError, PlanOptions, Purpose, DEFAULT_RAMP_STEPS,
 };
 pub use report::{write_report, Report, ReportError};
-pub use session::{MeasureOptions, Measured, Progress, Session, SessionError};
+pub use run::{log_path, run, CharacterizeError, LogDetails, Options, Outcome, LOG_FILE};
 pub use verify::{average, verify, AveragedPatch, Verification};

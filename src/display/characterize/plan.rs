@@ -10,10 +10,19 @@
 //! encoded as sRGB (IEC 61966-2-1:1999 matrix and transfer function): natural colours
 //! spread over the drive cube as a display would show them.
 
+use std::time::Duration;
+
+use metamer_drivers::MeasureMode;
 use serde::{Deserialize, Serialize};
 
 use crate::color::{self, ColorCheckerSet, Illuminant, ObserverKind};
 use crate::display::ModelKind;
+use crate::session::{Prepare, SessionPlan, Step};
+
+/// The journal's session kind.
+pub const SESSION_KIND: &str = "characterize";
+/// The role of the one instrument a characterization uses.
+pub const METER: &str = "meter";
 
 /// Default number of levels per ramp, 0 and 255 included.
 pub const DEFAULT_RAMP_STEPS: usize = 9;
@@ -33,9 +42,10 @@ pub enum Purpose {
     Verify,
 }
 
-/// One patch of the plan.
+/// One drive colour of the plan as it is measured: what is shown, which pass, and what
+/// it is for.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct PlannedPatch {
+pub struct DriveStep {
     /// Position in the measuring order, 0-based over all repeats.
     pub index: usize,
     /// Which of the distinct patches this is (0-based; the same in every repeat).
@@ -85,13 +95,11 @@ impl Default for PlanOptions {
 /// Options that make no plan.
 #[derive(Debug, thiserror::Error)]
 pub enum PlanError {
-    #[error(
-        "--ramp-steps must be between 2 and 256 (levels per ramp, 0 and 255 included), got {0}"
-    )]
+    #[error("ramp steps must be between 2 and 256 (levels per ramp, 0 and 255 included), got {0}")]
     RampSteps(usize),
-    #[error("--repeats must be at least 1, got {0}")]
+    #[error("repeats must be at least 1, got {0}")]
     Repeats(usize),
-    #[error("--grid-steps must be 0 (no grid) or between 2 and 64, got {0}")]
+    #[error("grid steps must be 0 (no grid) or between 2 and 64, got {0}")]
     GridSteps(usize),
 }
 
@@ -103,10 +111,10 @@ const KEY_PATCHES: usize = 5;
 pub struct Plan {
     pub options: PlanOptions,
     /// The distinct patches, in measuring order within a pass.
-    pub distinct: Vec<PlannedPatch>,
+    pub distinct: Vec<DriveStep>,
     /// Every measurement: `distinct` × repeats, and with one repeat a second reading of
     /// black, the primaries and white at the end.
-    pub patches: Vec<PlannedPatch>,
+    pub patches: Vec<DriveStep>,
 }
 
 impl Plan {
@@ -169,10 +177,10 @@ impl Plan {
         for (name, rgb) in colorchecker_srgb() {
             distinct.push((format!("ColorChecker {name}"), rgb, Purpose::Verify));
         }
-        let distinct: Vec<PlannedPatch> = distinct
+        let distinct: Vec<DriveStep> = distinct
             .into_iter()
             .enumerate()
-            .map(|(i, (label, rgb, purpose))| PlannedPatch {
+            .map(|(i, (label, rgb, purpose))| DriveStep {
                 index: i,
                 patch: i,
                 repeat: 0,
@@ -184,7 +192,7 @@ impl Plan {
         let mut patches = Vec::with_capacity(options.repeats * distinct.len());
         for repeat in 0..options.repeats {
             for p in &distinct {
-                patches.push(PlannedPatch {
+                patches.push(DriveStep {
                     index: repeat * distinct.len() + p.patch,
                     repeat,
                     ..p.clone()
@@ -197,7 +205,7 @@ impl Plan {
             // check combines five readings; the CS-100A's ±0.001 in xy alone is ΔE00 ≈ 1 on
             // it), and a change between the two readings shows drift during the session.
             for p in &distinct[..KEY_PATCHES] {
-                patches.push(PlannedPatch {
+                patches.push(DriveStep {
                     index: patches.len(),
                     repeat: 1,
                     ..p.clone()
@@ -211,24 +219,36 @@ impl Plan {
         })
     }
 
-    /// A fingerprint of everything measured and in which order (FNV-1a 64 of the patch
-    /// list): a log is resumed only by the plan that wrote it.
-    pub fn hash(&self) -> String {
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        let mut eat = |bytes: &[u8]| {
-            for &b in bytes {
-                h ^= u64::from(b);
-                h = h.wrapping_mul(0x0000_0100_0000_01b3);
-            }
-        };
-        eat(b"metamer characterize plan 1");
-        for p in &self.patches {
-            eat(&(p.index as u64).to_le_bytes());
-            eat(&(p.patch as u64).to_le_bytes());
-            eat(&p.rgb);
-            eat(&[p.purpose as u8]);
+    /// The plan as session steps, each shown on the screen and read by the [`METER`] in
+    /// emissive mode, waiting `settle` before each reading. `display` (the canonical display
+    /// name) is one of the plan's options: a journal is resumed on the display it measured.
+    pub fn session_plan(&self, display: &str, settle: Duration) -> SessionPlan<DriveStep> {
+        let o = &self.options;
+        let options = [
+            ("ramp_steps", o.ramp_steps.to_string()),
+            ("repeats", o.repeats.to_string()),
+            ("grid_steps", o.grid_steps.to_string()),
+            ("display", display.to_string()),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+        SessionPlan {
+            kind: SESSION_KIND.into(),
+            options,
+            steps: self
+                .patches
+                .iter()
+                .map(|p| Step {
+                    label: p.label.clone(),
+                    role: METER.into(),
+                    mode: MeasureMode::Emissive,
+                    prepare: Prepare::Show { rgb: p.rgb },
+                    settle,
+                    data: p.clone(),
+                })
+                .collect(),
         }
-        format!("{h:016x}")
     }
 }
 
@@ -288,6 +308,12 @@ pub fn colorchecker_srgb() -> Vec<(&'static str, [u8; 3])> {
 mod tests {
     use super::*;
 
+    fn fp(plan: &Plan) -> String {
+        plan.session_plan("virtual:ips-lcd", Duration::ZERO)
+            .fingerprint()
+            .unwrap()
+    }
+
     #[test]
     fn default_plan_has_the_promised_patches() {
         let plan = Plan::new(PlanOptions::default()).unwrap();
@@ -326,7 +352,7 @@ mod tests {
     }
 
     #[test]
-    fn repeats_are_whole_passes_and_the_hash_tracks_the_plan() {
+    fn repeats_are_whole_passes_and_the_fingerprint_tracks_the_plan() {
         let one = Plan::new(PlanOptions {
             ramp_steps: 3,
             repeats: 1,
@@ -346,21 +372,22 @@ mod tests {
             assert_eq!((p.repeat, p.patch), (i / n, i % n));
             assert_eq!(p.rgb, one.distinct[i % n].rgb);
         }
-        assert_eq!(
-            one.hash(),
-            Plan::new(PlanOptions {
-                ramp_steps: 3,
-                repeats: 1,
-                grid_steps: 0,
-            })
-            .unwrap()
-            .hash()
-        );
-        assert_ne!(one.hash(), three.hash());
-        assert_ne!(
-            one.hash(),
-            Plan::new(PlanOptions::default()).unwrap().hash()
-        );
+        let again = Plan::new(PlanOptions {
+            ramp_steps: 3,
+            repeats: 1,
+            grid_steps: 0,
+        })
+        .unwrap();
+        assert_eq!(fp(&one), fp(&again));
+        // The wait before a reading is how, not what: it does not change the fingerprint;
+        // the display measured does, and names itself as the option that differs.
+        let slow = one.session_plan("virtual:ips-lcd", Duration::from_millis(500));
+        assert_eq!(slow.fingerprint().unwrap(), fp(&one));
+        let elsewhere = one.session_plan("window:0", Duration::ZERO);
+        assert_ne!(elsewhere.fingerprint().unwrap(), fp(&one));
+        assert_eq!(elsewhere.options["display"], "window:0");
+        assert_ne!(fp(&one), fp(&three));
+        assert_ne!(fp(&one), fp(&Plan::new(PlanOptions::default()).unwrap()));
         assert!(matches!(
             Plan::new(PlanOptions {
                 ramp_steps: 1,
@@ -417,7 +444,7 @@ mod tests {
         // white, 3 primaries, and the 64/128/191 levels of the four ramps (12): 17.
         assert_eq!(grid.distinct.len(), base.distinct.len() + 125 - 17);
         assert!(grid.distinct.iter().any(|p| p.rgb == [64, 191, 0]));
-        assert_ne!(grid.hash(), base.hash());
+        assert_ne!(fp(&grid), fp(&base));
         for bad in [1, 65] {
             assert!(matches!(
                 Plan::new(PlanOptions {

@@ -6,7 +6,7 @@
 use metamer_drivers::{Flag, Reading};
 use serde::Serialize;
 
-use super::plan::{PlannedPatch, Purpose};
+use super::plan::{DriveStep, Purpose};
 use crate::color::{delta_e2000, Xyz};
 use crate::display::diagnostics::percentile;
 use crate::display::Patch;
@@ -14,7 +14,7 @@ use crate::display::Patch;
 /// A planned patch with its readings averaged.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct AveragedPatch {
-    /// [`PlannedPatch::patch`].
+    /// [`DriveStep::patch`].
     pub patch: usize,
     pub label: String,
     pub rgb8: [u8; 3],
@@ -50,7 +50,7 @@ pub fn usable(reading: &Reading) -> bool {
 
 /// Averages the usable readings of each distinct patch; patches without any usable
 /// reading are listed in the error.
-pub fn average(readings: &[(&PlannedPatch, &Reading)]) -> Result<Vec<AveragedPatch>, Vec<String>> {
+pub fn average(readings: &[(&DriveStep, &Reading)]) -> Result<Vec<AveragedPatch>, Vec<String>> {
     let n = readings.iter().map(|(p, _)| p.patch + 1).max().unwrap_or(0);
     let mut sums: Vec<Option<AveragedPatch>> = vec![None; n];
     for (p, r) in readings {
@@ -154,8 +154,8 @@ pub fn verify(
 mod tests {
     use super::*;
 
-    fn planned(patch: usize, rgb: [u8; 3], purpose: Purpose) -> PlannedPatch {
-        PlannedPatch {
+    fn planned(patch: usize, rgb: [u8; 3], purpose: Purpose) -> DriveStep {
+        DriveStep {
             index: patch,
             patch,
             repeat: 0,

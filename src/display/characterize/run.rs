@@ -1,0 +1,312 @@
+//! One characterization from start to finish on the session engine: the plan's drive
+//! colours as session steps, shown and measured with every reading journalled, then the
+//! fit, verification and files ([`super::finish`]). The command line and the simulated lab
+//! both come through [`run`].
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use metamer_drivers::Instrument;
+use serde::{Deserialize, Serialize};
+
+use super::finish::{finish, FinishError, Provenance, Summary};
+use super::plan::{DriveStep, Plan, PlanError, PlanOptions, METER};
+use crate::display::ModelKind;
+use crate::rig::Screen;
+use crate::session::{
+    Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, ProgressSink, Rig, RunEnd,
+    RunOptions, Session, SessionError,
+};
+
+/// The journal's file name inside the output directory.
+pub const LOG_FILE: &str = "log.jsonl";
+
+/// What the journal's header says about a characterization besides its plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LogDetails {
+    /// The display as named on the command line (`virtual:ips-lcd`, `window:0`).
+    pub display: String,
+    pub display_description: String,
+    /// The instrument as named on the command line (`sim:cs100a?time_scale=0`).
+    pub instrument: String,
+}
+
+/// What to characterize and how.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Output directory: the journal, profile, `.ti3`, report and summary.
+    pub dir: PathBuf,
+    pub plan: PlanOptions,
+    pub model: ModelKind,
+    /// The instrument as named by the user, for the files' provenance.
+    pub instrument: String,
+    /// Wait between showing a colour and measuring it; None: the display's default.
+    pub settle: Option<Duration>,
+    /// Continue the journal in `dir` instead of refusing it.
+    pub resume: bool,
+    pub run: RunOptions,
+}
+
+/// Where a characterization ended.
+#[derive(Debug)]
+pub enum Outcome {
+    /// Measured, fitted and verified; every file written.
+    Finished(Box<Summary>),
+    /// Not every reading is taken yet; the journal holds the others.
+    Incomplete {
+        end: RunEnd,
+        done: usize,
+        total: usize,
+        log: PathBuf,
+    },
+}
+
+/// A characterization failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CharacterizeError {
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error(transparent)]
+    Finish(#[from] FinishError),
+    #[error(transparent)]
+    Operator(#[from] OperatorError),
+    #[error("showing white to aim the instrument: {0}")]
+    Aim(#[source] crate::rig::ScreenError),
+}
+
+/// The journal of a characterization in `dir`.
+pub fn log_path(dir: &Path) -> PathBuf {
+    dir.join(LOG_FILE)
+}
+
+/// Characterizes `display` with `instrument`: measures what the journal in
+/// `options.dir` lacks (all of it for a new session), then fits, verifies and writes the
+/// profile, `.ti3`, report and summary. On a real screen the operator is first asked to aim
+/// the instrument at white.
+pub fn run(
+    options: &Options,
+    display: &mut dyn Screen,
+    instrument: &mut dyn Instrument,
+    operator: &mut dyn Operator,
+    progress: &mut dyn ProgressSink,
+) -> Result<Outcome, CharacterizeError> {
+    let plan = Plan::new(options.plan)?;
+    let settle = options.settle.unwrap_or_else(|| display.default_settle());
+    let display_name = display.spec();
+    let details = LogDetails {
+        display: display_name.clone(),
+        display_description: display.describe(),
+        instrument: options.instrument.clone(),
+    };
+    let instruments = [(METER.to_string(), InstrumentRecord::of(instrument))].into();
+    let mut session: Session<LogDetails, DriveStep> = Session::open(
+        &log_path(&options.dir),
+        plan.session_plan(&display_name, settle),
+        details.clone(),
+        instruments,
+        options.resume,
+    )?;
+    let total = session.plan().steps.len();
+    if session.recovered > 0 || session.torn_bytes > 0 {
+        let torn = if session.torn_bytes > 0 {
+            format!(
+                " ({} bytes of a reading cut off by the interruption were set aside in {})",
+                session.torn_bytes,
+                crate::session::torn_path(session.journal_path()).display()
+            )
+        } else {
+            String::new()
+        };
+        progress.note(&format!(
+            "resuming: {} of {total} readings in {}{torn}",
+            session.recovered,
+            session.journal_path().display()
+        ));
+    }
+    let incomplete = |session: &Session<LogDetails, DriveStep>, end| Outcome::Incomplete {
+        end,
+        done: session.done(),
+        total,
+        log: session.journal_path().to_path_buf(),
+    };
+    if session.done() < total && display.stimulus().is_none() {
+        display.show([255; 3]).map_err(CharacterizeError::Aim)?;
+        let prompt = format!(
+            "aim the instrument at the middle of the white {}",
+            display.describe()
+        );
+        if operator.ask(&prompt)? == Answer::Abort {
+            let missing = total - session.done();
+            return Ok(incomplete(&session, RunEnd::Aborted { missing }));
+        }
+    }
+    let end = {
+        let mut screen = DisplayScreen(display);
+        let mut rig = Rig {
+            screen: Some(&mut screen),
+            instruments: vec![(METER.to_string(), &mut *instrument)],
+            operator: &mut *operator,
+        };
+        session.run(&mut rig, &options.run, progress)?
+    };
+    if end != RunEnd::Complete {
+        return Ok(incomplete(&session, end));
+    }
+    let Some(entries) = session.complete_entries() else {
+        let missing = total - session.done();
+        return Ok(incomplete(&session, RunEnd::Stopped { missing }));
+    };
+    let readings: Vec<_> = entries.iter().map(|e| (&e.data, &e.reading)).collect();
+    let info = &instrument.info();
+    let summary = finish(
+        &options.dir,
+        session.journal_path(),
+        &readings,
+        options.model,
+        &Provenance {
+            display: &details.display,
+            display_description: &details.display_description,
+            instrument: &details.instrument,
+            instrument_info: info,
+        },
+    )?;
+    Ok(Outcome::Finished(Box::new(summary)))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::rig::{Preset, VirtualDisplay};
+    use crate::session::{NoProgress, ScriptedOperator, StepProgress};
+
+    fn options(tag: &str, resume: bool, run: RunOptions) -> Options {
+        let dir =
+            std::env::temp_dir().join(format!("metamer-charrun-{tag}-{}", std::process::id()));
+        if !resume {
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+        Options {
+            dir,
+            plan: PlanOptions {
+                ramp_steps: 3,
+                repeats: 2,
+                grid_steps: 0,
+            },
+            model: ModelKind::Plcc,
+            instrument: "sim:cs100a".into(),
+            settle: None,
+            resume,
+            run,
+        }
+    }
+
+    fn characterize(o: &Options, progress: &mut dyn ProgressSink) -> Outcome {
+        let mut display = VirtualDisplay::preset(Preset::IdealCrt);
+        let mut meter = metamer_drivers::open_instrument(
+            "sim:cs100a?time_scale=0&noise=off",
+            display.stimulus(),
+        )
+        .unwrap();
+        run(
+            o,
+            &mut display,
+            meter.as_mut(),
+            &mut ScriptedOperator::confirming(),
+            progress,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_split_session_finishes_with_the_straight_one_s_numbers() {
+        let straight = options("straight", false, RunOptions::default());
+        let Outcome::Finished(a) = characterize(&straight, &mut NoProgress) else {
+            panic!("a straight run finishes")
+        };
+        let stop = |n| RunOptions {
+            stop_after: Some(n),
+            ..RunOptions::default()
+        };
+        let first = options("split", false, stop(10));
+        let n = 2 * (5 + 4 + 48);
+        match characterize(&first, &mut NoProgress) {
+            Outcome::Incomplete {
+                end, done, total, ..
+            } => assert_eq!(
+                (end, done, total),
+                (RunEnd::Stopped { missing: n - 10 }, 10, n)
+            ),
+            Outcome::Finished(_) => panic!("stopped after 10"),
+        }
+        let Outcome::Finished(b) = characterize(
+            &options("split", true, RunOptions::default()),
+            &mut NoProgress,
+        ) else {
+            panic!("the resumed run finishes")
+        };
+        // Noise is off: the same readings, so the same fit and verification.
+        assert_eq!(a.readings, b.readings);
+        assert_eq!(a.verification.mean, b.verification.mean);
+        assert_eq!(a.verification.max, b.verification.max);
+        std::fs::remove_dir_all(&straight.dir).unwrap();
+        std::fs::remove_dir_all(&first.dir).unwrap();
+    }
+
+    #[test]
+    fn an_interrupt_stops_before_the_next_colour() {
+        let flag = Arc::new(AtomicBool::new(false));
+        let o = options(
+            "interrupt",
+            false,
+            RunOptions {
+                interrupt: Some(flag.clone()),
+                ..RunOptions::default()
+            },
+        );
+        let mut sink = |p: &StepProgress<'_>| {
+            if p.done == 5 {
+                flag.store(true, Ordering::SeqCst);
+            }
+        };
+        match characterize(&o, &mut sink) {
+            Outcome::Incomplete { end, done, .. } => {
+                assert_eq!((end, done), (RunEnd::Interrupted { missing: 114 - 5 }, 5))
+            }
+            Outcome::Finished(_) => panic!("interrupted"),
+        }
+        std::fs::remove_dir_all(&o.dir).unwrap();
+    }
+
+    #[test]
+    fn a_failing_instrument_says_what_is_safe() {
+        let o = options("fail", false, RunOptions::default());
+        let mut display = VirtualDisplay::preset(Preset::IdealCrt);
+        // Light far beyond the meter's range: the CS-100A answers ER10, an instrument error.
+        let blinding = Arc::new(metamer_drivers::SharedWorld::new([1e7; 3]));
+        let mut meter =
+            metamer_drivers::open_instrument("sim:cs100a?time_scale=0", Some(blinding)).unwrap();
+        let e = run(
+            &o,
+            &mut display,
+            meter.as_mut(),
+            &mut ScriptedOperator::confirming(),
+            &mut NoProgress,
+        )
+        .unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.starts_with("step 1 of 114 (black, RGB [0, 0, 0]): "),
+            "{text}"
+        );
+        assert!(
+            text.contains("0 of 114 steps are safe in") && text.contains("resume the session"),
+            "{text}"
+        );
+        std::fs::remove_dir_all(&o.dir).unwrap();
+    }
+}

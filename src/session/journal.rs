@@ -1,0 +1,480 @@
+//! The durable journal of a guided measurement session: a JSON Lines file whose first line
+//! is a header and whose other lines are entries or calibrations, each written whole,
+//! flushed and fsynced before the session goes on. A crash, a pulled cable or Ctrl-C loses
+//! at most the line being written; [`Journal::resume`] reads the file back, sets aside a
+//! torn last line and refuses a journal of another plan, naming the option that differs.
+//!
+//! The header's and the entries' contents are the caller's (`H`, `E`, through serde), so
+//! every kind of session shares one file discipline.
+
+use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions};
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+
+use metamer_drivers::{CalibrationCondition, MeasureMode};
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+/// `format` of every journal's header line.
+pub const JOURNAL_FORMAT: &str = "metamer-session-journal";
+pub const JOURNAL_VERSION: u32 = 2;
+
+/// The first line of a journal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Header<H> {
+    pub format: String,
+    pub version: u32,
+    /// What kind of session wrote it (`characterize`, `measure-box`).
+    pub kind: String,
+    /// The plan's fingerprint: a journal is resumed only by the plan that wrote it.
+    pub fingerprint: String,
+    /// The options the plan was made from, by name, so a refusal can say which differs.
+    pub options: BTreeMap<String, String>,
+    /// Number of steps in the plan.
+    pub steps: usize,
+    /// When the session started, seconds since the Unix epoch.
+    pub started_s: f64,
+    /// The caller's part.
+    pub data: H,
+}
+
+/// A calibration done during a session, journalled so a report can say what was
+/// calibrated when.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationRecord {
+    /// The instrument's role in the plan (`spot`, `spectral`).
+    pub role: String,
+    /// The instrument's model name.
+    pub instrument: String,
+    pub mode: MeasureMode,
+    /// What the operator set up for it.
+    pub condition: CalibrationCondition,
+    /// The step it was done before (0-based plan index).
+    pub before_step: usize,
+    /// When, seconds since the Unix epoch.
+    pub time_s: f64,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+enum Line<H, E> {
+    Header(Header<H>),
+    Entry(E),
+    Calibration(CalibrationRecord),
+}
+
+/// Borrowing twin of [`Line`] for writing without cloning.
+#[derive(Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+enum LineRef<'a, H, E> {
+    Header(&'a Header<H>),
+    Entry(&'a E),
+    Calibration(&'a CalibrationRecord),
+}
+
+/// The journal could not be written, read or resumed.
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    /// A new session was asked for where one already is.
+    #[error("{} exists with {entries} entries of an earlier session: resume that session, or choose another output directory", path.display())]
+    Exists { path: PathBuf, entries: usize },
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}, line {line}: {message}", path.display())]
+    Bad {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    /// The journal belongs to a plan made from other options.
+    #[error("{} was written by another session: its option {option} is {logged}, this one's is {now}; resume with the options it was started with, or choose another output directory", path.display())]
+    OptionDiffers {
+        path: PathBuf,
+        option: String,
+        logged: String,
+        now: String,
+    },
+    /// The same options, yet other steps: the program that plans them changed.
+    #[error("{} was written by another session: every option is the same but its steps differ (plan {logged}, this one {now}); it was planned by another version of this program", path.display())]
+    StepsDiffer {
+        path: PathBuf,
+        logged: String,
+        now: String,
+    },
+    #[error("{} was written by a {logged} session, not a {now} session", path.display())]
+    KindDiffers {
+        path: PathBuf,
+        logged: String,
+        now: String,
+    },
+}
+
+/// What resuming found: every line after the header with its 1-based line number.
+#[derive(Debug, PartialEq)]
+pub struct Recovered<H, E> {
+    /// The header as it was written.
+    pub header: Header<H>,
+    pub entries: Vec<(usize, E)>,
+    pub calibrations: Vec<CalibrationRecord>,
+    /// Bytes of a torn last line moved to the side file ([`torn_path`]); 0 if none.
+    pub torn_bytes: usize,
+}
+
+/// An open journal, appending.
+pub struct Journal<H, E> {
+    path: PathBuf,
+    file: File,
+    _types: PhantomData<fn(H, E)>,
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> JournalError + '_ {
+    move |source| JournalError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Where a torn last line of the journal at `path` is kept: `log.jsonl` → `log.torn.txt`.
+pub fn torn_path(path: &Path) -> PathBuf {
+    path.with_extension("torn.txt")
+}
+
+/// Makes a new file's directory entry durable too (POSIX: fsync of the file alone does
+/// not guarantee its name survives a crash).
+fn sync_dir(path: &Path) -> Result<(), JournalError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    File::open(dir).and_then(|d| d.sync_all()).map_err(io(dir))
+}
+
+impl<H, E> Journal<H, E>
+where
+    H: Serialize + DeserializeOwned,
+    E: Serialize + DeserializeOwned,
+{
+    /// Starts a new journal at `path` with `header`; an existing file is never overwritten.
+    pub fn create(path: &Path, header: &Header<H>) -> Result<Self, JournalError> {
+        let file = match OpenOptions::new().append(true).create_new(true).open(path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                return Err(JournalError::Exists {
+                    path: path.to_path_buf(),
+                    entries: count_entries(path),
+                });
+            }
+            Err(e) => return Err(io(path)(e)),
+        };
+        let mut journal = Journal {
+            path: path.to_path_buf(),
+            file,
+            _types: PhantomData,
+        };
+        journal.append_line(&LineRef::<H, E>::Header(header))?;
+        sync_dir(path)?;
+        Ok(journal)
+    }
+
+    /// Opens the journal at `path` to continue it: checks it was written for a plan with
+    /// `expected`'s kind, fingerprint and options, and returns what it holds. A last line
+    /// cut off by a crash is moved to [`torn_path`] and removed from the journal; any other
+    /// damage is an error naming the line that leaves the file untouched.
+    pub fn resume(
+        path: &Path,
+        expected: &Header<H>,
+    ) -> Result<(Self, Recovered<H, E>), JournalError> {
+        let mut file = OpenOptions::new()
+            .read(true)
+            .append(true)
+            .open(path)
+            .map_err(io(path))?;
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes).map_err(io(path))?;
+        let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let tail = &bytes[complete..];
+        // A tail that parses is a whole line that lost only its newline: keep it.
+        let tail_is_whole = !tail.is_empty() && serde_json::from_slice::<Line<H, E>>(tail).is_ok();
+        let bad = |line: usize, message: String| JournalError::Bad {
+            path: path.to_path_buf(),
+            line,
+            message,
+        };
+        let text_end = if tail_is_whole { bytes.len() } else { complete };
+        let text = std::str::from_utf8(&bytes[..text_end]).map_err(|e| {
+            let line = 1 + bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            bad(line, "not UTF-8 text".into())
+        })?;
+        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
+        let header = match lines.next() {
+            None => return Err(bad(1, "empty journal: no header line".into())),
+            Some((n, l)) => {
+                // The header's fixed fields first, so a journal of another format or
+                // version says so rather than failing on the caller's part.
+                let v: serde_json::Value = serde_json::from_str(l)
+                    .map_err(|e| bad(n, format!("not a journal header: {e}")))?;
+                if v["format"] != JOURNAL_FORMAT || v["version"] != JOURNAL_VERSION {
+                    return Err(bad(
+                        n,
+                        format!(
+                            "format {} version {} is not {JOURNAL_FORMAT} version {JOURNAL_VERSION}",
+                            v["format"], v["version"]
+                        ),
+                    ));
+                }
+                match serde_json::from_value::<Line<H, E>>(v) {
+                    Ok(Line::Header(h)) => h,
+                    Ok(_) => return Err(bad(n, "the first line must be the header".into())),
+                    Err(e) => return Err(bad(n, format!("not a journal header: {e}"))),
+                }
+            }
+        };
+        check_same_plan(path, &header, expected)?;
+        let mut entries = Vec::new();
+        let mut calibrations = Vec::new();
+        for (n, l) in lines {
+            match serde_json::from_str::<Line<H, E>>(l) {
+                Ok(Line::Entry(e)) => entries.push((n, e)),
+                Ok(Line::Calibration(c)) => calibrations.push(c),
+                Ok(Line::Header(_)) => return Err(bad(n, "a second header line".into())),
+                Err(e) => return Err(bad(n, format!("not an entry or calibration: {e}"))),
+            }
+        }
+        let mut torn_bytes = 0;
+        if tail_is_whole {
+            file.write_all(b"\n").map_err(io(path))?;
+            file.sync_data().map_err(io(path))?;
+        } else if !tail.is_empty() {
+            // Keep the fragment before cutting it off: nothing measured is thrown away.
+            let side = torn_path(path);
+            let mut torn = OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(&side)
+                .map_err(io(&side))?;
+            torn.write_all(tail)
+                .and_then(|()| torn.write_all(b"\n"))
+                .and_then(|()| torn.sync_data())
+                .map_err(io(&side))?;
+            file.set_len(complete as u64).map_err(io(path))?;
+            file.seek(SeekFrom::End(0)).map_err(io(path))?;
+            file.sync_data().map_err(io(path))?;
+            torn_bytes = tail.len();
+        }
+        let journal = Journal {
+            path: path.to_path_buf(),
+            file,
+            _types: PhantomData,
+        };
+        Ok((
+            journal,
+            Recovered {
+                header,
+                entries,
+                calibrations,
+                torn_bytes,
+            },
+        ))
+    }
+
+    /// Appends one entry; it is on disk when this returns.
+    pub fn append(&mut self, entry: &E) -> Result<(), JournalError> {
+        self.append_line(&LineRef::<H, E>::Entry(entry))
+    }
+
+    /// Appends one calibration; it is on disk when this returns.
+    pub fn append_calibration(&mut self, record: &CalibrationRecord) -> Result<(), JournalError> {
+        self.append_line(&LineRef::<H, E>::Calibration(record))
+    }
+
+    fn append_line(&mut self, line: &LineRef<'_, H, E>) -> Result<(), JournalError> {
+        let mut text = serde_json::to_string(line).map_err(|e| JournalError::Io {
+            path: self.path.clone(),
+            source: std::io::Error::other(e),
+        })?;
+        text.push('\n');
+        // One write of the whole line, so a crash leaves at most one torn line at the end.
+        self.file
+            .write_all(text.as_bytes())
+            .map_err(io(&self.path))?;
+        self.file.flush().map_err(io(&self.path))?;
+        self.file.sync_data().map_err(io(&self.path))
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// Whether the journal's header `logged` was written for the plan `now` describes.
+fn check_same_plan<H>(
+    path: &Path,
+    logged: &Header<H>,
+    now: &Header<H>,
+) -> Result<(), JournalError> {
+    if logged.kind != now.kind {
+        return Err(JournalError::KindDiffers {
+            path: path.to_path_buf(),
+            logged: logged.kind.clone(),
+            now: now.kind.clone(),
+        });
+    }
+    if logged.fingerprint == now.fingerprint {
+        return Ok(());
+    }
+    let absent = || "(not set)".to_string();
+    let names: std::collections::BTreeSet<&String> =
+        logged.options.keys().chain(now.options.keys()).collect();
+    for name in names {
+        let (a, b) = (logged.options.get(name), now.options.get(name));
+        if a != b {
+            return Err(JournalError::OptionDiffers {
+                path: path.to_path_buf(),
+                option: name.clone(),
+                logged: a.cloned().unwrap_or_else(absent),
+                now: b.cloned().unwrap_or_else(absent),
+            });
+        }
+    }
+    Err(JournalError::StepsDiffer {
+        path: path.to_path_buf(),
+        logged: logged.fingerprint.clone(),
+        now: now.fingerprint.clone(),
+    })
+}
+
+/// The error [`Journal::create`] would give for `path`, checked before anything is opened
+/// (a full-screen window, an instrument).
+pub fn refuse_existing(path: &Path) -> Result<(), JournalError> {
+    if path.exists() {
+        return Err(JournalError::Exists {
+            path: path.to_path_buf(),
+            entries: count_entries(path),
+        });
+    }
+    Ok(())
+}
+
+/// Entry lines in an existing journal (for the "exists" message; 0 if unreadable).
+fn count_entries(path: &Path) -> usize {
+    std::fs::read_to_string(path)
+        .map(|t| {
+            t.lines()
+                .filter(|l| l.starts_with("{\"type\":\"entry\""))
+                .count()
+        })
+        .unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, PartialEq, Serialize, Deserialize)]
+    struct Item {
+        n: u32,
+    }
+
+    fn header(options: &[(&str, &str)], fingerprint: &str) -> Header<String> {
+        Header {
+            format: JOURNAL_FORMAT.into(),
+            version: JOURNAL_VERSION,
+            kind: "test".into(),
+            fingerprint: fingerprint.into(),
+            options: options
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
+            steps: 3,
+            started_s: 1.0,
+            data: "rig".into(),
+        }
+    }
+
+    fn temp(tag: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("metamer-journal-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join("j.jsonl")
+    }
+
+    fn append_raw(path: &Path, bytes: &[u8]) {
+        OpenOptions::new()
+            .append(true)
+            .open(path)
+            .unwrap()
+            .write_all(bytes)
+            .unwrap();
+    }
+
+    #[test]
+    fn a_line_that_lost_only_its_newline_is_kept() {
+        let path = temp("newline");
+        let h = header(&[("a", "1")], "f1");
+        let mut j = Journal::<String, Item>::create(&path, &h).unwrap();
+        j.append(&Item { n: 1 }).unwrap();
+        drop(j);
+        append_raw(&path, br#"{"type":"entry","n":2}"#);
+        let (mut j, rec) = Journal::<String, Item>::resume(&path, &h).unwrap();
+        assert_eq!(rec.torn_bytes, 0);
+        assert_eq!(rec.entries, vec![(2, Item { n: 1 }), (3, Item { n: 2 })]);
+        assert_eq!(rec.header, h);
+        j.append(&Item { n: 3 }).unwrap();
+        drop(j);
+        let (_, rec) = Journal::<String, Item>::resume(&path, &h).unwrap();
+        assert_eq!(rec.entries.len(), 3);
+        assert!(!torn_path(&path).exists());
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+
+    #[test]
+    fn the_differing_option_is_named_and_other_damage_refused() {
+        let path = temp("refuse");
+        let h = header(&[("a", "1"), ("b", "2")], "f1");
+        drop(Journal::<String, Item>::create(&path, &h).unwrap());
+        let before = std::fs::read(&path).unwrap();
+        let resume = |h: &Header<String>| {
+            Journal::<String, Item>::resume(&path, h)
+                .err()
+                .unwrap()
+                .to_string()
+        };
+        // An option missing from one side is named too.
+        let e = resume(&header(&[("a", "1"), ("b", "2"), ("c", "3")], "f2"));
+        assert!(
+            e.contains("its option c is (not set), this one's is 3"),
+            "{e}"
+        );
+        let e = resume(&header(&[("a", "1"), ("b", "5")], "f2"));
+        assert!(e.contains("its option b is 2, this one's is 5"), "{e}");
+        let e = resume(&header(&[("a", "1"), ("b", "2")], "f2"));
+        assert!(
+            e.contains("every option is the same but its steps differ"),
+            "{e}"
+        );
+        let mut other_kind = h.clone();
+        other_kind.kind = "measure-box".into();
+        assert!(resume(&other_kind).contains("written by a test session, not a measure-box"));
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+        // A second header, and a journal of another format.
+        append_raw(&path, &before);
+        let e = resume(&h);
+        assert!(e.contains("j.jsonl, line 2: a second header line"), "{e}");
+        std::fs::write(&path, b"{\"format\":\"other\",\"version\":1}\n").unwrap();
+        let e = resume(&h);
+        assert!(
+            e.contains("line 1: format \"other\" version 1 is not metamer-session-journal"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    }
+}

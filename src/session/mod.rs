@@ -1,0 +1,24 @@
+//! One engine for every guided measurement session (display characterization, reading the
+//! validation box): a plan of steps ([`plan`]), a durable resumable journal ([`journal`]),
+//! and a runner that prepares, calibrates, measures and journals each step ([`runner`]),
+//! with the operator ([`operator`]), the screen ([`screen`]), progress ([`progress`]) and
+//! Ctrl-C ([`interrupt`]) as small parts a caller supplies or picks.
+
+pub mod interrupt;
+pub mod journal;
+pub mod operator;
+pub mod plan;
+pub mod progress;
+pub mod runner;
+pub mod screen;
+
+pub use interrupt::on_ctrl_c;
+pub use journal::{refuse_existing, torn_path, CalibrationRecord, Header, Journal, JournalError};
+pub use operator::{Answer, Operator, OperatorError, ScriptedOperator, TerminalOperator};
+pub use plan::{Prepare, SessionPlan, Step};
+pub use progress::{BarProgress, NoProgress, ProgressSink, StepProgress};
+pub use runner::{
+    Entry, InstrumentRecord, Rig, RunEnd, RunOptions, Session, SessionError, SessionHeader,
+    StepFailure,
+};
+pub use screen::{DisplayScreen, Screen};
