@@ -132,8 +132,8 @@ class Crate:
 
 
 def use_trees(text):
-    """Every `use` item as (is_public, list of expanded paths), and every inline `crate::`,
-    `super::` or `self::` path outside `use` items as a private one."""
+    """Every `use` item as (is_public, is_only_reexport, list of (path, name)), and every
+    inline `crate::`, `super::` or `self::` path outside `use` items as a private one."""
     items = []
 
     def expand(prefix, tree, out):
@@ -176,15 +176,15 @@ def use_trees(text):
     body = "".join(rest)
     # A re-exported name the file also uses itself is a dependency like any other.
     items = [
-        (public and not any(alias and re.search(r"\b%s\b" % re.escape(alias), body)
-                            for _, alias in out), out)
+        (public, public and not any(alias and re.search(r"\b%s\b" % re.escape(alias), body)
+                                    for _, alias in out), out)
         for public, out in items
     ]
     inline = []
     for m in re.finditer(r"(?<![\w:])((?:crate|super|self)(?:::\w+)+)", body):
         segments = m.group(1).split("::")
         inline.append((segments, segments[-1]))
-    items.append((False, inline))
+    items.append((False, False, inline))
     return items
 
 
@@ -216,7 +216,7 @@ def edges(crate):
         text = remove_test_modules(strip_comments_and_strings(open(path, encoding="utf-8").read()))
         trees[path] = use_trees(text)
         names = {}
-        for public, out in trees[path]:
+        for public, _, out in trees[path]:
             if public:
                 for segments, alias in out:
                     if segments and alias:
@@ -238,8 +238,8 @@ def edges(crate):
 
     result = {path: set() for path in crate.files.values()}
     for path, module in module_of.items():
-        for public, out in trees[path]:
-            if public:
+        for _, only_reexport, out in trees[path]:
+            if only_reexport:
                 continue
             for segments, _ in out:
                 if not segments:
