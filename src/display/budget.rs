@@ -1,4 +1,4 @@
-//! Speed against accuracy for display characterization (issue 5 item 6): how well each
+//! Speed against accuracy for display characterization: how well each
 //! model reproduces colours on each simulated monitor as the number of measured patches
 //! grows.
 //!
