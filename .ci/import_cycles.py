@@ -8,7 +8,7 @@ other and cannot be read, tested or moved one at a time. `mod` declarations are 
 (a parent owning a child module is the tree, not a dependency), and neither is a file's own
 `#[cfg(test)] mod tests` (tests of a file may use what the file's users provide).
 
-Usage: python3 .ci/import_cycles.py [CRATE_SRC ...]   (default: src drivers/src protocols/src)
+Usage: python3 .ci/import_cycles.py [CRATE_SRC ...]   (default: every workspace member's src/)
        python3 .ci/import_cycles.py --self-test         (checks the script on made-up crates)
 Exits 1 with a list of the cycles if there is any beyond the ALLOWED edges.
 """
@@ -28,7 +28,15 @@ ALLOWED = {
     frozenset({"drivers/src/error.rs", "drivers/src/instrument.rs"}),
 }
 
-DEFAULT_ROOTS = ["src", "drivers/src", "protocols/src"]
+
+
+def workspace_roots():
+    """The src/ folder of every member of the workspace in Cargo.toml, root package first."""
+    text = open("Cargo.toml", encoding="utf-8").read()
+    m = re.search(r"^\s*members\s*=\s*\[(.*?)\]", text, re.S | re.M)
+    members = re.findall(r'"([^"]+)"', m.group(1)) if m else ["."]
+    roots = [os.path.normpath(os.path.join(member, "src")) for member in members]
+    return [r for r in roots if os.path.isdir(r)]
 
 
 def strip_comments_and_strings(text):
@@ -343,7 +351,7 @@ def main(argv):
         return self_test()
     here = os.path.dirname(os.path.abspath(__file__))
     os.chdir(os.path.dirname(here))
-    roots = argv[1:] or DEFAULT_ROOTS
+    roots = argv[1:] or workspace_roots()
     bad = 0
     for root in roots:
         crate = Crate(root)
