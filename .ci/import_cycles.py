@@ -6,7 +6,9 @@ of another file (through `crate::`, `super::`, `self::` or a child module) is an
 strongly connected component with more than one file is a cycle: the files import each
 other and cannot be read, tested or moved one at a time. `mod` declarations are not edges
 (a parent owning a child module is the tree, not a dependency), and neither is a file's own
-`#[cfg(test)] mod tests` (tests of a file may use what the file's users provide).
+`#[cfg(test)] mod tests` (tests of a file may use what the file's users provide). A `pub use`
+is a module's public face, no edge unless the file uses the name itself; a path through it
+is followed to the file that defines the item.
 
 Usage: python3 .ci/import_cycles.py [CRATE_SRC ...]   (default: every workspace member's src/)
        python3 .ci/import_cycles.py --self-test         (checks the script on made-up crates)
