@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use metamer::color::{delta_e2000, Xyz};
+use metamer::display::model::Sample;
 use metamer::display::{
-    fit_profile, fit_profile_with, read_measurement_file, FitError, FitOptions, ModelKind, Patch,
-    Profile,
+    fit_profile, fit_profile_with, read_measurement_file, FitError, FitOptions, ModelKind, Profile,
 };
 
 /// XYZ = black + Σ col_c · d_c^γ_c, optionally with a blue chromaticity drift along its ramp
@@ -51,8 +51,8 @@ impl Analytic {
     }
 
     /// Black, white, ramps per channel and a 5³ grid, each drive triple once.
-    fn unique_patches(&self, ramp_levels: usize) -> Vec<Patch> {
-        let mut out: Vec<Patch> = Vec::new();
+    fn unique_patches(&self, ramp_levels: usize) -> Vec<Sample> {
+        let mut out: Vec<Sample> = Vec::new();
         for p in self.patches(ramp_levels) {
             if !out.iter().any(|q| q.rgb == p.rgb) {
                 out.push(p);
@@ -63,12 +63,12 @@ impl Analytic {
 
     /// Black, white, ramps per channel and a 5³ grid (black, white and grid levels of the
     /// ramps appear twice, with identical readings).
-    fn patches(&self, ramp_levels: usize) -> Vec<Patch> {
+    fn patches(&self, ramp_levels: usize) -> Vec<Sample> {
         self.patches_with_grid(ramp_levels, 5)
     }
 
     /// Black, white, `ramp_levels` levels per channel ramp and a `grid`³ grid.
-    fn patches_with_grid(&self, ramp_levels: usize, grid: usize) -> Vec<Patch> {
+    fn patches_with_grid(&self, ramp_levels: usize, grid: usize) -> Vec<Sample> {
         let mut rgbs = vec![[0.0; 3], [1.0; 3]];
         for c in 0..3 {
             for i in 1..=ramp_levels {
@@ -86,7 +86,7 @@ impl Analytic {
             }
         }
         rgbs.into_iter()
-            .map(|rgb| Patch {
+            .map(|rgb| Sample {
                 rgb,
                 xyz: self.forward(rgb),
             })
@@ -238,7 +238,7 @@ fn singular_primaries_are_a_clear_error() {
 #[test]
 fn missing_patches_are_named() {
     let d = ideal();
-    let no_black: Vec<Patch> = d
+    let no_black: Vec<Sample> = d
         .patches(4)
         .into_iter()
         .filter(|p| p.rgb != [0.0; 3])
@@ -248,7 +248,7 @@ fn missing_patches_are_named() {
         e.to_string(),
         "plcc needs the black patch (r,g,b = 0,0,0); the measurements have none"
     );
-    let corners: Vec<Patch> = d
+    let corners: Vec<Sample> = d
         .patches(1)
         .into_iter()
         .filter(|p| p.rgb.iter().all(|&v| v == 0.0 || v == 1.0))
@@ -418,7 +418,7 @@ fn richer_models_cope_where_plcc_fails() {
 #[test]
 fn lut_names_the_missing_grid_patches() {
     let d = ideal();
-    let patches: Vec<Patch> = d
+    let patches: Vec<Sample> = d
         .patches(4)
         .into_iter()
         .filter(|p| p.rgb != [0.5, 0.75, 0.25])
@@ -477,11 +477,11 @@ fn noise_is_estimated_from_repeated_patches() {
     let white = d.forward([1.0; 3]);
     // grey 0.5 measured twice more, ±0.5 % in luminance: ΔE00 of each from the mean
     let grey = d.forward([0.5; 3]);
-    patches.push(Patch {
+    patches.push(Sample {
         rgb: [0.5; 3],
         xyz: grey.map(|v| v * 1.005),
     });
-    patches.push(Patch {
+    patches.push(Sample {
         rgb: [0.5; 3],
         xyz: grey.map(|v| v * 0.995),
     });

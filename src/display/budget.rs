@@ -1,4 +1,4 @@
-//! Speed against accuracy for display characterization (issue 5 item 6): how well each
+//! Speed against accuracy for display characterization: how well each
 //! model reproduces colours on each simulated monitor as the number of measured patches
 //! grows.
 //!
@@ -21,7 +21,7 @@ use serde::Serialize;
 use super::characterize::plan::random_patches;
 use super::characterize::{default_grid_steps, DriveStep, Plan, PlanOptions, Purpose};
 use super::diagnostics::percentile;
-use super::Patch;
+use super::model::Sample;
 use super::{fit_profile, ModelKind};
 use crate::color::{delta_e2000, Xyz};
 use crate::plot::{write_log_log, LogLogChart, Series};
@@ -135,7 +135,7 @@ pub fn run_budget_study(
                     for rgb in &drive {
                         stimulus.set(panel.xyz(*rgb));
                         let reading = meter.measure(&Request::default())?;
-                        patches.push(Patch {
+                        patches.push(Sample {
                             rgb: rgb.map(|c| f64::from(c) / 255.0),
                             xyz: reading.xyz,
                         });
@@ -249,7 +249,7 @@ pub fn write_budget(dir: &std::path::Path, points: &[BudgetPoint]) -> Result<(),
 mod tests {
     use super::*;
 
-    /// Patch counts by hand: ramps of s steps give black + 4 (s − 1); a cube of g points per
+    /// Sample counts by hand: ramps of s steps give black + 4 (s − 1); a cube of g points per
     /// axis adds g³ minus what the ramps already hold; five of them are read twice.
     #[test]
     fn budget_patch_counts_match_a_hand_count() {

@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::model::samples::{PatchSet, CHANNEL_NAMES};
+use super::model::samples::{Sample, SortedSamples, CHANNEL_NAMES};
 use super::model::{condition_number, fit_power_gamma, ModelKind};
 use crate::color::{delta_e2000, Xyz};
 
@@ -83,9 +83,9 @@ pub struct Noise {
 
 /// The scatter of repeated readings: RMS ΔE00 of each reading from its patch's mean, with
 /// n − 1 degrees of freedom per patch; None when no patch was measured twice.
-pub fn repeat_noise(patches: &[super::Patch], white: [f64; 3]) -> Option<Noise> {
+pub fn repeat_noise(patches: &[Sample], white: [f64; 3]) -> Option<Noise> {
     let w = Xyz::from_array(white);
-    let key = |p: &super::Patch| p.rgb.map(|d| (d * 1e6).round() as i64);
+    let key = |p: &Sample| p.rgb.map(|d| (d * 1e6).round() as i64);
     let mut groups: std::collections::HashMap<[i64; 3], Vec<[f64; 3]>> = Default::default();
     for p in patches {
         groups.entry(key(p)).or_default().push(p.xyz);
@@ -120,7 +120,7 @@ impl Diagnostics {
     /// Checks the patch set; `white` is the Lab reference (the display white).
     /// `noise`: the measurement noise, when known (see [`repeat_noise`]).
     pub fn compute(
-        set: &PatchSet,
+        set: &SortedSamples,
         model: ModelKind,
         white: [f64; 3],
         residuals: Residuals,

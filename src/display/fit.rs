@@ -1,44 +1,19 @@
 //! Fitting a display model to measured patches: each model takes what it needs (black,
 //! primaries, ramps, a grid) and is judged on every patch; diagnostics go with the result.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
 use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals};
-use super::model::samples::PatchSet;
+use super::model::samples::SortedSamples;
+use super::model::Sample;
 use super::model::{
-    fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, ModelKind,
+    fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, FitError, ModelKind,
     ModelParams,
 };
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
-use super::Patch;
 use crate::color::{delta_e2000, Xyz};
-
-/// Why a model could not be fitted.
-#[derive(Debug, thiserror::Error)]
-pub enum FitError {
-    #[error("no patches to fit")]
-    NoPatches,
-    #[error("patch {index} (r,g,b = {rgb:?}) has a value that is not a finite number in range")]
-    BadPatch { index: usize, rgb: [f64; 3] },
-    #[error("{model} needs {what}; the measurements have none")]
-    Missing { model: ModelKind, what: String },
-    #[error(
-        "the primaries are (nearly) linearly dependent: the condition number of M (columns: \
-         full-on red, green, blue minus black) is {condition:.3e}, above {limit:.0e}; check that \
-         the three primaries were measured on the right patches and are above the black level"
-    )]
-    SingularPrimaries { condition: f64, limit: f64 },
-    #[error("{model}: {message}")]
-    Failed { model: ModelKind, message: String },
-    #[error("{file}: cannot read for its hash: {source}")]
-    Io {
-        file: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-}
 
 /// Choices beyond the model kind.
 #[derive(Clone, Debug, Default)]
@@ -53,7 +28,7 @@ pub struct FitOptions {
 /// Fits `kind` to `patches`; `source` is the measurement file whose hash the profile records.
 pub fn fit_profile(
     kind: ModelKind,
-    patches: &[Patch],
+    patches: &[Sample],
     source: Option<&Path>,
 ) -> Result<Profile, FitError> {
     fit_profile_with(kind, patches, source, &FitOptions::default())
@@ -62,7 +37,7 @@ pub fn fit_profile(
 /// [`fit_profile`] with options.
 pub fn fit_profile_with(
     kind: ModelKind,
-    patches: &[Patch],
+    patches: &[Sample],
     source: Option<&Path>,
     options: &FitOptions,
 ) -> Result<Profile, FitError> {
@@ -79,7 +54,7 @@ pub fn fit_profile_with(
             });
         }
     }
-    let set = PatchSet::new(patches);
+    let set = SortedSamples::new(patches);
     let params = match kind {
         ModelKind::Plcc => ModelParams::MatrixTrc(fit_plcc(&set)?),
         ModelKind::PlccGamma => ModelParams::MatrixTrc(fit_plcc_gamma(&set, options.gamma)?),
@@ -132,7 +107,7 @@ pub fn fit_profile_with(
 }
 
 /// ΔE00 (relative to `white`) and XYZ differences between the model and every patch.
-pub fn residuals(model: &dyn DisplayModel, patches: &[Patch], white: [f64; 3]) -> Residuals {
+pub fn residuals(model: &dyn DisplayModel, patches: &[Sample], white: [f64; 3]) -> Residuals {
     let w = Xyz::from_array(white);
     let mut des = Vec::with_capacity(patches.len());
     let mut sq = 0.0;

@@ -1,8 +1,6 @@
-//! Display characterization (issue 5): display models (paper Eq. 9 and richer), fitting,
-//! reproduction of XYZ on a display, gamut mapping, patch display backends, the
-//! `characterize` session and the patch-budget study.
-
-use serde::{Deserialize, Serialize};
+//! Display characterization: display models (paper Eq. 9 and richer), fitting,
+//! reproduction of XYZ on a display, gamut mapping, the `characterize` session and the
+//! patch-budget study. The screens that show the colours are devices, in `rig`.
 
 // Measurements, models and fitting.
 pub mod diagnostics;
@@ -15,21 +13,14 @@ pub mod profile;
 pub mod gamut;
 pub mod reproduce;
 
-// Showing and measuring patches.
+// Measuring a display.
 pub mod characterize;
 
 // Speed against accuracy.
 pub mod budget;
 
 pub use diagnostics::{Diagnostics, Noise, Residuals};
-pub use fit::{fit_profile, fit_profile_with, FitError, FitOptions};
+pub use fit::{fit_profile, fit_profile_with, FitOptions};
 pub use measurements::{read_measurement_file, read_measurements, write_ti3, MeasurementsError};
-pub use model::{DisplayModel, Inverse, ModelKind};
+pub use model::{DisplayModel, FitError, Inverse, ModelKind, Sample};
 pub use profile::{Profile, ProfileError};
-
-/// One measured patch: drive values 0–1 per channel and the XYZ measured, cd/m².
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Patch {
-    pub rgb: [f64; 3],
-    pub xyz: [f64; 3],
-}

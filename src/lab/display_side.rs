@@ -18,8 +18,8 @@ use crate::rig::virtual_display::quantize;
 use crate::rig::{Screen, VirtualPanel};
 use crate::session::{RunOptions, ScriptedOperator, StepProgress};
 
-use super::scene_readings::mean_reading;
-use super::LabError;
+use super::error::LabError;
+use super::meter::mean_reading;
 
 /// Headroom above the brightest in-gamut target, so no channel sits at its very end.
 const LUMINANCE_HEADROOM: f64 = 1.05;

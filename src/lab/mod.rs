@@ -2,7 +2,7 @@
 //! simulated hardware, so it runs on any machine and every stage is exercised end to end.
 //!
 //! 1. The box: the validation-box scene read patch by patch with the simulated CS-100A
-//!    ([`scene_readings`]).
+//!    ([`crate::rig::sim_box`]).
 //! 2. The simulation: the spectral path tracer's 24 spot readings (paper Eq. 8).
 //! 3. The display: a simulated monitor whose peak luminance is set so the rendered values
 //!    fit (the paper sets the display's maximum luminance; no tone mapping), characterized
@@ -12,15 +12,18 @@
 //! 5. Validation: display vs box (the paper's question), simulation vs box and display vs
 //!    simulation, in CIELAB relative to the box's reference white, with the JND count.
 
-mod scene_readings;
-
-pub use scene_readings::{measure_each, read_box_and_simulate, SceneReadings};
+mod box_side;
 mod display_side;
+mod error;
+mod meter;
+
+pub use box_side::{read_box_and_simulate, SceneReadings};
+pub use error::LabError;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use metamer_drivers::{open_instrument, DriverError, SharedWorld};
+use metamer_drivers::{open_instrument, SharedWorld};
 use serde::Serialize;
 
 pub use display_side::{
@@ -29,13 +32,11 @@ pub use display_side::{
 
 use crate::color::Xyz;
 use crate::display::characterize::finish::Summary;
-use crate::display::characterize::CharacterizeError;
 use crate::display::gamut::GamutMapping;
-use crate::display::{ModelKind, ProfileError};
-use crate::render::spot::SpotError;
-use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
-use crate::rig::{Preset, Screen, ScreenError, VirtualDisplay, VirtualPanel};
-use crate::validation::{compare, write_delta_e_chart_shaded, Comparison, ValidationError};
+use crate::display::ModelKind;
+use crate::render::{Scene, SpotOptions, SpotProgress};
+use crate::rig::{Preset, Screen, VirtualDisplay, VirtualPanel};
+use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
 
 /// What a lab run is made of.
 #[derive(Clone, Debug, Serialize)]
@@ -77,36 +78,6 @@ pub enum LabProgress<'a> {
     Render(SpotProgress),
     /// Readings done of a measuring stage.
     Readings { done: usize, total: usize },
-}
-
-/// Why a lab run failed.
-#[derive(Debug, thiserror::Error)]
-pub enum LabError {
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    #[error(transparent)]
-    Spot(#[from] SpotError),
-    #[error("the simulated meter: {0}")]
-    Meter(#[from] DriverError),
-    #[error(transparent)]
-    Display(#[from] ScreenError),
-    #[error(transparent)]
-    Characterize(#[from] CharacterizeError),
-    #[error(transparent)]
-    Profile(#[from] ProfileError),
-    #[error(transparent)]
-    Validation(#[from] ValidationError),
-    #[error("the display characterization stopped with {missing} readings missing; run again with --resume")]
-    Incomplete { missing: usize },
-    #[error("the lab needs a simulated display that a simulated meter can see")]
-    NotSimulated,
-    #[error("{} holds an earlier lab run; choose another directory or add --resume", dir.display())]
-    Exists { dir: PathBuf },
-    #[error("writing {}: {source}", file.display())]
-    Write {
-        file: PathBuf,
-        source: std::io::Error,
-    },
 }
 
 /// One patch through the whole chain.

@@ -3,6 +3,7 @@
 //! monitor); display mathematics (models, fitting, reproduction) stays in `display`.
 
 pub mod screen;
+pub mod sim_box;
 pub mod sim_meter;
 pub mod spec;
 pub mod virtual_display;

@@ -1,4 +1,4 @@
-//! A simulated monitor (issue 5 item 4) for characterizing without hardware: it shows 8-bit
+//! A simulated monitor for characterizing without hardware: it shows 8-bit
 //! drive values and the simulated instruments measure what it emits through the drivers'
 //! [`World`](metamer_drivers::World) trait (`open_instrument("sim:cs100a", Some(display.stimulus()))`).
 //!

@@ -10,7 +10,8 @@ use serde::Serialize;
 use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
 use super::verify::{average, usable, verify, Verification};
-use crate::display::{fit_profile, write_ti3, FitError, ModelKind, Patch, ProfileError, Residuals};
+use crate::display::model::{FitError, Sample};
+use crate::display::{fit_profile, write_ti3, ModelKind, ProfileError, Residuals};
 
 pub const PROFILE_FILE: &str = "profile.json";
 pub const TI3_FILE: &str = "readings.ti3";
@@ -101,10 +102,10 @@ pub fn finish(
         .map_or([0.0; 3], |p| p.xyz);
     // Every usable reading, not the averages: the fit averages repeats itself and needs them
     // to estimate the meter's noise for its verdict.
-    let training: Vec<Patch> = readings
+    let training: Vec<Sample> = readings
         .iter()
         .filter(|(p, r)| p.purpose == Purpose::Fit && usable(r))
-        .map(|(p, r)| Patch {
+        .map(|(p, r)| Sample {
             rgb: p.rgb.map(|c| f64::from(c) / 255.0),
             xyz: r.xyz,
         })
@@ -122,10 +123,10 @@ pub fn finish(
         summary: dir.join(SUMMARY_FILE),
     };
     profile.save(&files.profile)?;
-    let raw: Vec<Patch> = readings
+    let raw: Vec<Sample> = readings
         .iter()
         .filter(|(_, r)| usable(r))
-        .map(|(p, r)| Patch {
+        .map(|(p, r)| Sample {
             rgb: p.rgb.map(|c| f64::from(c) / 255.0),
             xyz: r.xyz,
         })

@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::plan::{DriveStep, Purpose};
 use crate::color::{delta_e2000, Xyz};
 use crate::display::diagnostics::percentile;
-use crate::display::Patch;
+use crate::display::model::Sample;
 
 /// A planned patch with its readings averaged.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -27,8 +27,8 @@ pub struct AveragedPatch {
 
 impl AveragedPatch {
     /// As the display models take it: drive 0–1 and XYZ.
-    pub fn to_patch(&self) -> Patch {
-        Patch {
+    pub fn to_patch(&self) -> Sample {
+        Sample {
             rgb: self.rgb8.map(|c| f64::from(c) / 255.0),
             xyz: self.xyz,
         }
@@ -206,7 +206,7 @@ mod tests {
                 readings: 1,
             })
             .collect();
-        // Patch i is predicted with lightness off by i/10 (moving Y by the slope of L*).
+        // Sample i is predicted with lightness off by i/10 (moving Y by the slope of L*).
         let predict = |rgb: [f64; 3]| {
             let i = (rgb[0] * 255.0).round();
             let l = 50.0 + i / 10.0;

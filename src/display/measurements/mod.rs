@@ -15,7 +15,7 @@ mod write;
 
 pub use write::write_ti3;
 
-use super::Patch;
+use super::model::Sample;
 use crate::numeric_csv::{CsvError, NumericCsv};
 
 /// What is wrong with a measurement file; every variant names the file, most the line.
@@ -43,7 +43,7 @@ pub enum MeasurementsError {
 /// XYZ scale was established.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Measurements {
-    pub patches: Vec<Patch>,
+    pub patches: Vec<Sample>,
     /// False when a `.ti3` holds only white-relative XYZ (Y = 100 at white, no
     /// `LUMINANCE_XYZ_CDM2`): the values are then taken as if the white had 100 cd/m².
     pub absolute: bool,
@@ -51,7 +51,7 @@ pub struct Measurements {
 
 /// Reads `.ti3` (CGATS) or `.csv` by extension; relative `.ti3` data are returned as if the
 /// white were 100 cd/m² (use [`read_measurement_file`] to know).
-pub fn read_measurements(path: &Path) -> Result<Vec<Patch>, MeasurementsError> {
+pub fn read_measurements(path: &Path) -> Result<Vec<Sample>, MeasurementsError> {
     read_measurement_file(path).map(|m| m.patches)
 }
 
@@ -77,7 +77,7 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
                     ),
                 });
             }
-            patches.push(Patch {
+            patches.push(Sample {
                 rgb,
                 xyz: [v[3], v[4], v[5]],
             });
@@ -318,7 +318,7 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
     Ok(Measurements {
         patches: rows
             .into_iter()
-            .map(|(_, v)| Patch {
+            .map(|(_, v)| Sample {
                 rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
                 xyz: [v[3] * scale, v[4] * scale, v[5] * scale],
             })
@@ -449,7 +449,7 @@ DESCRIPTOR "Argyll Device Calibration State"
         let p = read_measurements(&path).unwrap();
         assert_eq!(
             p[1],
-            Patch {
+            Sample {
                 rgb: [0.5, 0.0, 0.0],
                 xyz: [10.0, 5.0, 0.5]
             }

@@ -5,12 +5,12 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::display::Patch;
+use crate::display::model::Sample;
 
 /// The white used to normalise a `.ti3`: the brightest patch driven at full on all channels,
 /// or the brightest patch when none is.
-fn white_of(patches: &[Patch]) -> Option<[f64; 3]> {
-    let brightest = |it: &mut dyn Iterator<Item = &Patch>| {
+fn white_of(patches: &[Sample]) -> Option<[f64; 3]> {
+    let brightest = |it: &mut dyn Iterator<Item = &Sample>| {
         it.max_by(|a, b| a.xyz[1].total_cmp(&b.xyz[1]))
             .map(|p| p.xyz)
     };
@@ -60,7 +60,7 @@ fn ctime_utc(secs: i64) -> String {
 /// Writes patches as ArgyllCMS dispread does: RGB in 0–100, XYZ normalised to the white's
 /// Y = 100 with the white's absolute XYZ in `LUMINANCE_XYZ_CDM2`. `description` goes into the
 /// DESCRIPTOR keyword.
-pub fn write_ti3(path: &Path, patches: &[Patch], description: &str) -> std::io::Result<()> {
+pub fn write_ti3(path: &Path, patches: &[Sample], description: &str) -> std::io::Result<()> {
     let white = white_of(patches).filter(|w| w[1] > 0.0).ok_or_else(|| {
         std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
@@ -127,15 +127,15 @@ mod tests {
     #[test]
     fn write_then_read_round_trips_absolute_values() {
         let patches = vec![
-            Patch {
+            Sample {
                 rgb: [0.0, 0.0, 0.0],
                 xyz: [0.2, 0.21, 0.3],
             },
-            Patch {
+            Sample {
                 rgb: [1.0, 1.0, 1.0],
                 xyz: [152.0, 160.0, 174.2],
             },
-            Patch {
+            Sample {
                 rgb: [128.0 / 255.0, 0.25, 1.0],
                 xyz: [30.5, 20.25, 90.125],
             },

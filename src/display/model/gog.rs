@@ -3,11 +3,12 @@
 //! gain-offset-gamma curve `max(gain·d + offset, 0)^γ` (GOG, normalised so gain + offset =
 //! 1) or with an extra additive offset (GOGO), fitted by least squares to the channel's ramp.
 
+use super::error::FitError;
 use super::least_squares::levenberg_marquardt;
-use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
-use super::samples::{PatchSet, CHANNEL_NAMES};
+use super::plcc::{black_and_primaries, ramp_points, singular};
+use super::samples::{SortedSamples, CHANNEL_NAMES};
+use super::trc::fit_power_gamma;
 use super::{MatrixTrc, ModelKind, Trc};
-use crate::display::fit::FitError;
 
 /// Fits one channel's GOG (`flare` false) or GOGO curve to (drive, R′) points.
 pub fn fit_gog_curve(points: &[(f64, f64)], flare: bool) -> Trc {
@@ -54,7 +55,7 @@ pub fn fit_gog_curve(points: &[(f64, f64)], flare: bool) -> Trc {
 }
 
 /// GOG (`kind` Gog) or GOGO (`kind` Gogo).
-pub fn fit_gog(set: &PatchSet, kind: ModelKind) -> Result<MatrixTrc, FitError> {
+pub fn fit_gog(set: &SortedSamples, kind: ModelKind) -> Result<MatrixTrc, FitError> {
     let flare = kind == ModelKind::Gogo;
     let (black, m) = black_and_primaries(set, kind)?;
     let need = if flare { 3 } else { 2 };

@@ -13,11 +13,12 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::plcc::{black_and_primaries, fit_power_gamma, ramp_points, singular};
-use super::samples::{PatchSet, CHANNEL_NAMES, SAME_DRIVE};
+use super::error::FitError;
+use super::plcc::{black_and_primaries, ramp_points, singular};
+use super::samples::Sample;
+use super::samples::{SortedSamples, CHANNEL_NAMES, SAME_DRIVE};
+use super::trc::fit_power_gamma;
 use super::{condition_number, DisplayModel, FastInverse, Inverse, ModelKind, Trc, MAX_CONDITION};
-use crate::display::fit::FitError;
-use crate::display::Patch;
 
 /// Ramp levels from which the shaper interpolates the ramp instead of fitting a power law.
 const TABLE_SHAPER_LEVELS: usize = 8;
@@ -179,7 +180,7 @@ impl DisplayModel for Lut3d {
 
 /// Grid levels of channel `c`: drive values that occur together with another channel on
 /// (single-channel ramp levels do not), plus 0 and 1.
-fn grid_levels(patches: &[Patch], c: usize) -> Vec<f64> {
+fn grid_levels(patches: &[Sample], c: usize) -> Vec<f64> {
     let mut v: Vec<f64> = patches
         .iter()
         .filter(|p| (0..3).any(|o| o != c && p.rgb[o] > SAME_DRIVE))
@@ -191,7 +192,7 @@ fn grid_levels(patches: &[Patch], c: usize) -> Vec<f64> {
     v
 }
 
-pub fn fit_lut(set: &PatchSet, patches: &[Patch]) -> Result<Lut3d, FitError> {
+pub fn fit_lut(set: &SortedSamples, patches: &[Sample]) -> Result<Lut3d, FitError> {
     let kind = ModelKind::Lut;
     let (black, m) = black_and_primaries(set, kind)?;
     let cond = condition_number(&m);

@@ -6,13 +6,13 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::error::FitError;
 use super::plcc::{black_and_primaries, ramp_tables, singular};
-use super::samples::PatchSet;
+use super::samples::Sample;
+use super::samples::SortedSamples;
 use super::{MatrixTrc, ModelKind};
-use crate::display::fit::FitError;
-use crate::display::Patch;
 
-pub fn fit_matrix_lsq(set: &PatchSet, patches: &[Patch]) -> Result<MatrixTrc, FitError> {
+pub fn fit_matrix_lsq(set: &SortedSamples, patches: &[Sample]) -> Result<MatrixTrc, FitError> {
     let kind = ModelKind::MatrixLsq;
     let (black, m) = black_and_primaries(set, kind)?;
     let trc = ramp_tables(set, kind, black, &m)?;

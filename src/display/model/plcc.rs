@@ -8,13 +8,14 @@
 //! A ramp patch's normalised output is its black-corrected XYZ projected on the primary's
 //! column (least squares), not its Y alone: blue has little Y, so Y alone would be noisy.
 
-use super::samples::{PatchSet, CHANNEL_NAMES};
+use super::error::FitError;
+use super::samples::{SortedSamples, CHANNEL_NAMES};
+use super::trc::fit_power_gamma;
 use super::{MatrixTrc, ModelKind, Trc};
-use crate::display::fit::FitError;
 
 /// Black and the Eq. 9 matrix (columns: full-on primaries minus black).
 pub fn black_and_primaries(
-    set: &PatchSet,
+    set: &SortedSamples,
     kind: ModelKind,
 ) -> Result<([f64; 3], [[f64; 3]; 3]), FitError> {
     let black = set.black.ok_or_else(|| FitError::Missing {
@@ -37,7 +38,7 @@ pub fn black_and_primaries(
 /// The ramp of channel `c` as (drive, R′) points including (0, 0), R′ being the
 /// black-corrected XYZ projected on M's column `c`.
 pub fn ramp_points(
-    set: &PatchSet,
+    set: &SortedSamples,
     black: [f64; 3],
     m: &[[f64; 3]; 3],
     c: usize,
@@ -60,7 +61,7 @@ pub(crate) fn singular(condition: f64) -> FitError {
 }
 
 /// Paper Eq. 9 with TRCs interpolated through the measured ramps (see [`Trc::Table`]).
-pub fn fit_plcc(set: &PatchSet) -> Result<MatrixTrc, FitError> {
+pub fn fit_plcc(set: &SortedSamples) -> Result<MatrixTrc, FitError> {
     let kind = ModelKind::Plcc;
     let (black, m) = black_and_primaries(set, kind)?;
     let trc = ramp_tables(set, kind, black, &m)?;
@@ -70,7 +71,7 @@ pub fn fit_plcc(set: &PatchSet) -> Result<MatrixTrc, FitError> {
 /// Each channel's TRC interpolated through its measured ramp (black-corrected against
 /// `black` and the primaries' matrix `m`); a channel without a ramp is an error for `kind`.
 pub fn ramp_tables(
-    set: &PatchSet,
+    set: &SortedSamples,
     kind: ModelKind,
     black: [f64; 3],
     m: &[[f64; 3]; 3],
@@ -95,36 +96,9 @@ pub fn ramp_tables(
     }))
 }
 
-/// Least-squares exponent of `d^γ` through ramp points (golden-section search on ln γ;
-/// the sum of squares is unimodal in γ for a monotone ramp).
-pub fn fit_power_gamma(points: &[(f64, f64)]) -> f64 {
-    let cost = |g: f64| -> f64 { points.iter().map(|&(d, s)| (d.powf(g) - s).powi(2)).sum() };
-    let (mut a, mut b) = (0.1f64.ln(), 10.0f64.ln());
-    let phi = (5f64.sqrt() - 1.0) / 2.0;
-    let mut x1 = b - phi * (b - a);
-    let mut x2 = a + phi * (b - a);
-    let (mut f1, mut f2) = (cost(x1.exp()), cost(x2.exp()));
-    for _ in 0..100 {
-        if f1 <= f2 {
-            b = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = b - phi * (b - a);
-            f1 = cost(x1.exp());
-        } else {
-            a = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = a + phi * (b - a);
-            f2 = cost(x2.exp());
-        }
-    }
-    (0.5 * (a + b)).exp()
-}
-
 /// Paper Eq. 9 with a power-law TRC per channel: `gamma` given (the paper's 2.2) or fitted
 /// to each ramp.
-pub fn fit_plcc_gamma(set: &PatchSet, gamma: Option<f64>) -> Result<MatrixTrc, FitError> {
+pub fn fit_plcc_gamma(set: &SortedSamples, gamma: Option<f64>) -> Result<MatrixTrc, FitError> {
     let kind = ModelKind::PlccGamma;
     let (black, m) = black_and_primaries(set, kind)?;
     let mut trc: [Trc; 3] = std::array::from_fn(|_| Trc::Power { gamma: 1.0 });

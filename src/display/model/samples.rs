@@ -1,15 +1,22 @@
-//! Sorting a measured patch set into what the models need: black, full-on primaries, white,
-//! single-channel ramps. Repeated patches are averaged; everything else stays available for
-//! fitting and residuals.
+//! The fit input: measured samples (drive values and the XYZ they gave), and their sorting
+//! into what the models need: black, full-on primaries, white, single-channel ramps.
+//! Repeated samples are averaged; everything else stays available for fitting and residuals.
 
-use crate::display::Patch;
+use serde::{Deserialize, Serialize};
+
+/// One measurement of a display: drive values 0–1 per channel and the XYZ measured, cd/m².
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    pub rgb: [f64; 3],
+    pub xyz: [f64; 3],
+}
 
 /// Drive values closer than this count as equal (finer than a 16-bit step).
 pub const SAME_DRIVE: f64 = 1e-6;
 
-/// Black, white, primaries and ramps of a patch set, each averaged over repeats.
+/// Black, white, primaries and ramps of a set of samples, each averaged over repeats.
 #[derive(Clone, Debug, Default)]
-pub struct PatchSet {
+pub struct SortedSamples {
     pub black: Option<[f64; 3]>,
     pub white: Option<[f64; 3]>,
     /// Full-on red, green, blue alone.
@@ -36,9 +43,9 @@ fn mean(xs: &[[f64; 3]]) -> Option<[f64; 3]> {
     }))
 }
 
-impl PatchSet {
-    pub fn new(patches: &[Patch]) -> PatchSet {
-        let pick = |f: &dyn Fn(&Patch) -> bool| -> Vec<[f64; 3]> {
+impl SortedSamples {
+    pub fn new(patches: &[Sample]) -> SortedSamples {
+        let pick = |f: &dyn Fn(&Sample) -> bool| -> Vec<[f64; 3]> {
             patches.iter().filter(|p| f(p)).map(|p| p.xyz).collect()
         };
         let black = mean(&pick(&|p| p.rgb.iter().all(|&d| is(d, 0.0))));
@@ -73,7 +80,7 @@ impl PatchSet {
                 .filter(|(d, _)| is(*d, 1.0))
                 .map(|(_, xyz)| *xyz)
         });
-        PatchSet {
+        SortedSamples {
             black,
             white,
             primaries,
@@ -100,11 +107,11 @@ mod tests {
 
     #[test]
     fn sorts_and_averages() {
-        let p = |rgb: [f64; 3], y: f64| Patch {
+        let p = |rgb: [f64; 3], y: f64| Sample {
             rgb,
             xyz: [y, y, y],
         };
-        let set = PatchSet::new(&[
+        let set = SortedSamples::new(&[
             p([0.0, 0.0, 0.0], 1.0),
             p([0.0, 0.0, 0.0], 3.0),
             p([1.0, 1.0, 1.0], 100.0),

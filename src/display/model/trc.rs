@@ -94,7 +94,7 @@ impl Trc {
     /// interpolated in the domain of the ramp's least-squares power law.
     pub fn table_from_ramp(points: &[(f64, f64)]) -> Trc {
         let (drive, value) = isotonic(points);
-        let exponent = super::plcc::fit_power_gamma(points);
+        let exponent = fit_power_gamma(points);
         Trc::Table {
             drive,
             value,
@@ -226,6 +226,33 @@ fn isotonic(points: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>) {
         value[a..=b].iter_mut().for_each(|v| *v = m);
     }
     (drives.iter().map(|d| d.0).collect(), value)
+}
+
+/// Least-squares exponent of `d^γ` through ramp points (golden-section search on ln γ;
+/// the sum of squares is unimodal in γ for a monotone ramp).
+pub fn fit_power_gamma(points: &[(f64, f64)]) -> f64 {
+    let cost = |g: f64| -> f64 { points.iter().map(|&(d, s)| (d.powf(g) - s).powi(2)).sum() };
+    let (mut a, mut b) = (0.1f64.ln(), 10.0f64.ln());
+    let phi = (5f64.sqrt() - 1.0) / 2.0;
+    let mut x1 = b - phi * (b - a);
+    let mut x2 = a + phi * (b - a);
+    let (mut f1, mut f2) = (cost(x1.exp()), cost(x2.exp()));
+    for _ in 0..100 {
+        if f1 <= f2 {
+            b = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = b - phi * (b - a);
+            f1 = cost(x1.exp());
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + phi * (b - a);
+            f2 = cost(x2.exp());
+        }
+    }
+    (0.5 * (a + b)).exp()
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! The real patch display (issue 5 item 4): an override-redirect X11 window covering one
+//! The real screen: an override-redirect X11 window covering one
 //! monitor, filled with exactly the requested 8-bit RGB, with the pointer hidden over it.
 //!
 //! It speaks the X11 protocol itself through `x11rb` (no system library), so it works on

@@ -1,0 +1,83 @@
+//! The models `fit` offers, by name.
+
+use serde::{Deserialize, Serialize};
+
+/// The models `fit` offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ModelKind {
+    /// Paper Eq. 9 with TRCs interpolated through the measured ramps.
+    Plcc,
+    /// Paper Eq. 9 with a power-law TRC per channel (fitted, or given as the paper's 2.2).
+    PlccGamma,
+    /// Gain-offset-gamma per channel + primaries matrix, least squares.
+    Gog,
+    /// GOG with an extra additive offset per channel.
+    Gogo,
+    /// A 3D LUT over a measured grid, tetrahedral interpolation: no constant-chromaticity or
+    /// additivity assumption.
+    Lut,
+    /// Measured-ramp TRCs and a matrix + black offset fitted over all patches.
+    MatrixLsq,
+}
+
+impl ModelKind {
+    pub const ALL: [ModelKind; 6] = [
+        ModelKind::Plcc,
+        ModelKind::PlccGamma,
+        ModelKind::Gog,
+        ModelKind::Gogo,
+        ModelKind::Lut,
+        ModelKind::MatrixLsq,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Plcc => "plcc",
+            ModelKind::PlccGamma => "plcc-gamma",
+            ModelKind::Gog => "gog",
+            ModelKind::Gogo => "gogo",
+            ModelKind::Lut => "lut",
+            ModelKind::MatrixLsq => "matrix-lsq",
+        }
+    }
+}
+
+impl std::fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ModelKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                let names: Vec<&str> = ModelKind::ALL.iter().map(|k| k.name()).collect();
+                format!("unknown model '{s}' (known: {})", names.join(", "))
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kind_names_round_trip() {
+        for k in ModelKind::ALL {
+            assert_eq!(k.to_string().parse::<ModelKind>().unwrap(), k);
+            assert_eq!(
+                serde_json::to_string(&k).unwrap(),
+                format!("\"{}\"", k.name())
+            );
+        }
+        assert!("plc"
+            .parse::<ModelKind>()
+            .unwrap_err()
+            .contains("plcc-gamma"));
+    }
+}

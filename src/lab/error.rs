@@ -1,0 +1,45 @@
+//! Why a lab run failed.
+
+use std::path::PathBuf;
+
+use metamer_drivers::DriverError;
+
+use crate::display::characterize::CharacterizeError;
+use crate::display::ProfileError;
+use crate::render::spot::SpotError;
+use crate::render::SceneError;
+use crate::rig::sim_box::SimBoxError;
+use crate::rig::ScreenError;
+use crate::validation::ValidationError;
+
+/// Why a lab run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LabError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Spot(#[from] SpotError),
+    #[error(transparent)]
+    Box(#[from] SimBoxError),
+    #[error("the simulated meter: {0}")]
+    Meter(#[from] DriverError),
+    #[error(transparent)]
+    Display(#[from] ScreenError),
+    #[error(transparent)]
+    Characterize(#[from] CharacterizeError),
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    #[error(transparent)]
+    Validation(#[from] ValidationError),
+    #[error("the display characterization stopped with {missing} readings missing; run again with --resume")]
+    Incomplete { missing: usize },
+    #[error("the lab needs a simulated display that a simulated meter can see")]
+    NotSimulated,
+    #[error("{} holds an earlier lab run; choose another directory or add --resume", dir.display())]
+    Exists { dir: PathBuf },
+    #[error("writing {}: {source}", file.display())]
+    Write {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+}
