@@ -91,12 +91,7 @@ pub struct Rng {
 impl Rng {
     /// A stream for (seed, stream id, index) mixed with SplitMix64.
     pub fn new(seed: u64, stream: u64, index: u64) -> Rng {
-        let mix = |mut z: u64| {
-            z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^ (z >> 31)
-        };
+        let mix = metamer_drivers::noise::SplitMix64::mix;
         let s = mix(seed ^ mix(stream ^ mix(index)));
         let mut r = Rng {
             state: 0,

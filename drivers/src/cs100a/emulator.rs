@@ -21,6 +21,7 @@ use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
 
 use super::Speed;
 use crate::link::{LineSettings, LinkError, SerialLink};
+use crate::noise::SplitMix64;
 use crate::world::World;
 
 /// Upper end of the display range, cd/m² (fact sheet §5, unconfirmed).
@@ -69,7 +70,7 @@ impl Cs100aEmulator {
     pub fn new(world: Arc<dyn World>, config: EmulatorConfig) -> Cs100aEmulator {
         Cs100aEmulator {
             world,
-            rng: SplitMix64(config.seed),
+            rng: SplitMix64::new(config.seed),
             config,
             // The power-on speed is not documented; FAST is assumed [I].
             speed: Speed::Fast,
@@ -209,30 +210,6 @@ impl Cs100aEmulator {
             .name("cs100a-emulator".into())
             .spawn(move || self.serve(link, &AtomicBool::new(false)))
             .expect("spawning the emulator thread")
-    }
-}
-
-/// SplitMix64 (Steele, Lea & Flood 2014): small, seedable, good enough for noise.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in (0, 1].
-    fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 1.0) / (1u64 << 53) as f64
-    }
-
-    /// Standard normal by Box–Muller.
-    fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
     }
 }
 

@@ -252,19 +252,12 @@ impl Plan {
     }
 }
 
-/// `n` drive triplets from SplitMix64 (Steele, Lea, Flood 2014) seeded with `seed`.
+/// `n` drive triplets from the workspace's seeded generator (SplitMix64).
 pub fn random_patches(n: usize, seed: u64) -> Vec<[u8; 3]> {
-    let mut state = seed;
-    let mut next = move || {
-        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    };
+    let mut rng = metamer_drivers::noise::SplitMix64::new(seed);
     (0..n)
         .map(|_| {
-            let r = next();
+            let r = rng.next_u64();
             [(r >> 8) as u8, (r >> 24) as u8, (r >> 40) as u8]
         })
         .collect()
