@@ -42,13 +42,13 @@ pub fn fit_profile_with(
     options: &FitOptions,
 ) -> Result<Profile, FitError> {
     if patches.is_empty() {
-        return Err(FitError::NoPatches);
+        return Err(FitError::NoSamples);
     }
     for (index, p) in patches.iter().enumerate() {
         let ok =
             p.rgb.iter().all(|d| (0.0..=1.0).contains(d)) && p.xyz.iter().all(|v| v.is_finite());
         if !ok {
-            return Err(FitError::BadPatch {
+            return Err(FitError::BadSample {
                 index: index + 1,
                 rgb: p.rgb,
             });

@@ -9,9 +9,9 @@ use super::kind::ModelKind;
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
     #[error("no patches to fit")]
-    NoPatches,
+    NoSamples,
     #[error("patch {index} (r,g,b = {rgb:?}) has a value that is not a finite number in range")]
-    BadPatch { index: usize, rgb: [f64; 3] },
+    BadSample { index: usize, rgb: [f64; 3] },
     #[error("{model} needs {what}; the measurements have none")]
     Missing { model: ModelKind, what: String },
     #[error(
