@@ -12,6 +12,7 @@ pub mod devices;
 mod error;
 pub mod instrument;
 pub mod link;
+mod mode;
 mod open;
 mod permissions;
 pub mod registry;
