@@ -233,3 +233,33 @@ pub trait Instrument: Send {
         Vec::new()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use metamer_color::Quantity;
+
+    #[test]
+    fn a_spectral_reading_carries_its_grid_and_quantity_in_json() {
+        let spectrum = Spectrum::from_grid(380.0, 10.0, vec![0.25, 0.5, 0.75])
+            .unwrap()
+            .with_quantity(Quantity::Radiance);
+        let reading = Reading {
+            spectrum: Some(spectrum),
+            timestamp_s: 0.0,
+            ..Reading::from_yxy(30.0, 0.3, 0.6, "i1pro")
+        };
+        let json = serde_json::to_value(&reading).unwrap();
+        assert_eq!(
+            json["spectrum"],
+            serde_json::json!({"start_nm": 380, "step_nm": 10, "values": [0.25, 0.5, 0.75],
+                               "quantity": "radiance"})
+        );
+        // X = 0.3·30/0.6 = 15, Z = 0.1·30/0.6 = 5.
+        for (got, want) in reading.xyz.iter().zip([15.0, 30.0, 5.0]) {
+            assert!((got - want).abs() < 1e-12, "{:?}", reading.xyz);
+        }
+        let back: Reading = serde_json::from_value(json).unwrap();
+        assert_eq!(back, reading);
+    }
+}
