@@ -90,8 +90,8 @@ pub enum DriverError {
     #[error("the {instrument} must be calibrated for {mode} measurements first ({reason}): {}", condition.prompt())]
     NeedsCalibration {
         instrument: String,
-        mode: crate::instrument::MeasureMode,
-        condition: crate::instrument::CalibrationCondition,
+        mode: crate::mode::MeasureMode,
+        condition: crate::mode::CalibrationCondition,
         reason: String,
     },
     /// The simulated instrument could not be started.

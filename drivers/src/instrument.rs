@@ -8,6 +8,8 @@
 use metamer_color::{Spectrum, XyY};
 use serde::{Deserialize, Serialize};
 
+pub use crate::mode::{CalibrationCondition, MeasureMode};
+
 /// Who the instrument is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InstrumentInfo {
@@ -107,52 +109,6 @@ pub struct Request {
     pub mode: MeasureMode,
 }
 
-/// Kind of measurement.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MeasureMode {
-    /// A light source seen by the instrument: absolute XYZ in cd/m².
-    #[default]
-    Emissive,
-    /// A surface lit by the instrument's lamp: relative XYZ (Y = 100 for white).
-    Reflective,
-    /// The light falling on the instrument through a diffuser: illuminance XYZ in lux.
-    Ambient,
-}
-
-impl MeasureMode {
-    pub const ALL: [MeasureMode; 3] = [
-        MeasureMode::Emissive,
-        MeasureMode::Reflective,
-        MeasureMode::Ambient,
-    ];
-
-    /// The stable short name used in JSON, logs and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            MeasureMode::Emissive => "emissive",
-            MeasureMode::Reflective => "reflective",
-            MeasureMode::Ambient => "ambient",
-        }
-    }
-}
-
-impl std::fmt::Display for MeasureMode {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for MeasureMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        MeasureMode::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown mode '{s}' (known: emissive, reflective, ambient)"))
-    }
-}
-
 /// Conditions a reading is flagged with; the values may still be usable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -223,34 +179,6 @@ pub fn now_s() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Something the user must do before the instrument can calibrate or measure.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CalibrationCondition {
-    /// Put the instrument on its white reference tile.
-    OnWhiteTile,
-    /// Cover the sensor so no light reaches it (dark calibration).
-    SensorCapped,
-    /// Point the instrument at the target (e.g. the display), ready to measure.
-    OnTarget,
-    /// Anything else, in the instrument's own words.
-    Other(String),
-}
-
-impl CalibrationCondition {
-    /// What to tell the user.
-    pub fn prompt(&self) -> String {
-        match self {
-            CalibrationCondition::OnWhiteTile => {
-                "place the instrument on its white calibration tile".into()
-            }
-            CalibrationCondition::SensorCapped => "cap the sensor so no light reaches it".into(),
-            CalibrationCondition::OnTarget => "aim the instrument at the target".into(),
-            CalibrationCondition::Other(s) => s.clone(),
-        }
-    }
-}
-
 /// Outcome of [`Instrument::calibrate`].
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum CalibrationOutcome {
@@ -303,5 +231,35 @@ pub trait Instrument: Send {
     /// checks.
     fn option_values(&self) -> Vec<(String, String)> {
         Vec::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use metamer_color::Quantity;
+
+    #[test]
+    fn a_spectral_reading_carries_its_grid_and_quantity_in_json() {
+        let spectrum = Spectrum::from_grid(380.0, 10.0, vec![0.25, 0.5, 0.75])
+            .unwrap()
+            .with_quantity(Quantity::Radiance);
+        let reading = Reading {
+            spectrum: Some(spectrum),
+            timestamp_s: 0.0,
+            ..Reading::from_yxy(30.0, 0.3, 0.6, "i1pro")
+        };
+        let json = serde_json::to_value(&reading).unwrap();
+        assert_eq!(
+            json["spectrum"],
+            serde_json::json!({"start_nm": 380, "step_nm": 10, "values": [0.25, 0.5, 0.75],
+                               "quantity": "radiance"})
+        );
+        // X = 0.3·30/0.6 = 15, Z = 0.1·30/0.6 = 5.
+        for (got, want) in reading.xyz.iter().zip([15.0, 30.0, 5.0]) {
+            assert!((got - want).abs() < 1e-12, "{:?}", reading.xyz);
+        }
+        let back: Reading = serde_json::from_value(json).unwrap();
+        assert_eq!(back, reading);
     }
 }

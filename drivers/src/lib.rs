@@ -12,6 +12,7 @@ pub mod devices;
 mod error;
 pub mod instrument;
 pub mod link;
+mod mode;
 pub mod noise;
 mod open;
 mod permissions;

@@ -49,6 +49,9 @@ pub type OpenSim = fn(&SimSettings, &OpenOptions) -> Result<Box<dyn Instrument>,
 pub struct Real {
     /// What follows `PREFIX:` in a spec, as the user is told (`PORT`).
     pub address: &'static str,
+    /// False where the model can be found without it (the only one of its kind on USB), so
+    /// `PREFIX` alone opens it.
+    pub address_required: bool,
     pub open: OpenReal,
 }
 
@@ -79,6 +82,7 @@ pub const MODELS: &[Model] = &[
         spec_prefixes: &["cs100a"],
         real: Some(Real {
             address: "PORT",
+            address_required: true,
             open: crate::cs100a::open::real,
         }),
         replay: Some(crate::cs100a::open::replay),
@@ -184,13 +188,19 @@ pub fn replayable() -> Vec<&'static str> {
         .collect()
 }
 
-/// The real-hardware spec forms (`cs100a:PORT`), each model's first prefix.
+/// The real-hardware spec forms (`cs100a:PORT`, `i1pro[:SERIAL]` where the address may be
+/// left out), each with the model's first prefix.
 pub fn real_specs() -> Vec<String> {
     MODELS
         .iter()
         .filter_map(|m| {
             let real = m.real.as_ref()?;
-            Some(format!("{}:{}", m.spec_prefixes.first()?, real.address))
+            let prefix = m.spec_prefixes.first()?;
+            Some(if real.address_required {
+                format!("{prefix}:{}", real.address)
+            } else {
+                format!("{prefix}[:{}]", real.address)
+            })
         })
         .collect()
 }

@@ -17,7 +17,7 @@ use std::sync::Arc;
 use crate::instrument::Instrument;
 use crate::link::replay::Transcript;
 use crate::open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
-use crate::registry::{self, REPLAY_PREFIX, SIM_PREFIX};
+use crate::registry::{self, Model, REPLAY_PREFIX, SIM_PREFIX};
 use crate::world::World;
 use crate::DriverError;
 
@@ -40,18 +40,28 @@ pub fn open_instrument_with(
     spec: &str,
     options: &OpenOptions,
 ) -> Result<Box<dyn Instrument>, DriverError> {
+    open_in(registry::MODELS, spec, options)
+}
+
+/// Opens `spec` from the rows of `models` (the registry's, or a test's own).
+fn open_in(
+    models: &[Model],
+    spec: &str,
+    options: &OpenOptions,
+) -> Result<Box<dyn Instrument>, DriverError> {
     let unknown = || DriverError::UnknownSpec {
         spec: spec.to_string(),
         expected: registry::spec_forms(),
     };
-    let (kind, rest) = spec.split_once(':').ok_or_else(unknown)?;
+    let by_name = |name: &str| models.iter().find(|m| m.name == name);
+    // A bare prefix (`i1pro`) opens a model whose address may be left out.
+    let (kind, rest) = spec.split_once(':').unwrap_or((spec, ""));
     match kind {
         REPLAY_PREFIX if !rest.is_empty() => {
             let transcript = Transcript::load(Path::new(rest))?;
             let instrument = transcript.header.instrument.clone();
-            let open = registry::by_name(&instrument)
-                .and_then(|m| m.replay)
-                .ok_or_else(|| DriverError::Transcript {
+            let open = by_name(&instrument).and_then(|m| m.replay).ok_or_else(|| {
+                DriverError::Transcript {
                     file: rest.to_string(),
                     line: 1,
                     message: format!(
@@ -59,18 +69,21 @@ pub fn open_instrument_with(
                          (known: {})",
                         registry::replayable().join(", ")
                     ),
-                })?;
+                }
+            })?;
             open(transcript, options)
         }
         SIM_PREFIX => {
             let (model, query) = rest.split_once('?').unwrap_or((rest, ""));
-            let open = registry::by_name(model)
-                .and_then(|m| m.sim)
-                .ok_or_else(unknown)?;
+            let open = by_name(model).and_then(|m| m.sim).ok_or_else(unknown)?;
             open(&sim_settings(spec, query)?, options)
         }
-        prefix => match registry::by_prefix(prefix).and_then(|m| m.real) {
-            Some(real) if !rest.is_empty() => (real.open)(rest, options),
+        prefix => match models
+            .iter()
+            .find(|m| m.spec_prefixes.contains(&prefix))
+            .and_then(|m| m.real)
+        {
+            Some(real) if !rest.is_empty() || !real.address_required => (real.open)(rest, options),
             _ => Err(unknown()),
         },
     }
@@ -238,5 +251,44 @@ mod tests {
             "{:?}",
             r.xyy
         );
+    }
+
+    fn fake_open(address: &str, _: &OpenOptions) -> Result<Box<dyn Instrument>, DriverError> {
+        Err(DriverError::Simulation(format!("opened at '{address}'")))
+    }
+
+    /// A USB-like model whose address (a serial number) may be left out.
+    const FAKE: &[Model] = &[Model {
+        name: "fake",
+        title: "Fake",
+        usb: &[],
+        spec_prefixes: &["fake", "fk"],
+        real: Some(registry::Real {
+            address: "SERIAL",
+            address_required: false,
+            open: fake_open,
+        }),
+        replay: None,
+        sim: None,
+    }];
+
+    #[test]
+    fn a_row_is_opened_by_any_of_its_prefixes_with_or_without_its_optional_address() {
+        let opened = |spec: &str| {
+            open_in(FAKE, spec, &OpenOptions::default())
+                .err()
+                .unwrap()
+                .to_string()
+        };
+        assert_eq!(opened("fake"), "simulated instrument: opened at ''");
+        assert_eq!(opened("fake:"), "simulated instrument: opened at ''");
+        assert_eq!(opened("fk:A123"), "simulated instrument: opened at 'A123'");
+        // What the table does not offer is an unknown spec, never another row's opener.
+        for spec in ["sim:fake", "cs100a:/dev/ttyS0", "fak"] {
+            assert!(opened(spec).starts_with("unknown instrument"), "{spec}");
+        }
+        // The CS-100A's port is required.
+        let e = open_instrument("cs100a", None).err().unwrap().to_string();
+        assert!(e.starts_with("unknown instrument 'cs100a'"), "{e}");
     }
 }
