@@ -115,6 +115,10 @@ struct Spectrometer {
     dark_done: bool,
     valid: bool,
     used: usize,
+    /// Whether `calibration_needed` knows of an expiry a measurement found; if not, only
+    /// the measurement's error says what is needed.
+    reports_expiry: bool,
+    calibrated_once: bool,
 }
 
 impl Spectrometer {
@@ -124,6 +128,8 @@ impl Spectrometer {
             dark_done: false,
             valid: false,
             used: 0,
+            reports_expiry: true,
+            calibrated_once: false,
         }
     }
 }
@@ -157,6 +163,9 @@ impl Instrument for Spectrometer {
         &mut self,
         _: MeasureMode,
     ) -> Result<Option<CalibrationCondition>, DriverError> {
+        if !self.reports_expiry && self.calibrated_once {
+            return Ok(None);
+        }
         Ok(match (self.valid, self.dark_done) {
             (true, _) => None,
             (false, false) => Some(CalibrationCondition::SensorCapped),
@@ -169,12 +178,13 @@ impl Instrument for Spectrometer {
         condition: &CalibrationCondition,
     ) -> Result<CalibrationOutcome, DriverError> {
         match condition {
-            CalibrationCondition::SensorCapped => {
+            CalibrationCondition::SensorCapped if !self.valid => {
                 self.dark_done = true;
                 Ok(CalibrationOutcome::Needs(CalibrationCondition::OnWhiteTile))
             }
             CalibrationCondition::OnWhiteTile if self.dark_done => {
                 self.valid = true;
+                self.calibrated_once = true;
                 self.used = 0;
                 Ok(CalibrationOutcome::Done)
             }
@@ -291,11 +301,23 @@ fn open(path: &Path, plan: SessionPlan<Target>, resume: bool) -> Session<String,
 }
 
 /// Runs the plan on a fresh rig (instruments not calibrated, as after a restart).
-fn run(mut session: Session<String, Target>, answers: Vec<Answer>, options: &RunOptions) -> Ran {
+fn run(session: Session<String, Target>, answers: Vec<Answer>, options: &RunOptions) -> Ran {
+    run_with(session, answers, options, true)
+}
+
+fn run_with(
+    mut session: Session<String, Target>,
+    answers: Vec<Answer>,
+    options: &RunOptions,
+    reports_expiry: bool,
+) -> Ran {
     let world = Shared::default();
     let mut screen = FakeScreen(world.clone());
     let mut spot = SpotMeter(world.clone());
-    let mut spectro = Spectrometer::new(world.clone());
+    let mut spectro = Spectrometer {
+        reports_expiry,
+        ..Spectrometer::new(world.clone())
+    };
     let mut operator = TileOperator {
         script: ScriptedOperator::with_answers(answers),
         world,
@@ -376,6 +398,19 @@ fn calibrations_are_asked_for_when_due_and_everything_is_journalled() {
         tile(5),
     ];
     assert_eq!(ran.prompts, expected);
+
+    // An instrument whose calibration check does not know of the expiry: the condition
+    // its measurement error names is negotiated, with the same prompts.
+    let quiet = temp("quiet");
+    let ran_quiet = run_with(
+        open(&quiet, plan(TILES, Duration::ZERO), false),
+        vec![],
+        &RunOptions::default(),
+        false,
+    );
+    assert_eq!(ran_quiet.prompts, expected);
+    assert_eq!(entries(&ran_quiet.session), entries(&ran.session));
+    std::fs::remove_dir_all(quiet.parent().unwrap()).unwrap();
 
     let all = entries(&ran.session);
     assert_eq!(all.len(), 8);

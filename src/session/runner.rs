@@ -12,7 +12,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use metamer_drivers::{
-    CalibrationOutcome, DriverError, Instrument, InstrumentInfo, MeasureMode, Reading, Request,
+    CalibrationCondition, CalibrationOutcome, DriverError, Instrument, InstrumentInfo, MeasureMode,
+    Reading, Request,
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -476,15 +477,20 @@ where
             mode: self.step.mode,
         };
         let mut expired = 0;
+        // The condition a measurement asked for when its calibration had expired.
+        let mut asked = None;
         loop {
-            if !self.calibrate()? || !self.prepare()? {
+            if !self.calibrate(asked.take())? || !self.prepare()? {
                 return Ok(None);
             }
             std::thread::sleep(self.step.settle);
             match self.instrument()?.measure(&request) {
                 Ok(reading) => return Ok(Some(reading)),
-                Err(DriverError::NeedsCalibration { .. }) if expired < REMEASURE_ATTEMPTS => {
+                Err(DriverError::NeedsCalibration { condition, .. })
+                    if expired < REMEASURE_ATTEMPTS =>
+                {
                     expired += 1;
+                    asked = Some(condition);
                 }
                 Err(DriverError::NeedsCalibration { .. }) => {
                     return Err(StepFailure::Expiring {
@@ -505,11 +511,11 @@ where
             .ok_or_else(|| StepFailure::NoInstrument(role.clone()))
     }
 
-    /// Negotiates the calibration the step's instrument asks for, if any; false when the
-    /// operator aborted.
-    fn calibrate(&mut self) -> Result<bool, StepFailure> {
+    /// Negotiates the calibration the step's instrument asks for, if any, or else the one
+    /// a failed measurement `asked` for; false when the operator aborted.
+    fn calibrate(&mut self, asked: Option<CalibrationCondition>) -> Result<bool, StepFailure> {
         let (role, mode) = (self.step.role.clone(), self.step.mode);
-        let Some(mut condition) = self.instrument()?.calibration_needed(mode)? else {
+        let Some(mut condition) = self.instrument()?.calibration_needed(mode)?.or(asked) else {
             return Ok(true);
         };
         for _ in 0..CALIBRATION_ATTEMPTS {
