@@ -344,6 +344,7 @@ where
                 total,
                 index,
                 label: &step.label,
+                mode: step.mode,
                 reading: &entry.reading,
                 elapsed,
                 remaining: elapsed.mul_f64((total - done) as f64 / new as f64),
