@@ -373,6 +373,23 @@ fn a_changed_option_is_refused_by_name_and_the_journal_left_alone() {
         "{text}"
     );
     assert!(!text.contains("--"), "library errors name no flags: {text}");
+    // Another instrument model in a role: refused, naming the role and both models.
+    let mut swapped = instruments();
+    swapped.get_mut("spot").unwrap().info.model = "other-spot".into();
+    let e = Session::<String, Target>::open(
+        &path,
+        plan(TILES, Duration::ZERO),
+        "a test rig".into(),
+        swapped,
+        true,
+    )
+    .err()
+    .unwrap();
+    assert!(
+        e.to_string()
+            .contains("was written with spot instrument fake-spot, this session has other-spot"),
+        "{e}"
+    );
     // Starting anew where a journal is: refused, saying how many entries it holds.
     let e = Session::<String, Target>::open(
         &path,
