@@ -1,6 +1,7 @@
 //! One engine for every guided measurement session (display characterization, reading the
-//! validation box): a plan of steps ([`plan`]), a durable resumable journal ([`journal`]),
-//! and a runner that prepares, calibrates, measures and journals each step ([`runner`]),
+//! validation box): a plan of steps ([`plan`]), a durable resumable journal ([`journal`]) of
+//! what was measured ([`record`]), and a runner that takes each step the journal lacks
+//! ([`runner`]; calibrate, prepare, settle, measure: [`step`]),
 //! with the operator ([`operator`]), the screen ([`screen`]), progress ([`progress`]) and
 //! Ctrl-C ([`interrupt`]) as small parts a caller supplies or picks.
 
@@ -9,16 +10,17 @@ pub mod journal;
 pub mod operator;
 pub mod plan;
 pub mod progress;
+pub mod record;
 pub mod runner;
 pub mod screen;
+pub mod step;
 
 pub use interrupt::on_ctrl_c;
 pub use journal::{refuse_existing, torn_path, CalibrationRecord, Header, Journal, JournalError};
 pub use operator::{Answer, Operator, OperatorError, ScriptedOperator, TerminalOperator};
 pub use plan::{Prepare, SessionPlan, Step};
 pub use progress::{BarProgress, NoProgress, ProgressSink, StepProgress};
-pub use runner::{
-    Entry, InstrumentRecord, Rig, RunEnd, RunOptions, Session, SessionError, SessionHeader,
-    StepFailure,
-};
+pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
+pub use runner::{RunEnd, RunOptions, Session, SessionError};
 pub use screen::{DisplayScreen, Screen};
+pub use step::{Rig, StepFailure};

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use metamer_drivers::Reading;
+use metamer_drivers::{MeasureMode, Reading};
 
 /// One step as it is done.
 #[derive(Clone, Copy, Debug)]
@@ -14,6 +14,7 @@ pub struct StepProgress<'a> {
     /// The step's plan index.
     pub index: usize,
     pub label: &'a str,
+    pub mode: MeasureMode,
     pub reading: &'a Reading,
     /// Since this run (not the first run of a resumed session) started.
     pub elapsed: Duration,

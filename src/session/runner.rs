@@ -1,9 +1,6 @@
-//! Taking a plan's steps: for each step the journal lacks, in plan order, calibrate the
-//! step's instrument if it says it must, prepare the rig, let it settle, measure (and on an
-//! expired calibration negotiate and measure again), append the entry, report progress.
-//!
-//! Calibration comes before preparation: a calibration has the operator move the
-//! instrument (onto its white tile, under a cap), so the step's own setup must follow it.
+//! Taking a plan's steps: for each step the journal lacks, in plan order, take it (calibrate
+//! if due, prepare, settle, measure: [`super::step`]), append the entry, report progress;
+//! stop before the next step on an interrupt.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -11,97 +8,16 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use metamer_drivers::{
-    CalibrationOutcome, DriverError, Instrument, InstrumentInfo, MeasureMode, Reading, Request,
-};
 use serde::de::DeserializeOwned;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::journal::{
     CalibrationRecord, Header, Journal, JournalError, JOURNAL_FORMAT, JOURNAL_VERSION,
 };
-use super::operator::{Answer, Operator, OperatorError};
-use super::plan::{Prepare, SessionPlan, Step};
+use super::plan::{Prepare, SessionPlan};
 use super::progress::{ProgressSink, StepProgress};
-use super::screen::Screen;
-
-/// Calibration conditions asked for in one negotiation before giving up: instruments ask
-/// for a few in a row (dark, then white tile); more means the operator's action did not
-/// satisfy the instrument.
-pub const CALIBRATION_ATTEMPTS: usize = 5;
-/// Times a step is measured again after its calibration expired during the measurement.
-pub const REMEASURE_ATTEMPTS: usize = 2;
-
-/// One measured step as journalled.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Entry<D> {
-    /// The step's plan index.
-    pub index: usize,
-    pub label: String,
-    pub role: String,
-    pub mode: MeasureMode,
-    pub data: D,
-    pub reading: Reading,
-}
-
-/// The header's caller part the engine adds to: the instruments by role.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SessionHeader<H> {
-    /// Every instrument of the rig by role, with its model-specific settings in force.
-    pub instruments: BTreeMap<String, InstrumentRecord>,
-    /// The caller's part.
-    pub details: H,
-}
-
-/// An instrument as the journal records it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct InstrumentRecord {
-    pub info: InstrumentInfo,
-    /// Model-specific settings in force, name → value.
-    pub options: BTreeMap<String, String>,
-}
-
-impl InstrumentRecord {
-    pub fn of(instrument: &dyn Instrument) -> InstrumentRecord {
-        InstrumentRecord {
-            info: instrument.info(),
-            options: instrument.option_values().into_iter().collect(),
-        }
-    }
-}
-
-/// The journal type of a session with header data `H` and step data `D`.
-pub type SessionJournal<H, D> = Journal<SessionHeader<H>, Entry<D>>;
-
-/// A step could not be taken.
-#[derive(Debug, thiserror::Error)]
-pub enum StepFailure {
-    #[error("showing it: {0}")]
-    Screen(#[source] Box<dyn std::error::Error + Send + Sync>),
-    #[error("the plan shows drive values but the rig has no screen")]
-    NoScreen,
-    #[error("the plan names instrument role '{0}' but the rig has no instrument in it")]
-    NoInstrument(String),
-    #[error(transparent)]
-    Operator(#[from] OperatorError),
-    #[error(transparent)]
-    Instrument(#[from] DriverError),
-    #[error("the {role} instrument still asks for {mode} calibration after {attempts} attempts: the last request was to {prompt}")]
-    Calibration {
-        role: String,
-        mode: MeasureMode,
-        attempts: usize,
-        prompt: String,
-    },
-    #[error("the {role} instrument's {mode} calibration expired again right after calibrating, {attempts} times")]
-    Expiring {
-        role: String,
-        mode: MeasureMode,
-        attempts: usize,
-    },
-    #[error(transparent)]
-    Journal(#[from] JournalError),
-}
+use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
+use super::step::{Rig, StepFailure, StepTaker};
 
 /// The session could not start or go on.
 #[derive(Debug, thiserror::Error)]
@@ -168,23 +84,6 @@ pub enum RunEnd {
     Interrupted { missing: usize },
     /// The operator declined a request, with this many steps still missing.
     Aborted { missing: usize },
-}
-
-/// What the session runs on: a screen where steps show drive values, the instruments by
-/// role, and the operator.
-pub struct Rig<'a> {
-    pub screen: Option<&'a mut dyn Screen>,
-    pub instruments: Vec<(String, &'a mut dyn Instrument)>,
-    pub operator: &'a mut dyn Operator,
-}
-
-impl<'a> Rig<'a> {
-    fn instrument(&mut self, role: &str) -> Option<&mut (dyn Instrument + 'a)> {
-        self.instruments
-            .iter_mut()
-            .find(|(r, _)| r == role)
-            .map(|(_, i)| &mut **i)
-    }
 }
 
 /// A session bound to its journal.
@@ -445,6 +344,7 @@ where
                 total,
                 index,
                 label: &step.label,
+                mode: step.mode,
                 reading: &entry.reading,
                 elapsed,
                 remaining: elapsed.mul_f64((total - done) as f64 / new as f64),
@@ -452,121 +352,5 @@ where
             self.entries[index] = Some(entry);
         }
         Ok(RunEnd::Complete)
-    }
-}
-
-/// One step being taken, with what it needs borrowed from the session.
-struct StepTaker<'s, 'r, 'a, H, D> {
-    index: usize,
-    step: &'s Step<D>,
-    rig: &'r mut Rig<'a>,
-    journal: &'s mut SessionJournal<H, D>,
-    calibrations: &'s mut Vec<CalibrationRecord>,
-    progress: &'s mut dyn ProgressSink,
-}
-
-impl<'a, H, D> StepTaker<'_, '_, 'a, H, D>
-where
-    H: Serialize + DeserializeOwned,
-    D: Serialize + DeserializeOwned,
-{
-    /// The step's reading, or None when the operator aborted.
-    fn take(&mut self) -> Result<Option<Reading>, StepFailure> {
-        let request = Request {
-            mode: self.step.mode,
-        };
-        let mut expired = 0;
-        loop {
-            if !self.calibrate()? || !self.prepare()? {
-                return Ok(None);
-            }
-            std::thread::sleep(self.step.settle);
-            match self.instrument()?.measure(&request) {
-                Ok(reading) => return Ok(Some(reading)),
-                Err(DriverError::NeedsCalibration { .. }) if expired < REMEASURE_ATTEMPTS => {
-                    expired += 1;
-                }
-                Err(DriverError::NeedsCalibration { .. }) => {
-                    return Err(StepFailure::Expiring {
-                        role: self.step.role.clone(),
-                        mode: self.step.mode,
-                        attempts: expired + 1,
-                    })
-                }
-                Err(e) => return Err(e.into()),
-            }
-        }
-    }
-
-    fn instrument(&mut self) -> Result<&mut (dyn Instrument + 'a), StepFailure> {
-        let role = &self.step.role;
-        self.rig
-            .instrument(role)
-            .ok_or_else(|| StepFailure::NoInstrument(role.clone()))
-    }
-
-    /// Negotiates the calibration the step's instrument asks for, if any; false when the
-    /// operator aborted.
-    fn calibrate(&mut self) -> Result<bool, StepFailure> {
-        let (role, mode) = (self.step.role.clone(), self.step.mode);
-        let Some(mut condition) = self.instrument()?.calibration_needed(mode)? else {
-            return Ok(true);
-        };
-        for _ in 0..CALIBRATION_ATTEMPTS {
-            let model = self.instrument()?.info().model;
-            let prompt = format!(
-                "{role} instrument ({model}), {mode} calibration: {}",
-                condition.prompt()
-            );
-            if self.ask(&prompt)? == Answer::Abort {
-                return Ok(false);
-            }
-            let outcome = self.instrument()?.calibrate(mode, &condition)?;
-            let record = CalibrationRecord {
-                role: role.clone(),
-                instrument: model,
-                mode,
-                condition: condition.clone(),
-                before_step: self.index,
-                time_s: metamer_drivers::instrument::now_s(),
-            };
-            self.journal.append_calibration(&record)?;
-            self.progress.note(&format!(
-                "calibrated the {role} instrument for {mode}: {}",
-                condition.prompt()
-            ));
-            self.calibrations.push(record);
-            match outcome {
-                CalibrationOutcome::Done => return Ok(true),
-                CalibrationOutcome::Needs(next) => condition = next,
-            }
-        }
-        Err(StepFailure::Calibration {
-            role,
-            mode,
-            attempts: CALIBRATION_ATTEMPTS,
-            prompt: condition.prompt(),
-        })
-    }
-
-    /// Asks the operator with the progress display out of the way.
-    fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
-        let operator = &mut *self.rig.operator;
-        let mut answer = Ok(Answer::Abort);
-        self.progress.suspend(&mut || answer = operator.ask(prompt));
-        answer
-    }
-
-    /// Sets the rig up for the step; false when the operator aborted.
-    fn prepare(&mut self) -> Result<bool, StepFailure> {
-        match &self.step.prepare {
-            Prepare::Show { rgb } => {
-                let screen = self.rig.screen.as_mut().ok_or(StepFailure::NoScreen)?;
-                screen.show(*rgb).map_err(StepFailure::Screen)?;
-                Ok(true)
-            }
-            Prepare::Operator { prompt } => Ok(self.ask(prompt)? == Answer::Confirmed),
-            Prepare::None => Ok(true),
-        }
     }
 }

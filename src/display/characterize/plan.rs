@@ -1,4 +1,4 @@
-//! What a characterization measures (issue 5 item 5): black, the full-on primaries and
+//! What a characterization measures: black, the full-on primaries and
 //! white, per-channel and grey ramps for the fit, optionally an N×N×N grid of the drive
 //! cube (for models without PLCC's assumptions, such as a 3D LUT), and a fixed set of
 //! verification patches

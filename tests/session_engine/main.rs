@@ -8,213 +8,23 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use metamer::session::{
-    Answer, Entry, InstrumentRecord, Operator, OperatorError, Prepare, Rig, RunEnd, RunOptions,
-    Screen, ScriptedOperator, Session, SessionError, SessionPlan, Step, StepProgress,
+    Answer, Entry, InstrumentRecord, Prepare, Rig, RunEnd, RunOptions, ScriptedOperator, Session,
+    SessionError, SessionPlan, Step, StepProgress,
 };
-use metamer_drivers::{
-    CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, DriverError,
-    Instrument, InstrumentInfo, MeasureMode, ModeInfo, Reading, Request,
-};
+use metamer_drivers::{CalibrationCondition, Instrument, MeasureMode};
 use serde::{Deserialize, Serialize};
 
-/// Measurements a spectrometer calibration lasts.
-const VALID_FOR: usize = 2;
+mod rig;
+
+use rig::{FakeScreen, Shared, Spectrometer, SpotMeter, TileOperator, VALID_FOR};
+
 /// Tiles the spectrometer reads.
 const TILES: usize = 5;
 /// Set in the child process that is killed mid-run: the journal's path.
 const CHILD_ENV: &str = "METAMER_SESSION_ENGINE_CHILD";
-
-/// What the rig looks at: the screen's drive values and the tile under the spectrometer.
-#[derive(Default)]
-struct World {
-    rgb: [u8; 3],
-    tile: usize,
-}
-
-type Shared = Arc<Mutex<World>>;
-
-struct FakeScreen(Shared);
-
-impl Screen for FakeScreen {
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-        self.0.lock().unwrap().rgb = rgb;
-        Ok(())
-    }
-}
-
-fn info(model: &str) -> InstrumentInfo {
-    InstrumentInfo {
-        model: model.into(),
-        serial: None,
-        firmware: None,
-        connection: "test".into(),
-    }
-}
-
-/// Reads the screen: XYZ = drive values × 0.5 cd/m², no calibration.
-struct SpotMeter(Shared);
-
-impl Instrument for SpotMeter {
-    fn info(&self) -> InstrumentInfo {
-        info("fake-spot")
-    }
-    fn capabilities(&self) -> Capabilities {
-        Capabilities {
-            modes: vec![ModeInfo {
-                mode: MeasureMode::Emissive,
-                spot: true,
-                calibrations: vec![],
-            }],
-            spectral: false,
-            acceptance_angle_deg: Some(1.0),
-            luminance_range_cd_m2: None,
-            options: vec![],
-        }
-    }
-    fn calibration_needed(
-        &mut self,
-        _: MeasureMode,
-    ) -> Result<Option<CalibrationCondition>, DriverError> {
-        Ok(None)
-    }
-    fn calibrate(
-        &mut self,
-        _: MeasureMode,
-        _: &CalibrationCondition,
-    ) -> Result<CalibrationOutcome, DriverError> {
-        Ok(CalibrationOutcome::Done)
-    }
-    fn measure(&mut self, _: &Request) -> Result<Reading, DriverError> {
-        let rgb = self.0.lock().unwrap().rgb;
-        Ok(fixed(rgb.map(|c| f64::from(c) * 0.5), "fake-spot"))
-    }
-}
-
-/// A reading with a fixed timestamp, so two runs' readings compare equal.
-fn fixed(xyz: [f64; 3], instrument: &str) -> Reading {
-    Reading {
-        timestamp_s: 0.0,
-        ..Reading::from_yxy(
-            xyz[1],
-            xyz[0] / xyz.iter().sum::<f64>(),
-            xyz[1] / xyz.iter().sum::<f64>(),
-            instrument,
-        )
-    }
-}
-
-/// Reflective readings of the tile it is on; needs a dark then a white calibration, which
-/// lasts [`VALID_FOR`] measurements. Like a calibration that expires by time, the expiry is
-/// found only when measuring.
-struct Spectrometer {
-    world: Shared,
-    dark_done: bool,
-    valid: bool,
-    used: usize,
-}
-
-impl Spectrometer {
-    fn new(world: Shared) -> Spectrometer {
-        Spectrometer {
-            world,
-            dark_done: false,
-            valid: false,
-            used: 0,
-        }
-    }
-}
-
-impl Instrument for Spectrometer {
-    fn info(&self) -> InstrumentInfo {
-        info("fake-spectro")
-    }
-    fn capabilities(&self) -> Capabilities {
-        let need = |name: &str, condition| CalibrationNeed {
-            name: name.into(),
-            condition,
-            valid_for_s: Some(1.0),
-        };
-        Capabilities {
-            modes: vec![ModeInfo {
-                mode: MeasureMode::Reflective,
-                spot: false,
-                calibrations: vec![
-                    need("dark", CalibrationCondition::SensorCapped),
-                    need("white", CalibrationCondition::OnWhiteTile),
-                ],
-            }],
-            spectral: true,
-            acceptance_angle_deg: None,
-            luminance_range_cd_m2: None,
-            options: vec![],
-        }
-    }
-    fn calibration_needed(
-        &mut self,
-        _: MeasureMode,
-    ) -> Result<Option<CalibrationCondition>, DriverError> {
-        Ok(match (self.valid, self.dark_done) {
-            (true, _) => None,
-            (false, false) => Some(CalibrationCondition::SensorCapped),
-            (false, true) => Some(CalibrationCondition::OnWhiteTile),
-        })
-    }
-    fn calibrate(
-        &mut self,
-        mode: MeasureMode,
-        condition: &CalibrationCondition,
-    ) -> Result<CalibrationOutcome, DriverError> {
-        match condition {
-            CalibrationCondition::SensorCapped => {
-                self.dark_done = true;
-                Ok(CalibrationOutcome::Needs(CalibrationCondition::OnWhiteTile))
-            }
-            CalibrationCondition::OnWhiteTile if self.dark_done => {
-                self.valid = true;
-                self.used = 0;
-                Ok(CalibrationOutcome::Done)
-            }
-            other => Err(DriverError::Unsupported {
-                instrument: "fake-spectro".into(),
-                what: format!("{mode} calibration on {other:?} before the dark calibration"),
-            }),
-        }
-    }
-    fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
-        if !self.valid || self.used >= VALID_FOR {
-            self.valid = false;
-            self.dark_done = false;
-            return Err(DriverError::NeedsCalibration {
-                instrument: "fake-spectro".into(),
-                mode: request.mode,
-                condition: CalibrationCondition::SensorCapped,
-                reason: "the calibration expired".into(),
-            });
-        }
-        self.used += 1;
-        let t = self.world.lock().unwrap().tile as f64;
-        Ok(fixed([10.0 * t, 11.0 * t, 12.0 * t], "fake-spectro"))
-    }
-}
-
-/// A scripted operator who also does what the tile prompts ask.
-struct TileOperator {
-    script: ScriptedOperator,
-    world: Shared,
-}
-
-impl Operator for TileOperator {
-    fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
-        if let Some(tile) = prompt.strip_prefix("place the spectrometer on tile ") {
-            self.world.lock().unwrap().tile = tile.parse().unwrap();
-        }
-        self.script.ask(prompt)
-    }
-}
 
 /// The caller's data of a step.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -291,11 +101,23 @@ fn open(path: &Path, plan: SessionPlan<Target>, resume: bool) -> Session<String,
 }
 
 /// Runs the plan on a fresh rig (instruments not calibrated, as after a restart).
-fn run(mut session: Session<String, Target>, answers: Vec<Answer>, options: &RunOptions) -> Ran {
+fn run(session: Session<String, Target>, answers: Vec<Answer>, options: &RunOptions) -> Ran {
+    run_with(session, answers, options, true)
+}
+
+fn run_with(
+    mut session: Session<String, Target>,
+    answers: Vec<Answer>,
+    options: &RunOptions,
+    reports_expiry: bool,
+) -> Ran {
     let world = Shared::default();
     let mut screen = FakeScreen(world.clone());
     let mut spot = SpotMeter(world.clone());
-    let mut spectro = Spectrometer::new(world.clone());
+    let mut spectro = Spectrometer {
+        reports_expiry,
+        ..Spectrometer::new(world.clone())
+    };
     let mut operator = TileOperator {
         script: ScriptedOperator::with_answers(answers),
         world,
@@ -376,6 +198,19 @@ fn calibrations_are_asked_for_when_due_and_everything_is_journalled() {
         tile(5),
     ];
     assert_eq!(ran.prompts, expected);
+
+    // An instrument whose calibration check does not know of the expiry: the condition
+    // its measurement error names is negotiated, with the same prompts.
+    let quiet = temp("quiet");
+    let ran_quiet = run_with(
+        open(&quiet, plan(TILES, Duration::ZERO), false),
+        vec![],
+        &RunOptions::default(),
+        false,
+    );
+    assert_eq!(ran_quiet.prompts, expected);
+    assert_eq!(entries(&ran_quiet.session), entries(&ran.session));
+    std::fs::remove_dir_all(quiet.parent().unwrap()).unwrap();
 
     let all = entries(&ran.session);
     assert_eq!(all.len(), 8);
@@ -538,6 +373,23 @@ fn a_changed_option_is_refused_by_name_and_the_journal_left_alone() {
         "{text}"
     );
     assert!(!text.contains("--"), "library errors name no flags: {text}");
+    // Another instrument model in a role: refused, naming the role and both models.
+    let mut swapped = instruments();
+    swapped.get_mut("spot").unwrap().info.model = "other-spot".into();
+    let e = Session::<String, Target>::open(
+        &path,
+        plan(TILES, Duration::ZERO),
+        "a test rig".into(),
+        swapped,
+        true,
+    )
+    .err()
+    .unwrap();
+    assert!(
+        e.to_string()
+            .contains("was written with spot instrument fake-spot, this session has other-spot"),
+        "{e}"
+    );
     // Starting anew where a journal is: refused, saying how many entries it holds.
     let e = Session::<String, Target>::open(
         &path,

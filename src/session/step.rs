@@ -1,0 +1,194 @@
+//! Taking one step: negotiate the calibration its instrument asks for, prepare the rig,
+//! settle, measure, and on an expired calibration negotiate and measure again (bounded).
+//!
+//! Calibration comes before preparation: a calibration has the operator move the
+//! instrument (onto its white tile, under a cap), so the step's own setup must follow it.
+
+use metamer_drivers::{
+    CalibrationCondition, CalibrationOutcome, DriverError, Instrument, MeasureMode, Reading,
+    Request,
+};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+use super::journal::{CalibrationRecord, JournalError};
+use super::operator::{Answer, Operator, OperatorError};
+use super::plan::{Prepare, Step};
+use super::progress::ProgressSink;
+use super::record::SessionJournal;
+use super::screen::Screen;
+
+/// What the session runs on: a screen where steps show drive values, the instruments by
+/// role, and the operator.
+pub struct Rig<'a> {
+    pub screen: Option<&'a mut dyn Screen>,
+    pub instruments: Vec<(String, &'a mut dyn Instrument)>,
+    pub operator: &'a mut dyn Operator,
+}
+
+impl<'a> Rig<'a> {
+    pub(super) fn instrument(&mut self, role: &str) -> Option<&mut (dyn Instrument + 'a)> {
+        self.instruments
+            .iter_mut()
+            .find(|(r, _)| r == role)
+            .map(|(_, i)| &mut **i)
+    }
+}
+
+/// Calibration conditions asked for in one negotiation before giving up: instruments ask
+/// for a few in a row (dark, then white tile); more means the operator's action did not
+/// satisfy the instrument.
+pub const CALIBRATION_ATTEMPTS: usize = 5;
+/// Times a step is measured again after its calibration expired during the measurement.
+pub const REMEASURE_ATTEMPTS: usize = 2;
+
+/// A step could not be taken.
+#[derive(Debug, thiserror::Error)]
+pub enum StepFailure {
+    #[error("showing it: {0}")]
+    Screen(#[source] Box<dyn std::error::Error + Send + Sync>),
+    #[error("the plan shows drive values but the rig has no screen")]
+    NoScreen,
+    #[error("the plan names instrument role '{0}' but the rig has no instrument in it")]
+    NoInstrument(String),
+    #[error(transparent)]
+    Operator(#[from] OperatorError),
+    #[error(transparent)]
+    Instrument(#[from] DriverError),
+    #[error("the {role} instrument still asks for {mode} calibration after {attempts} attempts: the last request was to {prompt}")]
+    Calibration {
+        role: String,
+        mode: MeasureMode,
+        attempts: usize,
+        prompt: String,
+    },
+    #[error("the {role} instrument's {mode} calibration expired again right after calibrating, {attempts} times")]
+    Expiring {
+        role: String,
+        mode: MeasureMode,
+        attempts: usize,
+    },
+    #[error(transparent)]
+    Journal(#[from] JournalError),
+}
+
+/// One step being taken, with what it needs borrowed from the session.
+pub(super) struct StepTaker<'s, 'r, 'a, H, D> {
+    pub(super) index: usize,
+    pub(super) step: &'s Step<D>,
+    pub(super) rig: &'r mut Rig<'a>,
+    pub(super) journal: &'s mut SessionJournal<H, D>,
+    pub(super) calibrations: &'s mut Vec<CalibrationRecord>,
+    pub(super) progress: &'s mut dyn ProgressSink,
+}
+
+impl<'a, H, D> StepTaker<'_, '_, 'a, H, D>
+where
+    H: Serialize + DeserializeOwned,
+    D: Serialize + DeserializeOwned,
+{
+    /// The step's reading, or None when the operator aborted.
+    pub(super) fn take(&mut self) -> Result<Option<Reading>, StepFailure> {
+        let request = Request {
+            mode: self.step.mode,
+        };
+        let mut expired = 0;
+        // The condition a measurement asked for when its calibration had expired.
+        let mut asked = None;
+        loop {
+            if !self.calibrate(asked.take())? || !self.prepare()? {
+                return Ok(None);
+            }
+            std::thread::sleep(self.step.settle);
+            match self.instrument()?.measure(&request) {
+                Ok(reading) => return Ok(Some(reading)),
+                Err(DriverError::NeedsCalibration { condition, .. })
+                    if expired < REMEASURE_ATTEMPTS =>
+                {
+                    expired += 1;
+                    asked = Some(condition);
+                }
+                Err(DriverError::NeedsCalibration { .. }) => {
+                    return Err(StepFailure::Expiring {
+                        role: self.step.role.clone(),
+                        mode: self.step.mode,
+                        attempts: expired + 1,
+                    })
+                }
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+
+    fn instrument(&mut self) -> Result<&mut (dyn Instrument + 'a), StepFailure> {
+        let role = &self.step.role;
+        self.rig
+            .instrument(role)
+            .ok_or_else(|| StepFailure::NoInstrument(role.clone()))
+    }
+
+    /// Negotiates the calibration the step's instrument asks for, if any, or else the one
+    /// a failed measurement `asked` for; false when the operator aborted.
+    fn calibrate(&mut self, asked: Option<CalibrationCondition>) -> Result<bool, StepFailure> {
+        let (role, mode) = (self.step.role.clone(), self.step.mode);
+        let Some(mut condition) = self.instrument()?.calibration_needed(mode)?.or(asked) else {
+            return Ok(true);
+        };
+        for _ in 0..CALIBRATION_ATTEMPTS {
+            let model = self.instrument()?.info().model;
+            let prompt = format!(
+                "{role} instrument ({model}), {mode} calibration: {}",
+                condition.prompt()
+            );
+            if self.ask(&prompt)? == Answer::Abort {
+                return Ok(false);
+            }
+            let outcome = self.instrument()?.calibrate(mode, &condition)?;
+            let record = CalibrationRecord {
+                role: role.clone(),
+                instrument: model,
+                mode,
+                condition: condition.clone(),
+                before_step: self.index,
+                time_s: metamer_drivers::instrument::now_s(),
+            };
+            self.journal.append_calibration(&record)?;
+            self.progress.note(&format!(
+                "calibrated the {role} instrument for {mode}: {}",
+                condition.prompt()
+            ));
+            self.calibrations.push(record);
+            match outcome {
+                CalibrationOutcome::Done => return Ok(true),
+                CalibrationOutcome::Needs(next) => condition = next,
+            }
+        }
+        Err(StepFailure::Calibration {
+            role,
+            mode,
+            attempts: CALIBRATION_ATTEMPTS,
+            prompt: condition.prompt(),
+        })
+    }
+
+    /// Asks the operator with the progress display out of the way.
+    fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
+        let operator = &mut *self.rig.operator;
+        let mut answer = Ok(Answer::Abort);
+        self.progress.suspend(&mut || answer = operator.ask(prompt));
+        answer
+    }
+
+    /// Sets the rig up for the step; false when the operator aborted.
+    fn prepare(&mut self) -> Result<bool, StepFailure> {
+        match &self.step.prepare {
+            Prepare::Show { rgb } => {
+                let screen = self.rig.screen.as_mut().ok_or(StepFailure::NoScreen)?;
+                screen.show(*rgb).map_err(StepFailure::Screen)?;
+                Ok(true)
+            }
+            Prepare::Operator { prompt } => Ok(self.ask(prompt)? == Answer::Confirmed),
+            Prepare::None => Ok(true),
+        }
+    }
+}
