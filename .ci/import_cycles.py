@@ -22,13 +22,7 @@ import sys
 # Import edges known and owned by someone else, as unordered pairs of paths from the
 # repository root; both directions between the two files are ignored. Each entry is a debt:
 # delete it once the cycle is gone (the script says when an entry has become stale).
-ALLOWED = {
-    # The driver registry and the driver error name each other; the drivers' owner fixes it.
-    frozenset({"drivers/src/devices.rs", "drivers/src/error.rs"}),
-    # The Instrument trait returns DriverError, whose variants carry the trait's mode and
-    # calibration types; the drivers' owner fixes it with the pair above.
-    frozenset({"drivers/src/error.rs", "drivers/src/instrument.rs"}),
-}
+ALLOWED: set = set()
 
 
 
