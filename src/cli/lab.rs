@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
-use metamer::lab::{run_lab, LabOptions, LabProgress, LabResult, DISPLAY_DIR};
+use metamer::lab::{run_lab, LabError, LabOptions, LabProgress, LabResult, DISPLAY_DIR};
 use metamer::rig::Preset;
 
 use super::{CliError, CliResult};
@@ -91,7 +91,24 @@ pub fn run(args: Args) -> CliResult {
         }
     });
     bar.finish_and_clear();
-    let result = result?;
+    let result = result.map_err(|e| match e {
+        // The library says what to do; here that is a flag.
+        LabError::Exists { dir } => CliError::Failed(
+            format!(
+                "{} holds an earlier lab run; choose another directory or add --resume",
+                dir.display()
+            )
+            .into(),
+        ),
+        LabError::Incomplete { missing } => CliError::Failed(
+            format!(
+                "the display characterization stopped with {missing} readings missing; run \
+                 the same command with --resume"
+            )
+            .into(),
+        ),
+        e => CliError::from(e),
+    })?;
     let written = result.write(&args.out)?;
     print_summary(&result);
     println!(

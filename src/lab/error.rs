@@ -31,11 +31,11 @@ pub enum LabError {
     Profile(#[from] ProfileError),
     #[error(transparent)]
     Validation(#[from] ValidationError),
-    #[error("the display characterization stopped with {missing} readings missing; run again with --resume")]
+    #[error("the display characterization stopped with {missing} readings missing; resume the lab run to take them")]
     Incomplete { missing: usize },
     #[error("the lab needs a simulated display that a simulated meter can see")]
     NotSimulated,
-    #[error("{} holds an earlier lab run; choose another directory or add --resume", dir.display())]
+    #[error("{} holds an earlier lab run; choose another directory or resume that run", dir.display())]
     Exists { dir: PathBuf },
     #[error("writing {}: {source}", file.display())]
     Write {

@@ -195,7 +195,13 @@ pub struct VirtualPanel {
 
 /// XYZ of chromaticity (x, y) at luminance `lum`.
 fn xyy_to_xyz(x: f64, y: f64, lum: f64) -> [f64; 3] {
-    [x / y * lum, lum, (1.0 - x - y) / y * lum]
+    crate::color::XyY {
+        x,
+        y,
+        luminance: lum,
+    }
+    .to_xyz()
+    .to_array()
 }
 
 impl VirtualPanel {

@@ -24,9 +24,9 @@ use crate::link::{LineSettings, LinkError, SerialLink};
 use crate::noise::SplitMix64;
 use crate::world::World;
 
-/// Upper end of the display range, cd/m² (fact sheet §5, unconfirmed).
+/// Upper end of the display range, cd/m² (protocols/cs100a/README.md, "Measurement facts": unconfirmed).
 pub const MAX_LUMINANCE: f64 = 299_000.0;
-/// Below this the meter flags low light, cd/m² (fact sheet §5, unconfirmed).
+/// Below this the meter flags low light, cd/m² (protocols/cs100a/README.md, "Measurement facts": unconfirmed).
 pub const MIN_LUMINANCE: f64 = 0.01;
 /// Relative 1σ noise of Y: half the ±0.2 % repeatability.
 pub const SIGMA_Y_REL: f64 = 0.001;

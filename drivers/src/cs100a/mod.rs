@@ -1,6 +1,6 @@
 //! Konica Minolta CS-100A chroma meter driver, generic over its serial link, so the real
-//! port, a replayed transcript and the emulator run the same code. Facts: fact sheet
-//! `shared/protocols/cs100a.md`; codec: `metamer_protocols::cs100a`.
+//! port, a replayed transcript and the emulator run the same code. Facts, their sources and
+//! tags: `protocols/cs100a/README.md`; codec: `metamer_protocols::cs100a`.
 //!
 //! Session: `MDS,04` (absolute Yxy) on connect, `MDS,06`/`MDS,07` (FAST/SLOW) whenever the
 //! requested speed differs from the one last set, then `MES` per reading. Every exchange
@@ -279,7 +279,7 @@ impl<L: SerialLink + 'static> Instrument for Cs100a<L> {
     fn info(&self) -> InstrumentInfo {
         InstrumentInfo {
             model: MODEL.into(),
-            // The CS-100A has no identify command (fact sheet §2).
+            // The CS-100A has no identify command (protocols/cs100a/README.md, "Line and framing").
             serial: None,
             firmware: None,
             connection: self.link.describe(),
@@ -298,7 +298,7 @@ impl<L: SerialLink + 'static> Instrument for Cs100a<L> {
             }],
             spectral: false,
             // 1° and 0.01–299,000 cd/m² are general knowledge, unconfirmed by a KM source
-            // (fact sheet §5).
+            // (protocols/cs100a/README.md, "Measurement facts").
             acceptance_angle_deg: Some(1.0),
             luminance_range_cd_m2: Some((0.01, 299_000.0)),
             options: vec![OptionInfo {

@@ -143,7 +143,7 @@ mod tests {
 
     #[test]
     fn cs100a_character_takes_eleven_bit_times() {
-        // 1 start + 7 data + 1 parity + 2 stop = 11 bits at 4800 baud (fact sheet §1).
+        // 1 start + 7 data + 1 parity + 2 stop = 11 bits at 4800 baud (protocols/cs100a/README.md, "Line and framing").
         let t = LineSettings::CS100A.char_time().as_secs_f64();
         assert!((t - 11.0 / 4800.0).abs() < 1e-9);
     }

@@ -1,4 +1,4 @@
-//! Codec tests on bytes: the fact sheet's example exchanges and property tests.
+//! Codec tests on bytes: the example exchanges of protocols/cs100a/README.md and property tests.
 
 use super::*;
 

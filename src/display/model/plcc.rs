@@ -78,7 +78,7 @@ pub fn ramp_tables(
 ) -> Result<[Trc; 3], FitError> {
     if let Some(c) = (0..3).find(|&c| set.intermediate_levels(c) == 0) {
         let hint = if kind == ModelKind::Plcc {
-            "; use plcc-gamma with --gamma to assume a power law instead"
+            "; use plcc-gamma with a given exponent to assume a power law instead"
         } else {
             ""
         };
@@ -110,7 +110,7 @@ pub fn fit_plcc_gamma(set: &SortedSamples, gamma: Option<f64>) -> Result<MatrixT
                     return Err(FitError::Missing {
                         model: kind,
                         what: format!(
-                            "a {} ramp to fit its exponent (or give one with --gamma)",
+                            "a {} ramp to fit its exponent (or give it one)",
                             CHANNEL_NAMES[c]
                         ),
                     });

@@ -29,7 +29,7 @@ use super::screen::{Screen, ScreenError};
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]
 pub enum WindowError {
-    #[error("no X display: the environment variable DISPLAY is not set (run this in the desktop session of the monitor to measure, e.g. DISPLAY=:0, or use --display virtual)")]
+    #[error("no X display: the environment variable DISPLAY is not set (run this in the desktop session of the monitor to measure, e.g. DISPLAY=:0, or use a virtual display)")]
     NoDisplay,
     #[error("cannot connect to X display '{display}': {message} (is an X server running there, and may this user use it? see xhost and XAUTHORITY)")]
     Connect { display: String, message: String },
