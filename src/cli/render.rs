@@ -8,12 +8,21 @@ use super::{parse_triple, CliError, CliResult};
 use metamer::render::convergence;
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
+use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
 #[derive(clap::Args)]
 pub struct Args {
     #[command(subcommand)]
     command: Cmd,
+}
+
+/// How the spot readings are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    Radiosity,
+    Path,
+    Auto,
 }
 
 #[derive(Subcommand)]
@@ -31,6 +40,10 @@ enum Cmd {
         max_seconds: f64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
+        /// path: the path tracer; auto: radiosity when the scene qualifies.
+        #[arg(long, value_enum, default_value_t = Method::Path)]
+        method: Method,
         #[arg(long)]
         json: bool,
     },
@@ -77,12 +90,30 @@ pub fn run(args: Args) -> CliResult {
             white,
             max_seconds,
             seed,
+            method,
             json,
         } => {
             if target_de.is_nan() || target_de <= 0.0 {
                 return Err(CliError::Usage("--target-de must be > 0".into()));
             }
             let scene = Scene::load(&scene)?;
+            let use_radiosity = match method {
+                Method::Path => false,
+                Method::Radiosity => {
+                    radiosity::qualifies(&scene)?;
+                    true
+                }
+                Method::Auto => match radiosity::qualifies(&scene) {
+                    Ok(()) => true,
+                    Err(why) => {
+                        eprintln!("using the path tracer: {why}");
+                        false
+                    }
+                },
+            };
+            if use_radiosity {
+                return spots_radiosity(&scene, target_de, white, json);
+            }
             let opts = SpotOptions {
                 target_de,
                 white,
@@ -105,7 +136,13 @@ pub fn run(args: Args) -> CliResult {
             })?;
             bar.finish_and_clear();
             if json {
-                println!("{}", serde_json::to_string(&r)?);
+                println!(
+                    "{}",
+                    serde_json::to_string(&Tagged {
+                        method: "path",
+                        result: &r
+                    })?
+                );
             } else {
                 println!(
                     "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
@@ -215,4 +252,65 @@ pub fn run(args: Args) -> CliResult {
             Ok(())
         }
     }
+}
+
+/// A result with the method that produced it, for `--json`.
+#[derive(serde::Serialize)]
+struct Tagged<'a, T: serde::Serialize> {
+    method: &'static str,
+    #[serde(flatten)]
+    result: &'a T,
+}
+
+fn spots_radiosity(
+    scene: &Scene,
+    target_de: f64,
+    white: Option<[f64; 3]>,
+    json: bool,
+) -> CliResult {
+    let opts = RadiosityOptions {
+        target_de,
+        white,
+        ..RadiosityOptions::default()
+    };
+    let r = render_spots_radiosity(scene, &opts, &|l| {
+        eprintln!(
+            "level {}: {} elements, {} sweeps, {:.2} s",
+            l.level, l.elements, l.sweeps, l.seconds
+        )
+    })?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string(&Tagged {
+                method: "radiosity",
+                result: &r
+            })?
+        );
+        return Ok(());
+    }
+    println!(
+        "radiosity: white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.2} s, {} levels{}",
+        r.white[0],
+        r.white[1],
+        r.white[2],
+        r.seconds,
+        r.levels.len(),
+        if r.converged {
+            ""
+        } else {
+            "  (finest level reached: bound above the target)"
+        }
+    );
+    println!(
+        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>9}",
+        "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE bound"
+    );
+    for p in &r.patches {
+        println!(
+            "{:>5} {:>10.4} {:>10.4} {:>10.4} {:>8.3} {:>8.3} {:>8.3} {:>9.5}",
+            p.patch, p.xyz[0], p.xyz[1], p.xyz[2], p.lab[0], p.lab[1], p.lab[2], p.de_bound
+        );
+    }
+    Ok(())
 }

@@ -21,3 +21,4 @@ pub use spot::{
 pub mod convergence;
 pub mod image;
 pub mod image_io;
+pub mod radiosity;
