@@ -42,7 +42,7 @@ enum Cmd {
         seed: u64,
         /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
         /// path: the path tracer; auto: radiosity when the scene qualifies.
-        #[arg(long, value_enum, default_value_t = Method::Path)]
+        #[arg(long, value_enum, default_value_t = Method::Auto)]
         method: Method,
         #[arg(long)]
         json: bool,

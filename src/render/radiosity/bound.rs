@@ -16,7 +16,13 @@ pub fn richardson(coarse: f64, h_coarse: f64, fine: f64, h_fine: f64, p: f64) ->
 }
 
 /// The same for XYZ triples.
-pub fn richardson3(coarse: [f64; 3], h_coarse: f64, fine: [f64; 3], h_fine: f64, p: f64) -> [f64; 3] {
+pub fn richardson3(
+    coarse: [f64; 3],
+    h_coarse: f64,
+    fine: [f64; 3],
+    h_fine: f64,
+    p: f64,
+) -> [f64; 3] {
     std::array::from_fn(|k| richardson(coarse[k], h_coarse, fine[k], h_fine, p))
 }
 

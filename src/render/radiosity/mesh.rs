@@ -238,7 +238,7 @@ pub fn elements(
 /// `size` whose source is `dist` away: the midpoint when far, up to 4×4 when adjacent.
 /// The rule depends on the ratio only, so a refined mesh meets the same rules.
 pub fn receiver_nodes(size: f64, dist: f64) -> usize {
-    ((1.0 + 2.0 * size / dist.max(1e-12)).floor() as usize).clamp(1, 4)
+    ((1.0 + 6.0 * size / dist.max(1e-12)).floor() as usize).clamp(1, 6)
 }
 
 /// Mean of `f(x)` over a rectangle by an n×n Gauss–Legendre rule.

@@ -21,8 +21,8 @@ use std::time::Instant;
 
 use self::bound::extrapolate;
 use self::gather::{footprint, reading, ConeRule};
-use self::mesh::{check_convex, elements, faces, Face, FaceKind, Mesh};
 pub use self::mesh::NotConvex;
+use self::mesh::{check_convex, elements, faces, Face, FaceKind, Mesh};
 use self::solve::{sources, Bands};
 use super::scene::Scene;
 use super::spot::{patch_aim, SpotError};
@@ -202,7 +202,11 @@ pub fn solve_level(
 }
 
 /// The 24 readings and the white of one level.
-pub fn run_level(p: &Prepared, opts: &RadiosityOptions, level: usize) -> Result<Level, RadiosityError> {
+pub fn run_level(
+    p: &Prepared,
+    opts: &RadiosityOptions,
+    level: usize,
+) -> Result<Level, RadiosityError> {
     let start = Instant::now();
     let scene = p.scene;
     let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
@@ -210,7 +214,14 @@ pub fn run_level(p: &Prepared, opts: &RadiosityOptions, level: usize) -> Result<
     let mut patches = Vec::with_capacity(24);
     for k in 1..=24 {
         let aim = patch_aim(scene, k)?;
-        let fp = footprint(scene, &p.faces, &solved.mesh, &aim, opts.direct_rule, opts.indirect_rule);
+        let fp = footprint(
+            scene,
+            &p.faces,
+            &solved.mesh,
+            &aim,
+            opts.direct_rule,
+            opts.indirect_rule,
+        );
         patches.push(reading(scene, &fp, &refl, &solved.bands, &solved.l));
     }
     let white = match opts.white {
@@ -221,7 +232,14 @@ pub fn run_level(p: &Prepared, opts: &RadiosityOptions, level: usize) -> Result<
             wrefl[p.white_face] = &ones;
             let ws = solve_level(p, &wrefl, opts, level, Some(&solved));
             let aim = patch_aim(scene, 19)?;
-            let fp = footprint(scene, &p.faces, &ws.mesh, &aim, opts.direct_rule, opts.indirect_rule);
+            let fp = footprint(
+                scene,
+                &p.faces,
+                &ws.mesh,
+                &aim,
+                opts.direct_rule,
+                opts.indirect_rule,
+            );
             reading(scene, &fp, &wrefl, &ws.bands, &ws.l)
         }
     };
@@ -243,7 +261,7 @@ pub fn render_spots_radiosity(
     progress: &dyn Fn(&Level),
 ) -> Result<RadiosityResult, RadiosityError> {
     let start = Instant::now();
-    if !(opts.target_de > 0.0) {
+    if opts.target_de.is_nan() || opts.target_de <= 0.0 {
         return Err(RadiosityError::BadOption {
             what: "the ΔE*ab target",
             need: "> 0",
@@ -294,7 +312,11 @@ pub fn combine(three: &[Level], opts: &RadiosityOptions) -> (Vec<RadiosityReadin
     let patches = (0..24)
         .map(|k| {
             let e = extrapolate(
-                [three[0].patches[k], three[1].patches[k], three[2].patches[k]],
+                [
+                    three[0].patches[k],
+                    three[1].patches[k],
+                    three[2].patches[k],
+                ],
                 whites,
                 h,
                 opts.order,

@@ -85,7 +85,11 @@ fn edge_sum(n: Vec3, rel: &[Vec3]) -> f64 {
         let d = a.dot(b);
         // γ·(n·c)/|c|, with γ/|c| → 1/d as the edge shrinks to a point seen head-on.
         let g = s.atan2(d);
-        let w = if s > 1e-12 { g / s } else { 1.0 / d.max(1e-300) };
+        let w = if s > 1e-12 {
+            g / s
+        } else {
+            1.0 / d.max(1e-300)
+        };
         sum += w * n.dot(c);
     }
     sum
@@ -179,9 +183,15 @@ mod tests {
     fn back_side_and_below_the_horizon_give_zero() {
         let r = unit_square_at(1.0);
         // Above the square: behind its emitting side.
-        assert_eq!(point_to_rect(Vec3([0.0, 0.0, 2.0]), Vec3([0.0, 0.0, -1.0]), &r), 0.0);
+        assert_eq!(
+            point_to_rect(Vec3([0.0, 0.0, 2.0]), Vec3([0.0, 0.0, -1.0]), &r),
+            0.0
+        );
         // Facing away.
-        assert_eq!(point_to_rect(Vec3([0.0; 3]), Vec3([0.0, 0.0, -1.0]), &r), 0.0);
+        assert_eq!(
+            point_to_rect(Vec3([0.0; 3]), Vec3([0.0, 0.0, -1.0]), &r),
+            0.0
+        );
     }
 
     /// A receiver tilted 90° sees half of a square centred over it: the clip must give
@@ -213,7 +223,10 @@ mod tests {
             let q = gauss_legendre(n);
             for k in 0..(2 * n) {
                 let s: f64 = q.iter().map(|(x, w)| w * x.powi(k as i32)).sum();
-                assert!((s - 1.0 / (k as f64 + 1.0)).abs() < 1e-13, "n {n} k {k}: {s}");
+                assert!(
+                    (s - 1.0 / (k as f64 + 1.0)).abs() < 1e-13,
+                    "n {n} k {k}: {s}"
+                );
             }
         }
     }

@@ -64,12 +64,11 @@ pub fn sources(scene: &Scene, mesh: &Mesh) -> Vec<Vec<f64>> {
                 .par_iter()
                 .map(|el| {
                     let dist = el.rect.centre().minus(ec).length();
-                    let nodes = ((1.0 + 4.0 * el.size / (dist - esize / 2.0).max(el.size))
-                        .ceil() as usize)
+                    let nodes = ((1.0 + 4.0 * el.size / (dist - esize / 2.0).max(el.size)).ceil()
+                        as usize)
                         .clamp(1, 8);
-                    average_over(&el.rect, nodes, |x| {
-                        irradiance_factor(e, x, el.rect.normal)
-                    }) / std::f64::consts::PI
+                    average_over(&el.rect, nodes, |x| irradiance_factor(e, x, el.rect.normal))
+                        / std::f64::consts::PI
                 })
                 .collect()
         })
