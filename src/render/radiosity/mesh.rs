@@ -137,6 +137,9 @@ pub fn check_convex(faces: &[Face]) -> Result<Vec<Vec<usize>>, NotConvex> {
     Ok(decals)
 }
 
+/// Intervals narrower than this fraction of the base size are never subdivided.
+pub const SMALL_INTERVAL: f64 = 0.25;
+
 /// One piecewise-constant element.
 #[derive(Clone, Debug)]
 pub struct Element {
@@ -162,7 +165,14 @@ fn splits(len: f64, cuts: &mut Vec<f64>, base: f64, level: usize) -> Vec<f64> {
     cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     let mut out = vec![0.0];
     for w in cuts.windows(2) {
-        let pieces = (((w[1] - w[0]) * len / base - 1e-9).ceil().max(1.0) as usize) * level;
+        let width = (w[1] - w[0]) * len;
+        // Strips cut by decals (the gaps between patches, the patches themselves) are
+        // already finer than the mesh needs to be; refining them only adds elements.
+        let pieces = if width < base * SMALL_INTERVAL {
+            1
+        } else {
+            ((width / base - 1e-9).ceil().max(1.0) as usize) * level
+        };
         for p in 1..=pieces {
             out.push(w[0] + (w[1] - w[0]) * p as f64 / pieces as f64);
         }
@@ -257,26 +267,47 @@ pub fn average_over(r: &Rect, n: usize, mut f: impl FnMut(Vec3) -> f64) -> f64 {
 }
 
 impl Mesh {
-    /// The mesh and its form factors (rows computed in parallel).
+    /// The mesh and its form factors. Each pair is integrated once, over the smaller of
+    /// the two elements, and the other direction follows by reciprocity (A_i F_ik =
+    /// A_k F_ki); rows of pairs are computed in parallel.
     pub fn build(elements: Vec<Element>) -> Mesh {
         let n = elements.len();
+        let area: Vec<f64> = elements.iter().map(|e| e.rect.area_m2).collect();
+        let upper: Vec<Vec<f64>> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let ei = &elements[i];
+                ((i + 1)..n)
+                    .map(|k| {
+                        let ek = &elements[k];
+                        if ei.face == ek.face {
+                            return 0.0;
+                        }
+                        let dist = ek.rect.centre().minus(ei.rect.centre()).length();
+                        let nodes = receiver_nodes(ei.size + ek.size, dist);
+                        // F from the smaller element, expressed as F_ik.
+                        if area[i] <= area[k] {
+                            average_over(&ei.rect, nodes, |x| {
+                                point_to_rect(x, ei.rect.normal, &ek.rect)
+                            })
+                        } else {
+                            average_over(&ek.rect, nodes, |x| {
+                                point_to_rect(x, ek.rect.normal, &ei.rect)
+                            }) * area[k]
+                                / area[i]
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
         let mut form = vec![0.0; n * n];
-        form.par_chunks_mut(n.max(1))
-            .zip(elements.par_iter())
-            .enumerate()
-            .for_each(|(i, (row, ei))| {
-                let c = ei.rect.centre();
-                for (k, ek) in elements.iter().enumerate() {
-                    if k == i || ei.face == ek.face {
-                        continue;
-                    }
-                    let dist = ek.rect.centre().minus(c).length();
-                    let nodes = receiver_nodes(ei.size + ek.size, dist);
-                    row[k] = average_over(&ei.rect, nodes, |x| {
-                        point_to_rect(x, ei.rect.normal, &ek.rect)
-                    });
-                }
-            });
+        for (i, row) in upper.iter().enumerate() {
+            for (off, &f) in row.iter().enumerate() {
+                let k = i + 1 + off;
+                form[i * n + k] = f;
+                form[k * n + i] = f * area[i] / area[k];
+            }
+        }
         Mesh { elements, form }
     }
 }

@@ -70,7 +70,7 @@ impl Default for RadiosityOptions {
         RadiosityOptions {
             target_de: 0.1,
             white: None,
-            band_nm: 10,
+            band_nm: 5,
             base_m: 0.25,
             order: 2.0,
             max_level: 12,
