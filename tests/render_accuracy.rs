@@ -213,7 +213,7 @@ fn spot_matches_image_over_the_cone() {
     // a uniform patch adds none).
     let scene = build(&box_json());
     let (w, h) = (203usize, 203usize);
-    let cam = scene.camera;
+    let cam = scene.camera.expect("the box has a camera");
     let aim = patch_aim(&scene, 19).unwrap();
     let half_h = (cam.vfov_deg.to_radians() / 2.0).tan();
     let cos_max = (aim.acceptance_deg.to_radians() / 2.0).cos();
@@ -245,7 +245,8 @@ fn spot_matches_image_over_the_cone() {
             window: Some([x0, y0, x1, y1]),
         },
         &|_| {},
-    );
+    )
+    .unwrap();
     let mut acc = [0.0f64; 3];
     for &(x, y) in &inside {
         let p = img.at(x, y);

@@ -5,9 +5,13 @@ use std::path::PathBuf;
 use clap::Subcommand;
 
 use super::{parse_triple, CliError, CliResult};
+use metamer::numeric_csv::NumericCsv;
 use metamer::render::convergence;
+use metamer::render::geometry::Vec3;
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
+use metamer::render::probes::probe_illuminance_path;
+use metamer::render::radiosity::probes::{probe_illuminance, Illuminance, Probe};
 use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
@@ -65,6 +69,25 @@ enum Cmd {
         preview: Option<PathBuf>,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// Illuminance (lux: direct, indirect, total) at points given as CSV rows
+    /// x,y,z,nx,ny,nz (header line), the normal being the measuring surface's.
+    Probes {
+        scene: PathBuf,
+        #[arg(long)]
+        points: PathBuf,
+        #[arg(long, value_enum, default_value_t = Method::Auto)]
+        method: Method,
+        /// Radiosity: refine until every bound is below this fraction of the total.
+        #[arg(long, default_value_t = 0.001)]
+        rel_tolerance: f64,
+        /// Path tracing: paths per point.
+        #[arg(long, default_value_t = 65536)]
+        samples: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[arg(long)]
+        json: bool,
     },
     /// CSV and SVG of ΔE*ab error against seconds for each sampling strategy.
     Convergence {
@@ -189,9 +212,13 @@ pub fn run(args: Args) -> CliResult {
             if spp == 0 {
                 return Err(CliError::Usage("--spp must be ≥ 1".into()));
             }
-            let scene = Scene::load(&scene)?;
-            let width = width.unwrap_or(scene.camera.width);
-            let height = height.unwrap_or(scene.camera.height);
+            let file = scene;
+            let scene = Scene::load(&file)?;
+            let camera = scene.camera.ok_or_else(|| {
+                CliError::Failed(format!("{}: the scene has no camera", file.display()).into())
+            })?;
+            let width = width.unwrap_or(camera.width);
+            let height = height.unwrap_or(camera.height);
             if width == 0 || height == 0 {
                 return Err(CliError::Usage("--width and --height must be ≥ 1".into()));
             }
@@ -211,7 +238,7 @@ pub fn run(args: Args) -> CliResult {
                 window: None,
             };
             let t = std::time::Instant::now();
-            let img = render_image(&scene, &opts, &|n| bar.inc(n as u64));
+            let img = render_image(&scene, &opts, &|n| bar.inc(n as u64))?;
             bar.finish_and_clear();
             let secs = t.elapsed().as_secs_f64();
             write_xyz_image(&output, &img)?;
@@ -234,6 +261,15 @@ pub fn run(args: Args) -> CliResult {
             }
             Ok(())
         }
+        Cmd::Probes {
+            scene,
+            points,
+            method,
+            rel_tolerance,
+            samples,
+            seed,
+            json,
+        } => probes(&scene, &points, method, rel_tolerance, samples, seed, json),
         Cmd::Convergence {
             scene,
             output,
@@ -310,6 +346,93 @@ fn spots_radiosity(
         println!(
             "{:>5} {:>10.4} {:>10.4} {:>10.4} {:>8.3} {:>8.3} {:>8.3} {:>9.5}",
             p.patch, p.xyz[0], p.xyz[1], p.xyz[2], p.lab[0], p.lab[1], p.lab[2], p.de_bound
+        );
+    }
+    Ok(())
+}
+
+fn probes(
+    scene: &std::path::Path,
+    points: &std::path::Path,
+    method: Method,
+    rel_tolerance: f64,
+    samples: u64,
+    seed: u64,
+    json: bool,
+) -> CliResult {
+    if rel_tolerance.is_nan() || rel_tolerance <= 0.0 {
+        return Err(CliError::Usage("--rel-tolerance must be > 0".into()));
+    }
+    if samples < 2 {
+        return Err(CliError::Usage("--samples must be ≥ 2".into()));
+    }
+    let scene = Scene::load(scene)?;
+    let csv = NumericCsv::read(points, &["x", "y", "z", "nx", "ny", "nz"])?;
+    let mut probes = Vec::with_capacity(csv.rows.len());
+    for (line, v) in &csv.rows {
+        let normal = Vec3([v[3], v[4], v[5]]);
+        if normal.length() == 0.0 {
+            return Err(CliError::Failed(
+                format!("{}:{line}: the normal is zero", points.display()).into(),
+            ));
+        }
+        probes.push(Probe {
+            position: Vec3([v[0], v[1], v[2]]),
+            normal: normal.normalized(),
+        });
+    }
+    let use_radiosity = match method {
+        Method::Path => false,
+        Method::Radiosity => {
+            radiosity::qualifies(&scene)?;
+            true
+        }
+        Method::Auto => match radiosity::qualifies(&scene) {
+            Ok(()) => true,
+            Err(why) => {
+                eprintln!("using the path tracer: {why}");
+                false
+            }
+        },
+    };
+    let t = std::time::Instant::now();
+    let out = if use_radiosity {
+        probe_illuminance(&scene, &probes, &RadiosityOptions::default(), rel_tolerance)?
+    } else {
+        probe_illuminance_path(&scene, &probes, samples, seed)
+    };
+    let method = if use_radiosity { "radiosity" } else { "path" };
+    if json {
+        #[derive(serde::Serialize)]
+        struct Row<'a> {
+            point: [f64; 3],
+            normal: [f64; 3],
+            #[serde(flatten)]
+            lux: &'a Illuminance,
+        }
+        let rows: Vec<Row> = probes
+            .iter()
+            .zip(&out)
+            .map(|(p, lux)| Row {
+                point: p.position.0,
+                normal: p.normal.0,
+                lux,
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({"method": method, "seconds": t.elapsed().as_secs_f64(), "probes": rows})
+        );
+        return Ok(());
+    }
+    eprintln!("{method}: {:.2} s", t.elapsed().as_secs_f64());
+    println!("x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux,bound_lux");
+    for (p, e) in probes.iter().zip(&out) {
+        let [x, y, z] = p.position.0;
+        let [a, b, c] = p.normal.0;
+        println!(
+            "{x},{y},{z},{a},{b},{c},{:.6},{:.6},{:.6},{:.6}",
+            e.direct_lux, e.indirect_lux, e.total_lux, e.bound_lux
         );
     }
     Ok(())

@@ -15,6 +15,7 @@ pub mod direct;
 pub mod gather;
 pub mod mesh;
 pub mod polygon;
+pub mod probes;
 pub mod solve;
 
 use std::time::Instant;
@@ -55,8 +56,9 @@ pub struct RadiosityOptions {
     pub white: Option<[f64; 3]>,
     /// Spacing of the wavelength nodes the system is solved at.
     pub band_nm: usize,
-    /// Element size of level 1 (m); level m divides it by m.
-    pub base_m: f64,
+    /// Element size of level 1 (m; default half the longest face edge); level m divides
+    /// it by m.
+    pub base_m: Option<f64>,
     /// Convergence order assumed by the extrapolation.
     pub order: f64,
     /// The finest level tried before giving up on the target.
@@ -71,7 +73,7 @@ impl Default for RadiosityOptions {
             target_de: 0.1,
             white: None,
             band_nm: 5,
-            base_m: 0.25,
+            base_m: None,
             order: 2.0,
             max_level: 12,
             direct_rule: ConeRule {
@@ -130,24 +132,42 @@ pub struct Prepared<'a> {
     pub scene: &'a Scene,
     pub faces: Vec<Face<'a>>,
     pub decals: Vec<Vec<usize>>,
-    /// The face of patch 19, white in the reference scene.
-    pub white_face: usize,
+    /// The face of patch 19, white in the reference scene (None for probes only).
+    pub white_face: Option<usize>,
 }
 
 impl<'a> Prepared<'a> {
+    /// For the meter readings: the scene must have patch 19 for the reference white.
     pub fn new(scene: &'a Scene) -> Result<Prepared<'a>, RadiosityError> {
+        let mut p = Prepared::for_probes(scene)?;
+        let s19 = scene.patch_surface(19).ok_or(SpotError::MissingPatch(19))?;
+        p.white_face = p
+            .faces
+            .iter()
+            .position(|f| f.kind == FaceKind::Surface(s19));
+        Ok(p)
+    }
+
+    /// For illuminance probes: any convex scene.
+    pub fn for_probes(scene: &'a Scene) -> Result<Prepared<'a>, RadiosityError> {
         let faces = faces(scene);
         let decals = check_convex(&faces)?;
-        let s19 = scene.patch_surface(19).ok_or(SpotError::MissingPatch(19))?;
-        let white_face = faces
-            .iter()
-            .position(|f| f.kind == FaceKind::Surface(s19))
-            .ok_or(SpotError::MissingPatch(19))?;
         Ok(Prepared {
             scene,
             faces,
             decals,
-            white_face,
+            white_face: None,
+        })
+    }
+
+    /// The element size of level 1.
+    pub fn base(&self, opts: &RadiosityOptions) -> f64 {
+        opts.base_m.unwrap_or_else(|| {
+            self.faces
+                .iter()
+                .map(|f| f.rect.edge_u.length().max(f.rect.edge_v.length()))
+                .fold(0.0, f64::max)
+                / 2.0
         })
     }
 }
@@ -173,7 +193,7 @@ pub fn solve_level(
             elements: w.mesh.elements.clone(),
             form: w.mesh.form.clone(),
         },
-        None => Mesh::build(elements(p.scene, &p.faces, &p.decals, opts.base_m, level)),
+        None => Mesh::build(elements(p.scene, &p.faces, &p.decals, p.base(opts), level)),
     };
     let bands = Bands::new(opts.band_nm);
     let nb = bands.len();
@@ -224,12 +244,13 @@ pub fn run_level(
         );
         patches.push(reading(scene, &fp, &refl, &solved.bands, &solved.l));
     }
-    let white = match opts.white {
-        Some(w) => w,
-        None => {
-            let ones = vec![1.0; refl[p.white_face].len()];
+    let white = match (opts.white, p.white_face) {
+        (Some(w), _) => w,
+        (None, None) => return Err(SpotError::MissingPatch(19).into()),
+        (None, Some(wf)) => {
+            let ones = vec![1.0; refl[wf].len()];
             let mut wrefl = refl.clone();
-            wrefl[p.white_face] = &ones;
+            wrefl[wf] = &ones;
             let ws = solve_level(p, &wrefl, opts, level, Some(&solved));
             let aim = patch_aim(scene, 19)?;
             let fp = footprint(
@@ -245,7 +266,7 @@ pub fn run_level(
     };
     Ok(Level {
         level,
-        h_m: opts.base_m / level as f64,
+        h_m: p.base(opts) / level as f64,
         elements: solved.mesh.elements.len(),
         sweeps: solved.sweeps,
         seconds: start.elapsed().as_secs_f64(),
@@ -268,12 +289,14 @@ pub fn render_spots_radiosity(
             got: opts.target_de,
         });
     }
-    if !(opts.base_m > 0.0 && opts.base_m.is_finite()) {
-        return Err(RadiosityError::BadOption {
-            what: "the base element size",
-            need: "> 0 m",
-            got: opts.base_m,
-        });
+    if let Some(b) = opts.base_m {
+        if !(b > 0.0 && b.is_finite()) {
+            return Err(RadiosityError::BadOption {
+                what: "the base element size",
+                need: "> 0 m",
+                got: b,
+            });
+        }
     }
     if let Some(w) = opts.white {
         if w[1].is_nan() || w[1] <= 0.0 {
