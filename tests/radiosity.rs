@@ -88,3 +88,96 @@ fn a_surface_inside_the_box_is_refused() {
     // The box as it is qualifies: the chart and patches are decals on the right wall.
     assert!(qualifies(&build(&load("validation-box.json"))).is_ok());
 }
+
+fn temp_dir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("metamer-radiosity-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn metamer(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+/// `render spots --method radiosity` on a scene that is not convex says why and fails;
+/// the JSON of a radiosity run names its method and carries each patch's bound.
+#[test]
+fn cli_method_choice() {
+    let dir = temp_dir("cli");
+    let mut v = load("validation-box.json");
+    v["surfaces"].as_array_mut().unwrap().push(json!({
+        "name": "shelf", "corner": [0.1, 0.2, 0.1], "edge_u": [0.0, 0.0, 0.2],
+        "edge_v": [0.2, 0.0, 0.0], "reflectance": 0.5
+    }));
+    // The scene's spectra are relative paths: write it next to the bundled one's data.
+    let file = dir.join("shelf.json");
+    let text = serde_json::to_string(&v)
+        .unwrap()
+        .replace("\"../", &format!("\"{}/../", data_dir().display()));
+    std::fs::write(&file, text).unwrap();
+    let o = metamer(&[
+        "render".as_ref(),
+        "spots".as_ref(),
+        file.as_os_str(),
+        "--method".as_ref(),
+        "radiosity".as_ref(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("not a convex enclosure") && err.contains("shelf"),
+        "{err}"
+    );
+
+    let o = metamer(&[
+        "render".as_ref(),
+        "spots".as_ref(),
+        "data/scenes/validation-box.json".as_ref(),
+        "--json".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["method"], "radiosity");
+    let patches = r["patches"].as_array().unwrap();
+    assert_eq!(patches.len(), 24);
+    assert!(patches
+        .iter()
+        .all(|p| p["de_bound"].as_f64().unwrap() < 0.1));
+}
+
+/// `render probes`: a panel of 1000 cd/m², 1 m², 2 m above a black floor gives
+/// E = π·L·4·F(0.5, 0.5, 2) under its centre (the corner factor of catalogue C-11).
+#[test]
+fn cli_probes() {
+    let dir = temp_dir("probes");
+    let scene = json!({"name": "plane", "surfaces": [{"name": "floor",
+        "corner": [-5.0, 0.0, -5.0], "edge_u": [0.0, 0.0, 10.0], "edge_v": [10.0, 0.0, 0.0],
+        "reflectance": 0.0}],
+        "emitters": [{"corner": [-0.5, 2.0, -0.5], "edge_u": [1.0, 0.0, 0.0],
+        "edge_v": [0.0, 0.0, 1.0], "luminance_cd_m2": 1000.0}]});
+    std::fs::write(dir.join("plane.json"), scene.to_string()).unwrap();
+    std::fs::write(dir.join("points.csv"), "x,y,z,nx,ny,nz\n0,0,0,0,1,0\n").unwrap();
+    let o = metamer(&[
+        "render".as_ref(),
+        "probes".as_ref(),
+        dir.join("plane.json").as_os_str(),
+        "--points".as_ref(),
+        dir.join("points.csv").as_os_str(),
+        "--json".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["method"], "radiosity");
+    let (x, y) = (0.25f64, 0.25f64);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    let corner =
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI);
+    let want = std::f64::consts::PI * 1000.0 * 4.0 * corner;
+    let got = r["probes"][0]["total_lux"].as_f64().unwrap();
+    assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+}

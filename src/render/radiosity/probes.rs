@@ -85,7 +85,7 @@ pub fn element_lux(scene: &Scene, solved: &Solved) -> Vec<(f64, f64, f64)> {
         .map(|i| {
             let mut direct = 0.0;
             let mut indirect = 0.0;
-            for e in 0..scene.emitters.len() {
+            for (e, src_e) in src.iter().enumerate() {
                 let mut q = vec![0.0; nb];
                 for j in 0..n {
                     let f = solved.mesh.form[i * n + j];
@@ -96,7 +96,7 @@ pub fn element_lux(scene: &Scene, solved: &Solved) -> Vec<(f64, f64, f64)> {
                     }
                 }
                 let q = solved.bands.interpolate(&q);
-                direct += photometric(scene, e, |_| std::f64::consts::PI * src[e][i]);
+                direct += photometric(scene, e, |_| std::f64::consts::PI * src_e[i]);
                 indirect += photometric(scene, e, |k| std::f64::consts::PI * q[k]);
             }
             (solved.mesh.elements[i].rect.area_m2, direct, indirect)
