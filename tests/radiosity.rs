@@ -181,3 +181,47 @@ fn cli_probes() {
     let got = r["probes"][0]["total_lux"].as_f64().unwrap();
     assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
 }
+
+/// Against the pooled Mitsuba 3 readings of `benches/mitsuba/results` (four runs, each to a
+/// 95 % half-width of 0.1; pooled, the half-width of a patch's mean is ≈ 0.06): every
+/// patch within 0.083, the pooled half-width of the path tracer's own comparison there.
+#[test]
+fn radiosity_agrees_with_pooled_mitsuba() {
+    let dir = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/benches/mitsuba/results"
+    ));
+    let runs: Vec<Value> = ["cmf_1", "cmf_2", "light_1", "light_2"]
+        .iter()
+        .map(|r| {
+            let text = std::fs::read_to_string(dir.join(format!("mitsuba_{r}.json"))).unwrap();
+            serde_json::from_str(&text).unwrap()
+        })
+        .collect();
+    let mean = |get: &dyn Fn(&Value) -> &Value| -> [f64; 3] {
+        std::array::from_fn(|i| {
+            runs.iter()
+                .map(|r| get(r)[i].as_f64().unwrap())
+                .sum::<f64>()
+                / runs.len() as f64
+        })
+    };
+    let white = mean(&|r| &r["white"]);
+    let scene = build(&load("validation-box.json"));
+    let rad = render_spots_radiosity(&scene, &RadiosityOptions::default(), &|_| {}).unwrap();
+    let to_lab = |x: [f64; 3], w: [f64; 3]| {
+        metamer::color::Xyz::from_array(x).to_lab(metamer::color::Xyz::from_array(w))
+    };
+    let mut worst: f64 = 0.0;
+    for (k, r) in rad.patches.iter().enumerate() {
+        let m = mean(&|run| &run["patches"][k]["XYZ"]);
+        let de = delta_e76(to_lab(r.xyz, rad.white), to_lab(m, white));
+        worst = worst.max(de);
+        assert!(
+            de < 0.083,
+            "patch {}: ΔE*ab {de:.3} against Mitsuba",
+            r.patch
+        );
+    }
+    eprintln!("max ΔE*ab against pooled Mitsuba: {worst:.4}");
+}
