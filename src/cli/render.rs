@@ -135,7 +135,7 @@ pub fn run(args: Args) -> CliResult {
                 },
             };
             if use_radiosity {
-                return spots_radiosity(&scene, target_de, white, json);
+                return spots_radiosity(&scene, target_de, white, max_seconds, json);
             }
             let opts = SpotOptions {
                 target_de,
@@ -302,11 +302,13 @@ fn spots_radiosity(
     scene: &Scene,
     target_de: f64,
     white: Option<[f64; 3]>,
+    max_seconds: f64,
     json: bool,
 ) -> CliResult {
     let opts = RadiosityOptions {
         target_de,
         white,
+        max_seconds,
         ..RadiosityOptions::default()
     };
     let r = render_spots_radiosity(scene, &opts, &|l| {
@@ -335,7 +337,7 @@ fn spots_radiosity(
         if r.converged {
             ""
         } else {
-            "  (finest level reached: bound above the target)"
+            "  (level or time limit reached: bound above the target)"
         }
     );
     println!(

@@ -63,6 +63,8 @@ pub struct RadiosityOptions {
     pub order: f64,
     /// The finest level tried before giving up on the target.
     pub max_level: usize,
+    /// No further level is started after this many seconds.
+    pub max_seconds: f64,
     pub direct_rule: ConeRule,
     pub indirect_rule: ConeRule,
 }
@@ -76,6 +78,7 @@ impl Default for RadiosityOptions {
             base_m: None,
             order: 2.0,
             max_level: 12,
+            max_seconds: 600.0,
             direct_rule: ConeRule {
                 radial: 4,
                 azimuthal: 8,
@@ -123,7 +126,7 @@ pub struct RadiosityResult {
     pub seconds: f64,
     pub levels: Vec<Level>,
     pub patches: Vec<RadiosityReading>,
-    /// Every bound is below the target (false if `max_level` came first).
+    /// Every bound is below the target (false if `max_level` or `max_seconds` came first).
     pub converged: bool,
 }
 
@@ -315,7 +318,8 @@ pub fn render_spots_radiosity(
         }
         let (patches, white) = combine(&levels[levels.len() - 3..], opts);
         let converged = patches.iter().all(|r| r.de_bound < opts.target_de);
-        if converged || level >= opts.max_level.max(3) {
+        let out_of_time = start.elapsed().as_secs_f64() > opts.max_seconds;
+        if converged || out_of_time || level >= opts.max_level.max(3) {
             return Ok(RadiosityResult {
                 white,
                 seconds: start.elapsed().as_secs_f64(),
