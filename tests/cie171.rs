@@ -9,6 +9,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use metamer::render::geometry::Vec3;
+use metamer::render::probes::probe_illuminance_path;
 use metamer::render::radiosity::probes::{element_lux, probe_illuminance, Probe};
 use metamer::render::radiosity::{solve_level, Prepared, RadiosityOptions};
 use metamer::render::scene::{Scene, SceneFile};
@@ -225,5 +226,32 @@ fn inter_reflections_in_a_closed_cube() {
             (indirect - want).abs() < 1e-5 * want,
             "ρ {rho}: mean indirect {indirect} vs {want}"
         );
+    }
+}
+
+/// The path-traced probes on the plane case: the same analytic value within their own
+/// 95 % half-width (fixed seed), and no indirect light off a black floor.
+#[test]
+fn path_probes_agree_with_the_analytic_plane() {
+    let floor = json!({"name": "floor", "corner": [-10.0, 0.0, -10.0],
+        "edge_u": [0.0, 0.0, 20.0], "edge_v": [20.0, 0.0, 0.0], "reflectance": 0.0});
+    let scene = build(json!({"name": "plane", "surfaces": [floor],
+        "emitters": [panel(0.0, 2.0, 0.0)]}));
+    let points = [[0.0, 0.0], [1.5, -0.2]];
+    let probes: Vec<Probe> = points
+        .iter()
+        .map(|&[x, z]| probe([x, 0.0, z], [0.0, 1.0, 0.0]))
+        .collect();
+    let got = probe_illuminance_path(&scene, &probes, 40_000, 3);
+    for ([x, z], e) in points.iter().zip(&got) {
+        let want = PI * L * parallel(-0.5 - x, 0.5 - x, -0.5 - z, 0.5 - z, 2.0);
+        assert!(
+            (e.total_lux - want).abs() < e.bound_lux,
+            "({x}, {z}): {} ± {} vs {want}",
+            e.total_lux,
+            e.bound_lux
+        );
+        assert!(e.bound_lux < 0.2 * want, "half-width {}", e.bound_lux);
+        assert!(e.indirect_lux.abs() < 1e-9 * want, "{}", e.indirect_lux);
     }
 }
