@@ -65,8 +65,8 @@ fn perpendicular(w1: f64, w2: f64, l1: f64, l2: f64, c: f64) -> f64 {
 
 fn probe(p: [f64; 3], n: [f64; 3]) -> Probe {
     Probe {
-        position: Vec3(p),
-        normal: Vec3(n),
+        position: Vec3::from_array(p),
+        normal: Vec3::from_array(n),
     }
 }
 

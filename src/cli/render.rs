@@ -7,7 +7,7 @@ use clap::Subcommand;
 use super::{parse_triple, CliError, CliResult};
 use metamer::numeric_csv::NumericCsv;
 use metamer::render::convergence;
-use metamer::render::geometry::Vec3;
+use metamer::render::geometry::{Vec3, VecOps};
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
 use metamer::render::probes::probe_illuminance_path;
@@ -372,14 +372,14 @@ fn probes(
     let csv = NumericCsv::read(points, &["x", "y", "z", "nx", "ny", "nz"])?;
     let mut probes = Vec::with_capacity(csv.rows.len());
     for (line, v) in &csv.rows {
-        let normal = Vec3([v[3], v[4], v[5]]);
+        let normal = Vec3::from_array([v[3], v[4], v[5]]);
         if normal.length() == 0.0 {
             return Err(CliError::Failed(
                 format!("{}:{line}: the normal is zero", points.display()).into(),
             ));
         }
         probes.push(Probe {
-            position: Vec3([v[0], v[1], v[2]]),
+            position: Vec3::from_array([v[0], v[1], v[2]]),
             normal: normal.normalized(),
         });
     }
@@ -416,8 +416,8 @@ fn probes(
             .iter()
             .zip(&out)
             .map(|(p, lux)| Row {
-                point: p.position.0,
-                normal: p.normal.0,
+                point: p.position.to_array(),
+                normal: p.normal.to_array(),
                 lux,
             })
             .collect();
@@ -430,8 +430,8 @@ fn probes(
     eprintln!("{method}: {:.2} s", t.elapsed().as_secs_f64());
     println!("x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux,bound_lux");
     for (p, e) in probes.iter().zip(&out) {
-        let [x, y, z] = p.position.0;
-        let [a, b, c] = p.normal.0;
+        let [x, y, z] = p.position.to_array();
+        let [a, b, c] = p.normal.to_array();
         println!(
             "{x},{y},{z},{a},{b},{c},{:.6},{:.6},{:.6},{:.6}",
             e.direct_lux, e.indirect_lux, e.total_lux, e.bound_lux

@@ -3,6 +3,7 @@
 
 use rayon::prelude::*;
 
+use super::geometry::VecOps;
 use super::image_io::XyzImage;
 use super::integrator::{Strategy, Tracer};
 use super::scene::Scene;

@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::geometry::VecOps;
 use super::integrator::{Strategy, Tracer};
 use super::radiosity::probes::{Illuminance, Probe};
 use super::scene::Scene;

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::geometry::{Rect, Vec3};
+use super::geometry::{Rect, Vec3, VecOps};
 use super::spectral::{bin, cmf_bins, Binned};
 use crate::color::{luminance, ObserverKind, Outside, SpectralTable, Spectrum};
 
@@ -312,13 +312,13 @@ impl Scene {
 }
 
 fn camera(c: &CameraFile) -> Result<Camera, (String, String)> {
-    let position = Vec3(c.position);
-    let forward = Vec3(c.look_at).minus(position);
+    let position = Vec3::from_array(c.position);
+    let forward = Vec3::from_array(c.look_at).minus(position);
     if forward.length() == 0.0 || !forward.length().is_finite() {
         return Err(("camera.look_at".into(), "must differ from position".into()));
     }
     let forward = forward.normalized();
-    let right = forward.cross(Vec3(c.up));
+    let right = forward.cross(Vec3::from_array(c.up));
     if right.length() < 1e-9 {
         return Err((
             "camera.up".into(),
@@ -346,7 +346,7 @@ fn camera(c: &CameraFile) -> Result<Camera, (String, String)> {
 
 fn finite3(path: &str, v: [f64; 3]) -> Result<Vec3, (String, String)> {
     if v.iter().all(|x| x.is_finite()) {
-        Ok(Vec3(v))
+        Ok(Vec3::from_array(v))
     } else {
         Err((path.into(), "must be finite numbers".into()))
     }

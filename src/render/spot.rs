@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::geometry::Vec3;
+use super::geometry::{Vec3, VecOps};
 use super::integrator::{Strategy, Tracer};
 use super::scene::Scene;
 use super::spectral::Rng;

@@ -4,7 +4,7 @@
 //! directional factor f(ω) is integrated by Gauss–Legendre over the tile with the number
 //! of nodes chosen from its size over the distance.
 
-use super::super::geometry::{Rect, Vec3};
+use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::scene::{Distribution, Emitter};
 use super::polygon::{gauss_legendre, point_to_rect};
 
@@ -85,9 +85,9 @@ mod tests {
     fn emitter(distribution: Distribution) -> Emitter {
         Emitter {
             rect: Rect::new(
-                Vec3([-0.5, -0.5, 1.0]),
-                Vec3([0.0, 1.0, 0.0]),
-                Vec3([1.0, 0.0, 0.0]),
+                Vec3::from_array([-0.5, -0.5, 1.0]),
+                Vec3::from_array([0.0, 1.0, 0.0]),
+                Vec3::from_array([1.0, 0.0, 0.0]),
             ),
             rows: 3,
             cols: 3,
@@ -105,9 +105,18 @@ mod tests {
         let lam = emitter(Distribution::Lambertian);
         let cos0 = emitter(Distribution::CosPower(0.0));
         for (x, n) in [
-            (Vec3([0.0, 0.0, 0.0]), Vec3([0.0, 0.0, 1.0])),
-            (Vec3([0.3, -0.2, 0.5]), Vec3([0.0, 0.0, 1.0])),
-            (Vec3([0.6, 0.1, 0.7]), Vec3([-0.6, 0.0, 0.8])),
+            (
+                Vec3::from_array([0.0, 0.0, 0.0]),
+                Vec3::from_array([0.0, 0.0, 1.0]),
+            ),
+            (
+                Vec3::from_array([0.3, -0.2, 0.5]),
+                Vec3::from_array([0.0, 0.0, 1.0]),
+            ),
+            (
+                Vec3::from_array([0.6, 0.1, 0.7]),
+                Vec3::from_array([-0.6, 0.0, 0.8]),
+            ),
         ] {
             let a = irradiance_factor(&lam, x, n);
             let b = irradiance_factor(&cos0, x, n);
@@ -121,7 +130,11 @@ mod tests {
     fn far_field_is_inverse_square() {
         let e = emitter(Distribution::CosPower(3.0));
         let d = 200.0;
-        let g = irradiance_factor(&e, Vec3([0.0, 0.0, 1.0 - d]), Vec3([0.0, 0.0, 1.0]));
+        let g = irradiance_factor(
+            &e,
+            Vec3::from_array([0.0, 0.0, 1.0 - d]),
+            Vec3::from_array([0.0, 0.0, 1.0]),
+        );
         let want = 1.0 / (d * d);
         assert!((g - want).abs() < 1e-4 * want, "{g} vs {want}");
     }

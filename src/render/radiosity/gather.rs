@@ -8,7 +8,7 @@
 //! closed form and the indirect term from the radiosity solution by exact point-to-element
 //! factors.
 
-use super::super::geometry::Vec3;
+use super::super::geometry::{Vec3, VecOps};
 use super::super::spectral::N_BINS;
 use super::super::spot::{cone_direction, Aim};
 use super::direct::irradiance_factor;

@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use super::super::geometry::{Rect, Vec3};
+use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::scene::Scene;
 use super::super::spectral::Binned;
 use super::polygon::{corners, gauss_legendre, point_to_rect};

@@ -8,7 +8,7 @@
 //! clipped against that plane first; after the clip cos θ ≥ 0 over it and the sum's
 //! magnitude is the factor whatever the vertex order.
 
-use super::super::geometry::{Rect, Vec3};
+use super::super::geometry::{Rect, Vec3, VecOps};
 
 /// Most vertices a clipped quadrilateral can have (one plane adds at most one vertex).
 const MAX_VERTS: usize = 5;
@@ -22,7 +22,7 @@ pub fn point_to_polygon(x: Vec3, n: Vec3, verts: &[Vec3], front: Vec3) -> f64 {
         return 0.0;
     }
     // Vertices relative to x, clipped to the half-space n·p ≥ 0 (Sutherland–Hodgman).
-    let mut rel = [Vec3([0.0; 3]); MAX_VERTS];
+    let mut rel = [Vec3::from_array([0.0; 3]); MAX_VERTS];
     let mut h = [0.0; 4];
     let mut all_above = true;
     let mut any_above = false;
@@ -37,7 +37,7 @@ pub fn point_to_polygon(x: Vec3, n: Vec3, verts: &[Vec3], front: Vec3) -> f64 {
         return 0.0;
     }
     let m = verts.len();
-    let mut clipped = [Vec3([0.0; 3]); MAX_VERTS + 1];
+    let mut clipped = [Vec3::from_array([0.0; 3]); MAX_VERTS + 1];
     let count = if all_above {
         clipped[..m].copy_from_slice(&rel[..m]);
         m
@@ -66,7 +66,7 @@ pub fn point_to_polygon(x: Vec3, n: Vec3, verts: &[Vec3], front: Vec3) -> f64 {
 
 /// Σ γᵢ (n·Γᵢ) over the edges of a polygon given relative to the receiving point.
 fn edge_sum(n: Vec3, rel: &[Vec3]) -> f64 {
-    let mut unit = [Vec3([0.0; 3]); MAX_VERTS + 1];
+    let mut unit = [Vec3::from_array([0.0; 3]); MAX_VERTS + 1];
     for (u, r) in unit.iter_mut().zip(rel) {
         let l = r.length();
         if l == 0.0 {
@@ -154,9 +154,9 @@ mod tests {
     fn unit_square_at(h: f64) -> Rect {
         // 1×1 square centred on the z axis at height h, facing down (−z).
         Rect::new(
-            Vec3([-0.5, -0.5, h]),
-            Vec3([0.0, 1.0, 0.0]),
-            Vec3([1.0, 0.0, 0.0]),
+            Vec3::from_array([-0.5, -0.5, h]),
+            Vec3::from_array([0.0, 1.0, 0.0]),
+            Vec3::from_array([1.0, 0.0, 0.0]),
         )
     }
 
@@ -171,9 +171,9 @@ mod tests {
 
     #[test]
     fn parallel_square_matches_the_catalogue() {
-        let up = Vec3([0.0, 0.0, 1.0]);
+        let up = Vec3::from_array([0.0, 0.0, 1.0]);
         for h in [0.1, 0.5, 1.0, 3.0] {
-            let f = point_to_rect(Vec3([0.0; 3]), up, &unit_square_at(h));
+            let f = point_to_rect(Vec3::from_array([0.0; 3]), up, &unit_square_at(h));
             let want = 4.0 * corner_factor(0.5, 0.5, h);
             assert!((f - want).abs() < 1e-12, "h {h}: {f} vs {want}");
         }
@@ -184,12 +184,20 @@ mod tests {
         let r = unit_square_at(1.0);
         // Above the square: behind its emitting side.
         assert_eq!(
-            point_to_rect(Vec3([0.0, 0.0, 2.0]), Vec3([0.0, 0.0, -1.0]), &r),
+            point_to_rect(
+                Vec3::from_array([0.0, 0.0, 2.0]),
+                Vec3::from_array([0.0, 0.0, -1.0]),
+                &r
+            ),
             0.0
         );
         // Facing away.
         assert_eq!(
-            point_to_rect(Vec3([0.0; 3]), Vec3([0.0, 0.0, -1.0]), &r),
+            point_to_rect(
+                Vec3::from_array([0.0; 3]),
+                Vec3::from_array([0.0, 0.0, -1.0]),
+                &r
+            ),
             0.0
         );
     }
@@ -202,7 +210,11 @@ mod tests {
     fn straddling_polygon_is_clipped() {
         let r = unit_square_at(1.0);
         // Normal +x: keeps the half x ≥ 0 (a 0.5 × 1 rectangle at height 1).
-        let f = point_to_rect(Vec3([0.0; 3]), Vec3([1.0, 0.0, 0.0]), &r);
+        let f = point_to_rect(
+            Vec3::from_array([0.0; 3]),
+            Vec3::from_array([1.0, 0.0, 0.0]),
+            &r,
+        );
         // Point in the plane perpendicular to the half-square through its edge x = 0;
         // split the half into two 0.5 × 0.5 pieces at y = 0 sharing the corner above x.
         // Each piece: a rectangle parallel to the receiver's normal direction, at

@@ -8,6 +8,8 @@
 
 use rayon::prelude::*;
 
+use super::super::geometry::VecOps;
+
 use super::super::spectral::N_BINS;
 use super::direct::irradiance_factor;
 use super::mesh::{average_over, Mesh};
