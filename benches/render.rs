@@ -1,10 +1,12 @@
 //! The path tracer's inner loop: one meter sample (a path from the pinhole into the 1°
-//! cone at patch 19, all its bounces and next-event estimates) per strategy.
+//! cone at patch 19, all its bounces and next-event estimates) per strategy; and the
+//! radiosity solver's whole run (`render spots --method radiosity --target-de 0.1`).
 
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use metamer::render::convergence::strategies;
+use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
 use metamer::render::spectral::Rng;
 use metamer::render::spot::{cone_direction, patch_aim};
 use metamer::render::{Scene, Tracer};
@@ -31,5 +33,26 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+fn radiosity(c: &mut Criterion) {
+    let scene = Scene::load(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/scenes/validation-box.json"
+    )))
+    .expect("bundled scene loads");
+    let opts = RadiosityOptions {
+        target_de: 0.1,
+        ..RadiosityOptions::default()
+    };
+    let mut group = c.benchmark_group("radiosity");
+    group.sample_size(10);
+    group.bench_function("24 spots to ΔE*ab bound 0.1", |b| {
+        b.iter(|| {
+            let r = render_spots_radiosity(&scene, &opts, &|_| {}).expect("box qualifies");
+            std::hint::black_box(r.patches[0].xyz)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, radiosity);
 criterion_main!(benches);

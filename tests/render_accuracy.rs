@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use metamer::color::{observer, ObserverKind, SpectralTable};
-use metamer::render::geometry::Vec3;
+use metamer::render::geometry::{Vec3, VecOps};
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::scene::{Scene, SceneFile};
 use metamer::render::spot::{patch_aim, sample_cone, Aim};
@@ -58,8 +58,8 @@ fn emitter_head_on_reads_its_luminance() {
         let scene = build(&serde_json::from_str(&text).unwrap());
         let tracer = Tracer::new(&scene, Strategy::default());
         let aim = Aim {
-            origin: Vec3([0.3, 0.25, 0.25]),
-            axis: Vec3([-1.0, 0.0, 0.0]),
+            origin: Vec3::from_array([0.3, 0.25, 0.25]),
+            axis: Vec3::from_array([-1.0, 0.0, 0.0]),
             acceptance_deg: 1e-4,
         };
         let st = sample_cone(&tracer, aim, 1, 0, 0, 16);
@@ -78,8 +78,8 @@ fn emitter_head_on_reads_its_luminance() {
         .unwrap();
     let scene = build(&v);
     let tracer = Tracer::new(&scene, Strategy::default());
-    let dir = Vec3([-(60f64.to_radians().cos()), 0.0, 60f64.to_radians().sin()]);
-    let target = Vec3([0.0, 0.25, 0.25]);
+    let dir = Vec3::from_array([-(60f64.to_radians().cos()), 0.0, 60f64.to_radians().sin()]);
+    let target = Vec3::from_array([0.0, 0.25, 0.25]);
     let aim = Aim {
         origin: target.minus(dir.times(0.2)),
         axis: dir,
@@ -125,8 +125,8 @@ fn white_furnace() {
     ] {
         let tracer = Tracer::new(&scene, strategy);
         let aim = Aim {
-            origin: Vec3([0.3, 0.5, 0.6]),
-            axis: Vec3([0.5, -0.3, 0.8]).normalized(),
+            origin: Vec3::from_array([0.3, 0.5, 0.6]),
+            axis: Vec3::from_array([0.5, -0.3, 0.8]).normalized(),
             acceptance_deg: 30.0,
         };
         let st = sample_cone(&tracer, aim, 3, 0, 0, 150_000);
@@ -213,7 +213,7 @@ fn spot_matches_image_over_the_cone() {
     // a uniform patch adds none).
     let scene = build(&box_json());
     let (w, h) = (203usize, 203usize);
-    let cam = scene.camera;
+    let cam = scene.camera.expect("the box has a camera");
     let aim = patch_aim(&scene, 19).unwrap();
     let half_h = (cam.vfov_deg.to_radians() / 2.0).tan();
     let cos_max = (aim.acceptance_deg.to_radians() / 2.0).cos();
@@ -245,7 +245,8 @@ fn spot_matches_image_over_the_cone() {
             window: Some([x0, y0, x1, y1]),
         },
         &|_| {},
-    );
+    )
+    .unwrap();
     let mut acc = [0.0f64; 3];
     for &(x, y) in &inside {
         let p = img.at(x, y);

@@ -5,15 +5,28 @@ use std::path::PathBuf;
 use clap::Subcommand;
 
 use super::{parse_triple, CliError, CliResult};
+use metamer::numeric_csv::NumericCsv;
 use metamer::render::convergence;
+use metamer::render::geometry::{Vec3, VecOps};
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
+use metamer::render::probes::probe_illuminance_path;
+use metamer::render::radiosity::probes::{probe_illuminance, Illuminance, Probe};
+use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
 #[derive(clap::Args)]
 pub struct Args {
     #[command(subcommand)]
     command: Cmd,
+}
+
+/// How the spot readings are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    Radiosity,
+    Path,
+    Auto,
 }
 
 #[derive(Subcommand)]
@@ -31,6 +44,10 @@ enum Cmd {
         max_seconds: f64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
+        /// path: the path tracer; auto: radiosity when the scene qualifies.
+        #[arg(long, value_enum, default_value_t = Method::Auto)]
+        method: Method,
         #[arg(long)]
         json: bool,
     },
@@ -52,6 +69,25 @@ enum Cmd {
         preview: Option<PathBuf>,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// Illuminance (lux: direct, indirect, total) at points given as CSV rows
+    /// x,y,z,nx,ny,nz (header line), the normal being the measuring surface's.
+    Probes {
+        scene: PathBuf,
+        #[arg(long)]
+        points: PathBuf,
+        #[arg(long, value_enum, default_value_t = Method::Auto)]
+        method: Method,
+        /// Radiosity: refine until every bound is below this fraction of the total.
+        #[arg(long, default_value_t = 0.001)]
+        rel_tolerance: f64,
+        /// Path tracing: paths per point.
+        #[arg(long, default_value_t = 65536)]
+        samples: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[arg(long)]
+        json: bool,
     },
     /// CSV and SVG of ΔE*ab error against seconds for each sampling strategy.
     Convergence {
@@ -77,12 +113,30 @@ pub fn run(args: Args) -> CliResult {
             white,
             max_seconds,
             seed,
+            method,
             json,
         } => {
             if target_de.is_nan() || target_de <= 0.0 {
                 return Err(CliError::Usage("--target-de must be > 0".into()));
             }
             let scene = Scene::load(&scene)?;
+            let use_radiosity = match method {
+                Method::Path => false,
+                Method::Radiosity => {
+                    radiosity::qualifies(&scene)?;
+                    true
+                }
+                Method::Auto => match radiosity::qualifies(&scene) {
+                    Ok(()) => true,
+                    Err(why) => {
+                        eprintln!("using the path tracer: {why}");
+                        false
+                    }
+                },
+            };
+            if use_radiosity {
+                return spots_radiosity(&scene, target_de, white, max_seconds, json);
+            }
             let opts = SpotOptions {
                 target_de,
                 white,
@@ -105,7 +159,13 @@ pub fn run(args: Args) -> CliResult {
             })?;
             bar.finish_and_clear();
             if json {
-                println!("{}", serde_json::to_string(&r)?);
+                println!(
+                    "{}",
+                    serde_json::to_string(&Tagged {
+                        method: "path",
+                        result: &r
+                    })?
+                );
             } else {
                 println!(
                     "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
@@ -152,9 +212,13 @@ pub fn run(args: Args) -> CliResult {
             if spp == 0 {
                 return Err(CliError::Usage("--spp must be ≥ 1".into()));
             }
-            let scene = Scene::load(&scene)?;
-            let width = width.unwrap_or(scene.camera.width);
-            let height = height.unwrap_or(scene.camera.height);
+            let file = scene;
+            let scene = Scene::load(&file)?;
+            let camera = scene.camera.ok_or_else(|| {
+                CliError::Failed(format!("{}: the scene has no camera", file.display()).into())
+            })?;
+            let width = width.unwrap_or(camera.width);
+            let height = height.unwrap_or(camera.height);
             if width == 0 || height == 0 {
                 return Err(CliError::Usage("--width and --height must be ≥ 1".into()));
             }
@@ -174,7 +238,7 @@ pub fn run(args: Args) -> CliResult {
                 window: None,
             };
             let t = std::time::Instant::now();
-            let img = render_image(&scene, &opts, &|n| bar.inc(n as u64));
+            let img = render_image(&scene, &opts, &|n| bar.inc(n as u64))?;
             bar.finish_and_clear();
             let secs = t.elapsed().as_secs_f64();
             write_xyz_image(&output, &img)?;
@@ -197,6 +261,15 @@ pub fn run(args: Args) -> CliResult {
             }
             Ok(())
         }
+        Cmd::Probes {
+            scene,
+            points,
+            method,
+            rel_tolerance,
+            samples,
+            seed,
+            json,
+        } => probes(&scene, &points, method, rel_tolerance, samples, seed, json),
         Cmd::Convergence {
             scene,
             output,
@@ -215,4 +288,154 @@ pub fn run(args: Args) -> CliResult {
             Ok(())
         }
     }
+}
+
+/// A result with the method that produced it, for `--json`.
+#[derive(serde::Serialize)]
+struct Tagged<'a, T: serde::Serialize> {
+    method: &'static str,
+    #[serde(flatten)]
+    result: &'a T,
+}
+
+fn spots_radiosity(
+    scene: &Scene,
+    target_de: f64,
+    white: Option<[f64; 3]>,
+    max_seconds: f64,
+    json: bool,
+) -> CliResult {
+    let opts = RadiosityOptions {
+        target_de,
+        white,
+        max_seconds,
+        ..RadiosityOptions::default()
+    };
+    let r = render_spots_radiosity(scene, &opts, &|l| {
+        eprintln!(
+            "level {}: {} elements, {} sweeps, {:.2} s",
+            l.level, l.elements, l.sweeps, l.seconds
+        )
+    })?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string(&Tagged {
+                method: "radiosity",
+                result: &r
+            })?
+        );
+        return Ok(());
+    }
+    println!(
+        "radiosity: white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.2} s, {} levels{}",
+        r.white[0],
+        r.white[1],
+        r.white[2],
+        r.seconds,
+        r.levels.len(),
+        if r.converged {
+            ""
+        } else {
+            "  (level or time limit reached: bound above the target)"
+        }
+    );
+    println!(
+        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>9}",
+        "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE bound"
+    );
+    for p in &r.patches {
+        println!(
+            "{:>5} {:>10.4} {:>10.4} {:>10.4} {:>8.3} {:>8.3} {:>8.3} {:>9.5}",
+            p.patch, p.xyz[0], p.xyz[1], p.xyz[2], p.lab[0], p.lab[1], p.lab[2], p.de_bound
+        );
+    }
+    Ok(())
+}
+
+fn probes(
+    scene: &std::path::Path,
+    points: &std::path::Path,
+    method: Method,
+    rel_tolerance: f64,
+    samples: u64,
+    seed: u64,
+    json: bool,
+) -> CliResult {
+    if rel_tolerance.is_nan() || rel_tolerance <= 0.0 {
+        return Err(CliError::Usage("--rel-tolerance must be > 0".into()));
+    }
+    if samples < 2 {
+        return Err(CliError::Usage("--samples must be ≥ 2".into()));
+    }
+    let scene = Scene::load(scene)?;
+    let csv = NumericCsv::read(points, &["x", "y", "z", "nx", "ny", "nz"])?;
+    let mut probes = Vec::with_capacity(csv.rows.len());
+    for (line, v) in &csv.rows {
+        let normal = Vec3::from_array([v[3], v[4], v[5]]);
+        if normal.length() == 0.0 {
+            return Err(CliError::Failed(
+                format!("{}:{line}: the normal is zero", points.display()).into(),
+            ));
+        }
+        probes.push(Probe {
+            position: Vec3::from_array([v[0], v[1], v[2]]),
+            normal: normal.normalized(),
+        });
+    }
+    let use_radiosity = match method {
+        Method::Path => false,
+        Method::Radiosity => {
+            radiosity::qualifies(&scene)?;
+            true
+        }
+        Method::Auto => match radiosity::qualifies(&scene) {
+            Ok(()) => true,
+            Err(why) => {
+                eprintln!("using the path tracer: {why}");
+                false
+            }
+        },
+    };
+    let t = std::time::Instant::now();
+    let out = if use_radiosity {
+        probe_illuminance(&scene, &probes, &RadiosityOptions::default(), rel_tolerance)?
+    } else {
+        probe_illuminance_path(&scene, &probes, samples, seed)
+    };
+    let method = if use_radiosity { "radiosity" } else { "path" };
+    if json {
+        #[derive(serde::Serialize)]
+        struct Row<'a> {
+            point: [f64; 3],
+            normal: [f64; 3],
+            #[serde(flatten)]
+            lux: &'a Illuminance,
+        }
+        let rows: Vec<Row> = probes
+            .iter()
+            .zip(&out)
+            .map(|(p, lux)| Row {
+                point: p.position.to_array(),
+                normal: p.normal.to_array(),
+                lux,
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({"method": method, "seconds": t.elapsed().as_secs_f64(), "probes": rows})
+        );
+        return Ok(());
+    }
+    eprintln!("{method}: {:.2} s", t.elapsed().as_secs_f64());
+    println!("x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux,bound_lux");
+    for (p, e) in probes.iter().zip(&out) {
+        let [x, y, z] = p.position.to_array();
+        let [a, b, c] = p.normal.to_array();
+        println!(
+            "{x},{y},{z},{a},{b},{c},{:.6},{:.6},{:.6},{:.6}",
+            e.direct_lux, e.indirect_lux, e.total_lux, e.bound_lux
+        );
+    }
+    Ok(())
 }

@@ -1,5 +1,7 @@
 //! Speed against accuracy: the largest ΔE*ab over the 24 spot readings, against a long
-//! reference run, as a function of render time for each sampling strategy.
+//! reference run, as a function of render time for each sampling strategy; and for the
+//! radiosity solver its error bound and its true error (against its finest solution) as
+//! the mesh is refined.
 
 use std::path::Path;
 use std::time::Instant;
@@ -7,6 +9,7 @@ use std::time::Instant;
 use crate::plot::{write_log_log, LogLogChart, Series};
 
 use super::integrator::{Strategy, Tracer, Wavelengths};
+use super::radiosity::{combine, run_level, Prepared, RadiosityError, RadiosityOptions};
 use super::scene::Scene;
 use super::spot::{patch_aim, render_spots, sample_cone, Aim, SpotError, SpotOptions};
 use crate::color::{delta_e76, Xyz};
@@ -50,6 +53,8 @@ pub struct Point {
 pub enum ConvergenceError {
     #[error(transparent)]
     Spot(#[from] SpotError),
+    #[error(transparent)]
+    Radiosity(#[from] RadiosityError),
     #[error("{file}: {source}")]
     Io {
         file: std::path::PathBuf,
@@ -120,7 +125,66 @@ pub fn run(
             n *= 2;
         }
     }
+    if super::radiosity::qualifies(scene).is_ok() {
+        points.extend(radiosity_points(scene, RADIOSITY_LEVELS, log)?);
+    }
     Ok((points, reference.white))
+}
+
+/// Mesh levels the radiosity curves run to; the last three give the "true" answer.
+pub const RADIOSITY_LEVELS: usize = 9;
+
+/// The two radiosity curves of the chart.
+pub const RADIOSITY_BOUND: &str = "radiosity: error bound";
+pub const RADIOSITY_TRUE: &str = "radiosity: true error";
+
+/// Levels 1…`levels`: at each level from the third on, the seconds spent on all levels so
+/// far (the bound needs them all), the largest bound, and the largest ΔE*ab against the
+/// extrapolation of the finest three levels (each against its own white).
+pub fn radiosity_points(
+    scene: &Scene,
+    levels: usize,
+    log: &dyn Fn(&str),
+) -> Result<Vec<Point>, ConvergenceError> {
+    let opts = RadiosityOptions::default();
+    let prepared = Prepared::new(scene).map_err(ConvergenceError::Radiosity)?;
+    let mut done = Vec::new();
+    let mut spent = Vec::new();
+    let mut total = 0.0;
+    for level in 1..=levels.max(4) {
+        let l = run_level(&prepared, &opts, level)?;
+        total += l.seconds;
+        log(&format!(
+            "radiosity level {level}: {} elements, {:.2} s",
+            l.elements, l.seconds
+        ));
+        spent.push(total);
+        done.push(l);
+    }
+    let n = done.len();
+    let (finest, fw) = combine(&done[n - 3..], &opts);
+    let lab = |x: [f64; 3], w: [f64; 3]| Xyz::from_array(x).to_lab(Xyz::from_array(w));
+    let mut points = Vec::new();
+    for m in 3..n {
+        let (r, w) = combine(&done[m - 3..m], &opts);
+        let errors: Vec<f64> = r
+            .iter()
+            .zip(&finest)
+            .map(|(a, b)| delta_e76(lab(a.xyz, w), lab(b.xyz, fw)))
+            .collect();
+        let bounds: Vec<f64> = r.iter().map(|a| a.de_bound).collect();
+        let elements = done[m - 1].elements as u64;
+        for (name, v) in [(RADIOSITY_BOUND, &bounds), (RADIOSITY_TRUE, &errors)] {
+            points.push(Point {
+                strategy: name,
+                samples_per_patch: elements,
+                seconds: spent[m - 1],
+                max_de: v.iter().cloned().fold(0.0, f64::max),
+                mean_de: v.iter().sum::<f64>() / v.len() as f64,
+            });
+        }
+    }
+    Ok(points)
 }
 
 /// Writes `convergence.csv` and `convergence.svg` into `dir`.
@@ -132,6 +196,7 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let csv = dir.join("convergence.csv");
     // Strategy names contain commas: quoted (RFC 4180).
+    // For the radiosity rows the second column is the finest level's element count.
     let mut text = String::from("strategy,samples_per_patch,seconds,max_de_ab,mean_de_ab\n");
     for p in points {
         text.push_str(&format!(
@@ -141,9 +206,12 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
     }
     std::fs::write(&csv, text).map_err(io(&csv))?;
     let svg = dir.join("convergence.svg");
-    let series: Vec<Series> = strategies()
+    let mut names: Vec<&str> = strategies().iter().map(|(name, _)| *name).collect();
+    names.extend([RADIOSITY_BOUND, RADIOSITY_TRUE]);
+    let series: Vec<Series> = names
         .iter()
-        .map(|(name, _)| Series {
+        .filter(|name| points.iter().any(|p| p.strategy == **name))
+        .map(|name| Series {
             name: name.to_string(),
             points: points
                 .iter()

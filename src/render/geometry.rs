@@ -1,48 +1,41 @@
 //! Vectors, one-sided rectangles and ray intersection: everything in the validation box is
 //! a rectangle, so a linear scan over a few dozen of them is all the acceleration it needs.
 
-/// A 3-vector in metres (positions) or a direction.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Vec3(pub [f64; 3]);
+/// A 3-vector in metres (positions) or a direction: glam's `DVec3`.
+pub type Vec3 = glam::DVec3;
 
-impl Vec3 {
-    pub fn plus(self, o: Vec3) -> Vec3 {
-        Vec3([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
+/// The renderer's vector vocabulary on `DVec3`, so the tracer's arithmetic reads as it
+/// always has; new code may as well use glam's operators.
+pub trait VecOps {
+    fn plus(self, o: Vec3) -> Vec3;
+    fn minus(self, o: Vec3) -> Vec3;
+    fn times(self, k: f64) -> Vec3;
+    fn normalized(self) -> Vec3;
+    /// Two unit vectors completing `self` (unit) to an orthonormal basis (Duff et al.
+    /// 2017, "Building an Orthonormal Basis, Revisited", which is what glam implements).
+    fn basis(self) -> (Vec3, Vec3);
+}
+
+impl VecOps for Vec3 {
+    #[inline]
+    fn plus(self, o: Vec3) -> Vec3 {
+        self + o
     }
-    pub fn minus(self, o: Vec3) -> Vec3 {
-        Vec3([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
+    #[inline]
+    fn minus(self, o: Vec3) -> Vec3 {
+        self - o
     }
-    pub fn times(self, k: f64) -> Vec3 {
-        Vec3([self.0[0] * k, self.0[1] * k, self.0[2] * k])
+    #[inline]
+    fn times(self, k: f64) -> Vec3 {
+        self * k
     }
-    pub fn dot(self, o: Vec3) -> f64 {
-        self.0[0] * o.0[0] + self.0[1] * o.0[1] + self.0[2] * o.0[2]
+    #[inline]
+    fn normalized(self) -> Vec3 {
+        self * (1.0 / self.length())
     }
-    pub fn cross(self, o: Vec3) -> Vec3 {
-        let (a, b) = (self.0, o.0);
-        Vec3([
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ])
-    }
-    pub fn length(self) -> f64 {
-        self.dot(self).sqrt()
-    }
-    pub fn normalized(self) -> Vec3 {
-        self.times(1.0 / self.length())
-    }
-    /// Two unit vectors completing `self` (unit) to an orthonormal basis (Duff et al. 2017,
-    /// "Building an Orthonormal Basis, Revisited").
-    pub fn basis(self) -> (Vec3, Vec3) {
-        let n = self.0;
-        let sign = 1.0f64.copysign(n[2]);
-        let a = -1.0 / (sign + n[2]);
-        let b = n[0] * n[1] * a;
-        (
-            Vec3([1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]]),
-            Vec3([b, sign + n[1] * n[1] * a, -n[1]]),
-        )
+    #[inline]
+    fn basis(self) -> (Vec3, Vec3) {
+        self.any_orthonormal_pair()
     }
 }
 
@@ -128,28 +121,43 @@ mod tests {
     fn hits_front_and_back() {
         // Unit square in z = 1 facing −z (u = y, v = x gives y × x = −z).
         let r = Rect::new(
-            Vec3([0.0, 0.0, 1.0]),
-            Vec3([0.0, 1.0, 0.0]),
-            Vec3([1.0, 0.0, 0.0]),
+            Vec3::from_array([0.0, 0.0, 1.0]),
+            Vec3::from_array([0.0, 1.0, 0.0]),
+            Vec3::from_array([1.0, 0.0, 0.0]),
         );
-        assert_eq!(r.normal.0, [0.0, 0.0, -1.0]);
+        assert_eq!(r.normal.to_array(), [0.0, 0.0, -1.0]);
         let h = r
-            .intersect(Vec3([0.25, 0.5, 0.0]), Vec3([0.0, 0.0, 1.0]), 0.0, 9.0)
+            .intersect(
+                Vec3::from_array([0.25, 0.5, 0.0]),
+                Vec3::from_array([0.0, 0.0, 1.0]),
+                0.0,
+                9.0,
+            )
             .unwrap();
         assert!((h.t - 1.0).abs() < 1e-12 && h.front);
         assert!((h.a - 0.5).abs() < 1e-12 && (h.b - 0.25).abs() < 1e-12);
         let back = r
-            .intersect(Vec3([0.5, 0.5, 2.0]), Vec3([0.0, 0.0, -1.0]), 0.0, 9.0)
+            .intersect(
+                Vec3::from_array([0.5, 0.5, 2.0]),
+                Vec3::from_array([0.0, 0.0, -1.0]),
+                0.0,
+                9.0,
+            )
             .unwrap();
         assert!(!back.front);
         assert!(r
-            .intersect(Vec3([1.5, 0.5, 0.0]), Vec3([0.0, 0.0, 1.0]), 0.0, 9.0)
+            .intersect(
+                Vec3::from_array([1.5, 0.5, 0.0]),
+                Vec3::from_array([0.0, 0.0, 1.0]),
+                0.0,
+                9.0
+            )
             .is_none());
     }
 
     #[test]
     fn basis_is_orthonormal() {
-        let n = Vec3([0.3, -0.5, 0.8]).normalized();
+        let n = Vec3::from_array([0.3, -0.5, 0.8]).normalized();
         let (s, t) = n.basis();
         for (x, y) in [(s, t), (s, n), (t, n)] {
             assert!(x.dot(y).abs() < 1e-12);

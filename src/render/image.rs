@@ -3,6 +3,7 @@
 
 use rayon::prelude::*;
 
+use super::geometry::VecOps;
 use super::image_io::XyzImage;
 use super::integrator::{Strategy, Tracer};
 use super::scene::Scene;
@@ -21,14 +22,21 @@ pub struct ImageOptions {
     pub window: Option<[usize; 4]>,
 }
 
+/// Why an image cannot be rendered.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("the scene has no camera")]
+    NoCamera,
+}
+
 /// Renders the image; `progress(rows_done)` is called as rows finish.
 pub fn render_image(
     scene: &Scene,
     opts: &ImageOptions,
     progress: &(dyn Fn(usize) + Sync),
-) -> XyzImage {
+) -> Result<XyzImage, ImageError> {
+    let cam = scene.camera.ok_or(ImageError::NoCamera)?;
     let tracer = Tracer::new(scene, opts.strategy);
-    let cam = scene.camera;
     let (w, h) = (opts.width.max(1), opts.height.max(1));
     let half_h = (cam.vfov_deg.to_radians() / 2.0).tan();
     let half_w = half_h * w as f64 / h as f64;
@@ -67,9 +75,9 @@ pub fn render_image(
             row
         })
         .collect();
-    XyzImage {
+    Ok(XyzImage {
         width: w,
         height: h,
         pixels: rows.into_iter().flatten().collect(),
-    }
+    })
 }

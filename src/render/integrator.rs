@@ -8,7 +8,7 @@
 //! Geometry does not depend on wavelength here, so the hero wavelengths share every vertex
 //! and their estimates are exact per-wavelength path-tracing estimates.
 
-use super::geometry::Vec3;
+use super::geometry::{Vec3, VecOps};
 use super::scene::Scene;
 use super::spectral::{Rng, WavelengthSampler, N_BINS};
 use crate::color::K_M;

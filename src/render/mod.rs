@@ -21,3 +21,5 @@ pub use spot::{
 pub mod convergence;
 pub mod image;
 pub mod image_io;
+pub mod probes;
+pub mod radiosity;

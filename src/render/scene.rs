@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::geometry::{Rect, Vec3};
+use super::geometry::{Rect, Vec3, VecOps};
 use super::spectral::{bins, cmf_bins, constant_bins};
 use crate::color::{luminance, ObserverKind, Outside, SpectralTable, Spectrum};
 
@@ -73,14 +73,13 @@ pub struct SurfaceFile {
     pub patch: Option<usize>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum DistributionFile {
+    #[default]
     Lambertian,
     /// f(θ) = cosᵐθ relative to a Lambertian emitter (f = 1 on the normal).
-    CosPower {
-        exponent: f64,
-    },
+    CosPower { exponent: f64 },
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -98,11 +97,20 @@ pub struct EmitterFile {
     pub corner: [f64; 3],
     pub edge_u: [f64; 3],
     pub edge_v: [f64; 3],
+    /// Tile grid (default 1 × 1: an untiled panel).
+    #[serde(default = "one")]
     pub rows: usize,
+    #[serde(default = "one")]
     pub cols: usize,
+    /// Tile gains; omitted, every tile has gain 1.
+    #[serde(default)]
     pub tiles: Vec<TileFile>,
+    /// Relative spectral radiance (default: equal energy, as for a photometric-only light).
+    #[serde(default = "equal_energy")]
     pub spectrum: SpectrumRef,
     pub luminance_cd_m2: f64,
+    /// Directional factor (default Lambertian).
+    #[serde(default)]
     pub distribution: DistributionFile,
     /// Reflectance of the emitting surface (default 0: the light absorbs what reaches it).
     #[serde(default)]
@@ -135,8 +143,19 @@ pub struct SceneFile {
     pub description: Option<String>,
     pub surfaces: Vec<SurfaceFile>,
     pub emitters: Vec<EmitterFile>,
-    pub camera: CameraFile,
-    pub meter: MeterFile,
+    /// A room lit for illuminance probes needs neither camera nor meter.
+    #[serde(default)]
+    pub camera: Option<CameraFile>,
+    #[serde(default)]
+    pub meter: Option<MeterFile>,
+}
+
+fn one() -> usize {
+    1
+}
+
+fn equal_energy() -> SpectrumRef {
+    SpectrumRef::Constant(1.0)
 }
 
 /// A reflecting rectangle ready to render.
@@ -208,8 +227,10 @@ pub struct Scene {
     pub name: String,
     pub surfaces: Vec<Surface>,
     pub emitters: Vec<Emitter>,
-    pub camera: Camera,
-    pub meter_acceptance_deg: f64,
+    /// None when the file has no camera (a room for illuminance probes).
+    pub camera: Option<Camera>,
+    /// None when the file has no meter.
+    pub meter_acceptance_deg: Option<f64>,
     /// x̄, ȳ, z̄ on the grid (CIE 1931 2°).
     pub cmf: [Vec<f64>; 3],
 }
@@ -260,46 +281,26 @@ impl Scene {
         for (i, e) in file.emitters.iter().enumerate() {
             emitters.push(emitter(&format!("emitters[{i}]"), e, dir)?);
         }
-        let c = &file.camera;
-        let position = Vec3(c.position);
-        let forward = Vec3(c.look_at).minus(position);
-        if forward.length() == 0.0 || !forward.length().is_finite() {
-            return Err(("camera.look_at".into(), "must differ from position".into()));
-        }
-        let forward = forward.normalized();
-        let right = forward.cross(Vec3(c.up));
-        if right.length() < 1e-9 {
-            return Err((
-                "camera.up".into(),
-                "must not be parallel to the view".into(),
-            ));
-        }
-        let right = right.normalized();
-        let up = right.cross(forward);
-        if !(c.vfov_deg > 0.0 && c.vfov_deg < 179.0) {
-            return Err(("camera.vfov_deg".into(), "must be in (0, 179)".into()));
-        }
-        if c.width == 0 || c.height == 0 {
-            return Err(("camera.width".into(), "image size must be ≥ 1".into()));
-        }
-        let a = file.meter.acceptance_deg;
-        if !(a > 0.0 && a < 90.0) {
-            return Err(("meter.acceptance_deg".into(), "must be in (0, 90)".into()));
-        }
+        let camera = match &file.camera {
+            Some(c) => Some(camera(c)?),
+            None => None,
+        };
+        let meter_acceptance_deg = match &file.meter {
+            Some(m) => {
+                let a = m.acceptance_deg;
+                if !(a > 0.0 && a < 90.0) {
+                    return Err(("meter.acceptance_deg".into(), "must be in (0, 90)".into()));
+                }
+                Some(a)
+            }
+            None => None,
+        };
         Ok(Scene {
             name: file.name.clone(),
             surfaces,
             emitters,
-            camera: Camera {
-                position,
-                forward,
-                right,
-                up,
-                vfov_deg: c.vfov_deg,
-                width: c.width,
-                height: c.height,
-            },
-            meter_acceptance_deg: a,
+            camera,
+            meter_acceptance_deg,
             cmf: cmf_bins(ObserverKind::Cie1931),
         })
     }
@@ -310,9 +311,42 @@ impl Scene {
     }
 }
 
+fn camera(c: &CameraFile) -> Result<Camera, (String, String)> {
+    let position = Vec3::from_array(c.position);
+    let forward = Vec3::from_array(c.look_at).minus(position);
+    if forward.length() == 0.0 || !forward.length().is_finite() {
+        return Err(("camera.look_at".into(), "must differ from position".into()));
+    }
+    let forward = forward.normalized();
+    let right = forward.cross(Vec3::from_array(c.up));
+    if right.length() < 1e-9 {
+        return Err((
+            "camera.up".into(),
+            "must not be parallel to the view".into(),
+        ));
+    }
+    let right = right.normalized();
+    let up = right.cross(forward);
+    if !(c.vfov_deg > 0.0 && c.vfov_deg < 179.0) {
+        return Err(("camera.vfov_deg".into(), "must be in (0, 179)".into()));
+    }
+    if c.width == 0 || c.height == 0 {
+        return Err(("camera.width".into(), "image size must be ≥ 1".into()));
+    }
+    Ok(Camera {
+        position,
+        forward,
+        right,
+        up,
+        vfov_deg: c.vfov_deg,
+        width: c.width,
+        height: c.height,
+    })
+}
+
 fn finite3(path: &str, v: [f64; 3]) -> Result<Vec3, (String, String)> {
     if v.iter().all(|x| x.is_finite()) {
-        Ok(Vec3(v))
+        Ok(Vec3::from_array(v))
     } else {
         Err((path.into(), "must be finite numbers".into()))
     }
@@ -388,7 +422,9 @@ fn emitter(p: &str, e: &EmitterFile, dir: &Path) -> Result<Emitter, (String, Str
     if e.cols == 0 {
         return Err((format!("{p}.cols"), "must be ≥ 1".into()));
     }
-    let mut gains = vec![f64::NAN; e.rows * e.cols];
+    // No tiles listed: an untiled panel, every tile at gain 1.
+    let fill = if e.tiles.is_empty() { 1.0 } else { f64::NAN };
+    let mut gains = vec![fill; e.rows * e.cols];
     for (i, t) in e.tiles.iter().enumerate() {
         let tp = format!("{p}.tiles[{i}]");
         if t.row >= e.rows {
@@ -401,7 +437,7 @@ fn emitter(p: &str, e: &EmitterFile, dir: &Path) -> Result<Emitter, (String, Str
             return Err((format!("{tp}.gain"), "must be ≥ 0".into()));
         }
         let g = &mut gains[t.row * e.cols + t.col];
-        if !g.is_nan() {
+        if !g.is_nan() && !e.tiles.is_empty() {
             return Err((tp, format!("tile ({}, {}) given twice", t.row, t.col)));
         }
         *g = t.gain;

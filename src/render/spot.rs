@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::geometry::Vec3;
+use super::geometry::{Vec3, VecOps};
 use super::integrator::{Strategy, Tracer};
 use super::scene::Scene;
 use super::spectral::Rng;
@@ -207,16 +207,20 @@ pub enum SpotError {
     MissingPatch(usize),
     #[error("reference white must have Y > 0, got {0:?}")]
     BadWhite([f64; 3]),
+    #[error("the scene has no camera: the meter stands at the camera's optical centre")]
+    NoCamera,
+    #[error("the scene has no meter (its acceptance angle)")]
+    NoMeter,
 }
 
 /// The meter aim at patch `k` of `scene`.
 pub fn patch_aim(scene: &Scene, k: usize) -> Result<Aim, SpotError> {
     let s = scene.patch_surface(k).ok_or(SpotError::MissingPatch(k))?;
-    let origin = scene.camera.position;
+    let origin = scene.camera.ok_or(SpotError::NoCamera)?.position;
     Ok(Aim {
         origin,
         axis: scene.surfaces[s].rect.centre().minus(origin).normalized(),
-        acceptance_deg: scene.meter_acceptance_deg,
+        acceptance_deg: scene.meter_acceptance_deg.ok_or(SpotError::NoMeter)?,
     })
 }
 

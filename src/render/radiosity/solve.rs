@@ -1,0 +1,154 @@
+//! The radiosity system per wavelength band, solved by Gauss–Seidel.
+//!
+//! Light leaves the emitters with radiance s·S(λ)·(tile gain)·f(ω), and every other bounce
+//! is Lambertian, so the outgoing radiance of element i is L_i(λ) = s·S(λ)·ℓ_i(λ) with
+//! ℓ = ρ(λ) ∘ (g/π + F ℓ), g the element's direct irradiance per unit source radiance.
+//! ℓ depends on λ only through the smooth reflectances, so it is solved on a coarse band
+//! grid and interpolated linearly; the spectra themselves stay at 1 nm.
+
+use rayon::prelude::*;
+
+use super::super::geometry::VecOps;
+
+use super::super::spectral::N_BINS;
+use super::direct::irradiance_factor;
+use super::mesh::{average_over, Mesh};
+use crate::render::scene::Scene;
+
+/// The wavelength nodes the system is solved at: every `step` bins from the first.
+#[derive(Clone, Debug)]
+pub struct Bands {
+    pub bins: Vec<usize>,
+}
+
+impl Bands {
+    /// Nodes every `step_nm` (≥ 1) from 380 nm, always including 780 nm.
+    pub fn new(step_nm: usize) -> Bands {
+        let step = step_nm.max(1);
+        let mut bins: Vec<usize> = (0..N_BINS).step_by(step).collect();
+        if *bins.last().unwrap_or(&0) != N_BINS - 1 {
+            bins.push(N_BINS - 1);
+        }
+        Bands { bins }
+    }
+
+    pub fn len(&self) -> usize {
+        self.bins.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bins.is_empty()
+    }
+
+    /// Values at the nodes → every 1 nm bin, linearly.
+    pub fn interpolate(&self, at_nodes: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; N_BINS];
+        for (w, v) in self.bins.windows(2).zip(at_nodes.windows(2)) {
+            let span = (w[1] - w[0]) as f64;
+            for (k, o) in out[w[0]..=w[1]].iter_mut().enumerate() {
+                let t = k as f64 / span;
+                *o = v[0] * (1.0 - t) + v[1] * t;
+            }
+        }
+        out
+    }
+}
+
+/// g/π per element for each emitter, averaged over the element (more nodes near the light).
+pub fn sources(scene: &Scene, mesh: &Mesh) -> Vec<Vec<f64>> {
+    scene
+        .emitters
+        .iter()
+        .map(|e| {
+            let ec = e.rect.centre();
+            let esize = e.rect.edge_u.length().max(e.rect.edge_v.length());
+            mesh.elements
+                .par_iter()
+                .map(|el| {
+                    let dist = el.rect.centre().minus(ec).length();
+                    let nodes = ((1.0 + 4.0 * el.size / (dist - esize / 2.0).max(el.size)).ceil()
+                        as usize)
+                        .clamp(1, 8);
+                    average_over(&el.rect, nodes, |x| irradiance_factor(e, x, el.rect.normal))
+                        / std::f64::consts::PI
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Relative change below which Gauss–Seidel stops.
+pub const TOLERANCE: f64 = 1e-10;
+
+/// ℓ (N × bands, row-major) for one emitter's source `src`; `refl` is N × bands. `warm`
+/// starts the iteration from a neighbouring solution (the white scene from the scene's).
+/// Returns the solution and the number of sweeps.
+pub fn solve(
+    mesh: &Mesh,
+    refl: &[f64],
+    src: &[f64],
+    bands: usize,
+    warm: Option<&[f64]>,
+) -> (Vec<f64>, usize) {
+    let n = mesh.elements.len();
+    // Bands are independent: split them over the cores, each chunk its own Gauss–Seidel.
+    let chunk = bands.div_ceil(rayon::current_num_threads().max(1)).max(1);
+    let ranges: Vec<(usize, usize)> = (0..bands)
+        .step_by(chunk)
+        .map(|b| (b, (b + chunk).min(bands)))
+        .collect();
+    let parts: Vec<(Vec<f64>, usize)> = ranges
+        .par_iter()
+        .map(|&(b0, b1)| {
+            let k = b1 - b0;
+            let mut l = vec![0.0; n * k];
+            let mut r = vec![0.0; n * k];
+            for i in 0..n {
+                r[i * k..(i + 1) * k].copy_from_slice(&refl[i * bands + b0..i * bands + b1]);
+                if let Some(w) = warm {
+                    l[i * k..(i + 1) * k].copy_from_slice(&w[i * bands + b0..i * bands + b1]);
+                }
+            }
+            let mut acc = vec![0.0; k];
+            let mut sweeps = 0;
+            loop {
+                sweeps += 1;
+                let mut change: f64 = 0.0;
+                let mut size: f64 = 0.0;
+                for i in 0..n {
+                    acc.iter_mut().for_each(|a| *a = src[i]);
+                    let row = &mesh.form[i * n..(i + 1) * n];
+                    for (j, &f) in row.iter().enumerate() {
+                        if f != 0.0 {
+                            let lj = &l[j * k..(j + 1) * k];
+                            for (a, v) in acc.iter_mut().zip(lj) {
+                                *a += f * v;
+                            }
+                        }
+                    }
+                    let li = &mut l[i * k..(i + 1) * k];
+                    for ((v, a), rr) in li.iter_mut().zip(&acc).zip(&r[i * k..(i + 1) * k]) {
+                        let new = rr * a;
+                        change = change.max((new - *v).abs());
+                        size = size.max(new.abs());
+                        *v = new;
+                    }
+                }
+                if change <= TOLERANCE * size || sweeps >= 1000 {
+                    break;
+                }
+            }
+            (l, sweeps)
+        })
+        .collect();
+    let mut out = vec![0.0; n * bands];
+    let mut sweeps = 0;
+    for ((b0, b1), (l, s)) in ranges.iter().zip(parts) {
+        let k = b1 - b0;
+        sweeps = sweeps.max(s);
+        for i in 0..n {
+            out[i * bands + b0..i * bands + b1].copy_from_slice(&l[i * k..(i + 1) * k]);
+        }
+    }
+    (out, sweeps)
+}
