@@ -1,8 +1,10 @@
-//! The bundled spectral path tracer for the validation box (issue 4).
+//! The renderers of the validation box and of rooms like it: a spectral path tracer (the
+//! general method) and a deterministic radiosity solver for convex Lambertian enclosures
+//! (`radiosity`, the fast one).
 //!
-//! It renders exactly the scene of `shared/validation-box.md`: rectangles with Lambertian
-//! spectral reflectance and a tiled spectral emitter, traced with hero wavelengths and
-//! projected on the CIE 1931 observer with K_m = 683 lm/W (paper Eq. 8), so its output is
+//! They render the scene of `docs/validation-box.md`: rectangles with Lambertian spectral
+//! reflectance and a tiled spectral emitter. The path tracer uses hero wavelengths; both
+//! project on the CIE 1931 observer with K_m = 683 lm/W (paper Eq. 8), so its output is
 //! absolute XYZ in cd/m². Spot mode simulates the 1° meter; image mode is the paper's
 //! idealised film (Eq. 2–3).
 

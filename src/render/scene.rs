@@ -1,6 +1,6 @@
 //! The scene file (serde JSON) and its validated, render-ready form.
 //!
-//! The file states the validation box of `shared/validation-box.md`: rectangles with a
+//! The file states the validation box of `docs/validation-box.md` (or a room like it): rectangles with a
 //! Lambertian spectral reflectance, one tiled emitter whose radiance is
 //! L(λ, ω) = s·S(λ)·g[row][col]·f(ω) with s chosen so the untiled source has the stated
 //! luminance (683·Σ s·S·ȳ = luminance_cd_m2), a pinhole camera and the spot meter.
