@@ -4,7 +4,7 @@
 //!
 //! They render the scene of `docs/validation-box.md`: rectangles with Lambertian spectral
 //! reflectance and a tiled spectral emitter. The path tracer uses hero wavelengths; both
-//! project on the CIE 1931 observer with K_m = 683 lm/W (paper Eq. 8), so its output is
+//! project on the CIE 1931 observer with K_m = 683 lm/W (paper Eq. 8), so their output is
 //! absolute XYZ in cd/m². Spot mode simulates the 1° meter; image mode is the paper's
 //! idealised film (Eq. 2–3).
 
