@@ -8,6 +8,7 @@
 
 pub mod cs100a;
 pub mod devices;
+pub mod i1pro;
 
 mod error;
 pub mod instrument;
@@ -20,6 +21,7 @@ pub mod world;
 
 pub use cs100a::Cs100aError;
 pub use cs100a::Speed;
+pub use i1pro::I1ProError;
 pub use error::DriverError;
 pub use instrument::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,

@@ -49,6 +49,8 @@ pub type OpenSim = fn(&SimSettings, &OpenOptions) -> Result<Box<dyn Instrument>,
 pub struct Real {
     /// What follows `PREFIX:` in a spec, as the user is told (`PORT`).
     pub address: &'static str,
+    /// The address may be left out (`i1pro` opens the first i1Pro found).
+    pub optional: bool,
     pub open: OpenReal,
 }
 
@@ -68,6 +70,8 @@ pub struct Model {
     pub real: Option<Real>,
     pub replay: Option<OpenReplay>,
     pub sim: Option<OpenSim>,
+    /// Options of its simulation beyond `time_scale`, `seed` and `noise`.
+    pub sim_options: &'static [&'static str],
 }
 
 /// Every known model. USB IDs from ArgyllCMS `usb/55-Argyll.rules` (facts only).
@@ -79,23 +83,30 @@ pub const MODELS: &[Model] = &[
         spec_prefixes: &["cs100a"],
         real: Some(Real {
             address: "PORT",
+            optional: false,
             open: crate::cs100a::open::real,
         }),
         replay: Some(crate::cs100a::open::replay),
         sim: Some(crate::cs100a::open::sim),
+        sim_options: &[],
     },
     Model {
-        name: "i1pro",
+        name: crate::i1pro::MODEL,
         title: "X-Rite i1Pro / i1Pro 2",
         usb: &[UsbId {
             vid: 0x0971,
             pid: 0x2000,
             bus: Bus::Usb,
         }],
-        spec_prefixes: &[],
-        real: None,
-        replay: None,
-        sim: None,
+        spec_prefixes: &["i1pro"],
+        real: Some(Real {
+            address: "SERIAL",
+            optional: true,
+            open: crate::i1pro::open::real,
+        }),
+        replay: Some(crate::i1pro::open::replay),
+        sim: Some(crate::i1pro::open::sim),
+        sim_options: &["rev", "diffuser"],
     },
     Model {
         name: "i1pro3",
@@ -109,6 +120,7 @@ pub const MODELS: &[Model] = &[
         real: None,
         replay: None,
         sim: None,
+        sim_options: &[],
     },
     Model {
         name: "colormunki",
@@ -122,6 +134,7 @@ pub const MODELS: &[Model] = &[
         real: None,
         replay: None,
         sim: None,
+        sim_options: &[],
     },
     Model {
         name: "i1d3",
@@ -135,6 +148,7 @@ pub const MODELS: &[Model] = &[
         real: None,
         replay: None,
         sim: None,
+        sim_options: &[],
     },
 ];
 
@@ -190,7 +204,12 @@ pub fn real_specs() -> Vec<String> {
         .iter()
         .filter_map(|m| {
             let real = m.real.as_ref()?;
-            Some(format!("{}:{}", m.spec_prefixes.first()?, real.address))
+            let prefix = m.spec_prefixes.first()?;
+            Some(if real.optional {
+                format!("{prefix}[:{}]", real.address)
+            } else {
+                format!("{prefix}:{}", real.address)
+            })
         })
         .collect()
 }
@@ -241,9 +260,13 @@ mod tests {
 
     #[test]
     fn the_table_gives_the_known_forms_and_ids() {
-        assert_eq!(spec_forms(), "cs100a:PORT, replay:FILE.jsonl or sim:cs100a");
-        assert_eq!(simulated_specs(), vec!["sim:cs100a"]);
-        assert_eq!(replayable(), vec!["cs100a"]);
+        assert_eq!(
+            spec_forms(),
+            "cs100a:PORT, i1pro[:SERIAL], replay:FILE.jsonl, sim:cs100a or sim:i1pro"
+        );
+        assert_eq!(simulated_specs(), vec!["sim:cs100a", "sim:i1pro"]);
+        assert_eq!(replayable(), vec!["cs100a", "i1pro"]);
+        assert_eq!(by_prefix("i1pro").unwrap().name, "i1pro");
         assert!(by_name("cs100a").unwrap().usb.is_empty());
         assert_eq!(by_prefix("cs100a").unwrap().name, "cs100a");
         assert!(by_prefix("sim").is_none());
