@@ -15,15 +15,15 @@ use metamer_drivers::i1pro::{I1Pro, ManualClock};
 use metamer_drivers::link::replay::Transcript;
 use metamer_drivers::link::usb::ReplayUsb;
 use metamer_drivers::{
-    CalibrationCondition, Instrument, MeasureMode, OpenOptions, Request, SharedWorld, View,
-    World,
+    CalibrationCondition, Instrument, MeasureMode, OpenOptions, Request, SharedWorld, View, World,
 };
 
 const READINGS: usize = 20;
 
 /// Records open, dark calibration and READINGS readings at a fixed 0.25 s.
 fn transcript() -> Transcript {
-    let path = std::env::temp_dir().join(format!("metamer-i1pro-bench-{}.jsonl", std::process::id()));
+    let path =
+        std::env::temp_dir().join(format!("metamer-i1pro-bench-{}.jsonl", std::process::id()));
     let _ = std::fs::remove_file(&path);
     let world = Arc::new(SharedWorld::new(View::WhiteTile));
     let options = OpenOptions {
@@ -58,25 +58,28 @@ fn bench(c: &mut Criterion) {
     let t = transcript();
     let mut group = c.benchmark_group("i1pro");
     group.throughput(Throughput::Elements(READINGS as u64));
-    group.bench_function("replayed emissive reading (transfers + pipeline + XYZ)", |b| {
-        b.iter_batched(
-            || {
-                let link = ReplayUsb::new(t.clone()).unwrap();
-                let mut m = I1Pro::open(link, Arc::new(ManualClock::new())).unwrap();
-                m.calibrate(MeasureMode::Emissive, &CalibrationCondition::OnWhiteTile)
-                    .unwrap();
-                m.set_option("integration_s", "0.25").unwrap();
-                m
-            },
-            |mut m| {
-                for _ in 0..READINGS {
-                    std::hint::black_box(m.measure(&Request::default()).unwrap());
-                }
-                m
-            },
-            BatchSize::SmallInput,
-        )
-    });
+    group.bench_function(
+        "replayed emissive reading (transfers + pipeline + XYZ)",
+        |b| {
+            b.iter_batched(
+                || {
+                    let link = ReplayUsb::new(t.clone()).unwrap();
+                    let mut m = I1Pro::open(link, Arc::new(ManualClock::new())).unwrap();
+                    m.calibrate(MeasureMode::Emissive, &CalibrationCondition::OnWhiteTile)
+                        .unwrap();
+                    m.set_option("integration_s", "0.25").unwrap();
+                    m
+                },
+                |mut m| {
+                    for _ in 0..READINGS {
+                        std::hint::black_box(m.measure(&Request::default()).unwrap());
+                    }
+                    m
+                },
+                BatchSize::SmallInput,
+            )
+        },
+    );
     group.finish();
 }
 

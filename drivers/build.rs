@@ -54,6 +54,7 @@ fn generate(model: &str) {
         )
         .unwrap();
     }
-    let out = Path::new(&std::env::var("OUT_DIR").unwrap()).join(format!("{model}_transcript_tests.rs"));
+    let out =
+        Path::new(&std::env::var("OUT_DIR").unwrap()).join(format!("{model}_transcript_tests.rs"));
     std::fs::write(out, code).unwrap();
 }

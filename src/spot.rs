@@ -119,7 +119,10 @@ pub fn read(
 /// the very numbers the instrument reported. None when no reading has a spectrum or their
 /// wavelengths differ.
 pub fn spectra_csv(readings: &[Reading]) -> Option<String> {
-    let spectra: Vec<_> = readings.iter().map(|r| r.spectrum.as_ref()).collect::<Option<_>>()?;
+    let spectra: Vec<_> = readings
+        .iter()
+        .map(|r| r.spectrum.as_ref())
+        .collect::<Option<_>>()?;
     let first = spectra.first()?;
     if spectra
         .iter()

@@ -26,11 +26,7 @@ fn metamer(args: &[&str]) -> Output {
 }
 
 fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
@@ -70,7 +66,13 @@ fn light_on_the_grid(dir: &std::path::Path) -> [f64; 3] {
     }
     let path = dir.join("led_grid.csv");
     std::fs::write(&path, csv).unwrap();
-    xyz(ok(&metamer(&["color", "xyz", path.to_str().unwrap(), "--json"])).trim())
+    xyz(ok(&metamer(&[
+        "color",
+        "xyz",
+        path.to_str().unwrap(),
+        "--json",
+    ]))
+    .trim())
 }
 
 #[test]
@@ -101,7 +103,10 @@ fn emissive_json_matches_color_xyz_of_its_spectrum_and_of_the_light() {
         // The CSV gives the very same XYZ through the colour core.
         let again = xyz(ok(&metamer(&["color", "xyz", csv.to_str().unwrap(), "--json"])).trim());
         for k in 0..3 {
-            assert!((got[k] - again[k]).abs() <= 1e-12 * got[k].abs(), "{got:?} {again:?}");
+            assert!(
+                (got[k] - again[k]).abs() <= 1e-12 * got[k].abs(),
+                "{got:?} {again:?}"
+            );
             assert!(
                 (got[k] - want[k]).abs() / want[k] < tol,
                 "{spec}: {got:?} vs {want:?}"
@@ -180,7 +185,13 @@ fn reflective_colorchecker_prompts_for_the_tile_once_and_again_after_expiry() {
             world: world.clone(),
             target,
         };
-        let r = read(m.as_mut(), MeasureMode::Reflective, &mut operator, Some(&hands)).unwrap();
+        let r = read(
+            m.as_mut(),
+            MeasureMode::Reflective,
+            &mut operator,
+            Some(&hands),
+        )
+        .unwrap();
         let s = r.spectrum.unwrap();
         for (w, v) in s.values().iter().enumerate() {
             let want = patch.value_at(380.0 + 10.0 * w as f64);
@@ -207,7 +218,10 @@ fn bad_integration_and_modes_are_usage_or_instrument_errors() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("--integration 10: expected auto or a time in seconds from 0.005 to 4.45"), "{e}");
+    assert!(
+        e.contains("--integration 10: expected auto or a time in seconds from 0.005 to 4.45"),
+        "{e}"
+    );
     let o = metamer(&[
         "spot",
         "--instrument",
@@ -218,7 +232,13 @@ fn bad_integration_and_modes_are_usage_or_instrument_errors() {
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("the cs100a has no integration time"), "{e}");
-    let o = metamer(&["spot", "--instrument", "sim:cs100a?time_scale=0", "--mode", "ambient"]);
+    let o = metamer(&[
+        "spot",
+        "--instrument",
+        "sim:cs100a?time_scale=0",
+        "--mode",
+        "ambient",
+    ]);
     assert_eq!(o.status.code(), Some(1));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("the cs100a cannot do"), "{e}");

@@ -15,8 +15,7 @@ use metamer_drivers::i1pro::emulator::{default_light, EmulatorConfig, Fault};
 use metamer_drivers::i1pro::open::sim_with;
 use metamer_drivers::i1pro::ManualClock;
 use metamer_drivers::{
-    CalibrationCondition, Instrument, MeasureMode, OpenOptions, Request, SharedWorld, View,
-    World,
+    CalibrationCondition, Instrument, MeasureMode, OpenOptions, Request, SharedWorld, View, World,
 };
 use metamer_protocols::i1pro::calibration::key;
 use metamer_protocols::i1pro::Revision;
@@ -72,9 +71,7 @@ impl Run {
 
     fn calibrate(&mut self, mode: MeasureMode) {
         self.world.set(View::WhiteTile);
-        let r = self
-            .m()
-            .calibrate(mode, &CalibrationCondition::OnWhiteTile);
+        let r = self.m().calibrate(mode, &CalibrationCondition::OnWhiteTile);
         self.steps.push(match r {
             Ok(_) => json!({"calibrate": mode.name()}),
             Err(e) => json!({"calibrate": mode.name(), "error": message(&e)}),
@@ -172,17 +169,33 @@ fn main() {
     let mut r = Run::open(&path, EmulatorConfig::default(), View::WhiteTile);
     r.calibrate(reflective);
     r.measure(reflective, View::surface(patches[0].clone()).unwrap(), None);
-    r.measure(reflective, View::surface(patches[18].clone()).unwrap(), None);
+    r.measure(
+        reflective,
+        View::surface(patches[18].clone()).unwrap(),
+        None,
+    );
     r.finish(&path, "Rev D: reflective calibration on the white tile (a lamp-off dark and a lamp-lit white, 8 readings of 20 ms each), then ColorChecker dark skin and white 9.5. Recorded from sim:i1pro with its noise (seed 1).");
 
     let path = p("calibration_expired");
     let mut r = Run::open(&path, EmulatorConfig::default(), View::WhiteTile);
     r.calibrate(reflective);
-    r.measure(reflective, View::surface(patches[14].clone()).unwrap(), None);
+    r.measure(
+        reflective,
+        View::surface(patches[14].clone()).unwrap(),
+        None,
+    );
     r.advance(1801.0);
-    r.measure(reflective, View::surface(patches[14].clone()).unwrap(), None);
+    r.measure(
+        reflective,
+        View::surface(patches[14].clone()).unwrap(),
+        None,
+    );
     r.calibrate(reflective);
-    r.measure(reflective, View::surface(patches[14].clone()).unwrap(), None);
+    r.measure(
+        reflective,
+        View::surface(patches[14].clone()).unwrap(),
+        None,
+    );
     r.finish(&path, "Rev D: a reflective reading, then 30 min 1 s later (the dark's validity on Rev A–D) the driver refuses to measure without a transfer, asks for the white tile again, calibrates and measures. Recorded from sim:i1pro with its noise; the clock is advanced by hand.");
 
     let path = p("saturated");
@@ -191,13 +204,21 @@ fn main() {
     r.calibrate(emissive);
     r.measure(emissive, bright.clone(), None);
     r.option("integration_s", "0.5");
-    r.measure(emissive, View::radiance(default_light().scaled(10.0)).unwrap(), None);
+    r.measure(
+        emissive,
+        View::radiance(default_light().scaled(10.0)).unwrap(),
+        None,
+    );
     r.finish(&path, "Rev D: 100 000 cd/m² saturates the sensor at the trial time and again at the shortest time (too bright); then 1000 cd/m² at a fixed 0.5 s saturates too. Both are errors that say what to do, never a clipped spectrum. Recorded from sim:i1pro with noise off.");
 
     let path = p("too_dark");
     let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
     r.calibrate(emissive);
-    r.measure(emissive, View::radiance(default_light().scaled(1e-6)).unwrap(), None);
+    r.measure(
+        emissive,
+        View::radiance(default_light().scaled(1e-6)).unwrap(),
+        None,
+    );
     r.finish(&path, "Rev D: 0.0001 cd/m² gives no signal above the dark threshold even at the longest integration time (4.46 s): too dark. Recorded from sim:i1pro with noise off.");
 
     let path = p("eeprom_missing_key");

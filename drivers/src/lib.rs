@@ -21,8 +21,8 @@ pub mod world;
 
 pub use cs100a::Cs100aError;
 pub use cs100a::Speed;
-pub use i1pro::I1ProError;
 pub use error::DriverError;
+pub use i1pro::I1ProError;
 pub use instrument::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,
     InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,

@@ -77,7 +77,11 @@ fn replay_transcript(path: &str) {
                 mode: mode.parse().unwrap(),
             });
             if step.get("error").is_some() {
-                check_error(r.err().unwrap_or_else(|| panic!("{at}: measured")), step, &at);
+                check_error(
+                    r.err().unwrap_or_else(|| panic!("{at}: measured")),
+                    step,
+                    &at,
+                );
                 continue;
             }
             let r = r.unwrap_or_else(|e| panic!("{at}: {e}"));

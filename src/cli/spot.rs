@@ -11,8 +11,8 @@ use metamer::session::TerminalOperator;
 use metamer::spot::{read, spectra_csv, SimulatedHands};
 use metamer_drivers::i1pro::emulator::default_light;
 use metamer_drivers::{
-    open_instrument_with, DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Speed,
-    View, World,
+    open_instrument_with, DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Speed, View,
+    World,
 };
 
 use super::{CliError, CliResult};
@@ -89,9 +89,7 @@ pub fn run(args: Args) -> CliResult {
         .then(|| simulated_target(mode))
         .transpose()?;
     let options = OpenOptions {
-        stimulus: hands
-            .as_ref()
-            .map(|h| h.world.clone() as Arc<dyn World>),
+        stimulus: hands.as_ref().map(|h| h.world.clone() as Arc<dyn World>),
         record: args.record.clone(),
     };
     let mut instrument = open_instrument_with(&args.instrument, &options).map_err(|e| match e {

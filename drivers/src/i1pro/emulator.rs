@@ -20,8 +20,8 @@ use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Exposure};
 use metamer_protocols::i1pro::replies::MeasChar;
 use metamer_protocols::i1pro::{
     commands::{Setup, Transfer},
-    readings, Calibration, Gain, RawReading, Request, Revision, Spectrum as Bands, BANDS,
-    CELLS, SHIELDED_CELLS, START_NM, STEP_NM,
+    readings, Calibration, Gain, RawReading, Request, Revision, Spectrum as Bands, BANDS, CELLS,
+    SHIELDED_CELLS, START_NM, STEP_NM,
 };
 use metamer_protocols::transcript::TransferKind;
 
@@ -118,7 +118,10 @@ pub fn metamer_for(xyz: [f64; 3]) -> Spectrum {
         .iter()
         .map(|c| {
             let nm: Vec<f64> = (380..=780).map(f64::from).collect();
-            let v = nm.iter().map(|l| (-((l - c) / 30.0f64).powi(2)).exp()).collect();
+            let v = nm
+                .iter()
+                .map(|l| (-((l - c) / 30.0f64).powi(2)).exp())
+                .collect();
             Spectrum::new(nm, v).expect("an even grid")
         })
         .collect();
@@ -240,8 +243,8 @@ impl I1ProEmulator {
         let shielded_count = (0..SHIELDED_CELLS)
             .map(|j| Self::dark_count(CELLS + j, t).round() as u16)
             .collect::<Vec<_>>();
-        let shielded: Option<[u16; SHIELDED_CELLS]> = (revision == Revision::E)
-            .then(|| std::array::from_fn(|j| shielded_count[j]));
+        let shielded: Option<[u16; SHIELDED_CELLS]> =
+            (revision == Revision::E).then(|| std::array::from_fn(|j| shielded_count[j]));
         let dark_raw = RawReading {
             cells: std::array::from_fn(|j| dark_counts[j].round() as i32),
             shielded,
@@ -249,8 +252,8 @@ impl I1ProEmulator {
         let dark: AbsRaw = pipeline::to_absraw(&self.cal, &dark_raw, &e).map_err(err)?;
         let seen = self.seen(lamp_on)?;
         let signal = inverse::cells_for(&self.cal, &seen).map_err(err)?;
-        let clean = inverse::counts_for(&self.cal, &e, &signal, &dark, shielded, u16::MAX)
-            .map_err(err)?;
+        let clean =
+            inverse::counts_for(&self.cal, &e, &signal, &dark, shielded, u16::MAX).map_err(err)?;
         let mut out = Vec::new();
         for _ in 0..n {
             let mut r = clean.clone();
@@ -271,7 +274,11 @@ impl I1ProEmulator {
         match self.readings(int_clocks, n, lamp_on) {
             Ok(bytes) => {
                 let t = int_clocks as f64 * self.clock_s() * n as f64
-                    + if lamp_on { super::wire::LAMP_WARMUP_S } else { 0.0 };
+                    + if lamp_on {
+                        super::wire::LAMP_WARMUP_S
+                    } else {
+                        0.0
+                    };
                 let delay = Duration::from_secs_f64((t * self.config.time_scale).max(0.0));
                 self.measurements += 1;
                 self.pending = Some((delay, bytes));

@@ -1,9 +1,9 @@
 //! What can go wrong with an i1Pro, with what the user can do about it.
 
-use metamer_protocols::i1pro::replies::ReplyError;
-use metamer_protocols::i1pro::{CalibrationError, EepromError, PipelineError, ReadingError};
 use metamer_protocols::i1pro::commands::RequestError;
+use metamer_protocols::i1pro::replies::ReplyError;
 use metamer_protocols::i1pro::timing::TimingError;
+use metamer_protocols::i1pro::{CalibrationError, EepromError, PipelineError, ReadingError};
 
 /// An i1Pro failure. Link failures (timeout, stall, disconnect) are wrapped with the
 /// request that was under way, so a message says what the instrument was doing.
@@ -66,7 +66,10 @@ pub enum I1ProError {
 
 /// A USB transfer that failed, with the request it belonged to.
 #[derive(Debug, thiserror::Error)]
-#[error("the i1Pro on {device} failed during '{request}': {source}{}", advice(source))]
+#[error(
+    "the i1Pro on {device} failed during '{request}': {source}{}",
+    advice(source)
+)]
 pub struct TransferError {
     pub device: String,
     pub request: &'static str,

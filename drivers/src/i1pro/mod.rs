@@ -19,8 +19,7 @@ mod wire;
 use std::sync::Arc;
 
 use metamer_color::{
-    radiance_to_xyz, reflectance_to_xyz, Illuminant, ObserverKind, Outside, Quantity, Spectrum,
-    Xyz,
+    radiance_to_xyz, reflectance_to_xyz, Illuminant, ObserverKind, Outside, Quantity, Spectrum, Xyz,
 };
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw};
 use metamer_protocols::i1pro::replies::{ClockMode, MeasChar, Misc};
@@ -79,7 +78,8 @@ impl<L: UsbLink> I1Pro<L> {
     /// the link]. `clock` judges calibration validity.
     pub fn open(link: L, clock: Arc<dyn Clock>) -> Result<I1Pro<L>, DriverError> {
         let mut wire = Wire::new(link, Revision::AToD);
-        let misc = Misc::parse(&wire.request(Request::GetMisc)?).map_err(|e| reply("get misc", e))?;
+        let misc =
+            Misc::parse(&wire.request(Request::GetMisc)?).map_err(|e| reply("get misc", e))?;
         let revision = if misc.firmware >= 600 {
             Revision::E
         } else {
@@ -183,7 +183,8 @@ impl<L: UsbLink> I1Pro<L> {
     fn due(&self, mode: MeasureMode) -> Option<String> {
         let now = self.clock.now_s();
         let age = |at: f64, valid: f64, what: &str| {
-            (now - at > valid).then(|| format!("the {what} calibration expired after {} min", valid / 60.0))
+            (now - at > valid)
+                .then(|| format!("the {what} calibration expired after {} min", valid / 60.0))
         };
         match mode {
             MeasureMode::Emissive | MeasureMode::Ambient => match &self.darks {
@@ -192,8 +193,9 @@ impl<L: UsbLink> I1Pro<L> {
             },
             MeasureMode::Reflective => match (&self.reflective_dark, &self.white) {
                 (None, _) | (_, None) => Some("no white-tile calibration yet".into()),
-                (Some((_, d)), Some((_, w))) => age(*d, self.dark_valid_s(), "dark")
-                    .or_else(|| age(*w, WHITE_VALID_S, "white")),
+                (Some((_, d)), Some((_, w))) => {
+                    age(*d, self.dark_valid_s(), "dark").or_else(|| age(*w, WHITE_VALID_S, "white"))
+                }
             },
         }
     }
@@ -303,9 +305,7 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
         if !self.supports(mode) {
             return Err(self.unsupported(mode));
         }
-        Ok(self
-            .due(mode)
-            .map(|_| CalibrationCondition::OnWhiteTile))
+        Ok(self.due(mode).map(|_| CalibrationCondition::OnWhiteTile))
     }
 
     /// Every calibration of the i1Pro is done on its white tile: the tile covers the sensor
@@ -358,7 +358,8 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
         match mode {
             MeasureMode::Emissive | MeasureMode::Ambient => {
                 let (darks, _) = self.darks.as_ref().expect("checked by due()");
-                let p = engine::emissive_shot(&mut self.wire, &self.cal, darks, self.integration_s)?;
+                let p =
+                    engine::emissive_shot(&mut self.wire, &self.cal, darks, self.integration_s)?;
                 if mode == MeasureMode::Emissive {
                     let s = pipeline::emissive(&self.cal, &p.spectrum);
                     Ok(self.reading(watts(&s), Quantity::Radiance, p.integration_s))
@@ -371,8 +372,7 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
                 let (dark, _) = self.reflective_dark.as_ref().expect("checked by due()");
                 let (factors, _) = self.white.as_ref().expect("checked by due()");
                 let (r, p) = engine::reflective(&mut self.wire, &self.cal, dark, factors)?;
-                let mut reading =
-                    self.reading(r.to_vec(), Quantity::Reflectance, p.integration_s);
+                let mut reading = self.reading(r.to_vec(), Quantity::Reflectance, p.integration_s);
                 if p.averaged.saturated {
                     reading.flags.push(Flag::Saturated);
                 }

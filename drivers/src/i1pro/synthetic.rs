@@ -6,7 +6,7 @@
 use metamer_protocols::i1pro::calibration::{caps_e, CAPS_AMBIENT};
 use metamer_protocols::i1pro::replies::{ClockMode, Misc};
 use metamer_protocols::i1pro::{
-    eeprom, wavelength, Calibration, Eeprom, Model, Revision, RevECalibration, BANDS, START_NM,
+    eeprom, wavelength, Calibration, Eeprom, Model, RevECalibration, Revision, BANDS, START_NM,
     STEP_NM,
 };
 

@@ -42,7 +42,10 @@ fn quiet(revision: Revision) -> EmulatorConfig {
 }
 
 fn calibrate(m: &mut dyn Instrument, mode: MeasureMode) {
-    let c = m.calibration_needed(mode).unwrap().expect("a calibration is due");
+    let c = m
+        .calibration_needed(mode)
+        .unwrap()
+        .expect("a calibration is due");
     assert_eq!(c, CalibrationCondition::OnWhiteTile);
     assert_eq!(m.calibrate(mode, &c).unwrap(), CalibrationOutcome::Done);
     assert_eq!(m.calibration_needed(mode).unwrap(), None);
@@ -74,7 +77,11 @@ fn emissive_matches_the_light(revision: Revision, noise: bool, tol: f64) {
     let r = m.measure(&Request::default()).unwrap();
     let want = radiance_to_xyz(&on_grid(&light), ObserverKind::Cie1931).to_array();
     for k in 0..3 {
-        assert!(rel(r.xyz[k], want[k]) < tol, "{revision:?} {:?} vs {want:?}", r.xyz);
+        assert!(
+            rel(r.xyz[k], want[k]) < tol,
+            "{revision:?} {:?} vs {want:?}",
+            r.xyz
+        );
     }
     // The band-limited grid loses little of the full 1 nm light.
     let full = radiance_to_xyz(&light, ObserverKind::Cie1931).to_array();
@@ -129,7 +136,11 @@ fn a_fixed_integration_time_is_used_and_checked() {
     world.set(View::radiance(default_light().scaled(20.0)).unwrap());
     m.set_option("integration_s", "1").unwrap();
     let e = m.measure(&Request::default()).unwrap_err();
-    assert!(e.to_string().contains("saturated at the fixed integration time"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("saturated at the fixed integration time"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -210,7 +221,11 @@ fn a_dark_calibration_expires_after_30_minutes_on_rev_d() {
     m.measure(&Request::default()).unwrap();
     clock.advance(2.0);
     let e = m.measure(&Request::default()).unwrap_err();
-    assert!(e.to_string().contains("dark calibration expired after 30 min"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("dark calibration expired after 30 min"),
+        "{e}"
+    );
     // The wrong condition is answered with the right one.
     assert_eq!(
         m.calibrate(MeasureMode::Emissive, &CalibrationCondition::SensorCapped)
@@ -247,8 +262,8 @@ fn ambient_through_the_diffuser_gives_pi_times_the_radiance_in_lux() {
             mode: MeasureMode::Ambient,
         })
         .unwrap();
-    let want = std::f64::consts::PI
-        * radiance_to_xyz(&on_grid(&default_light()), ObserverKind::Cie1931).y;
+    let want =
+        std::f64::consts::PI * radiance_to_xyz(&on_grid(&default_light()), ObserverKind::Cie1931).y;
     assert!(rel(r.xyz[1], want) < 1e-4, "{} vs {want}", r.xyz[1]);
 }
 
@@ -265,7 +280,10 @@ fn faults_are_clear_errors_never_wrong_spectra() {
     .err()
     .unwrap();
     assert!(e.to_string().contains("factory calibration"), "{e}");
-    assert!(e.to_string().contains("0x044d") || e.to_string().contains("0x044D"), "{e}");
+    assert!(
+        e.to_string().contains("0x044d") || e.to_string().contains("0x044D"),
+        "{e}"
+    );
     let (mut m, _) = open(
         &world,
         EmulatorConfig {

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use metamer_protocols::i1pro::commands::{
-    flags, flags_e, MeasParams, MeasParamsE, Setup, EP_DATA_IN, EEPROM_READ_TIMEOUT_S,
+    flags, flags_e, MeasParams, MeasParamsE, Setup, EEPROM_READ_TIMEOUT_S, EP_DATA_IN,
 };
 use metamer_protocols::i1pro::readings::{self, RawReading};
 use metamer_protocols::i1pro::timing::{self, readings_timeout_s};
@@ -203,12 +203,9 @@ impl<L: UsbLink> Wire<L> {
             }
             .into());
         }
-        Ok(readings::parse(
-            &bytes,
-            self.revision,
-            shot.readings,
-            self.max_positive,
+        Ok(
+            readings::parse(&bytes, self.revision, shot.readings, self.max_positive)
+                .map_err(I1ProError::from)?,
         )
-        .map_err(I1ProError::from)?)
     }
 }

@@ -58,30 +58,28 @@ mod tests {
 
     #[test]
     fn a_linear_mapping_gives_normalised_triangles_centred_on_each_band() {
-        // Cells 3.125 nm apart from 345 nm: band 0 (380 nm) is centred on cell 11.2.
-        let poly = [345.0, 3.125, 0.0, 0.0];
+        // Cells 5 nm apart from 340 nm: band w (380 + 10w nm) is centred on cell 8 + 2w,
+        // and its neighbours at ±5 nm weigh 1 − 5/10 = 0.5 (those at ±10 nm weigh 0), so
+        // by hand the weights are 0.5, 1, 0.5 over 2: 0.25, 0.5, 0.25 from cell 7 + 2w.
+        let poly = [340.0, 5.0, 0.0, 0.0];
         let f = filter_from_poly(&poly).unwrap();
         for w in 0..BANDS {
-            let c = &f.coefficients()[w];
-            let s = f.starts()[w];
-            assert!((c.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-            // The weighted mean wavelength is the band centre (a symmetric triangle on an
-            // even grid), by hand: Σ c_k λ_k = 380 + 10 w.
-            let mean: f64 = c
-                .iter()
-                .enumerate()
-                .map(|(k, v)| v * cell_nm(&poly, s + k))
-                .sum();
-            assert!((mean - (380.0 + 10.0 * w as f64)).abs() < 1e-9, "{w}: {mean}");
+            assert_eq!(f.starts()[w], 7 + 2 * w, "{w}");
+            assert_eq!(f.coefficients()[w], vec![0.25, 0.5, 0.25], "{w}");
         }
-        // Cells within 10 nm of 380: (370, 390) → cells 8.0 (excluded, weight 0) … 14.4.
-        assert_eq!(f.starts()[0], 9);
-        assert_eq!(f.coefficients()[0].len(), 6);
+        // A cubic bends the mapping; the weights still sum to 1.
+        let f = filter_from_poly(&[343.5, 3.2, -0.0005, 0.0]).unwrap();
+        for c in f.coefficients() {
+            assert!((c.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        }
     }
 
     #[test]
     fn a_mapping_that_misses_the_range_is_refused() {
         let e = filter_from_poly(&[500.0, 1.0, 0.0, 0.0]).unwrap_err();
-        assert!(matches!(e, CalibrationError::FilterRange { band: 0, .. }), "{e}");
+        assert!(
+            matches!(e, CalibrationError::FilterRange { band: 0, .. }),
+            "{e}"
+        );
     }
 }
