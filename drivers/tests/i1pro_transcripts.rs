@@ -33,23 +33,17 @@ fn replay_transcript(path: &str) {
         .clone();
     let clock = ManualClock::new();
     let link = ReplayUsb::new(t).unwrap();
-    let mut meter = None;
-    for (i, step) in steps.iter().enumerate() {
-        let at = format!("{path} step {i} {step}");
-        if step.get("open").is_some() {
-            match I1Pro::open(link, Arc::new(clock.clone())) {
-                Ok(m) if step["open"] == "ok" => meter = Some(m),
-                Ok(_) => panic!("{at}: opened, expected an error"),
-                Err(e) => {
-                    check_error(e, step, &at);
-                    return;
-                }
-            }
-            break;
+    let first = &steps[0];
+    let at = format!("{path} step 0 {first}");
+    assert!(first.get("open").is_some(), "{at}: the first step must be open");
+    let mut m = match I1Pro::open(link, Arc::new(clock.clone())) {
+        Ok(m) if first["open"] == "ok" => m,
+        Ok(_) => panic!("{at}: opened, expected an error"),
+        Err(e) => {
+            check_error(e, first, &at);
+            return;
         }
-        panic!("{at}: the first step must be open");
-    }
-    let mut m = meter.expect("opened");
+    };
     for (i, step) in steps.iter().enumerate().skip(1) {
         let at = format!("{path} step {i} {step}");
         if let Some(o) = step.get("option").and_then(Value::as_array) {
