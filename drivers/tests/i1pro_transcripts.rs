@@ -35,7 +35,10 @@ fn replay_transcript(path: &str) {
     let link = ReplayUsb::new(t).unwrap();
     let first = &steps[0];
     let at = format!("{path} step 0 {first}");
-    assert!(first.get("open").is_some(), "{at}: the first step must be open");
+    assert!(
+        first.get("open").is_some(),
+        "{at}: the first step must be open"
+    );
     let mut m = match I1Pro::open(link, Arc::new(clock.clone())) {
         Ok(m) if first["open"] == "ok" => m,
         Ok(_) => panic!("{at}: opened, expected an error"),
