@@ -1,11 +1,25 @@
-//! Generates one test per CS-100A transcript (`protocols/cs100a/transcripts/*.jsonl`), so a
-//! new transcript is a new test without touching any code.
+//! Generates one test per transcript of each instrument (`protocols/MODEL/transcripts/
+//! *.jsonl`), so a new transcript is a new test without touching any code. Each model's
+//! tests go to `OUT_DIR/MODEL_transcript_tests.rs` and call that test file's
+//! `replay_transcript(path)`.
 
 use std::fmt::Write;
 use std::path::Path;
 
+/// The models with transcripts.
+const MODELS: &[&str] = &["cs100a", "i1pro"];
+
 fn main() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../protocols/cs100a/transcripts");
+    for model in MODELS {
+        generate(model);
+    }
+}
+
+fn generate(model: &str) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../protocols")
+        .join(model)
+        .join("transcripts");
     println!("cargo:rerun-if-changed={}", dir.display());
     let mut names: Vec<_> = std::fs::read_dir(&dir)
         .map(|entries| {
@@ -40,6 +54,7 @@ fn main() {
         )
         .unwrap();
     }
-    let out = Path::new(&std::env::var("OUT_DIR").unwrap()).join("cs100a_transcript_tests.rs");
+    let out =
+        Path::new(&std::env::var("OUT_DIR").unwrap()).join(format!("{model}_transcript_tests.rs"));
     std::fs::write(out, code).unwrap();
 }

@@ -14,4 +14,5 @@ pub mod plot;
 pub mod render;
 pub mod rig;
 pub mod session;
+pub mod spot;
 pub mod validation;

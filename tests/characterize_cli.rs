@@ -392,8 +392,8 @@ fn usage_and_environment_errors() {
             "--repeats must be at least 1",
         ),
         (
-            vec!["--display", "virtual", "--instrument", "sim:i1pro", "-o", d],
-            "sim:i1pro",
+            vec!["--display", "virtual", "--instrument", "sim:i1d3", "-o", d],
+            "sim:i1d3",
         ),
     ] {
         let o = metamer(&args);

@@ -220,10 +220,10 @@ fn device_faults_are_explained() {
 
 #[test]
 fn bad_specs_and_arguments() {
-    let o = metamer(&["spot", "--instrument", "sim:i1pro"]);
+    let o = metamer(&["spot", "--instrument", "sim:i1d3"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("unknown instrument 'sim:i1pro': expected cs100a:PORT"),
+        stderr(&o).contains("unknown instrument 'sim:i1d3': expected cs100a:PORT"),
         "{}",
         stderr(&o)
     );

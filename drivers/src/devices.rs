@@ -54,6 +54,9 @@ pub struct InstrumentEntry {
     /// `bus 001 address 004` or the hidraw path.
     pub location: String,
     pub serial: Option<String>,
+    /// Hardware revision where the descriptors tell it (an i1Pro: `Rev A–D` or `Rev E`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub revision: Option<String>,
     #[serde(flatten)]
     pub access: Access,
 }
@@ -215,9 +218,34 @@ fn usb_instruments(list: &mut DeviceList) {
                 device.address()
             ),
             serial,
+            revision: i1pro_revision(&device, &desc),
             access,
         });
     }
+}
+
+/// An i1Pro's revision from the endpoint count of its first configuration (the firmware,
+/// which also decides, is only known once the driver has opened it).
+fn i1pro_revision(
+    device: &rusb::Device<rusb::Context>,
+    desc: &rusb::DeviceDescriptor,
+) -> Option<String> {
+    let config = device.config_descriptor(0).ok()?;
+    let endpoints = config
+        .interfaces()
+        .flat_map(|i| i.descriptors())
+        .map(|d| usize::from(d.num_endpoints()))
+        .sum();
+    let model = metamer_protocols::i1pro::Model::detect(
+        desc.vendor_id(),
+        desc.product_id(),
+        endpoints,
+        None,
+    )?;
+    Some(match model.revision() {
+        metamer_protocols::i1pro::Revision::AToD => "Rev A–D".into(),
+        metamer_protocols::i1pro::Revision::E => "Rev E (i1Pro 2)".into(),
+    })
 }
 
 fn hid_instruments(list: &mut DeviceList) {
@@ -239,6 +267,7 @@ fn hid_instruments(list: &mut DeviceList) {
             bus: Bus::Hid.name(),
             vid: info.vendor_id(),
             pid: info.product_id(),
+            revision: None,
             access: path_access(&path, USB_PERMISSION_FIX),
             location: path,
             serial: info.serial_number().map(str::to_string),

@@ -41,6 +41,9 @@ pub enum DriverError {
     /// A CS-100A failure (not in remote mode, silent, garbled or refusing).
     #[error(transparent)]
     Cs100a(#[from] crate::cs100a::error::Cs100aError),
+    /// An i1Pro failure (EEPROM, readings, too bright or too dark, a failed transfer).
+    #[error(transparent)]
+    I1Pro(#[from] crate::i1pro::I1ProError),
     /// A link failure not covered above (I/O error, replay mismatch).
     #[error("{0}")]
     Link(#[from] LinkError),

@@ -8,6 +8,7 @@
 
 pub mod cs100a;
 pub mod devices;
+pub mod i1pro;
 
 mod error;
 pub mod instrument;
@@ -23,6 +24,7 @@ pub mod world;
 pub use cs100a::Cs100aError;
 pub use cs100a::Speed;
 pub use error::DriverError;
+pub use i1pro::I1ProError;
 pub use instrument::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,
     InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,

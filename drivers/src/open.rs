@@ -21,7 +21,7 @@ pub struct OpenOptions {
 }
 
 /// How a simulated instrument behaves, from `sim:MODEL?time_scale=…&seed=…&noise=…`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SimSettings {
     /// Multiplies every delay: 1 is the real instrument's pace, 0 no delay at all.
     pub time_scale: f64,
@@ -29,6 +29,9 @@ pub struct SimSettings {
     pub seed: u64,
     /// Add the instrument's repeatability noise.
     pub noise: bool,
+    /// The model's own options (`rev=e` of `sim:i1pro`), named in its registry row's
+    /// `sim_options`, in the order given.
+    pub extra: Vec<(String, String)>,
 }
 
 impl Default for SimSettings {
@@ -37,6 +40,7 @@ impl Default for SimSettings {
             time_scale: 1.0,
             seed: 1,
             noise: true,
+            extra: Vec::new(),
         }
     }
 }

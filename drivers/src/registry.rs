@@ -71,6 +71,8 @@ pub struct Model {
     pub real: Option<Real>,
     pub replay: Option<OpenReplay>,
     pub sim: Option<OpenSim>,
+    /// Options of its simulation beyond `time_scale`, `seed` and `noise`.
+    pub sim_options: &'static [&'static str],
 }
 
 /// Every known model. USB IDs from ArgyllCMS `usb/55-Argyll.rules` (facts only).
@@ -87,19 +89,25 @@ pub const MODELS: &[Model] = &[
         }),
         replay: Some(crate::cs100a::open::replay),
         sim: Some(crate::cs100a::open::sim),
+        sim_options: &[],
     },
     Model {
-        name: "i1pro",
+        name: crate::i1pro::MODEL,
         title: "X-Rite i1Pro / i1Pro 2",
         usb: &[UsbId {
             vid: 0x0971,
             pid: 0x2000,
             bus: Bus::Usb,
         }],
-        spec_prefixes: &[],
-        real: None,
-        replay: None,
-        sim: None,
+        spec_prefixes: &["i1pro"],
+        real: Some(Real {
+            address: "SERIAL",
+            address_required: false,
+            open: crate::i1pro::open::real,
+        }),
+        replay: Some(crate::i1pro::open::replay),
+        sim: Some(crate::i1pro::open::sim),
+        sim_options: &["rev", "diffuser"],
     },
     Model {
         name: "i1pro3",
@@ -113,6 +121,7 @@ pub const MODELS: &[Model] = &[
         real: None,
         replay: None,
         sim: None,
+        sim_options: &[],
     },
     Model {
         name: "colormunki",
@@ -126,6 +135,7 @@ pub const MODELS: &[Model] = &[
         real: None,
         replay: None,
         sim: None,
+        sim_options: &[],
     },
     Model {
         name: "i1d3",
@@ -139,6 +149,7 @@ pub const MODELS: &[Model] = &[
         real: None,
         replay: None,
         sim: None,
+        sim_options: &[],
     },
 ];
 
@@ -251,9 +262,13 @@ mod tests {
 
     #[test]
     fn the_table_gives_the_known_forms_and_ids() {
-        assert_eq!(spec_forms(), "cs100a:PORT, replay:FILE.jsonl or sim:cs100a");
-        assert_eq!(simulated_specs(), vec!["sim:cs100a"]);
-        assert_eq!(replayable(), vec!["cs100a"]);
+        assert_eq!(
+            spec_forms(),
+            "cs100a:PORT, i1pro[:SERIAL], replay:FILE.jsonl, sim:cs100a or sim:i1pro"
+        );
+        assert_eq!(simulated_specs(), vec!["sim:cs100a", "sim:i1pro"]);
+        assert_eq!(replayable(), vec!["cs100a", "i1pro"]);
+        assert_eq!(by_prefix("i1pro").unwrap().name, "i1pro");
         assert!(by_name("cs100a").unwrap().usb.is_empty());
         assert_eq!(by_prefix("cs100a").unwrap().name, "cs100a");
         assert!(by_prefix("sim").is_none());

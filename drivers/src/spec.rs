@@ -6,7 +6,10 @@
 //! - `sim:cs100a` — the emulated CS-100A, answering from a world. Options after `?`,
 //!   separated by `&`: `time_scale=F` (1 = the real meter's ≈100/400 ms per reading,
 //!   0.01 a hundred times faster, 0 instant; default 1, or the environment variable
-//!   `METAMER_SIM_TIME_SCALE`), `seed=N` (noise seed, default 1), `noise=off`.
+//!   `METAMER_SIM_TIME_SCALE`), `seed=N` (noise seed, default 1), `noise=off`;
+//! - `sim:i1pro` — the emulated i1Pro on the in-process USB pair, with the same options and
+//!   its own (`rev=d|e`, `diffuser=on`), listed in its registry row;
+//! - `i1pro[:SERIAL]` — an i1Pro on USB (`i1pro` alone: the first one found).
 //!
 //! Which models exist and how each is opened is the driver registry's; this file only reads
 //! the spec.
@@ -75,8 +78,11 @@ fn open_in(
         }
         SIM_PREFIX => {
             let (model, query) = rest.split_once('?').unwrap_or((rest, ""));
-            let open = by_name(model).and_then(|m| m.sim).ok_or_else(unknown)?;
-            open(&sim_settings(spec, query)?, options)
+            let row = by_name(model)
+                .filter(|m| m.sim.is_some())
+                .ok_or_else(unknown)?;
+            let open = row.sim.ok_or_else(unknown)?;
+            open(&sim_settings(spec, query, row.sim_options)?, options)
         }
         prefix => match models
             .iter()
@@ -90,7 +96,11 @@ fn open_in(
 }
 
 /// Parses `time_scale=…&seed=…&noise=off`.
-fn sim_settings(spec: &str, query: &str) -> Result<SimSettings, DriverError> {
+fn sim_settings(
+    spec: &str,
+    query: &str,
+    model_options: &[&str],
+) -> Result<SimSettings, DriverError> {
     let bad = |message: String| DriverError::BadSpecOption {
         spec: spec.to_string(),
         message,
@@ -119,10 +129,16 @@ fn sim_settings(spec: &str, query: &str) -> Result<SimSettings, DriverError> {
                     _ => return Err(bad(format!("noise={value:?}: expected on or off"))),
                 }
             }
+            key if model_options.contains(&key) => {
+                config.extra.push((key.to_string(), value.to_string()))
+            }
             _ => {
+                let mut known = vec!["time_scale", "seed", "noise"];
+                known.extend(model_options);
                 return Err(bad(format!(
-                    "unknown option '{key}' (known: time_scale, seed, noise)"
-                )))
+                    "unknown option '{key}' (known: {})",
+                    known.join(", ")
+                )));
             }
         }
     }
@@ -192,7 +208,7 @@ mod tests {
         assert_eq!(r.xyy[2], 100.0);
         assert!((r.xyy[0] - 0.4558).abs() < 1e-9, "{:?}", r.xyy);
         assert!((r.xyy[1] - 0.4211).abs() < 1e-9, "{:?}", r.xyy);
-        for spec in ["nothing", "sim:i1pro", "cs100a:", "replay:"] {
+        for spec in ["nothing", "sim:i1d3", "cs100a:", "replay:"] {
             let e = open_instrument(spec, None).err().unwrap();
             assert!(
                 e.to_string().contains("expected cs100a:PORT"),
@@ -201,6 +217,23 @@ mod tests {
         }
         let e = open_instrument("sim:cs100a?speed=9", None).err().unwrap();
         assert!(e.to_string().contains("unknown option 'speed'"), "{e}");
+        // A model's own options are known to it alone.
+        let e = open_instrument("sim:cs100a?rev=e", None).err().unwrap();
+        assert!(
+            e.to_string()
+                .ends_with("unknown option 'rev' (known: time_scale, seed, noise)"),
+            "{e}"
+        );
+        let e = open_instrument("sim:i1pro?time_scale=0&rev=x", None)
+            .err()
+            .unwrap();
+        assert!(e.to_string().contains("rev=\"x\": expected d or e"), "{e}");
+        let e = open_instrument("sim:i1pro?colour=red", None).err().unwrap();
+        assert!(
+            e.to_string()
+                .ends_with("(known: time_scale, seed, noise, rev, diffuser)"),
+            "{e}"
+        );
         let e = open_instrument("sim:cs100a?time_scale=-1", None)
             .err()
             .unwrap();
@@ -211,10 +244,10 @@ mod tests {
     fn a_transcript_of_a_model_without_a_driver_names_those_with_one() {
         let dir = std::env::temp_dir().join(format!("metamer-spec-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("i1pro.jsonl");
+        let path = dir.join("i1d3.jsonl");
         std::fs::write(
             &path,
-            "{\"format\":\"metamer-transcript/1\",\"instrument\":\"i1pro\",\"transport\":\"usb\",\
+            "{\"format\":\"metamer-transcript/1\",\"instrument\":\"i1d3\",\"transport\":\"hid\",\
              \"origin\":\"synthesized from the protocol documentation\"}\n",
         )
         .unwrap();
@@ -223,7 +256,7 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(
-            e.ends_with("line 1: the transcript is of instrument 'i1pro', which has no driver yet (known: cs100a)"),
+            e.ends_with("line 1: the transcript is of instrument 'i1d3', which has no driver yet (known: cs100a, i1pro)"),
             "{e}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
@@ -270,6 +303,7 @@ mod tests {
         }),
         replay: None,
         sim: None,
+        sim_options: &[],
     }];
 
     #[test]

@@ -18,6 +18,7 @@ pub mod replies;
 #[cfg(test)]
 mod session_tests;
 pub mod timing;
+pub mod wavelength;
 
 pub use calibration::{Calibration, CalibrationError, Filter, Gain, RevECalibration};
 pub use commands::{Request, Transfer};

@@ -72,6 +72,9 @@ fn human(list: &DeviceList) -> String {
         if let Some(serial) = &d.serial {
             s.push_str(&format!("  serial {serial}"));
         }
+        if let Some(revision) = &d.revision {
+            s.push_str(&format!("  {revision}"));
+        }
         s.push_str(&access_text(&d.access));
         s.push('\n');
     }

@@ -1,10 +1,19 @@
-//! `metamer spot`: spot readings from an instrument (real, replayed or simulated).
+//! `metamer spot`: spot readings from an instrument (real, replayed or simulated), with the
+//! instrument's calibrations negotiated at the terminal.
 
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use clap::ValueEnum;
-use metamer_drivers::{open_instrument_with, DriverError, OpenOptions, Reading, Request, Speed};
+use metamer::color::{colorchecker, ColorCheckerSet};
+use metamer::session::TerminalOperator;
+use metamer::spot::{read, spectra_csv, SimulatedHands};
+use metamer_drivers::i1pro::emulator::default_light;
+use metamer_drivers::{
+    open_instrument_with, DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Speed, View,
+    World,
+};
 
 use super::{CliError, CliResult};
 
@@ -16,22 +25,42 @@ enum SpeedArg {
     Slow,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum ModeArg {
+    /// Light from a source: XYZ in cd/m².
+    Emissive,
+    /// A surface under the instrument's lamp: XYZ with Y = 100 for white (D65).
+    Reflective,
+    /// Light falling on the diffuser: XYZ in lux.
+    Ambient,
+}
+
 #[derive(clap::Args)]
 pub struct Args {
-    /// cs100a:PORT (e.g. cs100a:/dev/ttyUSB0), replay:FILE.jsonl, or sim:cs100a
-    /// (options: sim:cs100a?time_scale=0.01&seed=N&noise=off).
+    /// cs100a:PORT (e.g. cs100a:/dev/ttyUSB0), i1pro[:SERIAL], replay:FILE.jsonl, sim:cs100a
+    /// or sim:i1pro (options: sim:i1pro?time_scale=0.01&seed=N&noise=off&rev=d|e).
     #[arg(long, value_name = "SPEC")]
     instrument: String,
+    /// What to measure.
+    #[arg(long, value_enum, default_value = "emissive")]
+    mode: ModeArg,
     /// Response speed of instruments that have one (the CS-100A); default: the
     /// instrument's (fast).
     #[arg(long, value_enum)]
     speed: Option<SpeedArg>,
+    /// Integration time in seconds, or auto, for instruments that have one (the i1Pro);
+    /// default: auto.
+    #[arg(long, value_name = "S")]
+    integration: Option<String>,
     /// Number of readings.
     #[arg(long, default_value_t = 1, value_name = "N")]
     count: u32,
     /// One JSON object per reading per line.
     #[arg(long)]
     json: bool,
+    /// Write the readings' spectra to this CSV (nm and one column per reading).
+    #[arg(long, value_name = "FILE.csv")]
+    spectrum: Option<PathBuf>,
     /// Record the exchange with the instrument to this new transcript (never overwritten).
     #[arg(long, value_name = "FILE.jsonl")]
     record: Option<PathBuf>,
@@ -49,8 +78,18 @@ pub fn run(args: Args) -> CliResult {
             )));
         }
     }
+    let mode = match args.mode {
+        ModeArg::Emissive => MeasureMode::Emissive,
+        ModeArg::Reflective => MeasureMode::Reflective,
+        ModeArg::Ambient => MeasureMode::Ambient,
+    };
+    let hands = args
+        .instrument
+        .starts_with("sim:")
+        .then(|| simulated_target(mode))
+        .transpose()?;
     let options = OpenOptions {
-        stimulus: None,
+        stimulus: hands.as_ref().map(|h| h.world.clone() as Arc<dyn World>),
         record: args.record.clone(),
     };
     let mut instrument = open_instrument_with(&args.instrument, &options).map_err(|e| match e {
@@ -66,29 +105,76 @@ pub fn run(args: Args) -> CliResult {
         };
         instrument.set_option("speed", speed.name())?;
     }
-    let request = Request::default();
+    if let Some(t) = &args.integration {
+        instrument
+            .set_option("integration_s", t)
+            .map_err(|e| match e {
+                DriverError::UnknownOption { instrument, .. } => CliError::Usage(format!(
+                    "--integration: the {instrument} has no integration time to set"
+                )),
+                DriverError::BadOption { message, .. } => {
+                    CliError::Usage(format!("--integration {t}: {message}"))
+                }
+                e => CliError::from(e),
+            })?;
+    }
     let info = instrument.info();
     let mut out = std::io::stdout().lock();
     if !args.json {
         writeln!(out, "{} on {}", info.model, info.connection)?;
     }
+    let mut operator = TerminalOperator;
+    let mut readings = Vec::new();
     for i in 1..=args.count {
-        let reading = instrument.measure(&request)?;
+        let reading = read(instrument.as_mut(), mode, &mut operator, hands.as_ref())?;
         if args.json {
             writeln!(out, "{}", json_line(&reading))?;
         } else {
-            writeln!(out, "{}", human_line(i, &reading))?;
+            writeln!(out, "{}", human_line(i, mode, &reading))?;
         }
         // Each reading is shown as it arrives: a later failure must not hide earlier ones.
         out.flush()?;
+        readings.push(reading);
+    }
+    if let Some(path) = &args.spectrum {
+        let csv = spectra_csv(&readings).ok_or_else(|| {
+            CliError::Usage(format!(
+                "--spectrum: the {} measures no spectrum (a colorimeter); leave --spectrum out",
+                info.model
+            ))
+        })?;
+        std::fs::write(path, csv)
+            .map_err(|e| CliError::Usage(format!("cannot write {}: {e}", path.display())))?;
     }
     Ok(())
 }
 
-/// `{"XYZ":[X,Y,Z],"xyY":[x,y,Y],"flags":[…],"instrument":"cs100a"}`; values the instrument
-/// did not measure are null.
+/// What a simulated instrument is aimed at or placed on: 100 cd/m² of CIE LED-RGB1 for
+/// light, the ColorChecker's white 9.5 for a surface.
+fn simulated_target(mode: MeasureMode) -> Result<SimulatedHands, CliError> {
+    let target = match mode {
+        MeasureMode::Reflective => {
+            View::surface(colorchecker(ColorCheckerSet::BabelColorAverage)[18].clone())?
+        }
+        _ => View::radiance(default_light())?,
+    };
+    Ok(SimulatedHands {
+        world: Arc::new(SharedWorld::new(target.clone())),
+        target,
+    })
+}
+
+/// `{"XYZ":[X,Y,Z],"xyY":[x,y,Y],"flags":[…],"instrument":"cs100a"}` and, from spectral
+/// instruments, `"spectrum":{"start_nm":380,"step_nm":10,"values":[…]}`; values the
+/// instrument did not measure are null.
 fn json_line(r: &Reading) -> String {
     // A struct, not json!(), to keep the documented key order.
+    #[derive(serde::Serialize)]
+    struct Grid<'a> {
+        start_nm: f64,
+        step_nm: f64,
+        values: &'a [f64],
+    }
     #[derive(serde::Serialize)]
     struct Line<'a> {
         #[serde(rename = "XYZ")]
@@ -97,17 +183,31 @@ fn json_line(r: &Reading) -> String {
         xyy: [f64; 3],
         flags: Vec<&'static str>,
         instrument: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        integration_s: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        spectrum: Option<Grid<'a>>,
     }
+    let spectrum = r.spectrum.as_ref().and_then(|s| {
+        let (start_nm, step_nm) = s.grid()?;
+        Some(Grid {
+            start_nm,
+            step_nm,
+            values: s.values(),
+        })
+    });
     let line = Line {
         xyz: r.xyz,
         xyy: r.xyy,
         flags: r.flags.iter().map(|f| f.name()).collect(),
         instrument: &r.instrument,
+        integration_s: r.spectrum.as_ref().and(r.integration_s),
+        spectrum,
     };
     serde_json::to_string(&line).expect("a reading serializes")
 }
 
-fn human_line(i: u32, r: &Reading) -> String {
+fn human_line(i: u32, mode: MeasureMode, r: &Reading) -> String {
     // Five significant digits: one more than the CS-100A sends, so nothing it reports is
     // rounded away; "—" for what it did not measure.
     let sig = |v: f64| {
@@ -129,9 +229,14 @@ fn human_line(i: u32, r: &Reading) -> String {
             "—".to_string()
         }
     };
+    let unit = match mode {
+        MeasureMode::Emissive => " cd/m²",
+        MeasureMode::Ambient => " lx",
+        MeasureMode::Reflective => " (white = 100)",
+    };
     let [x, y, lum] = r.xyy;
     let mut line = format!(
-        "#{i}  Y {} cd/m²  x {}  y {}  XYZ {} {} {}",
+        "#{i}  Y {}{unit}  x {}  y {}  XYZ {} {} {}",
         sig(lum),
         chroma(x),
         chroma(y),
@@ -139,6 +244,9 @@ fn human_line(i: u32, r: &Reading) -> String {
         sig(r.xyz[1]),
         sig(r.xyz[2])
     );
+    if let (Some(t), Some(_)) = (r.integration_s, &r.spectrum) {
+        line.push_str(&format!("  ({} s)", sig(t)));
+    }
     for flag in &r.flags {
         line.push_str(&format!("  [{}]", flag.name().replace('_', " ")));
     }

@@ -93,6 +93,12 @@ impl ReplayUsb {
     pub fn finish(&self) -> Result<(), LinkError> {
         match self.t.events.get(self.next) {
             None => Ok(()),
+            // A device that went away ends its transcript; every transfer after it failed.
+            Some((_, e))
+                if e.kind == EventKind::Disconnect && self.next + 1 == self.t.events.len() =>
+            {
+                Ok(())
+            }
             Some((line, e)) => Err(LinkError::Replay(format!(
                 "transcript {} line {line}: the driver stopped, but the transcript goes on with {:?}",
                 self.t.file, e.kind

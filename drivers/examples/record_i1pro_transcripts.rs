@@ -1,0 +1,265 @@
+//! Records the i1Pro transcripts in `protocols/i1pro/transcripts/` from the simulated i1Pro
+//! through the USB record backend, and writes each header's `origin`, `description` and
+//! `expect` (the steps `drivers/tests/i1pro_transcripts.rs` replays, with the readings the
+//! live driver got). Run from the repository root:
+//!
+//! ```sh
+//! cargo run --release -p metamer-drivers --example record_i1pro_transcripts
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use metamer_color::{colorchecker, radiance_to_xyz, ColorCheckerSet, ObserverKind, Spectrum};
+use metamer_drivers::i1pro::emulator::{default_light, EmulatorConfig, Fault};
+use metamer_drivers::i1pro::open::sim_with;
+use metamer_drivers::i1pro::ManualClock;
+use metamer_drivers::{
+    CalibrationCondition, Instrument, MeasureMode, OpenOptions, Request, SharedWorld, View, World,
+};
+use metamer_protocols::i1pro::calibration::key;
+use metamer_protocols::i1pro::Revision;
+use serde_json::{json, Value};
+
+/// One scenario's live run: the steps and their outcomes, in the harness's format.
+struct Run {
+    world: Arc<SharedWorld>,
+    clock: ManualClock,
+    m: Option<Box<dyn Instrument>>,
+    steps: Vec<Value>,
+}
+
+impl Run {
+    fn open(path: &Path, config: EmulatorConfig, view: View) -> Run {
+        let world = Arc::new(SharedWorld::new(view));
+        let clock = ManualClock::new();
+        let _ = std::fs::remove_file(path);
+        let options = OpenOptions {
+            stimulus: None,
+            record: Some(path.to_path_buf()),
+        };
+        let config = EmulatorConfig {
+            time_scale: 0.0,
+            ..config
+        };
+        let r = sim_with(
+            world.clone() as Arc<dyn World>,
+            config,
+            &options,
+            Arc::new(clock.clone()),
+        );
+        let (m, step) = match r {
+            Ok(m) => (Some(m), json!({"open": "ok"})),
+            Err(e) => (None, json!({"open": "error", "error": message(&e)})),
+        };
+        Run {
+            world,
+            clock,
+            m,
+            steps: vec![step],
+        }
+    }
+
+    fn m(&mut self) -> &mut dyn Instrument {
+        self.m.as_deref_mut().expect("opened")
+    }
+
+    fn option(&mut self, name: &str, value: &str) {
+        self.m().set_option(name, value).unwrap();
+        self.steps.push(json!({"option": [name, value]}));
+    }
+
+    fn calibrate(&mut self, mode: MeasureMode) {
+        self.world.set(View::WhiteTile);
+        let r = self.m().calibrate(mode, &CalibrationCondition::OnWhiteTile);
+        self.steps.push(match r {
+            Ok(_) => json!({"calibrate": mode.name()}),
+            Err(e) => json!({"calibrate": mode.name(), "error": message(&e)}),
+        });
+    }
+
+    fn advance(&mut self, s: f64) {
+        self.clock.advance(s);
+        self.steps.push(json!({"advance_s": s}));
+    }
+
+    /// Measures `view`; `light` is what an exact instrument would read (noise off only).
+    fn measure(&mut self, mode: MeasureMode, view: View, exact: Option<[f64; 3]>) {
+        self.world.set(view);
+        let r = self.m().measure(&Request { mode });
+        let mut step = json!({"measure": mode.name()});
+        match r {
+            Ok(r) => {
+                step["XYZ"] = json!(r.xyz);
+                step["integration_s"] = json!(r.integration_s);
+                step["flags"] = json!(r.flags.iter().map(|f| f.name()).collect::<Vec<_>>());
+                if let Some(x) = exact {
+                    step["exact_XYZ"] = json!(x);
+                }
+            }
+            Err(e) => step["error"] = json!(message(&e)),
+        }
+        self.steps.push(step);
+    }
+
+    fn finish(self, path: &Path, description: &str) {
+        drop(self.m);
+        let text = std::fs::read_to_string(path).unwrap();
+        let (head, rest) = text.split_once('\n').unwrap();
+        let mut header: Value = serde_json::from_str(head).unwrap();
+        header["origin"] = json!("synthesized from the protocol documentation");
+        header["description"] = json!(description);
+        header["expect"] = Value::Array(self.steps);
+        std::fs::write(path, format!("{header}\n{rest}")).unwrap();
+        println!("{}", path.display());
+    }
+}
+
+/// The error as the replay must show it: without the link's name, which is the
+/// simulator's when recording and the file's when replaying.
+fn message(e: &metamer_drivers::DriverError) -> String {
+    let s = e.to_string();
+    match s.find("disconnected during") {
+        Some(i) => s[i..].to_string(),
+        None => s,
+    }
+}
+
+fn light() -> View {
+    View::radiance(default_light()).unwrap()
+}
+
+/// The XYZ of the light on the instrument's 36 bands.
+fn exact(s: &Spectrum) -> [f64; 3] {
+    let grid = Spectrum::from_grid(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
+    radiance_to_xyz(&grid, ObserverKind::Cie1931).to_array()
+}
+
+fn quiet(revision: Revision) -> EmulatorConfig {
+    EmulatorConfig {
+        revision,
+        noise: false,
+        ..EmulatorConfig::default()
+    }
+}
+
+fn main() {
+    let dir = PathBuf::from("protocols/i1pro/transcripts");
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |name: &str| dir.join(format!("{name}.jsonl"));
+    let emissive = MeasureMode::Emissive;
+    let reflective = MeasureMode::Reflective;
+    let led = exact(&default_light());
+
+    let path = p("open_emissive");
+    let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
+    r.calibrate(emissive);
+    r.measure(emissive, light(), Some(led));
+    r.finish(&path, "Rev D (firmware 505): open (GetMisc, reset, clock mode, whole EEPROM), dark calibration on the white tile (darks at 5 ms and 2 s), one emissive reading of 100 cd/m² of LED-RGB1 with the integration time found by a trial reading. Recorded from sim:i1pro with noise off.");
+
+    let path = p("fixed_integration");
+    let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
+    r.calibrate(emissive);
+    r.option("integration_s", "0.25");
+    r.measure(emissive, light(), Some(led));
+    r.finish(&path, "Rev D: emissive reading at a fixed integration time of 0.25 s (3676 clocks of 68 µs, three readings), no trial reading. Recorded from sim:i1pro with noise off.");
+
+    let patches = colorchecker(ColorCheckerSet::BabelColorAverage);
+    let path = p("reflective_calibration");
+    let mut r = Run::open(&path, EmulatorConfig::default(), View::WhiteTile);
+    r.calibrate(reflective);
+    r.measure(reflective, View::surface(patches[0].clone()).unwrap(), None);
+    r.measure(
+        reflective,
+        View::surface(patches[18].clone()).unwrap(),
+        None,
+    );
+    r.finish(&path, "Rev D: reflective calibration on the white tile (a lamp-off dark and a lamp-lit white, 8 readings of 20 ms each), then ColorChecker dark skin and white 9.5. Recorded from sim:i1pro with its noise (seed 1).");
+
+    let path = p("calibration_expired");
+    let mut r = Run::open(&path, EmulatorConfig::default(), View::WhiteTile);
+    r.calibrate(reflective);
+    r.measure(
+        reflective,
+        View::surface(patches[14].clone()).unwrap(),
+        None,
+    );
+    r.advance(1801.0);
+    r.measure(
+        reflective,
+        View::surface(patches[14].clone()).unwrap(),
+        None,
+    );
+    r.calibrate(reflective);
+    r.measure(
+        reflective,
+        View::surface(patches[14].clone()).unwrap(),
+        None,
+    );
+    r.finish(&path, "Rev D: a reflective reading, then 30 min 1 s later (the dark's validity on Rev A–D) the driver refuses to measure without a transfer, asks for the white tile again, calibrates and measures. Recorded from sim:i1pro with its noise; the clock is advanced by hand.");
+
+    let path = p("saturated");
+    let bright = View::radiance(default_light().scaled(1000.0)).unwrap();
+    let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
+    r.calibrate(emissive);
+    r.measure(emissive, bright.clone(), None);
+    r.option("integration_s", "0.5");
+    r.measure(
+        emissive,
+        View::radiance(default_light().scaled(10.0)).unwrap(),
+        None,
+    );
+    r.finish(&path, "Rev D: 100 000 cd/m² saturates the sensor at the trial time and again at the shortest time (too bright); then 1000 cd/m² at a fixed 0.5 s saturates too. Both are errors that say what to do, never a clipped spectrum. Recorded from sim:i1pro with noise off.");
+
+    let path = p("too_dark");
+    let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
+    r.calibrate(emissive);
+    r.measure(
+        emissive,
+        View::radiance(default_light().scaled(1e-6)).unwrap(),
+        None,
+    );
+    r.finish(&path, "Rev D: 0.0001 cd/m² gives no signal above the dark threshold even at the longest integration time (4.46 s): too dark. Recorded from sim:i1pro with noise off.");
+
+    let path = p("eeprom_missing_key");
+    let r = Run::open(
+        &path,
+        EmulatorConfig {
+            missing_keys: vec![key::EMISSIVE],
+            ..quiet(Revision::AToD)
+        },
+        View::WhiteTile,
+    );
+    r.finish(&path, "Rev D whose EEPROM lacks the emissive calibration factors (key 0x044D): open reads the whole EEPROM and fails naming the key. Recorded from sim:i1pro with that key left out of its image.");
+
+    let path = p("short_bulk_read");
+    let mut r = Run::open(
+        &path,
+        EmulatorConfig {
+            fault: Some(Fault::ShortRead(1)),
+            ..quiet(Revision::AToD)
+        },
+        View::WhiteTile,
+    );
+    r.calibrate(emissive);
+    r.finish(&path, "Rev D: the first dark's bulk read delivers 1024 of its 2048 bytes; the driver reports the short read and makes no reading of it. Recorded from sim:i1pro with its short-read fault injected.");
+
+    let path = p("disconnect_mid_read");
+    let mut r = Run::open(
+        &path,
+        EmulatorConfig {
+            fault: Some(Fault::DisconnectMidRead(3)),
+            ..quiet(Revision::AToD)
+        },
+        View::WhiteTile,
+    );
+    r.calibrate(emissive);
+    r.measure(emissive, light(), None);
+    r.finish(&path, "Rev D: the instrument is unplugged while the driver waits for the trial reading's data: a disconnect error naming the request, no reading. Recorded from sim:i1pro with its disconnect fault injected.");
+
+    let path = p("rev_e_open_reading");
+    let mut r = Run::open(&path, quiet(Revision::E), View::WhiteTile);
+    r.calibrate(emissive);
+    r.measure(emissive, light(), Some(led));
+    r.finish(&path, "Rev E (i1Pro 2, firmware 629): open (GetMisc, reset, measurement characteristics, EEPROM size, 16 KiB EEPROM with both directories), bands from the factory wavelength cubic, dark calibration and one emissive reading with 0xD4. Recorded from sim:i1pro?rev=e with noise off.");
+}

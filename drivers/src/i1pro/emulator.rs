@@ -1,0 +1,392 @@
+//! A simulated i1Pro on the USB level: it answers the vendor requests and bulk reads the
+//! real driver sends, from its synthetic EEPROM and the simulated world, so the driver runs
+//! unchanged against it.
+//!
+//! Counts come from running the codec's pipeline backwards: the spectrum the instrument
+//! sees (a light's radiance; under its lamp a surface's or the white tile's reflectance
+//! times the lamp) → the resampled values the calibration factors turn into it → the cell
+//! values the filter maps to them → plus the dark current → raw counts. Then the sensor's
+//! noise (photon noise, √counts, and a read noise of [`READ_NOISE`] counts) and its
+//! full well ([`FULL_WELL`], above the EEPROM's saturation threshold so the driver sees the
+//! saturation) apply.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use metamer_color::{radiance_to_xyz, Illuminant, ObserverKind, Spectrum};
+use metamer_protocols::i1pro::commands::EP_DATA_IN;
+use metamer_protocols::i1pro::inverse;
+use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Exposure};
+use metamer_protocols::i1pro::replies::MeasChar;
+use metamer_protocols::i1pro::{
+    commands::{Setup, Transfer},
+    readings, Calibration, Gain, RawReading, Request, Revision, Spectrum as Bands, BANDS, CELLS,
+    SHIELDED_CELLS, START_NM, STEP_NM,
+};
+use metamer_protocols::transcript::TransferKind;
+
+use super::synthetic;
+use crate::link::usb::ControlSetup;
+use crate::link::usb_pair::{Answer, UsbDevice};
+use crate::world::{Light, View, World};
+
+/// Read noise of the simulated sensor, counts (1σ).
+pub const READ_NOISE: f64 = 2.0;
+/// Counts at which the simulated sensor's cells clip.
+pub const FULL_WELL: f64 = 60_000.0;
+/// What the simulated lamp gives on a perfect white, in counts per second of a band: a
+/// warm lamp, stronger in the red.
+pub fn lamp(nm: f64) -> f64 {
+    1.5e6 * (0.25 + 0.75 * (nm - START_NM) / 350.0)
+}
+/// Repeatability the simulated instrument declares for an emissive reading near the sensor
+/// target: relative 1σ of Y (photon noise of ~37 000 counts averaged over the cells and
+/// readings, with margin).
+pub const REPEATABILITY_Y: f64 = 0.001;
+/// Repeatability of a reflectance band, absolute 1σ (both the white and the sample shot are
+/// noisy).
+pub const REPEATABILITY_REFLECTANCE: f64 = 0.002;
+
+/// A fault to inject, for transcripts of what the driver does when things go wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// The `n`th measurement's bulk read (from 1) returns half its bytes.
+    ShortRead(u32),
+    /// The device goes away during the `n`th measurement's bulk read.
+    DisconnectMidRead(u32),
+}
+
+/// How the simulated unit behaves.
+#[derive(Clone, Debug)]
+pub struct EmulatorConfig {
+    pub revision: Revision,
+    pub seed: u64,
+    pub noise: bool,
+    /// Multiplies the integration delays (0 answers at once).
+    pub time_scale: f64,
+    /// The diffuser is over the optics: the instrument sees irradiance, π × the radiance of
+    /// a light filling its view.
+    pub diffuser: bool,
+    /// EEPROM keys left out of the image.
+    pub missing_keys: Vec<u16>,
+    pub fault: Option<Fault>,
+}
+
+impl Default for EmulatorConfig {
+    fn default() -> Self {
+        EmulatorConfig {
+            revision: Revision::AToD,
+            seed: 1,
+            noise: true,
+            time_scale: 1.0,
+            diffuser: false,
+            missing_keys: Vec::new(),
+            fault: None,
+        }
+    }
+}
+
+/// The emulator's state between transfers.
+pub struct I1ProEmulator {
+    config: EmulatorConfig,
+    world: Arc<dyn World>,
+    cal: Calibration,
+    image: Vec<u8>,
+    params: (u64, u64, u64, bool),
+    pending: Option<(Duration, Vec<u8>)>,
+    measurements: u32,
+    rng: u64,
+}
+
+/// The light a world gives as the instrument's 36 bands, mW·m⁻²·sr⁻¹·nm⁻¹.
+fn light_bands(light: &Light) -> Bands {
+    let s = match light {
+        Light::Radiance(s) => s.clone(),
+        Light::Xyz(xyz) => metamer_for(*xyz),
+    };
+    let mut b = [0.0; BANDS];
+    for (w, v) in b.iter_mut().enumerate() {
+        *v = 1000.0 * s.value_at(START_NM + STEP_NM * w as f64);
+    }
+    b
+}
+
+/// A smooth spectrum of this XYZ (cd/m²), for worlds that know only the colour: a blend of
+/// three broad bands at 450, 540 and 610 nm.
+pub fn metamer_for(xyz: [f64; 3]) -> Spectrum {
+    let basis: Vec<Spectrum> = [450.0, 540.0, 610.0]
+        .iter()
+        .map(|c| {
+            let nm: Vec<f64> = (380..=780).map(f64::from).collect();
+            let v = nm
+                .iter()
+                .map(|l| (-((l - c) / 30.0f64).powi(2)).exp())
+                .collect();
+            Spectrum::new(nm, v).expect("an even grid")
+        })
+        .collect();
+    let m: Vec<[f64; 3]> = basis
+        .iter()
+        .map(|b| radiance_to_xyz(b, ObserverKind::Cie1931).to_array())
+        .collect();
+    // Solve Σ_k a_k m_k = xyz (3×3, Cramer's rule).
+    let det = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        a[0] * (b[1] * c[2] - b[2] * c[1]) - b[0] * (a[1] * c[2] - a[2] * c[1])
+            + c[0] * (a[1] * b[2] - a[2] * b[1])
+    };
+    let d = det(m[0], m[1], m[2]);
+    let a = [
+        det(xyz, m[1], m[2]) / d,
+        det(m[0], xyz, m[2]) / d,
+        det(m[0], m[1], xyz) / d,
+    ];
+    let nm: Vec<f64> = (380..=780).map(f64::from).collect();
+    let values = (0..nm.len())
+        .map(|i| (0..3).map(|k| a[k] * basis[k].values()[i]).sum())
+        .collect();
+    Spectrum::new(nm, values).expect("an even grid")
+}
+
+/// The light of the simulated world when none is given: 100 cd/m² of CIE LED-RGB1, the
+/// same light [`DEFAULT_STIMULUS_XYZ`](crate::world::DEFAULT_STIMULUS_XYZ) is the colour of.
+pub fn default_light() -> Spectrum {
+    let s = Illuminant::LedRgb1.spectrum();
+    let y = radiance_to_xyz(&s, ObserverKind::Cie1931).y;
+    s.scaled(100.0 / y)
+}
+
+impl I1ProEmulator {
+    pub fn new(world: Arc<dyn World>, config: EmulatorConfig) -> Result<I1ProEmulator, String> {
+        let image = synthetic::eeprom_image(config.revision, &config.missing_keys)
+            .map_err(|e| e.to_string())?;
+        // The emulator computes with what the driver will read: the full image, parsed.
+        let full = synthetic::eeprom_image(config.revision, &[]).map_err(|e| e.to_string())?;
+        let cal = super::unit_calibration(&full, config.revision).map_err(|e| e.to_string())?;
+        Ok(I1ProEmulator {
+            rng: config.seed,
+            config,
+            world,
+            cal,
+            image,
+            params: (0, 0, 0, false),
+            pending: None,
+            measurements: 0,
+        })
+    }
+
+    fn clock_s(&self) -> f64 {
+        match self.config.revision {
+            Revision::AToD => f64::from(synthetic::CLOCK_MODE.clock_us) * 1e-6,
+            Revision::E => MeasChar::KNOWN.clock_s(),
+        }
+    }
+
+    /// Dark counts of cell `j` after `t` seconds: the converter's bias, a whole number of
+    /// counts, and a dark current of 25–35 counts per second, both varying from cell to
+    /// cell. (A fractional bias would put up to half a count of rounding into the short
+    /// dark, which the driver's interpolation carries to every integration time.)
+    pub fn dark_count(j: usize, t: f64) -> f64 {
+        let j = j as f64;
+        (120.0 + 10.0 * (0.37 * j).sin()).round() + (30.0 + 5.0 * (0.11 * j).cos()) * t
+    }
+
+    fn gauss(&mut self) -> f64 {
+        // Box–Muller on two SplitMix64 uniforms.
+        let mut u = || {
+            self.rng = self.rng.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.rng;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^= z >> 31;
+            ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let (a, b) = (u(), u());
+        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    }
+
+    /// The resampled, uncalibrated values the instrument sees now.
+    fn seen(&self, lamp_on: bool) -> Result<Bands, String> {
+        let cal = &self.cal;
+        let err = |e: pipeline::PipelineError| e.to_string();
+        let zero = [0.0; BANDS];
+        Ok(match (self.world.view(), lamp_on) {
+            (View::Emissive(light), false) if self.config.diffuser => {
+                let mut e = light_bands(&light);
+                e.iter_mut().for_each(|v| *v *= std::f64::consts::PI);
+                inverse::uncalibrate_ambient(cal, &e).map_err(err)?
+            }
+            (View::Emissive(light), false) => {
+                inverse::uncalibrate_emissive(cal, &light_bands(&light)).map_err(err)?
+            }
+            (View::Emissive(_), true) | (View::Capped, _) => zero,
+            (_, false) => zero,
+            (View::WhiteTile, true) => {
+                let r = cal.white_reference.unwrap_or([0.9; BANDS]);
+                std::array::from_fn(|w| r[w] * lamp(START_NM + STEP_NM * w as f64))
+            }
+            (View::Surface(s), true) => std::array::from_fn(|w| {
+                let nm = START_NM + STEP_NM * w as f64;
+                s.value_at(nm) * lamp(nm)
+            }),
+        })
+    }
+
+    fn readings(&mut self, int_clocks: u64, n: u64, lamp_on: bool) -> Result<Vec<u8>, String> {
+        let t = int_clocks as f64 * self.clock_s();
+        let e = Exposure {
+            integration_s: t,
+            gain: Gain::Normal,
+        };
+        let err = |e: pipeline::PipelineError| e.to_string();
+        let revision = self.config.revision;
+        let dark_counts: Vec<f64> = (0..CELLS).map(|j| Self::dark_count(j, t)).collect();
+        let shielded_count = (0..SHIELDED_CELLS)
+            .map(|j| Self::dark_count(CELLS + j, t).round() as u16)
+            .collect::<Vec<_>>();
+        let shielded: Option<[u16; SHIELDED_CELLS]> =
+            (revision == Revision::E).then(|| std::array::from_fn(|j| shielded_count[j]));
+        let dark_raw = RawReading {
+            cells: std::array::from_fn(|j| dark_counts[j].round() as i32),
+            shielded,
+        };
+        let dark: AbsRaw = pipeline::to_absraw(&self.cal, &dark_raw, &e).map_err(err)?;
+        let seen = self.seen(lamp_on)?;
+        let signal = inverse::cells_for(&self.cal, &seen).map_err(err)?;
+        let clean =
+            inverse::counts_for(&self.cal, &e, &signal, &dark, shielded, u16::MAX).map_err(err)?;
+        let mut out = Vec::new();
+        for _ in 0..n {
+            let mut r = clean.clone();
+            for (j, c) in r.cells.iter_mut().enumerate() {
+                let mut v = f64::from(*c);
+                if self.config.noise {
+                    let photons = (v - dark_counts[j]).max(0.0);
+                    v += (photons + READ_NOISE * READ_NOISE).sqrt() * self.gauss();
+                }
+                *c = v.round().clamp(0.0, FULL_WELL) as i32;
+            }
+            out.push(r);
+        }
+        readings::encode(&out, revision, synthetic::MAX_POSITIVE).map_err(|e| e.to_string())
+    }
+
+    fn start(&mut self, int_clocks: u64, n: u64, lamp_on: bool) -> Answer<()> {
+        match self.readings(int_clocks, n, lamp_on) {
+            Ok(bytes) => {
+                let t = int_clocks as f64 * self.clock_s() * n as f64
+                    + if lamp_on {
+                        super::wire::LAMP_WARMUP_S
+                    } else {
+                        0.0
+                    };
+                let delay = Duration::from_secs_f64((t * self.config.time_scale).max(0.0));
+                self.measurements += 1;
+                self.pending = Some((delay, bytes));
+                Answer::Done(())
+            }
+            Err(_) => Answer::Stall,
+        }
+    }
+}
+
+fn transfer_in(setup: ControlSetup, len: usize) -> Transfer {
+    Transfer::In {
+        setup: Setup {
+            request_type: setup.request_type,
+            request: setup.request,
+            value: setup.value,
+            index: setup.index,
+        },
+        length: len as u16,
+    }
+}
+
+impl UsbDevice for I1ProEmulator {
+    fn control_in(&mut self, setup: ControlSetup, len: usize) -> Answer<Vec<u8>> {
+        let revision = self.config.revision;
+        match Request::decode(&transfer_in(setup, len), revision) {
+            Ok(Request::GetMisc) => Answer::Done(synthetic::misc(revision).encode().to_vec()),
+            Ok(Request::GetClockMode) if revision == Revision::AToD => {
+                Answer::Done(synthetic::CLOCK_MODE.encode().to_vec())
+            }
+            Ok(Request::GetMeasChar) => Answer::Done(MeasChar::KNOWN.encode().to_vec()),
+            Ok(Request::GetEepromSize) => {
+                Answer::Done((self.image.len() as u32).to_be_bytes().to_vec())
+            }
+            Ok(Request::GetChipId) => Answer::Done(vec![0; 8]),
+            _ => Answer::Stall,
+        }
+    }
+
+    fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> Answer<()> {
+        let transfer = Transfer::Out {
+            setup: Setup {
+                request_type: setup.request_type,
+                request: setup.request,
+                value: setup.value,
+                index: setup.index,
+            },
+            data: data.to_vec(),
+        };
+        match Request::decode(&transfer, self.config.revision) {
+            Ok(Request::Reset { .. }) => {
+                self.pending = None;
+                Answer::Done(())
+            }
+            Ok(Request::ReadEeprom { address, length }) => {
+                let (a, l) = (address as usize, usize::from(length));
+                match self.image.get(a..a + l) {
+                    Some(bytes) => {
+                        self.pending = Some((Duration::ZERO, bytes.to_vec()));
+                        Answer::Done(())
+                    }
+                    None => Answer::Stall,
+                }
+            }
+            Ok(Request::SetMeasParams(p)) => {
+                self.params = (
+                    u64::from(p.int_clocks),
+                    u64::from(p.lamp_clocks),
+                    u64::from(p.readings),
+                    p.flags & metamer_protocols::i1pro::commands::flags::LAMP_OFF == 0,
+                );
+                Answer::Done(())
+            }
+            Ok(Request::Trigger) => {
+                let (t, _, n, lamp_on) = self.params;
+                self.start(t, n, lamp_on)
+            }
+            Ok(Request::MeasureE(p)) => {
+                let lamp_on = p.flags & metamer_protocols::i1pro::commands::flags_e::LAMP != 0;
+                self.start(u64::from(p.int_clocks), u64::from(p.readings), lamp_on)
+            }
+            Ok(_) => Answer::Done(()),
+            Err(_) => Answer::Stall,
+        }
+    }
+
+    fn read(&mut self, kind: TransferKind, endpoint: u8, len: usize) -> Answer<Vec<u8>> {
+        if kind != TransferKind::Bulk || endpoint != EP_DATA_IN {
+            return Answer::Silent;
+        }
+        let Some((delay, mut bytes)) = self.pending.take() else {
+            return Answer::Silent;
+        };
+        let scaled = |d: Duration| d;
+        match self.config.fault {
+            Some(Fault::ShortRead(n)) if n == self.measurements && !bytes.is_empty() => {
+                bytes.truncate(bytes.len() / 2);
+            }
+            Some(Fault::DisconnectMidRead(n)) if n == self.measurements => {
+                return Answer::Disconnect
+            }
+            _ => {}
+        }
+        bytes.truncate(len);
+        Answer::After(scaled(delay), bytes)
+    }
+
+    fn write(&mut self, _kind: TransferKind, _endpoint: u8, _data: &[u8]) -> Answer<()> {
+        Answer::Stall
+    }
+}

@@ -1,0 +1,87 @@
+//! What can go wrong with an i1Pro, with what the user can do about it.
+
+use metamer_protocols::i1pro::commands::RequestError;
+use metamer_protocols::i1pro::replies::ReplyError;
+use metamer_protocols::i1pro::timing::TimingError;
+use metamer_protocols::i1pro::{CalibrationError, EepromError, PipelineError, ReadingError};
+
+/// An i1Pro failure. Link failures (timeout, stall, disconnect) are wrapped with the
+/// request that was under way, so a message says what the instrument was doing.
+#[derive(Debug, thiserror::Error)]
+pub enum I1ProError {
+    /// A reply of the wrong length or content.
+    #[error("the i1Pro answered '{request}' with a reply that cannot be right: {source}")]
+    Reply {
+        request: &'static str,
+        #[source]
+        source: ReplyError,
+    },
+    /// The driver built a request the instrument's revision does not have (a driver bug).
+    #[error("i1Pro request: {0}")]
+    Request(#[from] RequestError),
+    /// The EEPROM could not be read as a directory of items.
+    #[error("the i1Pro's EEPROM is not readable ({0}); unplug and replug it, and if it stays, the unit needs service")]
+    Eeprom(#[from] EepromError),
+    /// The EEPROM lacks or garbles a calibration item.
+    #[error("the i1Pro's factory calibration in its EEPROM is unusable: {0}")]
+    Calibration(#[from] CalibrationError),
+    /// Fewer (or more) bytes than were asked for arrived on the data endpoint.
+    #[error("the i1Pro sent {got} of the {expected} bytes of {what}; no reading was made from them (unplug and replug the instrument if this repeats)")]
+    ShortRead {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+    },
+    /// Readings that parsed badly.
+    #[error("the i1Pro's readings are malformed: {0}")]
+    Readings(#[from] ReadingError),
+    /// A pipeline step refused its input.
+    #[error("processing the i1Pro's readings: {0}")]
+    Pipeline(#[from] PipelineError),
+    /// An integration time out of the instrument's range.
+    #[error("i1Pro timing: {0}")]
+    Timing(#[from] TimingError),
+    /// The light saturates the sensor even at the shortest integration time.
+    #[error("the light is too bright for the i1Pro: the sensor saturates even at its shortest integration time of {min_s} s; measure a dimmer target or further away")]
+    TooBright { min_s: f64 },
+    /// A fixed integration time lets the sensor saturate.
+    #[error("the i1Pro's sensor saturated at the fixed integration time of {integration_s} s; set a shorter integration time or let the instrument choose it (auto)")]
+    SaturatedAtFixedTime { integration_s: f64 },
+    /// Not enough light to measure even at the longest integration time.
+    #[error("too dark for the i1Pro: even at its longest integration time of {max_s} s the signal ({signal:.0} counts) stays below the sensor's noise floor ({floor:.0} counts); check that the instrument faces the light source and nothing covers it")]
+    TooDark { max_s: f64, signal: f64, floor: f64 },
+    /// A dark calibration saw light.
+    #[error("the dark calibration saw light (mean {mean:.0} counts/s, limit {limit:.0}): place the instrument on its white tile, which covers the sensor, and calibrate again")]
+    DarkNotDark { mean: f64, limit: f64 },
+    /// Readings of one exposure disagreed (the light or the instrument moved).
+    #[error("the i1Pro's readings of one exposure disagree by more than 10 %: keep the instrument and the target still while it measures")]
+    Inconsistent,
+    /// A USB transfer failed.
+    #[error(transparent)]
+    Transfer(#[from] TransferError),
+    /// The white-tile reading saturated or was too dim.
+    #[error("the white-tile reading was {problem}: make sure the instrument sits flat on its own white tile and calibrate again")]
+    BadWhite { problem: &'static str },
+}
+
+/// A USB transfer that failed, with the request it belonged to.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the i1Pro on {device} failed during '{request}': {source}{}",
+    advice(source)
+)]
+pub struct TransferError {
+    pub device: String,
+    pub request: &'static str,
+    #[source]
+    pub source: crate::link::LinkError,
+}
+
+fn advice(e: &crate::link::LinkError) -> &'static str {
+    use crate::link::LinkError;
+    match e {
+        LinkError::Timeout { .. } => "; unplug and replug the instrument and try again",
+        LinkError::Stalled { .. } => "; the instrument refused it (reset it by replugging)",
+        _ => "",
+    }
+}
