@@ -54,6 +54,10 @@ pub enum Fault {
     ShortRead(u32),
     /// The device goes away during the `n`th measurement's bulk read.
     DisconnectMidRead(u32),
+    /// The device stalls the `n`th measurement's trigger.
+    StallTrigger(u32),
+    /// The device never answers the `n`th measurement's bulk read.
+    SilentRead(u32),
 }
 
 /// How the simulated unit behaves.
@@ -70,6 +74,9 @@ pub struct EmulatorConfig {
     /// EEPROM keys left out of the image.
     pub missing_keys: Vec<u16>,
     pub fault: Option<Fault>,
+    /// The unit starts in low power and still answers this many GetMisc in low power after
+    /// the power-up reset.
+    pub low_power_polls: u32,
 }
 
 impl Default for EmulatorConfig {
@@ -82,6 +89,7 @@ impl Default for EmulatorConfig {
             diffuser: false,
             missing_keys: Vec::new(),
             fault: None,
+            low_power_polls: 0,
         }
     }
 }
@@ -96,6 +104,8 @@ pub struct I1ProEmulator {
     pending: Option<(Duration, Vec<u8>)>,
     measurements: u32,
     rng: u64,
+    /// In low power; after the power-up reset, the GetMisc answers still to come in it.
+    low_power: Option<(bool, u32)>,
 }
 
 /// The light a world gives as the instrument's 36 bands, mW·m⁻²·sr⁻¹·nm⁻¹.
@@ -163,6 +173,7 @@ impl I1ProEmulator {
         let full = synthetic::eeprom_image(config.revision, &[]).map_err(|e| e.to_string())?;
         let cal = super::unit_calibration(&full, config.revision).map_err(|e| e.to_string())?;
         Ok(I1ProEmulator {
+            low_power: (config.low_power_polls > 0).then_some((false, config.low_power_polls)),
             rng: config.seed,
             config,
             world,
@@ -305,7 +316,16 @@ impl UsbDevice for I1ProEmulator {
     fn control_in(&mut self, setup: ControlSetup, len: usize) -> Answer<Vec<u8>> {
         let revision = self.config.revision;
         match Request::decode(&transfer_in(setup, len), revision) {
-            Ok(Request::GetMisc) => Answer::Done(synthetic::misc(revision).encode().to_vec()),
+            Ok(Request::GetMisc) => {
+                let mut misc = synthetic::misc(revision);
+                if let Some((reset, left)) = self.low_power {
+                    misc.power = metamer_protocols::i1pro::replies::POWER_LOW;
+                    if reset {
+                        self.low_power = left.checked_sub(1).filter(|n| *n > 0).map(|n| (true, n));
+                    }
+                }
+                Answer::Done(misc.encode().to_vec())
+            }
             Ok(Request::GetClockMode) if revision == Revision::AToD => {
                 Answer::Done(synthetic::CLOCK_MODE.encode().to_vec())
             }
@@ -329,8 +349,11 @@ impl UsbDevice for I1ProEmulator {
             data: data.to_vec(),
         };
         match Request::decode(&transfer, self.config.revision) {
-            Ok(Request::Reset { .. }) => {
+            Ok(Request::Reset { mask }) => {
                 self.pending = None;
+                if mask == metamer_protocols::i1pro::commands::RESET_POWER {
+                    self.low_power = self.low_power.map(|(_, n)| (true, n));
+                }
                 Answer::Done(())
             }
             Ok(Request::ReadEeprom { address, length }) => {
@@ -351,6 +374,11 @@ impl UsbDevice for I1ProEmulator {
                     p.flags & metamer_protocols::i1pro::commands::flags::LAMP_OFF == 0,
                 );
                 Answer::Done(())
+            }
+            Ok(Request::Trigger)
+                if self.config.fault == Some(Fault::StallTrigger(self.measurements + 1)) =>
+            {
+                Answer::Stall
             }
             Ok(Request::Trigger) => {
                 let (t, _, n, lamp_on) = self.params;
@@ -380,6 +408,7 @@ impl UsbDevice for I1ProEmulator {
             Some(Fault::DisconnectMidRead(n)) if n == self.measurements => {
                 return Answer::Disconnect
             }
+            Some(Fault::SilentRead(n)) if n == self.measurements => return Answer::Silent,
             _ => {}
         }
         bytes.truncate(len);

@@ -56,6 +56,12 @@ pub enum I1ProError {
     /// Readings of one exposure disagreed (the light or the instrument moved).
     #[error("the i1Pro's readings of one exposure disagree by more than 10 %: keep the instrument and the target still while it measures")]
     Inconsistent,
+    /// The unit did not leave low power.
+    #[error("the i1Pro stays in low power after 1.5 s: plug it into a USB port that supplies full power (not an unpowered hub) and try again")]
+    LowPower,
+    /// A reflective sample saturated the sensor under the lamp.
+    #[error("the sample saturated the i1Pro's sensor under its lamp (a fluorescent or glossy sample, or light leaking in): shade the sample and measure again")]
+    SaturatedSample,
     /// A USB transfer failed.
     #[error(transparent)]
     Transfer(#[from] TransferError),

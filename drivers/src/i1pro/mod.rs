@@ -77,7 +77,17 @@ impl<L: UsbLink> I1Pro<L> {
     /// is taken as Rev E [I: the endpoint count that also tells it is not visible through
     /// the link]. `clock` judges calibration validity.
     pub fn open(link: L, clock: Arc<dyn Clock>) -> Result<I1Pro<L>, DriverError> {
+        I1Pro::open_with(link, clock, false)
+    }
+
+    /// [`I1Pro::open`]; `settle` waits 100 ms between power polls, as a real unit needs.
+    pub fn open_with(
+        link: L,
+        clock: Arc<dyn Clock>,
+        settle: bool,
+    ) -> Result<I1Pro<L>, DriverError> {
         let mut wire = Wire::new(link, Revision::AToD);
+        wire.settle = settle;
         let misc =
             Misc::parse(&wire.request(Request::GetMisc)?).map_err(|e| reply("get misc", e))?;
         let revision = if misc.firmware >= 600 {
@@ -88,6 +98,9 @@ impl<L: UsbLink> I1Pro<L> {
         wire.revision = revision;
         wire.firmware = misc.firmware;
         wire.max_positive = misc.max_positive;
+        if !misc.high_power() {
+            power_up(&mut wire)?;
+        }
         wire.request(Request::Reset {
             mask: commands::RESET_NORMAL,
         })?;
@@ -223,6 +236,28 @@ impl<L: UsbLink> I1Pro<L> {
             timestamp_s: now_s(),
         }
     }
+}
+
+/// How often GetMisc is asked whether a unit in low power has come up, 100 ms apart.
+const POWER_POLLS: usize = 15;
+
+/// Brings a unit that reports low power up: reset with the power mask, then GetMisc until
+/// the power state changes (Argyll polls 15 times, 100 ms apart).
+fn power_up<L: UsbLink>(wire: &mut Wire<L>) -> Result<(), DriverError> {
+    wire.request(Request::Reset {
+        mask: commands::RESET_POWER,
+    })?;
+    for _ in 0..POWER_POLLS {
+        let misc =
+            Misc::parse(&wire.request(Request::GetMisc)?).map_err(|e| reply("get misc", e))?;
+        if misc.high_power() {
+            return Ok(());
+        }
+        if wire.settle {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+    }
+    Err(I1ProError::LowPower.into())
 }
 
 /// The calibration of a unit from its EEPROM image. On Rev E the bands are built from the
@@ -372,11 +407,10 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
                 let (dark, _) = self.reflective_dark.as_ref().expect("checked by due()");
                 let (factors, _) = self.white.as_ref().expect("checked by due()");
                 let (r, p) = engine::reflective(&mut self.wire, &self.cal, dark, factors)?;
-                let mut reading = self.reading(r.to_vec(), Quantity::Reflectance, p.integration_s);
                 if p.averaged.saturated {
-                    reading.flags.push(Flag::Saturated);
+                    return Err(I1ProError::SaturatedSample.into());
                 }
-                Ok(reading)
+                Ok(self.reading(r.to_vec(), Quantity::Reflectance, p.integration_s))
             }
         }
     }

@@ -25,7 +25,7 @@ pub const PRODUCT_ID: u16 = 0x2000;
 pub fn real(serial: &str, options: &OpenOptions) -> Result<Box<dyn Instrument>, DriverError> {
     let serial = (!serial.is_empty()).then_some(serial);
     let link = RusbLink::open(VENDOR_ID, PRODUCT_ID, serial, 0)?;
-    connect(link, options, Arc::new(SystemClock::default()))
+    connect(link, options, Arc::new(SystemClock::default()), true)
 }
 
 /// The driver run against a recorded session. Its clock never moves, so calibrations in the
@@ -38,6 +38,7 @@ pub fn replay(
         ReplayUsb::new(transcript)?,
         options,
         Arc::new(super::clock::ManualClock::new()),
+        false,
     )
 }
 
@@ -86,21 +87,23 @@ pub fn sim_with(
 ) -> Result<Box<dyn Instrument>, DriverError> {
     let device = I1ProEmulator::new(world, config).map_err(DriverError::Simulation)?;
     let (host, _thread) = usb_pair(device, &format!("sim:{MODEL}"));
-    connect(host, options, clock)
+    connect(host, options, clock, false)
 }
 
-/// Opens the driver on `link`, recording the session when asked.
+/// Opens the driver on `link`, recording the session when asked; `settle` waits out a
+/// real unit's power-up.
 pub fn connect<L: UsbLink + 'static>(
     link: L,
     options: &OpenOptions,
     clock: Arc<dyn Clock>,
+    settle: bool,
 ) -> Result<Box<dyn Instrument>, DriverError> {
     match &options.record {
         Some(path) => {
             let description = format!("metamer session with the i1Pro on {}", link.describe());
             let rec = RecordUsb::create(link, path, MODEL, "usb", &description)?;
-            Ok(Box::new(I1Pro::open(rec, clock)?))
+            Ok(Box::new(I1Pro::open_with(rec, clock, settle)?))
         }
-        None => Ok(Box::new(I1Pro::open(link, clock)?)),
+        None => Ok(Box::new(I1Pro::open_with(link, clock, settle)?)),
     }
 }

@@ -310,3 +310,79 @@ fn faults_are_clear_errors_never_wrong_spectra() {
     assert!(matches!(e, DriverError::Disconnected { .. }), "{e}");
     assert!(e.to_string().contains("read measurement"), "{e}");
 }
+
+#[test]
+fn a_unit_in_low_power_is_brought_up_or_reported() {
+    let world = Arc::new(SharedWorld::new(View::WhiteTile));
+    let (m, _) = open(
+        &world,
+        EmulatorConfig {
+            low_power_polls: 3,
+            ..quiet(Revision::AToD)
+        },
+    )
+    .unwrap();
+    assert_eq!(m.info().serial.as_deref(), Some("9000001"));
+    let e = open(
+        &world,
+        EmulatorConfig {
+            low_power_polls: 20,
+            ..quiet(Revision::AToD)
+        },
+    )
+    .err()
+    .unwrap();
+    assert!(e.to_string().contains("stays in low power"), "{e}");
+}
+
+#[test]
+fn a_stall_and_a_timeout_are_errors_that_name_the_request() {
+    let world = Arc::new(SharedWorld::new(View::WhiteTile));
+    let (mut m, _) = open(
+        &world,
+        EmulatorConfig {
+            fault: Some(Fault::StallTrigger(1)),
+            ..quiet(Revision::AToD)
+        },
+    )
+    .unwrap();
+    let e = m
+        .calibrate(MeasureMode::Emissive, &CalibrationCondition::OnWhiteTile)
+        .unwrap_err();
+    let text = e.to_string();
+    assert!(text.contains("during 'trigger measurement'"), "{text}");
+    assert!(text.contains("stalled endpoint 0x00"), "{text}");
+    // The read of 8 readings of 5 ms waits 2 s + 40 ms, as the codec's timeout rule says.
+    let (mut m, _) = open(
+        &world,
+        EmulatorConfig {
+            fault: Some(Fault::SilentRead(1)),
+            ..quiet(Revision::AToD)
+        },
+    )
+    .unwrap();
+    let e = m
+        .calibrate(MeasureMode::Emissive, &CalibrationCondition::OnWhiteTile)
+        .unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("during 'read measurement': no reply within 2040 ms"),
+        "{text}"
+    );
+    assert!(text.contains("unplug and replug"), "{text}");
+}
+
+#[test]
+fn a_sample_that_saturates_under_the_lamp_is_an_error() {
+    let world = Arc::new(SharedWorld::new(View::WhiteTile));
+    let (mut m, _) = open(&world, quiet(Revision::AToD)).unwrap();
+    calibrate(m.as_mut(), MeasureMode::Reflective);
+    // A fluorescent sample giving back 2.5 times the lamp's light.
+    world.set(View::surface(Spectrum::constant(380.0, 730.0, 2.5)).unwrap());
+    let e = m
+        .measure(&Request {
+            mode: MeasureMode::Reflective,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("sample saturated"), "{e}");
+}

@@ -45,6 +45,9 @@ pub struct Wire<L> {
     pub firmware: u16,
     /// The integration time of the previous shot (firmware 200–399 measures it first).
     previous_s: f64,
+    /// Wait out the instrument's settling times (a real unit); replays and the emulator
+    /// answer when they are ready.
+    pub settle: bool,
 }
 
 fn setup(s: Setup) -> ControlSetup {
@@ -69,6 +72,7 @@ impl<L: UsbLink> Wire<L> {
                 * f64::from(timing::SUB_CLOCK_DIVIDER_BEFORE_301),
             firmware: 0,
             previous_s: 0.0,
+            settle: false,
         }
     }
 

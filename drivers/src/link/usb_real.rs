@@ -8,7 +8,6 @@ use metamer_protocols::transcript::TransferKind;
 
 use super::usb::{ControlSetup, HidLink, UsbLink};
 use super::LinkError;
-use crate::devices::USB_PERMISSION_FIX;
 use crate::DriverError;
 
 /// A claimed interface of a USB device.
@@ -209,10 +208,17 @@ impl HidapiLink {
             return Err(DriverError::UsbNotFound { device: name });
         };
         let path = info.path().to_string_lossy().into_owned();
-        if let crate::devices::Access::Denied { .. } =
-            crate::devices::path_access(&path, USB_PERMISSION_FIX)
+        // Opening the hidraw node read-write has no side effects (unlike a tty's DTR) and
+        // tells a permission problem apart from hidapi's opaque errors. Checked here rather
+        // than with the device listing's helper, which would tie this link to the registry.
+        if let Err(e) = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&path)
         {
-            return Err(DriverError::UsbPermission { device: name });
+            if e.kind() == std::io::ErrorKind::PermissionDenied {
+                return Err(DriverError::UsbPermission { device: name });
+            }
         }
         let device = info
             .open_device(&api)
