@@ -246,7 +246,7 @@ const SOLVERS: [(&str, Solver); 2] = [("hand", levenberg_marquardt), ("crate", c
 fn bench(c: &mut Criterion) {
     let problems = problems();
     println!(
-        "{:<28} {:>6} {:>12} {:>12} {:>7}",
+        "{:<28} {:>6} {:>12} {:>12} {:>7}  parameters",
         "problem", "solver", "cost", "max |Δp|", "bounds"
     );
     for p in &problems {
@@ -263,7 +263,7 @@ fn bench(c: &mut Criterion) {
             });
             let inside = (0..x.len()).all(|i| x[i] >= p.lower[i] && x[i] <= p.upper[i]);
             println!(
-                "{:<28} {name:>6} {cost:>12.4e} {err:>12} {inside:>7}",
+                "{:<28} {name:>6} {cost:>12.4e} {err:>12} {inside:>7}  {x:.4?}",
                 p.name
             );
         }
