@@ -19,7 +19,8 @@ use metamer::rig::{Preset, VirtualPanel};
 use nalgebra::storage::Owned;
 use nalgebra::{DMatrix, DVector, Dyn};
 
-type Residual<'a> = &'a dyn Fn(&[f64]) -> Vec<f64>;
+type ResidualFn = dyn Fn(&[f64]) -> Vec<f64>;
+type Residual<'a> = &'a ResidualFn;
 
 struct Bounded<'a> {
     residual: Residual<'a>,
@@ -95,7 +96,7 @@ fn crate_lm(residual: Residual, start: &[f64], lower: &[f64], upper: &[f64]) -> 
 
 struct Problem {
     name: String,
-    residual: Box<dyn Fn(&[f64]) -> Vec<f64>>,
+    residual: Box<ResidualFn>,
     start: Vec<f64>,
     lower: Vec<f64>,
     upper: Vec<f64>,
