@@ -1,6 +1,15 @@
 //! A small Levenberg–Marquardt for curve fits with a handful of parameters (Marquardt,
 //! "An algorithm for least-squares estimation of nonlinear parameters", SIAM J. Appl. Math.
 //! 11(2), 1963): forward-difference Jacobian, parameters kept inside box bounds.
+//!
+//! Measured against the `levenberg-marquardt` crate 0.15 (same Jacobian, bounds by the
+//! smooth `lo + (hi − lo)(1 + sin u)/2` map) with `cargo bench --bench least_squares`: both
+//! recover the exponential below and the synthetic GOG and GOGO curves to 2e-15; on the 18
+//! GOG/GOGO fits of the virtual displays' ramps the crate takes 2.0 ms in all against 5.2 ms
+//! and ends lower on five GOGO fits (by up to 7 % in cost), but it is slower on the synthetic
+//! curves (113 against 85 µs, 243 against 161 µs), on three wide-gamut-ccfl GOG fits (up to
+//! 104 against 53 µs) and on ips-lcd green GOGO, and ends 17 % higher on wide-gamut-ccfl blue
+//! GOGO. Not at least as accurate and as fast on every problem, so this solver stays.
 
 use nalgebra::{DMatrix, DVector};
 
