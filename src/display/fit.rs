@@ -9,8 +9,8 @@ use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals
 use super::model::samples::SortedSamples;
 use super::model::Sample;
 use super::model::{
-    fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, FitError, ModelKind,
-    ModelParams,
+    default_knots, fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, fit_shaper_matrix,
+    DisplayModel, FitError, ModelKind, ModelParams,
 };
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
 use crate::color::{delta_e2000, Xyz};
@@ -61,6 +61,11 @@ pub fn fit_profile_with(
         ModelKind::Gog | ModelKind::Gogo => ModelParams::MatrixTrc(fit_gog(&set, kind)?),
         ModelKind::MatrixLsq => ModelParams::MatrixTrc(fit_matrix_lsq(&set, patches)?),
         ModelKind::Lut => ModelParams::Lut(fit_lut(&set, patches)?),
+        ModelKind::ShaperMatrix => ModelParams::MatrixTrc(fit_shaper_matrix(
+            &set,
+            patches,
+            default_knots(patches.len()),
+        )?),
     };
     let model = params.model();
     let white = set.white.unwrap_or_else(|| model.forward([1.0; 3]));

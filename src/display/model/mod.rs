@@ -14,6 +14,7 @@ mod matrix_lsq;
 mod matrix_trc;
 mod plcc;
 pub mod samples;
+mod shaper_matrix;
 mod trc;
 
 pub use display_model::{DisplayModel, Inverse, GAMUT_TOLERANCE};
@@ -26,6 +27,7 @@ pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma};
 pub use samples::Sample;
+pub use shaper_matrix::{default_knots, fit_shaper_matrix};
 pub use trc::{fit_power_gamma, FastInverse, Trc};
 
 use serde::{Deserialize, Serialize};
