@@ -19,7 +19,7 @@ pub fn scattered_patches(n: usize, seed: u64) -> Vec<[u8; 3]> {
             }
         }));
     }
-    let shift: [f64; 3] = std::array::from_fn(|c| unit(splitmix(seed ^ (c as u64 + 1) * 0x51ED)));
+    let shift: [f64; 3] = std::array::from_fn(|c| unit(splitmix(seed ^ ((c as u64 + 1) * 0x51ED))));
     let mut i = 1;
     while out.len() < n {
         let code: [u8; 3] = std::array::from_fn(|c| {

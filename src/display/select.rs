@@ -63,7 +63,7 @@ pub fn select_model(
     let corner = |p: &Sample| {
         p.rgb
             .iter()
-            .all(|&d| d < SAME_DRIVE || d > 1.0 - SAME_DRIVE)
+            .all(|&d| !(SAME_DRIVE..=1.0 - SAME_DRIVE).contains(&d))
     };
     let rotating: Vec<usize> = (0..patches.len())
         .filter(|&i| !corner(&patches[i]))
