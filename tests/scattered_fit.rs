@@ -6,7 +6,7 @@ use metamer::display::characterize::plan::random_patches;
 use metamer::display::fit::fit_params;
 use metamer::display::model::samples::SortedSamples;
 use metamer::display::scattered::scattered_patches;
-use metamer::display::{fit_profile, select_model, FitOptions, ModelKind, Sample};
+use metamer::display::{fit_profile, select_model, write_ti3, FitOptions, ModelKind, Sample};
 use metamer::rig::{Preset, VirtualPanel};
 
 fn measure(panel: &VirtualPanel, codes: &[[u8; 3]]) -> Vec<Sample> {
@@ -57,6 +57,16 @@ fn print_held_out_table() {
                 if let Some(e) = try_held_out(&panel, kind, &patches) {
                     line += &format!(" {kind} {e:.3} ({} ms)", t.elapsed().as_millis());
                 }
+            }
+            // For the ArgyllCMS side benchmark (benches/argyll/scattered.py): the fit set
+            // and the held-out set as .ti3.
+            if let Some(dir) = std::env::var_os("METAMER_SCATTERED_OUT") {
+                let dir = std::path::Path::new(&dir).join(format!("{}-{n}", panel.name()));
+                std::fs::create_dir_all(&dir).unwrap();
+                write_ti3(&dir.join("fit.ti3"), &patches, "scattered fit set").unwrap();
+                let mut test = measure(&panel, &[[255; 3]]);
+                test.extend(measure(&panel, &random_patches(500, 77)));
+                write_ti3(&dir.join("heldout.ti3"), &test, "held-out set").unwrap();
             }
             let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
             line += &format!(" auto→{}", sel.model);

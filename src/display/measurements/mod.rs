@@ -6,8 +6,11 @@
 //! `RGB_R RGB_G RGB_B` are percentages 0–100; for `DEVICE_CLASS "DISPLAY"` the XYZ values are
 //! normalised so that the white has Y = 100 unless the keyword `NORMALIZED_TO_Y_100` is
 //! `"NO"`, and the keyword `LUMINANCE_XYZ_CDM2 "X Y Z"` gives the white's absolute XYZ in
-//! cd/m², so absolute = value × LUMINANCE_Y / 100. Only the first table is read: dispread
-//! may append a second (`CAL`) table with the video LUT.
+//! cd/m², so absolute = value × LUMINANCE_Y / 100. The first table holds the measurements;
+//! dispread and DisplayCAL may append a second table with the identifier `CAL` and fields
+//! `RGB_I RGB_R RGB_G RGB_B` (the video-card curves loaded while measuring, 0–1), which is
+//! kept. Fields `SPEC_nnn` (a spectrometer's readings at nnn nm) are kept as spectra;
+//! `SAMPLE_ID` and other fields are optional and ignored, keywords may come in any order.
 
 use std::path::{Path, PathBuf};
 
@@ -47,6 +50,25 @@ pub struct Measurements {
     /// False when a `.ti3` holds only white-relative XYZ (Y = 100 at white, no
     /// `LUMINANCE_XYZ_CDM2`): the values are then taken as if the white had 100 cd/m².
     pub absolute: bool,
+    /// Spectral readings when the file has `SPEC_nnn` fields, one per patch, in file order.
+    pub spectra: Option<Spectra>,
+    /// The `CAL` table's video-card curves, when the file has one.
+    pub calibration: Option<Vec<CalibrationEntry>>,
+}
+
+/// Spectra of the patches: values at `wavelengths_nm`, in the file's units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spectra {
+    pub wavelengths_nm: Vec<f64>,
+    /// One row per patch, one value per wavelength.
+    pub values: Vec<Vec<f64>>,
+}
+
+/// One row of a `CAL` table: input level and the output of each channel's curve, 0–1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CalibrationEntry {
+    pub input: f64,
+    pub rgb: [f64; 3],
 }
 
 /// Reads `.ti3` (CGATS) or `.csv` by extension; relative `.ti3` data are returned as if the
@@ -85,6 +107,8 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
         return Ok(Measurements {
             patches,
             absolute: true,
+            spectra: None,
+            calibration: None,
         });
     }
     let text = std::fs::read_to_string(path).map_err(|source| MeasurementsError::Io {
@@ -150,6 +174,9 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
     let mut declared_sets: Option<(usize, usize)> = None;
     let mut columns: Option<[usize; 6]> = None;
     let mut rows: Vec<(usize, [f64; 6])> = Vec::new();
+    let mut spectral: Vec<(usize, f64)> = Vec::new();
+    let mut spectra: Vec<Vec<f64>> = Vec::new();
+    let mut end_line = 0;
     let mut ended = false;
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
@@ -201,6 +228,7 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
                         }
                     }
                     columns = Some(cols);
+                    spectral = spectral_columns(&fields).map_err(|m| err(line, m))?;
                     state = State::Data;
                 }
                 "KEYWORD" => {}
@@ -219,6 +247,7 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
             State::Data => {
                 if toks[0] == "END_DATA" {
                     ended = true;
+                    end_line = index;
                     break;
                 }
                 let cols = columns.expect("set when the data began");
@@ -250,6 +279,27 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
                     if !(0.0..=100.0).contains(&v[k]) {
                         return Err(err(line, format!("{name} = {} is outside 0–100", v[k])));
                     }
+                }
+                if !spectral.is_empty() {
+                    let mut row = Vec::with_capacity(spectral.len());
+                    for &(c, _) in &spectral {
+                        row.push(
+                            toks[c]
+                                .parse::<f64>()
+                                .ok()
+                                .filter(|x| x.is_finite())
+                                .ok_or_else(|| {
+                                    err(
+                                        line,
+                                        format!(
+                                            "field {} ('{}') is not a number",
+                                            fields[c], toks[c]
+                                        ),
+                                    )
+                                })?,
+                        );
+                    }
+                    spectra.push(row);
                 }
                 rows.push((line, v));
             }
@@ -324,7 +374,142 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
             })
             .collect(),
         absolute,
+        spectra: (!spectral.is_empty()).then(|| Spectra {
+            wavelengths_nm: spectral.iter().map(|&(_, nm)| nm).collect(),
+            values: spectra,
+        }),
+        calibration: calibration_table(text, end_line + 1).map_err(|(l, m)| err(l, m))?,
     })
+}
+
+/// Columns and wavelengths of `SPEC_nnn` fields, which must rise in wavelength.
+fn spectral_columns(fields: &[String]) -> Result<Vec<(usize, f64)>, String> {
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for (c, f) in fields.iter().enumerate() {
+        if let Some(nm) = f.strip_prefix("SPEC_") {
+            let nm = nm
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| format!("spectral field {f} does not end in a wavelength in nm"))?;
+            if out.last().is_some_and(|&(_, last)| nm <= last) {
+                return Err(format!(
+                    "spectral field {f} does not follow a shorter wavelength"
+                ));
+            }
+            out.push((c, nm));
+        }
+    }
+    Ok(out)
+}
+
+/// The `CAL` table after line index `from` (0-based), if any; errors carry the 1-based line.
+fn calibration_table(
+    text: &str,
+    from: usize,
+) -> Result<Option<Vec<CalibrationEntry>>, (usize, String)> {
+    let mut lines = text.lines().enumerate().skip(from);
+    let mut found = false;
+    for (_, raw) in lines.by_ref() {
+        match tokens(raw).ok().and_then(|t| t.first().cloned()) {
+            Some(t) if t == "CAL" => {
+                found = true;
+                break;
+            }
+            // Another table type that is not the calibration: nothing more is read.
+            Some(t)
+                if t.chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
+                    && !t.contains('_')
+                    && raw.trim() == t =>
+            {
+                return Ok(None)
+            }
+            _ => {}
+        }
+    }
+    if !found {
+        return Ok(None);
+    }
+    let mut fields: Vec<String> = Vec::new();
+    let mut in_format = false;
+    let mut columns: Option<[usize; 4]> = None;
+    let mut out = Vec::new();
+    for (index, raw) in lines {
+        let line = index + 1;
+        let toks = tokens(raw).map_err(|m| (line, m))?;
+        let Some(first) = toks.first() else { continue };
+        if in_format {
+            if first == "END_DATA_FORMAT" {
+                in_format = false;
+            } else {
+                fields.extend(toks.iter().cloned());
+            }
+            continue;
+        }
+        match (first.as_str(), columns) {
+            ("BEGIN_DATA_FORMAT", _) => {
+                in_format = true;
+                fields.extend(toks[1..].iter().cloned());
+            }
+            ("BEGIN_DATA", _) => {
+                let names = ["RGB_I", "RGB_R", "RGB_G", "RGB_B"];
+                let mut cols = [0; 4];
+                for (c, n) in cols.iter_mut().zip(names) {
+                    *c = fields.iter().position(|f| f == n).ok_or_else(|| {
+                        (
+                            line,
+                            format!(
+                                "the CAL table lacks the field {n} (found: {})",
+                                fields.join(" ")
+                            ),
+                        )
+                    })?;
+                }
+                columns = Some(cols);
+            }
+            ("END_DATA", Some(_)) => return Ok(Some(out)),
+            (_, Some(cols)) => {
+                if toks.len() != fields.len() {
+                    return Err((
+                        line,
+                        format!(
+                            "the CAL table expects {} values, found {}",
+                            fields.len(),
+                            toks.len()
+                        ),
+                    ));
+                }
+                let v: Vec<f64> = cols
+                    .iter()
+                    .map(|&c| {
+                        toks[c]
+                            .parse::<f64>()
+                            .ok()
+                            .filter(|x| (0.0..=1.0).contains(x))
+                            .ok_or_else(|| {
+                                (
+                                    line,
+                                    format!(
+                                        "CAL field {} ('{}') is not a number in 0–1",
+                                        fields[c], toks[c]
+                                    ),
+                                )
+                            })
+                    })
+                    .collect::<Result<_, _>>()?;
+                out.push(CalibrationEntry {
+                    input: v[0],
+                    rgb: [v[1], v[2], v[3]],
+                });
+            }
+            _ => {}
+        }
+    }
+    Err((
+        text.lines().count().max(1),
+        "the CAL table's END_DATA is missing: the file is cut short".into(),
+    ))
 }
 
 fn find_columns(fields: &[String]) -> Result<[usize; 6], String> {
@@ -467,5 +652,54 @@ DESCRIPTOR "Argyll Device Calibration State"
             "{e}"
         );
         std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+#[cfg(test)]
+mod quirk_tests {
+    use super::*;
+
+    /// A file in the shape DisplayCAL writes from a spectrometer: CRLF line ends, tabs, no
+    /// SAMPLE_ID, keywords after the data format, SPEC_nnn fields and a CAL table after the
+    /// measurements.
+    #[test]
+    fn reads_spectra_and_the_calibration_table() {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/displaycal_spectral_cal.ti3");
+        let m = read_measurement_file(&path).unwrap();
+        assert!(m.absolute);
+        assert_eq!(m.patches.len(), 3);
+        // 50 % red, 25 % green; Y 10 of a 100 normalised to an 80 cd/m² white = 8 cd/m².
+        assert_eq!(m.patches[2].rgb, [0.5, 0.25, 0.0]);
+        assert!((m.patches[2].xyz[1] - 8.0).abs() < 1e-12);
+        let s = m.spectra.unwrap();
+        assert_eq!(s.wavelengths_nm, vec![450.0, 550.0, 650.0]);
+        assert_eq!(s.values[2], vec![0.05, 0.20, 0.35]);
+        let cal = m.calibration.unwrap();
+        assert_eq!(cal.len(), 3);
+        assert_eq!(
+            cal[1],
+            CalibrationEntry {
+                input: 0.5,
+                rgb: [0.48, 0.5, 0.52]
+            }
+        );
+    }
+
+    #[test]
+    fn a_broken_calibration_table_names_its_line() {
+        let text = std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/displaycal_spectral_cal.ti3"),
+        )
+        .unwrap();
+        let bad = text.replace("0.5 0.48 0.5 0.52", "0.5 0.48 0.5");
+        let e = parse_ti3(&bad, Path::new("c.ti3")).unwrap_err().to_string();
+        assert_eq!(e, "c.ti3:48: the CAL table expects 4 values, found 3");
+        let cut: String = text.lines().take(48).collect::<Vec<_>>().join("\n");
+        let e = parse_ti3(&cut, Path::new("c.ti3")).unwrap_err().to_string();
+        assert!(e.contains("CAL table's END_DATA is missing"), "{e}");
+        let bad = text.replace("SPEC_550", "SPEC_x");
+        let e = parse_ti3(&bad, Path::new("c.ti3")).unwrap_err().to_string();
+        assert!(e.starts_with("c.ti3:26: spectral field SPEC_x"), "{e}");
     }
 }
