@@ -47,6 +47,14 @@ fn try_held_out(panel: &VirtualPanel, kind: ModelKind, patches: &[Sample]) -> Op
 #[test]
 #[ignore]
 fn print_held_out_table() {
+    if let Some(dir) = std::env::var_os("METAMER_SCATTERED_OUT") {
+        // A 10,000-patch file for measuring `metamer fit`'s peak memory.
+        let panel = VirtualPanel::preset(Preset::IpsLcd);
+        let patches = measure(&panel, &scattered_patches(10_000, 5));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = std::path::Path::new(&dir).with_extension("10000.ti3");
+        write_ti3(&path, &patches, "10,000 scattered patches").unwrap();
+    }
     for preset in Preset::ALL {
         let panel = VirtualPanel::preset(preset);
         for n in [50, 200, 1000] {
