@@ -40,7 +40,11 @@ fn auto_explains_its_choice_and_verify_reports_held_out_errors() {
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(text.contains("5-fold cross-validation"), "{text}");
     assert!(text.contains("shaper-matrix  CV mean ΔE00"), "{text}");
     // plcc needs ramps, which a scattered set does not have: it is listed with the reason.
@@ -52,7 +56,11 @@ fn auto_explains_its_choice_and_verify_reports_held_out_errors() {
         .arg(dir.join("test.csv"))
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["patches"], 40);
     let (mean, p95, max) = (
