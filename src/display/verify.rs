@@ -131,9 +131,8 @@ impl std::fmt::Display for Verification {
 mod tests {
     use super::*;
 
-    /// Stats by hand: ΔE00 of (50,0,0) against (50,0,0), (51,0,0) and (54,0,0) in lightness
-    /// only, at L 50 where S_L = 1: ΔE00 = ΔL; the mean is 5/3, the p95 by linear
-    /// interpolation between the 2nd and 3rd values at rank 1.9 is 1 + 0.9·3 = 3.7.
+    /// Stats of 0, 1, 4 by hand: the mean is 5/3; the p95 lies at rank 0.95·2 = 1.9, so
+    /// linearly between the 2nd and 3rd values, 1 + 0.9·3 = 3.7.
     #[test]
     fn stats_follow_a_hand_computation() {
         let s = Stats::of(&[0.0, 1.0, 4.0]);
