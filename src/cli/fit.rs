@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use super::{CliError, CliResult};
-use metamer::display::{fit_profile_with, read_measurement_file, FitOptions, ModelKind};
+use metamer::display::{
+    fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
+};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -12,9 +14,13 @@ pub struct Args {
     /// (drive 0–1, XYZ cd/m²).
     #[arg(long, value_name = "FILE")]
     measurements: PathBuf,
-    /// Display model: plcc, plcc-gamma, gog, gogo, lut, matrix-lsq.
+    /// Display model: plcc, plcc-gamma, gog, gogo, lut, matrix-lsq, shaper-matrix, or auto
+    /// (k-fold cross-validation over the patches picks the model and prints why).
     #[arg(long, default_value = "plcc")]
-    model: ModelKind,
+    model: ModelChoice,
+    /// auto only: the number of cross-validation folds.
+    #[arg(long, default_value_t = 5)]
+    folds: usize,
     /// plcc-gamma only: this exponent for every channel instead of fitting (the paper: 2.2).
     #[arg(long)]
     gamma: Option<f64>,
@@ -27,9 +33,28 @@ pub struct Args {
     output: PathBuf,
 }
 
+/// A model by name, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ModelChoice {
+    Auto,
+    Kind(ModelKind),
+}
+
+impl std::str::FromStr for ModelChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim().eq_ignore_ascii_case("auto") {
+            return Ok(ModelChoice::Auto);
+        }
+        s.parse::<ModelKind>()
+            .map(ModelChoice::Kind)
+            .map_err(|e| format!("{e}, or auto"))
+    }
+}
+
 pub fn run(args: Args) -> CliResult {
     if let Some(g) = args.gamma {
-        if args.model != ModelKind::PlccGamma {
+        if args.model != ModelChoice::Kind(ModelKind::PlccGamma) {
             return Err(CliError::Usage(
                 "--gamma applies to --model plcc-gamma only".into(),
             ));
@@ -59,7 +84,21 @@ pub fn run(args: Args) -> CliResult {
         gamma: args.gamma,
         noise_de00: args.noise,
     };
-    let profile = fit_profile_with(args.model, &m.patches, Some(&args.measurements), &options)?;
+    if args.folds < 2 {
+        return Err(CliError::Usage(format!(
+            "--folds must be at least 2, got {}",
+            args.folds
+        )));
+    }
+    let kind = match args.model {
+        ModelChoice::Kind(kind) => kind,
+        ModelChoice::Auto => {
+            let selection = select_model(&m.patches, args.folds, &options)?;
+            println!("{selection}");
+            selection.model
+        }
+    };
+    let profile = fit_profile_with(kind, &m.patches, Some(&args.measurements), &options)?;
     println!(
         "{} patches from {}; model {}",
         m.patches.len(),

@@ -15,6 +15,7 @@ mod render;
 mod reproduce;
 mod simulate;
 mod spot;
+mod verify;
 
 /// metamer: prove a rendering is colour-true.
 #[derive(Parser)]
@@ -36,6 +37,8 @@ enum Command {
     Render(render::Args),
     /// Fit a display model to measured patches.
     Fit(fit::Args),
+    /// Check a display profile against measured patches (e.g. ones it was not fitted to).
+    Verify(verify::Args),
     /// XYZ targets or images to display drive values through a display profile.
     Reproduce(reproduce::Args),
     /// Show and measure patches on a display, fit and verify a profile.
@@ -70,6 +73,7 @@ pub fn main() -> ExitCode {
         Command::Spot(args) => spot::run(args),
         Command::Render(args) => render::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Verify(args) => verify::run(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Characterize(args) => characterize::run(args),
         Command::Lab(args) => lab::run(args),

@@ -9,7 +9,8 @@ use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals
 use super::model::samples::SortedSamples;
 use super::model::Sample;
 use super::model::{
-    fit_gog, fit_lut, fit_matrix_lsq, fit_plcc, fit_plcc_gamma, DisplayModel, FitError, ModelKind,
+    default_grid, default_knots, fit_gog, fit_lut, fit_lut_scattered, fit_matrix_lsq, fit_plcc,
+    fit_plcc_gamma, fit_shaper_matrix, has_full_grid, DisplayModel, FitError, ModelKind,
     ModelParams,
 };
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
@@ -41,27 +42,9 @@ pub fn fit_profile_with(
     source: Option<&Path>,
     options: &FitOptions,
 ) -> Result<Profile, FitError> {
-    if patches.is_empty() {
-        return Err(FitError::NoSamples);
-    }
-    for (index, p) in patches.iter().enumerate() {
-        let ok =
-            p.rgb.iter().all(|d| (0.0..=1.0).contains(d)) && p.xyz.iter().all(|v| v.is_finite());
-        if !ok {
-            return Err(FitError::BadSample {
-                index: index + 1,
-                rgb: p.rgb,
-            });
-        }
-    }
+    check_samples(patches)?;
     let set = SortedSamples::new(patches);
-    let params = match kind {
-        ModelKind::Plcc => ModelParams::MatrixTrc(fit_plcc(&set)?),
-        ModelKind::PlccGamma => ModelParams::MatrixTrc(fit_plcc_gamma(&set, options.gamma)?),
-        ModelKind::Gog | ModelKind::Gogo => ModelParams::MatrixTrc(fit_gog(&set, kind)?),
-        ModelKind::MatrixLsq => ModelParams::MatrixTrc(fit_matrix_lsq(&set, patches)?),
-        ModelKind::Lut => ModelParams::Lut(fit_lut(&set, patches)?),
-    };
+    let params = fit_params(kind, &set, patches, options)?;
     let model = params.model();
     let white = set.white.unwrap_or_else(|| model.forward([1.0; 3]));
     let black = set.black.unwrap_or_else(|| model.forward([0.0; 3]));
@@ -103,6 +86,48 @@ pub fn fit_profile_with(
         residuals,
         diagnostics,
         input,
+    })
+}
+
+/// Refuses an empty set and patches with drive values outside 0–1 or non-finite XYZ.
+pub fn check_samples(patches: &[Sample]) -> Result<(), FitError> {
+    if patches.is_empty() {
+        return Err(FitError::NoSamples);
+    }
+    for (index, p) in patches.iter().enumerate() {
+        let ok =
+            p.rgb.iter().all(|d| (0.0..=1.0).contains(d)) && p.xyz.iter().all(|v| v.is_finite());
+        if !ok {
+            return Err(FitError::BadSample {
+                index: index + 1,
+                rgb: p.rgb,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The model's parameters alone, without diagnostics (what cross-validation refits).
+pub fn fit_params(
+    kind: ModelKind,
+    set: &SortedSamples,
+    patches: &[Sample],
+    options: &FitOptions,
+) -> Result<ModelParams, FitError> {
+    Ok(match kind {
+        ModelKind::Plcc => ModelParams::MatrixTrc(fit_plcc(set)?),
+        ModelKind::PlccGamma => ModelParams::MatrixTrc(fit_plcc_gamma(set, options.gamma)?),
+        ModelKind::Gog | ModelKind::Gogo => ModelParams::MatrixTrc(fit_gog(set, kind)?),
+        ModelKind::MatrixLsq => ModelParams::MatrixTrc(fit_matrix_lsq(set, patches)?),
+        ModelKind::Lut if has_full_grid(patches) => ModelParams::Lut(fit_lut(set, patches)?),
+        ModelKind::Lut => ModelParams::Lut(
+            fit_lut_scattered(set, patches, default_grid(patches.len()), None)?.lut,
+        ),
+        ModelKind::ShaperMatrix => ModelParams::MatrixTrc(fit_shaper_matrix(
+            set,
+            patches,
+            default_knots(patches.len()),
+        )?),
     })
 }
 

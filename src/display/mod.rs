@@ -8,6 +8,9 @@ pub mod fit;
 pub mod measurements;
 pub mod model;
 pub mod profile;
+pub mod scattered;
+pub mod select;
+pub mod verify;
 
 // Using a profile.
 pub mod gamut;
@@ -21,6 +24,11 @@ pub mod budget;
 
 pub use diagnostics::{Diagnostics, Noise, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitOptions};
-pub use measurements::{read_measurement_file, read_measurements, write_ti3, MeasurementsError};
+pub use measurements::{
+    read_measurement_file, read_measurements, write_ti3, CalibrationEntry, Measurements,
+    MeasurementsError, Spectra,
+};
 pub use model::{DisplayModel, FitError, Inverse, ModelKind, Sample};
 pub use profile::{Profile, ProfileError};
+pub use select::{select_model, Selection};
+pub use verify::{verify_profile, Verification};

@@ -6,12 +6,21 @@
 //! `RGB_R RGB_G RGB_B` are percentages 0–100; for `DEVICE_CLASS "DISPLAY"` the XYZ values are
 //! normalised so that the white has Y = 100 unless the keyword `NORMALIZED_TO_Y_100` is
 //! `"NO"`, and the keyword `LUMINANCE_XYZ_CDM2 "X Y Z"` gives the white's absolute XYZ in
-//! cd/m², so absolute = value × LUMINANCE_Y / 100. Only the first table is read: dispread
-//! may append a second (`CAL`) table with the video LUT.
+//! cd/m², so absolute = value × LUMINANCE_Y / 100. The first table holds the measurements;
+//! dispread and DisplayCAL may append a second table with the identifier `CAL` and fields
+//! `RGB_I RGB_R RGB_G RGB_B` (the video-card curves loaded while measuring, 0–1), which is
+//! kept. Fields `SPEC_nnn` (a spectrometer's readings at nnn nm) are kept as spectra;
+//! `SAMPLE_ID` and other fields are optional and ignored, keywords may come in any order.
 
 use std::path::{Path, PathBuf};
 
+mod calibration;
+mod tokens;
 mod write;
+
+use calibration::calibration_table;
+pub use calibration::CalibrationEntry;
+use tokens::tokens;
 
 pub use write::write_ti3;
 
@@ -47,6 +56,18 @@ pub struct Measurements {
     /// False when a `.ti3` holds only white-relative XYZ (Y = 100 at white, no
     /// `LUMINANCE_XYZ_CDM2`): the values are then taken as if the white had 100 cd/m².
     pub absolute: bool,
+    /// Spectral readings when the file has `SPEC_nnn` fields, one per patch, in file order.
+    pub spectra: Option<Spectra>,
+    /// The `CAL` table's video-card curves, when the file has one.
+    pub calibration: Option<Vec<CalibrationEntry>>,
+}
+
+/// Spectra of the patches: values at `wavelengths_nm`, in the file's units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spectra {
+    pub wavelengths_nm: Vec<f64>,
+    /// One row per patch, one value per wavelength.
+    pub values: Vec<Vec<f64>>,
 }
 
 /// Reads `.ti3` (CGATS) or `.csv` by extension; relative `.ti3` data are returned as if the
@@ -85,6 +106,8 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
         return Ok(Measurements {
             patches,
             absolute: true,
+            spectra: None,
+            calibration: None,
         });
     }
     let text = std::fs::read_to_string(path).map_err(|source| MeasurementsError::Io {
@@ -92,41 +115,6 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
         source,
     })?;
     parse_ti3(&text, path)
-}
-
-/// Splits a CGATS line into tokens: whitespace separated, double quotes group.
-fn tokens(line: &str) -> Result<Vec<String>, String> {
-    let mut out = Vec::new();
-    let mut chars = line.chars().peekable();
-    while let Some(&c) = chars.peek() {
-        if c.is_whitespace() {
-            chars.next();
-        } else if c == '#' {
-            break;
-        } else if c == '"' {
-            chars.next();
-            let mut s = String::new();
-            loop {
-                match chars.next() {
-                    Some('"') => break,
-                    Some(ch) => s.push(ch),
-                    None => return Err("a quoted value is not closed".into()),
-                }
-            }
-            out.push(s);
-        } else {
-            let mut s = String::new();
-            while let Some(&ch) = chars.peek() {
-                if ch.is_whitespace() {
-                    break;
-                }
-                s.push(ch);
-                chars.next();
-            }
-            out.push(s);
-        }
-    }
-    Ok(out)
 }
 
 /// Parses the first table of a CGATS `.ti3` text; `path` names it in errors.
@@ -150,6 +138,9 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
     let mut declared_sets: Option<(usize, usize)> = None;
     let mut columns: Option<[usize; 6]> = None;
     let mut rows: Vec<(usize, [f64; 6])> = Vec::new();
+    let mut spectral: Vec<(usize, f64)> = Vec::new();
+    let mut spectra: Vec<Vec<f64>> = Vec::new();
+    let mut end_line = 0;
     let mut ended = false;
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
@@ -201,6 +192,7 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
                         }
                     }
                     columns = Some(cols);
+                    spectral = spectral_columns(&fields).map_err(|m| err(line, m))?;
                     state = State::Data;
                 }
                 "KEYWORD" => {}
@@ -219,6 +211,7 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
             State::Data => {
                 if toks[0] == "END_DATA" {
                     ended = true;
+                    end_line = index;
                     break;
                 }
                 let cols = columns.expect("set when the data began");
@@ -250,6 +243,27 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
                     if !(0.0..=100.0).contains(&v[k]) {
                         return Err(err(line, format!("{name} = {} is outside 0–100", v[k])));
                     }
+                }
+                if !spectral.is_empty() {
+                    let mut row = Vec::with_capacity(spectral.len());
+                    for &(c, _) in &spectral {
+                        row.push(
+                            toks[c]
+                                .parse::<f64>()
+                                .ok()
+                                .filter(|x| x.is_finite())
+                                .ok_or_else(|| {
+                                    err(
+                                        line,
+                                        format!(
+                                            "field {} ('{}') is not a number",
+                                            fields[c], toks[c]
+                                        ),
+                                    )
+                                })?,
+                        );
+                    }
+                    spectra.push(row);
                 }
                 rows.push((line, v));
             }
@@ -324,7 +338,33 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
             })
             .collect(),
         absolute,
+        spectra: (!spectral.is_empty()).then(|| Spectra {
+            wavelengths_nm: spectral.iter().map(|&(_, nm)| nm).collect(),
+            values: spectra,
+        }),
+        calibration: calibration_table(text, end_line + 1).map_err(|(l, m)| err(l, m))?,
     })
+}
+
+/// Columns and wavelengths of `SPEC_nnn` fields, which must rise in wavelength.
+fn spectral_columns(fields: &[String]) -> Result<Vec<(usize, f64)>, String> {
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for (c, f) in fields.iter().enumerate() {
+        if let Some(nm) = f.strip_prefix("SPEC_") {
+            let nm = nm
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| format!("spectral field {f} does not end in a wavelength in nm"))?;
+            if out.last().is_some_and(|&(_, last)| nm <= last) {
+                return Err(format!(
+                    "spectral field {f} does not follow a shorter wavelength"
+                ));
+            }
+            out.push((c, nm));
+        }
+    }
+    Ok(out)
 }
 
 fn find_columns(fields: &[String]) -> Result<[usize; 6], String> {

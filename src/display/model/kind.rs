@@ -19,16 +19,20 @@ pub enum ModelKind {
     Lut,
     /// Measured-ramp TRCs and a matrix + black offset fitted over all patches.
     MatrixLsq,
+    /// Monotone per-channel curves and a matrix + black offset fitted jointly over every
+    /// patch in CIELAB (needs no ramps).
+    ShaperMatrix,
 }
 
 impl ModelKind {
-    pub const ALL: [ModelKind; 6] = [
+    pub const ALL: [ModelKind; 7] = [
         ModelKind::Plcc,
         ModelKind::PlccGamma,
         ModelKind::Gog,
         ModelKind::Gogo,
         ModelKind::Lut,
         ModelKind::MatrixLsq,
+        ModelKind::ShaperMatrix,
     ];
 
     pub fn name(self) -> &'static str {
@@ -39,6 +43,7 @@ impl ModelKind {
             ModelKind::Gogo => "gogo",
             ModelKind::Lut => "lut",
             ModelKind::MatrixLsq => "matrix-lsq",
+            ModelKind::ShaperMatrix => "shaper-matrix",
         }
     }
 }

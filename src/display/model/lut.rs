@@ -92,6 +92,45 @@ impl Lut3d {
         Vector3::from(self.nodes[(i[0] * ng + i[1]) * nb + i[2]])
     }
 
+    /// A table from grid levels, shapers and node values, checked as a loaded one is.
+    pub fn from_parts(
+        levels: [Vec<f64>; 3],
+        shaper: [Trc; 3],
+        nodes: Vec<[f64; 3]>,
+    ) -> Result<Lut3d, String> {
+        let mut lut = Lut3d {
+            levels,
+            shaper,
+            nodes,
+            shaped: Default::default(),
+            fast: Default::default(),
+            scale: 1.0,
+            start: ([0.0; 3], None),
+        };
+        lut.prepare()?;
+        Ok(lut)
+    }
+
+    /// The four nodes (flat indices) and weights whose weighted sum is the forward value at
+    /// `rgb`: the forward map is linear in the node values, which a fit of the nodes uses.
+    pub fn weights(&self, rgb: [f64; 3]) -> [(usize, f64); 4] {
+        let s = std::array::from_fn(|c| self.shaper[c].eval(rgb[c]));
+        let (cell, f, _) = self.locate(s);
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| f[b].total_cmp(&f[a]));
+        let index =
+            |v: [usize; 3]| (v[0] * self.levels[1].len() + v[1]) * self.levels[2].len() + v[2];
+        // value = n0 + Σ f[axis]·(n_next − n_prev) along the sorted axes.
+        let mut corner = cell;
+        let mut out = [(index(corner), 1.0), (0, 0.0), (0, 0.0), (0, 0.0)];
+        for (step, &axis) in order.iter().enumerate() {
+            out[step].1 -= f[axis];
+            corner[axis] += 1;
+            out[step + 1] = (index(corner), f[axis]);
+        }
+        out
+    }
+
     /// Cell and fractions of a shaped point (fractions outside 0–1 beyond the cube).
     fn locate(&self, s: [f64; 3]) -> ([usize; 3], [f64; 3], [f64; 3]) {
         let mut cell = [0; 3];
@@ -190,6 +229,31 @@ fn grid_levels(patches: &[Sample], c: usize) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v.dedup_by(|a, b| (*a - *b).abs() < SAME_DRIVE);
     v
+}
+
+/// Whether the patches hold every combination of their grid levels (what [`fit_lut`]
+/// needs). Decided without allocating the grid when it has more cells than there are
+/// patches, which a scattered set (every patch its own level) always has.
+pub fn has_full_grid(patches: &[Sample]) -> bool {
+    let levels: [Vec<f64>; 3] = std::array::from_fn(|c| grid_levels(patches, c));
+    let cells = levels
+        .iter()
+        .map(Vec::len)
+        .try_fold(1usize, |a, n| a.checked_mul(n));
+    if cells.is_none_or(|c| c > patches.len()) {
+        return false;
+    }
+    let index = |c: usize, d: f64| levels[c].iter().position(|&l| (l - d).abs() < SAME_DRIVE);
+    let (ng, nb) = (levels[1].len(), levels[2].len());
+    let mut seen = vec![false; cells.unwrap_or(0)];
+    for p in patches {
+        if let (Some(i), Some(j), Some(k)) =
+            (index(0, p.rgb[0]), index(1, p.rgb[1]), index(2, p.rgb[2]))
+        {
+            seen[(i * ng + j) * nb + k] = true;
+        }
+    }
+    seen.into_iter().all(|s| s)
 }
 
 pub fn fit_lut(set: &SortedSamples, patches: &[Sample]) -> Result<Lut3d, FitError> {

@@ -10,10 +10,12 @@ mod gog;
 mod kind;
 mod least_squares;
 mod lut;
+mod lut_scattered;
 mod matrix_lsq;
 mod matrix_trc;
 mod plcc;
 pub mod samples;
+mod shaper_matrix;
 mod trc;
 
 pub use display_model::{DisplayModel, Inverse, GAMUT_TOLERANCE};
@@ -21,11 +23,13 @@ pub use error::FitError;
 pub use gog::{fit_gog, fit_gog_curve};
 pub use kind::ModelKind;
 pub use least_squares::levenberg_marquardt;
-pub use lut::{fit_lut, Lut3d};
+pub use lut::{fit_lut, has_full_grid, Lut3d};
+pub use lut_scattered::{default_grid, fit_lut_scattered, fold_of, ScatteredLut, LAMBDAS};
 pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma};
 pub use samples::Sample;
+pub use shaper_matrix::{default_knots, fit_shaper_matrix};
 pub use trc::{fit_power_gamma, FastInverse, Trc};
 
 use serde::{Deserialize, Serialize};

@@ -1,0 +1,319 @@
+//! A 3D LUT fitted to scattered patches: the grid is chosen (N evenly spaced drive levels
+//! per channel), not read off the data, and its nodes are found by regularised least
+//! squares, so any patch set fits in memory and time linear in patches + N³.
+//!
+//! The table is the shaper + matrix model (whose curves are also the LUT's shapers) plus a
+//! correction c at every node. Each patch constrains the four nodes of its tetrahedron
+//! through the interpolation weights; a discrete Laplacian (second differences along each
+//! axis) keeps the correction smooth where cells hold no patches, so an empty region of
+//! the cube follows the matrix model and its neighbours instead of drifting. Per channel of
+//! XYZ the normal equations
+//!   (Wᵀ Ω W + λ s DᵀD + μ s I) c = Wᵀ Ω (xyz − W·base)
+//! are solved by Jacobi-preconditioned conjugate gradients without forming a matrix. Ω
+//! weights each patch by dL*/dY at its luminance (the error is judged in CIELAB, where dark
+//! colours are more sensitive), s is that weight at mid grey so λ has no unit, and λ is
+//! chosen by k-fold cross-validation on held-out ΔE00.
+//!
+//! On a full grid of measured nodes with λ → 0 every node equals its measurement, which is
+//! what the grid LUT of [`super::fit_lut`] stores.
+
+use super::error::FitError;
+use super::samples::{Sample, SortedSamples};
+use super::shaper_matrix::{default_knots, fit_shaper_matrix};
+use super::{DisplayModel, Lut3d, ModelKind};
+use crate::color::{delta_e2000, Xyz};
+
+/// The regularisation weights cross-validation chooses from.
+pub const LAMBDAS: [f64; 6] = [1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0];
+
+/// Folds of the cross-validation that picks λ.
+const FOLDS: usize = 5;
+
+/// Grid points per axis for a patch count: more patches can pin a finer grid, and the
+/// grid never grows past 17³ = 4913 nodes whatever the input.
+pub fn default_grid(patches: usize) -> usize {
+    match patches {
+        0..=299 => 9,
+        300..=2999 => 13,
+        _ => 17,
+    }
+}
+
+/// A fitted scattered LUT and how its λ was chosen.
+#[derive(Clone, Debug)]
+pub struct ScatteredLut {
+    pub lut: Lut3d,
+    pub lambda: f64,
+    /// (λ, cross-validated mean ΔE00) for every λ tried; empty when λ was given.
+    pub cv: Vec<(f64, f64)>,
+}
+
+/// Fits an N³ LUT (`grid` points per axis, ≥ 2) to `patches`; `lambda` None chooses it by
+/// cross-validation from [`LAMBDAS`].
+pub fn fit_lut_scattered(
+    set: &SortedSamples,
+    patches: &[Sample],
+    grid: usize,
+    lambda: Option<f64>,
+) -> Result<ScatteredLut, FitError> {
+    let kind = ModelKind::Lut;
+    let failed = |message: String| FitError::Failed {
+        model: kind,
+        message,
+    };
+    if grid < 2 {
+        return Err(failed(format!(
+            "the grid needs at least 2 points per axis, not {grid}"
+        )));
+    }
+    let base = fit_shaper_matrix(set, patches, default_knots(patches.len())).map_err(|e| {
+        failed(format!(
+            "its shapers and start come from shaper-matrix, which failed: {e}"
+        ))
+    })?;
+    let level: Vec<f64> = (0..grid).map(|i| i as f64 / (grid - 1) as f64).collect();
+    let levels = [level.clone(), level.clone(), level.clone()];
+    let mut base_nodes = Vec::with_capacity(grid * grid * grid);
+    for &r in &level {
+        for &g in &level {
+            for &b in &level {
+                base_nodes.push(base.forward([r, g, b]));
+            }
+        }
+    }
+    let lut =
+        Lut3d::from_parts(levels.clone(), base.trc.clone(), base_nodes.clone()).map_err(failed)?;
+    let white = set.white.unwrap_or_else(|| base.forward([1.0; 3]));
+    let yw = white[1];
+    let slope = |y: f64| 116.0 / 3.0 / yw * (y / yw).max(0.008856).powf(-2.0 / 3.0);
+    let rows: Vec<Row> = patches
+        .iter()
+        .map(|p| {
+            let w = lut.weights(p.rgb);
+            let at_base: [f64; 3] =
+                std::array::from_fn(|k| w.iter().map(|&(i, f)| f * base_nodes[i][k]).sum::<f64>());
+            let omega = slope(p.xyz[1].max(0.0));
+            Row {
+                w,
+                omega2: omega * omega,
+                target: std::array::from_fn(|k| p.xyz[k] - at_base[k]),
+            }
+        })
+        .collect();
+    let scale = slope(0.2 * yw).powi(2);
+    let problem = Problem { grid, scale };
+    let (lambda, cv) = match lambda {
+        Some(l) => (l, Vec::new()),
+        None => {
+            let wl = Xyz::from_array(white);
+            let mut cv = Vec::new();
+            for &l in &LAMBDAS {
+                let mut sum = 0.0;
+                let mut count = 0usize;
+                for fold in 0..FOLDS.min(patches.len()) {
+                    let train: Vec<&Row> = rows
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| fold_of(*i) % FOLDS != fold)
+                        .map(|(_, r)| r)
+                        .collect();
+                    let c = problem.solve(&train, l);
+                    for (i, (row, p)) in rows.iter().zip(patches).enumerate() {
+                        if fold_of(i) % FOLDS == fold {
+                            let f = predict(row, &base_nodes, &c);
+                            sum += delta_e2000(
+                                Xyz::from_array(f).to_lab(wl),
+                                Xyz::from_array(p.xyz).to_lab(wl),
+                            );
+                            count += 1;
+                        }
+                    }
+                }
+                cv.push((l, sum / count.max(1) as f64));
+            }
+            let best = cv
+                .iter()
+                .copied()
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("LAMBDAS is not empty");
+            (best.0, cv)
+        }
+    };
+    let all: Vec<&Row> = rows.iter().collect();
+    let c = problem.solve(&all, lambda);
+    let nodes: Vec<[f64; 3]> = base_nodes
+        .iter()
+        .zip(&c)
+        .map(|(b, d)| std::array::from_fn(|k| b[k] + d[k]))
+        .collect();
+    let lut = Lut3d::from_parts(levels, base.trc, nodes).map_err(failed)?;
+    Ok(ScatteredLut { lut, lambda, cv })
+}
+
+/// A seeded scramble of patch indices, so folds do not follow the file's order (files
+/// list ramps and greys in blocks).
+pub fn fold_of(i: usize) -> usize {
+    let mut x = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (x ^ (x >> 31)) as usize
+}
+
+/// One patch in the normal equations.
+struct Row {
+    w: [(usize, f64); 4],
+    omega2: f64,
+    /// Measured XYZ minus the base model's interpolated XYZ.
+    target: [f64; 3],
+}
+
+fn predict(row: &Row, base: &[[f64; 3]], c: &[[f64; 3]]) -> [f64; 3] {
+    std::array::from_fn(|k| row.w.iter().map(|&(i, f)| f * (base[i][k] + c[i][k])).sum())
+}
+
+/// A small ridge so nodes no patch and no second difference pins (a null space of the
+/// Laplacian) stay at the base model.
+const RIDGE: f64 = 1e-6;
+
+struct Problem {
+    grid: usize,
+    scale: f64,
+}
+
+impl Problem {
+    fn nodes(&self) -> usize {
+        self.grid.pow(3)
+    }
+
+    /// Adds λ·s·DᵀD·x to `out`, D the second differences along each axis.
+    fn add_laplacian(&self, x: &[f64], weight: f64, out: &mut [f64]) {
+        let n = self.grid;
+        let strides = [n * n, n, 1];
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let idx = [i, j, k];
+                    let centre = (i * n + j) * n + k;
+                    for (axis, &stride) in strides.iter().enumerate() {
+                        if idx[axis] == 0 || idx[axis] + 1 == n {
+                            continue;
+                        }
+                        let (a, b) = (centre - stride, centre + stride);
+                        let d = weight * (x[a] - 2.0 * x[centre] + x[b]);
+                        out[a] += d;
+                        out[centre] -= 2.0 * d;
+                        out[b] += d;
+                    }
+                }
+            }
+        }
+    }
+
+    fn apply(&self, rows: &[&Row], lambda: f64, x: &[f64], out: &mut [f64]) {
+        let ridge = RIDGE * self.scale;
+        for (o, v) in out.iter_mut().zip(x) {
+            *o = ridge * v;
+        }
+        for r in rows {
+            let v: f64 = r.w.iter().map(|&(i, f)| f * x[i]).sum();
+            for &(i, f) in &r.w {
+                out[i] += r.omega2 * f * v;
+            }
+        }
+        self.add_laplacian(x, lambda * self.scale, out);
+    }
+
+    /// The corrections at every node for the rows given.
+    fn solve(&self, rows: &[&Row], lambda: f64) -> Vec<[f64; 3]> {
+        let v = self.nodes();
+        let mut diag = vec![RIDGE * self.scale; v];
+        for r in rows {
+            for &(i, f) in &r.w {
+                diag[i] += r.omega2 * f * f;
+            }
+        }
+        let lap_diag = laplacian_diagonal(self.grid);
+        for (d, l) in diag.iter_mut().zip(&lap_diag) {
+            *d += lambda * self.scale * l;
+        }
+        let mut out = vec![[0.0; 3]; v];
+        for k in 0..3 {
+            let mut rhs = vec![0.0; v];
+            for r in rows {
+                for &(i, f) in &r.w {
+                    rhs[i] += r.omega2 * f * r.target[k];
+                }
+            }
+            let x = conjugate_gradients(|x, y| self.apply(rows, lambda, x, y), &rhs, &diag);
+            for (o, xi) in out.iter_mut().zip(x) {
+                o[k] = xi;
+            }
+        }
+        out
+    }
+}
+
+/// The diagonal of DᵀD on an n³ grid: per axis, a node centring a second difference gets
+/// 4, one ending a difference 1 each.
+fn laplacian_diagonal(n: usize) -> Vec<f64> {
+    let per_axis = |i: usize| -> f64 {
+        let mut d = 0.0;
+        if i > 0 && i + 1 < n {
+            d += 4.0;
+        }
+        if i + 2 < n {
+            d += 1.0;
+        }
+        if i >= 2 {
+            d += 1.0;
+        }
+        d
+    };
+    let mut out = Vec::with_capacity(n * n * n);
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                out.push(per_axis(i) + per_axis(j) + per_axis(k));
+            }
+        }
+    }
+    out
+}
+
+/// Jacobi-preconditioned conjugate gradients for a symmetric positive definite operator.
+fn conjugate_gradients(apply: impl Fn(&[f64], &mut [f64]), b: &[f64], diag: &[f64]) -> Vec<f64> {
+    let n = b.len();
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let mut x = vec![0.0; n];
+    let mut r = b.to_vec();
+    let mut z: Vec<f64> = r.iter().zip(diag).map(|(r, d)| r / d).collect();
+    let mut p = z.clone();
+    let mut rz = dot(&r, &z);
+    let stop = 1e-20 * dot(b, b).max(1e-300);
+    let mut ap = vec![0.0; n];
+    for _ in 0..(4 * n).max(100) {
+        if dot(&r, &r) <= stop {
+            break;
+        }
+        apply(&p, &mut ap);
+        let pap = dot(&p, &ap);
+        if pap <= 0.0 {
+            break;
+        }
+        let alpha = rz / pap;
+        for i in 0..n {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+        }
+        for i in 0..n {
+            z[i] = r[i] / diag[i];
+        }
+        let rz_next = dot(&r, &z);
+        let beta = rz_next / rz;
+        rz = rz_next;
+        for i in 0..n {
+            p[i] = z[i] + beta * p[i];
+        }
+    }
+    x
+}

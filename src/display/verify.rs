@@ -1,0 +1,143 @@
+//! Checking a profile against measured patches, typically ones it was not fitted to: the
+//! profile's forward prediction of each patch against its measured XYZ, in CIELAB relative
+//! to the profile's white.
+
+use serde::Serialize;
+
+use super::diagnostics::percentile;
+use super::model::Sample;
+use super::profile::Profile;
+use crate::color::{delta_e2000, delta_e76, Xyz};
+
+/// How many of the worst patches a verification lists.
+pub const WORST_SHOWN: usize = 5;
+
+/// Mean, 95th percentile and maximum of a ΔE.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Stats {
+    pub mean: f64,
+    pub p95: f64,
+    pub max: f64,
+}
+
+impl Stats {
+    fn of(values: &[f64]) -> Stats {
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        Stats {
+            mean: values.iter().sum::<f64>() / values.len() as f64,
+            p95: percentile(&sorted, 0.95),
+            max: *sorted.last().expect("verified sets are not empty"),
+        }
+    }
+}
+
+/// One patch's prediction error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PatchError {
+    /// Index of the patch in the file, from 1.
+    pub index: usize,
+    pub rgb: [f64; 3],
+    pub measured_xyz: [f64; 3],
+    pub predicted_xyz: [f64; 3],
+    pub de00: f64,
+    pub de76: f64,
+}
+
+/// A profile's prediction errors on a set of patches.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verification {
+    pub patches: usize,
+    pub de00: Stats,
+    pub de76: Stats,
+    /// The [`WORST_SHOWN`] largest ΔE00, largest first.
+    pub worst: Vec<PatchError>,
+}
+
+/// Why patches cannot be verified.
+#[derive(Debug, thiserror::Error)]
+pub enum VerifyError {
+    #[error("no patches to verify")]
+    NoSamples,
+    #[error("patch {index} (r,g,b = {rgb:?}) has a drive value outside 0–1 or an XYZ that is not finite")]
+    BadSample { index: usize, rgb: [f64; 3] },
+}
+
+/// Predicts every patch with `profile` and compares with what was measured.
+pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verification, VerifyError> {
+    if patches.is_empty() {
+        return Err(VerifyError::NoSamples);
+    }
+    let white = Xyz::from_array(profile.white_xyz);
+    let mut errors = Vec::with_capacity(patches.len());
+    for (i, p) in patches.iter().enumerate() {
+        let ok =
+            p.rgb.iter().all(|d| (0.0..=1.0).contains(d)) && p.xyz.iter().all(|v| v.is_finite());
+        if !ok {
+            return Err(VerifyError::BadSample {
+                index: i + 1,
+                rgb: p.rgb,
+            });
+        }
+        let predicted = profile.forward(p.rgb);
+        let (a, b) = (
+            Xyz::from_array(predicted).to_lab(white),
+            Xyz::from_array(p.xyz).to_lab(white),
+        );
+        errors.push(PatchError {
+            index: i + 1,
+            rgb: p.rgb,
+            measured_xyz: p.xyz,
+            predicted_xyz: predicted,
+            de00: delta_e2000(a, b),
+            de76: delta_e76(a, b),
+        });
+    }
+    let de00: Vec<f64> = errors.iter().map(|e| e.de00).collect();
+    let de76: Vec<f64> = errors.iter().map(|e| e.de76).collect();
+    errors.sort_by(|a, b| b.de00.total_cmp(&a.de00));
+    errors.truncate(WORST_SHOWN);
+    Ok(Verification {
+        patches: patches.len(),
+        de00: Stats::of(&de00),
+        de76: Stats::of(&de76),
+        worst: errors,
+    })
+}
+
+impl std::fmt::Display for Verification {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "{} patches", self.patches)?;
+        for (name, s) in [("ΔE00 ", &self.de00), ("ΔE*ab", &self.de76)] {
+            writeln!(
+                f,
+                "{name} mean {:.3}  p95 {:.3}  max {:.3}",
+                s.mean, s.p95, s.max
+            )?;
+        }
+        write!(f, "worst patches (r,g,b 0–1: ΔE00):")?;
+        for e in &self.worst {
+            write!(
+                f,
+                "\n  #{} {:.4},{:.4},{:.4}: {:.3}",
+                e.index, e.rgb[0], e.rgb[1], e.rgb[2], e.de00
+            )?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Stats of 0, 1, 4 by hand: the mean is 5/3; the p95 lies at rank 0.95·2 = 1.9, so
+    /// linearly between the 2nd and 3rd values, 1 + 0.9·3 = 3.7.
+    #[test]
+    fn stats_follow_a_hand_computation() {
+        let s = Stats::of(&[0.0, 1.0, 4.0]);
+        assert!((s.mean - 5.0 / 3.0).abs() < 1e-12);
+        assert!((s.p95 - 3.7).abs() < 1e-12);
+        assert_eq!(s.max, 4.0);
+    }
+}
