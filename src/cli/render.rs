@@ -120,20 +120,7 @@ pub fn run(args: Args) -> CliResult {
                 return Err(CliError::Usage("--target-de must be > 0".into()));
             }
             let scene = Scene::load(&scene)?;
-            let use_radiosity = match method {
-                Method::Path => false,
-                Method::Radiosity => {
-                    radiosity::qualifies(&scene)?;
-                    true
-                }
-                Method::Auto => match radiosity::qualifies(&scene) {
-                    Ok(()) => true,
-                    Err(why) => {
-                        eprintln!("using the path tracer: {why}");
-                        false
-                    }
-                },
-            };
+            let use_radiosity = uses_radiosity(method, &scene)?;
             if use_radiosity {
                 return spots_radiosity(&scene, target_de, white, max_seconds, json);
             }
@@ -298,6 +285,24 @@ struct Tagged<'a, T: serde::Serialize> {
     result: &'a T,
 }
 
+/// Whether `method` renders `scene` by radiosity; `auto` says why when it cannot.
+fn uses_radiosity(method: Method, scene: &Scene) -> Result<bool, CliError> {
+    Ok(match method {
+        Method::Path => false,
+        Method::Radiosity => {
+            radiosity::qualifies(scene)?;
+            true
+        }
+        Method::Auto => match radiosity::qualifies(scene) {
+            Ok(()) => true,
+            Err(why) => {
+                eprintln!("using the path tracer: {why}");
+                false
+            }
+        },
+    })
+}
+
 fn spots_radiosity(
     scene: &Scene,
     target_de: f64,
@@ -383,20 +388,7 @@ fn probes(
             normal: normal.normalized(),
         });
     }
-    let use_radiosity = match method {
-        Method::Path => false,
-        Method::Radiosity => {
-            radiosity::qualifies(&scene)?;
-            true
-        }
-        Method::Auto => match radiosity::qualifies(&scene) {
-            Ok(()) => true,
-            Err(why) => {
-                eprintln!("using the path tracer: {why}");
-                false
-            }
-        },
-    };
+    let use_radiosity = uses_radiosity(method, &scene)?;
     let t = std::time::Instant::now();
     let out = if use_radiosity {
         probe_illuminance(&scene, &probes, &RadiosityOptions::default(), rel_tolerance)?
