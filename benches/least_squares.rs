@@ -14,7 +14,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use metamer::display::model::{fit_power_gamma, levenberg_marquardt, Trc};
+use metamer::display::model::{levenberg_marquardt, Trc};
 use metamer::rig::{Preset, VirtualPanel};
 use nalgebra::storage::Owned;
 use nalgebra::{DMatrix, DVector, Dyn};
@@ -119,50 +119,20 @@ fn exponential() -> Problem {
     }
 }
 
-/// The curve, residual, start and bounds exactly as `fit_gog_curve` builds them.
+/// The problem exactly as `fit_gog_curve` poses it.
 fn gog_problem(
     name: String,
     points: Vec<(f64, f64)>,
     flare: bool,
     truth: Option<Vec<f64>>,
 ) -> Problem {
-    let gamma0 = fit_power_gamma(&points);
-    let residual = move |p: &[f64]| -> Vec<f64> {
-        let t = if flare {
-            Trc::Gog {
-                gain: p[0],
-                offset: p[1],
-                gamma: p[2],
-                flare: p[3],
-            }
-        } else {
-            Trc::Gog {
-                gain: 1.0 - p[0],
-                offset: p[0],
-                gamma: p[1],
-                flare: 0.0,
-            }
-        };
-        points
-            .iter()
-            .map(|&(d, s)| t.eval(d).cbrt() - s.cbrt())
-            .collect()
-    };
-    let (start, lower, upper) = if flare {
-        (
-            vec![1.0, 0.0, gamma0, 0.0],
-            vec![0.2, -0.5, 0.3, -0.2],
-            vec![2.0, 0.8, 6.0, 0.2],
-        )
-    } else {
-        (vec![0.0, gamma0], vec![-0.5, 0.3], vec![0.8, 6.0])
-    };
+    let p = metamer::display::model::gog_problem(&points, flare);
     Problem {
         name,
-        residual: Box::new(residual),
-        start,
-        lower,
-        upper,
+        residual: p.residual,
+        start: p.start,
+        lower: p.lower,
+        upper: p.upper,
         truth,
     }
 }

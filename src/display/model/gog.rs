@@ -10,48 +10,80 @@ use super::samples::{SortedSamples, CHANNEL_NAMES};
 use super::trc::fit_power_gamma;
 use super::{MatrixTrc, ModelKind, Trc};
 
-/// Fits one channel's GOG (`flare` false) or GOGO curve to (drive, R′) points.
-pub fn fit_gog_curve(points: &[(f64, f64)], flare: bool) -> Trc {
-    let gamma0 = fit_power_gamma(points);
-    let curve = |p: &[f64]| -> Trc {
-        if flare {
-            Trc::Gog {
-                gain: p[0],
-                offset: p[1],
-                gamma: p[2],
-                flare: p[3],
-            }
-        } else {
-            Trc::Gog {
-                gain: 1.0 - p[0],
-                offset: p[0],
-                gamma: p[1],
-                flare: 0.0,
-            }
+/// Residuals of a parameter vector.
+pub type Residuals = dyn Fn(&[f64]) -> Vec<f64> + Send + Sync;
+
+/// One channel's GOG (`flare` false) or GOGO curve fit as a least-squares problem: the
+/// residual, the start and the box bounds of its parameters (see [`gog_curve`]).
+pub struct GogProblem {
+    pub residual: Box<Residuals>,
+    pub start: Vec<f64>,
+    pub lower: Vec<f64>,
+    pub upper: Vec<f64>,
+}
+
+/// The curve of parameters `p`: GOG as (offset, γ) with gain = 1 − offset, GOGO as (gain,
+/// offset, γ, flare).
+pub fn gog_curve(p: &[f64], flare: bool) -> Trc {
+    if flare {
+        Trc::Gog {
+            gain: p[0],
+            offset: p[1],
+            gamma: p[2],
+            flare: p[3],
         }
-    };
+    } else {
+        Trc::Gog {
+            gain: 1.0 - p[0],
+            offset: p[0],
+            gamma: p[1],
+            flare: 0.0,
+        }
+    }
+}
+
+/// The fit of one channel's curve to (drive, R′) points as a problem any solver can take.
+pub fn gog_problem(points: &[(f64, f64)], flare: bool) -> GogProblem {
+    let gamma0 = fit_power_gamma(points);
+    let points = points.to_vec();
     // Residuals in cube-root output: CIELAB lightness goes as Y^(1/3), so equal residuals
     // are roughly equal lightness errors. In linear output the fit gives up the dark end of
     // the ramp for the bright one, and reproduction pays for it in ΔE00 (on the LCD presets
     // of `metamer budget` the max error fell from ≈9 to ≈3.5 ΔE00).
-    let residual = |p: &[f64]| -> Vec<f64> {
-        let t = curve(p);
+    let residual = move |p: &[f64]| -> Vec<f64> {
+        let t = gog_curve(p, flare);
         points
             .iter()
             .map(|&(d, s)| t.eval(d).cbrt() - s.cbrt())
             .collect()
     };
-    let p = if flare {
-        levenberg_marquardt(
-            &residual,
-            &[1.0, 0.0, gamma0, 0.0],
-            &[0.2, -0.5, 0.3, -0.2],
-            &[2.0, 0.8, 6.0, 0.2],
+    let (start, lower, upper) = if flare {
+        (
+            vec![1.0, 0.0, gamma0, 0.0],
+            vec![0.2, -0.5, 0.3, -0.2],
+            vec![2.0, 0.8, 6.0, 0.2],
         )
     } else {
-        levenberg_marquardt(&residual, &[0.0, gamma0], &[-0.5, 0.3], &[0.8, 6.0])
+        (vec![0.0, gamma0], vec![-0.5, 0.3], vec![0.8, 6.0])
     };
-    curve(&p)
+    GogProblem {
+        residual: Box::new(residual),
+        start,
+        lower,
+        upper,
+    }
+}
+
+/// Fits one channel's GOG (`flare` false) or GOGO curve to (drive, R′) points.
+pub fn fit_gog_curve(points: &[(f64, f64)], flare: bool) -> Trc {
+    let problem = gog_problem(points, flare);
+    let p = levenberg_marquardt(
+        &*problem.residual,
+        &problem.start,
+        &problem.lower,
+        &problem.upper,
+    );
+    gog_curve(&p, flare)
 }
 
 /// GOG (`kind` Gog) or GOGO (`kind` Gogo).

@@ -20,7 +20,7 @@ mod trc;
 
 pub use display_model::{DisplayModel, Inverse, GAMUT_TOLERANCE};
 pub use error::FitError;
-pub use gog::{fit_gog, fit_gog_curve};
+pub use gog::{fit_gog, fit_gog_curve, gog_curve, gog_problem, GogProblem};
 pub use kind::ModelKind;
 pub use least_squares::levenberg_marquardt;
 pub use lut::{fit_lut, has_full_grid, Lut3d};
