@@ -9,6 +9,7 @@
 pub mod color;
 pub mod display;
 pub mod lab;
+pub mod light;
 pub mod numeric_csv;
 pub mod plot;
 pub mod render;
