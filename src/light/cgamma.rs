@@ -211,7 +211,7 @@ impl CGammaTable {
     /// `edge_v`, z along the emitting normal. Directions behind the panel give 0.
     pub fn factor(&self, local: [f64; 3]) -> f64 {
         let [x, y, z] = local;
-        if !(z > 0.0) {
+        if z.is_nan() || z <= 0.0 {
             return 0.0;
         }
         let gamma = x.hypot(y).atan2(z).to_degrees();
