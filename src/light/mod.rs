@@ -2,6 +2,7 @@
 //! (the fit writes it, scenes carry it, the renderers evaluate it, IES/LDT files hold it).
 
 pub mod cgamma;
+pub mod chart;
 pub mod fit;
 pub mod ies;
 pub mod ldt;

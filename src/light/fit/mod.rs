@@ -76,6 +76,8 @@ pub enum LdcError {
     },
     #[error("no model could be cross-validated: every half-plane needs at least 2 angles off the normal")]
     NothingToChoose,
+    #[error("cannot draw the chart: {message}")]
+    Chart { message: String },
     #[error("the fitted distribution is not a valid C-γ table: {0}")]
     Table(#[from] CGammaError),
 }
