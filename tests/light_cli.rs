@@ -8,17 +8,40 @@ fn fit_exports_and_show_reads_back() {
     std::fs::create_dir_all(&dir).unwrap();
     let bin = env!("CARGO_BIN_EXE_metamer");
     let run = |args: &[&str]| {
-        let out = Command::new(bin).args(args).current_dir(&dir).output().unwrap();
+        let out = Command::new(bin)
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
         (
             out.status.code(),
             String::from_utf8_lossy(&out.stdout).into_owned(),
             String::from_utf8_lossy(&out.stderr).into_owned(),
         )
     };
-    let csv = concat!(env!("CARGO_MANIFEST_DIR"), "/data/light_falloff_9_angles.csv");
+    let csv = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/light_falloff_9_angles.csv"
+    );
     let fit_args = [
-        "light", "fit", "--falloff", csv, "-o", "LIGHT.json", "--ies", "p.ies", "--ldt", "p.ldt",
-        "--chart", "LIGHT.svg", "--width-m", "0.3", "--height-m", "0.3", "--luminance", "1000",
+        "light",
+        "fit",
+        "--falloff",
+        csv,
+        "-o",
+        "LIGHT.json",
+        "--ies",
+        "p.ies",
+        "--ldt",
+        "p.ldt",
+        "--chart",
+        "LIGHT.svg",
+        "--width-m",
+        "0.3",
+        "--height-m",
+        "0.3",
+        "--luminance",
+        "1000",
     ];
     let (code, out, err) = run(&fit_args);
     assert_eq!(code, Some(0), "{out}{err}");
@@ -42,12 +65,31 @@ fn fit_exports_and_show_reads_back() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--force"), "{err}");
     let (code, _, err) = run(&[
-        "light", "fit", "--falloff", csv, "-o", "b.json", "--ies", "b.ies", "--width-m", "0.3",
-        "--height-m", "0.3",
+        "light",
+        "fit",
+        "--falloff",
+        csv,
+        "-o",
+        "b.json",
+        "--ies",
+        "b.ies",
+        "--width-m",
+        "0.3",
+        "--height-m",
+        "0.3",
     ]);
     assert_eq!(code, Some(2));
     assert!(err.contains("--luminance"), "{err}");
-    let (code, _, err) = run(&["light", "fit", "--falloff", csv, "-o", "c.json", "--ldt", "c.ldt"]);
+    let (code, _, err) = run(&[
+        "light",
+        "fit",
+        "--falloff",
+        csv,
+        "-o",
+        "c.json",
+        "--ldt",
+        "c.ldt",
+    ]);
     assert_eq!(code, Some(2));
     assert!(err.contains("--width-m"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();

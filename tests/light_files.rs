@@ -28,8 +28,13 @@ fn ldt_info() -> LdtInfo {
 
 /// An asymmetric fitted table: a different lobe mix in each half-plane.
 fn asymmetric_table() -> CGammaTable {
-    let truth = [(1.0, 1.7, 1.7), (0.3, 0.5, 4.0), (0.6, 1.0, 8.0), (0.8, 2.0, 20.0)]
-        .map(|(a, n, m)| Params::Lobes { a, n, m });
+    let truth = [
+        (1.0, 1.7, 1.7),
+        (0.3, 0.5, 4.0),
+        (0.6, 1.0, 8.0),
+        (0.8, 2.0, 20.0),
+    ]
+    .map(|(a, n, m)| Params::Lobes { a, n, m });
     let plane = |pos: &Params, neg: &Params| {
         let angles: Vec<f64> = (-8..=8).map(|k| 10.0 * k as f64).collect();
         let luminance = angles
@@ -121,12 +126,23 @@ fn cos_power_panel_flux_is_two_pi_l_a_over_n_plus_two() {
         let t = cos_power_table(n);
         let got = flux_lm(&t, &panel);
         assert!((got - want).abs() < 2e-4 * want, "n = {n}: {got} vs {want}");
-        let (_, p) = ldt::parse(&ldt::to_string(&t, &panel, &ldt_info()), Path::new("c.ldt")).unwrap();
-        assert!((p.flux_lm - want).abs() < 2e-4 * want, "n = {n}: {}", p.flux_lm);
+        let (_, p) =
+            ldt::parse(&ldt::to_string(&t, &panel, &ldt_info()), Path::new("c.ldt")).unwrap();
+        assert!(
+            (p.flux_lm - want).abs() < 2e-4 * want,
+            "n = {n}: {}",
+            p.flux_lm
+        );
     }
     // The same through the fit: cos^1.7 readings in both planes.
-    let angles: Vec<f64> = (-6..=6).map(|k| 15.0 * k as f64).filter(|a: &f64| a.abs() < 90.0).collect();
-    let lum: Vec<f64> = angles.iter().map(|a: &f64| a.to_radians().cos().powf(1.7)).collect();
+    let angles: Vec<f64> = (-6..=6)
+        .map(|k| 15.0 * k as f64)
+        .filter(|a: &f64| a.abs() < 90.0)
+        .collect();
+    let lum: Vec<f64> = angles
+        .iter()
+        .map(|a: &f64| a.to_radians().cos().powf(1.7))
+        .collect();
     let plane = PlaneData {
         angles_deg: angles,
         luminance: lum,

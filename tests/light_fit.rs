@@ -42,8 +42,13 @@ fn family(model: LdcModel) -> [Params; 4] {
         ]
         .map(|coeffs| Params::CosPoly { coeffs }),
         // C0 is cos^1.7 itself (a = 1), the others are mixes of a broad and a narrow lobe.
-        LdcModel::Lobes => [(1.0, 1.7, 1.7), (0.3, 0.5, 4.0), (0.6, 1.0, 8.0), (0.8, 2.0, 20.0)]
-            .map(|(a, n, m)| Params::Lobes { a, n, m }),
+        LdcModel::Lobes => [
+            (1.0, 1.7, 1.7),
+            (0.3, 0.5, 4.0),
+            (0.6, 1.0, 8.0),
+            (0.8, 2.0, 20.0),
+        ]
+        .map(|(a, n, m)| Params::Lobes { a, n, m }),
     }
 }
 
@@ -72,7 +77,10 @@ fn each_model_recovers_its_own_asymmetric_distribution() {
         assert!((f.normal_luminance - 250.0).abs() < 1e-12);
         let e = held_out_error(&f, &truth);
         assert!(e < 0.005, "{model}: {:.4} % at held-out angles", e * 100.0);
-        assert!(f.residuals.iter().all(|r| r.residual.abs() < 1e-4), "{model}");
+        assert!(
+            f.residuals.iter().all(|r| r.residual.abs() < 1e-4),
+            "{model}"
+        );
     }
 }
 
@@ -97,7 +105,11 @@ fn auto_picks_the_generating_family_or_one_as_good() {
     let truth = [
         Params::CosPower { n: 1.7 },
         Params::CosPower { n: 1.2 },
-        Params::Lobes { a: 0.6, n: 1.0, m: 8.0 },
+        Params::Lobes {
+            a: 0.6,
+            n: 1.0,
+            m: 8.0,
+        },
         Params::CosPower { n: 1.2 },
     ];
     let f = fit(&falloff(1.0, &truth), ModelChoice::Auto).unwrap();
@@ -110,7 +122,11 @@ fn auto_picks_the_generating_family_or_one_as_good() {
 #[test]
 fn the_table_blends_the_planes_with_elliptic_weights() {
     let truth = family(LdcModel::CosPower);
-    let f = fit(&falloff(1.0, &truth), ModelChoice::Named(LdcModel::CosPower)).unwrap();
+    let f = fit(
+        &falloff(1.0, &truth),
+        ModelChoice::Named(LdcModel::CosPower),
+    )
+    .unwrap();
     // C = 30° lies on the 5° grid: f = cos²30°·f_C0 + sin²30°·f_C90 = ¾·cos^1.7 + ¼·cos^2.5.
     for g in [20.0, 40.0, 60.0] {
         let want = 0.75 * cos(g).powf(1.7) + 0.25 * cos(g).powf(2.5);
@@ -125,7 +141,12 @@ fn the_table_blends_the_planes_with_elliptic_weights() {
 #[test]
 fn the_normal_luminance_is_the_mean_of_both_planes() {
     let mut d = falloff(100.0, &family(LdcModel::Lambertian));
-    let k = d.vertical.angles_deg.iter().position(|&a| a == 0.0).unwrap();
+    let k = d
+        .vertical
+        .angles_deg
+        .iter()
+        .position(|&a| a == 0.0)
+        .unwrap();
     d.vertical.luminance[k] = 98.0;
     let f = fit(&d, ModelChoice::Named(LdcModel::Lambertian)).unwrap();
     assert_eq!(f.normal_readings, [100.0, 98.0]);
@@ -182,11 +203,22 @@ fn with_horizontal(h: PlaneData) -> Falloff {
 fn every_class_of_bad_data_gets_its_error() {
     let auto = ModelChoice::Auto;
     let e = fit(&with_horizontal(PlaneData::default()), auto).unwrap_err();
-    assert!(matches!(e, LdcError::EmptyPlane { plane: Plane::Horizontal }), "{e}");
+    assert!(
+        matches!(
+            e,
+            LdcError::EmptyPlane {
+                plane: Plane::Horizontal
+            }
+        ),
+        "{e}"
+    );
     let e = fit(&with_horizontal(plane(&[0.0, 20.0, 10.0], &[1.0; 3])), auto).unwrap_err();
     assert!(matches!(e, LdcError::AnglesNotIncreasing { .. }), "{e}");
     let e = fit(&with_horizontal(plane(&[0.0, 20.0, 20.0], &[1.0; 3])), auto).unwrap_err();
-    assert!(matches!(e, LdcError::AnglesNotIncreasing { angle, .. } if angle == 20.0), "{e}");
+    assert!(
+        matches!(e, LdcError::AnglesNotIncreasing { angle, .. } if angle == 20.0),
+        "{e}"
+    );
     let e = fit(&with_horizontal(plane(&[-90.0, 0.0], &[0.1, 1.0])), auto).unwrap_err();
     assert!(matches!(e, LdcError::AngleOutOfRange { .. }), "{e}");
     let e = fit(&with_horizontal(plane(&[0.0, 95.0], &[1.0, 0.1])), auto).unwrap_err();
@@ -197,19 +229,39 @@ fn every_class_of_bad_data_gets_its_error() {
     }
     let e = fit(&with_horizontal(plane(&[-30.0, 30.0], &[0.8, 0.8])), auto).unwrap_err();
     assert!(matches!(e, LdcError::NoNormalReading { .. }), "{e}");
-    let e = fit(&with_horizontal(plane(&[-30.0, 0.0, 30.0], &[0.8, 0.0, 0.8])), auto).unwrap_err();
+    let e = fit(
+        &with_horizontal(plane(&[-30.0, 0.0, 30.0], &[0.8, 0.0, 0.8])),
+        auto,
+    )
+    .unwrap_err();
     assert!(matches!(e, LdcError::ZeroNormalReading { .. }), "{e}");
     let e = fit(&with_horizontal(plane(&[0.0, 30.0], &[1.0])), auto).unwrap_err();
     assert!(matches!(e, LdcError::LengthMismatch { .. }), "{e}");
     // Two angles per half-plane: lobes (3 parameters) cannot be fitted, auto still works
     // with the models that can be cross-validated.
-    let e = fit(&with_horizontal(ok_plane()), ModelChoice::Named(LdcModel::Lobes)).unwrap_err();
+    let e = fit(
+        &with_horizontal(ok_plane()),
+        ModelChoice::Named(LdcModel::Lobes),
+    )
+    .unwrap_err();
     assert!(
-        matches!(e, LdcError::TooFewAngles { model: LdcModel::Lobes, got: 2, need: 3, .. }),
+        matches!(
+            e,
+            LdcError::TooFewAngles {
+                model: LdcModel::Lobes,
+                got: 2,
+                need: 3,
+                ..
+            }
+        ),
         "{e}"
     );
     let f = fit(&with_horizontal(ok_plane()), auto).unwrap();
-    let lobes = f.candidates.iter().find(|c| c.model == LdcModel::Lobes).unwrap();
+    let lobes = f
+        .candidates
+        .iter()
+        .find(|c| c.model == LdcModel::Lobes)
+        .unwrap();
     assert!(lobes.note.as_deref().unwrap_or("").contains("needs 3"));
     // A half-plane without any angle off the normal: no model but Lambertian can be named.
     let e = fit(
@@ -217,7 +269,16 @@ fn every_class_of_bad_data_gets_its_error() {
         ModelChoice::Named(LdcModel::CosPower),
     )
     .unwrap_err();
-    assert!(matches!(e, LdcError::TooFewAngles { half: HalfPlane::C180, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            LdcError::TooFewAngles {
+                half: HalfPlane::C180,
+                ..
+            }
+        ),
+        "{e}"
+    );
 }
 
 #[test]
@@ -228,5 +289,13 @@ fn a_csv_column_without_readings_is_an_empty_plane() {
     )
     .unwrap();
     let e = fit(&d, ModelChoice::Auto).unwrap_err();
-    assert!(matches!(e, LdcError::EmptyPlane { plane: Plane::Vertical }), "{e}");
+    assert!(
+        matches!(
+            e,
+            LdcError::EmptyPlane {
+                plane: Plane::Vertical
+            }
+        ),
+        "{e}"
+    );
 }

@@ -97,7 +97,12 @@ fn run_fit(a: FitArgs) -> CliResult {
     };
     let mut policy = OutputPolicy::new(a.force);
     policy.input(&a.falloff);
-    let outputs = [Some(&a.output), a.ies.as_ref(), a.ldt.as_ref(), a.chart.as_ref()];
+    let outputs = [
+        Some(&a.output),
+        a.ies.as_ref(),
+        a.ldt.as_ref(),
+        a.chart.as_ref(),
+    ];
     for out in outputs.into_iter().flatten() {
         policy.check(out).map_err(output_error)?;
     }
@@ -106,7 +111,9 @@ fn run_fit(a: FitArgs) -> CliResult {
         .map_err(|e| CliError::Failed(format!("{}: {e}", a.falloff.display()).into()))?;
     print_fit(&a.falloff, &fit);
     let json = serde_json::to_string_pretty(&fit)?;
-    policy.write(&a.output, json.as_bytes()).map_err(output_error)?;
+    policy
+        .write(&a.output, json.as_bytes())
+        .map_err(output_error)?;
     println!("fit written to {}", a.output.display());
     if let Some(chart) = &a.chart {
         let svg = ldc_chart_svg(&fit)?;

@@ -98,11 +98,7 @@ fn draw(fit: &LdcFit, svg: &mut String) -> Result<(), LdcError> {
             .map(|r| (r.angle_deg, r.measured))
             .collect();
         chart
-            .draw_series(
-                points
-                    .iter()
-                    .map(|&p| Circle::new(p, 4, BLACK.filled())),
-            )
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, BLACK.filled())))
             .map_err(|e| chart_err(&e))?
             .label("measured")
             .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));

@@ -53,11 +53,23 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &IesInfo) -> String {
     };
     line(&mut out, "IES:LM-63-2019");
     line(&mut out, &format!("[TEST] {}", one_line(&info.test)));
-    line(&mut out, "[TESTLAB] none: fitted to measurements by metamer");
-    line(&mut out, &format!("[ISSUEDATE] {}", one_line(&info.issue_date)));
+    line(
+        &mut out,
+        "[TESTLAB] none: fitted to measurements by metamer",
+    );
+    line(
+        &mut out,
+        &format!("[ISSUEDATE] {}", one_line(&info.issue_date)),
+    );
     line(&mut out, "[MANUFAC] metamer");
-    line(&mut out, &format!("[LUMINAIRE] {}", one_line(&info.luminaire)));
-    line(&mut out, &format!("[FILEGENINFO] {}", one_line(&info.generation)));
+    line(
+        &mut out,
+        &format!("[LUMINAIRE] {}", one_line(&info.luminaire)),
+    );
+    line(
+        &mut out,
+        &format!("[FILEGENINFO] {}", one_line(&info.generation)),
+    );
     line(&mut out, "TILT=NONE");
     let gammas = table.gamma_deg();
     // A full circle is closed with 360° (= the 0° plane), as the format expects.
@@ -149,7 +161,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         next("the tilt geometry")?;
         let (line, n) = next("the number of tilt angles")?;
         if !(n >= 0.0 && n.fract() == 0.0) {
-            return Err(fmt_err(line, format!("the number of tilt angles {n} is not a count")));
+            return Err(fmt_err(
+                line,
+                format!("the number of tilt angles {n} is not a count"),
+            ));
         }
         for _ in 0..(2 * n as usize) {
             next("the tilt table")?;
@@ -165,7 +180,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     next("the number of lamps")?;
     next("the lumens per lamp")?;
     let (_, multiplier) = next("the candela multiplier")?;
-    let n_vertical = count(next("the number of vertical angles")?, "the number of vertical angles")?;
+    let n_vertical = count(
+        next("the number of vertical angles")?,
+        "the number of vertical angles",
+    )?;
     let n_horizontal = count(
         next("the number of horizontal angles")?,
         "the number of horizontal angles",
@@ -181,7 +199,12 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     let metres = match units as i64 {
         1 if units == 1.0 => 0.3048,
         2 if units == 2.0 => 1.0,
-        _ => return Err(fmt_err(line, format!("units type {units}: expected 1 (feet) or 2 (metres)"))),
+        _ => {
+            return Err(fmt_err(
+                line,
+                format!("units type {units}: expected 1 (feet) or 2 (metres)"),
+            ))
+        }
     };
     let (_, width) = next("the opening's width")?;
     let (_, length) = next("the opening's length")?;
@@ -206,14 +229,21 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     let mut rows = Vec::with_capacity(n_horizontal);
     for &c in &horizontal {
         let (_, row) = read_n(n_vertical, &format!("the candela values of C-plane {c}°"))?;
-        rows.push(row.into_iter().map(|v| v * multiplier).collect::<Vec<f64>>());
+        rows.push(
+            row.into_iter()
+                .map(|v| v * multiplier)
+                .collect::<Vec<f64>>(),
+        );
     }
     let first_c = horizontal[0];
     let last_c = horizontal[n_horizontal - 1];
     if let Some(w) = horizontal.windows(2).find(|w| !(w[1] > w[0])) {
         return Err(fmt_err(
             h_line,
-            format!("the horizontal angles must increase: {}° then {}°", w[0], w[1]),
+            format!(
+                "the horizontal angles must increase: {}° then {}°",
+                w[0], w[1]
+            ),
         ));
     }
     let stored: Vec<(f64, Vec<f64>)> = horizontal.iter().copied().zip(rows).collect();
@@ -258,11 +288,17 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         area_m2: area,
     };
     let stored_planes = n_horizontal;
-    finish(version, symmetry.into(), stored_planes, opening, planes, &gammas).map_err(|message| {
-        PhotometryError::Content {
-            file: source.to_path_buf(),
-            message,
-        }
+    finish(
+        version,
+        symmetry.into(),
+        stored_planes,
+        opening,
+        planes,
+        &gammas,
+    )
+    .map_err(|message| PhotometryError::Content {
+        file: source.to_path_buf(),
+        message,
     })
 }
 
@@ -291,7 +327,11 @@ mod tests {
 
     #[test]
     fn errors_name_the_file_and_line() {
-        let e = parse("IES:LM-63-2019\nTILT=NONE\n1 -1 1 2 1 3 2\n", Path::new("b.ies")).unwrap_err();
+        let e = parse(
+            "IES:LM-63-2019\nTILT=NONE\n1 -1 1 2 1 3 2\n",
+            Path::new("b.ies"),
+        )
+        .unwrap_err();
         assert_eq!(
             e.to_string(),
             "b.ies:3: photometric type 3: only type C (1) describes a panel by C-planes"
@@ -303,6 +343,9 @@ mod tests {
             Path::new("d.ies"),
         )
         .unwrap_err();
-        assert!(e.to_string().starts_with("d.ies:7: the candela values"), "{e}");
+        assert!(
+            e.to_string().starts_with("d.ies:7: the candela values"),
+            "{e}"
+        );
     }
 }

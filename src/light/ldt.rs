@@ -24,8 +24,8 @@ use std::path::Path;
 
 use super::cgamma::CGammaTable;
 use super::photometry::{
-    candela_grid, finish, flux_lm, format_sig, mirror_planes, tokens, Opening, Panel,
-    Photometry, PhotometryError,
+    candela_grid, finish, flux_lm, format_sig, mirror_planes, tokens, Opening, Panel, Photometry,
+    PhotometryError,
 };
 
 /// Text for the descriptive lines of a written file.
@@ -45,7 +45,10 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &LdtInfo) -> String {
     let g = table.gamma_deg();
     let symmetric = c.len() == 1;
     let dc = if symmetric { 0.0 } else { c[1] - c[0] };
-    let dg = if g.windows(2).all(|w| (w[1] - w[0] - (g[1] - g[0])).abs() < 1e-9) {
+    let dg = if g
+        .windows(2)
+        .all(|w| (w[1] - w[0] - (g[1] - g[0])).abs() < 1e-9)
+    {
         g[1] - g[0]
     } else {
         0.0
@@ -120,7 +123,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         lines.get(k - 1).copied().ok_or_else(|| {
             fmt_err(
                 lines.len().max(1),
-                format!("the file ends at line {}, before line {k} of the header", lines.len()),
+                format!(
+                    "the file ends at line {}, before line {k} of the header",
+                    lines.len()
+                ),
             )
         })
     };
@@ -142,14 +148,20 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     let mc = count(4, "the number of C-planes Mc")?;
     let ng = count(6, "the number of γ angles Ng")?;
     if ng < 2 {
-        return Err(fmt_err(6, format!("Ng = {ng}: a distribution needs at least 2 γ angles")));
+        return Err(fmt_err(
+            6,
+            format!("Ng = {ng}: a distribution needs at least 2 γ angles"),
+        ));
     }
     let length_mm = number(16, "the luminous area's length")?;
     let width_mm = number(17, "the luminous area's width")?;
     let conversion = number(24, "the intensity conversion factor")?;
     let sets = count(26, "the number of lamp sets")?;
     if sets == 0 {
-        return Err(fmt_err(26, "no lamp sets: the cd/klm values cannot be scaled to candela".into()));
+        return Err(fmt_err(
+            26,
+            "no lamp sets: the cd/klm values cannot be scaled to candela".into(),
+        ));
     }
     // Lines 27 … 26 + 6n: lamp counts, types, fluxes, colours, colour rendering, wattages.
     let mut total_flux = 0.0;
@@ -158,7 +170,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         total_flux += number(line, "a lamp set's luminous flux")?.abs();
     }
     if !(total_flux > 0.0) {
-        return Err(fmt_err(27 + 2 * sets, "the lamps' luminous flux is 0".into()));
+        return Err(fmt_err(
+            27 + 2 * sets,
+            "the lamps' luminous flux is 0".into(),
+        ));
     }
     let data_start = 27 + 6 * sets;
     let rest = lines.get(data_start - 1..).unwrap_or(&[]).join("\n");
@@ -166,7 +181,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     let mut pos = 0usize;
     let mut next = |what: &str| -> Result<f64, PhotometryError> {
         let Some((line, t)) = toks.get(pos) else {
-            return Err(fmt_err(lines.len().max(1), format!("the file ends before {what}")));
+            return Err(fmt_err(
+                lines.len().max(1),
+                format!("the file ends before {what}"),
+            ));
         };
         pos += 1;
         t.parse::<f64>()
@@ -175,16 +193,30 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     for _ in 0..10 {
         next("the direct ratios")?;
     }
-    let c_angles: Vec<f64> = (0..mc).map(|_| next("the C angles")).collect::<Result<_, _>>()?;
-    let gammas: Vec<f64> = (0..ng).map(|_| next("the γ angles")).collect::<Result<_, _>>()?;
+    let c_angles: Vec<f64> = (0..mc)
+        .map(|_| next("the C angles"))
+        .collect::<Result<_, _>>()?;
+    let gammas: Vec<f64> = (0..ng)
+        .map(|_| next("the γ angles"))
+        .collect::<Result<_, _>>()?;
     type Mirror = fn(f64) -> f64;
     let (first, stored, symmetry, mirrors): (usize, usize, &str, Vec<Mirror>) = match isym {
         0 => (0, mc, "none", vec![]),
         1 => (0, 1, "rotationally symmetric", vec![]),
-        2 => (0, mc / 2 + 1, "symmetric about the C0–C180 plane", vec![|c| 360.0 - c]),
+        2 => (
+            0,
+            mc / 2 + 1,
+            "symmetric about the C0–C180 plane",
+            vec![|c| 360.0 - c],
+        ),
         3 => {
             let start = c_angles.iter().position(|&c| c >= 90.0).unwrap_or(0);
-            (start, mc / 2 + 1, "symmetric about the C90–C270 plane", vec![|c| 180.0 - c])
+            (
+                start,
+                mc / 2 + 1,
+                "symmetric about the C90–C270 plane",
+                vec![|c| 180.0 - c],
+            )
         }
         4 => (
             0,
@@ -193,7 +225,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
             vec![|c| 180.0 - c, |c| 180.0 + c, |c| 360.0 - c],
         ),
         _ => {
-            return Err(fmt_err(3, format!("symmetry indicator Isym = {isym}: expected 0 to 4")));
+            return Err(fmt_err(
+                3,
+                format!("symmetry indicator Isym = {isym}: expected 0 to 4"),
+            ));
         }
     };
     if isym != 1 && first + stored > mc {
@@ -228,12 +263,18 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         height_m: l,
         area_m2: area.abs(),
     };
-    finish("EULUMDAT".into(), symmetry.into(), stored, opening, planes, &gammas).map_err(
-        |message| PhotometryError::Content {
-            file: source.to_path_buf(),
-            message,
-        },
+    finish(
+        "EULUMDAT".into(),
+        symmetry.into(),
+        stored,
+        opening,
+        planes,
+        &gammas,
     )
+    .map_err(|message| PhotometryError::Content {
+        file: source.to_path_buf(),
+        message,
+    })
 }
 
 /// Tokens of the numeric block with decimal commas read as points (EULUMDAT separates
@@ -275,7 +316,11 @@ mod tests {
         assert!((p.normal_intensity_cd - 1000.0).abs() < 1e-9);
         // f(45°) = I / (I₀ cos 45°): 1.0, 0.8, 0.6 in C0, C90, C180, and C270 mirrors C90.
         for (c, want) in [(0.0, 1.0), (90.0, 0.8), (180.0, 0.6), (270.0, 0.8)] {
-            assert!((t.at(c, 45.0) - want).abs() < 1e-7, "C{c}: {}", t.at(c, 45.0));
+            assert!(
+                (t.at(c, 45.0) - want).abs() < 1e-7,
+                "C{c}: {}",
+                t.at(c, 45.0)
+            );
         }
         assert!((p.area_m2 - 0.18).abs() < 1e-12);
         assert_eq!(p.stored_planes, 3);

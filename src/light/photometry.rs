@@ -41,7 +41,11 @@ pub enum PhotometryError {
 
 impl Panel {
     /// A panel with every dimension and the luminance checked positive and finite.
-    pub fn new(width_m: f64, height_m: f64, normal_luminance_cd_m2: f64) -> Result<Panel, PhotometryError> {
+    pub fn new(
+        width_m: f64,
+        height_m: f64,
+        normal_luminance_cd_m2: f64,
+    ) -> Result<Panel, PhotometryError> {
         for (what, value) in [
             ("width", width_m),
             ("height", height_m),
@@ -69,7 +73,9 @@ impl Panel {
 
     /// I(C, γ) in cd.
     pub fn intensity_cd(&self, table: &CGammaTable, c_deg: f64, gamma_deg: f64) -> f64 {
-        self.normal_intensity_cd() * table.at(c_deg, gamma_deg) * gamma_deg.to_radians().cos().max(0.0)
+        self.normal_intensity_cd()
+            * table.at(c_deg, gamma_deg)
+            * gamma_deg.to_radians().cos().max(0.0)
     }
 }
 
@@ -288,7 +294,10 @@ pub(crate) fn finish(
         ));
     }
     if let Some(w) = gamma_deg.windows(2).find(|w| !(w[1] > w[0])) {
-        return Err(format!("the γ angles must increase: {}° then {}°", w[0], w[1]));
+        return Err(format!(
+            "the γ angles must increase: {}° then {}°",
+            w[0], w[1]
+        ));
     }
     let last = gamma_deg[gamma_deg.len() - 1];
     if last < 90.0 {
@@ -304,7 +313,9 @@ pub(crate) fn finish(
     let (mut lo, mut hi, mut back) = (f64::INFINITY, 0.0f64, 0.0f64);
     for (c, row) in planes {
         if let Some(v) = row.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-            return Err(format!("C-plane {c}°: intensity {v} must be finite and ≥ 0"));
+            return Err(format!(
+                "C-plane {c}°: intensity {v} must be finite and ≥ 0"
+            ));
         }
         let mut r: Vec<f64> = row[..front].to_vec();
         let at90 = if gamma_deg[front] == 90.0 {
@@ -381,7 +392,12 @@ mod tests {
         let t = CGammaTable::new(
             vec![0.0, 90.0, 180.0, 270.0],
             vec![0.0, 90.0],
-            vec![vec![1.0, 1.0], vec![1.0, 0.0], vec![1.0, 1.0], vec![1.0, 0.0]],
+            vec![
+                vec![1.0, 1.0],
+                vec![1.0, 0.0],
+                vec![1.0, 1.0],
+                vec![1.0, 0.0],
+            ],
         )
         .unwrap();
         let want = 2.0 * PI * (0.5 + 0.25) / 2.0;

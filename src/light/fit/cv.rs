@@ -78,7 +78,10 @@ mod tests {
     #[test]
     fn held_out_errors_vanish_for_the_generating_model() {
         let g: Vec<f64> = (1..=6).map(|k| 12.0 * k as f64).collect();
-        let y: Vec<f64> = g.iter().map(|x: &f64| x.to_radians().cos().powf(2.5)).collect();
+        let y: Vec<f64> = g
+            .iter()
+            .map(|x: &f64| x.to_radians().cos().powf(2.5))
+            .collect();
         let e = leave_one_out(LdcModel::CosPower, &g, &y).unwrap();
         assert!(e.iter().all(|e| e.abs() < 1e-6), "{e:?}");
         // Lambertian predicts 1: the held-out error is the fall-off itself.

@@ -65,9 +65,13 @@ pub enum LdcError {
     },
     #[error("the {plane} plane has no reading at 0° (the normal), which the distribution is relative to")]
     NoNormalReading { plane: Plane },
-    #[error("the {plane} plane reads 0 at the normal: the distribution cannot be made relative to it")]
+    #[error(
+        "the {plane} plane reads 0 at the normal: the distribution cannot be made relative to it"
+    )]
     ZeroNormalReading { plane: Plane },
-    #[error("half-plane {half}: {got} angle(s) off the normal, the {model} model needs at least {need}")]
+    #[error(
+        "half-plane {half}: {got} angle(s) off the normal, the {model} model needs at least {need}"
+    )]
     TooFewAngles {
         half: HalfPlane,
         model: LdcModel,
@@ -275,7 +279,11 @@ fn candidate(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Candidate {
     let mut held_out = Some(Vec::new());
     for (&h, (g, y)) in HalfPlane::ALL.iter().zip(halves) {
         let params = models::fit_half(model, g, y);
-        let r: Vec<f64> = g.iter().zip(y).map(|(&gi, &yi)| yi - params.eval(gi)).collect();
+        let r: Vec<f64> = g
+            .iter()
+            .zip(y)
+            .map(|(&gi, &yi)| yi - params.eval(gi))
+            .collect();
         let half_sq: f64 = r.iter().map(|e| e * e).sum();
         sq += half_sq;
         n += r.len();

@@ -105,7 +105,9 @@ impl Params {
         match *self {
             Params::Lambertian => 1.0,
             Params::CosPower { n } => c.powf(n),
-            Params::CosPoly { coeffs: [a0, a1, a2] } => a0 + a1 * c + a2 * c * c,
+            Params::CosPoly {
+                coeffs: [a0, a1, a2],
+            } => a0 + a1 * c + a2 * c * c,
             Params::Lobes { a, n, m } => a * c.powf(n) + (1.0 - a) * c.powf(m),
         }
     }
@@ -115,7 +117,9 @@ impl Params {
         match *self {
             Params::Lambertian => "-".into(),
             Params::CosPower { n } => format!("n={n:.3}"),
-            Params::CosPoly { coeffs: [a0, a1, a2] } => {
+            Params::CosPoly {
+                coeffs: [a0, a1, a2],
+            } => {
                 format!("a0={a0:.3} a1={a1:.3} a2={a2:.3}")
             }
             Params::Lobes { a, n, m } => format!("a={a:.3} n={n:.3} m={m:.3}"),
@@ -200,7 +204,9 @@ fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
             }
         }
     }
-    let step = (MAX_EXPONENT / (K * K) as f64).max(best.0[1] * 0.1).max(0.05);
+    let step = (MAX_EXPONENT / (K * K) as f64)
+        .max(best.0[1] * 0.1)
+        .max(0.05);
     let p = nelder_mead(cost, best.0, step, 2000);
     let (mut n, mut m) = (p[0].clamp(0.0, MAX_EXPONENT), p[1].clamp(0.0, MAX_EXPONENT));
     if n > m {
@@ -250,14 +256,20 @@ pub(crate) fn minimise_1d(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize
 
 /// Nelder–Mead on two variables with the standard coefficients (reflection 1, expansion 2,
 /// contraction ½, shrink ½), from `start` with an initial simplex of edge `step`.
-fn nelder_mead(f: impl Fn([f64; 2]) -> f64, start: [f64; 2], step: f64, iterations: usize) -> [f64; 2] {
+fn nelder_mead(
+    f: impl Fn([f64; 2]) -> f64,
+    start: [f64; 2],
+    step: f64,
+    iterations: usize,
+) -> [f64; 2] {
     let mut s = [
         start,
         [start[0] + step, start[1]],
         [start[0], start[1] + step],
     ];
     let mut v = s.map(&f);
-    let lerp = |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+    let lerp =
+        |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
     for _ in 0..iterations {
         let mut idx = [0, 1, 2];
         idx.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
@@ -274,7 +286,11 @@ fn nelder_mead(f: impl Fn([f64; 2]) -> f64, start: [f64; 2], step: f64, iteratio
         if fr < v[0] {
             let expanded = lerp(s[2], centroid, 3.0);
             let fe = f(expanded);
-            (s[2], v[2]) = if fe < fr { (expanded, fe) } else { (reflected, fr) };
+            (s[2], v[2]) = if fe < fr {
+                (expanded, fe)
+            } else {
+                (reflected, fr)
+            };
         } else if fr < v[1] {
             (s[2], v[2]) = (reflected, fr);
         } else {
@@ -335,7 +351,10 @@ mod tests {
         let p = fit_half(LdcModel::Lobes, &g, &y);
         for x in [5.0, 25.0, 45.0, 65.0, 80.0] {
             let want = 0.6 * cos(x) + 0.4 * cos(x).powi(8);
-            assert!((p.eval(x) - want).abs() < 1e-4 * want.max(0.01), "{p:?} at {x}");
+            assert!(
+                (p.eval(x) - want).abs() < 1e-4 * want.max(0.01),
+                "{p:?} at {x}"
+            );
         }
     }
 

@@ -59,7 +59,12 @@ pub enum HalfPlane {
 }
 
 impl HalfPlane {
-    pub const ALL: [HalfPlane; 4] = [HalfPlane::C0, HalfPlane::C90, HalfPlane::C180, HalfPlane::C270];
+    pub const ALL: [HalfPlane; 4] = [
+        HalfPlane::C0,
+        HalfPlane::C90,
+        HalfPlane::C180,
+        HalfPlane::C270,
+    ];
 
     pub fn c_deg(self) -> f64 {
         match self {
@@ -207,7 +212,8 @@ impl Falloff {
 
 /// The header's plane columns after `angle_deg`; a column of another name is an error.
 fn header(cells: &[&str]) -> Result<Vec<Option<Plane>>, String> {
-    let expected = "expected the header 'angle_deg,horizontal,vertical' (either plane may be left out)";
+    let expected =
+        "expected the header 'angle_deg,horizontal,vertical' (either plane may be left out)";
     if cells.len() < 2 || !cells[0].eq_ignore_ascii_case("angle_deg") {
         return Err(format!("{expected}, found '{}'", cells.join(",")));
     }
@@ -252,7 +258,11 @@ fn validate_plane(plane: Plane, data: &PlaneData) -> Result<f64, LdcError> {
             });
         }
         if !value.is_finite() || value < 0.0 {
-            return Err(LdcError::BadLuminance { plane, angle, value });
+            return Err(LdcError::BadLuminance {
+                plane,
+                angle,
+                value,
+            });
         }
         if angle == 0.0 {
             normal = Some(value);
