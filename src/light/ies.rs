@@ -160,7 +160,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         // they scale the lamp's output with its tilt, which a fixed panel does not have.
         next("the tilt geometry")?;
         let (line, n) = next("the number of tilt angles")?;
-        if !(n >= 0.0 && n.fract() == 0.0) {
+        if n.is_nan() || n < 0.0 || n.fract() != 0.0 {
             return Err(fmt_err(
                 line,
                 format!("the number of tilt angles {n} is not a count"),
@@ -237,7 +237,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     }
     let first_c = horizontal[0];
     let last_c = horizontal[n_horizontal - 1];
-    if let Some(w) = horizontal.windows(2).find(|w| !(w[1] > w[0])) {
+    if let Some(w) = horizontal
+        .windows(2)
+        .find(|w| w[1].is_nan() || w[1] <= w[0])
+    {
         return Err(fmt_err(
             h_line,
             format!(

@@ -54,7 +54,13 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &LdtInfo) -> String {
         0.0
     };
     let mm = |m: f64| format_sig(m * 1000.0, 6);
-    let text = |s: &str| s.replace(['\r', '\n'], " ");
+    // EULUMDAT's text lines hold at most 78 characters.
+    let text = |s: &str| {
+        s.replace(['\r', '\n'], " ")
+            .chars()
+            .take(78)
+            .collect::<String>()
+    };
     let mut lines: Vec<String> = vec![
         "metamer".into(),
         if symmetric { "1" } else { "3" }.into(),
@@ -169,7 +175,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         let line = 27 + 2 * sets + k;
         total_flux += number(line, "a lamp set's luminous flux")?.abs();
     }
-    if !(total_flux > 0.0) {
+    if total_flux.is_nan() || total_flux <= 0.0 {
         return Err(fmt_err(
             27 + 2 * sets,
             "the lamps' luminous flux is 0".into(),

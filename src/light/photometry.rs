@@ -171,7 +171,7 @@ pub(crate) fn candela_to_table(
     let mut values = Vec::with_capacity(candela.len());
     for (plane, row) in c_deg.iter().zip(candela) {
         let i0 = row[0];
-        if !(i0 > 0.0) {
+        if i0.is_nan() || i0 <= 0.0 {
             return Err(format!(
                 "C-plane {plane}°: intensity {i0} cd along the normal; a distribution relative to it needs it > 0"
             ));
@@ -293,7 +293,7 @@ pub(crate) fn finish(
             gamma_deg.first().copied().unwrap_or(f64::NAN)
         ));
     }
-    if let Some(w) = gamma_deg.windows(2).find(|w| !(w[1] > w[0])) {
+    if let Some(w) = gamma_deg.windows(2).find(|w| w[1].is_nan() || w[1] <= w[0]) {
         return Err(format!(
             "the γ angles must increase: {}° then {}°",
             w[0], w[1]
