@@ -12,6 +12,7 @@ mod devices;
 mod experiment;
 mod fit;
 mod lab;
+mod light;
 mod render;
 mod reproduce;
 mod simulate;
@@ -51,6 +52,8 @@ enum Command {
     Experiment(experiment::Args),
     /// The whole validation chain on the built-in simulated lab: box, simulation, display.
     Lab(lab::Args),
+    /// The light source's distribution: fit it to fall-off readings, export and read IES/LDT.
+    Light(light::Args),
     /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
     Simulate(simulate::Args),
 }
@@ -84,6 +87,7 @@ pub fn main() -> ExitCode {
         Command::Lab(args) => lab::run(args),
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Light(args) => light::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
