@@ -15,6 +15,7 @@ mod render;
 mod reproduce;
 mod simulate;
 mod spot;
+mod validate;
 mod verify;
 
 /// metamer: prove a rendering is colour-true.
@@ -47,6 +48,8 @@ enum Command {
     Budget(budget::Args),
     /// The whole validation chain on the built-in simulated lab: box, simulation, display.
     Lab(lab::Args),
+    /// Box vs display (vs simulation) readings in CIELAB with uncertainty: table and report.
+    Validate(validate::Args),
     /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
     Simulate(simulate::Args),
 }
@@ -79,6 +82,7 @@ pub fn main() -> ExitCode {
         Command::Lab(args) => lab::run(args),
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Validate(args) => validate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
