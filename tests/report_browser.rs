@@ -74,14 +74,21 @@ fn report_renders_in_headless_chromium_without_console_errors() {
         .arg(&dir)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let page = dir.join("report.html");
 
     let shot = dir.join("report.png");
     let run = headless(
         &browser,
         &dir,
-        &[&format!("--screenshot={}", shot.display()), "--window-size=1100,2400"],
+        &[
+            &format!("--screenshot={}", shot.display()),
+            "--window-size=1100,2400",
+        ],
         &page,
     );
     let log = String::from_utf8_lossy(&run.stderr);
@@ -94,11 +101,19 @@ fn report_renders_in_headless_chromium_without_console_errors() {
                 || l.contains("report.html") && l.contains(":ERROR:")
         })
         .collect();
-    assert!(console_errors.is_empty(), "console errors: {console_errors:#?}");
-    let png = std::fs::read(&shot).unwrap_or_else(|e| panic!("no screenshot ({e}); chromium said:\n{log}"));
+    assert!(
+        console_errors.is_empty(),
+        "console errors: {console_errors:#?}"
+    );
+    let png = std::fs::read(&shot)
+        .unwrap_or_else(|e| panic!("no screenshot ({e}); chromium said:\n{log}"));
     assert_eq!(png_size(&png), Some((1100, 2400)), "not the PNG asked for");
     // A blank page compresses to a few kB; the figures, swatches and table do not.
-    assert!(png.len() > 60_000, "screenshot of {} bytes looks empty", png.len());
+    assert!(
+        png.len() > 60_000,
+        "screenshot of {} bytes looks empty",
+        png.len()
+    );
     if let Ok(keep) = std::env::var("METAMER_KEEP_SCREENSHOT") {
         std::fs::copy(&shot, keep).unwrap();
     }

@@ -10,8 +10,8 @@ use metamer::validation::export::{comparisons, to_json};
 use metamer::validation::readings::Format;
 use metamer::validation::report::{InputFile, InstrumentUsed};
 use metamer::validation::{
-    assess, read_readings, write_report_files, AssessOptions, Assessment, Propagation,
-    ReadingSet, ReportInput, ValidationError,
+    assess, read_readings, write_report_files, AssessOptions, Assessment, Propagation, ReadingSet,
+    ReportInput, ValidationError,
 };
 
 use super::{parse_triple, CliError, CliResult};
@@ -139,7 +139,11 @@ pub fn run(args: Args) -> CliResult {
         out_of_gamut: args.out_of_gamut.clone(),
         ..ReportInput::default()
     };
-    for (role, set) in [("box", Some(&reference)), ("display", Some(&test)), ("simulation", simulation.as_ref())] {
+    for (role, set) in [
+        ("box", Some(&reference)),
+        ("display", Some(&test)),
+        ("simulation", simulation.as_ref()),
+    ] {
         let Some(set) = set else { continue };
         input.inputs.push(InputFile {
             role: role.into(),
@@ -174,7 +178,10 @@ pub fn run(args: Args) -> CliResult {
     for note in &input.notes {
         eprintln!("note: {note}");
     }
-    println!("white X Y Z = {:.4} {:.4} {:.4} ({})", white.x, white.y, white.z, input.white_source);
+    println!(
+        "white X Y Z = {:.4} {:.4} {:.4} ({})",
+        white.x, white.y, white.z, input.white_source
+    );
     for (_, a) in comparisons(&input) {
         print_table(a);
     }

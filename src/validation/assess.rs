@@ -303,14 +303,13 @@ mod tests {
         let white = Xyz::new(95.047, 100.0, 108.883);
         // Greys at L* 50 (Y 18.418652), 51.5 (19.703227) and 60 (28.123334);
         // by hand from L* = 116 (Y/Yn)^(1/3) − 16.
-        let g = |k: usize, y: f64| {
-            format!(
-                "{k},{},{y},{}\n",
-                0.950_47 * y,
-                1.088_83 * y
-            )
-        };
-        let reference = set(&format!("patch,X,Y,Z\n{}{}{}", g(1, 18.418_652), g(2, 18.418_652), g(3, 18.418_652)));
+        let g = |k: usize, y: f64| format!("{k},{},{y},{}\n", 0.950_47 * y, 1.088_83 * y);
+        let reference = set(&format!(
+            "patch,X,Y,Z\n{}{}{}",
+            g(1, 18.418_652),
+            g(2, 18.418_652),
+            g(3, 18.418_652)
+        ));
         // Patch 1: ΔE 1.5 known exactly → below. Patch 2: ΔE 10 → above. Patch 3: repeats
         // 16.5 and 23.0 (mean 19.75, ΔE 1.6; the scatter along the grey axis is ±3.25 in Y,
         // ±3.8 in L*): too scattered to decide.
@@ -321,14 +320,29 @@ mod tests {
             g(3, 16.5),
             g(3, 23.0)
         ));
-        let a = assess("box", &reference, "display", &test, white, &AssessOptions::default()).unwrap();
+        let a = assess(
+            "box",
+            &reference,
+            "display",
+            &test,
+            white,
+            &AssessOptions::default(),
+        )
+        .unwrap();
         assert!((a.patches[0].de76 - 1.5).abs() < 1e-4);
         assert_eq!(
             a.patches.iter().map(|p| p.jnd).collect::<Vec<_>>(),
             [JndVerdict::Below, JndVerdict::Above, JndVerdict::Undecided]
         );
         assert_eq!(a.below_jnd_point, 2);
-        assert_eq!(a.jnd, JndCount { below: 1, above: 1, undecided: 1 });
+        assert_eq!(
+            a.jnd,
+            JndCount {
+                below: 1,
+                above: 1,
+                undecided: 1
+            }
+        );
         // The mean over the draws brackets the mean of the values.
         let m = a.mean_de76;
         let i = m.interval.unwrap();

@@ -267,7 +267,16 @@ pub fn lab_planes(a: &Assessment, id: &str, title: &str) -> String {
     };
     let ab = pts(|l| (l[1], l[2]));
     let la = pts(|l| (l[1], l[0]));
-    plane(&mut s, a, id, &ab, (40.0, 40.0, 420.0, 420.0), "a*", "b*", None);
+    plane(
+        &mut s,
+        a,
+        id,
+        &ab,
+        (40.0, 40.0, 420.0, 420.0),
+        "a*",
+        "b*",
+        None,
+    );
     plane(
         &mut s,
         a,
@@ -339,7 +348,11 @@ fn plane(
             r##"<line x1="{:.1}" x2="{:.1}" y1="{y:.1}" y2="{y:.1}" stroke="{}"/><text x="{:.1}" y="{:.1}" text-anchor="end" font-size="10" font-family="sans-serif">{}</text>"##,
             bx + pl,
             bx + pl + pw,
-            if v == 0.0 && y_range.is_none() { "#999" } else { "#e4e4e4" },
+            if v == 0.0 && y_range.is_none() {
+                "#999"
+            } else {
+                "#e4e4e4"
+            },
             bx + pl - 4.0,
             py(v) + 3.0,
             trim(v),

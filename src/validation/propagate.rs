@@ -286,11 +286,39 @@ mod tests {
         let lin = propagate(&r, &t, WHITE, Propagation::Linear, 15);
         let width = lin.de76.hi - lin.de76.lo;
         assert!(width > 0.5, "{width}");
-        assert!((mc.de76.lo - lin.de76.lo).abs() < 0.05 * width, "{:?} {:?} / {:?} {:?}", mc.de76, mc.de00, lin.de76, lin.de00);
-        assert!((mc.de76.hi - lin.de76.hi).abs() < 0.05 * width, "{:?} {:?} / {:?} {:?}", mc.de76, mc.de00, lin.de76, lin.de00);
+        assert!(
+            (mc.de76.lo - lin.de76.lo).abs() < 0.05 * width,
+            "{:?} {:?} / {:?} {:?}",
+            mc.de76,
+            mc.de00,
+            lin.de76,
+            lin.de00
+        );
+        assert!(
+            (mc.de76.hi - lin.de76.hi).abs() < 0.05 * width,
+            "{:?} {:?} / {:?} {:?}",
+            mc.de76,
+            mc.de00,
+            lin.de76,
+            lin.de00
+        );
         let w00 = lin.de00.hi - lin.de00.lo;
-        assert!((mc.de00.lo - lin.de00.lo).abs() < 0.08 * w00, "{:?} {:?} / {:?} {:?}", mc.de76, mc.de00, lin.de76, lin.de00);
-        assert!((mc.de00.hi - lin.de00.hi).abs() < 0.08 * w00, "{:?} {:?} / {:?} {:?}", mc.de76, mc.de00, lin.de76, lin.de00);
+        assert!(
+            (mc.de00.lo - lin.de00.lo).abs() < 0.08 * w00,
+            "{:?} {:?} / {:?} {:?}",
+            mc.de76,
+            mc.de00,
+            lin.de76,
+            lin.de00
+        );
+        assert!(
+            (mc.de00.hi - lin.de00.hi).abs() < 0.08 * w00,
+            "{:?} {:?} / {:?} {:?}",
+            mc.de76,
+            mc.de00,
+            lin.de76,
+            lin.de00
+        );
         // The same seed gives the same interval.
         assert_eq!(mc, propagate(&r, &t, WHITE, how, 15));
     }

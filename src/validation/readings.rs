@@ -344,10 +344,9 @@ impl Parsed {
             }
             let patch = match v.get("patch") {
                 None => None,
-                Some(p) => Some(
-                    patch_id(p)
-                        .ok_or_else(|| self.bad(line, format!("\"patch\": {p} is not 1–24 or \"white\"")))?,
-                ),
+                Some(p) => Some(patch_id(p).ok_or_else(|| {
+                    self.bad(line, format!("\"patch\": {p} is not 1–24 or \"white\""))
+                })?),
             };
             let row = Row {
                 line,
@@ -470,7 +469,11 @@ impl Parsed {
             if cells.len() != names.len() {
                 return Err(self.bad(
                     line,
-                    format!("expected {} cells as in the header, found {}", names.len(), cells.len()),
+                    format!(
+                        "expected {} cells as in the header, found {}",
+                        names.len(),
+                        cells.len()
+                    ),
                 ));
             }
             let num = |c: usize| -> Result<f64, ReadingsError> {
@@ -478,12 +481,20 @@ impl Parsed {
                     .parse::<f64>()
                     .ok()
                     .filter(|v| v.is_finite())
-                    .ok_or_else(|| self.bad(line, format!("{}: '{}' is not a number", names[c], cells[c])))
+                    .ok_or_else(|| {
+                        self.bad(
+                            line,
+                            format!("{}: '{}' is not a number", names[c], cells[c]),
+                        )
+                    })
             };
             let patch = patch_id(&Value::String(cells[cp].to_string())).ok_or_else(|| {
                 self.bad(
                     line,
-                    format!("patch '{}' is not 1–24, a ColorChecker name or 'white'", cells[cp]),
+                    format!(
+                        "patch '{}' is not 1–24, a ColorChecker name or 'white'",
+                        cells[cp]
+                    ),
                 )
             })?;
             let sd = match sd {
@@ -500,7 +511,10 @@ impl Parsed {
                 Some(c) => {
                     let v = num(c)?;
                     if v < 1.0 || v.fract() != 0.0 {
-                        return Err(self.bad(line, format!("n: '{}' must be a whole number ≥ 1", cells[c])));
+                        return Err(self.bad(
+                            line,
+                            format!("n: '{}' must be a whole number ≥ 1", cells[c]),
+                        ));
                     }
                     v as usize
                 }
@@ -510,7 +524,9 @@ impl Parsed {
                 Some(c) => match cells[c] {
                     "1" | "true" | "yes" => true,
                     "0" | "false" | "no" | "" => false,
-                    other => return Err(self.bad(line, format!("out_of_gamut: '{other}' is not 0 or 1"))),
+                    other => {
+                        return Err(self.bad(line, format!("out_of_gamut: '{other}' is not 0 or 1")))
+                    }
                 },
                 None => false,
             };
@@ -700,8 +716,9 @@ mod tests {
     #[test]
     fn csv_given_sd_and_n() {
         // sd 0.4 over n = 4 readings: u = 0.2; two such rows: √(0.2² + 0.2²)/2 = 0.1414214.
-        let s = parse("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n2,1,2,3,0.4,0.4,0.4,4\n2,1,2,3,0.4,0.4,0.4,4\n")
-            .unwrap();
+        let s =
+            parse("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n2,1,2,3,0.4,0.4,0.4,4\n2,1,2,3,0.4,0.4,0.4,4\n")
+                .unwrap();
         let p = &s.patches[&2];
         assert!((p.u_xyz[2] - 0.141_421_4).abs() < 1e-6);
         assert_eq!((p.n, p.source), (8, UncertaintySource::Given));
@@ -709,7 +726,9 @@ mod tests {
 
     #[test]
     fn csv_errors_name_the_line() {
-        let e = parse("patch,X,Y,Z\n1,1,2,3\n25,1,2,3\n").unwrap_err().to_string();
+        let e = parse("patch,X,Y,Z\n1,1,2,3\n25,1,2,3\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("r.csv:3:") && e.contains("'25'"), "{e}");
         let e = parse("patch,X,Y\n1,1,2\n").unwrap_err().to_string();
         assert!(e.contains("r.csv:1:") && e.contains("'Z'"), "{e}");
@@ -719,7 +738,9 @@ mod tests {
 
     #[test]
     fn spot_lines_unnumbered_are_patches_in_order_or_repeats() {
-        let line = |y: f64| format!("{{\"XYZ\":[1,{y},1],\"xyY\":[0.3,0.3,{y}],\"flags\":[],\"instrument\":\"cs100a\"}}\n");
+        let line = |y: f64| {
+            format!("{{\"XYZ\":[1,{y},1],\"xyY\":[0.3,0.3,{y}],\"flags\":[],\"instrument\":\"cs100a\"}}\n")
+        };
         let two: String = [1.0, 2.0].iter().map(|y| line(*y)).collect();
         let s = parse(&two).unwrap();
         assert_eq!(s.format, Format::SpotJson);
@@ -730,19 +751,32 @@ mod tests {
         assert_eq!(s.patches.len(), 24);
         assert_eq!(s.patches[&24].xyz[1], 46.5);
         let bad: String = (0..25).map(|i| line(i as f64)).collect();
-        assert!(parse(&bad).unwrap_err().to_string().contains("25 unnumbered"));
+        assert!(parse(&bad)
+            .unwrap_err()
+            .to_string()
+            .contains("25 unnumbered"));
         let null = "{\"XYZ\":[null,1,null],\"xyY\":[null,null,1]}\n";
         let e = parse(null).unwrap_err().to_string();
-        assert!(e.contains("r.csv:1:") && e.contains("did not measure"), "{e}");
+        assert!(
+            e.contains("r.csv:1:") && e.contains("did not measure"),
+            "{e}"
+        );
     }
 
     #[test]
     fn journal_entries_by_patch_number_or_colorchecker_label() {
         let header = r#"{"type":"header","format":"metamer-session-journal","version":2,"kind":"measure-box","fingerprint":"x","options":{},"steps":3,"started_s":0,"data":{"instruments":{"spot":{"info":{"model":"cs100a","serial":"7"},"options":{}}},"details":null}}"#;
         let entry = |patch: &str, y: f64| {
-            format!(r#"{{"type":"entry","index":0,"label":"p","role":"spot","mode":"emissive","data":{{"patch":{patch}}},"reading":{{"xyz":[1,{y},1],"xyy":[0,0,0],"spectrum":null,"flags":[],"integration_s":null,"instrument":"cs100a","timestamp_s":0}}}}"#)
+            format!(
+                r#"{{"type":"entry","index":0,"label":"p","role":"spot","mode":"emissive","data":{{"patch":{patch}}},"reading":{{"xyz":[1,{y},1],"xyy":[0,0,0],"spectrum":null,"flags":[],"integration_s":null,"instrument":"cs100a","timestamp_s":0}}}}"#
+            )
         };
-        let text = format!("{header}\n{}\n{}\n{}\n{{\"type\":\"ent", entry("3", 1.0), entry("3", 3.0), entry("\"white\"", 9.0));
+        let text = format!(
+            "{header}\n{}\n{}\n{}\n{{\"type\":\"ent",
+            entry("3", 1.0),
+            entry("3", 3.0),
+            entry("\"white\"", 9.0)
+        );
         let s = parse(&text).unwrap();
         assert_eq!(s.format, Format::Journal);
         assert_eq!(s.patches[&3].xyz[1], 2.0);

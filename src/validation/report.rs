@@ -131,7 +131,11 @@ pub fn render_html(input: &ReportInput) -> String {
     if let Some(a) = &input.box_vs_display {
         figure(
             &mut h,
-            &delta_e_bars(a, "fig4", &format!("Fig. 4 — {} vs {}: ΔE*ab per patch", a.test, a.reference)),
+            &delta_e_bars(
+                a,
+                "fig4",
+                &format!("Fig. 4 — {} vs {}: ΔE*ab per patch", a.test, a.reference),
+            ),
             &summary_line(a),
         );
         figure(
@@ -143,14 +147,22 @@ pub fn render_html(input: &ReportInput) -> String {
     if let Some(a) = &input.box_vs_simulation {
         figure(
             &mut h,
-            &delta_e_bars(a, "fig6", &format!("Fig. 6 — {} vs {}: ΔE*ab per patch", a.test, a.reference)),
+            &delta_e_bars(
+                a,
+                "fig6",
+                &format!("Fig. 6 — {} vs {}: ΔE*ab per patch", a.test, a.reference),
+            ),
             &summary_line(a),
         );
     }
     if let Some(a) = &input.display_vs_simulation {
         figure(
             &mut h,
-            &delta_e_bars(a, "fig7", &format!("{} vs {}: ΔE*ab per patch", a.test, a.reference)),
+            &delta_e_bars(
+                a,
+                "fig7",
+                &format!("{} vs {}: ΔE*ab per patch", a.test, a.reference),
+            ),
             &summary_line(a),
         );
     }
@@ -450,11 +462,8 @@ mod tests {
     use std::path::Path;
 
     fn assessment() -> Assessment {
-        let r = parse_readings(
-            "patch,X,Y,Z\n1,10,10,10\n2,40,30,10\n",
-            Path::new("r.csv"),
-        )
-        .unwrap();
+        let r =
+            parse_readings("patch,X,Y,Z\n1,10,10,10\n2,40,30,10\n", Path::new("r.csv")).unwrap();
         let t = parse_readings(
             "patch,X,Y,Z,out_of_gamut\n1,10,10,10,0\n2,30,30,20,1\n",
             Path::new("t.csv"),
