@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 use metamer::color::Xyz;
+use metamer::output::OutputPolicy;
 use metamer::validation::export::{comparisons, to_json};
 use metamer::validation::readings::Format;
 use metamer::validation::report::{InputFile, InstrumentUsed};
@@ -165,10 +166,17 @@ pub fn run(args: Args) -> CliResult {
             input.render_confidence = Some(render_confidence(set));
         }
     }
-    let files = write_report_files(&args.out, &input, args.force).map_err(|e| match e {
-        ValidationError::Exists { .. } => {
-            CliError::Usage(format!("{e}: pass --force or choose another -o directory"))
-        }
+    let mut policy = OutputPolicy::new(args.force);
+    policy.inputs(
+        [&args.reference, &args.test]
+            .into_iter()
+            .chain(&args.simulation)
+            .map(PathBuf::as_path),
+    );
+    let files = write_report_files(&args.out, &input, &policy).map_err(|e| match e {
+        ValidationError::Output(o) if o.needs_force() => CliError::Usage(format!(
+            "{o}: pass --force to replace the report, or choose another -o directory"
+        )),
         e => CliError::from(e),
     })?;
     if args.json {

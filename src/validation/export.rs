@@ -1,11 +1,11 @@
 //! The report's numbers as JSON and CSV, and writing the three report files into a
-//! directory, each atomically (a temporary file in the same directory, then a rename), so a
-//! crash never leaves half a report.
+//! directory under the output policy.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
+
+use crate::output::OutputPolicy;
 
 use super::assess::Assessment;
 use super::report::{render_html, ReportInput};
@@ -88,56 +88,29 @@ pub fn to_csv(input: &ReportInput) -> String {
 }
 
 /// Writes `validation.json`, `validation.csv` and `report.html` into `dir` (created if
-/// missing). Existing report files are replaced only with `overwrite`. Returns the paths.
+/// missing) under `policy`: each atomically, never onto an input, existing files only when
+/// forced. All three are checked before any is written, so a refusal leaves no mix of old
+/// and new files. Returns the paths.
 pub fn write_report_files(
     dir: &Path,
     input: &ReportInput,
-    overwrite: bool,
+    policy: &OutputPolicy,
 ) -> Result<Vec<PathBuf>, ValidationError> {
-    std::fs::create_dir_all(dir).map_err(|source| ValidationError::Write {
-        file: dir.to_path_buf(),
-        source,
-    })?;
+    policy.dir(dir)?;
     let files = [
         (JSON_FILE, to_json(input)),
         (CSV_FILE, to_csv(input)),
         (HTML_FILE, render_html(input)),
     ];
-    if !overwrite {
-        if let Some(existing) = files
-            .iter()
-            .map(|(name, _)| dir.join(name))
-            .find(|p| p.exists())
-        {
-            return Err(ValidationError::Exists { file: existing });
-        }
+    for (name, _) in &files {
+        policy.check(&dir.join(name))?;
     }
     files
         .iter()
         .map(|(name, text)| {
             let path = dir.join(name);
-            write_atomic(&path, text.as_bytes())?;
+            policy.write(&path, text.as_bytes())?;
             Ok(path)
         })
         .collect()
-}
-
-/// Writes through a temporary file in the same directory and renames it into place.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ValidationError> {
-    let err = |source| ValidationError::Write {
-        file: path.to_path_buf(),
-        source,
-    };
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        std::fs::remove_file(&tmp).ok();
-    }
-    result.map_err(err)
 }

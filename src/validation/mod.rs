@@ -79,8 +79,8 @@ pub enum ValidationError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{} exists; the report is not overwritten unless asked to", file.display())]
-    Exists { file: std::path::PathBuf },
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
     #[error("cannot draw the chart {file}: {message}")]
     Chart {
         file: std::path::PathBuf,
