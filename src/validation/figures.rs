@@ -259,7 +259,7 @@ pub fn lab_planes(a: &Assessment, id: &str, title: &str) -> String {
         w / 2.0,
         t = esc(title)
     );
-    let pts = |f: fn([f64; 3]) -> (f64, f64)| -> Vec<((f64, f64), (f64, f64))> {
+    let pts = |f: fn([f64; 3]) -> (f64, f64)| -> Vec<Arrow> {
         a.patches
             .iter()
             .map(|p| (f(p.reference.lab), f(p.test.lab)))
@@ -291,6 +291,9 @@ pub fn lab_planes(a: &Assessment, id: &str, title: &str) -> String {
     s
 }
 
+/// From a reference point to a test point in one plane.
+type Arrow = ((f64, f64), (f64, f64));
+
 /// One plane of [`lab_planes`] in the box `(x, y, w, h)`; `y_range` fixes the vertical axis
 /// (L* is 0–100), otherwise both axes share one symmetric range so hues keep their angles.
 #[allow(clippy::too_many_arguments)]
@@ -298,7 +301,7 @@ fn plane(
     s: &mut String,
     a: &Assessment,
     id: &str,
-    pts: &[((f64, f64), (f64, f64))],
+    pts: &[Arrow],
     (bx, by, bw, bh): (f64, f64, f64, f64),
     xlabel: &str,
     ylabel: &str,

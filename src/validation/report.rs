@@ -98,22 +98,22 @@ pub fn render_html(input: &ReportInput) -> String {
     } else {
         &input.title
     };
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>\n<h1>{}</h1>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>\n<h1>{}</h1>",
         esc(title),
         esc(title)
     );
     if let Some(a) = &input.box_vs_display {
-        let _ = write!(
+        let _ = writeln!(
             h,
-            "<p class=\"verdict\" id=\"verdict\">{}</p>\n",
+            "<p class=\"verdict\" id=\"verdict\">{}</p>",
             verdict(a, &input.out_of_gamut)
         );
     }
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<p>CIELAB relative to the white X, Y, Z = {}; {}. ΔE*ab is CIE 1976, ΔE00 CIEDE2000; the JND is ΔE*ab {JND_DE76}. Intervals are 95 %: {}. A patch is <span class=\"below\">below</span> the JND only where its interval's upper end is below {JND_DE76}, <span class=\"above\">above</span> only where the lower end is above; otherwise <span class=\"undecided\">undecided</span>.</p>\n",
+        "<p>CIELAB relative to the white X, Y, Z = {}; {}. ΔE*ab is CIE 1976, ΔE00 CIEDE2000; the JND is ΔE*ab {JND_DE76}. Intervals are 95 %: {}. A patch is <span class=\"below\">below</span> the JND only where its interval's upper end is below {JND_DE76}, <span class=\"above\">above</span> only where the lower end is above; otherwise <span class=\"undecided\">undecided</span>.</p>",
         input
             .box_vs_display
             .as_ref()
@@ -223,9 +223,9 @@ pub fn render_html(input: &ReportInput) -> String {
 }
 
 fn figure(h: &mut String, svg: &str, caption: &str) {
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<figure>{svg}<figcaption>{}</figcaption></figure>\n",
+        "<figure>{svg}<figcaption>{}</figcaption></figure>",
         esc(caption)
     );
 }
@@ -323,9 +323,9 @@ pub fn verdict(a: &Assessment, out_of_gamut: &[usize]) -> String {
 }
 
 fn table(h: &mut String, a: &Assessment) {
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<h2>{} vs {}: per patch</h2>\n<table class=\"patches\"><tr><th>#</th><th>patch</th><th>{}</th><th>{}</th><th>L*</th><th>a*</th><th>b*</th><th>L*</th><th>a*</th><th>b*</th><th>ΔE*ab</th><th>95 %</th><th>ΔE00</th><th>95 %</th><th>JND</th><th>uncertainty from</th></tr>\n",
+        "<h2>{} vs {}: per patch</h2>\n<table class=\"patches\"><tr><th>#</th><th>patch</th><th>{}</th><th>{}</th><th>L*</th><th>a*</th><th>b*</th><th>L*</th><th>a*</th><th>b*</th><th>ΔE*ab</th><th>95 %</th><th>ΔE00</th><th>95 %</th><th>JND</th><th>uncertainty from</th></tr>",
         esc(&a.test),
         esc(&a.reference),
         esc(&a.reference),
@@ -346,9 +346,9 @@ fn table(h: &mut String, a: &Assessment) {
                 .map(|v| format!("<td>{v:.2}</td>"))
                 .collect::<String>()
         };
-        let _ = write!(
+        let _ = writeln!(
             h,
-            "<tr><td>{}</td><td class=\"l\">{}{}</td><td>{}</td><td>{}</td>{}{}<td>{:.2}</td><td>[{:.2}, {:.2}]</td><td>{:.2}</td><td>[{:.2}, {:.2}]</td><td class=\"{}\">{}</td><td class=\"l\">{} / {}</td></tr>\n",
+            "<tr><td>{}</td><td class=\"l\">{}{}</td><td>{}</td><td>{}</td>{}{}<td>{:.2}</td><td>[{:.2}, {:.2}]</td><td>{:.2}</td><td>[{:.2}, {:.2}]</td><td class=\"{}\">{}</td><td class=\"l\">{} / {}</td></tr>",
             p.patch,
             esc(&p.name),
             if p.out_of_gamut { " (out of gamut)" } else { "" },
@@ -394,16 +394,16 @@ fn rows(h: &mut String, rows: &[(String, String)]) {
 }
 
 fn display_section(h: &mut String, d: &DisplayModelSection) {
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<h2 id=\"display-model\">Display model: {}</h2>\n<p>{}</p>\n",
+        "<h2 id=\"display-model\">Display model: {}</h2>\n<p>{}</p>",
         esc(&d.model),
         esc(&d.verdict)
     );
     if let Some([mean, p95, max]) = d.verification_de00 {
-        let _ = write!(
+        let _ = writeln!(
             h,
-            "<p>Verification on {} held-out patches: ΔE00 mean {mean:.2}, p95 {p95:.2}, max {max:.2}.</p>\n",
+            "<p>Verification on {} held-out patches: ΔE00 mean {mean:.2}, p95 {p95:.2}, max {max:.2}.</p>",
             d.verification_patches
         );
     }
@@ -414,7 +414,7 @@ fn light_section(h: &mut String, l: &LightFitSection) {
     h.push_str("<h2 id=\"light-fit\">Light distribution fit</h2>\n");
     rows(h, &l.summary);
     if let Some(svg) = &l.chart_svg {
-        let _ = write!(h, "<figure>{}</figure>\n", inline_svg(svg));
+        let _ = writeln!(h, "<figure>{}</figure>", inline_svg(svg));
     }
 }
 
@@ -436,9 +436,9 @@ fn has_handler(lower: &str) -> bool {
 }
 
 fn render_section(h: &mut String, r: &RenderConfidenceSection) {
-    let _ = write!(
+    let _ = writeln!(
         h,
-        "<h2 id=\"render-confidence\">Render confidence</h2>\n<p>{}{}</p>\n",
+        "<h2 id=\"render-confidence\">Render confidence</h2>\n<p>{}{}</p>",
         esc(&r.method),
         r.target_de
             .map(|t| format!("; target 95 % ΔE*ab half-width {t}"))
