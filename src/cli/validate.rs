@@ -223,10 +223,13 @@ fn render_confidence(set: &ReadingSet) -> metamer::validation::report::RenderCon
 
 fn print_table(a: &Assessment) {
     println!();
-    println!("{} vs {}", a.test, a.reference);
     println!(
-        "{:>3} {:<14} {:>7} {:>7} {:>7}  {:>7} {:>7} {:>7}  {:>7} {:>15}  {:>7} {:>15}  {}",
-        "#", "patch", "L*", "a*", "b*", "L*", "a*", "b*", "ΔE*ab", "95 %", "ΔE00", "95 %", "JND"
+        "{} vs {} (CIELAB of {} first, then of {})",
+        a.test, a.reference, a.reference, a.test
+    );
+    println!(
+        "{:>3} {:<14} {:>7} {:>7} {:>7}  {:>7} {:>7} {:>7}  {:>7} {:>15}  {:>7} {:>15}  JND",
+        "#", "patch", "L*", "a*", "b*", "L*", "a*", "b*", "ΔE*ab", "95 %", "ΔE00", "95 %"
     );
     for p in &a.patches {
         let [rl, ra, rb] = p.reference.lab;
