@@ -17,6 +17,7 @@ mod render;
 mod reproduce;
 mod simulate;
 mod spot;
+mod validate;
 mod verify;
 
 /// metamer: prove a rendering is colour-true.
@@ -54,6 +55,8 @@ enum Command {
     Lab(lab::Args),
     /// The light source's distribution: fit it to fall-off readings, export and read IES/LDT.
     Light(light::Args),
+    /// Box vs display (vs simulation) readings in CIELAB with uncertainty: table and report.
+    Validate(validate::Args),
     /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
     Simulate(simulate::Args),
 }
@@ -88,6 +91,7 @@ pub fn main() -> ExitCode {
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Light(args) => light::run(args),
+        Command::Validate(args) => validate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
