@@ -13,9 +13,12 @@
 //!   510 nm, weight fitted).
 //! - `ips-lcd`: a white-LED backlight — an InGaN blue die at 450 nm (20 nm FWHM) and the
 //!   YAG:Ce phosphor's broad band at 555 nm (120 nm FWHM, peak 0.35 of the blue) — through
-//!   colour filters: red a long-pass edge (edge and leakage fitted), green a band-pass
-//!   (centre and width fitted, 2 % leakage), blue a short-pass edge (edge and leakage
-//!   fitted).
+//!   colour filters: red a long-pass edge (edge and leakage fitted), green a 62 nm
+//!   band-pass (centre and leakage fitted), blue a short-pass edge (edge and leakage
+//!   fitted). The green filter's width is the one that leaves the ColorChecker's cyan and
+//!   yellow inside the panel's gamut under its own white (wider, cyan falls out; narrower,
+//!   with more leakage to keep the chromaticity, yellow does): with sRGB primaries both
+//!   sit at the gamut's edge.
 //! - `wide-gamut-ccfl`: a wide-gamut cold-cathode lamp — mercury lines at 405 and 436 nm,
 //!   BaMgAl₁₀O₁₇:Eu blue (450 nm band, 50 nm), BaMgAl₁₀O₁₇:Eu,Mn green (515 nm band,
 //!   30 nm) with some LaPO₄:Ce,Tb (543 nm line), Y₂O₃:Eu red (611 nm line with 587, 593
@@ -146,9 +149,9 @@ fn white_led_lcd() -> PanelSpectra {
                 floor: 0.00258,
             }),
             through(Filter::BandPass {
-                centre_nm: 539.50,
-                fwhm_nm: 73.07,
-                floor: 0.02,
+                centre_nm: 542.12,
+                fwhm_nm: 62.0,
+                floor: 0.04069,
             }),
             through(Filter::ShortPass {
                 edge_nm: 500.47,

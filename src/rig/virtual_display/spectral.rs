@@ -134,6 +134,20 @@ pub fn radiance(values: Vec<f64>) -> Spectrum {
         .with_quantity(Quantity::Radiance)
 }
 
+/// A spectrum as the project's spectral CSV: `#` lines of `comment`, the header
+/// `nm,<column>` and one row per sample, values with 7 significant digits.
+pub fn to_csv(spectrum: &Spectrum, comment: &str, column: &str) -> String {
+    let mut out = String::new();
+    for line in comment.lines() {
+        out.push_str(&format!("# {line}\n"));
+    }
+    out.push_str(&format!("nm,{column}\n"));
+    for (nm, v) in spectrum.wavelengths_nm().iter().zip(spectrum.values()) {
+        out.push_str(&format!("{nm},{v:.6e}\n"));
+    }
+    out
+}
+
 /// The emission shapes of a panel's three channels (R, G, B). Black and the chromaticity
 /// drift of dim channels are mixtures of these (see [`super::panel`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
