@@ -37,15 +37,10 @@ use std::time::Duration;
 
 use metamer_drivers::{Light, View, World};
 
-pub use panel::VirtualPanel;
+pub use panel::{quantize, VirtualPanel};
 pub use presets::{PanelParams, Preset, Trc};
 
 use super::screen::{Screen, ScreenError};
-
-/// The 8-bit code a display shows for drive `v` (0–1, clamped; halves round up).
-pub fn quantize(v: f64) -> u8 {
-    (v.clamp(0.0, 1.0) * 255.0).round() as u8
-}
 
 /// The panel plus what it shows now; this is what a simulated meter looks at.
 struct LitPanel {

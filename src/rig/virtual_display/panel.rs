@@ -35,6 +35,11 @@ pub struct VirtualPanel {
     channel_max_cd_m2: [f64; 3],
 }
 
+/// The 8-bit code a display shows for drive `v` (0–1, clamped; halves round up).
+pub fn quantize(v: f64) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
 /// XYZ of chromaticity (x, y) at luminance `lum`.
 fn xyy_to_xyz(x: f64, y: f64, lum: f64) -> Vector3<f64> {
     Vector3::from(
@@ -180,7 +185,7 @@ impl VirtualPanel {
 
     /// Emitted XYZ for drive values 0–1, quantised to 8 bits first as the display does.
     pub fn xyz_of_drive(&self, rgb: [f64; 3]) -> [f64; 3] {
-        self.xyz(rgb.map(super::quantize))
+        self.xyz(rgb.map(quantize))
     }
 
     /// Emitted spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹, 380–780 nm at 1 nm) for 8-bit drive
