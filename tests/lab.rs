@@ -124,6 +124,14 @@ fn bad_options_are_usage_errors() {
         (&["--model", "magic"][..], "magic"),
         (&["--gamut", "hue"][..], "unknown gamut mapping"),
         (&["--target-de", "0"][..], "--target-de"),
+        (
+            &["--scenario", "sodium"][..],
+            "unknown lab scenario 'sodium'",
+        ),
+        (
+            &["--scenario", "led-rgb1", "--scene", "x.json"][..],
+            "cannot be used with",
+        ),
     ] {
         let out = quick_lab("/nonexistent/never-written", args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");

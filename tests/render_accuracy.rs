@@ -27,10 +27,10 @@ fn build(v: &Value) -> Scene {
 #[test]
 fn source_scale_gives_100_cd_m2() {
     // 683·Σ s·S(λ)·ȳ(λ) over 380..=780 nm, summed here from the raw tables.
-    let scene = build(&box_json());
-    let led = SpectralTable::read(&data_dir().join("../illuminant_led_rgb1.csv"))
-        .unwrap()
-        .first();
+    let v = box_json();
+    let scene = build(&v);
+    let file = v["emitters"][0]["spectrum"]["file"].as_str().unwrap();
+    let led = SpectralTable::read(&data_dir().join(file)).unwrap().first();
     let o = observer(ObserverKind::Cie1931);
     let sum: f64 = (380..=780)
         .map(|nm| led.value_at(nm as f64) * o.at_nm(nm)[1])

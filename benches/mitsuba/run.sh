@@ -15,7 +15,7 @@ mkdir -p "$OUT"
 for r in $(seq 1 "$ROUNDS"); do
     echo "== round $r: metamer render spots"; uptime
     /usr/bin/time -f "metamer wall %e s, user %U s, sys %S s" \
-        nice -n 10 "$METAMER" render spots data/scenes/validation-box.json \
+        nice -n 10 "$METAMER" render spots data/scenes/validation-box-led-rgb1.json \
         --method path --target-de 0.1 --seed "$r" --json > "$OUT/metamer_$r.json"
     for wl in cmf light; do
         echo "== round $r: Mitsuba, wavelengths $wl"; uptime

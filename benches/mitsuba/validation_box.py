@@ -3,7 +3,7 @@
 
 A side benchmark, not part of the Rust build or CI (see README.md in this directory).
 
-The scene is read from metamer's own scene file (data/scenes/validation-box.json) and the CSV
+The scene is read from metamer's own scene file (data/scenes/validation-box-led-rgb1.json) and the CSV
 spectra it names, and rebuilt in Mitsuba:
 
 * every rectangle is a Mitsuba `rectangle` whose local frame maps onto corner/edge_u/edge_v,
@@ -440,7 +440,7 @@ def main():
     here = os.path.dirname(os.path.abspath(__file__))
     root = os.path.normpath(os.path.join(here, "..", ".."))
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--scene", default=os.path.join(root, "data/scenes/validation-box.json"))
+    p.add_argument("--scene", default=os.path.join(root, "data/scenes/validation-box-led-rgb1.json"))
     p.add_argument("--variant", default="scalar_spectral")
     p.add_argument("--target-de", type=float, default=0.1)
     p.add_argument("--seed", type=int, default=1)

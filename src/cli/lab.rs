@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
-use metamer::lab::{run_lab, LabError, LabOptions, LabProgress, LabResult, DISPLAY_DIR};
+use metamer::lab::{run_lab, LabError, LabOptions, LabProgress, LabResult, Scenario, DISPLAY_DIR};
 use metamer::rig::Preset;
 
 use super::{CliError, CliResult};
@@ -15,13 +15,15 @@ pub struct Args {
     /// characterization: log, profile, .ti3, report).
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: PathBuf,
-    /// The box scene.
-    #[arg(
-        long,
-        default_value = "data/scenes/validation-box.json",
-        value_name = "SCENE"
-    )]
-    scene: PathBuf,
+    /// The box: display-white (lit by the ips-lcd display's white, as the paper's box was
+    /// lit by an LCD; data/scenes/validation-box.json) or led-rgb1 (lit by CIE LED-RGB1, a
+    /// warm light whose saturated colours no virtual display can show;
+    /// data/scenes/validation-box-led-rgb1.json).
+    #[arg(long, default_value = "display-white", value_name = "NAME")]
+    scenario: String,
+    /// Another box scene file instead of a named scenario.
+    #[arg(long, value_name = "SCENE", conflicts_with = "scenario")]
+    scene: Option<PathBuf>,
     /// The simulated monitor: ideal-crt, ips-lcd or wide-gamut-ccfl.
     #[arg(long, default_value = "ips-lcd", value_name = "PRESET")]
     display: String,
@@ -50,6 +52,13 @@ pub struct Args {
 
 pub fn run(args: Args) -> CliResult {
     let display: Preset = args.display.parse().map_err(CliError::Usage)?;
+    let (scene, scenario) = match args.scene {
+        Some(scene) => (scene, None),
+        None => {
+            let scenario: Scenario = args.scenario.parse().map_err(CliError::Usage)?;
+            (PathBuf::from(scenario.scene()), Some(scenario))
+        }
+    };
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
     let gamut: GamutMapping = args.gamut.parse().map_err(CliError::Usage)?;
     if args.target_de.is_nan() || args.target_de <= 0.0 {
@@ -62,7 +71,8 @@ pub fn run(args: Args) -> CliResult {
         return Err(CliError::Usage("--time-scale must be 0 or more".into()));
     }
     let options = LabOptions {
-        scene: args.scene,
+        scene,
+        scenario,
         display,
         model,
         gamut,
@@ -129,6 +139,11 @@ fn print_summary(r: &LabResult) {
         "box: {} readings per patch; simulation: {:.1} s of rendering to ΔE*ab ±{} (95 %)",
         r.options.repeats, r.render_seconds, r.options.target_de
     );
+    let scene = r.options.scenario.map_or_else(
+        || r.options.scene.display().to_string(),
+        |s| format!("scenario {}", s.name()),
+    );
+    println!("box: {scene}");
     println!(
         "display: virtual:{} at {:.1} cd/m² white, model {} (held-out ΔE00 mean {:.2}, max {:.2}); {}",
         r.options.display.name(),

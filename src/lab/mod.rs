@@ -16,9 +16,11 @@ mod box_side;
 mod display_side;
 mod error;
 mod meter;
+mod scenario;
 
 pub use box_side::{read_box_and_simulate, SceneReadings};
 pub use error::LabError;
+pub use scenario::Scenario;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -42,6 +44,8 @@ use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
 #[derive(Clone, Debug, Serialize)]
 pub struct LabOptions {
     pub scene: PathBuf,
+    /// The named box `scene` is, if it is one.
+    pub scenario: Option<Scenario>,
     /// The simulated monitor.
     #[serde(serialize_with = "preset_name")]
     pub display: Preset,
