@@ -11,6 +11,7 @@ mod color;
 mod devices;
 mod fit;
 mod lab;
+mod measure_box;
 mod render;
 mod reproduce;
 mod simulate;
@@ -43,6 +44,8 @@ enum Command {
     Reproduce(reproduce::Args),
     /// Show and measure patches on a display, fit and verify a profile.
     Characterize(characterize::Args),
+    /// Measure the validation box: tiles, fall-off, materials and spots, into a scene.
+    MeasureBox(measure_box::Args),
     /// Display models' reproduction error against the number of measured patches.
     Budget(budget::Args),
     /// The whole validation chain on the built-in simulated lab: box, simulation, display.
@@ -77,6 +80,7 @@ pub fn main() -> ExitCode {
         Command::Reproduce(args) => reproduce::run(args),
         Command::Characterize(args) => characterize::run(args),
         Command::Lab(args) => lab::run(args),
+        Command::MeasureBox(args) => measure_box::run(args),
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),
     };
