@@ -10,9 +10,12 @@
 //!
 //! An outlier is a reading whose Y lies more than [`OUTLIER_SIGMAS`] noise σ from the median
 //! of its group (the median, not the mean, so the outlier does not hide itself); outliers
-//! are left out of the mean and reported, never dropped silently. A group whose standard
-//! deviation (outliers left out) exceeds [`SPREAD_LIMIT`] times the noise σ is flagged as
-//! spreading more than the instrument: the target moved, drifted or was not held still.
+//! are left out of the mean and reported, never dropped silently. A group whose spread
+//! (outliers left out) is beyond what the noise gives once in a thousand groups is flagged
+//! as spreading more than the instrument: the target moved, drifted or was not held still.
+//! The test is χ²: (n − 1)·s²/σ² against its 0.999 quantile with n − 1 degrees of freedom
+//! (Wilson–Hilferty: k·(1 − 2/(9k) + z·√(2/(9k)))³ with z = 3.090, within 3 % of the
+//! tabulated quantile for k = 1 and closer beyond).
 
 use metamer_drivers::{MeasureMode, Reading};
 use serde::{Deserialize, Serialize};
@@ -22,10 +25,15 @@ use crate::color::Spectrum;
 /// Distance from the median, in noise σ, beyond which a reading is an outlier. At 5σ a
 /// normal reading is flagged about once in 1.7 million.
 pub const OUTLIER_SIGMAS: f64 = 5.0;
-/// Ratio of a group's standard deviation to the noise σ above which it is flagged. For five
-/// readings the sample standard deviation exceeds 2σ with probability ≈ 0.9 % (χ² with 4
-/// degrees of freedom beyond 16).
-pub const SPREAD_LIMIT: f64 = 2.0;
+/// The standard normal quantile of 0.999.
+const Z_999: f64 = 3.090_232;
+
+/// The 0.999 quantile of χ² with `k` degrees of freedom (Wilson–Hilferty).
+pub fn chi2_999(k: usize) -> f64 {
+    let k = k as f64;
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + Z_999 * a.sqrt()).powi(3)
+}
 
 /// One reading's noise, 1σ of Y: relative (emissive) or absolute (reflective, Y of white
 /// = 100).
@@ -141,7 +149,8 @@ pub fn group(readings: &[&Reading], noise: Noise) -> Result<GroupStats, StatsErr
         xyz,
         sd_y,
         noise_y,
-        spread_exceeds_noise: sd_y > SPREAD_LIMIT * noise_y,
+        spread_exceeds_noise: kept.len() > 1
+            && (k - 1.0) * sd_y * sd_y > chi2_999(kept.len() - 1) * noise_y * noise_y,
         outliers: out,
     })
 }
@@ -205,20 +214,34 @@ mod tests {
         let g = group(&refs, noise).unwrap();
         assert_eq!(g.outliers, vec![4]);
         assert!((g.xyz[1] - 100.075).abs() < 1e-9, "{g:?}");
-        // sd of 100, 100.1, 99.9, 100.3 = 0.1708 < 2 × 0.1.
+        // sd of 100, 100.1, 99.9, 100.3 = 0.1708: 3·0.1708²/0.1² = 8.75 < χ²(3) 16.27.
         assert!((g.sd_y - 0.170_782_512_765_993_3).abs() < 1e-9, "{g:?}");
         assert!(!g.spread_exceeds_noise);
     }
 
     #[test]
-    fn a_spread_beyond_twice_the_noise_is_flagged_and_two_readings_have_no_outlier() {
+    fn a_spread_beyond_the_noise_is_flagged_and_two_readings_have_no_outlier() {
         let noise = Noise::Absolute { sigma: 0.2 };
         let rs: Vec<Reading> = [20.0, 21.0].iter().map(|&y| reading(y)).collect();
         let refs: Vec<&Reading> = rs.iter().collect();
         let g = group(&refs, noise).unwrap();
         assert!(g.outliers.is_empty());
-        // sd = 0.7071 > 2 × 0.2.
+        // sd = 0.7071: 1·0.5/0.04 = 12.5 > χ²(1) ≈ 11.
+
         assert!(g.spread_exceeds_noise, "{g:?}");
+        let rs: Vec<Reading> = [20.0, 20.6].iter().map(|&y| reading(y)).collect();
+        let refs: Vec<&Reading> = rs.iter().collect();
+        // sd = 0.4243: 0.18/0.04 = 4.5, within the noise.
+        assert!(!group(&refs, noise).unwrap().spread_exceeds_noise);
         assert_eq!(group(&[], noise).unwrap_err(), StatsError::Empty);
+    }
+
+    #[test]
+    fn the_chi2_quantile_is_near_the_table() {
+        // 0.999 quantiles of χ² (NIST/SEMATECH e-Handbook, table 1.3.6.7.4).
+        for (k, want) in [(1, 10.828), (4, 18.467), (10, 29.588), (30, 59.703)] {
+            let got = chi2_999(k);
+            assert!((got / want - 1.0).abs() < 0.035, "{k}: {got} vs {want}");
+        }
     }
 }

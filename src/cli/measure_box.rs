@@ -107,7 +107,7 @@ pub fn run(args: Args) -> CliResult {
             &seeded(&args.spot, args.seed.wrapping_add(1)),
             Some(world.clone()),
         )?;
-        let operator = BoxOperator::new(&truth, &plan, world)?;
+        let operator = BoxOperator::new(truth, world);
         (spectral, spot, Box::new(operator))
     } else {
         (

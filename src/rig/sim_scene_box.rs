@@ -24,7 +24,7 @@
 //! asymmetric table.
 
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 
@@ -64,8 +64,10 @@ pub struct TruthBox {
     pub wall: Spectrum,
     /// Patches 1–24.
     pub patches: Vec<Spectrum>,
-    /// The light at each patch seen from the viewpoint, cd/m², patches 1–24.
-    pub spots: Vec<[f64; 3]>,
+    /// The light at each patch seen from the viewpoint, cd/m², patches 1–24: rendered when
+    /// first needed ([`TruthBox::spots`]), since only the spots stage needs it.
+    spots: OnceLock<Vec<[f64; 3]>>,
+    plan: BoxPlan,
     /// The cosᵐ the truth box is rendered with.
     pub render_exponent: f64,
     falloff_tile: usize,
@@ -157,23 +159,31 @@ impl TruthBox {
         };
         let render_exponent =
             distribution(&plane(Plane::Horizontal), &plane(Plane::Vertical))?.cos_power;
-        let mut truth = TruthBox {
+        Ok(TruthBox {
             tiles,
             table,
             wall,
             patches,
-            spots: Vec::new(),
+            spots: OnceLock::new(),
             render_exponent,
             falloff_tile,
-        };
-        let scene = truth.scene_json(plan);
-        let (rendered, _, _) = render_scene(&scene)?;
-        truth.spots = rendered.iter().map(|r| r.1).collect();
-        Ok(truth)
+            plan: plan.clone(),
+        })
+    }
+
+    /// The light at each patch 1–24 seen from the viewpoint, cd/m² (rendered on the first
+    /// call).
+    pub fn spots(&self) -> Result<&[[f64; 3]], SimSceneBoxError> {
+        if let Some(s) = self.spots.get() {
+            return Ok(s);
+        }
+        let (rendered, _, _) = render_scene(&self.scene_json())?;
+        Ok(self.spots.get_or_init(|| rendered.iter().map(|r| r.1).collect()))
     }
 
     /// The truth as a scene file (with the rotationally symmetric stand-in distribution).
-    pub fn scene_json(&self, plan: &BoxPlan) -> serde_json::Value {
+    pub fn scene_json(&self) -> serde_json::Value {
+        let plan = &self.plan;
         scene_json(
             "simulated validation box (truth)",
             "The simulated box's truth: drifting tile spectra, perturbed materials.",
@@ -190,7 +200,8 @@ impl TruthBox {
     }
 
     /// What an instrument placed on or aimed at `target` sees.
-    pub fn view(&self, plan: &BoxPlan, target: &Target) -> Result<View, SimSceneBoxError> {
+    pub fn view(&self, target: &Target) -> Result<View, SimSceneBoxError> {
+        let plan = &self.plan;
         let drv = |e: metamer_drivers::DriverError| SimSceneBoxError::Spectrum(e.to_string());
         let cols = plan.geometry.cols;
         Ok(match target {
@@ -212,7 +223,11 @@ impl TruthBox {
                     })?,
             )
             .map_err(drv)?,
-            Target::Spot { patch } => View::xyz(self.spots[patch - 1]),
+            Target::Spot { patch } => View::xyz(
+                *self.spots()?.get(patch - 1).ok_or_else(|| {
+                    SimSceneBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
+                })?,
+            ),
         })
     }
 }
@@ -221,40 +236,45 @@ impl TruthBox {
 /// says (the world then shows that target), a calibration prompt puts it on its white tile
 /// or caps it. Every prompt is kept.
 pub struct BoxOperator {
+    truth: TruthBox,
     world: Arc<SharedWorld>,
-    views: HashMap<String, View>,
+    targets: HashMap<String, Target>,
     pub prompts: Vec<String>,
 }
 
 impl BoxOperator {
-    /// The operator of `plan` on the truth box, moving what `world` shows.
-    pub fn new(
-        truth: &TruthBox,
-        plan: &BoxPlan,
-        world: Arc<SharedWorld>,
-    ) -> Result<BoxOperator, SimSceneBoxError> {
-        let mut views = HashMap::new();
+    /// The operator of the truth box's plan, moving what `world` shows.
+    pub fn new(truth: TruthBox, world: Arc<SharedWorld>) -> BoxOperator {
+        let mut targets = HashMap::new();
         for stage in Stage::ALL {
-            for step in plan.steps(stage) {
-                let prompt = plan.prompt(&step.data.target);
-                if !views.contains_key(&prompt) {
-                    views.insert(prompt, truth.view(plan, &step.data.target)?);
-                }
+            for step in truth.plan.steps(stage) {
+                targets
+                    .entry(truth.plan.prompt(&step.data.target))
+                    .or_insert(step.data.target);
             }
         }
-        Ok(BoxOperator {
+        BoxOperator {
+            truth,
             world,
-            views,
+            targets,
             prompts: Vec::new(),
-        })
+        }
+    }
+
+    pub fn truth(&self) -> &TruthBox {
+        &self.truth
     }
 }
 
 impl Operator for BoxOperator {
     fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
         self.prompts.push(prompt.to_string());
-        if let Some(view) = self.views.get(prompt) {
-            self.world.set(view.clone());
+        if let Some(target) = self.targets.get(prompt) {
+            let view = self
+                .truth
+                .view(target)
+                .map_err(|e| OperatorError(std::io::Error::other(e.to_string())))?;
+            self.world.set(view);
         } else if prompt.ends_with(&CalibrationCondition::OnWhiteTile.prompt()) {
             self.world.set(View::WhiteTile);
         } else if prompt.ends_with(&CalibrationCondition::SensorCapped.prompt()) {
