@@ -18,6 +18,7 @@ use super::plan::{BoxPlan, BoxStep, Plane, Stage, Target};
 use super::run::BoxDetails;
 use super::scene::{scene_json, BoxContents, DistributionJson};
 use super::stats::{group, mean_spectrum, GroupStats, Noise, StatsError};
+use crate::output::{OutputError, OutputPolicy};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
 use crate::session::{Entry, InstrumentRecord};
 
@@ -127,6 +128,8 @@ pub enum AssembleError {
     },
     #[error(transparent)]
     Compare(#[from] CompareError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> AssembleError + '_ {
@@ -258,18 +261,21 @@ pub fn iso_date(unix_s: f64) -> String {
     )
 }
 
-fn write_json(path: &Path, value: &impl Serialize) -> Result<(), AssembleError> {
+fn write_json(
+    policy: &OutputPolicy,
+    path: &Path,
+    value: &impl Serialize,
+) -> Result<(), AssembleError> {
     let text = serde_json::to_string_pretty(value)
         .map_err(|e| io(path)(std::io::Error::other(e)))?;
-    // A temporary file renamed over the target, so a reader never sees half a file.
-    let tmp = path.with_extension("json.tmp");
-    std::fs::write(&tmp, text + "\n").map_err(io(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(io(path))
+    Ok(policy.write(path, (text + "\n").as_bytes())?)
 }
 
-/// Reduces the readings, writes `scene.json`, `light.json` and `summary.json` into `dir`,
-/// renders the scene and compares it with the spot readings.
+/// Reduces the readings, writes `scene.json`, `light.json` and `summary.json` into `dir`
+/// under `policy` (the journals are its inputs), renders the scene and compares it with the
+/// spot readings.
 pub fn assemble(
+    policy: &OutputPolicy,
     dir: &Path,
     plan: &BoxPlan,
     entries: &StageEntries,
@@ -350,14 +356,16 @@ pub fn assemble(
         g,
         &contents,
     );
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let mut policy = policy.clone();
+    policy.inputs(entries.stages.values().map(|(p, _)| p.as_path()));
+    policy.dir(dir)?;
     let files = Files {
         scene: dir.join("scene.json"),
         light: dir.join("light.json"),
         summary: dir.join("summary.json"),
     };
-    write_json(&files.scene, &scene)?;
-    write_json(&files.light, &light)?;
+    write_json(&policy, &files.scene, &scene)?;
+    write_json(&policy, &files.light, &light)?;
 
     let spot_xyz: Vec<(usize, [f64; 3])> = spots
         .targets
@@ -404,7 +412,7 @@ pub fn assemble(
         provenance,
         files,
     };
-    write_json(&summary.files.summary, &summary)?;
+    write_json(&policy, &summary.files.summary, &summary)?;
     Ok(summary)
 }
 

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::assemble::{assemble, AssembleError, StageEntries, Summary};
 use super::plan::{BoxPlan, BoxStep, Stage, SPECTRAL, SPOT};
+use crate::output::OutputPolicy;
 use crate::session::{
     Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session,
     SessionError,
@@ -38,6 +39,10 @@ pub struct Options {
     pub rig_options: BTreeMap<String, String>,
     pub details: BoxDetails,
     pub run: RunOptions,
+    /// How the scene, light and summary files are written (the plan file among its
+    /// inputs). They are replaced only when forced: by the caller, or because the session
+    /// resumes or measures a stage again and so owns them.
+    pub output: OutputPolicy,
 }
 
 /// The rig's two instruments.
@@ -197,6 +202,8 @@ pub fn run(
         return Ok(Outcome::StagesMissing(missing));
     }
     let entries = StageEntries { stages: loaded };
-    let summary = assemble(&options.dir, &options.plan, &entries, &records, &options.details)?;
+    let owned = options.output.force() || options.resume || options.stage.is_some();
+    let policy = options.output.with_force(owned);
+    let summary = assemble(&policy, &options.dir, &options.plan, &entries, &records, &options.details)?;
     Ok(Outcome::Finished(Box::new(summary)))
 }

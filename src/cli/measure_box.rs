@@ -9,6 +9,7 @@ use metamer::boxmeasure::{
     self, BoxDetails, BoxPlan, Instruments, MeasureBoxError, Options, Outcome, PlanError, Stage,
     Summary,
 };
+use metamer::output::OutputPolicy;
 use metamer::rig::sim_scene_box::{BoxOperator, TruthBox};
 use metamer::session::{
     on_ctrl_c, BarProgress, JournalError, Operator, RunEnd, RunOptions, SessionError,
@@ -45,6 +46,9 @@ pub struct Args {
     /// Seed of the simulated box's truth and of its instruments' noise (sim: only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     seed: u64,
+    /// Replace an existing scene.json, light.json or summary.json in DIR.
+    #[arg(long)]
+    force: bool,
     /// Stop after N new readings, as if interrupted (tests; splitting a long session).
     #[arg(long, value_name = "N", hide = true)]
     stop_after: Option<usize>,
@@ -116,7 +120,12 @@ pub fn run(args: Args) -> CliResult {
             Box::new(TerminalOperator),
         )
     };
+    let mut output = OutputPolicy::new(args.force);
+    if let Some(p) = &args.plan {
+        output.input(p);
+    }
     let options = Options {
+        output,
         dir: args.out.clone(),
         plan,
         stage,
