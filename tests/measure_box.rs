@@ -34,7 +34,12 @@ fn command(dir: &Path, extra: &[&str]) -> Command {
     let out = dir.join("out");
     let mut c = Command::new(env!("CARGO_BIN_EXE_metamer"));
     c.arg("measure-box")
-        .args(["-o", out.to_str().unwrap(), "--plan", plan.to_str().unwrap()])
+        .args([
+            "-o",
+            out.to_str().unwrap(),
+            "--plan",
+            plan.to_str().unwrap(),
+        ])
         .args(extra)
         .env_remove("METAMER_SIM_TIME_SCALE")
         .stdin(Stdio::null());
@@ -81,8 +86,16 @@ fn band_limited(truth: &TruthBox, plan: &BoxPlan) -> Value {
         &plan.geometry,
         &BoxContents {
             wall: bands(&truth.wall, Outside::HoldEnds),
-            patches: truth.patches.iter().map(|p| bands(p, Outside::HoldEnds)).collect(),
-            tiles: truth.tiles.iter().map(|t| bands(t, Outside::Zero)).collect(),
+            patches: truth
+                .patches
+                .iter()
+                .map(|p| bands(p, Outside::HoldEnds))
+                .collect(),
+            tiles: truth
+                .tiles
+                .iter()
+                .map(|t| bands(t, Outside::Zero))
+                .collect(),
             distribution: DistributionJson::CosPower {
                 exponent: truth.render_exponent,
             },
@@ -93,7 +106,10 @@ fn band_limited(truth: &TruthBox, plan: &BoxPlan) -> Value {
 #[test]
 fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     let dir = temp_dir("e2e");
-    let o = run(&dir, &["--spectral", SPECTRAL, "--spot", SPOT, "--seed", "7"]);
+    let o = run(
+        &dir,
+        &["--spectral", SPECTRAL, "--spot", SPOT, "--seed", "7"],
+    );
     let stdout = String::from_utf8_lossy(&o.stdout);
     let out = dir.join("out");
     let summary = json(&out.join("summary.json"));
@@ -129,15 +145,27 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     assert!((wall.value_at(550.0) - truth.wall.value_at(550.0)).abs() < 0.008);
     // Fall-off: the scene's cosᵐ is the truth's (fitted to the same angles) within the
     // meter's noise: m moves by ~σ/ln(cos 80°) per point, far less than 0.02.
-    let m = scene["emitters"][0]["distribution"]["exponent"].as_f64().unwrap();
-    assert!((m - truth.render_exponent).abs() < 0.02, "{m} vs {}", truth.render_exponent);
+    let m = scene["emitters"][0]["distribution"]["exponent"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (m - truth.render_exponent).abs() < 0.02,
+        "{m} vs {}",
+        truth.render_exponent
+    );
     // The light's C-γ table keeps the asymmetry: towards the front (C = 180°, cos^0.6)
     // brighter than downwards (C = 90°, cos^1.4) at 60°.
     let light = json(&out.join("light.json"));
     let row = |c: usize| light["table"]["values"][c].as_array().unwrap().clone();
     let gammas = light["table"]["gamma_deg"].as_array().unwrap();
-    let at60 = gammas.iter().position(|g| g.as_f64() == Some(60.0)).unwrap();
-    let (down, front) = (row(1)[at60].as_f64().unwrap(), row(2)[at60].as_f64().unwrap());
+    let at60 = gammas
+        .iter()
+        .position(|g| g.as_f64() == Some(60.0))
+        .unwrap();
+    let (down, front) = (
+        row(1)[at60].as_f64().unwrap(),
+        row(2)[at60].as_f64().unwrap(),
+    );
     assert!((front - 0.5f64.powf(0.6)).abs() < 0.01, "{front}");
     assert!((down - 0.5f64.powf(1.4)).abs() < 0.01, "{down}");
 
@@ -157,7 +185,10 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
         .iter()
         .map(|p| {
             let xyz = &p[1];
-            (p[0].as_u64().unwrap() as usize, [0, 1, 2].map(|i| xyz[i].as_f64().unwrap()))
+            (
+                p[0].as_u64().unwrap() as usize,
+                [0, 1, 2].map(|i| xyz[i].as_f64().unwrap()),
+            )
         })
         .collect();
     let truth_spots: Vec<(usize, [f64; 3], f64)> = truth
@@ -185,15 +216,27 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
         "measured scene vs box: ΔE*ab mean {:.3} max {:.3}; band-limited truth vs truth: mean {:.3} max {:.3}",
         c["mean_de76"], c["max_de76"], sys.mean_de76, sys.max_de76
     );
-    assert!(stdout.contains("measured scene rendered vs box spots"), "{stdout}");
+    assert!(
+        stdout.contains("measured scene rendered vs box spots"),
+        "{stdout}"
+    );
 
     // The nominal scene (data/ spectra and gains, cos^m guessed from the nominal fall-off).
     let nominal = Command::new(env!("CARGO_BIN_EXE_metamer"))
-        .args(["render", "spots", "data/scenes/validation-box-ldc.json", "--json"])
+        .args([
+            "render",
+            "spots",
+            "data/scenes/validation-box-ldc.json",
+            "--json",
+        ])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();
-    assert!(nominal.status.success(), "{}", String::from_utf8_lossy(&nominal.stderr));
+    assert!(
+        nominal.status.success(),
+        "{}",
+        String::from_utf8_lossy(&nominal.stderr)
+    );
     let n: Value = serde_json::from_slice(&nominal.stdout).unwrap();
     let nominal_xyz: Vec<(usize, [f64; 3], f64)> = n["patches"]
         .as_array()
@@ -201,7 +244,11 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
         .iter()
         .map(|p| {
             let x = &p["XYZ"];
-            (p["patch"].as_u64().unwrap() as usize, [0, 1, 2].map(|i| x[i].as_f64().unwrap()), 0.0)
+            (
+                p["patch"].as_u64().unwrap() as usize,
+                [0, 1, 2].map(|i| x[i].as_f64().unwrap()),
+                0.0,
+            )
         })
         .collect();
     let (nom, _) = compare_readings(&box_xyz, &nominal_xyz, white, "nominal scene").unwrap();
@@ -232,13 +279,23 @@ fn entries(path: &Path) -> Vec<String> {
 
 #[test]
 fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
-    let quiet = ["--spectral", "sim:i1pro?time_scale=0&noise=off", "--spot", "sim:cs100a?time_scale=0&noise=off"];
+    let quiet = [
+        "--spectral",
+        "sim:i1pro?time_scale=0&noise=off",
+        "--spot",
+        "sim:cs100a?time_scale=0&noise=off",
+    ];
     let whole = temp_dir("whole");
     run(&whole, &quiet);
 
     // At a twentieth of the i1Pro's pace a tile reading takes tens of milliseconds.
     let dir = temp_dir("killed");
-    let slow = ["--spectral", "sim:i1pro?time_scale=0.05&noise=off", "--spot", "sim:cs100a?time_scale=0&noise=off"];
+    let slow = [
+        "--spectral",
+        "sim:i1pro?time_scale=0.05&noise=off",
+        "--spot",
+        "sim:cs100a?time_scale=0&noise=off",
+    ];
     let mut child = command(&dir, &slow)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -247,13 +304,20 @@ fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
     let tiles = dir.join("out/tiles.jsonl");
     let start = Instant::now();
     while entries(&tiles).len() < 4 {
-        assert!(start.elapsed() < Duration::from_secs(120), "no readings arrive");
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no readings arrive"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     child.kill().unwrap();
     child.wait().unwrap();
     let before = entries(&tiles);
-    assert!(before.len() < 18, "{} of 18 tile readings before the kill", before.len());
+    assert!(
+        before.len() < 18,
+        "{} of 18 tile readings before the kill",
+        before.len()
+    );
     assert!(!dir.join("out/scene.json").exists());
 
     // Without --resume the journal is refused, not overwritten.
@@ -265,7 +329,11 @@ fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
     run(&dir, &[&quiet[..], &["--resume"]].concat());
     let after = entries(&tiles);
     assert_eq!(after.len(), 18);
-    assert_eq!(&after[..before.len()], &before[..], "readings before the kill are kept");
+    assert_eq!(
+        &after[..before.len()],
+        &before[..],
+        "readings before the kill are kept"
+    );
     // Noise is off: the same readings, so the same scene.
     let a = std::fs::read_to_string(whole.join("out/scene.json")).unwrap();
     let b = std::fs::read_to_string(dir.join("out/scene.json")).unwrap();
@@ -277,13 +345,30 @@ fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
 #[test]
 fn bad_flags_and_plans_are_usage_errors() {
     let dir = temp_dir("usage");
-    let o = command(&dir, &["--spectral", SPECTRAL, "--spot", "cs100a:/dev/null"]).output().unwrap();
+    let o = command(
+        &dir,
+        &["--spectral", SPECTRAL, "--spot", "cs100a:/dev/null"],
+    )
+    .output()
+    .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("both be simulated"));
-    let o = command(&dir, &["--spectral", SPECTRAL, "--spot", SPOT, "--repeats", "0"]).output().unwrap();
+    let o = command(
+        &dir,
+        &["--spectral", SPECTRAL, "--spot", SPOT, "--repeats", "0"],
+    )
+    .output()
+    .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--repeats must be between 1 and 100, got 0"));
-    let o = command(&dir, &["--spectral", SPECTRAL, "--spot", SPOT, "--stage", "lamps"]).output().unwrap();
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--repeats must be between 1 and 100, got 0")
+    );
+    let o = command(
+        &dir,
+        &["--spectral", SPECTRAL, "--spot", SPOT, "--stage", "lamps"],
+    )
+    .output()
+    .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("unknown stage 'lamps'"));
     std::fs::remove_dir_all(&dir).unwrap();

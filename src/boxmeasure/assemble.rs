@@ -15,12 +15,19 @@ use sha2::{Digest, Sha256};
 use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{distribution, FalloffError, LightDistribution, PlaneReadings};
 use super::plan::{BoxPlan, BoxStep, Plane, Stage, Target};
-use super::run::BoxDetails;
 use super::scene::{scene_json, BoxContents, DistributionJson};
 use super::stats::{group, mean_spectrum, GroupStats, Noise, StatsError};
-use crate::output::{OutputError, OutputPolicy};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
+use crate::output::{OutputError, OutputPolicy};
 use crate::session::{Entry, InstrumentRecord};
+
+/// What each stage journal's header says besides its plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BoxDetails {
+    /// The instruments as named by the user (`i1pro`, `sim:cs100a?time_scale=0`).
+    pub spectral: String,
+    pub spot: String,
+}
 
 /// Every stage's journal path and entries, complete.
 pub struct StageEntries {
@@ -266,8 +273,8 @@ fn write_json(
     path: &Path,
     value: &impl Serialize,
 ) -> Result<(), AssembleError> {
-    let text = serde_json::to_string_pretty(value)
-        .map_err(|e| io(path)(std::io::Error::other(e)))?;
+    let text =
+        serde_json::to_string_pretty(value).map_err(|e| io(path)(std::io::Error::other(e)))?;
     Ok(policy.write(path, (text + "\n").as_bytes())?)
 }
 
@@ -314,8 +321,9 @@ pub fn assemble(
     let mut tile_spectra = vec![None; g.rows * g.cols];
     for (t, s) in tiles.targets.iter().zip(&tiles.spectra) {
         if let (Target::Tile { row, col }, Some(s)) = (t, s) {
-            tile_spectra[row * g.cols + col] =
-                Some(clamped(s, 0.0, f64::INFINITY, &mut clamped_values).with_outside(Outside::Zero));
+            tile_spectra[row * g.cols + col] = Some(
+                clamped(s, 0.0, f64::INFINITY, &mut clamped_values).with_outside(Outside::Zero),
+            );
         }
     }
     let tile_spectra: Vec<Spectrum> = tile_spectra
@@ -424,7 +432,10 @@ mod tests {
     fn dates_are_civil_utc() {
         assert_eq!(iso_date(0.0), "1970-01-01T00:00:00Z");
         // 2000-03-01 is day 11017 after the epoch (30 years incl. 7 leap days + Jan + Feb 29).
-        assert_eq!(iso_date(11_017.0 * 86_400.0 + 3661.0), "2000-03-01T01:01:01Z");
+        assert_eq!(
+            iso_date(11_017.0 * 86_400.0 + 3661.0),
+            "2000-03-01T01:01:01Z"
+        );
         assert_eq!(iso_date(1_700_000_000.0), "2023-11-14T22:13:20Z");
     }
 }

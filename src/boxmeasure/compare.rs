@@ -39,7 +39,9 @@ pub enum CompareError {
 }
 
 /// The 24 readings of a scene file by the radiosity solver: (patch, XYZ, bound), white.
-pub fn render_scene(scene: &Value) -> Result<(Vec<(usize, [f64; 3], f64)>, [f64; 3], f64), CompareError> {
+pub fn render_scene(
+    scene: &Value,
+) -> Result<(Vec<(usize, [f64; 3], f64)>, [f64; 3], f64), CompareError> {
     let scene = build(scene)?;
     let opts = RadiosityOptions {
         target_de: RENDER_TARGET_DE,
@@ -47,7 +49,10 @@ pub fn render_scene(scene: &Value) -> Result<(Vec<(usize, [f64; 3], f64)>, [f64;
     };
     let r = render_spots_radiosity(&scene, &opts, &|_| {})?;
     Ok((
-        r.patches.iter().map(|p| (p.patch, p.xyz, p.de_bound)).collect(),
+        r.patches
+            .iter()
+            .map(|p| (p.patch, p.xyz, p.de_bound))
+            .collect(),
         r.white,
         r.seconds,
     ))

@@ -52,7 +52,9 @@ pub struct LightDistribution {
 /// Readings that make no distribution.
 #[derive(Debug, thiserror::Error)]
 pub enum FalloffError {
-    #[error("the {0} plane has no reading at 0° (the normal, which the distribution is relative to)")]
+    #[error(
+        "the {0} plane has no reading at 0° (the normal, which the distribution is relative to)"
+    )]
     NoNormal(&'static str),
     #[error("the {plane} plane's reading at {angle_deg}° is {value} cd/m²: luminance must be finite and > 0 on the normal, ≥ 0 elsewhere")]
     Bad {
@@ -217,6 +219,9 @@ mod tests {
         let mut bad = v.clone();
         bad.luminance[4] = 0.0;
         let e = distribution(&h, &bad).unwrap_err().to_string();
-        assert!(e.contains("vertical plane's reading at 0° is 0 cd/m²"), "{e}");
+        assert!(
+            e.contains("vertical plane's reading at 0° is 0 cd/m²"),
+            "{e}"
+        );
     }
 }

@@ -16,6 +16,6 @@ pub mod run;
 pub mod scene;
 pub mod stats;
 
-pub use assemble::Summary;
-pub use plan::{BoxPlan, BoxStep, Geometry, Plane, PlanError, Stage, Target};
-pub use run::{run, BoxDetails, Instruments, MeasureBoxError, Options, Outcome};
+pub use assemble::{BoxDetails, Summary};
+pub use plan::{BoxPlan, BoxStep, Geometry, PlanError, Plane, Stage, Target};
+pub use run::{run, Instruments, MeasureBoxError, Options, Outcome};

@@ -282,7 +282,10 @@ impl BoxPlan {
         }
         for (i, &p) in self.patches.iter().enumerate() {
             if !(1..=24).contains(&p) {
-                return Err(invalid("patches", format!("{p} is not a patch number 1–24")));
+                return Err(invalid(
+                    "patches",
+                    format!("{p} is not a patch number 1–24"),
+                ));
             }
             if self.patches[..i].contains(&p) {
                 return Err(invalid("patches", format!("patch {p} is listed twice")));
@@ -301,7 +304,10 @@ impl BoxPlan {
             if r >= g.rows || c >= g.cols {
                 return Err(invalid(
                     "falloff_tile",
-                    format!("tile [{r}, {c}] is outside the {} × {} grid", g.rows, g.cols),
+                    format!(
+                        "tile [{r}, {c}] is outside the {} × {} grid",
+                        g.rows, g.cols
+                    ),
                 ));
             }
         }
@@ -532,14 +538,23 @@ mod tests {
             let e = BoxPlan::load(&path).unwrap_err().to_string();
             assert!(e.contains(want), "{json}: {e}");
         };
-        check(r#"{"repeats":0}"#, "plan: repeats: must be between 1 and 100, got 0");
+        check(
+            r#"{"repeats":0}"#,
+            "plan: repeats: must be between 1 and 100, got 0",
+        );
         check(r#"{"falloff_angles_deg":[-20,20]}"#, "must contain 0");
         check(r#"{"falloff_angles_deg":[0,95]}"#, "95 is not an angle");
         check(r#"{"falloff_angles_deg":[0,20,10]}"#, "10 follows 20");
         check(r#"{"patches":[1,25]}"#, "25 is not a patch number");
         check(r#"{"patches":[3,3]}"#, "patch 3 is listed twice");
-        check(r#"{"geometry":{"rows":0}}"#, "geometry.rows: must be between 1 and 64");
-        check(r#"{"geometry":{"light_m":[0.4,0.1,0.1,0.4]}}"#, "geometry.light_m");
+        check(
+            r#"{"geometry":{"rows":0}}"#,
+            "geometry.rows: must be between 1 and 64",
+        );
+        check(
+            r#"{"geometry":{"light_m":[0.4,0.1,0.1,0.4]}}"#,
+            "geometry.light_m",
+        );
         check(r#"{"geometry":{"viewpoint_m":[0,0,1]}}"#, "z < 0");
         check(r#"{"falloff_tile":[5,0]}"#, "outside the 5 × 5 grid");
         check(r#"{"repeat":3}"#, "unknown field `repeat`");

@@ -7,23 +7,13 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use metamer_drivers::Instrument;
-use serde::{Deserialize, Serialize};
 
-use super::assemble::{assemble, AssembleError, StageEntries, Summary};
+use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary};
 use super::plan::{BoxPlan, BoxStep, Stage, SPECTRAL, SPOT};
 use crate::output::OutputPolicy;
 use crate::session::{
-    Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session,
-    SessionError,
+    Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session, SessionError,
 };
-
-/// What each stage journal's header says besides its plan.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BoxDetails {
-    /// The instruments as named by the user (`i1pro`, `sim:cs100a?time_scale=0`).
-    pub spectral: String,
-    pub spot: String,
-}
 
 /// What to measure and how.
 #[derive(Clone, Debug)]
@@ -133,7 +123,10 @@ pub fn run(
     progress: &mut dyn ProgressSink,
 ) -> Result<Outcome, MeasureBoxError> {
     let records: BTreeMap<String, InstrumentRecord> = [
-        (SPECTRAL.to_string(), InstrumentRecord::of(&*instruments.spectral)),
+        (
+            SPECTRAL.to_string(),
+            InstrumentRecord::of(&*instruments.spectral),
+        ),
         (SPOT.to_string(), InstrumentRecord::of(&*instruments.spot)),
     ]
     .into();
@@ -204,6 +197,13 @@ pub fn run(
     let entries = StageEntries { stages: loaded };
     let owned = options.output.force() || options.resume || options.stage.is_some();
     let policy = options.output.with_force(owned);
-    let summary = assemble(&policy, &options.dir, &options.plan, &entries, &records, &options.details)?;
+    let summary = assemble(
+        &policy,
+        &options.dir,
+        &options.plan,
+        &entries,
+        &records,
+        &options.details,
+    )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }

@@ -68,17 +68,61 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
     let [y0, y1, z0, z1] = g.light_m;
     let wall = inline(&c.wall);
     let mut surfaces = vec![
-        surface("floor", [0.0, 0.0, 0.0], [0.0, 0.0, s], [s, 0.0, 0.0], wall.clone()),
-        surface("ceiling", [0.0, s, 0.0], [s, 0.0, 0.0], [0.0, 0.0, s], wall.clone()),
-        surface("back wall", [0.0, 0.0, s], [0.0, s, 0.0], [s, 0.0, 0.0], wall.clone()),
-        surface("right wall", [s, 0.0, 0.0], [0.0, 0.0, s], [0.0, s, 0.0], wall.clone()),
+        surface(
+            "floor",
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, s],
+            [s, 0.0, 0.0],
+            wall.clone(),
+        ),
+        surface(
+            "ceiling",
+            [0.0, s, 0.0],
+            [s, 0.0, 0.0],
+            [0.0, 0.0, s],
+            wall.clone(),
+        ),
+        surface(
+            "back wall",
+            [0.0, 0.0, s],
+            [0.0, s, 0.0],
+            [s, 0.0, 0.0],
+            wall.clone(),
+        ),
+        surface(
+            "right wall",
+            [s, 0.0, 0.0],
+            [0.0, 0.0, s],
+            [0.0, s, 0.0],
+            wall.clone(),
+        ),
     ];
     // The left wall around the light opening, in up to four pieces.
     let left = [
-        ("left wall below the light", [0.0, 0.0, 0.0], [0.0, y0, 0.0], [0.0, 0.0, s]),
-        ("left wall above the light", [0.0, y1, 0.0], [0.0, s - y1, 0.0], [0.0, 0.0, s]),
-        ("left wall in front of the light", [0.0, y0, 0.0], [0.0, y1 - y0, 0.0], [0.0, 0.0, z0]),
-        ("left wall behind the light", [0.0, y0, z1], [0.0, y1 - y0, 0.0], [0.0, 0.0, s - z1]),
+        (
+            "left wall below the light",
+            [0.0, 0.0, 0.0],
+            [0.0, y0, 0.0],
+            [0.0, 0.0, s],
+        ),
+        (
+            "left wall above the light",
+            [0.0, y1, 0.0],
+            [0.0, s - y1, 0.0],
+            [0.0, 0.0, s],
+        ),
+        (
+            "left wall in front of the light",
+            [0.0, y0, 0.0],
+            [0.0, y1 - y0, 0.0],
+            [0.0, 0.0, z0],
+        ),
+        (
+            "left wall behind the light",
+            [0.0, y0, z1],
+            [0.0, y1 - y0, 0.0],
+            [0.0, 0.0, s - z1],
+        ),
     ];
     for (n, corner, u, v) in left {
         let area = (u[1] * v[2]).abs();
@@ -89,7 +133,11 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
     let centre = chart_centre(g);
     surfaces.push(surface(
         "chart frame",
-        [centre[0], centre[1] - FRAME_H_M / 2.0, centre[2] - FRAME_W_M / 2.0],
+        [
+            centre[0],
+            centre[1] - FRAME_H_M / 2.0,
+            centre[2] - FRAME_W_M / 2.0,
+        ],
         [0.0, 0.0, FRAME_W_M],
         [0.0, FRAME_H_M, 0.0],
         json!(FRAME_REFLECTANCE),

@@ -139,7 +139,12 @@ pub fn group(readings: &[&Reading], noise: Noise) -> Result<GroupStats, StatsErr
         }
     }
     let sd_y = if kept.len() > 1 {
-        (kept.iter().map(|r| (r.xyz[1] - xyz[1]).powi(2)).sum::<f64>() / (k - 1.0)).sqrt()
+        (kept
+            .iter()
+            .map(|r| (r.xyz[1] - xyz[1]).powi(2))
+            .sum::<f64>()
+            / (k - 1.0))
+            .sqrt()
     } else {
         0.0
     };

@@ -93,7 +93,12 @@ pub fn run(args: Args) -> CliResult {
         }
         e => usage(e),
     })?;
-    let stage: Option<Stage> = args.stage.as_deref().map(str::parse).transpose().map_err(usage)?;
+    let stage: Option<Stage> = args
+        .stage
+        .as_deref()
+        .map(str::parse)
+        .transpose()
+        .map_err(usage)?;
     let simulated = [&args.spectral, &args.spot].map(|s| s.starts_with("sim:"));
     if simulated[0] != simulated[1] {
         return Err(usage(
@@ -245,7 +250,10 @@ fn print_summary(s: &Summary) -> CliResult {
     )?;
     let flagged = &s.provenance.outliers;
     if flagged.is_empty() {
-        writeln!(out, "no outliers; every group's spread within the instruments' noise")?;
+        writeln!(
+            out,
+            "no outliers; every group's spread within the instruments' noise"
+        )?;
     }
     for f in flagged {
         writeln!(
@@ -255,10 +263,7 @@ fn print_summary(s: &Summary) -> CliResult {
             f.what,
             f.outliers,
             if f.spread_exceeds_noise {
-                format!(
-                    ", spread {:.4} > 2 × noise {:.4}",
-                    f.sd_y, f.noise_y
-                )
+                format!(", spread {:.4} > 2 × noise {:.4}", f.sd_y, f.noise_y)
             } else {
                 String::new()
             }

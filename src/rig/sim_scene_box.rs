@@ -133,7 +133,12 @@ impl TruthBox {
         let gammas: Vec<f64> = (0..=18).map(|i| 5.0 * f64::from(i)).collect();
         let values = TRUTH_EXPONENTS
             .iter()
-            .map(|m| gammas.iter().map(|g| g.to_radians().cos().max(0.0).powf(*m)).collect())
+            .map(|m| {
+                gammas
+                    .iter()
+                    .map(|g| g.to_radians().cos().max(0.0).powf(*m))
+                    .collect()
+            })
             .collect();
         let table = CGammaTable::new(vec![0.0, 90.0, 180.0, 270.0], gammas, values)?;
         let wall = perturbed(&paper_white(), &mut rng)?;
@@ -178,7 +183,9 @@ impl TruthBox {
             return Ok(s);
         }
         let (rendered, _, _) = render_scene(&self.scene_json())?;
-        Ok(self.spots.get_or_init(|| rendered.iter().map(|r| r.1).collect()))
+        Ok(self
+            .spots
+            .get_or_init(|| rendered.iter().map(|r| r.1).collect()))
     }
 
     /// The truth as a scene file (with the rotationally symmetric stand-in distribution).
@@ -214,20 +221,17 @@ impl TruthBox {
                 View::radiance(self.tiles[self.falloff_tile].scaled(f)).map_err(drv)?
             }
             Target::Wall => View::surface(self.wall.clone()).map_err(drv)?,
-            Target::Patch { patch } => View::surface(
-                self.patches
-                    .get(patch - 1)
-                    .cloned()
-                    .ok_or_else(|| {
-                        SimSceneBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
-                    })?,
-            )
-            .map_err(drv)?,
-            Target::Spot { patch } => View::xyz(
-                *self.spots()?.get(patch - 1).ok_or_else(|| {
+            Target::Patch { patch } => {
+                View::surface(self.patches.get(patch - 1).cloned().ok_or_else(|| {
                     SimSceneBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
-                })?,
-            ),
+                })?)
+                .map_err(drv)?
+            }
+            Target::Spot { patch } => {
+                View::xyz(*self.spots()?.get(patch - 1).ok_or_else(|| {
+                    SimSceneBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
+                })?)
+            }
         })
     }
 }
