@@ -38,10 +38,12 @@ pub enum CompareError {
     NoPatch(usize),
 }
 
-/// The 24 readings of a scene file by the radiosity solver: (patch, XYZ, bound), white.
-pub fn render_scene(
-    scene: &Value,
-) -> Result<(Vec<(usize, [f64; 3], f64)>, [f64; 3], f64), CompareError> {
+/// One patch rendered: (patch, XYZ in cd/m², the ΔE*ab bound).
+pub type RenderedPatch = (usize, [f64; 3], f64);
+
+/// The 24 readings of a scene file by the radiosity solver, its reference white and the
+/// seconds it took.
+pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedPatch>, [f64; 3], f64), CompareError> {
     let scene = build(scene)?;
     let opts = RadiosityOptions {
         target_de: RENDER_TARGET_DE,
@@ -61,7 +63,7 @@ pub fn render_scene(
 /// Compares `box_xyz` (patch, XYZ) with `rendered` in CIELAB relative to `white`.
 pub fn compare_readings(
     box_xyz: &[(usize, [f64; 3])],
-    rendered: &[(usize, [f64; 3], f64)],
+    rendered: &[RenderedPatch],
     white: [f64; 3],
     test: &str,
 ) -> Result<(Comparison, Vec<f64>), CompareError> {
