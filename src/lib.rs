@@ -6,6 +6,7 @@
 //! spectral path tracer, reproduction on the display and validation in CIELAB.
 //! The `metamer` binary is a thin command line over this library.
 
+pub mod boxmeasure;
 pub mod color;
 pub mod display;
 pub mod experiment;

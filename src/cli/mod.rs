@@ -13,6 +13,7 @@ mod experiment;
 mod fit;
 mod lab;
 mod light;
+mod measure_box;
 mod render;
 mod reproduce;
 mod simulate;
@@ -46,6 +47,8 @@ enum Command {
     Reproduce(reproduce::Args),
     /// Show and measure patches on a display, fit and verify a profile.
     Characterize(characterize::Args),
+    /// Measure the validation box: tiles, fall-off, materials and spots, into a scene.
+    MeasureBox(measure_box::Args),
     /// Display models' reproduction error against the number of measured patches.
     Budget(budget::Args),
     /// The paper's whole chain, stage by stage: box, simulation, display, reproduction,
@@ -88,6 +91,7 @@ pub fn main() -> ExitCode {
         Command::Characterize(args) => characterize::run(args),
         Command::Experiment(args) => experiment::run_cli(args),
         Command::Lab(args) => lab::run(args),
+        Command::MeasureBox(args) => measure_box::run(args),
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),
         Command::Light(args) => light::run(args),

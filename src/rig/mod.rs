@@ -5,6 +5,7 @@
 pub mod screen;
 pub mod sim_box;
 pub mod sim_meter;
+pub mod sim_scene_box;
 pub mod spec;
 pub mod virtual_display;
 pub mod window;

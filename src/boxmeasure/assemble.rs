@@ -1,0 +1,441 @@
+//! From the four stages' readings to the measured scene: per-tile mean spectra, the light's
+//! distribution, the measured materials, the spot readings; checked for outliers and
+//! spread; written as `scene.json` (the renderers' format), `light.json` (the distribution
+//! and its fit) and `summary.json` (everything reduced, with the provenance: journals'
+//! SHA-256, date, instruments with serial numbers, fit residuals, outliers). The measured
+//! scene is then rendered (radiosity) and compared with the box's own spot readings
+//! ([`super::compare`]).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use super::compare::{compare_render, CompareError, RenderComparison};
+use super::falloff::{distribution, FalloffError, LightDistribution, PlaneReadings};
+use super::plan::{BoxPlan, BoxStep, Plane, Stage, Target};
+use super::scene::{scene_json, BoxContents, DistributionJson};
+use super::stats::{group, mean_spectrum, GroupStats, Noise, StatsError};
+use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
+use crate::output::{OutputError, OutputPolicy};
+use crate::session::{Entry, InstrumentRecord};
+
+/// What each stage journal's header says besides its plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BoxDetails {
+    /// The instruments as named by the user (`i1pro`, `sim:cs100a?time_scale=0`).
+    pub spectral: String,
+    pub spot: String,
+}
+
+/// Every stage's journal path and entries, complete.
+pub struct StageEntries {
+    pub stages: BTreeMap<Stage, (PathBuf, Vec<Entry<BoxStep>>)>,
+}
+
+/// A group of readings flagged.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Flagged {
+    pub stage: Stage,
+    /// `tile 2,3`, `spot 7`.
+    pub what: String,
+    /// Repeats (1-based) left out of the mean as outliers.
+    pub outliers: Vec<usize>,
+    /// The kept readings spread more than the instrument's noise allows.
+    pub spread_exceeds_noise: bool,
+    pub sd_y: f64,
+    pub noise_y: f64,
+}
+
+/// A reduced target.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Reduced {
+    pub what: String,
+    pub stats: GroupStats,
+}
+
+/// A journal and its digest.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JournalDigest {
+    pub stage: Stage,
+    pub file: PathBuf,
+    pub sha256: String,
+}
+
+/// Where the measured scene comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// When the scene was assembled, UTC, ISO 8601.
+    pub date: String,
+    pub journals: Vec<JournalDigest>,
+    /// By role, with model, serial number, firmware and connection.
+    pub instruments: BTreeMap<String, InstrumentRecord>,
+    pub instrument_specs: BoxDetails,
+    /// The cosᵐ exponent the scene's emitters carry, its residual RMS and per angle.
+    pub distribution_fit: DistributionFit,
+    pub outliers: Vec<Flagged>,
+    /// ColorChecker patches the plan did not measure, taken from the nominal data.
+    pub nominal_patches: Vec<usize>,
+    /// Band values of the mean spectra moved into the renderer's range: radiance below 0
+    /// (noise in bands where the light has almost nothing) and reflectance outside [0, 1].
+    pub clamped_values: usize,
+    /// The chart frame's reflectance is the nominal 0.03, not measured.
+    pub nominal_frame_reflectance: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DistributionFit {
+    pub cos_power: f64,
+    pub rms: f64,
+    pub residuals: Vec<super::falloff::Residual>,
+}
+
+/// The files written.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Files {
+    pub scene: PathBuf,
+    pub light: PathBuf,
+    pub summary: PathBuf,
+}
+
+/// Everything a finished measurement reduced to.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Summary {
+    pub tiles: Vec<Reduced>,
+    pub falloff: Vec<Reduced>,
+    pub materials: Vec<Reduced>,
+    pub spots: Vec<Reduced>,
+    /// Mean spot reading of each patch in the plan's order, cd/m².
+    pub spot_xyz: Vec<(usize, [f64; 3])>,
+    pub light: LightDistribution,
+    /// The measured scene rendered against the box's spot readings.
+    pub render: RenderComparison,
+    pub provenance: Provenance,
+    pub files: Files,
+}
+
+/// The readings could not become a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum AssembleError {
+    #[error("{what}: {source}")]
+    Stats {
+        what: String,
+        #[source]
+        source: StatsError,
+    },
+    #[error(transparent)]
+    Falloff(#[from] FalloffError),
+    #[error("the {0} stage's readings are missing")]
+    Missing(Stage),
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Compare(#[from] CompareError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> AssembleError + '_ {
+    move |source| AssembleError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Groups entries by target in first-seen order.
+fn by_target(entries: &[Entry<BoxStep>]) -> Vec<(Target, Vec<&Entry<BoxStep>>)> {
+    let mut groups: Vec<(Target, Vec<&Entry<BoxStep>>)> = Vec::new();
+    for e in entries {
+        match groups.iter_mut().find(|(t, _)| *t == e.data.target) {
+            Some((_, g)) => g.push(e),
+            None => groups.push((e.data.target.clone(), vec![e])),
+        }
+    }
+    groups
+}
+
+fn what(target: &Target) -> String {
+    match target {
+        Target::Tile { row, col } => format!("tile {row},{col}"),
+        Target::Falloff { plane, angle_deg } => format!("falloff {} {angle_deg}°", plane.name()),
+        Target::Wall => "wall paper".into(),
+        Target::Patch { patch } => format!("reflectance {patch}"),
+        Target::Spot { patch } => format!("spot {patch}"),
+    }
+}
+
+/// A stage's groups reduced, with their flags and (for spectral stages) mean spectra.
+struct StageReduced {
+    reduced: Vec<Reduced>,
+    spectra: Vec<Option<Spectrum>>,
+    targets: Vec<Target>,
+}
+
+fn reduce(
+    stage: Stage,
+    entries: &[Entry<BoxStep>],
+    spectral: bool,
+    flags: &mut Vec<Flagged>,
+) -> Result<StageReduced, AssembleError> {
+    let mut out = StageReduced {
+        reduced: Vec::new(),
+        spectra: Vec::new(),
+        targets: Vec::new(),
+    };
+    for (target, group_entries) in by_target(entries) {
+        let w = what(&target);
+        let readings: Vec<_> = group_entries.iter().map(|e| &e.reading).collect();
+        let noise = Noise::of(&readings[0].instrument, group_entries[0].mode);
+        let err = |source| AssembleError::Stats {
+            what: format!("{stage} {w}"),
+            source,
+        };
+        let stats = group(&readings, noise).map_err(err)?;
+        let spectrum = if spectral {
+            Some(mean_spectrum(&readings, &stats).map_err(err)?)
+        } else {
+            None
+        };
+        if !stats.outliers.is_empty() || stats.spread_exceeds_noise {
+            flags.push(Flagged {
+                stage,
+                what: w.clone(),
+                outliers: stats.outliers.iter().map(|i| i + 1).collect(),
+                spread_exceeds_noise: stats.spread_exceeds_noise,
+                sd_y: stats.sd_y,
+                noise_y: stats.noise_y,
+            });
+        }
+        out.reduced.push(Reduced { what: w, stats });
+        out.spectra.push(spectrum);
+        out.targets.push(target);
+    }
+    Ok(out)
+}
+
+/// `s` with every value clamped into [lo, hi], counting the values moved.
+fn clamped(s: &Spectrum, lo: f64, hi: f64, count: &mut usize) -> Spectrum {
+    let values = s
+        .values()
+        .iter()
+        .map(|&v| {
+            let c = v.clamp(lo, hi);
+            *count += usize::from(c != v);
+            c
+        })
+        .collect();
+    let mut out = Spectrum::new(s.wavelengths_nm().to_vec(), values)
+        .unwrap_or_else(|_| s.clone())
+        .with_outside(s.outside());
+    if let Some(q) = s.quantity() {
+        out = out.with_quantity(q);
+    }
+    out
+}
+
+/// SHA-256 of a file in hex.
+pub fn sha256_file(path: &Path) -> Result<String, AssembleError> {
+    let bytes = std::fs::read(path).map_err(io(path))?;
+    Ok(Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect())
+}
+
+/// `YYYY-MM-DDTHH:MM:SSZ` of seconds since the Unix epoch (proleptic Gregorian calendar,
+/// days to civil date after H. Hinnant's `civil_from_days`).
+pub fn iso_date(unix_s: f64) -> String {
+    let secs = unix_s.max(0.0) as i64;
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+fn write_json(
+    policy: &OutputPolicy,
+    path: &Path,
+    value: &impl Serialize,
+) -> Result<(), AssembleError> {
+    let text =
+        serde_json::to_string_pretty(value).map_err(|e| io(path)(std::io::Error::other(e)))?;
+    Ok(policy.write(path, (text + "\n").as_bytes())?)
+}
+
+/// Reduces the readings, writes `scene.json`, `light.json` and `summary.json` into `dir`
+/// under `policy` (the journals are its inputs), renders the scene and compares it with the
+/// spot readings.
+pub fn assemble(
+    policy: &OutputPolicy,
+    dir: &Path,
+    plan: &BoxPlan,
+    entries: &StageEntries,
+    instruments: &BTreeMap<String, InstrumentRecord>,
+    details: &BoxDetails,
+) -> Result<Summary, AssembleError> {
+    let get = |stage: Stage| {
+        entries
+            .stages
+            .get(&stage)
+            .map(|(_, e)| e.as_slice())
+            .ok_or(AssembleError::Missing(stage))
+    };
+    let mut flags = Vec::new();
+    let tiles = reduce(Stage::Tiles, get(Stage::Tiles)?, true, &mut flags)?;
+    let falloff = reduce(Stage::Falloff, get(Stage::Falloff)?, false, &mut flags)?;
+    let materials = reduce(Stage::Materials, get(Stage::Materials)?, true, &mut flags)?;
+    let spots = reduce(Stage::Spots, get(Stage::Spots)?, false, &mut flags)?;
+
+    let mut planes = [Plane::Horizontal, Plane::Vertical].map(|plane| PlaneReadings {
+        plane,
+        angles_deg: Vec::new(),
+        luminance: Vec::new(),
+    });
+    for (t, r) in falloff.targets.iter().zip(&falloff.reduced) {
+        if let Target::Falloff { plane, angle_deg } = t {
+            let p = &mut planes[usize::from(*plane == Plane::Vertical)];
+            p.angles_deg.push(*angle_deg);
+            p.luminance.push(r.stats.xyz[1]);
+        }
+    }
+    let light = distribution(&planes[0], &planes[1])?;
+
+    let g = &plan.geometry;
+    let mut clamped_values = 0;
+    let mut tile_spectra = vec![None; g.rows * g.cols];
+    for (t, s) in tiles.targets.iter().zip(&tiles.spectra) {
+        if let (Target::Tile { row, col }, Some(s)) = (t, s) {
+            tile_spectra[row * g.cols + col] = Some(
+                clamped(s, 0.0, f64::INFINITY, &mut clamped_values).with_outside(Outside::Zero),
+            );
+        }
+    }
+    let tile_spectra: Vec<Spectrum> = tile_spectra
+        .into_iter()
+        .collect::<Option<_>>()
+        .ok_or(AssembleError::Missing(Stage::Tiles))?;
+    let nominal = colorchecker(ColorCheckerSet::BabelColorAverage);
+    let mut patches: Vec<Option<Spectrum>> = vec![None; 24];
+    let mut wall = None;
+    for (t, s) in materials.targets.iter().zip(&materials.spectra) {
+        let s = s
+            .as_ref()
+            .map(|s| clamped(s, 0.0, 1.0, &mut clamped_values).with_outside(Outside::HoldEnds));
+        match t {
+            Target::Wall => wall = s,
+            Target::Patch { patch } => patches[patch - 1] = s,
+            _ => {}
+        }
+    }
+    let wall = wall.ok_or(AssembleError::Missing(Stage::Materials))?;
+    let nominal_patches: Vec<usize> = (1..=24).filter(|k| patches[k - 1].is_none()).collect();
+    let patches: Vec<Spectrum> = patches
+        .into_iter()
+        .zip(nominal)
+        .map(|(m, n)| m.unwrap_or(n))
+        .collect();
+    let contents = BoxContents {
+        wall,
+        patches,
+        tiles: tile_spectra,
+        distribution: DistributionJson::CosPower {
+            exponent: light.cos_power,
+        },
+    };
+    let scene = scene_json(
+        "measured validation box",
+        "The validation box as measured by metamer measure-box: per-tile spectra, the fitted fall-off, measured materials.",
+        g,
+        &contents,
+    );
+    let mut policy = policy.clone();
+    policy.inputs(entries.stages.values().map(|(p, _)| p.as_path()));
+    policy.dir(dir)?;
+    let files = Files {
+        scene: dir.join("scene.json"),
+        light: dir.join("light.json"),
+        summary: dir.join("summary.json"),
+    };
+    write_json(&policy, &files.scene, &scene)?;
+    write_json(&policy, &files.light, &light)?;
+
+    let spot_xyz: Vec<(usize, [f64; 3])> = spots
+        .targets
+        .iter()
+        .zip(&spots.reduced)
+        .filter_map(|(t, r)| match t {
+            Target::Spot { patch } => Some((*patch, r.stats.xyz)),
+            _ => None,
+        })
+        .collect();
+    let render = compare_render(&scene, &spot_xyz)?;
+
+    let mut journals = Vec::new();
+    for (stage, (path, _)) in &entries.stages {
+        journals.push(JournalDigest {
+            stage: *stage,
+            file: path.clone(),
+            sha256: sha256_file(path)?,
+        });
+    }
+    let provenance = Provenance {
+        date: iso_date(metamer_drivers::instrument::now_s()),
+        journals,
+        instruments: instruments.clone(),
+        instrument_specs: details.clone(),
+        distribution_fit: DistributionFit {
+            cos_power: light.cos_power,
+            rms: light.rms,
+            residuals: light.residuals.clone(),
+        },
+        outliers: flags,
+        nominal_patches,
+        clamped_values,
+        nominal_frame_reflectance: super::scene::FRAME_REFLECTANCE,
+    };
+    let summary = Summary {
+        tiles: tiles.reduced,
+        falloff: falloff.reduced,
+        materials: materials.reduced,
+        spots: spots.reduced,
+        spot_xyz,
+        light,
+        render,
+        provenance,
+        files,
+    };
+    write_json(&policy, &summary.files.summary, &summary)?;
+    Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::iso_date;
+
+    #[test]
+    fn dates_are_civil_utc() {
+        assert_eq!(iso_date(0.0), "1970-01-01T00:00:00Z");
+        // 2000-03-01 is day 11017 after the epoch (30 years incl. 7 leap days + Jan + Feb 29).
+        assert_eq!(
+            iso_date(11_017.0 * 86_400.0 + 3661.0),
+            "2000-03-01T01:01:01Z"
+        );
+        assert_eq!(iso_date(1_700_000_000.0), "2023-11-14T22:13:20Z");
+    }
+}

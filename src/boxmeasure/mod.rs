@@ -1,0 +1,21 @@
+//! Measuring the validation box: the guided, resumable session that reads the light's
+//! tiles, its fall-off, the materials and the ColorChecker spots through the `Instrument`
+//! trait on the session engine, and turns the readings into the measured scene.
+//!
+//! [`plan`] says what is measured (the plan file, the stages as session plans), [`run`]
+//! takes the stages, [`stats`] reduces repeats and flags outliers, [`falloff`] makes the
+//! light's distribution, [`scene`] writes the box as a scene file, [`assemble`] puts the
+//! measured scene and its provenance together, and [`compare`] renders it against the box's
+//! spot readings.
+
+pub mod assemble;
+pub mod compare;
+pub mod falloff;
+pub mod plan;
+pub mod run;
+pub mod scene;
+pub mod stats;
+
+pub use assemble::{BoxDetails, Summary};
+pub use plan::{BoxPlan, BoxStep, Geometry, PlanError, Plane, Stage, Target};
+pub use run::{run, Instruments, MeasureBoxError, Options, Outcome};

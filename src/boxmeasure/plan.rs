@@ -1,0 +1,563 @@
+//! What a box measurement measures: the plan file (counts, angles, geometry) with its
+//! validation, and the four stages as session plans.
+//!
+//! The default plan is the paper's: every tile of the 5 × 5 light source with the
+//! spectral instrument; the centre tile's luminance at nine angles in the horizontal and
+//! nine in the vertical plane with the spot meter; the reflectance of the wall paper and
+//! of the 24 ColorChecker patches with the spectral instrument on its lamp; the 24 patches
+//! with the spot meter from the viewpoint.
+//!
+//! The fall-off is read with the spot meter, not the spectral instrument: the fit needs
+//! only luminance, a spot meter is aimed from a distance (its 1° cone sees only the centre
+//! tile from every angle), while a contact instrument tilted against the panel sees an
+//! area and light from the neighbouring tiles.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use metamer_drivers::MeasureMode;
+use serde::{Deserialize, Serialize};
+
+use crate::color::COLORCHECKER_NAMES;
+use crate::session::{Prepare, SessionPlan, Step};
+
+/// The journal's session kind.
+pub const SESSION_KIND: &str = "measure-box";
+/// The role of the spectral instrument (the i1Pro).
+pub const SPECTRAL: &str = "spectral";
+/// The role of the spot meter (the CS-100A).
+pub const SPOT: &str = "spot";
+
+/// The four stages, in the order a full session takes them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    Tiles,
+    Falloff,
+    Materials,
+    Spots,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 4] = [Stage::Tiles, Stage::Falloff, Stage::Materials, Stage::Spots];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Tiles => "tiles",
+            Stage::Falloff => "falloff",
+            Stage::Materials => "materials",
+            Stage::Spots => "spots",
+        }
+    }
+
+    /// The stage's journal inside the output directory.
+    pub fn journal(self, dir: &Path) -> PathBuf {
+        dir.join(format!("{}.jsonl", self.name()))
+    }
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Stage {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Stage, String> {
+        Stage::ALL
+            .into_iter()
+            .find(|st| st.name() == s)
+            .ok_or_else(|| format!("unknown stage '{s}' (known: tiles, falloff, materials, spots)"))
+    }
+}
+
+/// A plane the fall-off is measured in (the C-plane convention of `light::cgamma`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Plane {
+    /// Rotation about the vertical axis: C = 0° (positive angles, towards the emitter's
+    /// `edge_u`, the back of the box) and C = 180°.
+    Horizontal,
+    /// Rotation about the horizontal axis: C = 90° (positive angles, towards `edge_v`,
+    /// downwards) and C = 270°.
+    Vertical,
+}
+
+impl Plane {
+    /// (C, γ) in degrees of a signed angle in this plane.
+    pub fn c_gamma(self, angle_deg: f64) -> (f64, f64) {
+        let c = match (self, angle_deg >= 0.0) {
+            (Plane::Horizontal, true) => 0.0,
+            (Plane::Horizontal, false) => 180.0,
+            (Plane::Vertical, true) => 90.0,
+            (Plane::Vertical, false) => 270.0,
+        };
+        (c, angle_deg.abs())
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Plane::Horizontal => "horizontal",
+            Plane::Vertical => "vertical",
+        }
+    }
+}
+
+/// What one step measures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "target", rename_all = "snake_case")]
+pub enum Target {
+    /// A light tile's spectral radiance along its normal.
+    Tile { row: usize, col: usize },
+    /// The fall-off tile's luminance seen from `angle_deg` in `plane`.
+    Falloff { plane: Plane, angle_deg: f64 },
+    /// The wall paper's reflectance.
+    Wall,
+    /// A ColorChecker patch's reflectance (1–24).
+    Patch { patch: usize },
+    /// A ColorChecker patch seen by the spot meter from the viewpoint (1–24).
+    Spot { patch: usize },
+}
+
+/// One step's data in the journal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BoxStep {
+    pub stage: Stage,
+    #[serde(flatten)]
+    pub target: Target,
+    /// 0-based.
+    pub repeat: usize,
+}
+
+/// The box and where things are in it, in metres in the frame of the validation box
+/// (x left → right, y up, z into the box; the light on the left wall x = 0, the chart on the
+/// right wall).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Geometry {
+    /// Edge of the cubic box.
+    pub size_m: f64,
+    /// The light opening on the left wall: [y_min, y_max, z_min, z_max].
+    pub light_m: [f64; 4],
+    /// Tile grid of the light: rows (row 0 at the top), columns (column 0 at the front).
+    pub rows: usize,
+    pub cols: usize,
+    /// The optical centre of the spot meter (and camera), outside the box's open front.
+    pub viewpoint_m: [f64; 3],
+    /// The spot meter's acceptance angle (full cone).
+    pub acceptance_deg: f64,
+}
+
+impl Default for Geometry {
+    fn default() -> Self {
+        Geometry {
+            size_m: 0.5,
+            light_m: [0.1, 0.4, 0.1, 0.4],
+            rows: 5,
+            cols: 5,
+            viewpoint_m: [-0.4, 0.25, -0.3],
+            acceptance_deg: 1.0,
+        }
+    }
+}
+
+/// The plan file: every field optional, the paper's plan where left out.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BoxPlan {
+    /// Readings of each tile and each spot.
+    pub repeats: usize,
+    /// Readings of each reflectance (the i1Pro's reflectance is quiet; the paper read each
+    /// once).
+    pub material_repeats: usize,
+    /// Readings at each fall-off angle.
+    pub falloff_repeats: usize,
+    /// Signed fall-off angles, degrees, used in both planes; 0 is the normal.
+    pub falloff_angles_deg: Vec<f64>,
+    /// The tile whose fall-off is measured, [row, col]; default the centre tile.
+    pub falloff_tile: Option<[usize; 2]>,
+    /// The ColorChecker patches to read (reflectance and spots), 1–24.
+    pub patches: Vec<usize>,
+    pub geometry: Geometry,
+}
+
+impl Default for BoxPlan {
+    fn default() -> Self {
+        BoxPlan {
+            repeats: 5,
+            material_repeats: 1,
+            falloff_repeats: 1,
+            falloff_angles_deg: (-4..=4).map(|k| 20.0 * f64::from(k)).collect(),
+            falloff_tile: None,
+            patches: (1..=24).collect(),
+            geometry: Geometry::default(),
+        }
+    }
+}
+
+/// A plan that cannot be measured; each names the field.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    #[error("cannot read the plan {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: not a valid plan: {source} (fields: repeats, material_repeats, falloff_repeats, falloff_angles_deg, falloff_tile, patches, geometry {{size_m, light_m, rows, cols, viewpoint_m, acceptance_deg}})", path.display())]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    #[error("plan: {field}: {message}")]
+    Invalid { field: String, message: String },
+}
+
+fn invalid(field: &str, message: impl Into<String>) -> PlanError {
+    PlanError::Invalid {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// The most tiles a light may be divided into per side: beyond it the grid is finer than a
+/// contact instrument's aperture (≈ 4 mm on a 300 mm panel).
+pub const MAX_TILES_PER_SIDE: usize = 64;
+/// The most readings of one thing.
+pub const MAX_REPEATS: usize = 100;
+
+impl BoxPlan {
+    /// Reads and validates a plan file.
+    pub fn load(path: &Path) -> Result<BoxPlan, PlanError> {
+        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let plan: BoxPlan = serde_json::from_str(&text).map_err(|source| PlanError::Json {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        plan.validate()?;
+        Ok(plan)
+    }
+
+    /// Checks every field; the first bad one is named.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        for (field, n) in [
+            ("repeats", self.repeats),
+            ("material_repeats", self.material_repeats),
+            ("falloff_repeats", self.falloff_repeats),
+        ] {
+            if !(1..=MAX_REPEATS).contains(&n) {
+                return Err(invalid(
+                    field,
+                    format!("must be between 1 and {MAX_REPEATS}, got {n}"),
+                ));
+            }
+        }
+        let a = &self.falloff_angles_deg;
+        if a.is_empty() {
+            return Err(invalid("falloff_angles_deg", "needs at least one angle"));
+        }
+        if let Some(v) = a.iter().find(|v| !(v.is_finite() && v.abs() < 90.0)) {
+            return Err(invalid(
+                "falloff_angles_deg",
+                format!("{v} is not an angle off the normal: each must lie in (−90°, 90°)"),
+            ));
+        }
+        if let Some(w) = a.windows(2).find(|w| w[1] <= w[0]) {
+            return Err(invalid(
+                "falloff_angles_deg",
+                format!("must increase strictly: {} follows {}", w[1], w[0]),
+            ));
+        }
+        if !a.contains(&0.0) {
+            return Err(invalid(
+                "falloff_angles_deg",
+                "must contain 0 (the normal: the distribution is relative to it)",
+            ));
+        }
+        if self.patches.is_empty() {
+            return Err(invalid("patches", "needs at least one patch"));
+        }
+        for (i, &p) in self.patches.iter().enumerate() {
+            if !(1..=24).contains(&p) {
+                return Err(invalid(
+                    "patches",
+                    format!("{p} is not a patch number 1–24"),
+                ));
+            }
+            if self.patches[..i].contains(&p) {
+                return Err(invalid("patches", format!("patch {p} is listed twice")));
+            }
+        }
+        let g = &self.geometry;
+        for (field, n) in [("geometry.rows", g.rows), ("geometry.cols", g.cols)] {
+            if !(1..=MAX_TILES_PER_SIDE).contains(&n) {
+                return Err(invalid(
+                    field,
+                    format!("must be between 1 and {MAX_TILES_PER_SIDE}, got {n}"),
+                ));
+            }
+        }
+        if let Some([r, c]) = self.falloff_tile {
+            if r >= g.rows || c >= g.cols {
+                return Err(invalid(
+                    "falloff_tile",
+                    format!(
+                        "tile [{r}, {c}] is outside the {} × {} grid",
+                        g.rows, g.cols
+                    ),
+                ));
+            }
+        }
+        // The chart (204 mm × 291 mm) must fit on the right wall.
+        if !(g.size_m.is_finite() && (0.3..=5.0).contains(&g.size_m)) {
+            return Err(invalid(
+                "geometry.size_m",
+                format!(
+                    "must be between 0.3 m (the chart must fit) and 5 m, got {}",
+                    g.size_m
+                ),
+            ));
+        }
+        let [y0, y1, z0, z1] = g.light_m;
+        let inside = |v: f64| v.is_finite() && (0.0..=g.size_m).contains(&v);
+        if !(inside(y0) && inside(y1) && inside(z0) && inside(z1) && y0 < y1 && z0 < z1) {
+            return Err(invalid(
+                "geometry.light_m",
+                format!(
+                    "[y_min, y_max, z_min, z_max] must be increasing pairs inside the {} m wall, got {:?}",
+                    g.size_m, g.light_m
+                ),
+            ));
+        }
+        let v = g.viewpoint_m;
+        if !(v.iter().all(|c| c.is_finite()) && v[2] < 0.0) {
+            return Err(invalid(
+                "geometry.viewpoint_m",
+                format!(
+                    "must be in front of the box's open front (z < 0), got {:?}",
+                    g.viewpoint_m
+                ),
+            ));
+        }
+        if !(g.acceptance_deg > 0.0 && g.acceptance_deg <= 10.0) {
+            return Err(invalid(
+                "geometry.acceptance_deg",
+                format!("must be in (0°, 10°], got {}", g.acceptance_deg),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The tile whose fall-off is measured.
+    pub fn falloff_tile(&self) -> [usize; 2] {
+        self.falloff_tile
+            .unwrap_or([self.geometry.rows / 2, self.geometry.cols / 2])
+    }
+
+    /// The steps of one stage.
+    pub fn steps(&self, stage: Stage) -> Vec<Step<BoxStep>> {
+        let step = |target: Target, repeat: usize, role: &str, mode, prompt: String| Step {
+            label: label(&target, repeat),
+            role: role.to_string(),
+            mode,
+            prepare: Prepare::Operator { prompt },
+            settle: std::time::Duration::ZERO,
+            data: BoxStep {
+                stage,
+                target,
+                repeat,
+            },
+        };
+        let mut steps = Vec::new();
+        match stage {
+            Stage::Tiles => {
+                for row in 0..self.geometry.rows {
+                    for col in 0..self.geometry.cols {
+                        for r in 0..self.repeats {
+                            let t = Target::Tile { row, col };
+                            let p = self.prompt(&t);
+                            steps.push(step(t, r, SPECTRAL, MeasureMode::Emissive, p));
+                        }
+                    }
+                }
+            }
+            Stage::Falloff => {
+                for plane in [Plane::Horizontal, Plane::Vertical] {
+                    for &angle_deg in &self.falloff_angles_deg {
+                        for r in 0..self.falloff_repeats {
+                            let t = Target::Falloff { plane, angle_deg };
+                            let p = self.prompt(&t);
+                            steps.push(step(t, r, SPOT, MeasureMode::Emissive, p));
+                        }
+                    }
+                }
+            }
+            Stage::Materials => {
+                let targets = std::iter::once(Target::Wall)
+                    .chain(self.patches.iter().map(|&patch| Target::Patch { patch }));
+                for t in targets {
+                    for r in 0..self.material_repeats {
+                        let p = self.prompt(&t);
+                        steps.push(step(t.clone(), r, SPECTRAL, MeasureMode::Reflective, p));
+                    }
+                }
+            }
+            Stage::Spots => {
+                for &patch in &self.patches {
+                    for r in 0..self.repeats {
+                        let t = Target::Spot { patch };
+                        let p = self.prompt(&t);
+                        steps.push(step(t, r, SPOT, MeasureMode::Emissive, p));
+                    }
+                }
+            }
+        }
+        steps
+    }
+
+    /// What the operator is asked to do for a target; the same for every repeat, so a
+    /// reading after a calibration (the instrument moved to its tile) starts from the
+    /// target again.
+    pub fn prompt(&self, target: &Target) -> String {
+        match target {
+            Target::Tile { row, col } => {
+                format!("place the i1Pro on tile row {row}, column {col} of the light")
+            }
+            Target::Falloff { plane, angle_deg } => {
+                let [row, col] = self.falloff_tile();
+                format!(
+                    "aim the spot meter at the centre of tile row {row}, column {col} from {} in the {} plane ({})",
+                    signed(*angle_deg),
+                    plane.name(),
+                    direction(*plane, *angle_deg)
+                )
+            }
+            Target::Wall => {
+                "place the i1Pro on the wall paper (the box's floor, away from the chart)".into()
+            }
+            Target::Patch { patch } => format!(
+                "place the i1Pro on ColorChecker patch {patch} ({})",
+                patch_name(*patch)
+            ),
+            Target::Spot { patch } => format!(
+                "aim the spot meter from the viewpoint at ColorChecker patch {patch} ({})",
+                patch_name(*patch)
+            ),
+        }
+    }
+
+    /// One stage as a session plan; its options are the stage and the plan's canonical
+    /// JSON, plus the caller's (the simulated rig's seed), so a resume with another plan
+    /// is refused naming what differs.
+    pub fn session_plan(
+        &self,
+        stage: Stage,
+        extra: &BTreeMap<String, String>,
+    ) -> SessionPlan<BoxStep> {
+        let mut options = extra.clone();
+        options.insert("stage".into(), stage.name().into());
+        let value = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
+        options.insert("plan".into(), value.to_string());
+        SessionPlan {
+            kind: SESSION_KIND.into(),
+            options,
+            steps: self.steps(stage),
+        }
+    }
+}
+
+fn signed(angle_deg: f64) -> String {
+    if angle_deg > 0.0 {
+        format!("+{angle_deg}°")
+    } else {
+        format!("{angle_deg}°")
+    }
+}
+
+fn direction(plane: Plane, angle_deg: f64) -> &'static str {
+    match (plane, angle_deg.partial_cmp(&0.0)) {
+        (_, Some(std::cmp::Ordering::Equal)) => "on the normal",
+        (Plane::Horizontal, Some(std::cmp::Ordering::Greater)) => "towards the back of the box",
+        (Plane::Horizontal, _) => "towards the open front",
+        (Plane::Vertical, Some(std::cmp::Ordering::Greater)) => "from below",
+        (Plane::Vertical, _) => "from above",
+    }
+}
+
+fn patch_name(patch: usize) -> &'static str {
+    COLORCHECKER_NAMES.get(patch - 1).copied().unwrap_or("")
+}
+
+/// A step's label: `tile 2,3 #1`, `falloff horizontal +20° #1`, `patch 7 #1`, `spot 7 #2`.
+fn label(target: &Target, repeat: usize) -> String {
+    let what = match target {
+        Target::Tile { row, col } => format!("tile {row},{col}"),
+        Target::Falloff { plane, angle_deg } => {
+            format!("falloff {} {}", plane.name(), signed(*angle_deg))
+        }
+        Target::Wall => "wall paper".into(),
+        Target::Patch { patch } => format!("reflectance {patch}"),
+        Target::Spot { patch } => format!("spot {patch}"),
+    };
+    format!("{what} #{}", repeat + 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_plan_is_the_papers() {
+        let p = BoxPlan::default();
+        p.validate().unwrap();
+        // 25 tiles × 5, 2 planes × 9 angles, wall + 24 patches, 24 spots × 5.
+        let counts: Vec<usize> = Stage::ALL.iter().map(|&s| p.steps(s).len()).collect();
+        assert_eq!(counts, [125, 18, 25, 120]);
+        let tiles = p.steps(Stage::Tiles);
+        assert_eq!(
+            tiles[5 * 13].prepare,
+            Prepare::Operator {
+                prompt: "place the i1Pro on tile row 2, column 3 of the light".into()
+            }
+        );
+        assert_eq!(p.falloff_tile(), [2, 2]);
+        assert_eq!(Plane::Vertical.c_gamma(-40.0), (270.0, 40.0));
+        assert_eq!(Plane::Horizontal.c_gamma(20.0), (0.0, 20.0));
+    }
+
+    #[test]
+    fn bad_plans_name_the_field() {
+        let check = |json: &str, want: &str| {
+            let dir = std::env::temp_dir().join(format!("metamer-boxplan-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let path = dir.join("plan.json");
+            std::fs::write(&path, json).unwrap();
+            let e = BoxPlan::load(&path).unwrap_err().to_string();
+            assert!(e.contains(want), "{json}: {e}");
+        };
+        check(
+            r#"{"repeats":0}"#,
+            "plan: repeats: must be between 1 and 100, got 0",
+        );
+        check(r#"{"falloff_angles_deg":[-20,20]}"#, "must contain 0");
+        check(r#"{"falloff_angles_deg":[0,95]}"#, "95 is not an angle");
+        check(r#"{"falloff_angles_deg":[0,20,10]}"#, "10 follows 20");
+        check(r#"{"patches":[1,25]}"#, "25 is not a patch number");
+        check(r#"{"patches":[3,3]}"#, "patch 3 is listed twice");
+        check(
+            r#"{"geometry":{"rows":0}}"#,
+            "geometry.rows: must be between 1 and 64",
+        );
+        check(
+            r#"{"geometry":{"light_m":[0.4,0.1,0.1,0.4]}}"#,
+            "geometry.light_m",
+        );
+        check(r#"{"geometry":{"viewpoint_m":[0,0,1]}}"#, "z < 0");
+        check(r#"{"falloff_tile":[5,0]}"#, "outside the 5 × 5 grid");
+        check(r#"{"repeat":3}"#, "unknown field `repeat`");
+        check(r#"{"repeats":"x"}"#, "not a valid plan");
+    }
+}

@@ -1,0 +1,209 @@
+//! A box measurement on the session engine: each stage its own journal in the output
+//! directory (`tiles.jsonl`, `falloff.jsonl`, `materials.jsonl`, `spots.jsonl`), taken in
+//! order; when all four are complete the readings become the measured scene
+//! ([`super::assemble`]).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use metamer_drivers::Instrument;
+
+use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary};
+use super::plan::{BoxPlan, BoxStep, Stage, SPECTRAL, SPOT};
+use crate::output::OutputPolicy;
+use crate::session::{
+    Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session, SessionError,
+};
+
+/// What to measure and how.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub dir: PathBuf,
+    pub plan: BoxPlan,
+    /// Only this stage (measured again from the start unless resuming); None: every stage.
+    pub stage: Option<Stage>,
+    /// Continue the journals in `dir` instead of refusing them.
+    pub resume: bool,
+    /// Options of the rig that change what is measured (a simulated box's seed); recorded
+    /// in each journal's header and checked on resuming.
+    pub rig_options: BTreeMap<String, String>,
+    pub details: BoxDetails,
+    pub run: RunOptions,
+    /// How the scene, light and summary files are written (the plan file among its
+    /// inputs). They are replaced only when forced: by the caller, or because the session
+    /// resumes or measures a stage again and so owns them.
+    pub output: OutputPolicy,
+}
+
+/// The rig's two instruments.
+pub struct Instruments<'a> {
+    pub spectral: &'a mut dyn Instrument,
+    pub spot: &'a mut dyn Instrument,
+}
+
+/// Where a measurement ended.
+#[derive(Debug)]
+pub enum Outcome {
+    /// Every stage is complete: the scene and its files are written.
+    Finished(Box<Summary>),
+    /// A stage stopped before its end; its journal holds what was measured.
+    Incomplete {
+        stage: Stage,
+        end: RunEnd,
+        done: usize,
+        total: usize,
+        log: PathBuf,
+    },
+    /// The stages run are complete, these others have no complete journal yet.
+    StagesMissing(Vec<Stage>),
+}
+
+/// A box measurement failed.
+#[derive(Debug, thiserror::Error)]
+pub enum MeasureBoxError {
+    #[error("stage {stage}: {source}")]
+    Session {
+        stage: Stage,
+        #[source]
+        source: SessionError,
+    },
+    #[error("setting aside the earlier {stage} journal {}: {source}", path.display())]
+    SetAside {
+        stage: Stage,
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Assemble(#[from] AssembleError),
+}
+
+/// Moves an earlier journal of a stage to be measured again out of the way, to
+/// `NAME.replaced-K.jsonl` (nothing measured is deleted).
+fn set_aside(stage: Stage, path: &Path) -> Result<(), MeasureBoxError> {
+    if !path.exists() {
+        return Ok(());
+    }
+    let mut k = 1;
+    let target = loop {
+        let t = path.with_file_name(format!("{}.replaced-{k}.jsonl", stage.name()));
+        if !t.exists() {
+            break t;
+        }
+        k += 1;
+    };
+    std::fs::rename(path, &target).map_err(|source| MeasureBoxError::SetAside {
+        stage,
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn open_stage(
+    options: &Options,
+    stage: Stage,
+    instruments: &BTreeMap<String, InstrumentRecord>,
+    resume: bool,
+) -> Result<Session<BoxDetails, BoxStep>, MeasureBoxError> {
+    Session::open(
+        &stage.journal(&options.dir),
+        options.plan.session_plan(stage, &options.rig_options),
+        options.details.clone(),
+        instruments.clone(),
+        resume,
+    )
+    .map_err(|source| MeasureBoxError::Session { stage, source })
+}
+
+/// Measures what the journals in `options.dir` lack (every stage, or `options.stage`),
+/// then, when all four stages are complete, writes the measured scene and its files.
+pub fn run(
+    options: &Options,
+    instruments: Instruments<'_>,
+    operator: &mut dyn Operator,
+    progress: &mut dyn ProgressSink,
+) -> Result<Outcome, MeasureBoxError> {
+    let records: BTreeMap<String, InstrumentRecord> = [
+        (
+            SPECTRAL.to_string(),
+            InstrumentRecord::of(&*instruments.spectral),
+        ),
+        (SPOT.to_string(), InstrumentRecord::of(&*instruments.spot)),
+    ]
+    .into();
+    let stages: Vec<Stage> = match options.stage {
+        Some(s) => vec![s],
+        None => Stage::ALL.to_vec(),
+    };
+    let mut rig = Rig {
+        screen: None,
+        instruments: vec![
+            (SPECTRAL.to_string(), instruments.spectral),
+            (SPOT.to_string(), instruments.spot),
+        ],
+        operator,
+    };
+    for &stage in &stages {
+        let path = stage.journal(&options.dir);
+        if options.stage.is_some() && !options.resume {
+            set_aside(stage, &path)?;
+        }
+        let mut session = open_stage(options, stage, &records, options.resume)?;
+        let total = session.plan().steps.len();
+        if session.done() == total {
+            continue;
+        }
+        if session.recovered > 0 || session.torn_bytes > 0 {
+            progress.note(&format!(
+                "resuming {stage}: {} of {total} readings in {}",
+                session.recovered,
+                path.display()
+            ));
+        } else {
+            progress.note(&format!("stage {stage}: {total} readings"));
+        }
+        let end = session
+            .run(&mut rig, &options.run, progress)
+            .map_err(|source| MeasureBoxError::Session { stage, source })?;
+        if end != RunEnd::Complete {
+            return Ok(Outcome::Incomplete {
+                stage,
+                end,
+                done: session.done(),
+                total,
+                log: path,
+            });
+        }
+    }
+    // Every stage's readings, from the journals (earlier runs' included).
+    let mut missing = Vec::new();
+    let mut loaded: BTreeMap<Stage, (PathBuf, Vec<Entry<BoxStep>>)> = BTreeMap::new();
+    for stage in Stage::ALL {
+        let path = stage.journal(&options.dir);
+        if !path.exists() {
+            missing.push(stage);
+            continue;
+        }
+        let session = open_stage(options, stage, &records, true)?;
+        match session.complete_entries() {
+            Some(entries) => {
+                loaded.insert(stage, (path, entries.into_iter().cloned().collect()));
+            }
+            None => missing.push(stage),
+        }
+    }
+    if !missing.is_empty() {
+        return Ok(Outcome::StagesMissing(missing));
+    }
+    let entries = StageEntries { stages: loaded };
+    let owned = options.output.force() || options.resume || options.stage.is_some();
+    let policy = options.output.with_force(owned);
+    let summary = assemble(
+        &policy,
+        &options.dir,
+        &options.plan,
+        &entries,
+        &records,
+        &options.details,
+    )?;
+    Ok(Outcome::Finished(Box::new(summary)))
+}

@@ -1,0 +1,205 @@
+//! The validation box as a scene file for the renderers, from a geometry, the materials and
+//! the light: the contract of `docs/validation-box.md` with every dimension taken from the
+//! plan's [`Geometry`]. The simulated box and the measured scene are both built here, so
+//! they differ only in what was measured.
+//!
+//! Each light tile is written as its own one-tile emitter carrying its spectral radiance
+//! (W·sr⁻¹·m⁻²·nm⁻¹ along the normal) with `luminance_cd_m2` set to that spectrum's own
+//! luminance, so the renderer's scale factor is 1 and the tile emits exactly the spectrum.
+
+use serde_json::{json, Value};
+
+use super::plan::Geometry;
+use crate::color::{luminance, Outside, Spectrum};
+use crate::render::scene::SceneFile;
+use crate::render::Scene;
+
+/// The chart's frame (mm): 204 wide (along z) × 291 high, 1 mm off the wall.
+const FRAME_W_M: f64 = 0.204;
+const FRAME_H_M: f64 = 0.291;
+const FRAME_OFF_M: f64 = 0.001;
+/// Patches: 40 mm squares on a 46 mm pitch, 1.5 mm off the wall.
+const PATCH_M: f64 = 0.040;
+const PITCH_M: f64 = 0.046;
+const PATCH_OFF_M: f64 = 0.0015;
+/// The frame's flat reflectance (docs/validation-box.md); not measured.
+pub const FRAME_REFLECTANCE: f64 = 0.03;
+
+/// The emitter's angular distribution as the scene file states it.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum DistributionJson {
+    Lambertian,
+    CosPower { exponent: f64 },
+}
+
+/// What fills the box.
+#[derive(Clone, Debug)]
+pub struct BoxContents {
+    /// The wall paper's reflectance.
+    pub wall: Spectrum,
+    /// Reflectances of ColorChecker patches 1–24, in order.
+    pub patches: Vec<Spectrum>,
+    /// Each tile's spectral radiance along the normal, row-major (row 0 at the top).
+    pub tiles: Vec<Spectrum>,
+    pub distribution: DistributionJson,
+}
+
+fn inline(s: &Spectrum) -> Value {
+    json!({
+        "nm": s.wavelengths_nm(),
+        "values": s.values(),
+        "outside": match s.outside() { Outside::Zero => "zero", Outside::HoldEnds => "hold_ends" },
+    })
+}
+
+fn surface(name: &str, corner: [f64; 3], u: [f64; 3], v: [f64; 3], refl: Value) -> Value {
+    json!({"name": name, "corner": corner, "edge_u": u, "edge_v": v, "reflectance": refl})
+}
+
+/// The chart's centre on the right wall.
+pub fn chart_centre(g: &Geometry) -> [f64; 3] {
+    [g.size_m - FRAME_OFF_M, g.size_m / 2.0, g.size_m / 2.0]
+}
+
+/// The scene file of the box.
+pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) -> Value {
+    let s = g.size_m;
+    let [y0, y1, z0, z1] = g.light_m;
+    let wall = inline(&c.wall);
+    let mut surfaces = vec![
+        surface(
+            "floor",
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, s],
+            [s, 0.0, 0.0],
+            wall.clone(),
+        ),
+        surface(
+            "ceiling",
+            [0.0, s, 0.0],
+            [s, 0.0, 0.0],
+            [0.0, 0.0, s],
+            wall.clone(),
+        ),
+        surface(
+            "back wall",
+            [0.0, 0.0, s],
+            [0.0, s, 0.0],
+            [s, 0.0, 0.0],
+            wall.clone(),
+        ),
+        surface(
+            "right wall",
+            [s, 0.0, 0.0],
+            [0.0, 0.0, s],
+            [0.0, s, 0.0],
+            wall.clone(),
+        ),
+    ];
+    // The left wall around the light opening, in up to four pieces.
+    let left = [
+        (
+            "left wall below the light",
+            [0.0, 0.0, 0.0],
+            [0.0, y0, 0.0],
+            [0.0, 0.0, s],
+        ),
+        (
+            "left wall above the light",
+            [0.0, y1, 0.0],
+            [0.0, s - y1, 0.0],
+            [0.0, 0.0, s],
+        ),
+        (
+            "left wall in front of the light",
+            [0.0, y0, 0.0],
+            [0.0, y1 - y0, 0.0],
+            [0.0, 0.0, z0],
+        ),
+        (
+            "left wall behind the light",
+            [0.0, y0, z1],
+            [0.0, y1 - y0, 0.0],
+            [0.0, 0.0, s - z1],
+        ),
+    ];
+    for (n, corner, u, v) in left {
+        let area = (u[1] * v[2]).abs();
+        if area > 1e-12 {
+            surfaces.push(surface(n, corner, u, v, wall.clone()));
+        }
+    }
+    let centre = chart_centre(g);
+    surfaces.push(surface(
+        "chart frame",
+        [
+            centre[0],
+            centre[1] - FRAME_H_M / 2.0,
+            centre[2] - FRAME_W_M / 2.0,
+        ],
+        [0.0, 0.0, FRAME_W_M],
+        [0.0, FRAME_H_M, 0.0],
+        json!(FRAME_REFLECTANCE),
+    ));
+    for (i, refl) in c.patches.iter().enumerate() {
+        let (r, col) = ((i / 6) as f64, (i % 6) as f64);
+        let z = centre[2] + (r - 1.5) * PITCH_M;
+        let y = centre[1] + (2.5 - col) * PITCH_M;
+        let mut p = surface(
+            &format!("patch {}", i + 1),
+            [s - PATCH_OFF_M, y - PATCH_M / 2.0, z - PATCH_M / 2.0],
+            [0.0, 0.0, PATCH_M],
+            [0.0, PATCH_M, 0.0],
+            inline(refl),
+        );
+        p["patch"] = json!(i + 1);
+        surfaces.push(p);
+    }
+    let (h, w) = ((y1 - y0) / g.rows as f64, (z1 - z0) / g.cols as f64);
+    let emitters: Vec<Value> = c
+        .tiles
+        .iter()
+        .enumerate()
+        .map(|(i, spectrum)| {
+            let (row, col) = ((i / g.cols) as f64, (i % g.cols) as f64);
+            json!({
+                "corner": [0.0, y1 - row * h, z0 + col * w],
+                "edge_u": [0.0, 0.0, w],
+                "edge_v": [0.0, -h, 0.0],
+                "spectrum": inline(spectrum),
+                "luminance_cd_m2": luminance(spectrum),
+                "distribution": c.distribution,
+            })
+        })
+        .collect();
+    json!({
+        "name": name,
+        "description": description,
+        "surfaces": surfaces,
+        "emitters": emitters,
+        "camera": {
+            "position": g.viewpoint_m,
+            "look_at": centre,
+            "up": [0.0, 1.0, 0.0],
+            "vfov_deg": 15.71,
+            "width": 1014,
+            "height": 1014,
+        },
+        "meter": {"acceptance_deg": g.acceptance_deg},
+    })
+}
+
+/// A scene file that does not make a scene: a fault of this module, said with the JSON
+/// path the renderer names.
+#[derive(Debug, thiserror::Error)]
+#[error("the box's scene is not a valid scene: {0}")]
+pub struct BuildError(pub String);
+
+/// The render-ready scene of a scene file.
+pub fn build(value: &Value) -> Result<Scene, BuildError> {
+    let file: SceneFile =
+        serde_json::from_value(value.clone()).map_err(|e| BuildError(e.to_string()))?;
+    Scene::build(&file, std::path::Path::new("."))
+        .map_err(|(path, message)| BuildError(format!("{path}: {message}")))
+}

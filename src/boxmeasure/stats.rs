@@ -1,0 +1,252 @@
+//! Repeated readings of one target: their mean, their spread against what the instrument's
+//! noise allows, and the readings that lie too far off to be noise (outliers).
+//!
+//! The noise model is each instrument's stated repeatability (1σ of one reading):
+//! - CS-100A: ±0.2 % in Y and ±0.001 in x, y (Konica Minolta data sheet, as 2σ), so 0.1 %
+//!   of Y;
+//! - i1Pro, emissive: 0.1 % of Y; reflective: 0.002 absolute per band, i.e. 0.2 in Y on
+//!   the scale where white is 100 (the simulated unit's declared repeatability, matching
+//!   X-Rite's inter-reading figure for the i1Pro).
+//!
+//! An outlier is a reading whose Y lies more than [`OUTLIER_SIGMAS`] noise σ from the median
+//! of its group (the median, not the mean, so the outlier does not hide itself); outliers
+//! are left out of the mean and reported, never dropped silently. A group whose spread
+//! (outliers left out) is beyond what the noise gives once in a thousand groups is flagged
+//! as spreading more than the instrument: the target moved, drifted or was not held still.
+//! The test is χ²: (n − 1)·s²/σ² against its 0.999 quantile with n − 1 degrees of freedom
+//! (Wilson–Hilferty: k·(1 − 2/(9k) + z·√(2/(9k)))³ with z = 3.090, within 3 % of the
+//! tabulated quantile for k = 1 and closer beyond).
+
+use metamer_drivers::{MeasureMode, Reading};
+use serde::{Deserialize, Serialize};
+
+use crate::color::Spectrum;
+
+/// Distance from the median, in noise σ, beyond which a reading is an outlier. At 5σ a
+/// normal reading is flagged about once in 1.7 million.
+pub const OUTLIER_SIGMAS: f64 = 5.0;
+/// The standard normal quantile of 0.999.
+const Z_999: f64 = 3.090_232;
+
+/// The 0.999 quantile of χ² with `k` degrees of freedom (Wilson–Hilferty).
+pub fn chi2_999(k: usize) -> f64 {
+    let k = k as f64;
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + Z_999 * a.sqrt()).powi(3)
+}
+
+/// One reading's noise, 1σ of Y: relative (emissive) or absolute (reflective, Y of white
+/// = 100).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Noise {
+    Relative { sigma: f64 },
+    Absolute { sigma: f64 },
+}
+
+impl Noise {
+    /// The repeatability of `model` in `mode` (models this program drives; others get the
+    /// CS-100A's, the most conservative of them, for emissive and the i1Pro's for
+    /// reflective).
+    pub fn of(model: &str, mode: MeasureMode) -> Noise {
+        match (model, mode) {
+            (_, MeasureMode::Reflective) => Noise::Absolute { sigma: 0.2 },
+            _ => Noise::Relative { sigma: 0.001 },
+        }
+    }
+
+    /// σ of Y for a reading of `y`.
+    pub fn sigma(self, y: f64) -> f64 {
+        match self {
+            Noise::Relative { sigma } => sigma * y.abs(),
+            Noise::Absolute { sigma } => sigma,
+        }
+    }
+}
+
+/// A group of repeated readings reduced.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GroupStats {
+    /// Readings in the group.
+    pub n: usize,
+    /// Mean XYZ of the readings kept.
+    pub xyz: [f64; 3],
+    /// Standard deviation of Y of the readings kept (0 for one reading).
+    pub sd_y: f64,
+    /// The noise σ of Y the instrument allows at this level.
+    pub noise_y: f64,
+    /// Repeat numbers (0-based) left out as outliers.
+    pub outliers: Vec<usize>,
+    /// The readings kept spread more than the noise allows.
+    pub spread_exceeds_noise: bool,
+}
+
+/// Why a group cannot be reduced.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum StatsError {
+    #[error("no readings")]
+    Empty,
+    #[error("reading {repeat} has no spectrum: a spectral instrument is needed here")]
+    NoSpectrum { repeat: usize },
+    #[error("the spectra of reading {repeat} are on other wavelengths than reading 1's")]
+    Grid { repeat: usize },
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+/// Which of the Ys are outliers (needs three readings: with two, neither can be told
+/// from the other).
+fn outliers(ys: &[f64], noise: Noise) -> Vec<usize> {
+    if ys.len() < 3 {
+        return Vec::new();
+    }
+    let m = median(ys);
+    let sigma = noise.sigma(m).max(f64::MIN_POSITIVE);
+    ys.iter()
+        .enumerate()
+        .filter(|(_, y)| ((*y - m) / sigma).abs() > OUTLIER_SIGMAS)
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// Reduces the readings of one target.
+pub fn group(readings: &[&Reading], noise: Noise) -> Result<GroupStats, StatsError> {
+    if readings.is_empty() {
+        return Err(StatsError::Empty);
+    }
+    let ys: Vec<f64> = readings.iter().map(|r| r.xyz[1]).collect();
+    let out = outliers(&ys, noise);
+    let kept: Vec<&Reading> = readings
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !out.contains(i))
+        .map(|(_, r)| *r)
+        .collect();
+    let k = kept.len() as f64;
+    let mut xyz = [0.0; 3];
+    for r in &kept {
+        for (m, v) in xyz.iter_mut().zip(r.xyz) {
+            *m += v / k;
+        }
+    }
+    let sd_y = if kept.len() > 1 {
+        (kept
+            .iter()
+            .map(|r| (r.xyz[1] - xyz[1]).powi(2))
+            .sum::<f64>()
+            / (k - 1.0))
+            .sqrt()
+    } else {
+        0.0
+    };
+    let noise_y = noise.sigma(xyz[1]);
+    Ok(GroupStats {
+        n: readings.len(),
+        xyz,
+        sd_y,
+        noise_y,
+        spread_exceeds_noise: kept.len() > 1
+            && (k - 1.0) * sd_y * sd_y > chi2_999(kept.len() - 1) * noise_y * noise_y,
+        outliers: out,
+    })
+}
+
+/// The mean spectrum of the readings `stats` kept.
+pub fn mean_spectrum(readings: &[&Reading], stats: &GroupStats) -> Result<Spectrum, StatsError> {
+    let mut first: Option<&Spectrum> = None;
+    let mut sum: Vec<f64> = Vec::new();
+    let mut kept = 0usize;
+    for (i, r) in readings.iter().enumerate() {
+        let s = r
+            .spectrum
+            .as_ref()
+            .ok_or(StatsError::NoSpectrum { repeat: i + 1 })?;
+        if stats.outliers.contains(&i) {
+            continue;
+        }
+        match first {
+            None => {
+                first = Some(s);
+                sum = s.values().to_vec();
+            }
+            Some(f) => {
+                if f.wavelengths_nm() != s.wavelengths_nm() {
+                    return Err(StatsError::Grid { repeat: i + 1 });
+                }
+                sum.iter_mut().zip(s.values()).for_each(|(a, b)| *a += b);
+            }
+        }
+        kept += 1;
+    }
+    let f = first.ok_or(StatsError::Empty)?;
+    let values = sum.into_iter().map(|v| v / kept as f64).collect();
+    let mut out = Spectrum::new(f.wavelengths_nm().to_vec(), values)
+        .map_err(|_| StatsError::Grid { repeat: 1 })?
+        .with_outside(f.outside());
+    if let Some(q) = f.quantity() {
+        out = out.with_quantity(q);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reading(y: f64) -> Reading {
+        Reading {
+            timestamp_s: 0.0,
+            ..Reading::from_yxy(y, 0.3, 0.3, "cs100a")
+        }
+    }
+
+    #[test]
+    fn a_reading_five_sigma_off_the_median_is_an_outlier_and_left_out_of_the_mean() {
+        let noise = Noise::Relative { sigma: 0.001 };
+        // σ = 0.1 at Y = 100: 100.3 is 3σ off (kept), 101 is 10σ off (outlier).
+        let ys = [100.0, 100.1, 99.9, 100.3, 101.0];
+        let rs: Vec<Reading> = ys.iter().map(|&y| reading(y)).collect();
+        let refs: Vec<&Reading> = rs.iter().collect();
+        let g = group(&refs, noise).unwrap();
+        assert_eq!(g.outliers, vec![4]);
+        assert!((g.xyz[1] - 100.075).abs() < 1e-9, "{g:?}");
+        // sd of 100, 100.1, 99.9, 100.3 = 0.1708: 3·0.1708²/0.1² = 8.75 < χ²(3) 16.27.
+        assert!((g.sd_y - 0.170_782_512_765_993_3).abs() < 1e-9, "{g:?}");
+        assert!(!g.spread_exceeds_noise);
+    }
+
+    #[test]
+    fn a_spread_beyond_the_noise_is_flagged_and_two_readings_have_no_outlier() {
+        let noise = Noise::Absolute { sigma: 0.2 };
+        let rs: Vec<Reading> = [20.0, 21.0].iter().map(|&y| reading(y)).collect();
+        let refs: Vec<&Reading> = rs.iter().collect();
+        let g = group(&refs, noise).unwrap();
+        assert!(g.outliers.is_empty());
+        // sd = 0.7071: 1·0.5/0.04 = 12.5 > χ²(1) ≈ 11.
+
+        assert!(g.spread_exceeds_noise, "{g:?}");
+        let rs: Vec<Reading> = [20.0, 20.6].iter().map(|&y| reading(y)).collect();
+        let refs: Vec<&Reading> = rs.iter().collect();
+        // sd = 0.4243: 0.18/0.04 = 4.5, within the noise.
+        assert!(!group(&refs, noise).unwrap().spread_exceeds_noise);
+        assert_eq!(group(&[], noise).unwrap_err(), StatsError::Empty);
+    }
+
+    #[test]
+    fn the_chi2_quantile_is_near_the_table() {
+        // 0.999 quantiles of χ² (NIST/SEMATECH e-Handbook, table 1.3.6.7.4).
+        for (k, want) in [(1, 10.828), (4, 18.467), (10, 29.588), (30, 59.703)] {
+            let got = chi2_999(k);
+            assert!((got / want - 1.0).abs() < 0.035, "{k}: {got} vs {want}");
+        }
+    }
+}
