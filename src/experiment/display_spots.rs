@@ -67,17 +67,31 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
     }
 }
 
+/// What the display-spots session reads, and how.
+pub struct SpotSession<'a> {
+    pub setting: &'a DisplaySetting,
+    /// The spot meter as named by the user.
+    pub spot_spec: &'a str,
+    pub drives: &'a [PatchDrive],
+    pub repeats: usize,
+    pub resume: bool,
+    pub run: &'a RunOptions,
+}
+
 /// Shows and reads every patch into `dir`.
 pub fn measure(
     dir: &Path,
-    setting: &DisplaySetting,
-    spot_spec: &str,
-    drives: &[PatchDrive],
-    repeats: usize,
-    resume: bool,
-    run: &RunOptions,
+    s: &SpotSession<'_>,
     progress: &dyn Fn(Progress),
 ) -> Result<(Vec<PatchStat>, Vec<&'static str>), ExperimentError> {
+    let SpotSession {
+        setting,
+        spot_spec,
+        drives,
+        repeats,
+        resume,
+        run,
+    } = *s;
     let mut screen = open_screen(&setting.screen, setting.virtual_white_cd_m2)?;
     let mut meter = open_meter(spot_spec, screen.as_ref())?;
     // A real monitor takes a moment to settle after a change; a simulated one does not.

@@ -315,16 +315,15 @@ fn run_stage(
                 read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
             let setting: DisplaySetting =
                 read_json(&stage_path(opts, Stage::Display, display::SETTING_FILE))?;
-            let (_, files) = display_spots::measure(
-                &sd.dir,
-                &setting,
-                &opts.display.spot,
-                &r.patches,
-                opts.repeats,
-                opts.resume,
-                &opts.run,
-                progress,
-            )?;
+            let session = display_spots::SpotSession {
+                setting: &setting,
+                spot_spec: &opts.display.spot,
+                drives: &r.patches,
+                repeats: opts.repeats,
+                resume: opts.resume,
+                run: &opts.run,
+            };
+            let (_, files) = display_spots::measure(&sd.dir, &session, progress)?;
             Ok(owned(files))
         }
         Stage::Validation => {
