@@ -8,9 +8,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::color::{delta_e2000, delta_e76, Xyz, COLORCHECKER_NAMES};
 
+use super::error::ValidationError;
 use super::propagate::{percentiles, propagate, Interval, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
-use super::{ValidationError, JND_DE76};
+
+/// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
+pub const JND_DE76: f64 = 2.3;
 
 /// What the interval of a patch's ΔE*ab says about the JND.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{Comparison, ValidationError, JND_DE76};
+use super::assess::JND_DE76;
+use super::error::ValidationError;
+use super::Comparison;
 
 /// Writes the per-patch ΔE chart of `comparison` to `file` (SVG).
 pub fn write_delta_e_chart(comparison: &Comparison, file: &Path) -> Result<(), ValidationError> {

@@ -8,8 +8,8 @@ use serde::Serialize;
 use crate::output::OutputPolicy;
 
 use super::assess::Assessment;
+use super::error::ValidationError;
 use super::report::{render_html, ReportInput};
-use super::ValidationError;
 
 /// The file names inside the output directory.
 pub const JSON_FILE: &str = "validation.json";

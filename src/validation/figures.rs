@@ -9,8 +9,8 @@ use std::fmt::Write;
 
 use crate::color::{Lab, Xyz};
 
+use super::assess::JND_DE76;
 use super::assess::{Assessment, JndVerdict};
-use super::JND_DE76;
 
 /// Escapes text for HTML and SVG.
 pub fn esc(s: &str) -> String {

@@ -8,6 +8,7 @@
 
 pub mod assess;
 mod chart;
+mod error;
 pub mod export;
 pub mod figures;
 pub mod propagate;
@@ -18,15 +19,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz, COLORCHECKER_NAMES};
 
-pub use assess::{assess, AssessOptions, Assessment, JndVerdict, PatchAssessment};
+pub use assess::{assess, AssessOptions, Assessment, JndVerdict, PatchAssessment, JND_DE76};
 pub use chart::{write_delta_e_chart, write_delta_e_chart_shaded};
+pub use error::ValidationError;
 pub use export::write_report_files;
 pub use propagate::Propagation;
 pub use readings::{read_readings, ReadingSet, ReadingsError};
 pub use report::{render_html, ReportInput};
-
-/// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
-pub const JND_DE76: f64 = 2.3;
 
 /// One patch compared.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -57,35 +56,6 @@ pub struct Comparison {
     pub max_de00: f64,
     /// How many patches differ by less than [`JND_DE76`].
     pub below_jnd: usize,
-}
-
-/// What can be wrong with the inputs of a comparison.
-#[derive(Debug, thiserror::Error)]
-pub enum ValidationError {
-    #[error(
-        "the two sets of readings differ in length: {reference} reference vs {test} test readings"
-    )]
-    LengthMismatch { reference: usize, test: usize },
-    #[error("{} and {} have no patch in common to compare", reference.display(), test.display())]
-    NoCommonPatches {
-        reference: std::path::PathBuf,
-        test: std::path::PathBuf,
-    },
-    #[error("reference white {white:?} must have positive X, Y and Z")]
-    BadWhite { white: [f64; 3] },
-    #[error("cannot write {file}: {source}")]
-    Write {
-        file: std::path::PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error(transparent)]
-    Output(#[from] crate::output::OutputError),
-    #[error("cannot draw the chart {file}: {message}")]
-    Chart {
-        file: std::path::PathBuf,
-        message: String,
-    },
 }
 
 /// Compares `test` against `reference`, patch by patch, in CIELAB relative to `white`.

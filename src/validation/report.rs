@@ -7,10 +7,10 @@ use std::fmt::Write;
 
 use serde::{Deserialize, Serialize};
 
+use super::assess::JND_DE76;
 use super::assess::{Assessment, JndVerdict, PatchAssessment};
 use super::figures::{delta_e_bars, esc, lab_planes, srgb_swatch};
 use super::readings::UncertaintySource;
-use super::JND_DE76;
 
 /// Everything a report can show. `box_vs_display` is the paper's result and always there;
 /// the rest is drawn when given.

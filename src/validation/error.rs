@@ -1,0 +1,30 @@
+//! What can go wrong comparing readings and writing the report.
+
+/// What can be wrong with the inputs of a comparison.
+#[derive(Debug, thiserror::Error)]
+pub enum ValidationError {
+    #[error(
+        "the two sets of readings differ in length: {reference} reference vs {test} test readings"
+    )]
+    LengthMismatch { reference: usize, test: usize },
+    #[error("{} and {} have no patch in common to compare", reference.display(), test.display())]
+    NoCommonPatches {
+        reference: std::path::PathBuf,
+        test: std::path::PathBuf,
+    },
+    #[error("reference white {white:?} must have positive X, Y and Z")]
+    BadWhite { white: [f64; 3] },
+    #[error("cannot write {file}: {source}")]
+    Write {
+        file: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error("cannot draw the chart {file}: {message}")]
+    Chart {
+        file: std::path::PathBuf,
+        message: String,
+    },
+}
