@@ -11,6 +11,7 @@ pub mod display;
 pub mod lab;
 pub mod light;
 pub mod numeric_csv;
+pub mod output;
 pub mod plot;
 pub mod render;
 pub mod rig;
