@@ -97,7 +97,8 @@ fn the_ideal_display_reproduces_the_simulation() {
     );
     assert_eq!(std::fs::read(dir.join("display/log.jsonl")).unwrap(), log);
 
-    // With --resume the characterization is taken from its log; nothing is re-measured.
+    // With --resume a finished run is read back: nothing is rendered, measured or written.
+    let lab_json = std::fs::read(dir.join("lab.json")).unwrap();
     let resumed = quick_lab(
         dir.to_str().unwrap(),
         &[
@@ -114,6 +115,29 @@ fn the_ideal_display_reproduces_the_simulation() {
         String::from_utf8_lossy(&resumed.stderr)
     );
     assert_eq!(std::fs::read(dir.join("display/log.jsonl")).unwrap(), log);
+    assert_eq!(std::fs::read(dir.join("lab.json")).unwrap(), lab_json);
+    let said = String::from_utf8_lossy(&resumed.stdout);
+    assert!(
+        said.contains("nothing to resume") && said.contains("display_vs_box: "),
+        "{said}"
+    );
+    // Resuming it with another seed would mix two runs: refused, naming the option.
+    let other = quick_lab(
+        dir.to_str().unwrap(),
+        &[
+            "--display",
+            "ideal-crt",
+            "--model",
+            "plcc-gamma",
+            "--seed",
+            "2",
+            "--resume",
+        ],
+    );
+    assert_eq!(other.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(err.contains("its --seed is 1, this one's is 2"), "{err}");
+    assert_eq!(std::fs::read(dir.join("lab.json")).unwrap(), lab_json);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
