@@ -90,9 +90,12 @@ pub fn run(args: Args) -> CliResult {
         // Before a full-screen window or an instrument is opened for nothing.
         refuse_existing(&log_path(&args.out))
             .map_err(|e| translate(CharacterizeError::Session(SessionError::Journal(e))))?;
-        let out = OutputPolicy::new(args.force);
-        for f in files(&args.out, &log_path(&args.out)).outputs() {
-            out.check(f)?;
+        // Files another session left in the directory (a new directory has none).
+        if args.out.is_dir() {
+            let out = OutputPolicy::new(args.force);
+            for f in files(&args.out, &log_path(&args.out)).outputs() {
+                out.check(f)?;
+            }
         }
     }
 
