@@ -436,3 +436,35 @@ fn usage_and_environment_errors() {
         text(&o.stderr)
     );
 }
+
+#[test]
+fn a_log_that_holds_no_session_says_what_to_do_and_resume_sets_it_aside() {
+    let dir = temp_dir("broken");
+    let d = dir.to_str().unwrap();
+    std::fs::create_dir_all(&dir).unwrap();
+    // A crash while the header was written leaves a cut-off first line.
+    std::fs::write(dir.join("log.jsonl"), r#"{"type":"header","form"#).unwrap();
+    let args = [IPS, &["--ramp-steps", "3", "-o", d]].concat();
+    let o = metamer(&args);
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("holds no session to continue: its header line was cut off after 22 bytes")
+            && err.contains("run with --resume to set it aside"),
+        "{err}"
+    );
+    let o = metamer(&[args.as_slice(), &["--resume"]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("log.jsonl.broken-1"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("log.jsonl.broken-1")).unwrap(),
+        r#"{"type":"header","form"#
+    );
+    // Black, primaries, white; one level inside each of 4 ramps; 48 held out; the key 5 again.
+    assert_eq!(summary(&dir)["readings"], 5 + 4 + 48 + 5);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -248,4 +248,25 @@ mod tests {
         }
         std::fs::remove_dir_all(&dir).ok();
     }
+
+    /// An encoding that fails half-way (here: fewer pixels than the size says) leaves the
+    /// file it would have replaced as it was, and nothing beside it.
+    #[test]
+    fn a_failed_encoding_leaves_the_existing_file() {
+        let dir = std::env::temp_dir().join(format!("metamer-imgfail-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("preview.png");
+        std::fs::write(&p, "the earlier preview").unwrap();
+        let short = XyzImage {
+            width: 4,
+            height: 4,
+            pixels: vec![[1.0; 3]; 3],
+        };
+        let e = write_srgb_preview(&p, &short, 1.0, &OutputPolicy::new(true)).unwrap_err();
+        assert!(matches!(e, ImageIoError::Png { .. }), "{e}");
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "the earlier preview");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }
