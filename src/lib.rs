@@ -8,6 +8,7 @@
 
 pub mod color;
 pub mod display;
+pub mod experiment;
 pub mod lab;
 pub mod light;
 pub mod numeric_csv;
