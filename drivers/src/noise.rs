@@ -92,7 +92,9 @@ mod tests {
         assert_eq!(b.next_stream(9).next_u64(), second);
         // By the definition: three mixes of seed, index and count.
         let m = SplitMix64::mix;
-        assert_eq!(first, SplitMix64::new(m(m(m(9) ^ 42) ^ 0)).next_u64());
+        // Count 0 for the first (x ^ 0 = x), 1 for the second.
+        assert_eq!(first, SplitMix64::new(m(m(m(9) ^ 42))).next_u64());
+        assert_eq!(second, SplitMix64::new(m(m(m(9) ^ 42) ^ 1)).next_u64());
         assert_ne!(first, second);
         b.seek(43);
         assert_ne!(b.next_stream(9).next_u64(), first);

@@ -200,17 +200,13 @@ fn translate(e: CharacterizeError) -> CliError {
             "{} was measured with a {logged}, this session has a {now}: resume with the instrument it was started with (--instrument), or choose another output directory",
             path.display()
         )),
-        CharacterizeError::Session(SessionError::InstrumentSettingDiffers {
-            path,
-            model,
-            setting,
-            logged,
-            now,
-            ..
-        }) => Some(format!(
-            "{} was measured with a {model} whose {} was {logged}, this session's is {now}: resume with the settings it was started with, or choose another output directory",
-            path.display(),
-            setting_flag(setting)
+        CharacterizeError::Session(SessionError::InstrumentSettingDiffers(d)) => Some(format!(
+            "{} was measured with a {} whose {} was {}, this session's is {}: resume with the settings it was started with, or choose another output directory",
+            d.path.display(),
+            d.model,
+            setting_flag(&d.setting),
+            d.logged,
+            d.now
         )),
         CharacterizeError::Session(SessionError::Step {
             index,

@@ -68,6 +68,8 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
 }
 
 /// Shows and reads every patch into `dir`.
+// Eight plain inputs of one stage; bundling them would only move the list into a struct.
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     dir: &Path,
     setting: &DisplaySetting,

@@ -46,15 +46,8 @@ pub enum SessionError {
     },
     /// The same model, but readings taken another way (another unit, speed, integration
     /// time, or a simulation's seed, noise or time scale) would not be comparable.
-    #[error("{} was written with {role} instrument {model} whose {setting} was {logged}; this session's is {now}; resume with the settings it was started with, or choose another output directory", path.display())]
-    InstrumentSettingDiffers {
-        path: PathBuf,
-        role: String,
-        model: String,
-        setting: String,
-        logged: String,
-        now: String,
-    },
+    #[error("{} was written with {} instrument {} whose {} was {}; this session's is {}; resume with the settings it was started with, or choose another output directory", .0.path.display(), .0.role, .0.model, .0.setting, .0.logged, .0.now)]
+    InstrumentSettingDiffers(Box<SettingDiffers>),
     /// The rig cannot take a step of the plan; found before anything is measured.
     #[error("step {} ({label}) {need}; nothing was measured", index + 1)]
     RigLacks {
@@ -72,6 +65,17 @@ pub enum SessionError {
         journal: PathBuf,
         source: Box<StepFailure>,
     },
+}
+
+/// Which setting of which instrument differs between a journal and the session resuming it.
+#[derive(Debug)]
+pub struct SettingDiffers {
+    pub path: PathBuf,
+    pub role: String,
+    pub model: String,
+    pub setting: String,
+    pub logged: String,
+    pub now: String,
 }
 
 /// How to run.
@@ -399,14 +403,14 @@ fn same_instrument(
     }
     let differs = |setting: &str, a: Option<&String>, b: Option<&String>| {
         let shown = |v: Option<&String>| v.cloned().unwrap_or_else(|| "(not set)".into());
-        SessionError::InstrumentSettingDiffers {
+        SessionError::InstrumentSettingDiffers(Box::new(SettingDiffers {
             path: path.to_path_buf(),
             role: role.to_string(),
             model: now.info.model.clone(),
             setting: setting.to_string(),
             logged: shown(a),
             now: shown(b),
-        }
+        }))
     };
     if logged.info.serial != now.info.serial {
         return Err(differs(

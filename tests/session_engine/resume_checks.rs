@@ -4,9 +4,12 @@
 
 use std::time::Duration;
 
-use metamer::session::{RunEnd, RunOptions, Session, SessionError};
+use metamer::session::{InstrumentRecord, RunEnd, RunOptions, Session, SessionError};
 
 use super::{instruments, open, plan, run, temp, Target, TILES};
+
+/// A change to the record of an instrument.
+type Change = dyn Fn(&mut InstrumentRecord);
 
 #[test]
 fn another_setting_or_unit_of_the_same_model_is_refused_by_name() {
@@ -21,7 +24,7 @@ fn another_setting_or_unit_of_the_same_model_is_refused_by_name() {
     );
     assert_eq!(first.end, RunEnd::Stopped { missing: 6 });
     let before = std::fs::read(&path).unwrap();
-    let reopen = |changed: &dyn Fn(&mut metamer::session::InstrumentRecord)| {
+    let reopen = |changed: &Change| {
         let mut now = instruments();
         changed(now.get_mut("spot").unwrap());
         Session::<String, Target>::open(
@@ -35,7 +38,7 @@ fn another_setting_or_unit_of_the_same_model_is_refused_by_name() {
         .expect("refused")
     };
     // An option value (the CS-100A's speed, say), a simulation's seed, a new option.
-    let cases: [(&dyn Fn(&mut metamer::session::InstrumentRecord), &str); 3] = [
+    let cases: [(&Change, &str); 3] = [
         (
             &|r| {
                 r.options.insert("speed".into(), "slow".into());
@@ -56,7 +59,7 @@ fn another_setting_or_unit_of_the_same_model_is_refused_by_name() {
     for (change, says) in cases {
         let e = reopen(change);
         assert!(
-            matches!(e, SessionError::InstrumentSettingDiffers { .. }),
+            matches!(e, SessionError::InstrumentSettingDiffers(_)),
             "{e}"
         );
         let text = e.to_string();
