@@ -12,10 +12,12 @@ mod devices;
 mod experiment;
 mod fit;
 mod lab;
+mod light;
 mod render;
 mod reproduce;
 mod simulate;
 mod spot;
+mod validate;
 mod verify;
 
 /// metamer: prove a rendering is colour-true.
@@ -51,6 +53,10 @@ enum Command {
     Experiment(experiment::Args),
     /// The whole validation chain on the built-in simulated lab: box, simulation, display.
     Lab(lab::Args),
+    /// The light source's distribution: fit it to fall-off readings, export and read IES/LDT.
+    Light(light::Args),
+    /// Box vs display (vs simulation) readings in CIELAB with uncertainty: table and report.
+    Validate(validate::Args),
     /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
     Simulate(simulate::Args),
 }
@@ -84,6 +90,8 @@ pub fn main() -> ExitCode {
         Command::Lab(args) => lab::run(args),
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Light(args) => light::run(args),
+        Command::Validate(args) => validate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

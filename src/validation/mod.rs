@@ -1,14 +1,29 @@
 //! Validation: readings of the same 24 ColorChecker patches from two sources (the real box,
 //! the display showing the rendering, the simulation) compared in CIELAB with the display's
 //! white as reference white, as in the paper (JND ΔE*ab ≈ 2.3; CIEDE2000 reported too).
+//!
+//! [`compare`] is the plain comparison of two lists of XYZ (the simulated lab's); `validate`
+//! reads measured files ([`readings`]), propagates their uncertainty ([`propagate`],
+//! [`assess`]) and writes the report ([`figures`], [`report`], [`export`]).
 
+pub mod assess;
 mod chart;
+pub mod export;
+pub mod figures;
+pub mod propagate;
+pub mod readings;
+pub mod report;
 
 use serde::{Deserialize, Serialize};
 
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz, COLORCHECKER_NAMES};
 
+pub use assess::{assess, AssessOptions, Assessment, JndVerdict, PatchAssessment};
 pub use chart::{write_delta_e_chart, write_delta_e_chart_shaded};
+pub use export::write_report_files;
+pub use propagate::Propagation;
+pub use readings::{read_readings, ReadingSet, ReadingsError};
+pub use report::{render_html, ReportInput};
 
 /// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
 pub const JND_DE76: f64 = 2.3;
@@ -51,6 +66,11 @@ pub enum ValidationError {
         "the two sets of readings differ in length: {reference} reference vs {test} test readings"
     )]
     LengthMismatch { reference: usize, test: usize },
+    #[error("{} and {} have no patch in common to compare", reference.display(), test.display())]
+    NoCommonPatches {
+        reference: std::path::PathBuf,
+        test: std::path::PathBuf,
+    },
     #[error("reference white {white:?} must have positive X, Y and Z")]
     BadWhite { white: [f64; 3] },
     #[error("cannot write {file}: {source}")]
@@ -59,6 +79,8 @@ pub enum ValidationError {
         #[source]
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
     #[error("cannot draw the chart {file}: {message}")]
     Chart {
         file: std::path::PathBuf,

@@ -1,0 +1,67 @@
+//! Why a fall-off cannot be fitted.
+
+use std::path::PathBuf;
+
+use super::half::{HalfPlane, Plane};
+use super::models::LdcModel;
+use crate::light::cgamma::CGammaError;
+
+/// Why the fall-off cannot be fitted.
+#[derive(Debug, thiserror::Error)]
+pub enum LdcError {
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{file}:{line}: {message}")]
+    Csv {
+        file: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("the {plane} plane has no readings")]
+    EmptyPlane { plane: Plane },
+    #[error("the {plane} plane has {angles} angles but {readings} readings")]
+    LengthMismatch {
+        plane: Plane,
+        angles: usize,
+        readings: usize,
+    },
+    #[error("the {plane} plane: angle {angle}° is not within (−90°, 90°) (the light is seen from the front)")]
+    AngleOutOfRange { plane: Plane, angle: f64 },
+    #[error("the {plane} plane: angle {angle}° after {previous}°: angles must increase strictly (no repeats)")]
+    AnglesNotIncreasing {
+        plane: Plane,
+        previous: f64,
+        angle: f64,
+    },
+    #[error("the {plane} plane at {angle}°: luminance {value} must be finite and ≥ 0")]
+    BadLuminance {
+        plane: Plane,
+        angle: f64,
+        value: f64,
+    },
+    #[error("the {plane} plane has no reading at 0° (the normal), which the distribution is relative to")]
+    NoNormalReading { plane: Plane },
+    #[error(
+        "the {plane} plane reads 0 at the normal: the distribution cannot be made relative to it"
+    )]
+    ZeroNormalReading { plane: Plane },
+    #[error(
+        "half-plane {half}: {got} angle(s) off the normal, the {model} model needs at least {need}"
+    )]
+    TooFewAngles {
+        half: HalfPlane,
+        model: LdcModel,
+        got: usize,
+        need: usize,
+    },
+    #[error("no model could be cross-validated: every half-plane needs at least 2 angles off the normal")]
+    NothingToChoose,
+    #[error("cannot draw the chart: {message}")]
+    Chart { message: String },
+    #[error("the fitted distribution is not a valid C-γ table: {0}")]
+    Table(#[from] CGammaError),
+}

@@ -1,0 +1,293 @@
+//! The light distribution curve (LDC) fit: from readings of the light source's luminance in
+//! the horizontal and vertical plane to the emitter's relative luminance f(C, γ).
+//!
+//! Each of the four half-planes (C0, C90, C180, C270) gets its own parameters of one model
+//! family, since a panel seen from the left need not look like one seen from the right.
+//! Between the half-planes f is blended with the weights of an ellipse:
+//!
+//! f(C, γ) = cos²C · f_h(γ) + sin²C · f_v(γ)
+//!
+//! where f_h is the C0 fit for cos C ≥ 0 and the C180 fit otherwise, f_v the C90 fit for
+//! sin C ≥ 0 and the C270 fit otherwise. The blend is exact in the measured planes, smooth
+//! across them (no kink at C = 0°, 90°, …) and, to second order in γ, what any smooth
+//! distribution symmetric about both planes is. The [`CGammaTable`] written holds this f
+//! every 5° in C and every 1° in γ (values rounded to 10⁻⁶, clamped at 0).
+
+pub mod cv;
+pub mod error;
+pub mod half;
+pub mod models;
+pub mod planes;
+
+use serde::{Deserialize, Serialize};
+
+pub use error::LdcError;
+pub use half::{HalfPlane, Plane};
+pub use models::{LdcModel, Params};
+pub use planes::{Falloff, PlaneData};
+
+use super::cgamma::{CGammaError, CGammaTable};
+
+/// Which model to fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelChoice {
+    /// The model with the best leave-one-out score (see [`cv::choose`]).
+    Auto,
+    Named(LdcModel),
+}
+
+impl std::str::FromStr for ModelChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim().eq_ignore_ascii_case("auto") {
+            return Ok(ModelChoice::Auto);
+        }
+        s.parse::<LdcModel>()
+            .map(ModelChoice::Named)
+            .map_err(|e| format!("{e}, or auto"))
+    }
+}
+
+/// One half-plane's fit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HalfFit {
+    pub half: HalfPlane,
+    pub params: Params,
+    /// RMS of the fit's residuals at this half's off-normal angles (relative luminance).
+    pub rms: f64,
+}
+
+/// One model's fit and score, whether chosen or not.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Candidate {
+    pub model: LdcModel,
+    /// Per half-plane in C0, C90, C180, C270 order; empty when the model could not be
+    /// fitted (see `note`).
+    pub halves: Vec<HalfFit>,
+    /// RMS of the residuals over every off-normal angle.
+    pub rms: Option<f64>,
+    /// RMS and largest magnitude of the leave-one-out errors over every off-normal angle.
+    pub cv_rms: Option<f64>,
+    pub cv_max: Option<f64>,
+    pub note: Option<String>,
+}
+
+/// One reading against the chosen model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Residual {
+    pub plane: Plane,
+    pub angle_deg: f64,
+    /// The reading divided by the normal luminance.
+    pub measured: f64,
+    pub fitted: f64,
+    /// measured − fitted.
+    pub residual: f64,
+}
+
+/// The fit: the chosen model, its parameters, residuals, every model's scores, and the
+/// table the renderers and the IES/LDT writers use.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LdcFit {
+    pub model: LdcModel,
+    /// The chosen model per half-plane, C0, C90, C180, C270.
+    pub halves: Vec<HalfFit>,
+    pub residuals: Vec<Residual>,
+    pub candidates: Vec<Candidate>,
+    /// Why this model: the named one, or `auto`'s reason.
+    pub why: String,
+    /// The mean of both planes' readings at 0°, in the readings' unit.
+    pub normal_luminance: f64,
+    /// Each plane's reading at 0° (horizontal, vertical).
+    pub normal_readings: [f64; 2],
+    pub table: CGammaTable,
+}
+
+/// C-plane step of the table written, degrees.
+pub const TABLE_C_STEP: f64 = 5.0;
+/// γ step of the table written, degrees.
+pub const TABLE_GAMMA_STEP: f64 = 1.0;
+
+/// Fits `falloff` with the chosen model (or picks one by cross-validation).
+pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
+    let normal_readings = falloff.validate()?;
+    let l0 = (normal_readings[0] + normal_readings[1]) / 2.0;
+    let halves: Vec<(Vec<f64>, Vec<f64>)> = HalfPlane::ALL
+        .iter()
+        .map(|&h| {
+            let (g, l) = falloff.half(h);
+            (g, l.into_iter().map(|v| v / l0).collect())
+        })
+        .collect();
+    let candidates: Vec<Candidate> = LdcModel::ALL
+        .iter()
+        .map(|&m| candidate(m, &halves))
+        .collect();
+    let (chosen, why) = match choice {
+        ModelChoice::Named(m) => {
+            let need = m.parameters().max(1);
+            for (&h, (g, _)) in HalfPlane::ALL.iter().zip(&halves) {
+                if g.len() < need {
+                    return Err(LdcError::TooFewAngles {
+                        half: h,
+                        model: m,
+                        got: g.len(),
+                        need,
+                    });
+                }
+            }
+            let i = LdcModel::ALL.iter().position(|&x| x == m).unwrap_or(0);
+            (i, format!("{m}: named"))
+        }
+        ModelChoice::Auto => {
+            let scores: Vec<(LdcModel, Option<f64>)> =
+                candidates.iter().map(|c| (c.model, c.cv_rms)).collect();
+            cv::choose(&scores).ok_or(LdcError::NothingToChoose)?
+        }
+    };
+    let chosen_halves = candidates[chosen].halves.clone();
+    let model = candidates[chosen].model;
+    let mut residuals = Vec::new();
+    for plane in [Plane::Horizontal, Plane::Vertical] {
+        let data = falloff.plane(plane);
+        for (&a, &l) in data.angles_deg.iter().zip(&data.luminance) {
+            let fitted = eval_halves(&chosen_halves, plane_c(plane, a), a.abs());
+            let measured = l / l0;
+            residuals.push(Residual {
+                plane,
+                angle_deg: a,
+                measured,
+                fitted,
+                residual: measured - fitted,
+            });
+        }
+    }
+    let table = build_table(&chosen_halves)?;
+    Ok(LdcFit {
+        model,
+        halves: chosen_halves,
+        residuals,
+        candidates,
+        why,
+        normal_luminance: l0,
+        normal_readings,
+        table,
+    })
+}
+
+impl LdcFit {
+    /// f(C, γ) from the fitted parameters (the table holds this on its grid).
+    pub fn relative(&self, c_deg: f64, gamma_deg: f64) -> f64 {
+        eval_halves(&self.halves, c_deg, gamma_deg)
+    }
+
+    /// The chosen model's candidate entry (its RMS and CV scores).
+    pub fn chosen(&self) -> Option<&Candidate> {
+        self.candidates.iter().find(|c| c.model == self.model)
+    }
+}
+
+/// The C of a signed angle in a measured plane.
+pub fn plane_c(plane: Plane, angle_deg: f64) -> f64 {
+    match (plane, angle_deg >= 0.0) {
+        (Plane::Horizontal, true) => 0.0,
+        (Plane::Horizontal, false) => 180.0,
+        (Plane::Vertical, true) => 90.0,
+        (Plane::Vertical, false) => 270.0,
+    }
+}
+
+fn candidate(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Candidate {
+    let need = model.parameters().max(1);
+    let mut out = Candidate {
+        model,
+        halves: Vec::new(),
+        rms: None,
+        cv_rms: None,
+        cv_max: None,
+        note: None,
+    };
+    if let Some((h, (g, _))) = HalfPlane::ALL
+        .iter()
+        .zip(halves)
+        .find(|(_, (g, _))| g.len() < need)
+    {
+        out.note = Some(format!(
+            "not fitted: half-plane {h} has {} angle(s) off the normal, needs {need}",
+            g.len()
+        ));
+        return out;
+    }
+    let (mut sq, mut n) = (0.0, 0usize);
+    let mut held_out = Some(Vec::new());
+    for (&h, (g, y)) in HalfPlane::ALL.iter().zip(halves) {
+        let params = models::fit_half(model, g, y);
+        let r: Vec<f64> = g
+            .iter()
+            .zip(y)
+            .map(|(&gi, &yi)| yi - params.eval(gi))
+            .collect();
+        let half_sq: f64 = r.iter().map(|e| e * e).sum();
+        sq += half_sq;
+        n += r.len();
+        out.halves.push(HalfFit {
+            half: h,
+            params,
+            rms: (half_sq / r.len() as f64).sqrt(),
+        });
+        held_out = match (held_out, cv::leave_one_out(model, g, y)) {
+            (Some(mut all), Some(e)) => {
+                all.extend(e);
+                Some(all)
+            }
+            _ => None,
+        };
+    }
+    out.rms = Some((sq / n as f64).sqrt());
+    match held_out {
+        Some(e) => {
+            out.cv_rms = Some((e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt());
+            out.cv_max = Some(e.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        }
+        None => {
+            out.note = Some(format!(
+                "not cross-validated: every half-plane needs {} angles off the normal",
+                model.parameters() + 1
+            ))
+        }
+    }
+    out
+}
+
+/// The elliptic blend of the four half-plane fits (`halves` in C0, C90, C180, C270 order).
+fn eval_halves(halves: &[HalfFit], c_deg: f64, gamma_deg: f64) -> f64 {
+    let c = c_deg.to_radians();
+    let (cos_c, sin_c) = (c.cos(), c.sin());
+    let h = if cos_c >= 0.0 { &halves[0] } else { &halves[2] };
+    let v = if sin_c >= 0.0 { &halves[1] } else { &halves[3] };
+    let (wh, wv) = (cos_c * cos_c, sin_c * sin_c);
+    // Exactly in a measured plane only that plane's fit counts (cos²90° is 4e-33, not 0).
+    if wv < 1e-12 {
+        return h.params.eval(gamma_deg);
+    }
+    if wh < 1e-12 {
+        return v.params.eval(gamma_deg);
+    }
+    wh * h.params.eval(gamma_deg) + wv * v.params.eval(gamma_deg)
+}
+
+fn build_table(halves: &[HalfFit]) -> Result<CGammaTable, CGammaError> {
+    let nc = (360.0 / TABLE_C_STEP).round() as usize;
+    let ng = (90.0 / TABLE_GAMMA_STEP).round() as usize;
+    let c_deg: Vec<f64> = (0..nc).map(|k| k as f64 * TABLE_C_STEP).collect();
+    let gamma_deg: Vec<f64> = (0..=ng).map(|k| k as f64 * TABLE_GAMMA_STEP).collect();
+    let values = c_deg
+        .iter()
+        .map(|&c| {
+            gamma_deg
+                .iter()
+                .map(|&g| (eval_halves(halves, c, g).max(0.0) * 1e6).round() / 1e6)
+                .collect()
+        })
+        .collect();
+    CGammaTable::new(c_deg, gamma_deg, values)
+}

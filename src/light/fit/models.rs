@@ -1,0 +1,368 @@
+//! The fall-off models of one half-plane, f(γ) with f(0) = 1, and their least-squares fits.
+//!
+//! Every model is 1 along the normal by construction, so the normal reading only sets the
+//! scale (the normal luminance) and the fit uses the off-normal angles alone. Residuals are
+//! in relative luminance (reading / normal luminance − model).
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+/// A family of fall-off curves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LdcModel {
+    /// f = 1: the luminance does not depend on the direction.
+    Lambertian,
+    /// f = cosⁿγ.
+    CosPower,
+    /// f = a₀ + a₁·cos γ + a₂·cos²γ with a₀ + a₁ + a₂ = 1 (two free coefficients).
+    CosPoly,
+    /// f = a·cosⁿγ + (1 − a)·cosᵐγ, 0 ≤ a ≤ 1, n ≤ m: a broad and a narrow lobe.
+    Lobes,
+}
+
+impl LdcModel {
+    /// From the fewest free parameters to the most: the order `auto` prefers on a tie.
+    pub const ALL: [LdcModel; 4] = [
+        LdcModel::Lambertian,
+        LdcModel::CosPower,
+        LdcModel::CosPoly,
+        LdcModel::Lobes,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            LdcModel::Lambertian => "lambertian",
+            LdcModel::CosPower => "cos-power",
+            LdcModel::CosPoly => "cos-poly",
+            LdcModel::Lobes => "lobes",
+        }
+    }
+
+    /// Free parameters per half-plane.
+    pub fn parameters(self) -> usize {
+        match self {
+            LdcModel::Lambertian => 0,
+            LdcModel::CosPower => 1,
+            LdcModel::CosPoly => 2,
+            LdcModel::Lobes => 3,
+        }
+    }
+}
+
+impl std::fmt::Display for LdcModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for LdcModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim().to_ascii_lowercase();
+        LdcModel::ALL
+            .into_iter()
+            .find(|m| m.name() == t)
+            .ok_or_else(|| {
+                format!("unknown light distribution model '{s}': expected lambertian, cos-power, cos-poly or lobes")
+            })
+    }
+}
+
+/// The fitted parameters of one half-plane.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "kebab-case")]
+pub enum Params {
+    Lambertian,
+    CosPower {
+        n: f64,
+    },
+    /// Coefficients of 1, cos γ, cos²γ.
+    CosPoly {
+        coeffs: [f64; 3],
+    },
+    Lobes {
+        a: f64,
+        n: f64,
+        m: f64,
+    },
+}
+
+impl Params {
+    pub fn model(&self) -> LdcModel {
+        match self {
+            Params::Lambertian => LdcModel::Lambertian,
+            Params::CosPower { .. } => LdcModel::CosPower,
+            Params::CosPoly { .. } => LdcModel::CosPoly,
+            Params::Lobes { .. } => LdcModel::Lobes,
+        }
+    }
+
+    /// f(γ), γ in degrees within [0, 90]; may be negative for a polynomial extrapolated
+    /// past the data (the table clamps it to 0).
+    pub fn eval(&self, gamma_deg: f64) -> f64 {
+        let c = gamma_deg.to_radians().cos().max(0.0);
+        match *self {
+            Params::Lambertian => 1.0,
+            Params::CosPower { n } => c.powf(n),
+            Params::CosPoly {
+                coeffs: [a0, a1, a2],
+            } => a0 + a1 * c + a2 * c * c,
+            Params::Lobes { a, n, m } => a * c.powf(n) + (1.0 - a) * c.powf(m),
+        }
+    }
+
+    /// The parameters in words, for tables: `n=1.70`, `a=0.60 n=1.00 m=8.00`.
+    pub fn describe(&self) -> String {
+        match *self {
+            Params::Lambertian => "-".into(),
+            Params::CosPower { n } => format!("n={n:.3}"),
+            Params::CosPoly {
+                coeffs: [a0, a1, a2],
+            } => {
+                format!("a0={a0:.3} a1={a1:.3} a2={a2:.3}")
+            }
+            Params::Lobes { a, n, m } => format!("a={a:.3} n={n:.3} m={m:.3}"),
+        }
+    }
+}
+
+/// The largest exponent searched: cos¹⁰⁰ is already below 1 % at 12°, far narrower than
+/// any panel light.
+const MAX_EXPONENT: f64 = 100.0;
+
+/// Least-squares fit of `model` to points (γ in degrees, relative luminance). The caller
+/// guarantees at least `model.parameters()` points.
+pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
+    let c: Vec<f64> = gamma_deg.iter().map(|g| g.to_radians().cos()).collect();
+    match model {
+        LdcModel::Lambertian => Params::Lambertian,
+        LdcModel::CosPower => {
+            let sse = |n: f64| sse(&c, y, |ci| ci.powf(n));
+            Params::CosPower {
+                n: minimise_1d(sse, 0.0, MAX_EXPONENT, 2000),
+            }
+        }
+        LdcModel::CosPoly => fit_cos_poly(&c, y),
+        LdcModel::Lobes => fit_lobes(&c, y),
+    }
+}
+
+fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+    c.iter().zip(y).map(|(&ci, &yi)| (f(ci) - yi).powi(2)).sum()
+}
+
+/// y − 1 = a₁(c − 1) + a₂(c² − 1) is linear in (a₁, a₂); a₀ = 1 − a₁ − a₂.
+fn fit_cos_poly(c: &[f64], y: &[f64]) -> Params {
+    let a = DMatrix::from_fn(c.len(), 2, |i, j| c[i].powi(j as i32 + 1) - 1.0);
+    let b = DVector::from_iterator(y.len(), y.iter().map(|v| v - 1.0));
+    // SVD gives the minimum-norm solution when the points cannot tell the two terms apart
+    // (all at one angle), instead of failing.
+    let x = a
+        .svd(true, true)
+        .solve(&b, 1e-12)
+        .unwrap_or_else(|_| DVector::zeros(2));
+    let (a1, a2) = (x[0], x[1]);
+    Params::CosPoly {
+        coeffs: [1.0 - a1 - a2, a1, a2],
+    }
+}
+
+/// For fixed exponents the best weight is a linear least-squares problem
+/// (y − cᵐ = a·(cⁿ − cᵐ)), so the search runs over (n, m) only: a grid, then Nelder–Mead.
+fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
+    let best_a = |n: f64, m: f64| -> f64 {
+        let (mut uu, mut ur) = (0.0, 0.0);
+        for (&ci, &yi) in c.iter().zip(y) {
+            let (pn, pm) = (ci.powf(n), ci.powf(m));
+            uu += (pn - pm).powi(2);
+            ur += (pn - pm) * (yi - pm);
+        }
+        if uu < 1e-300 {
+            1.0
+        } else {
+            (ur / uu).clamp(0.0, 1.0)
+        }
+    };
+    let cost = |p: [f64; 2]| -> f64 {
+        let n = p[0].clamp(0.0, MAX_EXPONENT);
+        let m = p[1].clamp(0.0, MAX_EXPONENT);
+        let a = best_a(n, m);
+        sse(c, y, |ci| a * ci.powf(n) + (1.0 - a) * ci.powf(m))
+    };
+    // Exponents spaced quadratically: fine where panel lights live (0…10), coarse above.
+    const K: usize = 60;
+    let grid: Vec<f64> = (0..=K)
+        .map(|k| MAX_EXPONENT * (k as f64 / K as f64).powi(2))
+        .collect();
+    let mut best = ([0.0, 0.0], f64::INFINITY);
+    for (i, &n) in grid.iter().enumerate() {
+        for &m in &grid[i..] {
+            let v = cost([n, m]);
+            if v < best.1 {
+                best = ([n, m], v);
+            }
+        }
+    }
+    let step = (MAX_EXPONENT / (K * K) as f64)
+        .max(best.0[1] * 0.1)
+        .max(0.05);
+    let p = nelder_mead(cost, best.0, step, 2000);
+    let (mut n, mut m) = (p[0].clamp(0.0, MAX_EXPONENT), p[1].clamp(0.0, MAX_EXPONENT));
+    if n > m {
+        std::mem::swap(&mut n, &mut m);
+    }
+    let a = best_a(n, m);
+    Params::Lobes { a, n, m }
+}
+
+/// Minimum of `f` on [lo, hi]: the best of `steps` + 1 grid points, then golden-section
+/// search in the two grid cells around it (the sums of squares here are smooth but not
+/// always unimodal over the whole range).
+pub(crate) fn minimise_1d(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize) -> f64 {
+    let h = (hi - lo) / steps as f64;
+    let (mut best_x, mut best_v) = (lo, f64::INFINITY);
+    for k in 0..=steps {
+        let x = lo + h * k as f64;
+        let v = f(x);
+        if v < best_v {
+            (best_x, best_v) = (x, v);
+        }
+    }
+    let (mut a, mut b) = ((best_x - h).max(lo), (best_x + h).min(hi));
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..100 {
+        if f1 < f2 {
+            b = x2;
+            (x2, f2) = (x1, f1);
+            x1 = b - r * (b - a);
+            f1 = f(x1);
+        } else {
+            a = x1;
+            (x1, f1) = (x2, f2);
+            x2 = a + r * (b - a);
+            f2 = f(x2);
+        }
+    }
+    let x = (a + b) / 2.0;
+    if f(x) <= best_v {
+        x
+    } else {
+        best_x
+    }
+}
+
+/// Nelder–Mead on two variables with the standard coefficients (reflection 1, expansion 2,
+/// contraction ½, shrink ½), from `start` with an initial simplex of edge `step`.
+fn nelder_mead(
+    f: impl Fn([f64; 2]) -> f64,
+    start: [f64; 2],
+    step: f64,
+    iterations: usize,
+) -> [f64; 2] {
+    let mut s = [
+        start,
+        [start[0] + step, start[1]],
+        [start[0], start[1] + step],
+    ];
+    let mut v = s.map(&f);
+    let lerp =
+        |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+    for _ in 0..iterations {
+        let mut idx = [0, 1, 2];
+        idx.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
+        s = idx.map(|i| s[i]);
+        v = idx.map(|i| v[i]);
+        let spread = (v[2] - v[0]).abs();
+        let size = (s[2][0] - s[0][0]).abs().max((s[2][1] - s[0][1]).abs());
+        if spread <= 1e-30 + 1e-15 * v[0].abs() && size < 1e-12 {
+            break;
+        }
+        let centroid = lerp(s[0], s[1], 0.5);
+        let reflected = lerp(s[2], centroid, 2.0);
+        let fr = f(reflected);
+        if fr < v[0] {
+            let expanded = lerp(s[2], centroid, 3.0);
+            let fe = f(expanded);
+            (s[2], v[2]) = if fe < fr {
+                (expanded, fe)
+            } else {
+                (reflected, fr)
+            };
+        } else if fr < v[1] {
+            (s[2], v[2]) = (reflected, fr);
+        } else {
+            let contracted = lerp(s[2], centroid, 0.5);
+            let fc = f(contracted);
+            if fc < v[2] {
+                (s[2], v[2]) = (contracted, fc);
+            } else {
+                for k in 1..3 {
+                    s[k] = lerp(s[0], s[k], 0.5);
+                    v[k] = f(s[k]);
+                }
+            }
+        }
+    }
+    let best = (0..3).min_by(|&i, &j| v[i].total_cmp(&v[j])).unwrap_or(0);
+    s[best]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(f: impl Fn(f64) -> f64) -> (Vec<f64>, Vec<f64>) {
+        let g: Vec<f64> = (1..=7).map(|k| 10.0 * k as f64).collect();
+        let y = g.iter().map(|&x| f(x)).collect();
+        (g, y)
+    }
+
+    fn cos(g: f64) -> f64 {
+        g.to_radians().cos()
+    }
+
+    #[test]
+    fn cos_power_recovers_its_exponent() {
+        let (g, y) = sample(|x| cos(x).powf(1.7));
+        let Params::CosPower { n } = fit_half(LdcModel::CosPower, &g, &y) else {
+            panic!("wrong model")
+        };
+        assert!((n - 1.7).abs() < 1e-6, "{n}");
+    }
+
+    #[test]
+    fn cos_poly_recovers_its_coefficients() {
+        // 0.2 + 0.5c + 0.3c²: coefficients sum to 1.
+        let (g, y) = sample(|x| 0.2 + 0.5 * cos(x) + 0.3 * cos(x).powi(2));
+        let Params::CosPoly { coeffs } = fit_half(LdcModel::CosPoly, &g, &y) else {
+            panic!("wrong model")
+        };
+        for (got, want) in coeffs.iter().zip([0.2, 0.5, 0.3]) {
+            assert!((got - want).abs() < 1e-9, "{coeffs:?}");
+        }
+    }
+
+    #[test]
+    fn lobes_recover_a_mix() {
+        let (g, y) = sample(|x| 0.6 * cos(x) + 0.4 * cos(x).powi(8));
+        let p = fit_half(LdcModel::Lobes, &g, &y);
+        for x in [5.0, 25.0, 45.0, 65.0, 80.0] {
+            let want = 0.6 * cos(x) + 0.4 * cos(x).powi(8);
+            assert!(
+                (p.eval(x) - want).abs() < 1e-4 * want.max(0.01),
+                "{p:?} at {x}"
+            );
+        }
+    }
+
+    #[test]
+    fn model_names_round_trip() {
+        for m in LdcModel::ALL {
+            assert_eq!(m.name().parse::<LdcModel>().unwrap(), m);
+        }
+        assert!("gauss".parse::<LdcModel>().is_err());
+    }
+}

@@ -1,0 +1,354 @@
+//! IES LM-63 photometric files (the North American format): written as LM-63-2019, read
+//! from any version.
+//!
+//! The layout (sources in `src/light/README.md`): a version line (`IES:LM-63-2019`;
+//! `IESNA:LM-63-2002`, `IESNA:LM-63-1995` and `IESNA91` before it), keyword lines
+//! `[KEYWORD] text` in any order (2019 requires `[TEST]`, `[TESTLAB]`, `[ISSUEDATE]`,
+//! `[MANUFAC]`), the line `TILT=NONE` (or `TILT=INCLUDE` followed by the tilt table, or
+//! `TILT=<file>`), then numbers separated by blanks, commas or line breaks: lamps, lumens
+//! per lamp (−1 for absolute photometry), candela multiplier, number of vertical and of
+//! horizontal angles, photometric type (1 = C), units (1 = feet, 2 = metres), width, length
+//! and height of the luminous opening, ballast factor, file generation type (2019; "future
+//! use" before), input watts, the vertical angles, the horizontal angles, and the candela
+//! values, one horizontal angle after another.
+//!
+//! In type C the vertical angle is γ and the horizontal angle is C. The horizontal angles
+//! also say the symmetry: a single 0° is rotationally symmetric, 0…90° symmetric in each
+//! quadrant, 0…180° symmetric about the 0–180° plane, 90…270° symmetric about the 90–270°
+//! plane, 0…360° none. We write the opening's width along the 90–270° axis (our panel's
+//! `height_m`, along `edge_v`) and its length along 0–180° (`width_m`, along `edge_u`); the
+//! reader uses only their product, the area.
+
+use std::path::Path;
+
+use super::cgamma::CGammaTable;
+use super::photometry::{
+    candela_grid, finish, format_sig, mirror_planes, tokens, Opening, Panel, Photometry,
+    PhotometryError,
+};
+
+/// Text for the keyword lines of a written file.
+#[derive(Clone, Debug)]
+pub struct IesInfo {
+    /// `[TEST]`: a report or run identifier.
+    pub test: String,
+    /// `[ISSUEDATE]`, e.g. 2026-12-01.
+    pub issue_date: String,
+    /// `[LUMINAIRE]`.
+    pub luminaire: String,
+    /// `[FILEGENINFO]`: how the file was made.
+    pub generation: String,
+}
+
+/// File generation type of LM-63-2019 for a computer-generated (simulated) distribution.
+const FILE_GENERATION_SIMULATION: &str = "1.00010";
+const PER_LINE: usize = 10;
+
+/// The IES text of `table` for `panel` (absolute candela, I = L₀·A·f·cos γ).
+pub fn to_string(table: &CGammaTable, panel: &Panel, info: &IesInfo) -> String {
+    let mut out = String::new();
+    let line = |out: &mut String, s: &str| {
+        out.push_str(s);
+        out.push_str("\r\n");
+    };
+    line(&mut out, "IES:LM-63-2019");
+    line(&mut out, &format!("[TEST] {}", one_line(&info.test)));
+    line(
+        &mut out,
+        "[TESTLAB] none: fitted to measurements by metamer",
+    );
+    line(
+        &mut out,
+        &format!("[ISSUEDATE] {}", one_line(&info.issue_date)),
+    );
+    line(&mut out, "[MANUFAC] metamer");
+    line(
+        &mut out,
+        &format!("[LUMINAIRE] {}", one_line(&info.luminaire)),
+    );
+    line(
+        &mut out,
+        &format!("[FILEGENINFO] {}", one_line(&info.generation)),
+    );
+    line(&mut out, "TILT=NONE");
+    let gammas = table.gamma_deg();
+    // A full circle is closed with 360° (= the 0° plane), as the format expects.
+    let mut horizontal: Vec<f64> = table.c_deg().to_vec();
+    let mut candela = candela_grid(table, panel);
+    if horizontal.len() > 1 {
+        horizontal.push(360.0);
+        candela.push(candela[0].clone());
+    }
+    line(
+        &mut out,
+        &format!(
+            "1 -1 1 {} {} 1 2 {} {} 0",
+            gammas.len(),
+            horizontal.len(),
+            format_sig(panel.height_m, 6),
+            format_sig(panel.width_m, 6)
+        ),
+    );
+    line(&mut out, &format!("1 {FILE_GENERATION_SIMULATION} 0"));
+    let mut block = |values: &mut dyn Iterator<Item = String>| {
+        let v: Vec<String> = values.collect();
+        for chunk in v.chunks(PER_LINE) {
+            line(&mut out, &chunk.join(" "));
+        }
+    };
+    block(&mut gammas.iter().map(|g| format_sig(*g, 8)));
+    block(&mut horizontal.iter().map(|c| format_sig(*c, 8)));
+    for row in &candela {
+        block(&mut row.iter().map(|v| format_sig(*v, 7)));
+    }
+    out
+}
+
+fn one_line(s: &str) -> String {
+    s.replace(['\r', '\n'], " ")
+}
+
+/// Reads an IES file: the distribution as a C-γ table (front hemisphere) and its photometry.
+pub fn read(path: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
+    let text = std::fs::read_to_string(path).map_err(|source| PhotometryError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    parse(&text, path)
+}
+
+/// [`read`] on text; `source` names the file in errors.
+pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
+    let fmt_err = |line: usize, message: String| PhotometryError::Format {
+        file: source.to_path_buf(),
+        line,
+        message,
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let first = lines.iter().position(|l| !l.trim().is_empty()).unwrap_or(0);
+    let version = lines
+        .get(first)
+        .map(|l| l.trim())
+        .filter(|l| l.to_ascii_uppercase().starts_with("IES"))
+        .map(|l| l.to_string())
+        .unwrap_or_else(|| "IES LM-63-1986".into());
+    let Some(tilt) = lines
+        .iter()
+        .position(|l| l.trim_start().to_ascii_uppercase().starts_with("TILT="))
+    else {
+        return Err(fmt_err(
+            lines.len().max(1),
+            "no TILT= line: not an IES LM-63 file".into(),
+        ));
+    };
+    let tilt_value = lines[tilt].trim_start()[5..].trim().to_ascii_uppercase();
+    let rest = lines[tilt + 1..].join("\n");
+    let toks = tokens(&rest, tilt + 2);
+    let mut pos = 0usize;
+    let last_line = lines.len();
+    let mut next = |what: &str| -> Result<(usize, f64), PhotometryError> {
+        let Some((line, t)) = toks.get(pos) else {
+            return Err(fmt_err(last_line, format!("the file ends before {what}")));
+        };
+        pos += 1;
+        t.parse::<f64>()
+            .map(|v| (*line, v))
+            .map_err(|_| fmt_err(*line, format!("{what}: '{t}' is not a number")))
+    };
+    if tilt_value == "INCLUDE" {
+        // Lamp-to-luminaire geometry, the number of tilt angles, the angles, the factors:
+        // they scale the lamp's output with its tilt, which a fixed panel does not have.
+        next("the tilt geometry")?;
+        let (line, n) = next("the number of tilt angles")?;
+        if n.is_nan() || n < 0.0 || n.fract() != 0.0 {
+            return Err(fmt_err(
+                line,
+                format!("the number of tilt angles {n} is not a count"),
+            ));
+        }
+        for _ in 0..(2 * n as usize) {
+            next("the tilt table")?;
+        }
+    }
+    let count = |(line, v): (usize, f64), what: &str| -> Result<usize, PhotometryError> {
+        if v >= 1.0 && v.fract() == 0.0 {
+            Ok(v as usize)
+        } else {
+            Err(fmt_err(line, format!("{what} {v} is not a positive count")))
+        }
+    };
+    next("the number of lamps")?;
+    next("the lumens per lamp")?;
+    let (_, multiplier) = next("the candela multiplier")?;
+    let n_vertical = count(
+        next("the number of vertical angles")?,
+        "the number of vertical angles",
+    )?;
+    let n_horizontal = count(
+        next("the number of horizontal angles")?,
+        "the number of horizontal angles",
+    )?;
+    let (line, kind) = next("the photometric type")?;
+    if kind != 1.0 {
+        return Err(fmt_err(
+            line,
+            format!("photometric type {kind}: only type C (1) describes a panel by C-planes"),
+        ));
+    }
+    let (line, units) = next("the units type")?;
+    let metres = match units as i64 {
+        1 if units == 1.0 => 0.3048,
+        2 if units == 2.0 => 1.0,
+        _ => {
+            return Err(fmt_err(
+                line,
+                format!("units type {units}: expected 1 (feet) or 2 (metres)"),
+            ))
+        }
+    };
+    let (_, width) = next("the opening's width")?;
+    let (_, length) = next("the opening's length")?;
+    next("the opening's height")?;
+    next("the ballast factor")?;
+    next("the file generation type")?;
+    next("the input watts")?;
+    let mut read_n = |n: usize, what: &str| -> Result<(usize, Vec<f64>), PhotometryError> {
+        let mut v = Vec::with_capacity(n);
+        let mut first_line = 0;
+        for k in 0..n {
+            let (line, x) = next(what)?;
+            if k == 0 {
+                first_line = line;
+            }
+            v.push(x);
+        }
+        Ok((first_line, v))
+    };
+    let (_, gammas) = read_n(n_vertical, "the vertical angles")?;
+    let (h_line, horizontal) = read_n(n_horizontal, "the horizontal angles")?;
+    let mut rows = Vec::with_capacity(n_horizontal);
+    for &c in &horizontal {
+        let (_, row) = read_n(n_vertical, &format!("the candela values of C-plane {c}°"))?;
+        rows.push(
+            row.into_iter()
+                .map(|v| v * multiplier)
+                .collect::<Vec<f64>>(),
+        );
+    }
+    let first_c = horizontal[0];
+    let last_c = horizontal[n_horizontal - 1];
+    if let Some(w) = horizontal
+        .windows(2)
+        .find(|w| w[1].is_nan() || w[1] <= w[0])
+    {
+        return Err(fmt_err(
+            h_line,
+            format!(
+                "the horizontal angles must increase: {}° then {}°",
+                w[0], w[1]
+            ),
+        ));
+    }
+    let stored: Vec<(f64, Vec<f64>)> = horizontal.iter().copied().zip(rows).collect();
+    type Mirror = fn(f64) -> f64;
+    let (symmetry, mirrors): (&str, Vec<Mirror>) = if n_horizontal == 1 && first_c == 0.0 {
+        ("rotationally symmetric", vec![])
+    } else if first_c == 0.0 && last_c == 90.0 {
+        (
+            "symmetric in each quadrant",
+            vec![|c| 180.0 - c, |c| 180.0 + c, |c| 360.0 - c],
+        )
+    } else if first_c == 0.0 && last_c == 180.0 {
+        ("symmetric about the 0–180° plane", vec![|c| 360.0 - c])
+    } else if first_c == 90.0 && last_c == 270.0 {
+        ("symmetric about the 90–270° plane", vec![|c| 180.0 - c])
+    } else if first_c == 0.0 && last_c > 180.0 && last_c <= 360.0 {
+        ("none", vec![])
+    } else {
+        return Err(fmt_err(
+            h_line,
+            format!(
+                "horizontal angles {first_c}…{last_c}°: type C files run 0, 0…90, 0…180, \
+                 90…270 or 0…360"
+            ),
+        ));
+    };
+    let planes = if n_horizontal == 1 {
+        stored
+    } else {
+        mirror_planes(stored, &mirrors)
+    };
+    let (w, l) = (width * metres, length * metres);
+    // Negative dimensions describe round openings (a circle or an ellipse).
+    let area = if w < 0.0 && l < 0.0 {
+        std::f64::consts::PI / 4.0 * w * l
+    } else {
+        (w * l).max(0.0)
+    };
+    let opening = Opening {
+        width_m: l.abs(),
+        height_m: w.abs(),
+        area_m2: area,
+    };
+    let stored_planes = n_horizontal;
+    finish(
+        version,
+        symmetry.into(),
+        stored_planes,
+        opening,
+        planes,
+        &gammas,
+    )
+    .map_err(|message| PhotometryError::Content {
+        file: source.to_path_buf(),
+        message,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_a_quadrant_symmetric_file_with_wrapped_values_and_keywords_in_any_order() {
+        // A Lambertian 0.5 m × 0.2 m panel of 100 cd/m² (I₀ = 10 cd), in feet.
+        let ft = 1.0 / 0.3048;
+        let text = format!(
+            "IESNA:LM-63-2002\n[MANUFAC] x\n[TEST] t\nTILT=NONE\n1 -1 2 3 2 1 1 {} {} 0\n\
+             1 1 0\n0 45\n90\n0 90\n5 3.5355339\n0\n5 3.5355339 0\n",
+            0.2 * ft,
+            0.5 * ft
+        );
+        let (t, p) = parse(&text, Path::new("a.ies")).unwrap();
+        assert_eq!(t.c_deg(), &[0.0, 90.0, 180.0, 270.0]);
+        assert!((p.normal_intensity_cd - 10.0).abs() < 1e-12);
+        assert!((p.area_m2 - 0.1).abs() < 1e-12);
+        assert!((p.normal_luminance_cd_m2().unwrap() - 100.0).abs() < 1e-9);
+        assert!((t.at(200.0, 45.0) - 1.0).abs() < 1e-7);
+        assert_eq!(p.symmetry, "symmetric in each quadrant");
+    }
+
+    #[test]
+    fn errors_name_the_file_and_line() {
+        let e = parse(
+            "IES:LM-63-2019\nTILT=NONE\n1 -1 1 2 1 3 2\n",
+            Path::new("b.ies"),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "b.ies:3: photometric type 3: only type C (1) describes a panel by C-planes"
+        );
+        let e = parse("IES:LM-63-2019\n[TEST] x\n", Path::new("c.ies")).unwrap_err();
+        assert!(e.to_string().contains("no TILT= line"), "{e}");
+        let e = parse(
+            "IES:LM-63-2019\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 x\n",
+            Path::new("d.ies"),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().starts_with("d.ies:7: the candela values"),
+            "{e}"
+        );
+    }
+}

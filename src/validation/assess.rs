@@ -1,0 +1,360 @@
+//! Statistics of a comparison with uncertainty: per patch the colour differences, their
+//! 95 % intervals and what can be said about the JND; over the patches the mean and max.
+//!
+//! "Below the JND" is said of a patch only where its ΔE*ab interval's upper end is below
+//! 2.3, "above" only where the lower end is above it; otherwise it is undecided.
+
+use serde::{Deserialize, Serialize};
+
+use crate::color::{delta_e2000, delta_e76, Xyz, COLORCHECKER_NAMES};
+
+use super::propagate::{percentiles, propagate, Interval, Propagation, Uncertain};
+use super::readings::{PatchReading, ReadingSet, UncertaintySource};
+use super::{ValidationError, JND_DE76};
+
+/// What the interval of a patch's ΔE*ab says about the JND.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum JndVerdict {
+    Below,
+    Above,
+    Undecided,
+}
+
+impl JndVerdict {
+    pub fn of(interval: Interval) -> JndVerdict {
+        if interval.hi < JND_DE76 {
+            JndVerdict::Below
+        } else if interval.lo > JND_DE76 {
+            JndVerdict::Above
+        } else {
+            JndVerdict::Undecided
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            JndVerdict::Below => "below",
+            JndVerdict::Above => "above",
+            JndVerdict::Undecided => "undecided",
+        }
+    }
+}
+
+/// One side's reading of a patch as the assessment keeps it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Side {
+    pub xyz: [f64; 3],
+    pub u_xyz: [f64; 3],
+    pub u_lab: f64,
+    pub n: usize,
+    pub uncertainty: UncertaintySource,
+    pub lab: [f64; 3],
+}
+
+/// One patch assessed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PatchAssessment {
+    pub patch: usize,
+    pub name: String,
+    pub reference: Side,
+    pub test: Side,
+    pub de76: f64,
+    pub de00: f64,
+    pub de76_interval: Interval,
+    pub de00_interval: Interval,
+    pub jnd: JndVerdict,
+    /// Either input marks the colour as outside the display's gamut.
+    pub out_of_gamut: bool,
+}
+
+/// How many patches fall on each side of the JND.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct JndCount {
+    pub below: usize,
+    pub above: usize,
+    pub undecided: usize,
+}
+
+/// A statistic over the patches with its interval (Monte Carlo only).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stat {
+    pub value: f64,
+    pub interval: Option<Interval>,
+}
+
+/// A comparison of two sets of readings with uncertainty.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Assessment {
+    /// What the reference readings are ("box") and what is tested ("display").
+    pub reference: String,
+    pub test: String,
+    /// CIELAB's reference white.
+    pub white: [f64; 3],
+    pub propagation: String,
+    pub patches: Vec<PatchAssessment>,
+    pub mean_de76: Stat,
+    pub max_de76: Stat,
+    pub mean_de00: Stat,
+    pub max_de00: Stat,
+    /// Patches whose ΔE*ab itself is below the JND (no uncertainty considered), as the
+    /// paper counts them.
+    pub below_jnd_point: usize,
+    pub jnd: JndCount,
+}
+
+/// Options of an assessment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AssessOptions {
+    pub propagation: Propagation,
+    /// A standard uncertainty in ΔE*ab the test side's readings carry beyond their own
+    /// (e.g. a display model's verification error), spread evenly over L*, a*, b*.
+    pub model_term_de: f64,
+}
+
+impl Default for AssessOptions {
+    fn default() -> Self {
+        AssessOptions {
+            propagation: Propagation::default(),
+            model_term_de: 0.0,
+        }
+    }
+}
+
+fn side(p: &PatchReading, white: Xyz, extra_lab: f64) -> (Side, Uncertain) {
+    let u_lab = (p.u_lab.powi(2) + extra_lab.powi(2)).sqrt();
+    (
+        Side {
+            xyz: p.xyz,
+            u_xyz: p.u_xyz,
+            u_lab,
+            n: p.n,
+            uncertainty: p.source,
+            lab: Xyz::from_array(p.xyz).to_lab(white).to_array(),
+        },
+        Uncertain {
+            xyz: p.xyz,
+            factors: p.u_factors.clone(),
+            u_lab,
+        },
+    )
+}
+
+/// Assesses `test` against `reference` on the patches both have, in CIELAB relative to
+/// `white`.
+pub fn assess(
+    reference_name: &str,
+    reference: &ReadingSet,
+    test_name: &str,
+    test: &ReadingSet,
+    white: Xyz,
+    opts: &AssessOptions,
+) -> Result<Assessment, ValidationError> {
+    if !(white.x > 0.0 && white.y > 0.0 && white.z > 0.0) {
+        return Err(ValidationError::BadWhite {
+            white: white.to_array(),
+        });
+    }
+    let common: Vec<usize> = reference
+        .patches
+        .keys()
+        .filter(|k| test.patches.contains_key(k))
+        .copied()
+        .collect();
+    if common.is_empty() {
+        return Err(ValidationError::NoCommonPatches {
+            reference: reference.file.clone(),
+            test: test.file.clone(),
+        });
+    }
+    // Spread over three axes so the expected squared length of the term is its ΔE².
+    let model_lab = opts.model_term_de / 3f64.sqrt();
+    let mut draws76: Vec<Vec<f64>> = Vec::new();
+    let mut draws00: Vec<Vec<f64>> = Vec::new();
+    let patches: Vec<PatchAssessment> = common
+        .iter()
+        .map(|&k| {
+            let (r, ru) = side(&reference.patches[&k], white, 0.0);
+            let (t, tu) = side(&test.patches[&k], white, model_lab);
+            let p = propagate(&ru, &tu, white, opts.propagation, k);
+            let (rl, tl) = (
+                Xyz::from_array(r.xyz).to_lab(white),
+                Xyz::from_array(t.xyz).to_lab(white),
+            );
+            draws76.push(p.draws76);
+            draws00.push(p.draws00);
+            PatchAssessment {
+                patch: k,
+                name: COLORCHECKER_NAMES[k - 1].to_string(),
+                de76: delta_e76(rl, tl),
+                de00: delta_e2000(rl, tl),
+                de76_interval: p.de76,
+                de00_interval: p.de00,
+                jnd: JndVerdict::of(p.de76),
+                out_of_gamut: reference.patches[&k].out_of_gamut || test.patches[&k].out_of_gamut,
+                reference: r,
+                test: t,
+            }
+        })
+        .collect();
+    let mut jnd = JndCount::default();
+    for p in &patches {
+        match p.jnd {
+            JndVerdict::Below => jnd.below += 1,
+            JndVerdict::Above => jnd.above += 1,
+            JndVerdict::Undecided => jnd.undecided += 1,
+        }
+    }
+    let mean_de76 = summary(&patches, |p| p.de76, &draws76, mean);
+    let max_de76 = summary(&patches, |p| p.de76, &draws76, max);
+    let mean_de00 = summary(&patches, |p| p.de00, &draws00, mean);
+    let max_de00 = summary(&patches, |p| p.de00, &draws00, max);
+    Ok(Assessment {
+        reference: reference_name.into(),
+        test: test_name.into(),
+        white: white.to_array(),
+        propagation: opts.propagation.describe(),
+        below_jnd_point: patches.iter().filter(|p| p.de76 < JND_DE76).count(),
+        patches,
+        mean_de76,
+        max_de76,
+        mean_de00,
+        max_de00,
+        jnd,
+    })
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+fn max(v: &[f64]) -> f64 {
+    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// A statistic of the patches' values and, when every patch has Monte Carlo draws, the
+/// percentiles of the same statistic taken draw by draw.
+fn summary(
+    patches: &[PatchAssessment],
+    pick: fn(&PatchAssessment) -> f64,
+    draws: &[Vec<f64>],
+    stat: fn(&[f64]) -> f64,
+) -> Stat {
+    let values: Vec<f64> = patches.iter().map(pick).collect();
+    // A patch without uncertainty has no draws: its value stands in every draw.
+    let n = draws.iter().map(Vec::len).max().unwrap_or(0);
+    let interval = (n > 0)
+        .then(|| {
+            let per_draw: Vec<f64> = (0..n)
+                .map(|i| {
+                    let v: Vec<f64> = draws
+                        .iter()
+                        .zip(&values)
+                        .map(|(d, v)| d.get(i).copied().unwrap_or(*v))
+                        .collect();
+                    stat(&v)
+                })
+                .collect();
+            percentiles(&per_draw)
+        })
+        .flatten();
+    Stat {
+        value: stat(&values),
+        interval,
+    }
+}
+
+impl Assessment {
+    /// The one-line summary a user reads first.
+    pub fn summary(&self) -> String {
+        format!(
+            "{} vs {}: {} of {} patches below the JND (ΔE*ab {JND_DE76}) with 95 % confidence, {} above, {} undecided; ΔE*ab mean {:.2} max {:.2}; ΔE00 mean {:.2} max {:.2}",
+            self.test,
+            self.reference,
+            self.jnd.below,
+            self.patches.len(),
+            self.jnd.above,
+            self.jnd.undecided,
+            self.mean_de76.value,
+            self.max_de76.value,
+            self.mean_de00.value,
+            self.max_de00.value
+        )
+    }
+
+    /// The patches that are above the JND, or may be.
+    pub fn failing(&self) -> impl Iterator<Item = &PatchAssessment> {
+        self.patches.iter().filter(|p| p.jnd != JndVerdict::Below)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::validation::readings::parse_readings;
+    use std::path::Path;
+
+    fn set(text: &str) -> ReadingSet {
+        parse_readings(text, Path::new("t.csv")).unwrap()
+    }
+
+    #[test]
+    fn verdicts_follow_the_interval_not_the_point() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        // Greys at L* 50 (Y 18.418652), 51.5 (19.703227) and 60 (28.123334);
+        // by hand from L* = 116 (Y/Yn)^(1/3) − 16.
+        let g = |k: usize, y: f64| format!("{k},{},{y},{}\n", 0.950_47 * y, 1.088_83 * y);
+        let reference = set(&format!(
+            "patch,X,Y,Z\n{}{}{}",
+            g(1, 18.418_652),
+            g(2, 18.418_652),
+            g(3, 18.418_652)
+        ));
+        // Patch 1: ΔE 1.5 known exactly → below. Patch 2: ΔE 10 → above. Patch 3: repeats
+        // 16.5 and 23.0 (mean 19.75, ΔE 1.6; the scatter along the grey axis is ±3.25 in Y,
+        // ±3.8 in L*): too scattered to decide.
+        let test = set(&format!(
+            "patch,X,Y,Z\n{}{}{}{}",
+            g(1, 19.703_227),
+            g(2, 28.123_334),
+            g(3, 16.5),
+            g(3, 23.0)
+        ));
+        let a = assess(
+            "box",
+            &reference,
+            "display",
+            &test,
+            white,
+            &AssessOptions::default(),
+        )
+        .unwrap();
+        assert!((a.patches[0].de76 - 1.5).abs() < 1e-4);
+        assert_eq!(
+            a.patches.iter().map(|p| p.jnd).collect::<Vec<_>>(),
+            [JndVerdict::Below, JndVerdict::Above, JndVerdict::Undecided]
+        );
+        assert_eq!(a.below_jnd_point, 2);
+        assert_eq!(
+            a.jnd,
+            JndCount {
+                below: 1,
+                above: 1,
+                undecided: 1
+            }
+        );
+        // The mean over the draws brackets the mean of the values.
+        let m = a.mean_de76;
+        let i = m.interval.unwrap();
+        assert!(i.lo <= m.value + 0.5 && m.value - 0.5 <= i.hi, "{m:?}");
+    }
+
+    #[test]
+    fn disjoint_patch_sets_are_an_error() {
+        let white = Xyz::new(95.0, 100.0, 108.0);
+        let r = set("patch,X,Y,Z\n1,1,1,1\n");
+        let t = set("patch,X,Y,Z\n2,1,1,1\n");
+        let e = assess("box", &r, "display", &t, white, &AssessOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("no patch in common"), "{e}");
+    }
+}

@@ -1,0 +1,803 @@
+//! Readings of the ColorChecker patches as `validate` takes them: a session journal, the
+//! output of `metamer spot --json`, the output of `metamer render spots --json`, or a CSV
+//! `patch,X,Y,Z` with optional `sd_X,sd_Y,sd_Z`, `n` and `out_of_gamut` columns. The format
+//! is sniffed from the content; every error names the file and the line.
+//!
+//! Each patch ends with one mean XYZ and its standard uncertainty, and with where that
+//! uncertainty came from, so a report can say how far it may be trusted.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use crate::color::COLORCHECKER_NAMES;
+
+/// The number of patches of the chart.
+pub const PATCHES: usize = 24;
+
+/// The 95th percentile of the length of a 3-D isotropic normal vector in units of its
+/// per-axis σ (√χ²₃(0.95) = √7.8147): converts a renderer's 95 % ΔE half-width to a
+/// per-axis standard uncertainty in CIELAB.
+pub const CHI3_95: f64 = 2.795_483;
+
+/// Which file format the readings were in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Format {
+    Journal,
+    SpotJson,
+    RenderJson,
+    Csv,
+}
+
+impl Format {
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Journal => "session journal",
+            Format::SpotJson => "metamer spot --json",
+            Format::RenderJson => "metamer render spots --json",
+            Format::Csv => "CSV",
+        }
+    }
+}
+
+/// Where a patch's uncertainty comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum UncertaintySource {
+    /// The scatter of repeated readings (standard error of their mean).
+    Repeats,
+    /// Standard deviations given with the readings.
+    Given,
+    /// The renderer's confidence (standard error of its estimate, or its 95 % ΔE bound).
+    Render,
+    /// One reading and nothing said about it: its uncertainty is unknown (taken as 0).
+    Unknown,
+}
+
+/// One patch's readings reduced to a mean and its uncertainty.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PatchReading {
+    /// Mean XYZ, in the readings' units (cd/m² from a meter).
+    pub xyz: [f64; 3],
+    /// Standard uncertainty of the mean in X, Y and Z.
+    pub u_xyz: [f64; 3],
+    /// The uncertainty of the mean as independent standard-normal factors, each moving XYZ
+    /// along its vector: from repeats, each reading's deviation / √(k(k−1)), which keeps
+    /// the correlation of X, Y and Z (a meter's repeats mostly scale all three); from
+    /// given standard deviations, one factor per axis.
+    pub u_factors: Vec<[f64; 3]>,
+    /// An extra per-axis standard uncertainty in CIELAB (from a renderer's ΔE bound), 0 if
+    /// none.
+    pub u_lab: f64,
+    /// Readings averaged.
+    pub n: usize,
+    pub source: UncertaintySource,
+    /// The input marks this colour as outside the display's gamut.
+    pub out_of_gamut: bool,
+    /// Line of the first reading of this patch.
+    pub line: usize,
+}
+
+/// All patches of one file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReadingSet {
+    pub file: PathBuf,
+    pub format: Format,
+    /// By 1-based ColorChecker patch number.
+    pub patches: BTreeMap<usize, PatchReading>,
+    /// A reading labelled `white` (the display's or box's white), if the file has one.
+    pub white: Option<PatchReading>,
+    /// Instruments named in the file (journal header, spot lines).
+    pub instruments: Vec<String>,
+    /// Things the reader should know (skipped entries, a torn last line).
+    pub notes: Vec<String>,
+}
+
+impl ReadingSet {
+    /// The white this set offers as CIELAB's reference: its reading labelled `white`, else
+    /// its brightest reading (largest Y; on a display showing the chart that is patch 19,
+    /// white 9.5, which then gets L* = 100). Says which in words.
+    pub fn white_or_brightest(&self) -> (crate::color::Xyz, String) {
+        if let Some(w) = &self.white {
+            return (
+                crate::color::Xyz::from_array(w.xyz),
+                format!("the white reading of {}", self.file.display()),
+            );
+        }
+        let (k, p) = self
+            .patches
+            .iter()
+            .max_by(|a, b| a.1.xyz[1].total_cmp(&b.1.xyz[1]))
+            .expect("a reading set has at least one patch");
+        (
+            crate::color::Xyz::from_array(p.xyz),
+            format!(
+                "the brightest reading of {} (patch {k}, {}), which has no white reading",
+                self.file.display(),
+                COLORCHECKER_NAMES[k - 1]
+            ),
+        )
+    }
+}
+
+/// What is wrong with a readings file.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadingsError {
+    #[error("{}: cannot read: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}:{line}: {message}", file.display())]
+    Bad {
+        file: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{}: {message}", file.display())]
+    Empty { file: PathBuf, message: String },
+}
+
+/// A patch as a row names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PatchId {
+    Number(usize),
+    White,
+}
+
+/// One reading or row before the repeats of a patch are combined.
+#[derive(Clone, Debug)]
+struct Row {
+    line: usize,
+    patch: PatchId,
+    xyz: [f64; 3],
+    /// Standard deviation of one reading, and how many readings the row averages.
+    sd: Option<[f64; 3]>,
+    n: usize,
+    /// A renderer's standard error of XYZ.
+    stderr: Option<[f64; 3]>,
+    /// A renderer's 95 % ΔE*ab half-width or bound.
+    de95: Option<f64>,
+    out_of_gamut: bool,
+}
+
+/// Reads `file`, sniffing its format.
+pub fn read_readings(file: &Path) -> Result<ReadingSet, ReadingsError> {
+    let text = std::fs::read_to_string(file).map_err(|source| ReadingsError::Io {
+        file: file.to_path_buf(),
+        source,
+    })?;
+    parse_readings(&text, file)
+}
+
+/// Parses readings from `text`; `file` names it in errors.
+pub fn parse_readings(text: &str, file: &Path) -> Result<ReadingSet, ReadingsError> {
+    let first = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+        .ok_or_else(|| ReadingsError::Empty {
+            file: file.to_path_buf(),
+            message: "the file holds no readings".into(),
+        })?;
+    let mut p = Parsed {
+        file: file.to_path_buf(),
+        rows: Vec::new(),
+        instruments: Vec::new(),
+        notes: Vec::new(),
+    };
+    let format = if first.starts_with('{') {
+        let head: Option<Value> = serde_json::from_str(first).ok();
+        let is_journal = head
+            .as_ref()
+            .is_some_and(|v| v["type"] == "header" || v["format"] == "metamer-session-journal");
+        if is_journal {
+            p.journal(text)?;
+            Format::Journal
+        } else if let Ok(whole) = serde_json::from_str::<Value>(text) {
+            if whole.get("patches").is_some() {
+                p.render(&whole)?;
+                Format::RenderJson
+            } else {
+                p.spot_lines(text)?;
+                Format::SpotJson
+            }
+        } else {
+            p.spot_lines(text)?;
+            Format::SpotJson
+        }
+    } else {
+        p.csv(text)?;
+        Format::Csv
+    };
+    p.finish(format)
+}
+
+struct Parsed {
+    file: PathBuf,
+    rows: Vec<Row>,
+    instruments: Vec<String>,
+    notes: Vec<String>,
+}
+
+impl Parsed {
+    fn bad(&self, line: usize, message: impl Into<String>) -> ReadingsError {
+        ReadingsError::Bad {
+            file: self.file.clone(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    fn xyz_of(&self, v: &Value, key: &str, line: usize) -> Result<[f64; 3], ReadingsError> {
+        let arr = v
+            .get(key)
+            .and_then(Value::as_array)
+            .filter(|a| a.len() == 3)
+            .ok_or_else(|| self.bad(line, format!("expected \"{key}\": [X, Y, Z]")))?;
+        let mut out = [0.0; 3];
+        for (o, (x, name)) in out.iter_mut().zip(arr.iter().zip(["X", "Y", "Z"])) {
+            *o = x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+                self.bad(
+                    line,
+                    format!(
+                        "{name} is {x}: the instrument did not measure it (a reading without chromaticity cannot be compared)"
+                    ),
+                )
+            })?;
+        }
+        Ok(out)
+    }
+
+    fn note_instrument(&mut self, name: &str) {
+        if !name.is_empty() && !self.instruments.iter().any(|i| i == name) {
+            self.instruments.push(name.to_string());
+        }
+    }
+
+    /// A session journal: entries whose step data carry a ColorChecker patch.
+    fn journal(&mut self, text: &str) -> Result<(), ReadingsError> {
+        let mut kind = String::new();
+        let mut skipped = 0;
+        let lines: Vec<&str> = text.lines().collect();
+        let ends_with_newline = text.ends_with('\n');
+        for (i, raw) in lines.iter().enumerate() {
+            let line = i + 1;
+            if raw.trim().is_empty() {
+                continue;
+            }
+            let v: Value = match serde_json::from_str(raw) {
+                Ok(v) => v,
+                // The journal moves a torn last line aside only when resumed; a reader
+                // should not fail on what a crash left.
+                Err(_) if i + 1 == lines.len() && !ends_with_newline => {
+                    self.notes.push(format!(
+                        "line {line}: a torn last line (cut off mid-write) was ignored"
+                    ));
+                    continue;
+                }
+                Err(e) => return Err(self.bad(line, format!("not a JSON line: {e}"))),
+            };
+            match v["type"].as_str() {
+                Some("header") => {
+                    kind = v["kind"].as_str().unwrap_or_default().to_string();
+                    if let Some(instruments) = v["data"]["instruments"].as_object() {
+                        for (role, record) in instruments {
+                            let model = record["info"]["model"].as_str().unwrap_or(role);
+                            let serial = record["info"]["serial"].as_str().unwrap_or_default();
+                            let name = if serial.is_empty() {
+                                format!("{role}: {model}")
+                            } else {
+                                format!("{role}: {model} #{serial}")
+                            };
+                            self.note_instrument(&name);
+                        }
+                    }
+                }
+                Some("entry") => {
+                    let Some(patch) = journal_patch(&kind, &v) else {
+                        skipped += 1;
+                        continue;
+                    };
+                    let xyz = self.xyz_of(&v["reading"], "xyz", line)?;
+                    self.rows.push(Row {
+                        line,
+                        patch,
+                        xyz,
+                        sd: None,
+                        n: 1,
+                        stderr: None,
+                        de95: None,
+                        out_of_gamut: v["data"]["out_of_gamut"].as_bool().unwrap_or(false),
+                    });
+                }
+                Some("calibration") => {}
+                _ => return Err(self.bad(line, "expected a header, entry or calibration line")),
+            }
+        }
+        if skipped > 0 {
+            self.notes.push(format!(
+                "{skipped} journal entries name no ColorChecker patch and were left out"
+            ));
+        }
+        Ok(())
+    }
+
+    /// `metamer spot --json`: one reading per line, optionally with `"patch"`.
+    fn spot_lines(&mut self, text: &str) -> Result<(), ReadingsError> {
+        let mut unnumbered = Vec::new();
+        for (i, raw) in text.lines().enumerate() {
+            let line = i + 1;
+            let raw = raw.trim();
+            if raw.is_empty() || raw.starts_with('#') {
+                continue;
+            }
+            let v: Value = serde_json::from_str(raw)
+                .map_err(|e| self.bad(line, format!("not a JSON line: {e}")))?;
+            let xyz = self.xyz_of(&v, "XYZ", line)?;
+            if let Some(name) = v["instrument"].as_str() {
+                self.note_instrument(name);
+            }
+            let patch = match v.get("patch") {
+                None => None,
+                Some(p) => Some(patch_id(p).ok_or_else(|| {
+                    self.bad(line, format!("\"patch\": {p} is not 1–24 or \"white\""))
+                })?),
+            };
+            let row = Row {
+                line,
+                patch: patch.unwrap_or(PatchId::Number(0)),
+                xyz,
+                sd: None,
+                n: 1,
+                stderr: None,
+                de95: None,
+                out_of_gamut: v["out_of_gamut"].as_bool().unwrap_or(false),
+            };
+            if patch.is_none() {
+                unnumbered.push(self.rows.len());
+            }
+            self.rows.push(row);
+        }
+        if unnumbered.is_empty() {
+            return Ok(());
+        }
+        if unnumbered.len() != self.rows.len() {
+            let line = self.rows[unnumbered[0]].line;
+            return Err(self.bad(
+                line,
+                "some readings carry \"patch\" and this one does not: number all or none",
+            ));
+        }
+        // Without numbers, `spot --count k` per patch appended patch after patch gives k
+        // consecutive readings of patch 1, then of patch 2, …
+        let n = self.rows.len();
+        let per_patch = if n <= PATCHES {
+            1
+        } else if n % PATCHES == 0 {
+            n / PATCHES
+        } else {
+            return Err(ReadingsError::Empty {
+                file: self.file.clone(),
+                message: format!(
+                    "{n} unnumbered readings: expected up to 24 (one per patch) or a multiple of 24 (the same number of repeats per patch), or a \"patch\" key on each line"
+                ),
+            });
+        };
+        for (k, row) in self.rows.iter_mut().enumerate() {
+            row.patch = PatchId::Number(k / per_patch + 1);
+        }
+        if per_patch > 1 {
+            self.notes.push(format!(
+                "{n} unnumbered readings taken as {per_patch} consecutive repeats of each patch"
+            ));
+        }
+        Ok(())
+    }
+
+    /// `metamer render spots --json`: `{"patches":[{"patch":k,"XYZ":…,"XYZ_stderr":…,
+    /// "de_ci95"|"de_bound":…}]}`.
+    fn render(&mut self, whole: &Value) -> Result<(), ReadingsError> {
+        let patches = whole["patches"]
+            .as_array()
+            .ok_or_else(|| self.bad(1, "\"patches\" must be an array"))?;
+        self.note_instrument(&format!(
+            "renderer ({})",
+            whole["method"].as_str().unwrap_or("unknown method")
+        ));
+        for (i, p) in patches.iter().enumerate() {
+            let what = format!("patches[{i}]");
+            let patch = p
+                .get("patch")
+                .and_then(patch_id)
+                .ok_or_else(|| self.bad(1, format!("{what}.patch must be 1–24")))?;
+            let xyz = self
+                .xyz_of(p, "XYZ", 1)
+                .map_err(|e| self.bad(1, format!("{what}: {e}")))?;
+            let stderr = match p.get("XYZ_stderr") {
+                Some(_) => Some(self.xyz_of(p, "XYZ_stderr", 1)?),
+                None => None,
+            };
+            let de95 = p["de_ci95"].as_f64().or_else(|| p["de_bound"].as_f64());
+            self.rows.push(Row {
+                line: 1,
+                patch,
+                xyz,
+                sd: None,
+                n: 1,
+                stderr,
+                de95,
+                out_of_gamut: false,
+            });
+        }
+        Ok(())
+    }
+
+    /// `patch,X,Y,Z[,sd_X,sd_Y,sd_Z][,n][,out_of_gamut]`, columns in any order.
+    fn csv(&mut self, text: &str) -> Result<(), ReadingsError> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let (hline, header) = lines.next().expect("sniffed a first line");
+        let names: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
+        let col = |name: &str| names.iter().position(|n| n.eq_ignore_ascii_case(name));
+        let need = |name: &str| {
+            col(name).ok_or_else(|| {
+                self.bad(
+                    hline,
+                    format!(
+                        "the header '{header}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, n, out_of_gamut)"
+                    ),
+                )
+            })
+        };
+        let (cp, cx, cy, cz) = (need("patch")?, need("X")?, need("Y")?, need("Z")?);
+        let sd = match (col("sd_X"), col("sd_Y"), col("sd_Z")) {
+            (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+            (None, None, None) => None,
+            _ => return Err(self.bad(hline, "give all three of sd_X, sd_Y, sd_Z or none")),
+        };
+        let (cn, cg) = (col("n"), col("out_of_gamut"));
+        for (line, l) in lines {
+            let cells: Vec<&str> = l.split(',').map(str::trim).collect();
+            if cells.len() != names.len() {
+                return Err(self.bad(
+                    line,
+                    format!(
+                        "expected {} cells as in the header, found {}",
+                        names.len(),
+                        cells.len()
+                    ),
+                ));
+            }
+            let num = |c: usize| -> Result<f64, ReadingsError> {
+                cells[c]
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        self.bad(
+                            line,
+                            format!("{}: '{}' is not a number", names[c], cells[c]),
+                        )
+                    })
+            };
+            let patch = patch_id(&Value::String(cells[cp].to_string())).ok_or_else(|| {
+                self.bad(
+                    line,
+                    format!(
+                        "patch '{}' is not 1–24, a ColorChecker name or 'white'",
+                        cells[cp]
+                    ),
+                )
+            })?;
+            let sd = match sd {
+                Some(c) => {
+                    let v = [num(c[0])?, num(c[1])?, num(c[2])?];
+                    if v.iter().any(|s| *s < 0.0) {
+                        return Err(self.bad(line, "a standard deviation must be ≥ 0"));
+                    }
+                    Some(v)
+                }
+                None => None,
+            };
+            let n = match cn {
+                Some(c) => {
+                    let v = num(c)?;
+                    if v < 1.0 || v.fract() != 0.0 {
+                        return Err(self.bad(
+                            line,
+                            format!("n: '{}' must be a whole number ≥ 1", cells[c]),
+                        ));
+                    }
+                    v as usize
+                }
+                None => 1,
+            };
+            let out_of_gamut = match cg {
+                Some(c) => match cells[c] {
+                    "1" | "true" | "yes" => true,
+                    "0" | "false" | "no" | "" => false,
+                    other => {
+                        return Err(self.bad(line, format!("out_of_gamut: '{other}' is not 0 or 1")))
+                    }
+                },
+                None => false,
+            };
+            self.rows.push(Row {
+                line,
+                patch,
+                xyz: [num(cx)?, num(cy)?, num(cz)?],
+                sd,
+                n,
+                stderr: None,
+                de95: None,
+                out_of_gamut,
+            });
+        }
+        Ok(())
+    }
+
+    fn finish(self, format: Format) -> Result<ReadingSet, ReadingsError> {
+        if self.rows.is_empty() {
+            return Err(ReadingsError::Empty {
+                file: self.file,
+                message: format!(
+                    "no readings of ColorChecker patches found ({}); journal entries need a patch number in their step data",
+                    format.name()
+                ),
+            });
+        }
+        let mut groups: BTreeMap<usize, Vec<&Row>> = BTreeMap::new();
+        let mut white = Vec::new();
+        for r in &self.rows {
+            match r.patch {
+                PatchId::Number(k) => groups.entry(k).or_default().push(r),
+                PatchId::White => white.push(r),
+            }
+        }
+        let patches = groups
+            .into_iter()
+            .map(|(k, rows)| (k, combine(&rows)))
+            .collect();
+        Ok(ReadingSet {
+            file: self.file,
+            format,
+            patches,
+            white: (!white.is_empty()).then(|| combine(&white)),
+            instruments: self.instruments,
+            notes: self.notes,
+        })
+    }
+}
+
+/// The ColorChecker patch of a journal entry: the step data's `patch` (1-based ColorChecker
+/// number or "white"), except in a `characterize` journal, where `patch` numbers drive
+/// colours and a ColorChecker colour is known by its label ("ColorChecker dark skin").
+fn journal_patch(kind: &str, entry: &Value) -> Option<PatchId> {
+    let data = &entry["data"];
+    if kind != "characterize" {
+        if let Some(p) = data.get("patch").and_then(patch_id) {
+            return Some(p);
+        }
+    }
+    let label = data["label"]
+        .as_str()
+        .or_else(|| entry["label"].as_str())
+        .unwrap_or_default();
+    let name = label.strip_prefix("ColorChecker ")?;
+    by_name(name)
+}
+
+fn by_name(name: &str) -> Option<PatchId> {
+    if name.eq_ignore_ascii_case("white") {
+        return Some(PatchId::White);
+    }
+    COLORCHECKER_NAMES
+        .iter()
+        .position(|n| n.eq_ignore_ascii_case(name))
+        .map(|i| PatchId::Number(i + 1))
+}
+
+fn patch_id(v: &Value) -> Option<PatchId> {
+    match v {
+        Value::Number(n) => n
+            .as_u64()
+            .filter(|k| (1..=PATCHES as u64).contains(k))
+            .map(|k| PatchId::Number(k as usize)),
+        Value::String(s) => match s.trim().parse::<usize>() {
+            Ok(k) if (1..=PATCHES).contains(&k) => Some(PatchId::Number(k)),
+            Ok(_) => None,
+            Err(_) => by_name(s.trim()),
+        },
+        _ => None,
+    }
+}
+
+/// Combines the rows of one patch: the equal-weight mean and its standard uncertainty —
+/// from the given standard deviations where every row has them (each row's sd/√n, the
+/// mean's √Σu²/k), else from the scatter of the rows (s/√k) when there are several, else
+/// from a renderer's confidence; unknown (0) for one bare reading.
+fn combine(rows: &[&Row]) -> PatchReading {
+    let k = rows.len() as f64;
+    let mut mean = [0.0; 3];
+    for r in rows {
+        for (m, x) in mean.iter_mut().zip(r.xyz) {
+            *m += x / k;
+        }
+    }
+    let n: usize = rows.iter().map(|r| r.n).sum();
+    let axes = |u: [f64; 3]| -> Vec<[f64; 3]> {
+        (0..3)
+            .filter(|&i| u[i] > 0.0)
+            .map(|i| {
+                let mut v = [0.0; 3];
+                v[i] = u[i];
+                v
+            })
+            .collect()
+    };
+    let (u_factors, source) = if rows.iter().all(|r| r.sd.is_some()) {
+        let mut u = [0.0; 3];
+        for r in rows {
+            let sd = r.sd.expect("checked");
+            for (ui, s) in u.iter_mut().zip(sd) {
+                *ui += (s / (r.n as f64).sqrt()).powi(2);
+            }
+        }
+        (axes(u.map(|v| v.sqrt() / k)), UncertaintySource::Given)
+    } else if rows.len() >= 2 {
+        let scale = (k * (k - 1.0)).sqrt();
+        let factors = rows
+            .iter()
+            .map(|r| [0, 1, 2].map(|i| (r.xyz[i] - mean[i]) / scale))
+            .collect();
+        (factors, UncertaintySource::Repeats)
+    } else if let Some(se) = rows[0].stderr {
+        (axes(se), UncertaintySource::Render)
+    } else if rows[0].de95.is_some() {
+        (Vec::new(), UncertaintySource::Render)
+    } else {
+        (Vec::new(), UncertaintySource::Unknown)
+    };
+    let mut u_xyz = [0.0; 3];
+    for f in &u_factors {
+        for (u, v) in u_xyz.iter_mut().zip(f) {
+            *u += v * v;
+        }
+    }
+    let u_xyz = u_xyz.map(f64::sqrt);
+    // A ΔE bound stands for what the XYZ standard error does not say (a radiosity solver's
+    // discretisation); with a standard error it would count the same noise twice.
+    let u_lab = if source == UncertaintySource::Render && rows[0].stderr.is_none() {
+        rows[0].de95.unwrap_or(0.0) / CHI3_95
+    } else {
+        0.0
+    };
+    PatchReading {
+        xyz: mean,
+        u_xyz,
+        u_factors,
+        u_lab,
+        n,
+        source,
+        out_of_gamut: rows.iter().any(|r| r.out_of_gamut),
+        line: rows[0].line,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<ReadingSet, ReadingsError> {
+        parse_readings(text, Path::new("r.csv"))
+    }
+
+    #[test]
+    fn csv_repeats_give_the_standard_error_of_their_mean() {
+        // Rows 10, 12, 14 in Y: mean 12, s = 2, standard error 2/√3 = 1.1547005.
+        let s = parse("patch,X,Y,Z\n1,1,10,1\n1,1,12,1\n1,1,14,1\nwhite,95,100,108\n").unwrap();
+        assert_eq!(s.format, Format::Csv);
+        let p = &s.patches[&1];
+        assert_eq!(p.xyz, [1.0, 12.0, 1.0]);
+        assert!((p.u_xyz[1] - 1.154_700_5).abs() < 1e-6);
+        assert_eq!(p.u_xyz[0], 0.0);
+        assert_eq!((p.n, p.source), (3, UncertaintySource::Repeats));
+        assert_eq!(s.white.unwrap().xyz, [95.0, 100.0, 108.0]);
+    }
+
+    #[test]
+    fn csv_given_sd_and_n() {
+        // sd 0.4 over n = 4 readings: u = 0.2; two such rows: √(0.2² + 0.2²)/2 = 0.1414214.
+        let s =
+            parse("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n2,1,2,3,0.4,0.4,0.4,4\n2,1,2,3,0.4,0.4,0.4,4\n")
+                .unwrap();
+        let p = &s.patches[&2];
+        assert!((p.u_xyz[2] - 0.141_421_4).abs() < 1e-6);
+        assert_eq!((p.n, p.source), (8, UncertaintySource::Given));
+    }
+
+    #[test]
+    fn csv_errors_name_the_line() {
+        let e = parse("patch,X,Y,Z\n1,1,2,3\n25,1,2,3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("r.csv:3:") && e.contains("'25'"), "{e}");
+        let e = parse("patch,X,Y\n1,1,2\n").unwrap_err().to_string();
+        assert!(e.contains("r.csv:1:") && e.contains("'Z'"), "{e}");
+        let e = parse("patch,X,Y,Z\n1,1,x,3\n").unwrap_err().to_string();
+        assert!(e.contains("r.csv:2:") && e.contains("'x'"), "{e}");
+    }
+
+    #[test]
+    fn spot_lines_unnumbered_are_patches_in_order_or_repeats() {
+        let line = |y: f64| {
+            format!("{{\"XYZ\":[1,{y},1],\"xyY\":[0.3,0.3,{y}],\"flags\":[],\"instrument\":\"cs100a\"}}\n")
+        };
+        let two: String = [1.0, 2.0].iter().map(|y| line(*y)).collect();
+        let s = parse(&two).unwrap();
+        assert_eq!(s.format, Format::SpotJson);
+        assert_eq!(s.patches[&2].xyz[1], 2.0);
+        assert_eq!(s.instruments, ["cs100a"]);
+        let rep: String = (0..48).map(|i| line(i as f64)).collect();
+        let s = parse(&rep).unwrap();
+        assert_eq!(s.patches.len(), 24);
+        assert_eq!(s.patches[&24].xyz[1], 46.5);
+        let bad: String = (0..25).map(|i| line(i as f64)).collect();
+        assert!(parse(&bad)
+            .unwrap_err()
+            .to_string()
+            .contains("25 unnumbered"));
+        let null = "{\"XYZ\":[null,1,null],\"xyY\":[null,null,1]}\n";
+        let e = parse(null).unwrap_err().to_string();
+        assert!(
+            e.contains("r.csv:1:") && e.contains("did not measure"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn journal_entries_by_patch_number_or_colorchecker_label() {
+        let header = r#"{"type":"header","format":"metamer-session-journal","version":2,"kind":"measure-box","fingerprint":"x","options":{},"steps":3,"started_s":0,"data":{"instruments":{"spot":{"info":{"model":"cs100a","serial":"7"},"options":{}}},"details":null}}"#;
+        let entry = |patch: &str, y: f64| {
+            format!(
+                r#"{{"type":"entry","index":0,"label":"p","role":"spot","mode":"emissive","data":{{"patch":{patch}}},"reading":{{"xyz":[1,{y},1],"xyy":[0,0,0],"spectrum":null,"flags":[],"integration_s":null,"instrument":"cs100a","timestamp_s":0}}}}"#
+            )
+        };
+        let text = format!(
+            "{header}\n{}\n{}\n{}\n{{\"type\":\"ent",
+            entry("3", 1.0),
+            entry("3", 3.0),
+            entry("\"white\"", 9.0)
+        );
+        let s = parse(&text).unwrap();
+        assert_eq!(s.format, Format::Journal);
+        assert_eq!(s.patches[&3].xyz[1], 2.0);
+        assert_eq!(s.white.as_ref().unwrap().xyz[1], 9.0);
+        assert_eq!(s.instruments, ["spot: cs100a #7"]);
+        assert!(s.notes.iter().any(|n| n.contains("torn")));
+        // characterize journals number drive colours; ColorChecker ones are known by label.
+        let text = text
+            .replace("measure-box", "characterize")
+            .replace(r#""label":"p""#, r#""label":"ColorChecker orange""#);
+        let s = parse(&text).unwrap();
+        assert_eq!(s.patches.keys().collect::<Vec<_>>(), [&7]);
+    }
+
+    #[test]
+    fn render_json_carries_its_confidence() {
+        let text = r#"{"method":"radiosity","white":[1,1,1],"patches":[{"patch":5,"XYZ":[1,2,3],"de_bound":0.0279548}]}"#;
+        let s = parse(text).unwrap();
+        assert_eq!(s.format, Format::RenderJson);
+        let p = &s.patches[&5];
+        assert_eq!(p.source, UncertaintySource::Render);
+        assert!((p.u_lab - 0.01).abs() < 1e-6);
+    }
+}
