@@ -79,15 +79,14 @@ pub enum ValidationError {
         #[source]
         source: std::io::Error,
     },
-    #[error(transparent)]
+    // Not transparent: the command line looks for the OutputError among the sources.
+    #[error("{0}")]
     Output(#[from] crate::output::OutputError),
     #[error("cannot draw the chart {file}: {message}")]
     Chart {
         file: std::path::PathBuf,
         message: String,
     },
-    #[error("{0}")]
-    Output(#[from] crate::output::OutputError),
 }
 
 /// Compares `test` against `reference`, patch by patch, in CIELAB relative to `white`.
