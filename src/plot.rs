@@ -2,8 +2,6 @@
 //! figure here shares (render convergence, display patch budget). SVG only: text stays SVG
 //! `<text>`, so no font files are needed at build or run time.
 
-use std::path::Path;
-
 use plotters::prelude::*;
 
 /// One named curve.
@@ -26,8 +24,15 @@ pub struct LogLogChart<'a> {
     pub size: (u32, u32),
 }
 
-/// Draws `chart` to `file`; the error is plotters' message.
-pub fn write_log_log(chart: &LogLogChart, file: &Path) -> Result<(), String> {
+/// Draws `chart` as SVG text; the error is plotters' message. Callers write it through
+/// their output policy.
+pub fn log_log_svg(chart: &LogLogChart) -> Result<String, String> {
+    let mut svg = String::new();
+    draw_log_log(chart, &mut svg)?;
+    Ok(svg)
+}
+
+fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let points = chart
         .series
@@ -48,7 +53,7 @@ pub fn write_log_log(chart: &LogLogChart, file: &Path) -> Result<(), String> {
     if xmax <= 0.0 || ymax <= 0.0 {
         return Err("no positive points to draw".into());
     }
-    let root = SVGBackend::new(file, chart.size).into_drawing_area();
+    let root = SVGBackend::with_string(svg, chart.size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut c = ChartBuilder::on(&root)
         .caption(chart.title, ("sans-serif", 20))
@@ -139,9 +144,6 @@ mod tests {
 
     #[test]
     fn draws_every_series_and_the_target() {
-        let dir = std::env::temp_dir().join(format!("metamer-plot-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("c.svg");
         let series = [
             Series {
                 name: "alpha".into(),
@@ -160,8 +162,7 @@ mod tests {
             target: Some((0.5, "goal")),
             size: (400, 300),
         };
-        write_log_log(&chart, &file).unwrap();
-        let svg = std::fs::read_to_string(&file).unwrap();
+        let svg = log_log_svg(&chart).unwrap();
         for word in ["alpha", "beta", "goal"] {
             assert!(svg.contains(word), "{word} missing");
         }
@@ -170,7 +171,6 @@ mod tests {
             target: None,
             ..chart
         };
-        assert!(write_log_log(&empty, &file).is_err());
-        std::fs::remove_dir_all(dir).unwrap();
+        assert!(log_log_svg(&empty).is_err());
     }
 }

@@ -56,6 +56,19 @@ fn logged(dir: &Path) -> Vec<(u64, Vec<u64>)> {
         .collect()
 }
 
+/// Every reading's XYZ by plan index.
+fn readings(dir: &Path) -> Vec<(u64, Value)> {
+    let log = std::fs::read_to_string(dir.join("log.jsonl")).unwrap();
+    let mut v: Vec<(u64, Value)> = log
+        .lines()
+        .map(|l| serde_json::from_str::<Value>(l).unwrap())
+        .filter(|v| v["type"] == "entry")
+        .map(|v| (v["index"].as_u64().unwrap(), v["reading"]["xyz"].clone()))
+        .collect();
+    v.sort_by_key(|e| e.0);
+    v
+}
+
 const IPS: &[&str] = &[
     "--display",
     "virtual:ips-lcd",
@@ -276,7 +289,18 @@ fn a_killed_session_resumes_to_the_same_patches_as_an_uninterrupted_one() {
         "{partial} readings before the kill"
     );
 
+    // The simulated meter at another pace is another instrument setting: refused by name.
+    let before = std::fs::read(dir.join("log.jsonl")).unwrap();
     let o = metamer(&[IPS, &["-o", d, "--resume"]].concat());
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("time_scale") && err.contains("was 0.1, this session's is 0"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(dir.join("log.jsonl")).unwrap(), before);
+
+    let o = metamer(&[&slow[..], &["--resume"]].concat());
     assert!(o.status.success(), "{}", text(&o.stderr));
     let mut resumed = logged(&dir);
     resumed.sort();
@@ -286,6 +310,9 @@ fn a_killed_session_resumes_to_the_same_patches_as_an_uninterrupted_one() {
         resumed, straight,
         "each planned patch once, the same as without interruption"
     );
+    // And the same numbers: the meter's noise of reading k depends on its seed and k only,
+    // not on the process that took it or on the pace.
+    assert_eq!(readings(&dir), readings(&whole));
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_dir_all(&whole).unwrap();
 }
@@ -329,15 +356,7 @@ fn ctrl_c_stops_cleanly_and_the_session_resumes() {
     );
     let partial = logged(&dir).len();
     assert!(partial < 86, "{partial}");
-    let o = metamer(&[
-        "--display",
-        "virtual:ideal-crt",
-        "--instrument",
-        "sim:cs100a?time_scale=0",
-        "-o",
-        d,
-        "--resume",
-    ]);
+    let o = metamer(&[&slow[..], &["--resume"]].concat());
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(logged(&dir).len(), 86);
     std::fs::remove_dir_all(&dir).unwrap();
@@ -416,4 +435,36 @@ fn usage_and_environment_errors() {
         "{}",
         text(&o.stderr)
     );
+}
+
+#[test]
+fn a_log_that_holds_no_session_says_what_to_do_and_resume_sets_it_aside() {
+    let dir = temp_dir("broken");
+    let d = dir.to_str().unwrap();
+    std::fs::create_dir_all(&dir).unwrap();
+    // A crash while the header was written leaves a cut-off first line.
+    std::fs::write(dir.join("log.jsonl"), r#"{"type":"header","form"#).unwrap();
+    let args = [IPS, &["--ramp-steps", "3", "-o", d]].concat();
+    let o = metamer(&args);
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("holds no session to continue: its header line was cut off after 22 bytes")
+            && err.contains("run with --resume to set it aside"),
+        "{err}"
+    );
+    let o = metamer(&[args.as_slice(), &["--resume"]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("log.jsonl.broken-1"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("log.jsonl.broken-1")).unwrap(),
+        r#"{"type":"header","form"#
+    );
+    // Black, primaries, white; one level inside each of 4 ramps; 48 held out; the key 5 again.
+    assert_eq!(summary(&dir)["readings"], 5 + 4 + 48 + 5);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -303,7 +303,8 @@ fn profile_saves_and_loads() {
     let path = dir.join("p.json");
     for kind in ModelKind::ALL {
         let p = fit_profile(kind, &d.patches(16), None).unwrap();
-        p.save(&path).unwrap();
+        p.save(&path, &metamer::output::OutputPolicy::new(true))
+            .unwrap();
         let q = Profile::load(&path).unwrap();
         assert_eq!(q.model().name(), kind.name());
         for rgb in drives(20) {

@@ -210,7 +210,13 @@ fn image_is_mirrored_counted_and_written_at_both_depths() {
     let dir = temp_dir("repro-png");
     for bits in [8u8, 16] {
         let path = dir.join(format!("o{bits}.png"));
-        write_drive_png(&path, &plain, bits).unwrap();
+        write_drive_png(
+            &path,
+            &plain,
+            bits,
+            &metamer::output::OutputPolicy::new(true),
+        )
+        .unwrap();
         let decoder =
             png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
         let mut reader = decoder.read_info().unwrap();
@@ -244,7 +250,9 @@ fn image_is_mirrored_counted_and_written_at_both_depths() {
 fn reproduce_an_exr_image_from_the_command_line() {
     let dir = temp_dir("repro-exr");
     let profile_path = dir.join("p.json");
-    profile().save(&profile_path).unwrap();
+    profile()
+        .save(&profile_path, &metamer::output::OutputPolicy::new(true))
+        .unwrap();
     // 4×3: drive (x/3, y/2, 0.5) per pixel, and one pixel twice as bright as white
     let (w, h) = (4usize, 3usize);
     let drive = |x: usize, y: usize| [x as f64 / 3.0, y as f64 / 2.0, 0.5];
@@ -260,6 +268,7 @@ fn reproduce_an_exr_image_from_the_command_line() {
             height: h,
             pixels,
         },
+        &metamer::output::OutputPolicy::new(true),
     )
     .unwrap();
     let png_path = dir.join("o.png");

@@ -38,10 +38,13 @@ fn quick_lab(dir: &str, extra: &[&str]) -> Output {
 }
 
 /// On `ideal-crt` the assumptions of PLCC with a power-law TRC hold exactly, so every colour
-/// the display can show comes back from it within the meter's noise and the 8-bit steps
-/// (a hand estimate: well under 1.5 ΔE*ab even for the dark patches, where one 8-bit step
-/// of blue is a third of its light); the box and the simulation differ by meter noise and
-/// the renders' Monte Carlo error only, so all 24 agree within the JND.
+/// the display can show comes back from it within the meter's noise and the 8-bit steps.
+/// The fit sees one pass of 9-level ramps, and the meter's ±0.001 in xy on the dim low
+/// levels of the blue ramp moves the fitted blue TRC: measured over seeds 1–4 the worst
+/// in-gamut colour is off by 2.37, 1.15, 1.04 and 1.38 ΔE*ab (seed 1: 5 % of Z in patch 5,
+/// drive blue 57) and the mean by 0.96, 0.54, 0.54 and 0.71, hence the bounds 3 and 1.2.
+/// The box and the simulation differ by meter noise and the renders' Monte Carlo error
+/// only, so all 24 agree within the JND.
 #[test]
 fn the_ideal_display_reproduces_the_simulation() {
     let dir = temp_dir("ideal");
@@ -60,14 +63,21 @@ fn the_ideal_display_reproduces_the_simulation() {
     let patches = lab["patches"].as_array().unwrap();
     let compared = lab["display_vs_simulation"]["patches"].as_array().unwrap();
     let mut in_gamut = 0;
+    let mut sum = 0.0;
     for (p, c) in patches.iter().zip(compared) {
         if !p["display"]["out_of_gamut"].as_bool().unwrap() {
             in_gamut += 1;
             let de = c["de76"].as_f64().unwrap();
-            assert!(de < 1.5, "patch {}: ΔE*ab {de}", p["patch"]);
+            sum += de;
+            assert!(de < 3.0, "patch {}: ΔE*ab {de}", p["patch"]);
         }
     }
     assert!(in_gamut >= 12, "only {in_gamut} patches in gamut");
+    let mean = sum / in_gamut as f64;
+    assert!(
+        mean < 1.2,
+        "mean ΔE*ab {mean} over {in_gamut} in-gamut patches"
+    );
     for f in [
         "display_vs_box.csv",
         "display_vs_box.svg",
@@ -97,7 +107,8 @@ fn the_ideal_display_reproduces_the_simulation() {
     );
     assert_eq!(std::fs::read(dir.join("display/log.jsonl")).unwrap(), log);
 
-    // With --resume the characterization is taken from its log; nothing is re-measured.
+    // With --resume a finished run is read back: nothing is rendered, measured or written.
+    let lab_json = std::fs::read(dir.join("lab.json")).unwrap();
     let resumed = quick_lab(
         dir.to_str().unwrap(),
         &[
@@ -114,6 +125,29 @@ fn the_ideal_display_reproduces_the_simulation() {
         String::from_utf8_lossy(&resumed.stderr)
     );
     assert_eq!(std::fs::read(dir.join("display/log.jsonl")).unwrap(), log);
+    assert_eq!(std::fs::read(dir.join("lab.json")).unwrap(), lab_json);
+    let said = String::from_utf8_lossy(&resumed.stdout);
+    assert!(
+        said.contains("nothing to resume") && said.contains("display_vs_box: "),
+        "{said}"
+    );
+    // Resuming it with another seed would mix two runs: refused, naming the option.
+    let other = quick_lab(
+        dir.to_str().unwrap(),
+        &[
+            "--display",
+            "ideal-crt",
+            "--model",
+            "plcc-gamma",
+            "--seed",
+            "2",
+            "--resume",
+        ],
+    );
+    assert_eq!(other.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(err.contains("whose --seed is 1, this one's is 2"), "{err}");
+    assert_eq!(std::fs::read(dir.join("lab.json")).unwrap(), lab_json);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -53,7 +53,13 @@ fn print_held_out_table() {
         let patches = measure(&panel, &scattered_patches(10_000, 5));
         std::fs::create_dir_all(&dir).unwrap();
         let path = std::path::Path::new(&dir).with_extension("10000.ti3");
-        write_ti3(&path, &patches, "10,000 scattered patches").unwrap();
+        write_ti3(
+            &path,
+            &patches,
+            "10,000 scattered patches",
+            &metamer::output::OutputPolicy::new(true),
+        )
+        .unwrap();
     }
     for preset in Preset::ALL {
         let panel = VirtualPanel::preset(preset);
@@ -71,10 +77,22 @@ fn print_held_out_table() {
             if let Some(dir) = std::env::var_os("METAMER_SCATTERED_OUT") {
                 let dir = std::path::Path::new(&dir).join(format!("{}-{n}", panel.name()));
                 std::fs::create_dir_all(&dir).unwrap();
-                write_ti3(&dir.join("fit.ti3"), &patches, "scattered fit set").unwrap();
+                write_ti3(
+                    &dir.join("fit.ti3"),
+                    &patches,
+                    "scattered fit set",
+                    &metamer::output::OutputPolicy::new(true),
+                )
+                .unwrap();
                 let mut test = measure(&panel, &[[255; 3]]);
                 test.extend(measure(&panel, &random_patches(500, 77)));
-                write_ti3(&dir.join("heldout.ti3"), &test, "held-out set").unwrap();
+                write_ti3(
+                    &dir.join("heldout.ti3"),
+                    &test,
+                    "held-out set",
+                    &metamer::output::OutputPolicy::new(true),
+                )
+                .unwrap();
             }
             let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
             line += &format!(" auto→{}", sel.model);

@@ -232,6 +232,12 @@ pub trait Instrument: Send {
     fn option_values(&self) -> Vec<(String, String)> {
         Vec::new()
     }
+    /// The next measurements belong to reading `index` of a session. A simulated
+    /// instrument draws their noise from (seed, index), so a resumed session reads what an
+    /// uninterrupted one would; a real instrument has nothing to do.
+    fn seek_noise(&mut self, index: u64) {
+        let _ = index;
+    }
 }
 
 #[cfg(test)]

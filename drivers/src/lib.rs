@@ -18,6 +18,7 @@ pub mod noise;
 mod open;
 mod permissions;
 pub mod registry;
+pub mod simulated;
 mod spec;
 pub mod world;
 

@@ -8,6 +8,7 @@ use metamer::display::ModelKind;
 use metamer::rig::Preset;
 
 use super::{CliError, CliResult};
+use metamer::output::OutputPolicy;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -27,6 +28,9 @@ pub struct Args {
     /// Seed of the meter noise and of the verification colours.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Replace budget.csv and the charts if they exist.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -48,6 +52,13 @@ pub fn run(args: Args) -> CliResult {
             .collect::<Result<_, String>>()
             .map_err(CliError::Usage)?
     };
+    let out = OutputPolicy::new(args.force);
+    // Before the study, which takes minutes: a refused output is found now.
+    out.dir(&args.out)?;
+    out.check(&args.out.join("budget.csv"))?;
+    for p in &presets {
+        out.check(&args.out.join(format!("budget-{}.svg", p.name())))?;
+    }
     let total = presets.len() * models.len() * RAMP_STEPS.len();
     let bar = indicatif::ProgressBar::new(total as u64);
     bar.set_style(
@@ -59,7 +70,7 @@ pub fn run(args: Args) -> CliResult {
     });
     bar.finish_and_clear();
     let points = points?;
-    write_budget(&args.out, &points)?;
+    write_budget(&args.out, &points, &out)?;
     println!("preset            model        patches  mean ΔE00  p95 ΔE00  max ΔE00");
     for p in &points {
         println!(

@@ -5,12 +5,13 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::ValueEnum;
-use metamer::display::characterize::finish::Summary;
+use metamer::display::characterize::finish::{files, Summary};
 use metamer::display::characterize::{
     self, default_grid_steps, log_path, CharacterizeError, Options, Outcome, Plan, PlanError,
     PlanOptions, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::ModelKind;
+use metamer::output::OutputPolicy;
 use metamer::rig::ScreenSpec;
 use metamer::session::{
     on_ctrl_c, refuse_existing, BarProgress, JournalError, RunEnd, RunOptions, SessionError,
@@ -64,6 +65,10 @@ pub struct Args {
     /// Output directory: log.jsonl, profile.json, readings.ti3, report.svg, summary.json.
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: PathBuf,
+    /// Replace a profile, .ti3, report or summary already in DIR (a resumed session
+    /// replaces its own without it).
+    #[arg(long)]
+    force: bool,
     /// Stop after N new readings, as if interrupted (tests; splitting a long session).
     #[arg(long, value_name = "N", hide = true)]
     stop_after: Option<usize>,
@@ -85,6 +90,13 @@ pub fn run(args: Args) -> CliResult {
         // Before a full-screen window or an instrument is opened for nothing.
         refuse_existing(&log_path(&args.out))
             .map_err(|e| translate(CharacterizeError::Session(SessionError::Journal(e))))?;
+        // Files another session left in the directory (a new directory has none).
+        if args.out.is_dir() {
+            let out = OutputPolicy::new(args.force);
+            for f in files(&args.out, &log_path(&args.out)).outputs() {
+                out.check(f)?;
+            }
+        }
     }
 
     let mut display = spec.open()?;
@@ -117,6 +129,7 @@ pub fn run(args: Args) -> CliResult {
         instrument: args.instrument.clone(),
         settle: args.settle_ms.map(Duration::from_millis),
         resume: args.resume,
+        force: args.force,
         run: RunOptions {
             stop_after: args.stop_after,
             interrupt: Some(on_ctrl_c()),
@@ -187,6 +200,14 @@ fn translate(e: CharacterizeError) -> CliError {
             "{} was measured with a {logged}, this session has a {now}: resume with the instrument it was started with (--instrument), or choose another output directory",
             path.display()
         )),
+        CharacterizeError::Session(SessionError::InstrumentSettingDiffers(d)) => Some(format!(
+            "{} was measured with a {} whose {} was {}, this session's is {}: resume with the settings it was started with, or choose another output directory",
+            d.path.display(),
+            d.model,
+            setting_flag(&d.setting),
+            d.logged,
+            d.now
+        )),
         CharacterizeError::Session(SessionError::Step {
             index,
             total,
@@ -214,6 +235,11 @@ fn journal_text(e: &JournalError) -> Option<String> {
             "{} exists with {entries} reading(s) of an earlier session: continue it with --resume, or choose another output directory",
             path.display()
         ),
+        JournalError::Broken { path, what } => format!(
+            "{} holds no session to continue: {what}; run with --resume to set it aside (as {}.broken-N, kept) and start afresh",
+            path.display(),
+            path.display()
+        ),
         JournalError::OptionDiffers {
             path,
             option,
@@ -226,6 +252,18 @@ fn journal_text(e: &JournalError) -> Option<String> {
         ),
         _ => return None,
     })
+}
+
+/// An instrument setting as the user gave it: a flag, or an option of the `--instrument`
+/// spec of a simulation.
+fn setting_flag(setting: &str) -> String {
+    match setting {
+        "speed" => "--speed".into(),
+        s => match s.strip_prefix(metamer_drivers::simulated::SIM_OPTION_PREFIX) {
+            Some(sim) => format!("simulation's {sim} (--instrument sim:…?{sim}=)"),
+            None => s.to_string(),
+        },
+    }
 }
 
 fn print_summary(s: &Summary) -> Result<(), CliError> {

@@ -7,6 +7,7 @@ use super::{CliError, CliResult};
 use metamer::display::{
     fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
 };
+use metamer::output::OutputPolicy;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -31,6 +32,9 @@ pub struct Args {
     /// Where to write the profile (JSON).
     #[arg(short = 'o', long = "output", value_name = "PROFILE.json")]
     output: PathBuf,
+    /// Replace the output file if it exists (never one of the inputs).
+    #[arg(long)]
+    force: bool,
 }
 
 /// A model by name, or `auto`.
@@ -53,6 +57,10 @@ impl std::str::FromStr for ModelChoice {
 }
 
 pub fn run(args: Args) -> CliResult {
+    let mut out = OutputPolicy::new(args.force);
+    out.input(&args.measurements);
+    // Before the fit, which may take a while: a refused output is found now.
+    out.check(&args.output)?;
     if let Some(g) = args.gamma {
         if args.model != ModelChoice::Kind(ModelKind::PlccGamma) {
             return Err(CliError::Usage(
@@ -115,7 +123,7 @@ pub fn run(args: Args) -> CliResult {
         profile.black_xyz[2]
     );
     println!("{}", profile.diagnostics());
-    profile.save(&args.output)?;
+    profile.save(&args.output, &out)?;
     println!("profile written to {}", args.output.display());
     Ok(())
 }

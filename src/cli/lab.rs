@@ -1,11 +1,16 @@
 //! `metamer lab`: the whole validation chain on the built-in simulated lab.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
-use metamer::lab::{run_lab, LabError, LabOptions, LabProgress, LabResult, Scenario, DISPLAY_DIR};
+use metamer::lab::{
+    finished_run, result_files, run_lab, LabError, LabOptions, LabProgress, LabResult, Scenario,
+    DISPLAY_DIR, LAB_FILE,
+};
+use metamer::output::OutputPolicy;
 use metamer::rig::Preset;
+use metamer::validation::Comparison;
 
 use super::{CliError, CliResult};
 
@@ -81,6 +86,22 @@ pub fn run(args: Args) -> CliResult {
         seed: args.seed,
         time_scale: args.time_scale,
     };
+    if args.resume {
+        if let Some(json) = finished_run(&args.out, &options).map_err(translate)? {
+            return print_finished(&json);
+        }
+    }
+    let earlier = args.out.join(LAB_FILE).exists() || args.out.join(DISPLAY_DIR).exists();
+    if !args.resume && earlier {
+        return Err(translate(LabError::Exists { dir: args.out }));
+    }
+    // A resumed run replaces the files it wrote itself; a new one replaces nothing.
+    let mut out = OutputPolicy::new(args.resume);
+    out.input(&options.scene);
+    out.dir(&args.out)?;
+    for f in result_files(&args.out) {
+        out.check(&f)?;
+    }
     let bar = indicatif::ProgressBar::new_spinner();
     bar.set_style(
         indicatif::ProgressStyle::with_template("{spinner} {prefix}: {msg} ({elapsed})")
@@ -101,7 +122,43 @@ pub fn run(args: Args) -> CliResult {
         }
     });
     bar.finish_and_clear();
-    let result = result.map_err(|e| match e {
+    let result = result.map_err(translate)?;
+    let written = result.write(&args.out, &out)?;
+    print_summary(&result);
+    println!(
+        "wrote {} and the display characterization in {}",
+        written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        args.out.join(DISPLAY_DIR).display()
+    );
+    Ok(())
+}
+
+/// A finished run resumed: its results, read back; nothing is rendered or measured.
+fn print_finished(json: &Path) -> CliResult {
+    let text = std::fs::read_to_string(json)?;
+    let lab: serde_json::Value = serde_json::from_str(&text)?;
+    println!(
+        "{} holds the finished run with these options; nothing to resume",
+        json.display()
+    );
+    for name in [
+        "display_vs_box",
+        "simulation_vs_box",
+        "display_vs_simulation",
+    ] {
+        let c: Comparison = serde_json::from_value(lab[name].clone())?;
+        println!("{name}: {}", c.summary());
+    }
+    Ok(())
+}
+
+/// The library's errors in the words of this command's flags.
+fn translate(e: LabError) -> CliError {
+    match e {
         // The library says what to do; here that is a flag.
         LabError::Exists { dir } => CliError::Failed(
             format!(
@@ -117,20 +174,22 @@ pub fn run(args: Args) -> CliResult {
             )
             .into(),
         ),
+        LabError::OptionDiffers {
+            dir,
+            option,
+            logged,
+            now,
+        } => CliError::Failed(
+            format!(
+                "{} holds a finished lab run whose --{} is {logged}, this one's is {now}; run \
+                 with the options it was made with, or choose another directory",
+                dir.display(),
+                option.replace('_', "-")
+            )
+            .into(),
+        ),
         e => CliError::from(e),
-    })?;
-    let written = result.write(&args.out)?;
-    print_summary(&result);
-    println!(
-        "wrote {} and the display characterization in {}",
-        written
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-        args.out.join(DISPLAY_DIR).display()
-    );
-    Ok(())
+    }
 }
 
 fn print_summary(r: &LabResult) {

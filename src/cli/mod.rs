@@ -105,6 +105,9 @@ pub fn main() -> ExitCode {
         }
         Err(CliError::Failed(error)) => {
             eprintln!("error: {error}");
+            if needs_force(&*error) {
+                eprintln!("  add --force to replace it");
+            }
             let mut shown = error.to_string();
             let mut source = error.source();
             while let Some(cause) = source {
@@ -119,6 +122,18 @@ pub fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// Whether the failure is an output the command refused to overwrite, which `--force` lifts.
+fn needs_force(error: &(dyn std::error::Error + 'static)) -> bool {
+    let mut e = Some(error);
+    while let Some(cause) = e {
+        if let Some(o) = cause.downcast_ref::<metamer::output::OutputError>() {
+            return o.needs_force();
+        }
+        e = cause.source();
+    }
+    false
 }
 
 /// Parses `X,Y,Z` (three finite numbers) for clap.

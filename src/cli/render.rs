@@ -6,6 +6,7 @@ use clap::Subcommand;
 
 use super::{parse_triple, CliError, CliResult};
 use metamer::numeric_csv::NumericCsv;
+use metamer::output::{OutputError, OutputPolicy};
 use metamer::render::convergence;
 use metamer::render::geometry::{Vec3, VecOps};
 use metamer::render::image::{render_image, ImageOptions};
@@ -69,6 +70,9 @@ enum Cmd {
         preview: Option<PathBuf>,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Replace the image and preview if they exist.
+        #[arg(long)]
+        force: bool,
     },
     /// Illuminance (lux: direct, indirect, total) at points given as CSV rows
     /// x,y,z,nx,ny,nz (header line), the normal being the measuring surface's.
@@ -102,6 +106,9 @@ enum Cmd {
         seconds: f64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Replace convergence.csv and convergence.svg if they exist.
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -195,9 +202,26 @@ pub fn run(args: Args) -> CliResult {
             output,
             preview,
             seed,
+            force,
         } => {
             if spp == 0 {
                 return Err(CliError::Usage("--spp must be ≥ 1".into()));
+            }
+            let mut out = OutputPolicy::new(force);
+            out.input(&scene);
+            // Before the render: a refused output costs nothing yet.
+            out.check(&output)?;
+            if let Some(p) = &preview {
+                let mut besides_image = out.clone();
+                besides_image.input(&output);
+                if let Err(OutputError::IsInput { .. }) = besides_image.check(p) {
+                    return Err(CliError::Usage(format!(
+                        "--preview {} is the same file as --output {}",
+                        p.display(),
+                        output.display()
+                    )));
+                }
+                out.check(p)?;
             }
             let file = scene;
             let scene = Scene::load(&file)?;
@@ -228,7 +252,7 @@ pub fn run(args: Args) -> CliResult {
             let img = render_image(&scene, &opts, &|n| bar.inc(n as u64))?;
             bar.finish_and_clear();
             let secs = t.elapsed().as_secs_f64();
-            write_xyz_image(&output, &img)?;
+            write_xyz_image(&output, &img, &out)?;
             eprintln!(
                 "{width}×{height} at {spp} spp in {secs:.1} s ({:.0} samples/s), wrote {}",
                 (width * height) as f64 * spp as f64 / secs,
@@ -243,7 +267,7 @@ pub fn run(args: Args) -> CliResult {
                         ..SpotOptions::default()
                     },
                 )?;
-                write_srgb_preview(&p, &img, white[1])?;
+                write_srgb_preview(&p, &img, white[1], &out)?;
                 eprintln!("preview {}", p.display());
             }
             Ok(())
@@ -263,11 +287,18 @@ pub fn run(args: Args) -> CliResult {
             reference_de,
             seconds,
             seed,
+            force,
         } => {
+            let mut out = OutputPolicy::new(force);
+            out.input(&scene);
+            out.dir(&output)?;
+            for f in ["convergence.csv", "convergence.svg"] {
+                out.check(&output.join(f))?;
+            }
             let scene = Scene::load(&scene)?;
             let (points, _) =
                 convergence::run(&scene, reference_de, seconds, seed, &|m| eprintln!("{m}"))?;
-            convergence::write(&output, &points)?;
+            convergence::write(&output, &points, &out)?;
             eprintln!(
                 "wrote {}/convergence.csv and convergence.svg",
                 output.display()

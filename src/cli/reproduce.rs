@@ -10,6 +10,7 @@ use metamer::display::reproduce::{
     read_targets, reproduce_image, reproduce_targets, write_drive_csv, write_drive_png,
 };
 use metamer::display::Profile;
+use metamer::output::OutputPolicy;
 use metamer::render::image_io::read_xyz_image;
 
 #[derive(clap::Args)]
@@ -26,6 +27,9 @@ pub struct Args {
     /// Output: RGB.csv for --xyz, OUT.png for --image.
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
+    /// Replace the output file if it exists (never one of the inputs).
+    #[arg(long)]
+    force: bool,
     /// PNG bits per channel (8 or 16).
     #[arg(long, default_value_t = 8)]
     bits: u8,
@@ -45,6 +49,10 @@ pub fn run(args: Args) -> CliResult {
             args.bits
         )));
     }
+    let mut out = OutputPolicy::new(args.force);
+    out.input(&args.profile);
+    out.inputs(args.xyz.iter().chain(&args.image).map(PathBuf::as_path));
+    out.check(&args.output)?;
     let profile = Profile::load(&args.profile)?;
     match (&args.xyz, &args.image) {
         (Some(targets), None) => {
@@ -53,8 +61,7 @@ pub fn run(args: Args) -> CliResult {
             }
             let xyz = read_targets(targets)?;
             let drives = reproduce_targets(&profile, &xyz, args.gamut);
-            write_drive_csv(&args.output, &drives)
-                .map_err(|e| CliError::Failed(format!("{}: {e}", args.output.display()).into()))?;
+            write_drive_csv(&args.output, &drives, &out)?;
             let out = drives.iter().filter(|d| d.out_of_gamut).count();
             eprintln!(
                 "{} targets, {out} out of gamut ({}); written to {}",
@@ -75,7 +82,7 @@ pub fn run(args: Args) -> CliResult {
             let start = Instant::now();
             let drive = reproduce_image(&profile, &img, args.mirror, args.gamut);
             let elapsed = start.elapsed();
-            write_drive_png(&args.output, &drive, args.bits)?;
+            write_drive_png(&args.output, &drive, args.bits, &out)?;
             let total = img.width * img.height;
             eprintln!(
                 "{}×{} pixels converted in {:.1} ms; {} out of gamut ({:.3} %); {}-bit PNG \

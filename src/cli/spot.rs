@@ -2,7 +2,9 @@
 //! instrument's calibrations negotiated at the terminal.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use metamer::output::OutputPolicy;
 use std::sync::Arc;
 
 use clap::ValueEnum;
@@ -61,6 +63,9 @@ pub struct Args {
     /// Write the readings' spectra to this CSV (nm and one column per reading).
     #[arg(long, value_name = "FILE.csv")]
     spectrum: Option<PathBuf>,
+    /// Replace the --spectrum file if it exists.
+    #[arg(long)]
+    force: bool,
     /// Record the exchange with the instrument to this new transcript (never overwritten).
     #[arg(long, value_name = "FILE.jsonl")]
     record: Option<PathBuf>,
@@ -77,6 +82,17 @@ pub fn run(args: Args) -> CliResult {
                 path.display()
             )));
         }
+    }
+    let mut spectrum_out = OutputPolicy::new(args.force);
+    if let Some(replayed) = args.instrument.strip_prefix("replay:") {
+        spectrum_out.input(Path::new(replayed));
+    }
+    if let Some(record) = &args.record {
+        spectrum_out.input(record);
+    }
+    if let Some(path) = &args.spectrum {
+        // Before measuring: a refused output is found while nothing is lost.
+        spectrum_out.check(path)?;
     }
     let mode = match args.mode {
         ModeArg::Emissive => MeasureMode::Emissive,
@@ -143,8 +159,7 @@ pub fn run(args: Args) -> CliResult {
                 info.model
             ))
         })?;
-        std::fs::write(path, csv)
-            .map_err(|e| CliError::Usage(format!("cannot write {}: {e}", path.display())))?;
+        spectrum_out.write(path, csv.as_bytes())?;
     }
     Ok(())
 }

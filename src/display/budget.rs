@@ -24,7 +24,8 @@ use super::diagnostics::percentile;
 use super::model::Sample;
 use super::{fit_profile, ModelKind};
 use crate::color::{delta_e2000, Xyz};
-use crate::plot::{write_log_log, LogLogChart, Series};
+use crate::output::{OutputError, OutputPolicy};
+use crate::plot::{log_log_svg, LogLogChart, Series};
 use crate::rig::virtual_display::{Preset, VirtualPanel};
 
 /// One patch budget: ramp steps per channel (including 0 and full drive) and the points
@@ -87,12 +88,8 @@ pub struct BudgetPoint {
 pub enum BudgetError {
     #[error("the simulated meter failed: {0}")]
     Meter(#[from] metamer_drivers::DriverError),
-    #[error("cannot write {file}: {source}")]
-    Write {
-        file: std::path::PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error("{0}")]
+    Output(#[from] OutputError),
     #[error("cannot draw {file}: {message}")]
     Chart {
         file: std::path::PathBuf,
@@ -176,14 +173,22 @@ pub fn run_budget_study(
     Ok(points)
 }
 
-/// Writes `budget.csv` and one SVG chart per preset (`budget-PRESET.svg`) into `dir`.
-pub fn write_budget(dir: &std::path::Path, points: &[BudgetPoint]) -> Result<(), BudgetError> {
-    let io = |file: &std::path::Path| {
-        let file = file.to_path_buf();
-        move |source| BudgetError::Write { file, source }
-    };
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+/// Writes `budget.csv` and one SVG chart per preset (`budget-PRESET.svg`) into `dir`
+/// under the output policy `out`; every file is checked before the first is written, so a
+/// refusal leaves the directory as it was.
+pub fn write_budget(
+    dir: &std::path::Path,
+    points: &[BudgetPoint],
+    out: &OutputPolicy,
+) -> Result<(), BudgetError> {
+    out.dir(dir)?;
     let csv = dir.join("budget.csv");
+    let mut presets: Vec<&str> = points.iter().map(|p| p.preset.as_str()).collect();
+    presets.dedup();
+    out.check(&csv)?;
+    for preset in &presets {
+        out.check(&dir.join(format!("budget-{preset}.svg")))?;
+    }
     let mut text =
         String::from("preset,model,patches,ramp_steps,cube,mean_de00,p95_de00,max_de00,fit_ms\n");
     for p in points {
@@ -200,9 +205,7 @@ pub fn write_budget(dir: &std::path::Path, points: &[BudgetPoint]) -> Result<(),
             p.fit_ms
         ));
     }
-    std::fs::write(&csv, text).map_err(io(&csv))?;
-    let mut presets: Vec<&str> = points.iter().map(|p| p.preset.as_str()).collect();
-    presets.dedup();
+    out.write(&csv, text.as_bytes())?;
     for preset in presets {
         let mut models: Vec<&str> = points
             .iter()
@@ -237,10 +240,11 @@ pub fn write_budget(dir: &std::path::Path, points: &[BudgetPoint]) -> Result<(),
             target: Some((0.5, "ΔE00 0.5")),
             size: (900, 520),
         };
-        write_log_log(&chart, &file).map_err(|message| BudgetError::Chart {
+        let svg = log_log_svg(&chart).map_err(|message| BudgetError::Chart {
             file: file.clone(),
             message,
         })?;
+        out.write(&file, svg.as_bytes())?;
     }
     Ok(())
 }

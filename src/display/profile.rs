@@ -1,6 +1,7 @@
 //! A fitted display profile as a JSON document: model name and parameters, white and black
 //! XYZ, residuals, diagnostics and the measurement file's SHA-256.
 
+use crate::output::{OutputError, OutputPolicy};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,8 @@ pub enum ProfileError {
     Format { file: PathBuf, found: String },
     #[error("{file}: inconsistent parameters: {message}")]
     Parameters { file: PathBuf, message: String },
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }
 
 impl Profile {
@@ -74,17 +77,11 @@ impl Profile {
         self.model().inverse(xyz)
     }
 
-    /// Writes pretty JSON through a sibling file and a rename, so an interrupted save never
-    /// leaves a truncated profile behind.
-    pub fn save(&self, path: &Path) -> Result<(), ProfileError> {
-        let io = |source| ProfileError::Io {
-            file: path.to_path_buf(),
-            source,
-        };
+    /// Writes pretty JSON under the output policy `out` (atomically: an interrupted save
+    /// never leaves a truncated profile behind).
+    pub fn save(&self, path: &Path, out: &OutputPolicy) -> Result<(), ProfileError> {
         let text = serde_json::to_string_pretty(self).expect("a profile always serialises");
-        let tmp = path.with_extension("json.partial");
-        std::fs::write(&tmp, text + "\n").map_err(io)?;
-        std::fs::rename(&tmp, path).map_err(io)
+        Ok(out.write(path, (text + "\n").as_bytes())?)
     }
 
     pub fn load(path: &Path) -> Result<Profile, ProfileError> {

@@ -6,8 +6,9 @@
 //! `mirror` flips the image left–right for the paper's set-up, where the display is seen
 //! through a mirror beside the box.
 
-use std::io::Write;
 use std::path::Path;
+
+use crate::output::{OutputError, OutputPolicy};
 
 use rayon::prelude::*;
 
@@ -106,14 +107,15 @@ pub fn quantize(v: f32, bits: u8) -> u16 {
 }
 
 /// Writes an RGB PNG of 8 or 16 bits per channel.
-pub fn write_drive_png(path: &Path, image: &DriveImage, bits: u8) -> Result<(), ImageIoError> {
+pub fn write_drive_png(
+    path: &Path,
+    image: &DriveImage,
+    bits: u8,
+    out: &OutputPolicy,
+) -> Result<(), ImageIoError> {
     let png_err = |e: png::EncodingError| ImageIoError::Png {
         file: path.to_path_buf(),
         message: e.to_string(),
-    };
-    let io = |source| ImageIoError::Io {
-        file: path.to_path_buf(),
-        source,
     };
     let data: Vec<u8> = match bits {
         8 => image
@@ -134,12 +136,9 @@ pub fn write_drive_png(path: &Path, image: &DriveImage, bits: u8) -> Result<(), 
             })
         }
     };
-    let f = std::fs::File::create(path).map_err(io)?;
-    let mut enc = png::Encoder::new(
-        std::io::BufWriter::new(f),
-        image.width as u32,
-        image.height as u32,
-    );
+    // Encoded in memory first: an encoding error never reaches the file.
+    let mut png_bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut png_bytes, image.width as u32, image.height as u32);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(if bits == 8 {
         png::BitDepth::Eight
@@ -148,7 +147,8 @@ pub fn write_drive_png(path: &Path, image: &DriveImage, bits: u8) -> Result<(), 
     });
     let mut w = enc.write_header().map_err(png_err)?;
     w.write_image_data(&data).map_err(png_err)?;
-    w.finish().map_err(png_err)
+    w.finish().map_err(png_err)?;
+    Ok(out.write(path, &png_bytes)?)
 }
 
 /// Reads a targets CSV with the header `X,Y,Z` (cd/m²).
@@ -161,7 +161,11 @@ pub fn read_targets(path: &Path) -> Result<Vec<[f64; 3]>, CsvError> {
 }
 
 /// Writes `r,g,b,out_of_gamut` rows (drive values as floats, flag 0/1).
-pub fn write_drive_csv(path: &Path, drives: &[Drive]) -> std::io::Result<()> {
+pub fn write_drive_csv(
+    path: &Path,
+    drives: &[Drive],
+    out: &OutputPolicy,
+) -> Result<(), OutputError> {
     let mut s = String::from("r,g,b,out_of_gamut\n");
     for d in drives {
         s.push_str(&format!(
@@ -172,8 +176,7 @@ pub fn write_drive_csv(path: &Path, drives: &[Drive]) -> std::io::Result<()> {
             u8::from(d.out_of_gamut)
         ));
     }
-    let mut f = std::fs::File::create(path)?;
-    f.write_all(s.as_bytes())
+    out.write(path, s.as_bytes())
 }
 
 #[cfg(test)]

@@ -131,6 +131,8 @@ pub fn characterize_display(
         instrument: opts.spot.clone(),
         settle: virtual_white_cd_m2.map(|_| Duration::ZERO),
         resume,
+        // The stage directory is the experiment's own: a re-run replaces its profile.
+        force: true,
         run: RunOptions::default(),
     };
     let mut scripted = ScriptedOperator::confirming();

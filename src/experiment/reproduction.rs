@@ -13,6 +13,7 @@ use super::ExperimentError;
 use crate::display::gamut::GamutMapping;
 use crate::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use crate::display::Profile;
+use crate::output::OutputPolicy;
 use crate::render::image_io::read_xyz_image;
 use crate::rig::virtual_display::quantize;
 
@@ -85,7 +86,8 @@ pub fn reproduce(
         Some(path) => {
             let img = read_xyz_image(path)?;
             let drive = reproduce_image(profile, &img, opts.mirror, mapping);
-            write_drive_png(&dir.join(IMAGE_FILE), &drive, 8)?;
+            // The stage directory is the stage's own: a re-run replaces its files.
+            write_drive_png(&dir.join(IMAGE_FILE), &drive, 8, &OutputPolicy::new(true))?;
             files.push(IMAGE_FILE);
             Some(drive.out_of_gamut)
         }

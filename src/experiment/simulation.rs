@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::readings::{write_readings, PatchStat};
 use super::{ExperimentError, Progress};
+use crate::output::OutputPolicy;
 use crate::render::image::{render_image, ImageOptions};
 use crate::render::image_io::write_xyz_image;
 use crate::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
@@ -146,7 +147,8 @@ pub fn simulate(
                 window: None,
             };
             let img = render_image(&scene, &io, &|_| {})?;
-            write_xyz_image(&dir.join(IMAGE_FILE), &img)?;
+            // The stage directory is the stage's own: a re-run replaces its files.
+            write_xyz_image(&dir.join(IMAGE_FILE), &img, &OutputPolicy::new(true))?;
             files.push(IMAGE_FILE);
             Some(IMAGE_FILE.to_string())
         }

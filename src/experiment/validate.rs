@@ -9,6 +9,7 @@ use super::cache::write_atomic;
 use super::readings::PatchStat;
 use super::ExperimentError;
 use crate::color::Xyz;
+use crate::output::OutputPolicy;
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
 
 /// Everything the validation found, as `validation/validation.json`.
@@ -89,7 +90,14 @@ pub fn validate(
         } else {
             out_of_gamut
         };
-        write_delta_e_chart_shaded(c, shaded, "outside the display's gamut", &dir.join(&svg))?;
+        // The stage directory is the stage's own: a re-run replaces its files.
+        write_delta_e_chart_shaded(
+            c,
+            shaded,
+            "outside the display's gamut",
+            &dir.join(&svg),
+            &OutputPolicy::new(true),
+        )?;
         files.extend([csv, svg]);
     }
     let text = serde_json::to_string_pretty(&result).map_err(ExperimentError::Json)?;

@@ -21,6 +21,10 @@ use crate::session::{RunOptions, ScriptedOperator, StepProgress};
 use super::error::LabError;
 use super::meter::mean_reading;
 
+/// Noise index of the first reproduced target's readings: past any characterization
+/// plan's steps, which take the indices from 0.
+pub const REPRODUCTION_READINGS: u64 = 1 << 32;
+
 /// Headroom above the brightest in-gamut target, so no channel sits at its very end.
 const LUMINANCE_HEADROOM: f64 = 1.05;
 
@@ -76,6 +80,7 @@ pub fn characterize(
         instrument: instrument_spec.to_string(),
         settle: Some(Duration::ZERO),
         resume,
+        force: false,
         run: RunOptions::default(),
     };
     // A simulated rig: nothing to do by hand, every request is done.
@@ -120,7 +125,8 @@ pub fn reproduce_and_measure(
     let forward = |rgb: [f64; 3]| profile.forward(rgb);
     targets
         .iter()
-        .map(|&t| {
+        .enumerate()
+        .map(|(i, &t)| {
             let inverse = profile.inverse(t);
             let rgb = map_to_gamut(
                 mapping,
@@ -131,6 +137,9 @@ pub fn reproduce_and_measure(
             );
             let rgb8 = rgb.map(quantize);
             display.show(rgb8)?;
+            // Target i's noise is the same whether the characterization before it was
+            // measured in this run or read back from its journal.
+            meter.seek_noise(REPRODUCTION_READINGS + i as u64);
             let measured_xyz = mean_reading(meter, repeats)?;
             Ok(Reproduced {
                 target_xyz: t,

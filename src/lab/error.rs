@@ -6,6 +6,7 @@ use metamer_drivers::DriverError;
 
 use crate::display::characterize::CharacterizeError;
 use crate::display::ProfileError;
+use crate::output::OutputError;
 use crate::render::spot::SpotError;
 use crate::render::SceneError;
 use crate::rig::sim_box::SimBoxError;
@@ -37,9 +38,16 @@ pub enum LabError {
     NotSimulated,
     #[error("{} holds an earlier lab run; choose another directory or resume that run", dir.display())]
     Exists { dir: PathBuf },
-    #[error("writing {}: {source}", file.display())]
-    Write {
-        file: PathBuf,
-        source: std::io::Error,
+    /// Resuming a finished run with other options: its results answer another question.
+    #[error("{} holds a finished lab run whose {option} is {logged}, this one's is {now}; run with the options it was made with, or choose another directory", dir.display())]
+    OptionDiffers {
+        dir: PathBuf,
+        option: String,
+        logged: String,
+        now: String,
     },
+    #[error("{}: not a lab result: {message}", file.display())]
+    BadResult { file: PathBuf, message: String },
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }

@@ -36,6 +36,7 @@ use crate::color::Xyz;
 use crate::display::characterize::finish::Summary;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
+use crate::output::OutputPolicy;
 use crate::render::{Scene, SpotOptions, SpotProgress};
 use crate::rig::{Preset, Screen, VirtualDisplay, VirtualPanel};
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
@@ -118,6 +119,71 @@ pub struct LabResult {
 pub const LAB_FILE: &str = "lab.json";
 /// The display characterization's own directory inside the lab's.
 pub const DISPLAY_DIR: &str = "display";
+
+/// The comparison files and `lab.json` a finished run leaves in `dir`.
+pub fn result_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = [
+        "display_vs_box",
+        "simulation_vs_box",
+        "display_vs_simulation",
+    ]
+    .iter()
+    .flat_map(|stem| [format!("{stem}.csv"), format!("{stem}.svg")])
+    .map(|f| dir.join(f))
+    .collect();
+    files.push(dir.join(LAB_FILE));
+    files
+}
+
+/// The finished run in `dir` made with `opts`, if there is one: its `lab.json`. Resuming
+/// it has nothing left to do, so nothing is rendered or measured again. A finished run
+/// made with other options is an error naming the first that differs.
+pub fn finished_run(dir: &Path, opts: &LabOptions) -> Result<Option<PathBuf>, LabError> {
+    let file = dir.join(LAB_FILE);
+    let text = match std::fs::read_to_string(&file) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => {
+            return Err(LabError::BadResult {
+                file,
+                message: e.to_string(),
+            })
+        }
+    };
+    let bad = |message: String| LabError::BadResult {
+        file: file.clone(),
+        message,
+    };
+    let logged: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    let logged = logged
+        .get("options")
+        .and_then(|o| o.as_object())
+        .ok_or_else(|| bad("no options".into()))?;
+    let now = serde_json::to_value(opts).expect("lab options serialize");
+    let now = now.as_object().expect("lab options are an object");
+    let shown = |v: Option<&serde_json::Value>| match v {
+        Some(serde_json::Value::String(s)) => s.clone(),
+        Some(v) => v.to_string(),
+        None => "(not set)".into(),
+    };
+    for name in now.keys().chain(logged.keys()) {
+        let (a, b) = (logged.get(name), now.get(name));
+        // Numbers compare by value: 0.5 and 0.50 are the same target.
+        let same = match (a.and_then(|v| v.as_f64()), b.and_then(|v| v.as_f64())) {
+            (Some(x), Some(y)) => x == y,
+            _ => a == b,
+        };
+        if !same {
+            return Err(LabError::OptionDiffers {
+                dir: dir.to_path_buf(),
+                option: name.clone(),
+                logged: shown(a),
+                now: shown(b),
+            });
+        }
+    }
+    Ok(Some(file))
+}
 
 /// Runs the whole chain into `dir`. With `resume`, an interrupted display characterization
 /// in `dir` is continued; without it, a directory holding an earlier run is refused.
@@ -245,16 +311,16 @@ impl LabResult {
     }
 
     /// Writes `lab.json` and each comparison as CSV and SVG chart into `dir`.
-    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, LabError> {
-        let io = |file: &Path| {
-            let file = file.to_path_buf();
-            move |source| LabError::Write { file, source }
-        };
-        std::fs::create_dir_all(dir).map_err(io(dir))?;
+    /// Every file is checked under the output policy `out` before the first is written.
+    pub fn write(&self, dir: &Path, out: &OutputPolicy) -> Result<Vec<PathBuf>, LabError> {
+        out.dir(dir)?;
+        for f in result_files(dir) {
+            out.check(&f)?;
+        }
         let mut written = Vec::new();
         for (stem, c) in self.comparisons() {
             let csv = dir.join(format!("{stem}.csv"));
-            std::fs::write(&csv, c.to_csv()).map_err(io(&csv))?;
+            out.write(&csv, c.to_csv().as_bytes())?;
             let svg = dir.join(format!("{stem}.svg"));
             // Simulation vs box involves no display: nothing to shade there.
             let shaded: Vec<usize> = if stem == "simulation_vs_box" {
@@ -266,12 +332,13 @@ impl LabResult {
                     .map(|p| p.patch)
                     .collect()
             };
-            write_delta_e_chart_shaded(c, &shaded, "outside the display's gamut", &svg)?;
+            write_delta_e_chart_shaded(c, &shaded, "outside the display's gamut", &svg, out)?;
             written.extend([csv, svg]);
         }
         let json = dir.join(LAB_FILE);
         let text = serde_json::to_string_pretty(self).expect("lab results serialize");
-        std::fs::write(&json, text).map_err(io(&json))?;
+        // Last: lab.json is what marks the run finished.
+        out.write(&json, text.as_bytes())?;
         written.push(json);
         Ok(written)
     }

@@ -6,7 +6,8 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::plot::{write_log_log, LogLogChart, Series};
+use crate::output::{OutputError, OutputPolicy};
+use crate::plot::{log_log_svg, LogLogChart, Series};
 
 use super::integrator::{Strategy, Tracer, Wavelengths};
 use super::radiosity::{combine, run_level, Prepared, RadiosityError, RadiosityOptions};
@@ -62,6 +63,8 @@ pub enum ConvergenceError {
     },
     #[error("chart: {0}")]
     Chart(String),
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }
 
 /// Runs every strategy with doubling sample counts until `seconds_per_strategy` is spent.
@@ -187,14 +190,14 @@ pub fn radiosity_points(
     Ok(points)
 }
 
-/// Writes `convergence.csv` and `convergence.svg` into `dir`.
-pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
-    let io = |file: &Path| {
-        let file = file.to_path_buf();
-        move |source| ConvergenceError::Io { file, source }
-    };
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+/// Writes `convergence.csv` and `convergence.svg` into `dir` under the output policy `out`
+/// (both checked before either is written).
+pub fn write(dir: &Path, points: &[Point], out: &OutputPolicy) -> Result<(), ConvergenceError> {
+    out.dir(dir)?;
     let csv = dir.join("convergence.csv");
+    let svg = dir.join("convergence.svg");
+    out.check(&csv)?;
+    out.check(&svg)?;
     // Strategy names contain commas: quoted (RFC 4180).
     // For the radiosity rows the second column is the finest level's element count.
     let mut text = String::from("strategy,samples_per_patch,seconds,max_de_ab,mean_de_ab\n");
@@ -204,8 +207,7 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
             p.strategy, p.samples_per_patch, p.seconds, p.max_de, p.mean_de
         ));
     }
-    std::fs::write(&csv, text).map_err(io(&csv))?;
-    let svg = dir.join("convergence.svg");
+    out.write(&csv, text.as_bytes())?;
     let mut names: Vec<&str> = strategies().iter().map(|(name, _)| *name).collect();
     names.extend([RADIOSITY_BOUND, RADIOSITY_TRUE]);
     let series: Vec<Series> = names
@@ -228,5 +230,6 @@ pub fn write(dir: &Path, points: &[Point]) -> Result<(), ConvergenceError> {
         target: Some((0.1, "ΔE 0.1 target")),
         size: (900, 560),
     };
-    write_log_log(&chart, &svg).map_err(ConvergenceError::Chart)
+    let text = log_log_svg(&chart).map_err(ConvergenceError::Chart)?;
+    Ok(out.write(&svg, text.as_bytes())?)
 }

@@ -3,8 +3,10 @@
 //! bottom to top) and OpenEXR (the `exr` crate; X, Y, Z stored in the R, G, B channels),
 //! plus an sRGB PNG preview.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
+
+use crate::output::{OutputError, OutputPolicy};
 
 /// An XYZ image, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +37,8 @@ pub enum ImageIoError {
     Png { file: PathBuf, message: String },
     #[error("{file}: unknown image type (use .pfm or .exr)")]
     UnknownType { file: PathBuf },
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }
 
 fn io(file: &Path) -> impl Fn(std::io::Error) -> ImageIoError + '_ {
@@ -51,22 +55,38 @@ fn ext(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
-/// Writes `.pfm` or `.exr` by extension.
-pub fn write_xyz_image(path: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
-    match ext(path).as_str() {
-        "pfm" => write_pfm(path, img),
-        "exr" => exr::prelude::write_rgb_file(path, img.width, img.height, |x, y| {
-            let p = img.at(x, y);
-            (p[0], p[1], p[2])
-        })
-        .map_err(|e| ImageIoError::Exr {
-            file: path.to_path_buf(),
-            message: e.to_string(),
-        }),
-        _ => Err(ImageIoError::UnknownType {
-            file: path.to_path_buf(),
-        }),
-    }
+/// Writes `.pfm` or `.exr` by extension, under the output policy `out`. The image is
+/// encoded in memory first, so an encoding error never touches the file.
+pub fn write_xyz_image(
+    path: &Path,
+    img: &XyzImage,
+    out: &OutputPolicy,
+) -> Result<(), ImageIoError> {
+    let bytes = match ext(path).as_str() {
+        "pfm" => pfm_bytes(img),
+        "exr" => {
+            use exr::prelude::*;
+            let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+                let p = img.at(x, y);
+                (p[0], p[1], p[2])
+            });
+            let mut buf = std::io::Cursor::new(Vec::new());
+            Image::from_channels((img.width, img.height), channels)
+                .write()
+                .to_buffered(&mut buf)
+                .map_err(|e| ImageIoError::Exr {
+                    file: path.to_path_buf(),
+                    message: e.to_string(),
+                })?;
+            buf.into_inner()
+        }
+        _ => {
+            return Err(ImageIoError::UnknownType {
+                file: path.to_path_buf(),
+            })
+        }
+    };
+    Ok(out.write(path, &bytes)?)
 }
 
 /// Reads `.pfm` or `.exr` by extension.
@@ -99,7 +119,7 @@ pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
     }
 }
 
-fn write_pfm(path: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
+fn pfm_bytes(img: &XyzImage) -> Vec<u8> {
     let mut out = Vec::with_capacity(img.pixels.len() * 12 + 32);
     out.extend_from_slice(format!("PF\n{} {}\n-1.0\n", img.width, img.height).as_bytes());
     for y in (0..img.height).rev() {
@@ -109,8 +129,7 @@ fn write_pfm(path: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
             }
         }
     }
-    let mut f = std::fs::File::create(path).map_err(io(path))?;
-    f.write_all(&out).map_err(io(path))
+    out
 }
 
 fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
@@ -168,7 +187,12 @@ fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
 }
 
 /// An sRGB (IEC 61966-2-1) 8-bit preview, exposed so that `white_y` maps to 1.
-pub fn write_srgb_preview(path: &Path, img: &XyzImage, white_y: f64) -> Result<(), ImageIoError> {
+pub fn write_srgb_preview(
+    path: &Path,
+    img: &XyzImage,
+    white_y: f64,
+    out: &OutputPolicy,
+) -> Result<(), ImageIoError> {
     let enc = |v: f64| {
         let v = v.clamp(0.0, 1.0);
         let s = if v <= 0.003_130_8 {
@@ -191,16 +215,15 @@ pub fn write_srgb_preview(path: &Path, img: &XyzImage, white_y: f64) -> Result<(
         file: path.to_path_buf(),
         message: e.to_string(),
     };
-    let f = std::fs::File::create(path).map_err(io(path))?;
-    let mut enc = png::Encoder::new(
-        std::io::BufWriter::new(f),
-        img.width as u32,
-        img.height as u32,
-    );
+    // Encoded in memory first: a failed encoding never leaves a partial PNG in place.
+    let mut png_bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut png_bytes, img.width as u32, img.height as u32);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     let mut w = enc.write_header().map_err(png_err)?;
-    w.write_image_data(&data).map_err(png_err)
+    w.write_image_data(&data).map_err(png_err)?;
+    w.finish().map_err(png_err)?;
+    Ok(out.write(path, &png_bytes)?)
 }
 
 #[cfg(test)]
@@ -220,9 +243,30 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         for name in ["a.pfm", "a.exr"] {
             let p = dir.join(name);
-            write_xyz_image(&p, &img).unwrap();
+            write_xyz_image(&p, &img, &OutputPolicy::new(true)).unwrap();
             assert_eq!(read_xyz_image(&p).unwrap(), img, "{name}");
         }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// An encoding that fails half-way (here: fewer pixels than the size says) leaves the
+    /// file it would have replaced as it was, and nothing beside it.
+    #[test]
+    fn a_failed_encoding_leaves_the_existing_file() {
+        let dir = std::env::temp_dir().join(format!("metamer-imgfail-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("preview.png");
+        std::fs::write(&p, "the earlier preview").unwrap();
+        let short = XyzImage {
+            width: 4,
+            height: 4,
+            pixels: vec![[1.0; 3]; 3],
+        };
+        let e = write_srgb_preview(&p, &short, 1.0, &OutputPolicy::new(true)).unwrap_err();
+        assert!(matches!(e, ImageIoError::Png { .. }), "{e}");
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "the earlier preview");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
         std::fs::remove_dir_all(&dir).ok();
     }
 }

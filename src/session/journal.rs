@@ -106,6 +106,10 @@ pub enum JournalError {
         logged: String,
         now: String,
     },
+    /// The file holds no session to continue: empty, or its header was cut off by a crash
+    /// while it was being written. Nothing was measured into it.
+    #[error("{} holds no session to continue: {what}; resuming sets it aside and starts afresh", path.display())]
+    Broken { path: PathBuf, what: String },
     #[error("{} was written by a {logged} session, not a {now} session", path.display())]
     KindDiffers {
         path: PathBuf,
@@ -164,10 +168,7 @@ where
         let file = match OpenOptions::new().append(true).create_new(true).open(path) {
             Ok(f) => f,
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                return Err(JournalError::Exists {
-                    path: path.to_path_buf(),
-                    entries: count_entries(path),
-                });
+                return Err(existing(path));
             }
             Err(e) => return Err(io(path)(e)),
         };
@@ -196,6 +197,12 @@ where
             .map_err(io(path))?;
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes).map_err(io(path))?;
+        if let Some(what) = broken(&bytes) {
+            return Err(JournalError::Broken {
+                path: path.to_path_buf(),
+                what,
+            });
+        }
         let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
         let tail = &bytes[complete..];
         // A tail that parses is a whole line that lost only its newline: keep it.
@@ -213,7 +220,12 @@ where
                 .count();
             bad(line, "not UTF-8 text".into())
         })?;
-        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
+        // Blank lines carry nothing (an editor's trailing newline, a line a tool added): skip.
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l))
+            .filter(|(_, l)| !l.trim().is_empty());
         let header = match lines.next() {
             None => return Err(bad(1, "empty journal: no header line".into())),
             Some((n, l)) => {
@@ -355,12 +367,66 @@ fn check_same_plan<H>(
 /// (a full-screen window, an instrument).
 pub fn refuse_existing(path: &Path) -> Result<(), JournalError> {
     if path.exists() {
-        return Err(JournalError::Exists {
-            path: path.to_path_buf(),
-            entries: count_entries(path),
-        });
+        return Err(existing(path));
     }
     Ok(())
+}
+
+/// Why the existing journal at `path` cannot be started anew: it holds a session, or it
+/// holds nothing usable (and can be set aside).
+fn existing(path: &Path) -> JournalError {
+    match std::fs::read(path).ok().as_deref().and_then(broken) {
+        Some(what) => JournalError::Broken {
+            path: path.to_path_buf(),
+            what,
+        },
+        None => JournalError::Exists {
+            path: path.to_path_buf(),
+            entries: count_entries(path),
+        },
+    }
+}
+
+/// What makes a journal's bytes hold no session: nothing but blanks, or a first line cut
+/// off before its end (the crash came while the header was written). None when there is a
+/// header line to read (whether it is a valid one is for [`Journal::resume`] to say).
+fn broken(bytes: &[u8]) -> Option<String> {
+    let Some(start) = bytes.iter().position(|b| !b.is_ascii_whitespace()) else {
+        return Some(if bytes.is_empty() {
+            "it is empty".into()
+        } else {
+            "it holds only blank lines".into()
+        });
+    };
+    let rest = &bytes[start..];
+    let whole_line = rest.contains(&b'\n');
+    if !whole_line && serde_json::from_slice::<serde_json::Value>(rest).is_err() {
+        return Some(format!(
+            "its header line was cut off after {} bytes",
+            rest.len()
+        ));
+    }
+    None
+}
+
+/// Moves the journal at `path` aside to `PATH.broken-N` (the first N free) and returns
+/// where; nothing is deleted, so whatever it held can still be looked at.
+pub fn set_aside(path: &Path) -> Result<PathBuf, JournalError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut n = 1u64;
+    loop {
+        let aside = path.with_file_name(format!("{name}.broken-{n}"));
+        if std::fs::symlink_metadata(&aside).is_ok() {
+            n += 1;
+            continue;
+        }
+        std::fs::rename(path, &aside).map_err(io(path))?;
+        sync_dir(path)?;
+        return Ok(aside);
+    }
 }
 
 /// Entry lines in an existing journal (for the "exists" message; 0 if unreadable).
@@ -373,6 +439,9 @@ fn count_entries(path: &Path) -> usize {
         })
         .unwrap_or(0)
 }
+
+#[cfg(test)]
+mod recovery_tests;
 
 #[cfg(test)]
 mod tests {

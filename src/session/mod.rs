@@ -21,6 +21,6 @@ pub use operator::{Answer, Operator, OperatorError, ScriptedOperator, TerminalOp
 pub use plan::{Prepare, SessionPlan, Step};
 pub use progress::{BarProgress, NoProgress, ProgressSink, StepProgress};
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
-pub use runner::{RunEnd, RunOptions, Session, SessionError};
+pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
 pub use screen::{DisplayScreen, Screen};
 pub use step::{Rig, StepFailure};

@@ -44,6 +44,10 @@ pub enum SessionError {
         logged: String,
         now: String,
     },
+    /// The same model, but readings taken another way (another unit, speed, integration
+    /// time, or a simulation's seed, noise or time scale) would not be comparable.
+    #[error("{} was written with {} instrument {} whose {} was {}; this session's is {}; resume with the settings it was started with, or choose another output directory", .0.path.display(), .0.role, .0.model, .0.setting, .0.logged, .0.now)]
+    InstrumentSettingDiffers(Box<SettingDiffers>),
     /// The rig cannot take a step of the plan; found before anything is measured.
     #[error("step {} ({label}) {need}; nothing was measured", index + 1)]
     RigLacks {
@@ -61,6 +65,17 @@ pub enum SessionError {
         journal: PathBuf,
         source: Box<StepFailure>,
     },
+}
+
+/// Which setting of which instrument differs between a journal and the session resuming it.
+#[derive(Debug)]
+pub struct SettingDiffers {
+    pub path: PathBuf,
+    pub role: String,
+    pub model: String,
+    pub setting: String,
+    pub logged: String,
+    pub now: String,
 }
 
 /// How to run.
@@ -96,6 +111,8 @@ pub struct Session<H, D> {
     pub recovered: usize,
     /// Bytes of a torn last line set aside on resuming (0 if none).
     pub torn_bytes: usize,
+    /// Where a journal that held no session (empty, torn header) was moved on resuming.
+    pub set_aside: Option<PathBuf>,
 }
 
 impl<H, D> Session<H, D>
@@ -133,7 +150,21 @@ where
             },
         };
         let mut entries = vec![None; plan.steps.len()];
-        if !(resume && path.exists()) {
+        let mut set_aside = None;
+        let resumed = if resume && path.exists() {
+            match Journal::resume(path, &header) {
+                Ok(r) => Some(r),
+                // Nothing was measured into it: keep it for inspection, start afresh.
+                Err(JournalError::Broken { .. }) => {
+                    set_aside = Some(super::journal::set_aside(path)?);
+                    None
+                }
+                Err(e) => return Err(e.into()),
+            }
+        } else {
+            None
+        };
+        let Some((journal, recovered)) = resumed else {
             let journal = Journal::create(path, &header)?;
             return Ok(Session {
                 plan,
@@ -142,19 +173,13 @@ where
                 calibrations: Vec::new(),
                 recovered: 0,
                 torn_bytes: 0,
+                set_aside,
             });
-        }
-        let (journal, recovered): (SessionJournal<H, D>, _) = Journal::resume(path, &header)?;
+        };
+        let journal: SessionJournal<H, D> = journal;
         for (role, now) in &header.data.instruments {
             if let Some(logged) = recovered.header.data.instruments.get(role) {
-                if logged.info.model != now.info.model {
-                    return Err(SessionError::InstrumentDiffers {
-                        path: path.to_path_buf(),
-                        role: role.clone(),
-                        logged: logged.info.model.clone(),
-                        now: now.info.model.clone(),
-                    });
-                }
+                same_instrument(path, role, logged, now)?;
             }
         }
         let bad = |line: usize, message: String| SessionError::Entry {
@@ -199,6 +224,7 @@ where
             calibrations: recovered.calibrations,
             recovered: n,
             torn_bytes: recovered.torn_bytes,
+            set_aside: None,
         })
     }
 
@@ -304,6 +330,10 @@ where
                 return Ok(RunEnd::Stopped { missing });
             }
             let step = &self.plan.steps[index];
+            // Step k's noise is the same whichever run takes it (see Instrument::seek_noise).
+            if let Some(instrument) = rig.instrument(&step.role) {
+                instrument.seek_noise(index as u64);
+            }
             let fail = |source: StepFailure| SessionError::Step {
                 index,
                 total,
@@ -353,4 +383,49 @@ where
         }
         Ok(RunEnd::Complete)
     }
+}
+
+/// Whether readings of the instrument `now` are comparable with those of `logged`: the same
+/// model, the same unit where both report a serial, and every setting the same.
+fn same_instrument(
+    path: &Path,
+    role: &str,
+    logged: &InstrumentRecord,
+    now: &InstrumentRecord,
+) -> Result<(), SessionError> {
+    if logged.info.model != now.info.model {
+        return Err(SessionError::InstrumentDiffers {
+            path: path.to_path_buf(),
+            role: role.to_string(),
+            logged: logged.info.model.clone(),
+            now: now.info.model.clone(),
+        });
+    }
+    let differs = |setting: &str, a: Option<&String>, b: Option<&String>| {
+        let shown = |v: Option<&String>| v.cloned().unwrap_or_else(|| "(not set)".into());
+        SessionError::InstrumentSettingDiffers(Box::new(SettingDiffers {
+            path: path.to_path_buf(),
+            role: role.to_string(),
+            model: now.info.model.clone(),
+            setting: setting.to_string(),
+            logged: shown(a),
+            now: shown(b),
+        }))
+    };
+    if logged.info.serial != now.info.serial {
+        return Err(differs(
+            "serial number",
+            logged.info.serial.as_ref(),
+            now.info.serial.as_ref(),
+        ));
+    }
+    let names: std::collections::BTreeSet<&String> =
+        logged.options.keys().chain(now.options.keys()).collect();
+    for name in names {
+        let (a, b) = (logged.options.get(name), now.options.get(name));
+        if a != b {
+            return Err(differs(name, a, b));
+        }
+    }
+    Ok(())
 }

@@ -8,10 +8,16 @@ use plotters::prelude::*;
 use super::assess::JND_DE76;
 use super::error::ValidationError;
 use super::Comparison;
+use crate::output::OutputPolicy;
 
-/// Writes the per-patch ΔE chart of `comparison` to `file` (SVG).
-pub fn write_delta_e_chart(comparison: &Comparison, file: &Path) -> Result<(), ValidationError> {
-    write_delta_e_chart_shaded(comparison, &[], "", file)
+/// Writes the per-patch ΔE chart of `comparison` to `file` (SVG) under the output policy
+/// `out`.
+pub fn write_delta_e_chart(
+    comparison: &Comparison,
+    file: &Path,
+    out: &OutputPolicy,
+) -> Result<(), ValidationError> {
+    write_delta_e_chart_shaded(comparison, &[], "", file, out)
 }
 
 /// [`write_delta_e_chart`] with the 1-based patches in `shaded` on a grey band labelled
@@ -22,6 +28,19 @@ pub fn write_delta_e_chart_shaded(
     shaded: &[usize],
     shaded_label: &str,
     file: &Path,
+    out: &OutputPolicy,
+) -> Result<(), ValidationError> {
+    let mut svg = String::new();
+    draw(comparison, shaded, shaded_label, file, &mut svg)?;
+    Ok(out.write(file, svg.as_bytes())?)
+}
+
+fn draw(
+    comparison: &Comparison,
+    shaded: &[usize],
+    shaded_label: &str,
+    file: &Path,
+    svg: &mut String,
 ) -> Result<(), ValidationError> {
     let chart_err = |e: &dyn std::fmt::Display| ValidationError::Chart {
         file: file.to_path_buf(),
@@ -34,7 +53,7 @@ pub fn write_delta_e_chart_shaded(
         .map(|p| p.de76.max(p.de00))
         .fold(JND_DE76, f64::max)
         * 1.15;
-    let root = SVGBackend::new(file, (900, 420)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (900, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| chart_err(&e))?;
     let caption = format!(
         "{} vs {}: {} of {} below JND",

@@ -20,7 +20,8 @@ pub enum ValidationError {
         #[source]
         source: std::io::Error,
     },
-    #[error(transparent)]
+    // Not transparent: the command line looks for the OutputError among the sources.
+    #[error("{0}")]
     Output(#[from] crate::output::OutputError),
     #[error("cannot draw the chart {file}: {message}")]
     Chart {

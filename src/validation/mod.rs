@@ -202,9 +202,16 @@ mod chart_tests {
             .collect();
         let c = compare("box", &reference, "display", &test, white).unwrap();
         let file = std::env::temp_dir().join(format!("metamer-chart-{}.svg", std::process::id()));
-        write_delta_e_chart(&c, &file).unwrap();
+        write_delta_e_chart(&c, &file, &crate::output::OutputPolicy::new(true)).unwrap();
         let svg = std::fs::read_to_string(&file).unwrap();
-        write_delta_e_chart_shaded(&c, &[7, 16], "out of gamut", &file).unwrap();
+        write_delta_e_chart_shaded(
+            &c,
+            &[7, 16],
+            "out of gamut",
+            &file,
+            &crate::output::OutputPolicy::new(true),
+        )
+        .unwrap();
         let shaded = std::fs::read_to_string(&file).unwrap();
         assert!(shaded.contains("out of gamut") && !svg.contains("out of gamut"));
         assert_eq!(

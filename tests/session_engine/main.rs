@@ -17,6 +17,7 @@ use metamer::session::{
 use metamer_drivers::{CalibrationCondition, Instrument, MeasureMode};
 use serde::{Deserialize, Serialize};
 
+mod resume_checks;
 mod rig;
 
 use rig::{FakeScreen, Shared, Spectrometer, SpotMeter, TileOperator, VALID_FOR};

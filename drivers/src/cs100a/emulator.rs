@@ -21,7 +21,7 @@ use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
 
 use super::Speed;
 use crate::link::{LineSettings, LinkError, SerialLink};
-use crate::noise::SplitMix64;
+use crate::noise::NoiseCursor;
 use crate::world::World;
 
 /// Upper end of the display range, cd/m² (protocols/cs100a/README.md, "Measurement facts": unconfirmed).
@@ -62,7 +62,7 @@ impl Default for EmulatorConfig {
 pub struct Cs100aEmulator {
     world: Arc<dyn World>,
     config: EmulatorConfig,
-    rng: SplitMix64,
+    noise: NoiseCursor,
     speed: Speed,
 }
 
@@ -70,11 +70,16 @@ impl Cs100aEmulator {
     pub fn new(world: Arc<dyn World>, config: EmulatorConfig) -> Cs100aEmulator {
         Cs100aEmulator {
             world,
-            rng: SplitMix64::new(config.seed),
+            noise: NoiseCursor::default(),
             config,
             // The power-on speed is not documented; FAST is assumed [I].
             speed: Speed::Fast,
         }
+    }
+
+    /// The handle a session moves the noise stream with (see [`NoiseCursor`]).
+    pub fn noise_cursor(&self) -> NoiseCursor {
+        self.noise.clone()
     }
 
     /// The reply to one command line and how long the meter takes before sending it.
@@ -129,17 +134,15 @@ impl Cs100aEmulator {
         }
         let sum = x_ + y_ + z_;
         let chroma = (sum.is_finite() && sum > 0.0 && y_ > 0.0).then(|| (x_ / sum, y_ / sum));
+        let mut rng = self.noise.next_stream(self.config.seed);
         let noisy_lum = if self.config.noise {
-            lum * (1.0 + SIGMA_Y_REL * self.rng.normal())
+            lum * (1.0 + SIGMA_Y_REL * rng.normal())
         } else {
             lum
         };
         let noisy_chroma = chroma.map(|(x, y)| {
             if self.config.noise {
-                (
-                    x + SIGMA_XY * self.rng.normal(),
-                    y + SIGMA_XY * self.rng.normal(),
-                )
+                (x + SIGMA_XY * rng.normal(), y + SIGMA_XY * rng.normal())
             } else {
                 (x, y)
             }

@@ -12,6 +12,7 @@ use crate::link::replay::{ReplaySerial, Transcript};
 use crate::link::serial::PortLink;
 use crate::link::{LineSettings, SerialLink};
 use crate::open::{OpenOptions, SimSettings};
+use crate::simulated::Simulated;
 use crate::world::{SharedWorld, DEFAULT_STIMULUS_XYZ};
 use crate::DriverError;
 
@@ -43,8 +44,10 @@ pub fn sim(
         noise: settings.noise,
     };
     let (host, device) = pair(LineSettings::CS100A, "sim:cs100a");
-    Cs100aEmulator::new(world, config).spawn(device);
-    connect(host, options)
+    let emulator = Cs100aEmulator::new(world, config);
+    let noise = emulator.noise_cursor();
+    emulator.spawn(device);
+    Ok(Simulated::wrap(connect(host, options)?, noise, settings))
 }
 
 /// Puts the meter in absolute mode, recording the session when asked.

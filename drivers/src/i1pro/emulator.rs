@@ -104,6 +104,7 @@ pub struct I1ProEmulator {
     pending: Option<(Duration, Vec<u8>)>,
     measurements: u32,
     rng: u64,
+    noise: crate::noise::NoiseCursor,
     /// In low power; after the power-up reset, the GetMisc answers still to come in it.
     low_power: Option<(bool, u32)>,
 }
@@ -175,6 +176,7 @@ impl I1ProEmulator {
         Ok(I1ProEmulator {
             low_power: (config.low_power_polls > 0).then_some((false, config.low_power_polls)),
             rng: config.seed,
+            noise: crate::noise::NoiseCursor::default(),
             config,
             world,
             cal,
@@ -183,6 +185,12 @@ impl I1ProEmulator {
             pending: None,
             measurements: 0,
         })
+    }
+
+    /// The handle a session moves the noise stream with (see
+    /// [`NoiseCursor`](crate::noise::NoiseCursor)).
+    pub fn noise_cursor(&self) -> crate::noise::NoiseCursor {
+        self.noise.clone()
     }
 
     fn clock_s(&self) -> f64 {
@@ -265,6 +273,8 @@ impl I1ProEmulator {
         let signal = inverse::cells_for(&self.cal, &seen).map_err(err)?;
         let clean =
             inverse::counts_for(&self.cal, &e, &signal, &dark, shielded, u16::MAX).map_err(err)?;
+        // Each measurement's noise from its own stream (see NoiseCursor).
+        self.rng = self.noise.next_stream(self.config.seed).next_u64();
         let mut out = Vec::new();
         for _ in 0..n {
             let mut r = clean.clone();

@@ -14,7 +14,9 @@ use crate::link::replay::Transcript;
 use crate::link::usb::{RecordUsb, ReplayUsb, UsbLink};
 use crate::link::usb_pair::usb_pair;
 use crate::link::usb_real::RusbLink;
+use crate::noise::NoiseCursor;
 use crate::open::{OpenOptions, SimSettings};
+use crate::simulated::Simulated;
 use crate::world::{SharedWorld, View, World};
 use crate::DriverError;
 
@@ -75,7 +77,8 @@ pub fn sim(
         None => Arc::new(SharedWorld::new(View::radiance(default_light())?)) as Arc<dyn World>,
     };
     let clock = Arc::new(ScaledClock::new(settings.time_scale));
-    sim_with(world, config, options, clock)
+    let (instrument, noise) = sim_parts(world, config, options, clock)?;
+    Ok(Simulated::wrap(instrument, noise, settings))
 }
 
 /// The emulator with every setting given, for tests that inject faults or a clock.
@@ -85,9 +88,19 @@ pub fn sim_with(
     options: &OpenOptions,
     clock: Arc<dyn Clock>,
 ) -> Result<Box<dyn Instrument>, DriverError> {
+    sim_parts(world, config, options, clock).map(|(instrument, _)| instrument)
+}
+
+fn sim_parts(
+    world: Arc<dyn World>,
+    config: EmulatorConfig,
+    options: &OpenOptions,
+    clock: Arc<dyn Clock>,
+) -> Result<(Box<dyn Instrument>, NoiseCursor), DriverError> {
     let device = I1ProEmulator::new(world, config).map_err(DriverError::Simulation)?;
+    let noise = device.noise_cursor();
     let (host, _thread) = usb_pair(device, &format!("sim:{MODEL}"));
-    connect(host, options, clock, false)
+    Ok((connect(host, options, clock, false)?, noise))
 }
 
 /// Opens the driver on `link`, recording the session when asked; `settle` waits out a

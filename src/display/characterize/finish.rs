@@ -12,6 +12,7 @@ use super::report::{write_report, Report, ReportError};
 use super::verify::{average, usable, verify, Verification};
 use crate::display::model::{FitError, Sample};
 use crate::display::{fit_profile, write_ti3, ModelKind, ProfileError, Residuals};
+use crate::output::{OutputError, OutputPolicy};
 
 pub const PROFILE_FILE: &str = "profile.json";
 pub const TI3_FILE: &str = "readings.ti3";
@@ -39,6 +40,8 @@ pub enum FinishError {
     },
     #[error(transparent)]
     Report(#[from] ReportError),
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }
 
 /// Who measured what, for the files' descriptions.
@@ -81,15 +84,39 @@ pub struct Files {
     pub summary: PathBuf,
 }
 
+/// The files a characterization writes into `dir` beside its log at `log`.
+pub fn files(dir: &Path, log: &Path) -> Files {
+    Files {
+        log: log.to_path_buf(),
+        profile: dir.join(PROFILE_FILE),
+        ti3: dir.join(TI3_FILE),
+        report: dir.join(REPORT_FILE),
+        summary: dir.join(SUMMARY_FILE),
+    }
+}
+
+impl Files {
+    /// The files written (the log is not: it is the input).
+    pub fn outputs(&self) -> [&Path; 4] {
+        [&self.profile, &self.ti3, &self.report, &self.summary]
+    }
+}
+
 /// Fits, verifies and writes everything into `dir` from the complete `readings` of the
-/// log at `log`.
+/// log at `log`, under the output policy `out`.
 pub fn finish(
     dir: &Path,
     log: &Path,
     readings: &[(&DriveStep, &Reading)],
     model: ModelKind,
     who: &Provenance,
+    out: &OutputPolicy,
 ) -> Result<Summary, FinishError> {
+    let files = files(dir, log);
+    // Before the fit: a refusal costs nothing and leaves every file as it was.
+    for f in files.outputs() {
+        out.check(f)?;
+    }
     let averaged = average(readings).map_err(FinishError::Unusable)?;
     let white = averaged
         .iter()
@@ -115,14 +142,7 @@ pub fn finish(
     let forward = |rgb: [f64; 3]| profile.forward(rgb);
     let verification = verify(&averaged, white, &forward).ok_or(FinishError::NoVerification)?;
 
-    let files = Files {
-        log: log.to_path_buf(),
-        profile: dir.join(PROFILE_FILE),
-        ti3: dir.join(TI3_FILE),
-        report: dir.join(REPORT_FILE),
-        summary: dir.join(SUMMARY_FILE),
-    };
-    profile.save(&files.profile)?;
+    profile.save(&files.profile, out)?;
     let raw: Vec<Sample> = readings
         .iter()
         .filter(|(_, r)| usable(r))
@@ -135,7 +155,7 @@ pub fn finish(
         "metamer characterize: {} measured with {} ({})",
         who.display, who.instrument_info.model, who.instrument
     );
-    write_ti3(&files.ti3, &raw, &description).map_err(|source| FinishError::Io {
+    write_ti3(&files.ti3, &raw, &description, out).map_err(|source| FinishError::Io {
         path: files.ti3.clone(),
         source,
     })?;
@@ -151,6 +171,7 @@ pub fn finish(
             verification: Some(&verification),
         },
         &files.report,
+        out,
     )?;
     let summary = Summary {
         display: who.display.to_string(),
@@ -172,9 +193,6 @@ pub fn finish(
         files: files.clone(),
     };
     let text = serde_json::to_string_pretty(&summary).expect("a summary serializes") + "\n";
-    std::fs::write(&files.summary, text).map_err(|source| FinishError::Io {
-        path: files.summary.clone(),
-        source,
-    })?;
+    out.write(&files.summary, text.as_bytes())?;
     Ok(summary)
 }

@@ -9,14 +9,17 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::output::{OutputError, OutputPolicy};
+
 use super::verify::{AveragedPatch, Verification};
 
 /// The report could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
-#[error("writing the report {}: {message}", file.display())]
-pub struct ReportError {
-    pub file: PathBuf,
-    pub message: String,
+pub enum ReportError {
+    #[error("drawing the report {}: {message}", file.display())]
+    Draw { file: PathBuf, message: String },
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }
 
 /// What the report shows.
@@ -65,13 +68,19 @@ fn chromaticity(xyz: [f64; 3]) -> Option<(f64, f64)> {
     (s > 1e-9 && xyz[1] > 0.0).then(|| (xyz[0] / s, xyz[1] / s))
 }
 
-/// Draws `report` to `file` (SVG, 1200×860).
-pub fn write_report(report: &Report, file: &Path) -> Result<(), ReportError> {
-    let fail = |e: &dyn std::fmt::Display| ReportError {
+/// Draws `report` to `file` (SVG, 1200×860) under the output policy `out`.
+pub fn write_report(report: &Report, file: &Path, out: &OutputPolicy) -> Result<(), ReportError> {
+    let mut svg = String::new();
+    draw_report(report, file, &mut svg)?;
+    Ok(out.write(file, svg.as_bytes())?)
+}
+
+fn draw_report(report: &Report, file: &Path, svg: &mut String) -> Result<(), ReportError> {
+    let fail = |e: &dyn std::fmt::Display| ReportError::Draw {
         file: file.to_path_buf(),
         message: e.to_string(),
     };
-    let root = SVGBackend::new(file, (1200, 860)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (1200, 860)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     let root = root
         .titled(&report.title, ("sans-serif", 20))
@@ -311,6 +320,7 @@ mod tests {
                 verification: Some(&v),
             },
             &file,
+            &crate::output::OutputPolicy::new(true),
         )
         .unwrap();
         let svg = std::fs::read_to_string(&file).unwrap();

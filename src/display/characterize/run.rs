@@ -9,9 +9,10 @@ use std::time::Duration;
 use metamer_drivers::Instrument;
 use serde::{Deserialize, Serialize};
 
-use super::finish::{finish, FinishError, Provenance, Summary};
+use super::finish::{files, finish, FinishError, Provenance, Summary};
 use super::plan::{DriveStep, Plan, PlanError, PlanOptions, METER};
 use crate::display::ModelKind;
+use crate::output::{OutputError, OutputPolicy};
 use crate::rig::Screen;
 use crate::session::{
     Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, ProgressSink, Rig, RunEnd,
@@ -44,6 +45,9 @@ pub struct Options {
     pub settle: Option<Duration>,
     /// Continue the journal in `dir` instead of refusing it.
     pub resume: bool,
+    /// Replace a profile, `.ti3`, report or summary already in `dir`. Without it they are
+    /// replaced only when the journal being resumed holds readings (they are its own).
+    pub force: bool,
     pub run: RunOptions,
 }
 
@@ -74,6 +78,8 @@ pub enum CharacterizeError {
     Operator(#[from] OperatorError),
     #[error("showing white to aim the instrument: {0}")]
     Aim(#[source] crate::rig::ScreenError),
+    #[error("{0}")]
+    Output(#[from] OutputError),
 }
 
 /// The journal of a characterization in `dir`.
@@ -109,6 +115,19 @@ pub fn run(
         options.resume,
     )?;
     let total = session.plan().steps.len();
+    if let Some(aside) = &session.set_aside {
+        progress.note(&format!(
+            "{} held no session; it was set aside as {} and a new session started",
+            session.journal_path().display(),
+            aside.display()
+        ));
+    }
+    let mut out = OutputPolicy::new(options.force || session.recovered > 0);
+    out.input(session.journal_path());
+    // Before anything is measured: a profile that may not be replaced is found now.
+    for f in files(&options.dir, session.journal_path()).outputs() {
+        out.check(f)?;
+    }
     if session.recovered > 0 || session.torn_bytes > 0 {
         let torn = if session.torn_bytes > 0 {
             format!(
@@ -171,6 +190,7 @@ pub fn run(
             instrument: &details.instrument,
             instrument_info: info,
         },
+        &out,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }
@@ -201,6 +221,7 @@ mod tests {
             instrument: "sim:cs100a".into(),
             settle: None,
             resume,
+            force: false,
             run,
         }
     }
@@ -255,6 +276,79 @@ mod tests {
         assert_eq!(a.verification.max, b.verification.max);
         std::fs::remove_dir_all(&straight.dir).unwrap();
         std::fs::remove_dir_all(&first.dir).unwrap();
+    }
+
+    /// Each reading's XYZ by plan index, from the journal in `dir`.
+    fn logged_xyz(dir: &Path) -> Vec<(u64, Vec<f64>)> {
+        let text = std::fs::read_to_string(log_path(dir)).unwrap();
+        let mut v: Vec<(u64, Vec<f64>)> = text
+            .lines()
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+            .filter(|l| l["type"] == "entry")
+            .map(|l| {
+                let xyz = l["reading"]["xyz"].as_array().unwrap();
+                (
+                    l["index"].as_u64().unwrap(),
+                    xyz.iter().map(|c| c.as_f64().unwrap()).collect(),
+                )
+            })
+            .collect();
+        v.sort_by_key(|e| e.0);
+        v
+    }
+
+    /// With the meter's noise on, a session interrupted and resumed in a new "process" (a
+    /// fresh simulated meter) reads exactly the numbers of an uninterrupted one: the noise
+    /// of reading k depends on the seed and k only.
+    #[test]
+    fn a_resumed_noisy_session_reads_the_uninterrupted_numbers() {
+        let noisy = |o: &Options| {
+            let mut display = VirtualDisplay::preset(Preset::IdealCrt);
+            let mut meter = metamer_drivers::open_instrument(
+                "sim:cs100a?time_scale=0&seed=7",
+                display.stimulus(),
+            )
+            .unwrap();
+            run(
+                o,
+                &mut display,
+                meter.as_mut(),
+                &mut ScriptedOperator::confirming(),
+                &mut NoProgress,
+            )
+            .unwrap()
+        };
+        let straight = options("noisy-straight", false, RunOptions::default());
+        assert!(matches!(noisy(&straight), Outcome::Finished(_)));
+        let split = options(
+            "noisy-split",
+            false,
+            RunOptions {
+                stop_after: Some(37),
+                ..RunOptions::default()
+            },
+        );
+        assert!(matches!(
+            noisy(&split),
+            Outcome::Incomplete { done: 37, .. }
+        ));
+        let resumed = options("noisy-split", true, RunOptions::default());
+        assert!(matches!(noisy(&resumed), Outcome::Finished(_)));
+        let (a, b) = (logged_xyz(&straight.dir), logged_xyz(&split.dir));
+        assert_eq!(a.len(), 114);
+        assert_eq!(a, b);
+        // The noise is there: the two readings of white (passes 1 and 2) differ.
+        let white: Vec<&Vec<f64>> = {
+            let plan = Plan::new(split.plan).unwrap();
+            plan.patches
+                .iter()
+                .filter(|p| p.rgb == [255; 3])
+                .map(|p| &a[p.index].1)
+                .collect()
+        };
+        assert!(white.len() >= 2 && white[0] != white[1], "{white:?}");
+        std::fs::remove_dir_all(&straight.dir).unwrap();
+        std::fs::remove_dir_all(&split.dir).unwrap();
     }
 
     #[test]

@@ -2,8 +2,9 @@
 //! the facts about the format): RGB in 0–100, XYZ normalised to the white's Y = 100 and the
 //! white's absolute XYZ in `LUMINANCE_XYZ_CDM2`.
 
-use std::io::Write;
 use std::path::Path;
+
+use crate::output::OutputPolicy;
 
 use crate::display::model::Sample;
 
@@ -60,7 +61,12 @@ fn ctime_utc(secs: i64) -> String {
 /// Writes patches as ArgyllCMS dispread does: RGB in 0–100, XYZ normalised to the white's
 /// Y = 100 with the white's absolute XYZ in `LUMINANCE_XYZ_CDM2`. `description` goes into the
 /// DESCRIPTOR keyword.
-pub fn write_ti3(path: &Path, patches: &[Sample], description: &str) -> std::io::Result<()> {
+pub fn write_ti3(
+    path: &Path,
+    patches: &[Sample],
+    description: &str,
+    out: &OutputPolicy,
+) -> std::io::Result<()> {
     let white = white_of(patches).filter(|w| w[1] > 0.0).ok_or_else(|| {
         std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
@@ -103,12 +109,7 @@ pub fn write_ti3(path: &Path, patches: &[Sample], description: &str) -> std::io:
         ));
     }
     s.push_str("END_DATA\n");
-    // Write a sibling then rename: an interrupted write never leaves a half file in place.
-    let tmp = path.with_extension("ti3.partial");
-    let mut f = std::fs::File::create(&tmp)?;
-    f.write_all(s.as_bytes())?;
-    f.sync_all()?;
-    std::fs::rename(&tmp, path)
+    out.write(path, s.as_bytes()).map_err(std::io::Error::other)
 }
 
 #[cfg(test)]
@@ -143,7 +144,13 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("metamer-ti3-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("m.ti3");
-        write_ti3(&path, &patches, "test \"patches\"").unwrap();
+        write_ti3(
+            &path,
+            &patches,
+            "test \"patches\"",
+            &crate::output::OutputPolicy::new(true),
+        )
+        .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.contains("LUMINANCE_XYZ_CDM2 \"152.000000 160.000000 174.200000\""));
         assert!(text.contains("2 100.000000 100.000000 100.000000 95.000000 100.000000 108.875000"));

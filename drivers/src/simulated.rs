@@ -1,0 +1,90 @@
+//! A simulated instrument as a session sees it: the driver on its emulator, plus what makes
+//! its readings what they are — the simulation's seed, noise and time scale — among its
+//! option values (so a journal records them and a resume with others is refused), and the
+//! emulator's noise stream positioned per reading ([`Instrument::seek_noise`]).
+
+use crate::instrument::{
+    CalibrationCondition, CalibrationOutcome, Capabilities, Instrument, InstrumentInfo,
+    MeasureMode, Reading, Request,
+};
+use crate::noise::NoiseCursor;
+use crate::open::SimSettings;
+use crate::DriverError;
+
+/// Prefix of the simulation's settings among the option values, apart from the model's own.
+pub const SIM_OPTION_PREFIX: &str = "sim_";
+
+/// A driver talking to an emulator whose noise it can position.
+pub struct Simulated {
+    inner: Box<dyn Instrument>,
+    noise: NoiseCursor,
+    settings: Vec<(String, String)>,
+}
+
+impl Simulated {
+    /// Wraps `inner`, whose emulator draws its noise through `noise`.
+    pub fn wrap(
+        inner: Box<dyn Instrument>,
+        noise: NoiseCursor,
+        settings: &SimSettings,
+    ) -> Box<dyn Instrument> {
+        Box::new(Simulated {
+            inner,
+            noise,
+            settings: settings_values(settings),
+        })
+    }
+}
+
+/// The simulation's settings as option values: `sim_seed`, `sim_noise`, `sim_time_scale`,
+/// and the model's own (`sim_rev`).
+pub fn settings_values(s: &SimSettings) -> Vec<(String, String)> {
+    let mut v = vec![
+        ("seed".to_string(), s.seed.to_string()),
+        (
+            "noise".to_string(),
+            if s.noise { "on" } else { "off" }.to_string(),
+        ),
+        ("time_scale".to_string(), s.time_scale.to_string()),
+    ];
+    v.extend(s.extra.iter().cloned());
+    v.into_iter()
+        .map(|(k, value)| (format!("{SIM_OPTION_PREFIX}{k}"), value))
+        .collect()
+}
+
+impl Instrument for Simulated {
+    fn info(&self) -> InstrumentInfo {
+        self.inner.info()
+    }
+    fn capabilities(&self) -> Capabilities {
+        self.inner.capabilities()
+    }
+    fn calibration_needed(
+        &mut self,
+        mode: MeasureMode,
+    ) -> Result<Option<CalibrationCondition>, DriverError> {
+        self.inner.calibration_needed(mode)
+    }
+    fn calibrate(
+        &mut self,
+        mode: MeasureMode,
+        condition: &CalibrationCondition,
+    ) -> Result<CalibrationOutcome, DriverError> {
+        self.inner.calibrate(mode, condition)
+    }
+    fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
+        self.inner.measure(request)
+    }
+    fn set_option(&mut self, name: &str, value: &str) -> Result<(), DriverError> {
+        self.inner.set_option(name, value)
+    }
+    fn option_values(&self) -> Vec<(String, String)> {
+        let mut v = self.inner.option_values();
+        v.extend(self.settings.iter().cloned());
+        v
+    }
+    fn seek_noise(&mut self, index: u64) {
+        self.noise.seek(index);
+    }
+}
