@@ -107,8 +107,8 @@ fn sim_settings(
     };
     let mut config = SimSettings::default();
     if let Ok(v) = std::env::var(TIME_SCALE_ENV) {
-        config.time_scale = parse_scale(&v)
-            .ok_or_else(|| bad(format!("{TIME_SCALE_ENV}={v:?} {SCALE_RANGE}")))?;
+        config.time_scale =
+            parse_scale(&v).ok_or_else(|| bad(format!("{TIME_SCALE_ENV}={v:?} {SCALE_RANGE}")))?;
     }
     for option in query.split('&').filter(|o| !o.is_empty()) {
         let (key, value) = option.split_once('=').unwrap_or((option, ""));

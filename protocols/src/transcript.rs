@@ -109,18 +109,20 @@ pub enum TranscriptError {
 
 /// Parses line 1.
 pub fn parse_header(line: &str) -> Result<Header, TranscriptError> {
-    let header: Header =
-        serde_json::from_str(line).map_err(|e| TranscriptError::Json(metamer_color::text::echo_message(&e.to_string())))?;
+    let header: Header = serde_json::from_str(line)
+        .map_err(|e| TranscriptError::Json(metamer_color::text::echo_message(&e.to_string())))?;
     if header.format != FORMAT {
-        return Err(TranscriptError::Format(metamer_color::text::echo(&header.format)));
+        return Err(TranscriptError::Format(metamer_color::text::echo(
+            &header.format,
+        )));
     }
     Ok(header)
 }
 
 /// Parses one event line.
 pub fn parse_event(line: &str) -> Result<Event, TranscriptError> {
-    let value: Value =
-        serde_json::from_str(line).map_err(|e| TranscriptError::Json(metamer_color::text::echo_message(&e.to_string())))?;
+    let value: Value = serde_json::from_str(line)
+        .map_err(|e| TranscriptError::Json(metamer_color::text::echo_message(&e.to_string())))?;
     let obj = value
         .as_object()
         .ok_or_else(|| field_err("an event must be a JSON object"))?;
@@ -264,10 +266,12 @@ pub fn from_hex(text: &str) -> Result<Vec<u8>, TranscriptError> {
             std::str::from_utf8(pair)
                 .ok()
                 .and_then(|s| u8::from_str_radix(s, 16).ok())
-                .ok_or_else(|| field_err(&format!(
-                    "\"hex\" has a non-hex digit pair {:?}",
-                    metamer_color::text::echo(&String::from_utf8_lossy(pair))
-                )))
+                .ok_or_else(|| {
+                    field_err(&format!(
+                        "\"hex\" has a non-hex digit pair {:?}",
+                        metamer_color::text::echo(&String::from_utf8_lossy(pair))
+                    ))
+                })
         })
         .collect()
 }

@@ -53,6 +53,12 @@ impl std::str::FromStr for ModelChoice {
 }
 
 pub fn run(args: Args) -> CliResult {
+    if args.output.is_dir() {
+        return Err(CliError::Usage(format!(
+            "-o {}: is a directory; give the profile file to write",
+            args.output.display()
+        )));
+    }
     if let Some(g) = args.gamma {
         if args.model != ModelChoice::Kind(ModelKind::PlccGamma) {
             return Err(CliError::Usage(

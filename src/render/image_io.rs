@@ -113,10 +113,12 @@ fn exr_error(file: &Path, e: exr::error::Error) -> ImageIoError {
         Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             "the file ends early (truncated OpenEXR file)".to_string()
         }
-        Error::Io(io) => return ImageIoError::Io {
-            file: file.to_path_buf(),
-            source: io,
-        },
+        Error::Io(io) => {
+            return ImageIoError::Io {
+                file: file.to_path_buf(),
+                source: io,
+            }
+        }
         // The crate's words for an offset table pointing past the end of the data.
         Error::Invalid(m) if m.contains("missing bytes") => {
             "the file is truncated or corrupt: its table of pixel blocks points past the end of \
@@ -264,8 +266,7 @@ fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
             }));
         }
         header_bytes += n as u64;
-        let line = std::str::from_utf8(&line)
-            .map_err(|_| bad("the header is not text".into()))?;
+        let line = std::str::from_utf8(&line).map_err(|_| bad("the header is not text".into()))?;
         tokens.extend(line.split_whitespace().map(str::to_string));
     }
     if tokens[0] != "PF" {
@@ -281,7 +282,9 @@ fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
         .parse()
         .map_err(|_| bad(format!("bad scale '{}'", tokens[3])))?;
     if !scale.is_finite() || scale == 0.0 {
-        return Err(bad(format!("scale {scale} is not a finite, non-zero number")));
+        return Err(bad(format!(
+            "scale {scale} is not a finite, non-zero number"
+        )));
     }
     // Read one byte more than the pixels need, so a file with trailing data is told apart
     // without reading all of it.

@@ -212,7 +212,10 @@ impl<L: SerialLink> Cs100a<L> {
             if attempt >= ATTEMPTS {
                 return Err(error.into());
             }
-            let warning = format!("{error}; asking again (attempt {} of {ATTEMPTS})", attempt + 1);
+            let warning = format!(
+                "{error}; asking again (attempt {} of {ATTEMPTS})",
+                attempt + 1
+            );
             eprintln!("warning: {warning}");
             self.rejected.push(warning);
         }

@@ -51,7 +51,10 @@ mod tests {
 
     #[test]
     fn a_long_message_keeps_its_start_and_its_position() {
-        let m = format!("invalid type: string \"{}\", expected f64 at line 3 column 9", "y".repeat(5000));
+        let m = format!(
+            "invalid type: string \"{}\", expected f64 at line 3 column 9",
+            "y".repeat(5000)
+        );
         let shown = echo_message(&m);
         assert_eq!(shown.chars().count(), 80 + 1 + 40);
         assert!(shown.starts_with("invalid type: string \"yyy"));
