@@ -324,7 +324,13 @@ fn parse_signed(field: &str, name: &'static str) -> Result<f64, ReplyError> {
     {
         return Err(bad());
     }
-    digits.parse::<f64>().map(|v| sign * v).map_err(|_| bad())
+    // Hundreds of digits parse to infinity; no meter sends them.
+    digits
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .map(|v| sign * v)
+        .ok_or_else(bad)
 }
 
 // ---- device side (the emulator) ----
