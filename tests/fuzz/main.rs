@@ -167,3 +167,43 @@ fn every_parser_survives_a_long_run_of_mutated_inputs() {
     let report = fuzz(iterations, seed, &only);
     assert_clean(&report);
 }
+
+/// The LUT fit of a large scattered patch set once asked for 177 GB; its memory must grow
+/// with the patches, not with a grid built from their distinct levels. Under the counting
+/// allocator the run fails if any allocation passes the caps; peak heap is printed.
+#[test]
+#[ignore = "fits 10,000 patches: about 15 s"]
+fn a_lut_fit_of_10000_scattered_patches_stays_within_the_memory_cap() {
+    use metamer::display::{fit_profile, ModelKind, Sample};
+    use metamer_drivers::noise::SplitMix64;
+    let mut rng = SplitMix64::new(7);
+    // An additive γ 2.2 display with sRGB primaries and a black of 0.2 cd/m².
+    let m = [
+        [41.24, 35.76, 18.05],
+        [21.26, 71.52, 7.22],
+        [1.93, 11.92, 95.05],
+    ];
+    let patches: Vec<Sample> = (0..10_000)
+        .map(|i| {
+            let rgb: [f64; 3] = match i {
+                0 => [1.0; 3],
+                1 => [0.0; 3],
+                _ => std::array::from_fn(|_| (rng.uniform() * 1000.0).round() / 1000.0),
+            };
+            let lin = rgb.map(|d| d.powf(2.2));
+            let xyz = std::array::from_fn(|r| 0.2 + (0..3).map(|k| m[r][k] * lin[k]).sum::<f64>());
+            Sample { rgb, xyz }
+        })
+        .collect();
+    let before = alloc::stats().0;
+    let profile = fit_profile(ModelKind::Lut, &patches, None).unwrap();
+    let (peak, largest) = alloc::stats();
+    println!(
+        "10,000-patch LUT fit: peak heap {:.1} MB (before {:.1} MB), largest allocation {:.1} MB",
+        peak as f64 / 1e6,
+        before as f64 / 1e6,
+        largest as f64 / 1e6
+    );
+    assert!(profile.residuals.max_de00.is_finite());
+    assert!(peak < alloc::LIVE_CAP && largest < alloc::SINGLE_CAP);
+}
