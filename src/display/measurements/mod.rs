@@ -339,14 +339,19 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
         }
         (true, None) => (1.0, false),
     };
+    let mut patches = Vec::with_capacity(rows.len());
+    for (line, v) in rows {
+        let xyz = [v[3] * scale, v[4] * scale, v[5] * scale];
+        // Each row passed alone; the white's luminance can still scale it past belief.
+        metamer_color::check_xyz(xyz)
+            .map_err(|e| err(line, format!("not a measurement once scaled to cd/m²: {e}")))?;
+        patches.push(Sample {
+            rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
+            xyz,
+        });
+    }
     Ok(Measurements {
-        patches: rows
-            .into_iter()
-            .map(|(_, v)| Sample {
-                rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
-                xyz: [v[3] * scale, v[4] * scale, v[5] * scale],
-            })
-            .collect(),
+        patches,
         absolute,
         spectra: (!spectral.is_empty()).then(|| Spectra {
             wavelengths_nm: spectral.iter().map(|&(_, nm)| nm).collect(),
