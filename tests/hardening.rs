@@ -243,7 +243,7 @@ fn options_that_cannot_work_fail_before_the_work() {
 #[test]
 fn a_ti3_row_scaled_past_belief_by_its_white_luminance_is_refused() {
     // Found by the fuzz harness: each value is below 10¹⁰ but LUMINANCE_XYZ_CDM2's Y of
-    // 2·10⁹ scales the white-relative row to 2·10⁹ / 100 × 100 = 2·10⁹ … and Z to 4.6·10¹⁶.
+    // 2·10⁹ scales the white-relative row by 2·10⁹ / 100: Z becomes 4.6·10¹⁶ on line 10.
     let text = "CTI3\nKEYWORD \"LUMINANCE_XYZ_CDM2\"\nLUMINANCE_XYZ_CDM2 \"1 2000000000 1\"\n\
                 NUMBER_OF_FIELDS 6\nBEGIN_DATA_FORMAT\nRGB_R RGB_G RGB_B XYZ_X XYZ_Y XYZ_Z\n\
                 END_DATA_FORMAT\nNUMBER_OF_SETS 1\nBEGIN_DATA\n100 100 100 95 100 2305843009\n\
@@ -252,7 +252,7 @@ fn a_ti3_row_scaled_past_belief_by_its_white_luminance_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.starts_with("scaled.ti3:11: not a measurement once scaled to cd/m²"),
+        e.starts_with("scaled.ti3:10: not a measurement once scaled to cd/m²"),
         "{e}"
     );
 }
