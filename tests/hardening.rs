@@ -256,3 +256,26 @@ fn a_ti3_row_scaled_past_belief_by_its_white_luminance_is_refused() {
         "{e}"
     );
 }
+
+#[test]
+fn an_exr_header_claiming_more_pixels_than_its_file_can_hold_is_refused_before_decoding() {
+    // Found by the fuzz harness: a 300-byte file whose data window asked the decoder for
+    // 1.8 GB. A written 2×2 image with its data window's maximum raised to 8191×8191.
+    let img = XyzImage {
+        width: 2,
+        height: 2,
+        pixels: vec![[1.0, 2.0, 3.0]; 4],
+    };
+    let p = scratch("small.exr");
+    write_xyz_image(&p, &img).unwrap();
+    let mut bytes = std::fs::read(&p).unwrap();
+    let name = b"dataWindow\0box2i\0";
+    let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;
+    // box2i: xMin, yMin, xMax, yMax as little-endian i32.
+    bytes[at + 8..at + 12].copy_from_slice(&8191i32.to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&8191i32.to_le_bytes());
+    let big = scratch("big.exr");
+    std::fs::write(&big, &bytes).unwrap();
+    let e = read_xyz_image(&big).unwrap_err().to_string();
+    assert!(e.contains("8192×8192 pixels, more than a file of"), "{e}");
+}

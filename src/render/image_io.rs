@@ -34,6 +34,10 @@ impl XyzImage {
 /// the camera's 1014 × 1014, so a corrupt header cannot ask for an unbounded allocation.
 pub const MAX_PIXELS: usize = 1 << 26;
 
+/// Most pixels one byte of EXR can decode to: ZIP's deflate compresses at most about
+/// 1032 : 1 and a pixel is at least 6 bytes (three half floats), so 172; 256 leaves room.
+const EXR_PIXELS_PER_BYTE: u64 = 256;
+
 /// XYZ stored in R, G, B (see the module comment).
 fn xyz_chromaticities() -> exr::meta::attribute::Chromaticities {
     use exr::math::Vec2;
@@ -174,9 +178,23 @@ pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
             use exr::prelude::*;
             // The header first, so a corrupt size is refused before any pixel is allocated.
             let meta = MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
+            let file_len = std::fs::metadata(path).map_err(io(path))?.len();
             for header in meta.headers.iter() {
                 let size = header.layer_size;
-                pixel_count(path, size.width(), size.height())?;
+                let pixels = pixel_count(path, size.width(), size.height())?;
+                // The decoder allocates its whole image before it finds the data missing:
+                // a size no compression can fit into the file is a corrupt header.
+                if pixels as u64 > file_len.saturating_mul(EXR_PIXELS_PER_BYTE).max(4096) {
+                    return Err(ImageIoError::Exr {
+                        file: path.to_path_buf(),
+                        message: format!(
+                            "the header says {}×{} pixels, more than a file of {file_len} bytes \
+                             can hold: the header is corrupt",
+                            size.width(),
+                            size.height()
+                        ),
+                    });
+                }
                 let xyz = xyz_chromaticities();
                 if let Some(c) = header.shared_attributes.chromaticities {
                     if c != xyz {
