@@ -66,7 +66,7 @@ impl NumericCsv {
         let want = expected.join(",");
         let mut header: Option<Vec<String>> = None;
         let mut rows = Vec::new();
-        for (index, raw) in text.lines().enumerate() {
+        for (index, raw) in metamer_color::text::strip_bom(text).lines().enumerate() {
             let line = index + 1;
             let trimmed = raw.trim();
             if trimmed.is_empty() || trimmed.starts_with('#') {
@@ -85,7 +85,7 @@ impl NumericCsv {
                         file,
                         line,
                         expected: want,
-                        found: trimmed.chars().take(80).collect(),
+                        found: metamer_color::text::echo(trimmed),
                     });
                 }
                 header = Some(names);
@@ -109,7 +109,7 @@ impl NumericCsv {
                             line,
                             column: column + 1,
                             name: expected[column].to_string(),
-                            cell: cell.to_string(),
+                            cell: metamer_color::text::echo(cell),
                         })
                     }
                 }

@@ -497,3 +497,37 @@ fn noise_is_estimated_from_repeated_patches() {
     let p = fit_profile(ModelKind::Plcc, &patches, None).unwrap();
     assert_eq!(p.diagnostics().noise.as_ref().unwrap(), &n);
 }
+
+#[test]
+fn a_white_repeat_read_30_percent_low_is_warned_about_not_taken_as_noise() {
+    let d = ideal();
+    let mut patches = d.unique_patches(4);
+    let white = d.forward([1.0; 3]);
+    // White twice more: once within the CS-100A's ±0.2 %, once 30 % low.
+    for k in [1.002, 0.7] {
+        patches.push(Sample {
+            rgb: [1.0; 3],
+            xyz: white.map(|v| v * k),
+        });
+    }
+    let n = metamer::display::diagnostics::repeat_noise(&patches, white).unwrap();
+    // Y from 0.7·Yw to 1.002·Yw: (1.002 − 0.7)/1.002 = 30.1 % apart.
+    assert_eq!(n.disagreeing.len(), 1, "{:?}", n.disagreeing);
+    assert!(
+        n.disagreeing[0].contains("(30.1 % apart)"),
+        "{}",
+        n.disagreeing[0]
+    );
+    let p = fit_profile(ModelKind::Plcc, &patches, None).unwrap();
+    let verdict = &p.diagnostics().verdict;
+    assert!(
+        verdict.starts_with(
+            "Warning: repeated readings disagree beyond the instrument's repeatability"
+        ),
+        "{verdict}"
+    );
+    // Repeats within the stated repeatability raise no warning.
+    patches.pop();
+    let n = metamer::display::diagnostics::repeat_noise(&patches, white).unwrap();
+    assert!(n.disagreeing.is_empty(), "{:?}", n.disagreeing);
+}

@@ -107,15 +107,15 @@ fn sim_settings(
     };
     let mut config = SimSettings::default();
     if let Ok(v) = std::env::var(TIME_SCALE_ENV) {
-        config.time_scale = parse_scale(&v)
-            .ok_or_else(|| bad(format!("{TIME_SCALE_ENV}={v:?} is not a number ≥ 0")))?;
+        config.time_scale =
+            parse_scale(&v).ok_or_else(|| bad(format!("{TIME_SCALE_ENV}={v:?} {SCALE_RANGE}")))?;
     }
     for option in query.split('&').filter(|o| !o.is_empty()) {
         let (key, value) = option.split_once('=').unwrap_or((option, ""));
         match key {
             "time_scale" => {
                 config.time_scale = parse_scale(value)
-                    .ok_or_else(|| bad(format!("time_scale={value:?} is not a number ≥ 0")))?
+                    .ok_or_else(|| bad(format!("time_scale={value:?} {SCALE_RANGE}")))?
             }
             "seed" => {
                 config.seed = value
@@ -145,11 +145,17 @@ fn sim_settings(
     Ok(config)
 }
 
+/// Slowest simulated pace: 1000 times the real instrument's already makes one CS-100A
+/// reading take minutes; beyond it a scale can only be a typo, and the emulator's delays
+/// would overflow.
+const MAX_TIME_SCALE: f64 = 1000.0;
+const SCALE_RANGE: &str = "is not a number from 0 to 1000 (1 = the real instrument's pace)";
+
 fn parse_scale(v: &str) -> Option<f64> {
     v.trim()
         .parse::<f64>()
         .ok()
-        .filter(|s| s.is_finite() && *s >= 0.0)
+        .filter(|s| (0.0..=MAX_TIME_SCALE).contains(s))
 }
 
 #[cfg(test)]
@@ -238,6 +244,14 @@ mod tests {
             .err()
             .unwrap();
         assert!(e.to_string().contains("time_scale=\"-1\""), "{e}");
+        // A scale whose delays no Duration can hold is refused when the spec is read,
+        // not by a panic in the emulator thread later.
+        for scale in ["1e308", "inf", "NaN", "1000.5"] {
+            let e = open_instrument(&format!("sim:cs100a?time_scale={scale}"), None)
+                .err()
+                .unwrap_or_else(|| panic!("{scale} was accepted"));
+            assert!(e.to_string().contains("from 0 to 1000"), "{e}");
+        }
     }
 
     #[test]

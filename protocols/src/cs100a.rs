@@ -246,7 +246,7 @@ pub fn parse_reply(line: &[u8]) -> Result<Reply, ReplyError> {
     let mut fields = text.split(',');
     let code = fields.next().unwrap_or("");
     let status = Status::from_code(code.as_bytes())
-        .ok_or_else(|| ReplyError::UnknownStatus(code.to_string()))?;
+        .ok_or_else(|| ReplyError::UnknownStatus(metamer_color::text::echo(code)))?;
     let data: Vec<&str> = fields.collect();
     if !status.is_ok() {
         if !data.is_empty() {
@@ -309,7 +309,7 @@ fn check_ascii(body: &[u8]) -> Result<(), ReplyError> {
 fn parse_signed(field: &str, name: &'static str) -> Result<f64, ReplyError> {
     let bad = || ReplyError::BadNumber {
         field: name,
-        text: field.to_string(),
+        text: metamer_color::text::echo(field),
     };
     let (sign, rest) = match field.as_bytes().first() {
         Some(b' ') | Some(b'+') => (1.0, &field[1..]),
@@ -324,7 +324,13 @@ fn parse_signed(field: &str, name: &'static str) -> Result<f64, ReplyError> {
     {
         return Err(bad());
     }
-    digits.parse::<f64>().map(|v| sign * v).map_err(|_| bad())
+    // Hundreds of digits parse to infinity; no meter sends them.
+    digits
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .map(|v| sign * v)
+        .ok_or_else(bad)
 }
 
 // ---- device side (the emulator) ----

@@ -109,18 +109,20 @@ pub enum TranscriptError {
 
 /// Parses line 1.
 pub fn parse_header(line: &str) -> Result<Header, TranscriptError> {
-    let header: Header =
-        serde_json::from_str(line).map_err(|e| TranscriptError::Json(e.to_string()))?;
+    let header: Header = serde_json::from_str(line)
+        .map_err(|e| TranscriptError::Json(metamer_color::text::echo_message(&e.to_string())))?;
     if header.format != FORMAT {
-        return Err(TranscriptError::Format(header.format));
+        return Err(TranscriptError::Format(metamer_color::text::echo(
+            &header.format,
+        )));
     }
     Ok(header)
 }
 
 /// Parses one event line.
 pub fn parse_event(line: &str) -> Result<Event, TranscriptError> {
-    let value: Value =
-        serde_json::from_str(line).map_err(|e| TranscriptError::Json(e.to_string()))?;
+    let value: Value = serde_json::from_str(line)
+        .map_err(|e| TranscriptError::Json(metamer_color::text::echo_message(&e.to_string())))?;
     let obj = value
         .as_object()
         .ok_or_else(|| field_err("an event must be a JSON object"))?;
@@ -170,8 +172,9 @@ pub fn parse_event(line: &str) -> Result<Event, TranscriptError> {
         },
         other => {
             return Err(field_err(&format!(
-                "unknown \"dir\" {other:?} (host, device, control_in, control_out, bulk_in, \
-                 bulk_out, interrupt_in, interrupt_out)"
+                "unknown \"dir\" {:?} (host, device, control_in, control_out, bulk_in, \
+                 bulk_out, interrupt_in, interrupt_out)",
+                metamer_color::text::echo(other)
             )))
         }
     };
@@ -263,7 +266,12 @@ pub fn from_hex(text: &str) -> Result<Vec<u8>, TranscriptError> {
             std::str::from_utf8(pair)
                 .ok()
                 .and_then(|s| u8::from_str_radix(s, 16).ok())
-                .ok_or_else(|| field_err(&format!("\"hex\" has a non-hex digit pair {pair:?}")))
+                .ok_or_else(|| {
+                    field_err(&format!(
+                        "\"hex\" has a non-hex digit pair {:?}",
+                        metamer_color::text::echo(&String::from_utf8_lossy(pair))
+                    ))
+                })
         })
         .collect()
 }
@@ -271,11 +279,20 @@ pub fn from_hex(text: &str) -> Result<Vec<u8>, TranscriptError> {
 /// Shows bytes for a message: text as a quoted string with escapes, anything else as hex.
 pub fn show_bytes(bytes: &[u8]) -> String {
     if is_text(bytes) {
-        format!("{:?}", String::from_utf8_lossy(bytes))
+        metamer_color::text::echo(&format!("{:?}", String::from_utf8_lossy(bytes)))
+    } else if bytes.len() > SHOWN_HEX_BYTES {
+        format!(
+            "hex {}… ({} bytes in all)",
+            to_hex(&bytes[..SHOWN_HEX_BYTES]),
+            bytes.len()
+        )
     } else {
         format!("hex {}", to_hex(bytes))
     }
 }
+
+/// Bytes shown in hex in a message: 40 bytes are 80 hex digits, the length of quoted text.
+const SHOWN_HEX_BYTES: usize = 40;
 
 fn put_payload(obj: &mut Map<String, Value>, bytes: &[u8]) {
     if is_text(bytes) {

@@ -34,6 +34,19 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
+    // Options that cannot work are refused before minutes of fitting.
+    if args.trials == 0 {
+        return Err(CliError::Usage(
+            "--trials must be at least 1: each trial is one fresh set of readings".into(),
+        ));
+    }
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(CliError::Usage(format!(
+            "-o {}: is a file, but budget writes budget.csv and one chart per display into a \
+             directory",
+            args.out.display()
+        )));
+    }
     let presets: Vec<Preset> = if args.displays.is_empty() {
         Preset::ALL.to_vec()
     } else {

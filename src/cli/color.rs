@@ -113,7 +113,8 @@ fn xyz(a: XyzArgs) -> CliResult {
             .collect(),
     };
     let white = a.white.map(Xyz::from_array);
-    let several = columns.len() > 1;
+    // A chosen column is named in the output, as every column of a file with several is.
+    let named = columns.len() > 1 || a.column.is_some();
     for (name, spectrum) in columns {
         let d = describe(
             &spectrum.with_outside(outside),
@@ -122,6 +123,21 @@ fn xyz(a: XyzArgs) -> CliResult {
             a.observer,
             white,
         );
+        let mut numbers: Vec<f64> = d.xyz.to_array().into();
+        numbers.extend(d.xyy.to_array());
+        numbers.extend(d.lab.map(|l| l.to_array()).into_iter().flatten());
+        if numbers.iter().any(|v| !v.is_finite()) {
+            return Err(CliError::Failed(
+                format!(
+                    "{}: column '{}': the result is not a finite number (XYZ {:?}): the \
+                     values are too large to integrate, or the white has no luminance",
+                    a.spectrum.display(),
+                    metamer::color::text::echo(&name),
+                    d.xyz.to_array()
+                )
+                .into(),
+            ));
+        }
         if a.json {
             let mut obj = serde_json::json!({
                 "XYZ": d.xyz.to_array(),
@@ -130,7 +146,7 @@ fn xyz(a: XyzArgs) -> CliResult {
             if let Some(lab) = d.lab {
                 obj["Lab"] = serde_json::json!(lab.to_array());
             }
-            if several {
+            if named {
                 obj["column"] = serde_json::json!(name);
             }
             println!("{obj}");
@@ -150,15 +166,24 @@ fn xyz(a: XyzArgs) -> CliResult {
 
 fn delta_e(a: DeltaEArgs) -> CliResult {
     let csv = NumericCsv::read(&a.pairs, &["L1", "a1", "b1", "L2", "a2", "b2"])?;
-    let results: Vec<(f64, f64)> = csv
-        .rows
-        .iter()
-        .map(|(_, v)| {
-            let p = Lab::new(v[0], v[1], v[2]);
-            let q = Lab::new(v[3], v[4], v[5]);
-            (delta_e76(p, q), delta_e2000(p, q))
-        })
-        .collect();
+    let mut results: Vec<(f64, f64)> = Vec::with_capacity(csv.rows.len());
+    for (line, v) in &csv.rows {
+        let p = Lab::new(v[0], v[1], v[2]);
+        let q = Lab::new(v[3], v[4], v[5]);
+        let (d76, d00) = (delta_e76(p, q), delta_e2000(p, q));
+        // Finite Lab values far beyond any colour (1e308) overflow the formulas.
+        if !d76.is_finite() || !d00.is_finite() {
+            return Err(CliError::Failed(
+                format!(
+                    "{}:{line}: the colour difference is not a finite number (ΔE*ab {d76}, \
+                     ΔE00 {d00}): L*a*b* values of real colours lie within a few hundred",
+                    a.pairs.display()
+                )
+                .into(),
+            ));
+        }
+        results.push((d76, d00));
+    }
     if a.json {
         let arr: Vec<_> = results
             .iter()

@@ -57,6 +57,12 @@ impl std::str::FromStr for ModelChoice {
 }
 
 pub fn run(args: Args) -> CliResult {
+    if args.output.is_dir() {
+        return Err(CliError::Usage(format!(
+            "-o {}: is a directory; give the profile file to write",
+            args.output.display()
+        )));
+    }
     let mut out = OutputPolicy::new(args.force);
     out.input(&args.measurements);
     // Before the fit, which may take a while: a refused output is found now.

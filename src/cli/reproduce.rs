@@ -30,9 +30,9 @@ pub struct Args {
     /// Replace the output file if it exists (never one of the inputs).
     #[arg(long)]
     force: bool,
-    /// PNG bits per channel (8 or 16).
-    #[arg(long, default_value_t = 8)]
-    bits: u8,
+    /// PNG bits per channel (8 or 16; default 8), for --image only.
+    #[arg(long)]
+    bits: Option<u8>,
     /// Flip the image left–right, for the paper's set-up where the display is seen in a
     /// mirror.
     #[arg(long)]
@@ -43,10 +43,21 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    if args.bits != 8 && args.bits != 16 {
+    let bits = args.bits.unwrap_or(8);
+    if bits != 8 && bits != 16 {
         return Err(CliError::Usage(format!(
-            "--bits must be 8 or 16, got {}",
-            args.bits
+            "--bits must be 8 or 16, got {bits}"
+        )));
+    }
+    if args.bits.is_some() && args.xyz.is_some() {
+        return Err(CliError::Usage(
+            "--bits sets the PNG depth of --image; --xyz writes drive values as CSV numbers".into(),
+        ));
+    }
+    if args.output.is_dir() {
+        return Err(CliError::Usage(format!(
+            "-o {}: is a directory; give the file to write",
+            args.output.display()
         )));
     }
     let mut out = OutputPolicy::new(args.force);
@@ -82,7 +93,7 @@ pub fn run(args: Args) -> CliResult {
             let start = Instant::now();
             let drive = reproduce_image(&profile, &img, args.mirror, args.gamut);
             let elapsed = start.elapsed();
-            write_drive_png(&args.output, &drive, args.bits, &out)?;
+            write_drive_png(&args.output, &drive, bits, &out)?;
             let total = img.width * img.height;
             eprintln!(
                 "{}×{} pixels converted in {:.1} ms; {} out of gamut ({:.3} %); {}-bit PNG \
@@ -92,7 +103,7 @@ pub fn run(args: Args) -> CliResult {
                 elapsed.as_secs_f64() * 1e3,
                 drive.out_of_gamut,
                 100.0 * drive.out_of_gamut as f64 / total.max(1) as f64,
-                args.bits,
+                bits,
                 args.output.display()
             );
             Ok(())

@@ -79,6 +79,50 @@ pub struct Noise {
     pub de00: f64,
     /// Where the figure comes from ("7 repeated patches", "given").
     pub source: String,
+    /// Repeated patches whose readings disagree beyond what an instrument's repeatability
+    /// allows (see [`REPEAT_Y_TOLERANCE`]), one sentence each: a reading that went wrong,
+    /// not noise, and it inflates `de00`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub disagreeing: Vec<String>,
+}
+
+/// Largest relative spread of a patch's repeated luminances taken as noise: five times the
+/// CS-100A's stated repeatability of ±0.2 % in Y (the tighter of the instruments here), so
+/// honest noise never trips it and a reading 30 % low always does.
+pub const REPEAT_Y_TOLERANCE: f64 = 0.01;
+/// The same for chromaticity: five times the CS-100A's ±0.001 in x and y.
+pub const REPEAT_XY_TOLERANCE: f64 = 0.005;
+
+/// Why a patch's repeats disagree beyond the instruments' repeatability, if they do.
+fn disagreement(rgb: [f64; 3], xyzs: &[[f64; 3]]) -> Option<String> {
+    let ys: Vec<f64> = xyzs.iter().map(|x| x[1]).collect();
+    let (lo, hi) = ys
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| {
+            (a.min(y), b.max(y))
+        });
+    let xys: Vec<(f64, f64)> = xyzs.iter().map(|&x| xy(x)).collect();
+    let xy_spread = xys
+        .iter()
+        .flat_map(|a| {
+            xys.iter()
+                .map(move |b| (a.0 - b.0).abs().max((a.1 - b.1).abs()))
+        })
+        .fold(0.0, f64::max);
+    // Near black the relative spread means nothing; 0.01 is a meter's last digit.
+    let y_bad = hi - lo > REPEAT_Y_TOLERANCE * hi.abs().max(0.01 / REPEAT_Y_TOLERANCE);
+    let xy_bad = hi > 1.0 && xy_spread > REPEAT_XY_TOLERANCE;
+    (y_bad || xy_bad).then(|| {
+        format!(
+            "drive {:.3},{:.3},{:.3}: {} readings with Y from {lo:.4} to {hi:.4} \
+             ({:.1} % apart) and x, y up to {xy_spread:.4} apart",
+            rgb[0],
+            rgb[1],
+            rgb[2],
+            xyzs.len(),
+            100.0 * (hi - lo) / hi.abs().max(f64::MIN_POSITIVE)
+        )
+    })
 }
 
 /// The scatter of repeated readings: RMS ΔE00 of each reading from its patch's mean, with
@@ -91,7 +135,15 @@ pub fn repeat_noise(patches: &[Sample], white: [f64; 3]) -> Option<Noise> {
         groups.entry(key(p)).or_default().push(p.xyz);
     }
     let (mut sum, mut dof, mut repeated) = (0.0, 0usize, 0usize);
-    for xyzs in groups.values().filter(|g| g.len() > 1) {
+    let mut disagreeing = Vec::new();
+    let mut keys: Vec<&[i64; 3]> = groups.keys().collect();
+    keys.sort();
+    for key in keys {
+        let xyzs = &groups[key];
+        if xyzs.len() < 2 {
+            continue;
+        }
+        disagreeing.extend(disagreement(key.map(|k| k as f64 / 1e6), xyzs));
         let n = xyzs.len() as f64;
         let mean: [f64; 3] = std::array::from_fn(|k| xyzs.iter().map(|x| x[k]).sum::<f64>() / n);
         sum += xyzs.iter().map(|x| de(*x, mean, w).powi(2)).sum::<f64>();
@@ -101,6 +153,7 @@ pub fn repeat_noise(patches: &[Sample], white: [f64; 3]) -> Option<Noise> {
     (dof > 0).then(|| Noise {
         de00: (sum / dof as f64).sqrt(),
         source: format!("{repeated} repeated patches"),
+        disagreeing,
     })
 }
 
@@ -336,6 +389,14 @@ impl Diagnostics {
             )
         };
         verdict.push_str(&noise_note);
+        if let Some(n) = self.noise.as_ref().filter(|n| !n.disagreeing.is_empty()) {
+            verdict = format!(
+                "Warning: repeated readings disagree beyond the instrument's repeatability \
+                 ({}); that is a reading gone wrong, not noise, and it inflates the noise \
+                 figure this verdict allows for: re-measure those patches. {verdict}",
+                n.disagreeing.join("; ")
+            );
+        }
         if !power_law_model && !power_notes.is_empty() {
             verdict.push_str(&format!(
                 " Note: {} (plcc-gamma would not cope; measured-ramp TRCs do).",

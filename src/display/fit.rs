@@ -57,6 +57,10 @@ pub fn fit_profile_with(
     let residuals = residuals(model, patches, white);
     let noise = match options.noise_de00 {
         Some(de00) => Some(Noise {
+            // A given noise figure does not excuse repeats that disagree.
+            disagreeing: repeat_noise(patches, white)
+                .map(|n| n.disagreeing)
+                .unwrap_or_default(),
             de00,
             source: "given".into(),
         }),

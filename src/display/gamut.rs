@@ -71,8 +71,16 @@ pub fn nearest_lab(
         Vector3::new(l, a, b)
     };
     let mut x = clamp01(start);
+    if x.iter().any(|v| v.is_nan()) {
+        x = [0.5; 3];
+    }
     let mut r = lab_of(forward, x, white) - t;
     let mut f = r.norm_squared();
+    // A NaN target or white (or a model answering NaN) has no nearest colour, and an SVD
+    // of a non-finite Jacobian does not converge: answer the start instead of searching.
+    if !f.is_finite() {
+        return x;
+    }
     const H: f64 = 1e-6;
     for _ in 0..60 {
         // Forward differences stepping into the cube, so the model is never asked about
@@ -84,6 +92,9 @@ pub fn nearest_lab(
             xp[k] += h;
             let col = (lab_of(forward, xp, white) - t - r) / h;
             j.set_column(k, &col);
+        }
+        if j.iter().any(|v| !v.is_finite()) {
+            break;
         }
         let grad = j.transpose() * r;
         let free: Vec<usize> = (0..3)

@@ -90,16 +90,34 @@ impl Profile {
             file: file.clone(),
             source,
         })?;
-        let mut p: Profile = serde_json::from_str(&text).map_err(|e| ProfileError::Json {
+        let text = metamer_color::text::strip_bom(&text);
+        let mut p: Profile = serde_json::from_str(text).map_err(|e| ProfileError::Json {
             file: file.clone(),
             line: e.line(),
             column: e.column(),
-            message: e.to_string(),
+            message: metamer_color::text::echo_message(&e.to_string()),
         })?;
         if p.format != PROFILE_FORMAT {
             return Err(ProfileError::Format {
                 file,
-                found: p.format,
+                found: metamer_color::text::echo(&p.format),
+            });
+        }
+        // The white is the CIELAB reference of every colour reproduced: a zero or NaN white
+        // makes every L*a*b* NaN.
+        for (name, xyz) in [("white_xyz", p.white_xyz), ("black_xyz", p.black_xyz)] {
+            metamer_color::check_xyz(xyz).map_err(|e| ProfileError::Parameters {
+                file: file.clone(),
+                message: format!("{name}: {e}"),
+            })?;
+        }
+        if p.white_xyz[1] <= 0.0 {
+            return Err(ProfileError::Parameters {
+                file,
+                message: format!(
+                    "white_xyz {:?} has no luminance; the white must have Y > 0",
+                    p.white_xyz
+                ),
             });
         }
         p.parameters

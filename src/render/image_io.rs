@@ -1,7 +1,17 @@
 //! Reading and writing XYZ float images (absolute cd/m²): PFM (hand-written, the format of
 //! Debevec's HDRShop: "PF" header, width height, negative scale for little-endian, rows
-//! bottom to top) and OpenEXR (the `exr` crate; X, Y, Z stored in the R, G, B channels),
-//! plus an sRGB PNG preview.
+//! bottom to top) and OpenEXR (the `exr` crate), plus an sRGB PNG preview.
+//!
+//! OpenEXR has no XYZ channel layout of its own; its convention for XYZ data is R, G, B
+//! channels whose `chromaticities` attribute — the CIE xy of the triples (1,0,0), (0,1,0),
+//! (0,0,1) and (1,1,1) — is R = (1,0), G = (0,1), B = (0,0), W = (1/3,1/3): then (1,0,0) is
+//! pure X, and so on. `whiteLuminance`, the cd/m² of (1,1,1), is 1 because the values are
+//! cd/m² and (1,1,1) has Y = 1. A reader that honours the attributes converts to its display
+//! correctly; without them it would take XYZ for Rec. 709 RGB. Files are read back only
+//! when they carry these chromaticities or none (metamer wrote none before).
+//!
+//! Every reader refuses what would make the rest of the chain lie or stall: sizes whose
+//! pixel count overflows or exceeds [`MAX_PIXELS`], and NaN or infinite pixels.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -22,6 +32,25 @@ impl XyzImage {
     }
 }
 
+/// Largest image read, in pixels (12 bytes each in memory): 2²⁶, 8192 × 8192, far above
+/// the camera's 1014 × 1014, so a corrupt header cannot ask for an unbounded allocation.
+pub const MAX_PIXELS: usize = 1 << 26;
+
+/// Most pixels one byte of EXR can decode to: ZIP's deflate compresses at most about
+/// 1032 : 1 and a pixel is at least 6 bytes (three half floats), so 172; 256 leaves room.
+const EXR_PIXELS_PER_BYTE: u64 = 256;
+
+/// XYZ stored in R, G, B (see the module comment).
+fn xyz_chromaticities() -> exr::meta::attribute::Chromaticities {
+    use exr::math::Vec2;
+    exr::meta::attribute::Chromaticities {
+        red: Vec2(1.0, 0.0),
+        green: Vec2(0.0, 1.0),
+        blue: Vec2(0.0, 0.0),
+        white: Vec2(1.0 / 3.0, 1.0 / 3.0),
+    }
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum ImageIoError {
     #[error("{file}: {source}")]
@@ -39,6 +68,85 @@ pub enum ImageIoError {
     UnknownType { file: PathBuf },
     #[error("{0}")]
     Output(#[from] OutputError),
+    #[error(
+        "{file}: {width}×{height} pixels is more than this reader accepts ({MAX_PIXELS} pixels); \
+         the header is corrupt or the image is not one metamer rendered"
+    )]
+    TooLarge {
+        file: PathBuf,
+        width: usize,
+        height: usize,
+    },
+    #[error("{file}: pixel ({x}, {y}) (from the top left) is {value:?}, not a finite XYZ")]
+    NotFinite {
+        file: PathBuf,
+        x: usize,
+        y: usize,
+        value: [f32; 3],
+    },
+}
+
+/// The size's pixel count, if it can be held.
+fn pixel_count(file: &Path, width: usize, height: usize) -> Result<usize, ImageIoError> {
+    width
+        .checked_mul(height)
+        .filter(|&n| n <= MAX_PIXELS)
+        .ok_or_else(|| ImageIoError::TooLarge {
+            file: file.to_path_buf(),
+            width,
+            height,
+        })
+}
+
+fn check_finite(file: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
+    match img
+        .pixels
+        .iter()
+        .position(|p| p.iter().any(|v| !v.is_finite()))
+    {
+        None => Ok(()),
+        Some(i) => Err(ImageIoError::NotFinite {
+            file: file.to_path_buf(),
+            x: i % img.width.max(1),
+            y: i / img.width.max(1),
+            value: img.pixels[i],
+        }),
+    }
+}
+
+/// An `exr` crate error in terms of what is wrong with the file.
+fn exr_error(file: &Path, e: exr::error::Error) -> ImageIoError {
+    use exr::error::Error;
+    let message = match e {
+        Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the file ends early (truncated OpenEXR file)".to_string()
+        }
+        Error::Io(io) => {
+            return ImageIoError::Io {
+                file: file.to_path_buf(),
+                source: io,
+            }
+        }
+        // The crate's words for an offset table pointing past the end of the data.
+        Error::Invalid(m) if m.contains("missing bytes") => {
+            "the file is truncated or corrupt: its table of pixel blocks points past the end of \
+             the file"
+                .to_string()
+        }
+        Error::Invalid(m) => format!(
+            "not a valid OpenEXR file ({})",
+            metamer_color::text::echo(&m)
+        ),
+        Error::NotSupported(m) => format!(
+            "uses an OpenEXR feature this reader does not support ({})",
+            metamer_color::text::echo(&m)
+        ),
+        Error::Aborted => "reading was aborted".to_string(),
+    };
+    ImageIoError::Exr {
+        file: file.to_path_buf(),
+        message,
+    }
 }
 
 fn io(file: &Path) -> impl Fn(std::io::Error) -> ImageIoError + '_ {
@@ -71,13 +179,13 @@ pub fn write_xyz_image(
                 (p[0], p[1], p[2])
             });
             let mut buf = std::io::Cursor::new(Vec::new());
-            Image::from_channels((img.width, img.height), channels)
+            let mut image = Image::from_channels((img.width, img.height), channels);
+            image.attributes.chromaticities = Some(xyz_chromaticities());
+            image.layer_data.attributes.white_luminance = Some(1.0);
+            image
                 .write()
                 .to_buffered(&mut buf)
-                .map_err(|e| ImageIoError::Exr {
-                    file: path.to_path_buf(),
-                    message: e.to_string(),
-                })?;
+                .map_err(|e| exr_error(path, e))?;
             buf.into_inner()
         }
         _ => {
@@ -95,6 +203,39 @@ pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
         "pfm" => read_pfm(path),
         "exr" => {
             use exr::prelude::*;
+            // The header first, so a corrupt size is refused before any pixel is allocated.
+            let meta = MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
+            let file_len = std::fs::metadata(path).map_err(io(path))?.len();
+            for header in meta.headers.iter() {
+                let size = header.layer_size;
+                let pixels = pixel_count(path, size.width(), size.height())?;
+                // The decoder allocates its whole image before it finds the data missing:
+                // a size no compression can fit into the file is a corrupt header.
+                if pixels as u64 > file_len.saturating_mul(EXR_PIXELS_PER_BYTE).max(4096) {
+                    return Err(ImageIoError::Exr {
+                        file: path.to_path_buf(),
+                        message: format!(
+                            "the header says {}×{} pixels, more than a file of {file_len} bytes \
+                             can hold: the header is corrupt",
+                            size.width(),
+                            size.height()
+                        ),
+                    });
+                }
+                let xyz = xyz_chromaticities();
+                if let Some(c) = header.shared_attributes.chromaticities {
+                    if c != xyz {
+                        return Err(ImageIoError::Exr {
+                            file: path.to_path_buf(),
+                            message: format!(
+                                "holds RGB with primaries R {:?}, G {:?}, B {:?} (white {:?}), \
+                                 not XYZ (R (1,0), G (0,1), B (0,0), white (1/3,1/3))",
+                                c.red, c.green, c.blue, c.white
+                            ),
+                        });
+                    }
+                }
+            }
             let image = read_first_rgba_layer_from_file(
                 path,
                 |res, _| XyzImage {
@@ -107,11 +248,10 @@ pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
                     img.pixels[pos.y() * w + pos.x()] = [r, g, b];
                 },
             )
-            .map_err(|e| ImageIoError::Exr {
-                file: path.to_path_buf(),
-                message: e.to_string(),
-            })?;
-            Ok(image.layer_data.channel_data.pixels)
+            .map_err(|e| exr_error(path, e))?;
+            let img = image.layer_data.channel_data.pixels;
+            check_finite(path, &img)?;
+            Ok(img)
         }
         _ => Err(ImageIoError::UnknownType {
             file: path.to_path_buf(),
@@ -135,16 +275,30 @@ fn pfm_bytes(img: &XyzImage) -> Vec<u8> {
 fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
     let bad = |message: String| ImageIoError::Pfm {
         file: path.to_path_buf(),
-        message,
+        message: metamer_color::text::echo_message(&message),
     };
     let f = std::fs::File::open(path).map_err(io(path))?;
     let mut r = BufReader::new(f);
+    // A PFM header is three short text lines; reading more is not reading a PFM.
+    const MAX_HEADER: u64 = 256;
     let mut tokens = Vec::new();
+    let mut header_bytes = 0;
     while tokens.len() < 4 {
-        let mut line = String::new();
-        if r.read_line(&mut line).map_err(io(path))? == 0 {
-            return Err(bad("header ends early".into()));
+        let mut line = Vec::new();
+        let n = r
+            .by_ref()
+            .take(MAX_HEADER - header_bytes)
+            .read_until(b'\n', &mut line)
+            .map_err(io(path))?;
+        if n == 0 {
+            return Err(bad(if header_bytes >= MAX_HEADER {
+                format!("no PF header within its first {MAX_HEADER} bytes")
+            } else {
+                "header ends early".into()
+            }));
         }
+        header_bytes += n as u64;
+        let line = std::str::from_utf8(&line).map_err(|_| bad("the header is not text".into()))?;
         tokens.extend(line.split_whitespace().map(str::to_string));
     }
     if tokens[0] != "PF" {
@@ -155,19 +309,33 @@ fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
             .map_err(|_| bad(format!("bad size '{s}'")))
     };
     let (w, h) = (num(&tokens[1])?, num(&tokens[2])?);
+    let count = pixel_count(path, w, h)?;
     let scale: f32 = tokens[3]
         .parse()
         .map_err(|_| bad(format!("bad scale '{}'", tokens[3])))?;
-    let mut data = Vec::new();
-    r.read_to_end(&mut data).map_err(io(path))?;
-    if data.len() != w * h * 12 {
+    if !scale.is_finite() || scale == 0.0 {
         return Err(bad(format!(
-            "{} data bytes for {w}×{h} pixels (expected {})",
-            data.len(),
-            w * h * 12
+            "scale {scale} is not a finite, non-zero number"
         )));
     }
-    let mut pixels = vec![[0.0f32; 3]; w * h];
+    // Read one byte more than the pixels need, so a file with trailing data is told apart
+    // without reading all of it.
+    let expected = count * 12;
+    let mut data = Vec::new();
+    r.take(expected as u64 + 1)
+        .read_to_end(&mut data)
+        .map_err(io(path))?;
+    if data.len() != expected {
+        let found = if data.len() > expected {
+            "more".to_string()
+        } else {
+            data.len().to_string()
+        };
+        return Err(bad(format!(
+            "{found} data bytes for {w}×{h} pixels (expected {expected})"
+        )));
+    }
+    let mut pixels = vec![[0.0f32; 3]; count];
     for (i, chunk) in data.chunks_exact(4).enumerate() {
         let b = [chunk[0], chunk[1], chunk[2], chunk[3]];
         let v = if scale < 0.0 {
@@ -179,11 +347,13 @@ fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
         let (x, yb) = (p % w, p / w);
         pixels[(h - 1 - yb) * w + x][c] = v;
     }
-    Ok(XyzImage {
+    let img = XyzImage {
         width: w,
         height: h,
         pixels,
-    })
+    };
+    check_finite(path, &img)?;
+    Ok(img)
 }
 
 /// An sRGB (IEC 61966-2-1) 8-bit preview, exposed so that `white_y` maps to 1.

@@ -164,7 +164,7 @@ impl Cs100aEmulator {
     }
 
     fn scaled(&self, t: Duration) -> Duration {
-        t.mul_f64(self.config.time_scale.max(0.0))
+        crate::link::duration_s(t.as_secs_f64() * self.config.time_scale)
     }
 
     /// Answers commands on `link` until the host disconnects or `stop` is set.
@@ -207,11 +207,22 @@ impl Cs100aEmulator {
         }
     }
 
-    /// Serves `link` on a new thread until the host end disconnects.
+    /// Serves `link` on a new thread until the host end disconnects. A panic while serving
+    /// is handed to the link before it is dropped, so the host reports a failed simulation
+    /// rather than a disconnected cable.
     pub fn spawn<L: SerialLink + 'static>(self, link: L) -> std::thread::JoinHandle<()> {
         std::thread::Builder::new()
             .name("cs100a-emulator".into())
-            .spawn(move || self.serve(link, &AtomicBool::new(false)))
+            .spawn(move || {
+                let mut link = link;
+                let served = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    self.serve(&mut link, &AtomicBool::new(false))
+                }));
+                if let Err(payload) = served {
+                    let message = crate::link::panic_message(payload.as_ref());
+                    link.report_panic(&format!("CS-100A emulator: {message}"));
+                }
+            })
             .expect("spawning the emulator thread")
     }
 }

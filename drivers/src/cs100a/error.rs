@@ -50,6 +50,15 @@ pub enum Cs100aError {
         #[source]
         reason: ReplyError,
     },
+    /// A reply that is valid protocol but carries values no meter can have measured.
+    #[error("the CS-100A on {port} answered '{command}' with {received}, an impossible reading: {reason}")]
+    ImpossibleReading {
+        port: String,
+        command: String,
+        received: String,
+        #[source]
+        reason: metamer_color::Implausible,
+    },
     /// A reply that is valid protocol but not an answer to the command sent (e.g. bare OK00
     /// to MES).
     #[error("the CS-100A on {port} answered '{command}' with {received}: {reason}")]

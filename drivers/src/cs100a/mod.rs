@@ -80,6 +80,8 @@ pub struct Cs100a<L: SerialLink> {
     /// The meter has answered at least once on this link, so silence now means it went
     /// away rather than that it was never in remote mode.
     answered: bool,
+    /// Replies that were rejected and retried (see [`Cs100a::exchange`]).
+    rejected: Vec<String>,
 }
 
 impl<L: SerialLink> Cs100a<L> {
@@ -92,6 +94,7 @@ impl<L: SerialLink> Cs100a<L> {
             absolute: false,
             timeout: REPLY_TIMEOUT,
             answered: false,
+            rejected: Vec::new(),
         }
     }
 
@@ -173,32 +176,54 @@ impl<L: SerialLink> Cs100a<L> {
     /// Sends a command and parses its reply.
     ///
     /// Retry policy: a reply that arrives complete but garbled (parity substitutes, bytes
-    /// that are not the protocol) is retried once, because every command this driver sends
-    /// is idempotent: `MES` measures the same target again, `MDS` sets the same mode again
-    /// and `CLE` clears an already clear memory. Silence, a half reply, a disconnect and ER
-    /// codes are not retried: silence means the meter is not in remote mode (waiting again
-    /// only doubles the wait), a half reply or a disconnect means the cable or the meter
-    /// needs attention, and an ER code is the meter's considered answer.
+    /// that are not the protocol, an unknown status code) or that carries a reading no meter
+    /// can have measured (negative luminance, x + y > 1) is measured again once, because
+    /// every command this driver sends is idempotent: `MES` measures the same target again,
+    /// `MDS` sets the same mode again and `CLE` clears an already clear memory. The rejected
+    /// reply is never silent: its bytes and the reason go to standard error as a warning and
+    /// are kept in [`Cs100a::rejected_replies`]; a second bad reply is an error. Silence, a
+    /// half reply, a disconnect and ER codes are not retried: silence means the meter is not
+    /// in remote mode (waiting again only doubles the wait), a half reply or a disconnect
+    /// means the cable or the meter needs attention, and an ER code is the meter's
+    /// considered answer.
     fn exchange(&mut self, command: Command) -> Result<Reply, DriverError> {
         const ATTEMPTS: usize = 2;
         let mut attempt = 0;
         loop {
             attempt += 1;
             let line = self.transact(command)?;
-            match cs100a::parse_reply(&line) {
-                Ok(reply) => return Ok(reply),
-                Err(reason) if attempt < ATTEMPTS => drop(reason),
-                Err(reason) => {
-                    return Err(Cs100aError::BadReply {
+            let error = match cs100a::parse_reply(&line) {
+                Ok(reply) => match implausible(&reply) {
+                    None => return Ok(reply),
+                    Some(reason) => Cs100aError::ImpossibleReading {
                         port: self.link.describe(),
                         command: command.text(),
                         received: show_bytes(&line),
                         reason,
-                    }
-                    .into())
-                }
+                    },
+                },
+                Err(reason) => Cs100aError::BadReply {
+                    port: self.link.describe(),
+                    command: command.text(),
+                    received: show_bytes(&line),
+                    reason,
+                },
+            };
+            if attempt >= ATTEMPTS {
+                return Err(error.into());
             }
+            let warning = format!(
+                "{error}; asking again (attempt {} of {ATTEMPTS})",
+                attempt + 1
+            );
+            eprintln!("warning: {warning}");
+            self.rejected.push(warning);
         }
+    }
+
+    /// Replies rejected and asked again during this session, each with its bytes and why.
+    pub fn rejected_replies(&self) -> &[String] {
+        &self.rejected
     }
 
     /// Writes a command and reads one line, turning link failures into driver errors.
@@ -253,6 +278,20 @@ impl<L: SerialLink> Cs100a<L> {
         })
         .inspect(|_| self.answered = true)
     }
+}
+
+/// Why a well-formed measurement reply cannot be a reading, if it cannot: values the
+/// meter flagged as not measured (OK11, OK12) are not checked.
+fn implausible(reply: &Reply) -> Option<metamer_color::Implausible> {
+    let Reply::Measurement { value, .. } = reply else {
+        return None;
+    };
+    let luminance = value.luminance.unwrap_or(0.0);
+    let (x, y) = match (value.x, value.y) {
+        (Some(x), Some(y)) => (x, y),
+        _ => (0.3, 0.3),
+    };
+    metamer_color::check_yxy(luminance, x, y).err()
 }
 
 /// A reading from what the meter sent: Yxy → XYZ by the colour core. Values the

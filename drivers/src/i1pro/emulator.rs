@@ -300,7 +300,7 @@ impl I1ProEmulator {
                     } else {
                         0.0
                     };
-                let delay = Duration::from_secs_f64((t * self.config.time_scale).max(0.0));
+                let delay = crate::link::duration_s(t * self.config.time_scale);
                 self.measurements += 1;
                 self.pending = Some((delay, bytes));
                 Answer::Done(())

@@ -195,7 +195,7 @@ impl<L: UsbLink> Wire<L> {
             TransferKind::Bulk,
             EP_DATA_IN,
             want,
-            Duration::from_secs_f64(timeout),
+            crate::link::duration_s(timeout),
         );
         let bytes = got.map_err(|e| self.failed("read measurement", e))?;
         self.previous_s = shot.integration_s;

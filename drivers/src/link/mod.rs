@@ -65,6 +65,12 @@ pub enum LinkError {
         metamer_protocols::transcript::show_bytes(received)
     )]
     Disconnected { received: Vec<u8> },
+    /// The simulated device's thread panicked: a bug in the simulation, not a cable.
+    #[error(
+        "the simulated device on {link} failed: its thread panicked ({message}); this is a \
+         bug in metamer's simulation, not a problem with a cable or an instrument"
+    )]
+    PeerPanicked { link: String, message: String },
     /// The device refused a USB transfer by stalling the endpoint (0x00 for control
     /// transfers): a request it does not support, or one it cannot take in its state.
     #[error("the device stalled endpoint 0x{endpoint:02x} (it refused the request)")]
@@ -87,6 +93,27 @@ pub enum LinkError {
     },
 }
 
+/// The message of a caught panic, for [`LinkError::PeerPanicked`].
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "a panic without a message".to_string()
+    }
+}
+
+/// Seconds as a `Duration` for any float: NaN and negatives are no time, and a value too
+/// large to represent (a scaled delay, a timeout computed from a device's parameters) is the
+/// longest `Duration`, where `Duration::from_secs_f64` would panic.
+pub fn duration_s(seconds: f64) -> Duration {
+    if seconds.is_nan() || seconds <= 0.0 {
+        return Duration::ZERO;
+    }
+    Duration::try_from_secs_f64(seconds).unwrap_or(Duration::MAX)
+}
+
 /// A serial byte pipe with line-oriented reads.
 pub trait SerialLink: Send {
     /// Writes all bytes and flushes them to the device.
@@ -103,6 +130,34 @@ pub trait SerialLink: Send {
     fn set_settings(&mut self, settings: LineSettings) -> Result<(), LinkError>;
     /// Where the link goes, for messages: `/dev/ttyUSB0`, `replay:FILE`, `sim`.
     fn describe(&self) -> String;
+    /// Called by a simulated device's thread whose serving code panicked, before the link is
+    /// dropped, so the other end reports the panic instead of a disconnected cable. Links
+    /// with no simulated peer ignore it.
+    fn report_panic(&mut self, _message: &str) {}
+}
+
+impl<L: SerialLink + ?Sized> SerialLink for &mut L {
+    fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        (**self).write_all(bytes)
+    }
+    fn read_until(&mut self, terminator: &[u8], timeout: Duration) -> Result<Vec<u8>, LinkError> {
+        (**self).read_until(terminator, timeout)
+    }
+    fn discard_input(&mut self) -> Result<(), LinkError> {
+        (**self).discard_input()
+    }
+    fn settings(&self) -> LineSettings {
+        (**self).settings()
+    }
+    fn set_settings(&mut self, settings: LineSettings) -> Result<(), LinkError> {
+        (**self).set_settings(settings)
+    }
+    fn describe(&self) -> String {
+        (**self).describe()
+    }
+    fn report_panic(&mut self, message: &str) {
+        (**self).report_panic(message)
+    }
 }
 
 impl<L: SerialLink + ?Sized> SerialLink for Box<L> {
@@ -140,6 +195,15 @@ pub(crate) fn find_end(haystack: &[u8], needle: &[u8]) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn any_float_becomes_a_duration_without_panicking() {
+        assert_eq!(duration_s(1.5), Duration::from_millis(1500));
+        assert_eq!(duration_s(f64::NAN), Duration::ZERO);
+        assert_eq!(duration_s(-3.0), Duration::ZERO);
+        assert_eq!(duration_s(1e308), Duration::MAX);
+        assert_eq!(duration_s(f64::INFINITY), Duration::MAX);
+    }
 
     #[test]
     fn cs100a_character_takes_eleven_bit_times() {

@@ -2,6 +2,7 @@
 //! running on another thread. Dropping one end is a disconnect for the other.
 
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use super::{find_end, LineSettings, LinkError, SerialLink};
@@ -13,29 +14,45 @@ pub struct PairEnd {
     buffer: Vec<u8>,
     settings: LineSettings,
     name: String,
+    /// Shared by both ends: why the other end's thread panicked, if it did.
+    panic: Arc<Mutex<Option<String>>>,
 }
 
 /// Two connected ends with the given line settings; `name` is what messages call the link.
 pub fn pair(settings: LineSettings, name: &str) -> (PairEnd, PairEnd) {
     let (tx_a, rx_b) = mpsc::channel();
     let (tx_b, rx_a) = mpsc::channel();
+    let panic = Arc::new(Mutex::new(None));
     let end = |tx, rx| PairEnd {
         tx,
         rx,
         buffer: Vec::new(),
         settings,
         name: name.to_string(),
+        panic: Arc::clone(&panic),
     };
     (end(tx_a, rx_a), end(tx_b, rx_b))
+}
+
+impl PairEnd {
+    /// A disconnect, or the other end's panic when that is why it went.
+    fn gone(&self, received: Vec<u8>) -> LinkError {
+        let panic = self.panic.lock().map(|p| p.clone()).unwrap_or(None);
+        match panic {
+            Some(message) => LinkError::PeerPanicked {
+                link: self.name.clone(),
+                message,
+            },
+            None => LinkError::Disconnected { received },
+        }
+    }
 }
 
 impl SerialLink for PairEnd {
     fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         self.tx
             .send(bytes.to_vec())
-            .map_err(|_| LinkError::Disconnected {
-                received: Vec::new(),
-            })
+            .map_err(|_| self.gone(Vec::new()))
     }
 
     fn read_until(&mut self, terminator: &[u8], timeout: Duration) -> Result<Vec<u8>, LinkError> {
@@ -54,9 +71,8 @@ impl SerialLink for PairEnd {
                     })
                 }
                 Err(RecvTimeoutError::Disconnected) => {
-                    return Err(LinkError::Disconnected {
-                        received: std::mem::take(&mut self.buffer),
-                    })
+                    let received = std::mem::take(&mut self.buffer);
+                    return Err(self.gone(received));
                 }
             }
         }
@@ -81,6 +97,12 @@ impl SerialLink for PairEnd {
 
     fn describe(&self) -> String {
         self.name.clone()
+    }
+
+    fn report_panic(&mut self, message: &str) {
+        if let Ok(mut slot) = self.panic.lock() {
+            *slot = Some(message.to_string());
+        }
     }
 }
 
@@ -107,5 +129,25 @@ mod tests {
             Err(LinkError::Disconnected { received }) => assert_eq!(received, b"OK"),
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn a_panicked_peer_is_reported_as_a_panic_not_a_disconnect() {
+        let (mut host, mut device) = pair(LineSettings::CS100A, "sim:test");
+        device.report_panic("attempt to divide by zero");
+        drop(device);
+        let e = host
+            .read_until(b"\r\n", Duration::from_millis(10))
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the simulated device on sim:test failed: its thread panicked (attempt to divide by \
+             zero); this is a bug in metamer's simulation, not a problem with a cable or an \
+             instrument"
+        );
+        assert!(matches!(
+            host.write_all(b"MES\r\n"),
+            Err(LinkError::PeerPanicked { .. })
+        ));
     }
 }

@@ -37,7 +37,7 @@ impl Transcript {
             line,
             message,
         };
-        let mut lines = text
+        let mut lines = metamer_color::text::strip_bom(text)
             .lines()
             .enumerate()
             .map(|(i, l)| (i + 1, l))

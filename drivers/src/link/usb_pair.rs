@@ -72,6 +72,8 @@ enum Transfer {
 enum Outcome {
     Data(Vec<u8>),
     Stall,
+    /// The device's code panicked on this transfer; the thread ends after sending it.
+    Panicked(String),
 }
 
 type Request = (Transfer, Sender<Outcome>);
@@ -109,7 +111,7 @@ fn serve<D: UsbDevice>(mut device: D, rx: Receiver<Request>) -> D {
     let mut unanswered: Option<Sender<Outcome>> = None;
     while let Ok((transfer, reply)) = rx.recv() {
         unanswered = None;
-        let answer = match transfer {
+        let answer = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match transfer {
             Transfer::ControlIn(setup, len) => device.control_in(setup, len).map(|mut d| {
                 d.truncate(len);
                 d
@@ -120,6 +122,13 @@ fn serve<D: UsbDevice>(mut device: D, rx: Receiver<Request>) -> D {
             Transfer::Read(kind, endpoint, len) => device.read(kind, endpoint, len),
             Transfer::Write(kind, endpoint, data) => {
                 device.write(kind, endpoint, &data).map(|()| Vec::new())
+            }
+        }));
+        let answer = match answer {
+            Ok(answer) => answer,
+            Err(payload) => {
+                let _ = reply.send(Outcome::Panicked(super::panic_message(payload.as_ref())));
+                break;
             }
         };
         let outcome = match answer {
@@ -164,6 +173,13 @@ impl UsbPairHost {
         match reply_rx.recv_timeout(timeout) {
             Ok(Outcome::Data(data)) => Ok(data),
             Ok(Outcome::Stall) => Err(LinkError::Stalled { endpoint }),
+            Ok(Outcome::Panicked(message)) => {
+                self.tx = None;
+                Err(LinkError::PeerPanicked {
+                    link: self.name.clone(),
+                    message,
+                })
+            }
             Err(RecvTimeoutError::Timeout) => Err(LinkError::Timeout {
                 timeout_ms: timeout.as_millis() as u64,
                 received: Vec::new(),

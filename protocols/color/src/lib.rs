@@ -6,10 +6,12 @@ mod coords;
 mod delta_e;
 mod describe;
 mod error;
+mod plausible;
 mod spectrum;
 mod spectrum_json;
 mod table;
 mod tables;
+pub mod text;
 
 pub use colorimetry::{
     illuminant_white, luminance, radiance_to_xyz, reflectance_to_xyz, END_NM, K_M, START_NM,
@@ -18,6 +20,7 @@ pub use coords::{Lab, Lch, XyY, Xyz, D65_XY};
 pub use delta_e::{delta_e2000, delta_e76};
 pub use describe::{describe, Description};
 pub use error::ColorError;
+pub use plausible::{check_xyz, check_yxy, Implausible, MAX_CD_M2};
 pub use spectrum::{Outside, Quantity, Spectrum};
 pub use table::SpectralTable;
 pub use tables::{

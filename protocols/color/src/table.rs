@@ -38,7 +38,7 @@ impl SpectralTable {
         let mut header: Option<Vec<String>> = None;
         let mut wavelengths_nm = Vec::new();
         let mut data: Vec<Vec<f64>> = Vec::new();
-        for (index, raw) in text.lines().enumerate() {
+        for (index, raw) in crate::text::strip_bom(text).lines().enumerate() {
             let line = index + 1;
             let trimmed = raw.trim();
             if trimmed.is_empty() {
@@ -55,7 +55,7 @@ impl SpectralTable {
                     return Err(ColorError::MissingHeader {
                         file,
                         line,
-                        found: trimmed.chars().take(60).collect(),
+                        found: crate::text::echo(trimmed),
                     });
                 }
                 let names: Vec<String> = cells[1..].iter().map(|s| s.to_string()).collect();
@@ -85,7 +85,7 @@ impl SpectralTable {
                             } else {
                                 names[column - 1].clone()
                             },
-                            cell: cell.to_string(),
+                            cell: crate::text::echo(cell),
                         })
                     }
                 }
@@ -139,7 +139,7 @@ impl SpectralTable {
             .map(|i| self.spectrum(i))
             .ok_or_else(|| ColorError::NoSuchColumn {
                 file: self.source.clone(),
-                column: name.to_string(),
+                column: crate::text::echo(name),
                 available: self.columns.join(", "),
             })
     }

@@ -246,3 +246,17 @@ proptest::proptest! {
         proptest::prop_assert!((value.y.unwrap() - y).abs() <= 5e-5 + 1e-12);
     }
 }
+
+#[test]
+fn a_number_too_long_for_a_float_is_not_infinity() {
+    let digits = "9".repeat(400);
+    let reply = format!("OK00, {digits},.3127,.3290\r\n");
+    assert!(matches!(
+        parse_reply(reply.as_bytes()),
+        Err(ReplyError::BadNumber { field: "Y", .. })
+    ));
+    // The error quotes at most 80 characters of the field.
+    let e = parse_reply(reply.as_bytes()).unwrap_err().to_string();
+    assert!(e.contains("(401 characters in all)"), "{e}");
+    assert!(e.len() < 200, "{e}");
+}

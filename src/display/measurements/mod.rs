@@ -98,10 +98,13 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
                     ),
                 });
             }
-            patches.push(Sample {
-                rgb,
-                xyz: [v[3], v[4], v[5]],
-            });
+            let xyz = [v[3], v[4], v[5]];
+            metamer_color::check_xyz(xyz).map_err(|e| MeasurementsError::Cgats {
+                file: path.to_path_buf(),
+                line: *line,
+                message: format!("not a measurement: {e}"),
+            })?;
+            patches.push(Sample { rgb, xyz });
         }
         return Ok(Measurements {
             patches,
@@ -119,11 +122,13 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
 
 /// Parses the first table of a CGATS `.ti3` text; `path` names it in errors.
 pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsError> {
+    let text = metamer_color::text::strip_bom(text);
     let file = path.to_path_buf();
+    // Messages quote fields of the file; any of them may be huge.
     let err = |line: usize, message: String| MeasurementsError::Cgats {
         file: file.clone(),
         line,
-        message,
+        message: metamer_color::text::echo_message(&message),
     };
     enum State {
         Header,
@@ -244,6 +249,8 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
                         return Err(err(line, format!("{name} = {} is outside 0–100", v[k])));
                     }
                 }
+                metamer_color::check_xyz([v[3], v[4], v[5]])
+                    .map_err(|e| err(line, format!("not a measurement: {e}")))?;
                 if !spectral.is_empty() {
                     let mut row = Vec::with_capacity(spectral.len());
                     for &(c, _) in &spectral {
@@ -319,7 +326,10 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
                 .split_whitespace()
                 .filter_map(|t| t.parse::<f64>().ok())
                 .collect();
-            if xyz.len() != 3 || !xyz[1].is_finite() || xyz[1] <= 0.0 {
+            if xyz.len() != 3
+                || xyz[1] <= 0.0
+                || metamer_color::check_xyz([xyz[0], xyz[1], xyz[2]]).is_err()
+            {
                 return Err(err(
                     *l,
                     format!("LUMINANCE_XYZ_CDM2 must be three numbers X Y Z with Y > 0, found \"{value}\""),
@@ -329,14 +339,19 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
         }
         (true, None) => (1.0, false),
     };
+    let mut patches = Vec::with_capacity(rows.len());
+    for (line, v) in rows {
+        let xyz = [v[3] * scale, v[4] * scale, v[5] * scale];
+        // Each row passed alone; the white's luminance can still scale it past belief.
+        metamer_color::check_xyz(xyz)
+            .map_err(|e| err(line, format!("not a measurement once scaled to cd/m²: {e}")))?;
+        patches.push(Sample {
+            rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
+            xyz,
+        });
+    }
     Ok(Measurements {
-        patches: rows
-            .into_iter()
-            .map(|(_, v)| Sample {
-                rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
-                xyz: [v[3] * scale, v[4] * scale, v[5] * scale],
-            })
-            .collect(),
+        patches,
         absolute,
         spectra: (!spectral.is_empty()).then(|| Spectra {
             wavelengths_nm: spectral.iter().map(|&(_, nm)| nm).collect(),

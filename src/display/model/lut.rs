@@ -51,6 +51,12 @@ impl Lut3d {
             if n < 2 {
                 return Err(format!("the {name} axis has fewer than 2 levels"));
             }
+            if self.levels[c].iter().any(|l| !(0.0..=1.0).contains(l)) {
+                return Err(format!("the {name} axis has a level outside 0–1"));
+            }
+            self.shaper[c]
+                .check()
+                .map_err(|e| format!("the {name} shaper is unusable: {e}"))?;
             self.shaped[c] = self.levels[c]
                 .iter()
                 .map(|&d| self.shaper[c].eval(d))
@@ -74,6 +80,9 @@ impl Lut3d {
                 self.levels[1].len(),
                 self.levels[2].len()
             ));
+        }
+        if self.nodes.iter().flatten().any(|v| !v.is_finite()) {
+            return Err("a grid node's XYZ is not a finite number".into());
         }
         self.scale = self.nodes.iter().map(|n| n[1].abs()).fold(1e-12, f64::max);
         let black = self.node([0, 0, 0]);

@@ -24,6 +24,10 @@ pub struct MatrixTrc {
 
 /// 2-norm condition number of a 3×3 matrix (∞ when singular).
 pub fn condition_number(m: &[[f64; 3]; 3]) -> f64 {
+    // The SVD's iteration does not terminate on NaN entries.
+    if m.iter().flatten().any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
     let mat = nalgebra::Matrix3::from_fn(|r, c| m[r][c]);
     let sv = mat.singular_values();
     let (max, min) = (sv.max(), sv.min());

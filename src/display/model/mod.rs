@@ -32,6 +32,7 @@ pub use samples::Sample;
 pub use shaper_matrix::{default_knots, fit_shaper_matrix};
 pub use trc::{fit_power_gamma, FastInverse, Trc};
 
+use samples::CHANNEL_NAMES;
 use serde::{Deserialize, Serialize};
 
 /// A fitted model's parameters, as saved in a profile.
@@ -55,9 +56,24 @@ impl ModelParams {
     /// Rebuilds derived data after loading; the error says what is inconsistent.
     pub fn prepare(&mut self, kind: ModelKind) -> Result<(), String> {
         match self {
-            ModelParams::MatrixTrc(m) => m.prepare(kind).map_err(|condition| {
-                format!("the model's matrix cannot be inverted (condition number {condition:.3e})")
-            }),
+            ModelParams::MatrixTrc(m) => {
+                for (curve, name) in m.trc.iter().zip(CHANNEL_NAMES) {
+                    curve
+                        .check()
+                        .map_err(|e| format!("the {name} tone curve is unusable: {e}"))?;
+                }
+                let numbers = m.black.iter().chain(m.matrix.iter().flatten());
+                if let Some(v) = numbers.into_iter().find(|v| !v.is_finite()) {
+                    return Err(format!(
+                        "the model's black or matrix holds {v}, not a finite number"
+                    ));
+                }
+                m.prepare(kind).map_err(|condition| {
+                    format!(
+                        "the model's matrix cannot be inverted (condition number {condition:.3e})"
+                    )
+                })
+            }
             ModelParams::Lut(l) => l.prepare(),
         }
     }

@@ -89,6 +89,82 @@ impl Trc {
         }
     }
 
+    /// Whether the curve's parameters describe a curve at all: a loaded profile can hold
+    /// anything, and an empty or unordered table, a NaN or a zero gamma would make
+    /// evaluation index out of bounds or answer NaN for every colour.
+    pub fn check(&self) -> Result<(), String> {
+        let finite = |name: &str, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("{name} is {v}, not a finite number"))
+            }
+        };
+        match self {
+            Trc::Power { gamma } => {
+                finite("gamma", *gamma)?;
+                if *gamma <= 0.0 {
+                    return Err(format!("gamma is {gamma}; it must be > 0"));
+                }
+            }
+            Trc::Table {
+                drive,
+                value,
+                exponent,
+            } => {
+                if drive.len() < 2 || drive.len() != value.len() {
+                    return Err(format!(
+                        "a table needs at least 2 drive levels and one value per level, found \
+                         {} drive levels and {} values",
+                        drive.len(),
+                        value.len()
+                    ));
+                }
+                finite("exponent", *exponent)?;
+                if *exponent <= 0.0 {
+                    return Err(format!("exponent is {exponent}; it must be > 0"));
+                }
+                for (&d, &v) in drive.iter().zip(value) {
+                    finite("a drive level", d)?;
+                    finite("a value", v)?;
+                }
+                if let Some(w) = drive.windows(2).find(|w| w[1] <= w[0]) {
+                    return Err(format!(
+                        "drive levels must increase, but {} follows {}",
+                        w[1], w[0]
+                    ));
+                }
+                if let Some(w) = value.windows(2).find(|w| w[1] < w[0]) {
+                    return Err(format!(
+                        "values must not decrease, but {} follows {}",
+                        w[1], w[0]
+                    ));
+                }
+            }
+            Trc::Gog {
+                gain,
+                offset,
+                gamma,
+                flare,
+            } => {
+                for (name, v) in [
+                    ("gain", *gain),
+                    ("offset", *offset),
+                    ("gamma", *gamma),
+                    ("flare", *flare),
+                ] {
+                    finite(name, v)?;
+                }
+                if *gain <= 0.0 || *gamma <= 0.0 {
+                    return Err(format!(
+                        "gain ({gain}) and gamma ({gamma}) must be > 0 for a rising curve"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// A ramp table, made monotone by pool-adjacent-violators so measurement noise near
     /// black cannot make the curve fold back (which would give two drives for one output),
     /// interpolated in the domain of the ramp's least-squares power law.
