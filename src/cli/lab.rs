@@ -15,13 +15,10 @@ pub struct Args {
     /// characterization: log, profile, .ti3, report).
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: PathBuf,
-    /// The box scene.
-    #[arg(
-        long,
-        default_value = "data/scenes/validation-box.json",
-        value_name = "SCENE"
-    )]
-    scene: PathBuf,
+    /// The box scene (default: the validation box built into the program, the same as
+    /// data/scenes/validation-box.json).
+    #[arg(long, value_name = "SCENE")]
+    scene: Option<PathBuf>,
     /// The simulated monitor: ideal-crt, ips-lcd or wide-gamut-ccfl.
     #[arg(long, default_value = "ips-lcd", value_name = "PRESET")]
     display: String,

@@ -34,14 +34,15 @@ use crate::color::Xyz;
 use crate::display::characterize::finish::Summary;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
-use crate::render::{Scene, SpotOptions, SpotProgress};
+use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
 use crate::rig::{Preset, Screen, VirtualDisplay, VirtualPanel};
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
 
 /// What a lab run is made of.
 #[derive(Clone, Debug, Serialize)]
 pub struct LabOptions {
-    pub scene: PathBuf,
+    /// The box scene file; None: the built-in validation box.
+    pub scene: Option<PathBuf>,
     /// The simulated monitor.
     #[serde(serialize_with = "preset_name")]
     pub display: Preset,
@@ -129,7 +130,15 @@ pub fn run_lab(
             dir: dir.to_path_buf(),
         });
     }
-    let scene = Scene::load(&opts.scene)?;
+    let scene = match &opts.scene {
+        Some(path) => Scene::load(path)?,
+        None => crate::render::scene::builtin::validation_box().map_err(|source| {
+            SceneError::Invalid {
+                file: "(built-in validation box)".into(),
+                source,
+            }
+        })?,
+    };
     let spot = SpotOptions {
         target_de: opts.target_de,
         seed: opts.seed,
