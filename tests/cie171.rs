@@ -8,11 +8,11 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
+use metamer::render::deadline::Deadline;
 use metamer::render::geometry::Vec3;
 use metamer::render::probes::probe_illuminance_path;
 use metamer::render::radiosity::probes::{element_lux, probe_illuminance, Probe};
 use metamer::render::radiosity::{solve_level, Prepared, RadiosityOptions};
-use metamer::render::deadline::Deadline;
 use metamer::render::scene::{Scene, SceneFile};
 use serde_json::{json, Value};
 

@@ -129,9 +129,7 @@ pub fn run(args: Args) -> CliResult {
             }
             if let Some(w) = white {
                 if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
-                    return Err(CliError::Usage(
-                        "--white must be finite with Y > 0".into(),
-                    ));
+                    return Err(CliError::Usage("--white must be finite with Y > 0".into()));
                 }
             }
             let scene = load(scene.as_deref())?;
@@ -444,7 +442,12 @@ fn probes(
             .all(|x| x.is_finite())
     }) {
         return Err(CliError::Failed(
-            format!("{}: probe {} has no finite illuminance", points.display(), i + 1).into(),
+            format!(
+                "{}: probe {} has no finite illuminance",
+                points.display(),
+                i + 1
+            )
+            .into(),
         ));
     }
     if json {

@@ -207,7 +207,10 @@ mod tests {
             let x = centre.plus(dir.times(r));
             let got = g(&e, x, dir.times(-1.0));
             let want = area * f * gm.cos() / (r * r);
-            assert!((got - want).abs() < 1e-5 * want, "C {c} γ {gamma}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-5 * want,
+                "C {c} γ {gamma}: {got} vs {want}"
+            );
         }
         // Left and right of the axis at the same distance: the ratio is f(0, 45)/f(180, 45).
         let at = |c: f64| {

@@ -313,7 +313,14 @@ pub fn run_level(
             opts.direct_rule,
             opts.indirect_rule,
         );
-        patches.push(reading(scene, &p.lights, &fp, &refl, &solved.bands, &solved.l));
+        patches.push(reading(
+            scene,
+            &p.lights,
+            &fp,
+            &refl,
+            &solved.bands,
+            &solved.l,
+        ));
     }
     let white = match (opts.white, p.white_face) {
         (Some(w), _) => w,

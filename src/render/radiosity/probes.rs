@@ -7,9 +7,9 @@ use super::bound::richardson;
 use super::direct::irradiance_factor;
 use super::lights::Lights;
 use super::polygon::point_to_rect;
-use crate::render::deadline::Deadline;
 use super::{solve_level, Prepared, RadiosityError, RadiosityOptions, Solved};
 use crate::color::K_M;
+use crate::render::deadline::Deadline;
 use crate::render::scene::Scene;
 
 /// A probe: a point and the unit normal of the surface it measures on.
@@ -83,8 +83,8 @@ pub fn element_lux(scene: &Scene, solved: &Solved) -> Vec<(f64, f64, f64)> {
     let n = solved.mesh.elements.len();
     let nb = solved.bands.len();
     let lights = Lights::new(scene);
-    let src = super::solve::sources(scene, &lights, &solved.mesh, Deadline::never())
-        .unwrap_or_default();
+    let src =
+        super::solve::sources(scene, &lights, &solved.mesh, Deadline::never()).unwrap_or_default();
     (0..n)
         .map(|i| {
             let mut direct = 0.0;

@@ -211,7 +211,13 @@ pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
     let mut emitters = Vec::new();
     let mut distinct = 0;
     for (i, e) in file.emitters.iter().enumerate() {
-        let em = emitter(&format!("emitters[{i}]"), e, &mut loader, &cmf[1], &mut warnings)?;
+        let em = emitter(
+            &format!("emitters[{i}]"),
+            e,
+            &mut loader,
+            &cmf[1],
+            &mut warnings,
+        )?;
         distinct += em.spectra.len();
         if distinct > MAX_TILE_SPECTRA {
             return err(
@@ -310,7 +316,10 @@ fn rect(p: &str, c: [f64; 3], u: [f64; 3], v: [f64; 3]) -> R<Rect> {
         return err(format!("{p}.edge_u"), "edges must be non-zero");
     }
     if !(u.cross(v).length().is_finite() && u.cross(v).length() > 0.0) {
-        return err(format!("{p}.edge_u"), "the area must be finite and non-zero");
+        return err(
+            format!("{p}.edge_u"),
+            "the area must be finite and non-zero",
+        );
     }
     if u.dot(v).abs() > 1e-9 * u.length() * v.length() {
         return err(format!("{p}.edge_v"), "must be orthogonal to edge_u");

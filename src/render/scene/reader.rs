@@ -176,7 +176,10 @@ pub fn spectrum(p: &str, v: &Value) -> Result<SpectrumRef, PathError> {
         }
         other => err(
             p,
-            format!("expected a spectrum: {SPECTRUM_SHAPES}; got {}", kind(other)),
+            format!(
+                "expected a spectrum: {SPECTRUM_SHAPES}; got {}",
+                kind(other)
+            ),
         ),
     }
 }
@@ -370,9 +373,15 @@ mod tests {
         let mut v = minimal();
         v["surfaces"][0].as_object_mut().unwrap().remove("corner");
         let e = scene(&v).unwrap_err();
-        assert_eq!((e.path.as_str(), e.message.as_str()), ("surfaces[0].corner", "missing"));
+        assert_eq!(
+            (e.path.as_str(), e.message.as_str()),
+            ("surfaces[0].corner", "missing")
+        );
         let mut v = minimal();
         v["emitters"][0]["distribution"] = json!({"kind": "c_gamma", "table": {"c_deg": [0]}});
-        assert_eq!(scene(&v).unwrap_err().path, "emitters[0].distribution.table");
+        assert_eq!(
+            scene(&v).unwrap_err().path,
+            "emitters[0].distribution.table"
+        );
     }
 }
