@@ -124,7 +124,7 @@ pub fn run(args: Args) -> CliResult {
             if target_de.is_nan() || target_de <= 0.0 {
                 return Err(CliError::Usage("--target-de must be > 0".into()));
             }
-            if !(max_seconds > 0.0) {
+            if max_seconds.is_nan() || max_seconds <= 0.0 {
                 return Err(CliError::Usage("--max-seconds must be > 0".into()));
             }
             if let Some(w) = white {

@@ -283,10 +283,10 @@ pub fn reference_white(scene: &Scene, opts: &SpotOptions) -> Result<[f64; 3], Sp
 }
 
 fn check_options(opts: &SpotOptions) -> Result<(), SpotError> {
-    if !(opts.max_seconds > 0.0) {
+    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
         return Err(SpotError::BadTimeLimit(opts.max_seconds));
     }
-    if !(opts.target_de > 0.0) {
+    if opts.target_de.is_nan() || opts.target_de <= 0.0 {
         return Err(SpotError::BadTarget(opts.target_de));
     }
     Ok(())

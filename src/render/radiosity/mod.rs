@@ -361,7 +361,7 @@ pub fn render_spots_radiosity(
     progress: &dyn Fn(&Level),
 ) -> Result<RadiosityResult, RadiosityError> {
     let start = Instant::now();
-    if !(opts.max_seconds > 0.0) {
+    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
         return Err(RadiosityError::BadOption {
             what: "the time limit",
             need: "> 0 s",

@@ -275,7 +275,7 @@ fn camera(c: &CameraFile) -> R<Camera> {
     }
     let forward = forward.normalized();
     let right = forward.cross(finite3("camera.up", c.up)?);
-    if !(right.length() >= 1e-9) {
+    if right.length().is_nan() || right.length() < 1e-9 {
         return err("camera.up", "must not be parallel to the view");
     }
     let right = right.normalized();
@@ -401,7 +401,7 @@ fn emitter(
                 return err(sp, "a spectral radiance must be ≥ 0");
             }
             let lum = luminance(&s, ybar);
-            if !(lum <= MAX_LUMINANCE_CD_M2) {
+            if lum.is_nan() || lum > MAX_LUMINANCE_CD_M2 {
                 return err(
                     sp,
                     format!("luminance {lum:e} cd/m² is above {MAX_LUMINANCE_CD_M2:e}"),
@@ -473,7 +473,7 @@ fn emitter(
     };
     for (k, g) in gains.iter().enumerate() {
         let lum = g * luminance(&spectra[tile_spectrum[k] as usize], ybar);
-        if !(lum <= MAX_LUMINANCE_CD_M2) {
+        if lum.is_nan() || lum > MAX_LUMINANCE_CD_M2 {
             return err(
                 format!("{p}.tiles[{}].gain", given[k].unwrap_or(0)),
                 format!(
