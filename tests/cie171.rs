@@ -8,6 +8,7 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
+use metamer::render::deadline::Deadline;
 use metamer::render::geometry::Vec3;
 use metamer::render::probes::probe_illuminance_path;
 use metamer::render::radiosity::probes::{element_lux, probe_illuminance, Probe};
@@ -209,7 +210,15 @@ fn inter_reflections_in_a_closed_cube() {
         );
         let p = Prepared::for_probes(&scene).unwrap();
         let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
-        let solved = solve_level(&p, &refl, &RadiosityOptions::default(), 3, None);
+        let solved = solve_level(
+            &p,
+            &refl,
+            &RadiosityOptions::default(),
+            3,
+            None,
+            Deadline::never(),
+        )
+        .unwrap();
         let lux = element_lux(&scene, &solved);
         let s: f64 = lux.iter().map(|e| e.0).sum();
         assert!((s - 6.0 * a * a).abs() < 1e-9, "area {s}");

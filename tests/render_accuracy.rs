@@ -294,7 +294,8 @@ fn bad_field_is_named_by_json_path() {
     let mut v = box_json();
     v["emitters"][0]["tiles"][3]["gain"] = json!(-1.0);
     let f: SceneFile = serde_json::from_value(v).unwrap();
-    let (path, message) = Scene::build(&f, data_dir()).unwrap_err();
+    let e = Scene::build(&f, data_dir()).unwrap_err();
+    let (path, message) = (e.path, e.message);
     assert_eq!(path, "emitters[0].tiles[3].gain");
     assert_eq!(message, "must be ≥ 0");
 }

@@ -110,6 +110,15 @@ def load_spectrum(ref, scene_dir, what):
     if isinstance(ref, (int, float)):
         # A flat value: one constant over Mitsuba's whole range.
         return Spectrum([MI_MIN, MI_MAX], [float(ref)] * 2, hold_ends=True)
+    outside = ref.get("outside", "zero")
+    if outside not in ("zero", "hold_ends"):
+        raise SystemExit(f"{what}: unknown 'outside': {outside!r}")
+    if "nm" in ref:
+        return Spectrum(
+            np.asarray(ref["nm"], float),
+            np.asarray(ref["values"], float),
+            hold_ends=(outside == "hold_ends"),
+        )
     path = os.path.normpath(os.path.join(scene_dir, ref["file"]))
     header, table = read_csv_table(path)
     col = int(ref.get("column", 1))
@@ -215,16 +224,37 @@ class Box:
         if len(self.json["emitters"]) != 1:
             raise SystemExit("expected exactly one emitter")
         e = self.json["emitters"][0]
-        if e.get("distribution", {}).get("kind", "lambertian") != "lambertian":
-            raise SystemExit("only the canonical Lambertian emitter is modelled here")
-        self.spectrum = load_spectrum(e["spectrum"], self.dir, "emitter spectrum")
-        ybar_sum = (self.spectrum.at(self.cmf_nm) * self.cmf[:, 1]).sum()
-        self.scale = e["luminance_cd_m2"] / (K_M * ybar_sum)
-        self.luminance = e["luminance_cd_m2"]
+        kind = e.get("distribution", {}).get("kind", "lambertian")
+        if kind != "lambertian":
+            # Mitsuba 3's `area` emitter radiates the same radiance in every direction; a
+            # cos_power or C-gamma (measured) distribution has no equivalent without a
+            # custom plugin, so such a scene is not compared at all rather than wrongly.
+            raise SystemExit(
+                f"the emitter's distribution is {kind!r}: Mitsuba 3's area emitter is "
+                "Lambertian only, so this scene cannot be cross-checked here"
+            )
         self.emitter = e
-        self.gains = {(t["row"], t["col"]): t["gain"] for t in e["tiles"]}
+        self.gains = {(t["row"], t["col"]): t.get("gain", 1.0) for t in e["tiles"]}
         if len(self.gains) != e["rows"] * e["cols"]:
             raise SystemExit("emitter: tile gains do not cover the grid")
+        with_spectra = [t for t in e["tiles"] if "spectrum" in t]
+        if with_spectra:
+            # Absolute per-tile spectral radiance (W/sr/m2/nm along the normal) times gain.
+            if len(with_spectra) != len(e["tiles"]):
+                raise SystemExit("emitter: some tiles have a spectrum and some do not")
+            self.tile_spectra = {
+                (t["row"], t["col"]): load_spectrum(
+                    t["spectrum"], self.dir, f"tile ({t['row']}, {t['col']}) spectrum"
+                )
+                for t in e["tiles"]
+            }
+            self.scale = 1.0
+            self.spectrum = None
+        else:
+            self.tile_spectra = None
+            self.spectrum = load_spectrum(e["spectrum"], self.dir, "emitter spectrum")
+            ybar_sum = (self.spectrum.at(self.cmf_nm) * self.cmf[:, 1]).sum()
+            self.scale = e["luminance_cd_m2"] / (K_M * ybar_sum)
         self.emitter_refl = (
             load_spectrum(e["reflectance"], self.dir, "emitter reflectance")
             if e.get("reflectance") is not None
@@ -251,20 +281,38 @@ class Box:
                 )
         raise SystemExit(f"patch {k} not in the scene")
 
+    def tile_luminance(self, row, col):
+        """Luminance along the normal of one tile (cd/m2), as metamer computes it."""
+        s = self.tile_radiance_spectrum(row, col)
+        return K_M * (s.at(self.cmf_nm) * self.cmf[:, 1]).sum()
+
     def channels(self):
         """Spectral response functions of the film's X, Y, Z channels."""
+        if self.wavelengths == "light" and self.spectrum is None:
+            raise SystemExit(
+                "--wavelengths light needs one light spectrum; this scene's tiles have their own"
+            )
         if self.wavelengths == "light":
             w = self.spectrum.at(self.cmf_nm)[:, None] * self.cmf
         else:
             w = self.cmf
         return [Spectrum(self.cmf_nm, np.maximum(w[:, i], 0.0)) for i in range(3)]
 
-    def tile_radiance(self, gain):
+    def tile_radiance_spectrum(self, row, col):
+        """The tile's absolute spectral radiance (gain included)."""
+        g = self.gains[(row, col)]
+        if self.tile_spectra is not None:
+            return self.tile_spectra[(row, col)].scaled(g)
+        return self.spectrum.scaled(self.scale * g)
+
+    def tile_radiance(self, row, col):
         if self.wavelengths == "light":
+            self.channels()  # refuses per-tile spectra
             # The light's spectrum S(lambda) lives in the film's channels instead (see
             # --wavelengths); the tiles emit the flat s * gain.
-            return Spectrum([MI_MIN, MI_MAX], [self.scale * gain] * 2, hold_ends=True)
-        return self.spectrum.scaled(self.scale * gain)
+            g = self.gains[(row, col)]
+            return Spectrum([MI_MIN, MI_MAX], [self.scale * g] * 2, hold_ends=True)
+        return self.tile_radiance_spectrum(row, col)
 
     def mitsuba_dict(self, mi, white_patch=None, max_depth=-1, rr_depth=5):
         d = {
@@ -293,7 +341,7 @@ class Box:
                 "to_world": rect_to_world(mi, c, u, v),
                 "emitter": {
                     "type": "area",
-                    "radiance": self.tile_radiance(g).mitsuba(),
+                    "radiance": self.tile_radiance(row, col).mitsuba(),
                 },
                 "bsdf": {"type": "diffuse", "reflectance": self.emitter_refl.mitsuba()},
             }
@@ -381,7 +429,6 @@ class Meter:
 def check_emitter(mi, box, args):
     """The emitter head-on, one tile at a time: must read luminance x gain."""
     scene = mi.load_dict(box.mitsuba_dict(mi, max_depth=args.max_depth))
-    expected_rel = xyz_of(box.spectrum.scaled(box.scale), box.cmf_nm, box.cmf)
     rows = []
     worst = 0.0
     for (row, col), g in sorted(box.gains.items()):
@@ -393,7 +440,7 @@ def check_emitter(mi, box, args):
         m = Meter(mi, scene, sensor, seed_base=7_000_000 + 100 * row + col)
         m.add(args.check_spp)
         got = m.mean()
-        exp = expected_rel * g
+        exp = xyz_of(box.tile_radiance_spectrum(row, col), box.cmf_nm, box.cmf)
         rel = got / exp - 1
         worst = max(worst, float(np.abs(rel).max()))
         rows.append(dict(row=row, col=col, gain=g, XYZ=got.tolist(), expected=exp.tolist()))
@@ -474,7 +521,11 @@ def main():
         f"Mitsuba {mi.__version__}, variant {args.variant}, threads {dr.thread_count()}, "
         f"wavelength sampling: {args.wavelengths}"
     )
-    print(f"emitter scale s = {box.scale:.6e} (683 * sum s*S*ybar = {box.luminance} cd/m2)")
+    if box.spectrum is not None:
+        lum = box.emitter["luminance_cd_m2"]
+        print(f"emitter scale s = {box.scale:.6e} (683 * sum s*S*ybar = {lum} cd/m2)")
+    else:
+        print("emitter: absolute spectral radiance per tile")
 
     if args.check_emitter:
         res = check_emitter(mi, box, args)

@@ -58,10 +58,10 @@ pub struct Args {
 pub fn run(args: Args) -> CliResult {
     let display: Preset = args.display.parse().map_err(CliError::Usage)?;
     let (scene, scenario) = match args.scene {
-        Some(scene) => (scene, None),
+        Some(scene) => (Some(scene), None),
         None => {
             let scenario: Scenario = args.scenario.parse().map_err(CliError::Usage)?;
-            (PathBuf::from(scenario.scene()), Some(scenario))
+            (None, Some(scenario))
         }
     };
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
@@ -97,7 +97,9 @@ pub fn run(args: Args) -> CliResult {
     }
     // A resumed run replaces the files it wrote itself; a new one replaces nothing.
     let mut out = OutputPolicy::new(args.resume);
-    out.input(&options.scene);
+    if let Some(s) = &options.scene {
+        out.input(s);
+    }
     out.dir(&args.out)?;
     for f in result_files(&args.out) {
         out.check(&f)?;

@@ -14,6 +14,7 @@ use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
 use metamer::render::probes::probe_illuminance_path;
 use metamer::render::radiosity::probes::{probe_illuminance, Illuminance, Probe};
 use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
+use metamer::render::scene::builtin;
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
 #[derive(clap::Args)]
@@ -34,13 +35,15 @@ pub enum Method {
 enum Cmd {
     /// The 24 simulated 1° meter readings, refined to a ΔE*ab confidence target.
     Spots {
-        scene: PathBuf,
+        /// The scene file (default: the validation box built into the program).
+        scene: Option<PathBuf>,
         /// Stop when every patch's 95 % half-width of ΔE*ab is below this.
         #[arg(long, default_value_t = 0.1)]
         target_de: f64,
         /// Reference white X,Y,Z (default: a perfect white diffuser in place of patch 19).
         #[arg(long, value_parser = parse_triple)]
         white: Option<[f64; 3]>,
+        /// Wall-clock limit (s): the readings so far are reported, marked not converged.
         #[arg(long, default_value_t = 600.0)]
         max_seconds: f64,
         #[arg(long, default_value_t = 1)]
@@ -54,7 +57,8 @@ enum Cmd {
     },
     /// The camera's XYZ image (absolute cd/m², float) as .exr or .pfm.
     Image {
-        scene: PathBuf,
+        /// The scene file (default: the built-in validation box).
+        scene: Option<PathBuf>,
         /// Samples per pixel.
         #[arg(long)]
         spp: u64,
@@ -95,7 +99,8 @@ enum Cmd {
     },
     /// CSV and SVG of ΔE*ab error against seconds for each sampling strategy.
     Convergence {
-        scene: PathBuf,
+        /// The scene file (default: the built-in validation box).
+        scene: Option<PathBuf>,
         #[arg(short, long)]
         output: PathBuf,
         /// Confidence target of the reference run.
@@ -126,7 +131,15 @@ pub fn run(args: Args) -> CliResult {
             if target_de.is_nan() || target_de <= 0.0 {
                 return Err(CliError::Usage("--target-de must be > 0".into()));
             }
-            let scene = Scene::load(&scene)?;
+            if max_seconds.is_nan() || max_seconds <= 0.0 {
+                return Err(CliError::Usage("--max-seconds must be > 0".into()));
+            }
+            if let Some(w) = white {
+                if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
+                    return Err(CliError::Usage("--white must be finite with Y > 0".into()));
+                }
+            }
+            let scene = load(scene.as_deref())?;
             let use_radiosity = uses_radiosity(method, &scene)?;
             if use_radiosity {
                 return spots_radiosity(&scene, target_de, white, max_seconds, json);
@@ -157,10 +170,12 @@ pub fn run(args: Args) -> CliResult {
                     "{}",
                     serde_json::to_string(&Tagged {
                         method: "path",
+                        provenance: scene.provenance.as_ref(),
                         result: &r
                     })?
                 );
             } else {
+                print_provenance(&scene);
                 println!(
                     "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
                     r.white[0],
@@ -208,7 +223,9 @@ pub fn run(args: Args) -> CliResult {
                 return Err(CliError::Usage("--spp must be ≥ 1".into()));
             }
             let mut out = OutputPolicy::new(force);
-            out.input(&scene);
+            if let Some(s) = &scene {
+                out.input(s);
+            }
             // Before the render: a refused output costs nothing yet.
             out.check(&output)?;
             if let Some(p) = &preview {
@@ -223,10 +240,12 @@ pub fn run(args: Args) -> CliResult {
                 }
                 out.check(p)?;
             }
-            let file = scene;
-            let scene = Scene::load(&file)?;
+            let name = scene
+                .as_ref()
+                .map_or("the built-in scene".into(), |p| p.display().to_string());
+            let scene = load(scene.as_deref())?;
             let camera = scene.camera.ok_or_else(|| {
-                CliError::Failed(format!("{}: the scene has no camera", file.display()).into())
+                CliError::Failed(format!("{name}: the scene has no camera").into())
             })?;
             let width = width.unwrap_or(camera.width);
             let height = height.unwrap_or(camera.height);
@@ -290,12 +309,14 @@ pub fn run(args: Args) -> CliResult {
             force,
         } => {
             let mut out = OutputPolicy::new(force);
-            out.input(&scene);
+            if let Some(s) = &scene {
+                out.input(s);
+            }
             out.dir(&output)?;
             for f in ["convergence.csv", "convergence.svg"] {
                 out.check(&output.join(f))?;
             }
-            let scene = Scene::load(&scene)?;
+            let scene = load(scene.as_deref())?;
             let (points, _) =
                 convergence::run(&scene, reference_de, seconds, seed, &|m| eprintln!("{m}"))?;
             convergence::write(&output, &points, &out)?;
@@ -312,8 +333,29 @@ pub fn run(args: Args) -> CliResult {
 #[derive(serde::Serialize)]
 struct Tagged<'a, T: serde::Serialize> {
     method: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    provenance: Option<&'a serde_json::Map<String, serde_json::Value>>,
     #[serde(flatten)]
     result: &'a T,
+}
+
+/// The scene at `path`, or the built-in validation box; its warnings go to stderr.
+fn load(path: Option<&std::path::Path>) -> Result<Scene, CliError> {
+    let scene = match path {
+        Some(p) => Scene::load(p)?,
+        None => builtin::validation_box()?,
+    };
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}
+
+/// The scene's provenance, one line, ahead of the readings.
+fn print_provenance(scene: &Scene) {
+    if let Some(p) = &scene.provenance {
+        println!("provenance: {}", serde_json::Value::Object(p.clone()));
+    }
 }
 
 /// Whether `method` renders `scene` by radiosity; `auto` says why when it cannot.
@@ -358,11 +400,13 @@ fn spots_radiosity(
             "{}",
             serde_json::to_string(&Tagged {
                 method: "radiosity",
+                provenance: scene.provenance.as_ref(),
                 result: &r
             })?
         );
         return Ok(());
     }
+    print_provenance(scene);
     println!(
         "radiosity: white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.2} s, {} levels{}",
         r.white[0],
@@ -404,7 +448,7 @@ fn probes(
     if samples < 2 {
         return Err(CliError::Usage("--samples must be ≥ 2".into()));
     }
-    let scene = Scene::load(scene)?;
+    let scene = load(Some(scene))?;
     let csv = NumericCsv::read(points, &["x", "y", "z", "nx", "ny", "nz"])?;
     let mut probes = Vec::with_capacity(csv.rows.len());
     for (line, v) in &csv.rows {
@@ -427,6 +471,20 @@ fn probes(
         probe_illuminance_path(&scene, &probes, samples, seed)
     };
     let method = if use_radiosity { "radiosity" } else { "path" };
+    if let Some((i, _)) = out.iter().enumerate().find(|(_, e)| {
+        ![e.direct_lux, e.indirect_lux, e.total_lux, e.bound_lux]
+            .iter()
+            .all(|x| x.is_finite())
+    }) {
+        return Err(CliError::Failed(
+            format!(
+                "{}: probe {} has no finite illuminance",
+                points.display(),
+                i + 1
+            )
+            .into(),
+        ));
+    }
     if json {
         #[derive(serde::Serialize)]
         struct Row<'a> {

@@ -37,15 +37,16 @@ use crate::display::characterize::finish::Summary;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
 use crate::output::OutputPolicy;
-use crate::render::{Scene, SpotOptions, SpotProgress};
+use crate::render::{Scene, SceneError, SpotOptions, SpotProgress};
 use crate::rig::{Preset, Screen, VirtualDisplay, VirtualPanel};
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
 
 /// What a lab run is made of.
 #[derive(Clone, Debug, Serialize)]
 pub struct LabOptions {
-    pub scene: PathBuf,
-    /// The named box `scene` is, if it is one.
+    /// The box scene file; None: the built-in box of `scenario`.
+    pub scene: Option<PathBuf>,
+    /// The named box the lab measures when no scene file is given.
     pub scenario: Option<Scenario>,
     /// The simulated monitor.
     #[serde(serialize_with = "preset_name")]
@@ -199,7 +200,18 @@ pub fn run_lab(
             dir: dir.to_path_buf(),
         });
     }
-    let scene = Scene::load(&opts.scene)?;
+    let scene = match &opts.scene {
+        Some(path) => Scene::load(path)?,
+        None => {
+            let scenario = opts.scenario.unwrap_or(Scenario::DisplayWhite);
+            crate::render::scene::builtin::scenario_box(scenario.builtin_name()).map_err(
+                |source| SceneError::Invalid {
+                    file: format!("(built-in {} box)", scenario.name()).into(),
+                    source,
+                },
+            )?
+        }
+    };
     let spot = SpotOptions {
         target_de: opts.target_de,
         seed: opts.seed,

@@ -30,6 +30,14 @@ impl Scenario {
         }
     }
 
+    /// The name of its scene among the scenes built into the program.
+    pub fn builtin_name(self) -> &'static str {
+        match self {
+            Scenario::DisplayWhite => "validation-box",
+            Scenario::LedRgb1 => "validation-box-led-rgb1",
+        }
+    }
+
     /// The scene file, relative to the repository's root.
     pub fn scene(self) -> &'static str {
         match self {

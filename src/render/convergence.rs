@@ -155,7 +155,7 @@ pub fn radiosity_points(
     let mut spent = Vec::new();
     let mut total = 0.0;
     for level in 1..=levels.max(4) {
-        let l = run_level(&prepared, &opts, level)?;
+        let l = run_level(&prepared, &opts, level, super::deadline::Deadline::never())?;
         total += l.seconds;
         log(&format!(
             "radiosity level {level}: {} elements, {:.2} s",

@@ -1,7 +1,8 @@
 //! Spectral path tracing of the scene: radiance along a ray at a few wavelengths at once.
 //!
 //! Next-event estimation picks an emitter tile with probability proportional to its power
-//! (gain × area; every tile shares one directional distribution) and a uniform point on it;
+//! along the normal (gain × area × Σ spectrum) and a uniform point on it; the tile's own
+//! spectrum and the directional factor f(C, γ) in the emitter's frame weight the sample;
 //! BRDF sampling is cosine-weighted, so a Lambertian bounce multiplies the throughput by
 //! the reflectance alone. The two are combined with the power heuristic (Veach 1997,
 //! §9.2.2). Russian roulette on the largest throughput ends paths without bias.
@@ -78,14 +79,35 @@ impl<'a> Tracer<'a> {
         };
         let active: Vec<usize> = (0..N_BINS)
             .filter(|&i| {
-                scene.emitters.iter().any(|e| e.radiance[i] > 0.0)
+                scene
+                    .emitters
+                    .iter()
+                    .any(|e| e.spectra.iter().any(|s| s[i] > 0.0))
                     && scene.cmf.iter().any(|c| c[i] > 0.0)
+            })
+            .collect();
+        // Per emitter and spectrum: Σ gain × tile area of the tiles that radiate it.
+        let weight: Vec<Vec<f64>> = scene
+            .emitters
+            .iter()
+            .map(|e| {
+                let area = e.rect.area_m2 / e.gains.len() as f64;
+                let mut w = vec![0.0; e.spectra.len()];
+                for (g, k) in e.gains.iter().zip(&e.tile_spectrum) {
+                    w[*k as usize] += g * area;
+                }
+                w
             })
             .collect();
         let sampler = if strategy.wavelength_is {
             let w: Vec<f64> = (0..scene.cmf[0].len())
                 .map(|i| {
-                    let s: f64 = scene.emitters.iter().map(|e| e.radiance[i]).sum();
+                    let s: f64 = scene
+                        .emitters
+                        .iter()
+                        .zip(&weight)
+                        .map(|(e, w)| e.spectra.iter().zip(w).map(|(s, w)| w * s[i]).sum::<f64>())
+                        .sum();
                     s * (scene.cmf[0][i] + scene.cmf[1][i] + scene.cmf[2][i])
                 })
                 .collect();
@@ -95,8 +117,9 @@ impl<'a> Tracer<'a> {
         };
         let mut power = Vec::new();
         for (ei, e) in scene.emitters.iter().enumerate() {
-            let lum: f64 = e.radiance.iter().sum();
+            let sums: Vec<f64> = e.spectra.iter().map(|s| s.iter().sum()).collect();
             for (ti, g) in e.gains.iter().enumerate() {
+                let lum = sums[e.tile_spectrum[ti] as usize];
                 power.push((ei, ti, g * lum * e.rect.area_m2 / e.gains.len() as f64));
             }
         }
@@ -229,7 +252,7 @@ impl<'a> Tracer<'a> {
                     let e = &self.scene.emitters[ei];
                     let cos_l = -d.dot(e.rect.normal);
                     let tile = e.tile_at(a, b);
-                    let f = e.gains[tile] * e.distribution.factor(cos_l);
+                    let f = e.gains[tile] * e.directional(-d);
                     let w = match prev_brdf_pdf {
                         Some(pb) if self.strategy.nee_mis => {
                             let pl = self.light_pdf_sa(ei, a, b, t * t, cos_l);
@@ -237,7 +260,7 @@ impl<'a> Tracer<'a> {
                         }
                         _ => 1.0,
                     };
-                    let le = bins.of(&e.radiance, &mut buf);
+                    let le = bins.of(e.tile_spectrum(tile), &mut buf);
                     let k = w * f;
                     for ((o, b), l) in out.iter_mut().zip(&beta[..n]).zip(le) {
                         *o += b * k * l;
@@ -326,9 +349,9 @@ impl<'a> Tracer<'a> {
         let w = pl * pl / (pl * pl + pb * pb);
         // ρ/π · L · cos_x / pl (beta already holds ρ).
         let g =
-            e.gains[ti] * e.distribution.factor(cos_l) * w * cos_x / (std::f64::consts::PI * pl);
+            e.gains[ti] * e.directional(wi.times(-1.0)) * w * cos_x / (std::f64::consts::PI * pl);
         let mut buf = [0.0; MAX_HERO];
-        let le = bins.of(&e.radiance, &mut buf);
+        let le = bins.of(e.tile_spectrum(ti), &mut buf);
         for ((o, b), l) in out.iter_mut().zip(&beta[..bins.idx.len()]).zip(le) {
             *o += b * g * l;
         }

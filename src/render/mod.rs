@@ -21,6 +21,7 @@ pub use spot::{
     SpotResult,
 };
 pub mod convergence;
+pub mod deadline;
 pub mod image;
 pub mod image_io;
 pub mod probes;

@@ -10,6 +10,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use super::deadline::Deadline;
 use super::geometry::{Vec3, VecOps};
 use super::integrator::{Strategy, Tracer};
 use super::scene::Scene;
@@ -126,6 +127,19 @@ pub fn sample_cone(
     first: u64,
     count: u64,
 ) -> XyzStats {
+    sample_cone_until(tracer, aim, seed, stream, first, count, Deadline::never())
+}
+
+/// [`sample_cone`], stopping early (with fewer samples) once `deadline` has passed.
+pub fn sample_cone_until(
+    tracer: &Tracer,
+    aim: Aim,
+    seed: u64,
+    stream: u64,
+    first: u64,
+    count: u64,
+    deadline: Deadline,
+) -> XyzStats {
     const CHUNK: u64 = 256;
     let cos_max = (aim.acceptance_deg.to_radians() / 2.0).cos();
     let chunks: Vec<u64> = (0..count.div_ceil(CHUNK)).collect();
@@ -136,6 +150,11 @@ pub fn sample_cone(
             let lo = first + c * CHUNK;
             let hi = (first + (c + 1) * CHUNK).min(first + count);
             for i in lo..hi {
+                // A sample costs microseconds in the box but can cost milliseconds in a
+                // scene of thousands of surfaces: look at the clock every few.
+                if (i - lo) % 8 == 0 && deadline.passed() {
+                    break;
+                }
                 let mut rng = Rng::new(seed, stream, i);
                 let d = cone_direction(aim.axis, cos_max, rng.next_f64(), rng.next_f64());
                 st.push(tracer.xyz_sample(aim.origin, d, &mut rng));
@@ -211,6 +230,19 @@ pub enum SpotError {
     NoCamera,
     #[error("the scene has no meter (its acceptance angle)")]
     NoMeter,
+    #[error("the time limit must be > 0 s, got {0}")]
+    BadTimeLimit(f64),
+    #[error("the ΔE*ab target must be > 0, got {0}")]
+    BadTarget(f64),
+    #[error(
+        "the time limit of {seconds} s ran out before {what} had two samples: no reading \
+         and no confidence interval can be given"
+    )]
+    TimeLimit { seconds: f64, what: String },
+    #[error("the reference white is not lit (Y = {0}): the meter sees no light from patch 19")]
+    DarkWhite(f64),
+    #[error("patch {patch}: the reading is not a finite number ({xyz:?})")]
+    NonFinite { patch: usize, xyz: [f64; 3] },
 }
 
 /// The meter aim at patch `k` of `scene`.
@@ -246,21 +278,54 @@ pub struct SpotProgress {
 /// refined to a third of `opts.target_de`. Its error shifts every patch alike and is not in
 /// the patches' half-widths, so it has to be well below theirs.
 pub fn reference_white(scene: &Scene, opts: &SpotOptions) -> Result<[f64; 3], SpotError> {
-    let start = Instant::now();
+    check_options(opts)?;
+    reference_white_until(scene, opts, Deadline::after(opts.max_seconds))
+}
+
+fn check_options(opts: &SpotOptions) -> Result<(), SpotError> {
+    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
+        return Err(SpotError::BadTimeLimit(opts.max_seconds));
+    }
+    if opts.target_de.is_nan() || opts.target_de <= 0.0 {
+        return Err(SpotError::BadTarget(opts.target_de));
+    }
+    Ok(())
+}
+
+fn reference_white_until(
+    scene: &Scene,
+    opts: &SpotOptions,
+    deadline: Deadline,
+) -> Result<[f64; 3], SpotError> {
     let ws = white_scene(scene)?;
     let wt = Tracer::new(&ws, opts.strategy);
     let aim = patch_aim(&ws, 19)?;
     let mut st = XyzStats::default();
     let mut batch = opts.first_batch;
     loop {
-        st.merge(&sample_cone(&wt, aim, opts.seed, 1000, st.n, batch));
-        let w = Xyz::from_array(st.mean());
-        if st.de_ci95(w) < opts.target_de / 3.0 || start.elapsed().as_secs_f64() > opts.max_seconds
-        {
-            return Ok(st.mean());
+        st.merge(&sample_cone_until(
+            &wt, aim, opts.seed, 1000, st.n, batch, deadline,
+        ));
+        if st.n < 2 {
+            return Err(SpotError::TimeLimit {
+                seconds: opts.max_seconds,
+                what: "the reference white".into(),
+            });
+        }
+        let white = st.mean();
+        if !(white[1] > 0.0 && white.iter().all(|x| x.is_finite())) {
+            return Err(SpotError::DarkWhite(white[1]));
+        }
+        if deadline.passed() || st.de_ci95(Xyz::from_array(white)) < opts.target_de / 3.0 {
+            break;
         }
         batch = st.n;
     }
+    let white = st.mean();
+    if !(white[1] > 0.0 && white.iter().all(|x| x.is_finite())) {
+        return Err(SpotError::DarkWhite(white[1]));
+    }
+    Ok(white)
 }
 
 /// The 24 readings, refined until every ΔE*ab 95 % half-width is below the target.
@@ -275,18 +340,20 @@ pub fn render_spots_with_progress(
     progress: &dyn Fn(SpotProgress),
 ) -> Result<SpotResult, SpotError> {
     let start = Instant::now();
+    check_options(opts)?;
+    let deadline = Deadline::after(opts.max_seconds);
     let aims: Vec<Aim> = (1..=24)
         .map(|k| patch_aim(scene, k))
         .collect::<Result<_, _>>()?;
     let tracer = Tracer::new(scene, opts.strategy);
     let white = match opts.white {
         Some(w) => {
-            if w[1].is_nan() || w[1] <= 0.0 {
+            if !(w[1] > 0.0 && w.iter().all(|x| x.is_finite())) {
                 return Err(SpotError::BadWhite(w));
             }
             Xyz::from_array(w)
         }
-        None => Xyz::from_array(reference_white(scene, opts)?),
+        None => Xyz::from_array(reference_white_until(scene, opts, deadline)?),
     };
     let mut stats = vec![XyzStats::default(); 24];
     let mut batch = [opts.first_batch; 24];
@@ -299,7 +366,15 @@ pub fn render_spots_with_progress(
             }
             converged = false;
             let first = stats[k].n;
-            let add = sample_cone(&tracer, aims[k], opts.seed, k as u64 + 1, first, batch[k]);
+            let add = sample_cone_until(
+                &tracer,
+                aims[k],
+                opts.seed,
+                k as u64 + 1,
+                first,
+                batch[k],
+                deadline,
+            );
             stats[k].merge(&add);
             // Next batch sized from the 1/√N law, at most doubling.
             let ci = stats[k].de_ci95(white);
@@ -316,9 +391,15 @@ pub fn render_spots_with_progress(
             worst_de: stats.iter().map(|st| st.de_ci95(white)).fold(0.0, f64::max),
             seconds: start.elapsed().as_secs_f64(),
         });
-        if converged || start.elapsed().as_secs_f64() > opts.max_seconds {
+        if converged || deadline.passed() {
             break;
         }
+    }
+    if let Some(k) = stats.iter().position(|st| st.n < 2) {
+        return Err(SpotError::TimeLimit {
+            seconds: opts.max_seconds,
+            what: format!("patch {}", k + 1),
+        });
     }
     let patches = stats
         .iter()
@@ -335,7 +416,20 @@ pub fn render_spots_with_progress(
                 samples: st.n,
             }
         })
-        .collect();
+        .collect::<Vec<PatchReading>>();
+    if let Some(p) = patches.iter().find(|p| {
+        !p.xyz
+            .iter()
+            .chain(&p.lab)
+            .chain(&p.xyz_stderr)
+            .chain([&p.de_ci95])
+            .all(|x| x.is_finite())
+    }) {
+        return Err(SpotError::NonFinite {
+            patch: p.patch,
+            xyz: p.xyz,
+        });
+    }
     Ok(SpotResult {
         white: white.to_array(),
         seconds: start.elapsed().as_secs_f64(),

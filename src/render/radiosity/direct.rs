@@ -1,11 +1,13 @@
-//! The direct term: irradiance from the emitter tiles at a point, per unit of each
-//! emitter's spectral radiance s·S(λ). A Lambertian tile is a uniform polygon, so the
-//! point-to-polygon factor gives it in closed form (E = π·gain·F); a tile with a
-//! directional factor f(ω) is integrated by Gauss–Legendre over the tile with the number
-//! of nodes chosen from its size over the distance.
+//! The direct term: irradiance from the emitter tiles at a point, per unit of one
+//! component's spectral radiance (the tiles that radiate that spectrum, each with its gain
+//! as weight). A Lambertian tile is a uniform polygon, so the point-to-polygon factor gives
+//! it in closed form (E = π·gain·F); a tile with a directional factor f(ω) — cosᵐ or a
+//! C-γ table, evaluated in the emitter's frame — is integrated by Gauss–Legendre over the
+//! tile with the number of nodes chosen from its size over the distance.
 
 use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::scene::{Distribution, Emitter};
+
 use super::polygon::{gauss_legendre, point_to_rect};
 
 /// The tile (row, col) of an emitter as a rectangle.
@@ -29,13 +31,14 @@ pub fn nodes_for(size: f64, dist: f64) -> usize {
     ((4.0 + 8.0 * ratio).ceil() as usize).min(24)
 }
 
-/// g(x) = E(x)/(s·S(λ)) for one emitter: irradiance at `x` (unit normal `n`) per unit
-/// spectral radiance, in sr (W·m⁻² per W·sr⁻¹·m⁻²).
-pub fn irradiance_factor(e: &Emitter, x: Vec3, n: Vec3) -> f64 {
+/// g(x) = E(x)/S(λ) for the tiles of emitter `e` weighted by `weights` (one per tile, 0 to
+/// leave a tile out): irradiance at `x` (unit normal `n`) per unit spectral radiance, in sr
+/// (W·m⁻² per W·sr⁻¹·m⁻²).
+pub fn irradiance_factor(e: &Emitter, weights: &[f64], x: Vec3, n: Vec3) -> f64 {
     let mut total = 0.0;
     for row in 0..e.rows {
         for col in 0..e.cols {
-            let gain = e.gains[row * e.cols + col];
+            let gain = weights[row * e.cols + col];
             if gain == 0.0 {
                 continue;
             }
@@ -43,15 +46,15 @@ pub fn irradiance_factor(e: &Emitter, x: Vec3, n: Vec3) -> f64 {
             total += gain
                 * match e.distribution {
                     Distribution::Lambertian => std::f64::consts::PI * point_to_rect(x, n, &tile),
-                    d => quadrature(&tile, d, x, n),
+                    _ => quadrature(e, &tile, x, n),
                 };
         }
     }
     total
 }
 
-/// ∫ f(cos θ_s) cos θ_x cos θ_s / r² dA over a tile, by tensor Gauss–Legendre.
-fn quadrature(tile: &Rect, d: Distribution, x: Vec3, n: Vec3) -> f64 {
+/// ∫ f(ω) cos θ_x cos θ_s / r² dA over a tile, by tensor Gauss–Legendre.
+fn quadrature(e: &Emitter, tile: &Rect, x: Vec3, n: Vec3) -> f64 {
     // Behind the emitting side nothing arrives.
     if x.minus(tile.corner).dot(tile.normal) <= 0.0 {
         return 0.0;
@@ -71,7 +74,7 @@ fn quadrature(tile: &Rect, d: Distribution, x: Vec3, n: Vec3) -> f64 {
                 continue;
             }
             let cos_s = -r.dot(tile.normal) / rl;
-            s += wa * wb * d.factor(cos_s) * cos_x * cos_s / r2;
+            s += wa * wb * e.directional(r.times(-1.0 / rl)) * cos_x * cos_s / r2;
         }
     }
     s * tile.area_m2
@@ -80,23 +83,38 @@ fn quadrature(tile: &Rect, d: Distribution, x: Vec3, n: Vec3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::light::CGammaTable;
     use crate::render::spectral::constant_bins;
+    use std::sync::Arc;
 
-    fn emitter(distribution: Distribution) -> Emitter {
+    fn panel(corner: [f64; 3], side: f64, n: usize, distribution: Distribution) -> Emitter {
+        // edge_u along +y, edge_v along +x: the normal y × x = −z.
+        let rect = Rect::new(
+            Vec3::from_array(corner),
+            Vec3::from_array([0.0, side, 0.0]),
+            Vec3::from_array([side, 0.0, 0.0]),
+        );
         Emitter {
-            rect: Rect::new(
-                Vec3::from_array([-0.5, -0.5, 1.0]),
-                Vec3::from_array([0.0, 1.0, 0.0]),
-                Vec3::from_array([1.0, 0.0, 0.0]),
-            ),
-            rows: 3,
-            cols: 3,
-            gains: vec![1.0; 9],
-            radiance: constant_bins(1.0),
+            axis_u: rect.edge_u.normalized(),
+            axis_v: rect.edge_v.normalized(),
+            rect,
+            rows: n,
+            cols: n,
+            gains: vec![1.0; n * n],
+            tile_spectrum: vec![0; n * n],
+            spectra: vec![constant_bins(1.0)],
             scale: 1.0,
             distribution,
             reflectance: constant_bins(0.0),
         }
+    }
+
+    fn emitter(distribution: Distribution) -> Emitter {
+        panel([-0.5, -0.5, 1.0], 1.0, 3, distribution)
+    }
+
+    fn g(e: &Emitter, x: Vec3, n: Vec3) -> f64 {
+        irradiance_factor(e, &e.gains, x, n)
     }
 
     /// cos⁰ is Lambertian: the quadrature must reproduce the closed form.
@@ -104,6 +122,9 @@ mod tests {
     fn quadrature_matches_the_closed_form() {
         let lam = emitter(Distribution::Lambertian);
         let cos0 = emitter(Distribution::CosPower(0.0));
+        let flat = emitter(Distribution::Table(Arc::new(
+            CGammaTable::symmetric(vec![0.0, 90.0], vec![1.0, 1.0]).unwrap(),
+        )));
         for (x, n) in [
             (
                 Vec3::from_array([0.0, 0.0, 0.0]),
@@ -118,9 +139,11 @@ mod tests {
                 Vec3::from_array([-0.6, 0.0, 0.8]),
             ),
         ] {
-            let a = irradiance_factor(&lam, x, n);
-            let b = irradiance_factor(&cos0, x, n);
-            assert!((a - b).abs() < 1e-6 * a, "{x:?}: {a} vs {b}");
+            let a = g(&lam, x, n);
+            for other in [&cos0, &flat] {
+                let b = g(other, x, n);
+                assert!((a - b).abs() < 1e-6 * a, "{x:?}: {a} vs {b}");
+            }
         }
     }
 
@@ -130,12 +153,73 @@ mod tests {
     fn far_field_is_inverse_square() {
         let e = emitter(Distribution::CosPower(3.0));
         let d = 200.0;
-        let g = irradiance_factor(
+        let g = g(
             &e,
             Vec3::from_array([0.0, 0.0, 1.0 - d]),
             Vec3::from_array([0.0, 0.0, 1.0]),
         );
         let want = 1.0 / (d * d);
         assert!((g - want).abs() < 1e-4 * want, "{g} vs {want}");
+    }
+
+    /// f = 1 − a·γ/90 in the four half-planes C = 0, 90, 180, 270 with a = 0.2, 0.4, 0.6,
+    /// 0.8: asymmetric left/right and front/back.
+    fn table() -> Arc<CGammaTable> {
+        let rows = [0.2, 0.4, 0.6, 0.8]
+            .iter()
+            .map(|a| vec![1.0, 1.0 - a / 2.0, 1.0 - a])
+            .collect();
+        Arc::new(
+            CGammaTable::new(vec![0.0, 90.0, 180.0, 270.0], vec![0.0, 45.0, 90.0], rows).unwrap(),
+        )
+    }
+
+    /// A 10 µm tile seen from r = 0.5 m at (C, γ), the receiver facing it (the tile spans
+    /// 0.001° there, so the table's kinks across C-planes stay below 1e-6 relative):
+    /// E = L₀·A·f(C, γ)·cos γ / r² (cos θ_x = 1), per unit L₀. By hand for the table above:
+    /// C = 0, γ = 45°: f = 0.9; C = 180°: f = 0.7; C = 90°, γ = 22.5°: f = 1 − 0.4/4 = 0.9;
+    /// C = 45°, γ = 45°: halfway between planes 0 and 90, f = 1 − 0.3/2 = 0.85.
+    #[test]
+    fn a_small_c_gamma_emitter_follows_its_table() {
+        let side = 1e-5;
+        let e = panel(
+            [-side / 2.0, -side / 2.0, 1.0],
+            side,
+            1,
+            Distribution::Table(table()),
+        );
+        let centre = e.rect.centre();
+        let (u, v, n) = (e.axis_u, e.axis_v, e.rect.normal);
+        let r = 0.5;
+        let area = side * side;
+        for (c, gamma, f) in [
+            (0.0f64, 45.0f64, 0.9),
+            (180.0, 45.0, 0.7),
+            (90.0, 22.5, 0.9),
+            (45.0, 45.0, 0.85),
+            (0.0, 0.0, 1.0),
+        ] {
+            let (c, gm) = (c.to_radians(), gamma.to_radians());
+            let dir = u
+                .times(gm.sin() * c.cos())
+                .plus(v.times(gm.sin() * c.sin()))
+                .plus(n.times(gm.cos()));
+            let x = centre.plus(dir.times(r));
+            let got = g(&e, x, dir.times(-1.0));
+            let want = area * f * gm.cos() / (r * r);
+            assert!(
+                (got - want).abs() < 1e-5 * want,
+                "C {c} γ {gamma}: {got} vs {want}"
+            );
+        }
+        // Left and right of the axis at the same distance: the ratio is f(0, 45)/f(180, 45).
+        let at = |c: f64| {
+            let dir = u
+                .times(c.to_radians().cos() * 0.5f64.sqrt())
+                .plus(n.times(0.5f64.sqrt()));
+            g(&e, centre.plus(dir.times(r)), n.times(-1.0))
+        };
+        let ratio = at(0.0) / at(180.0);
+        assert!((ratio - 0.9 / 0.7).abs() < 1e-5, "{ratio}");
     }
 }

@@ -12,6 +12,7 @@ use super::super::geometry::{Vec3, VecOps};
 use super::super::spectral::N_BINS;
 use super::super::spot::{cone_direction, Aim};
 use super::direct::irradiance_factor;
+use super::lights::Lights;
 use super::mesh::{Face, FaceKind, Mesh};
 use super::polygon::{gauss_legendre, point_to_rect};
 use super::solve::Bands;
@@ -46,14 +47,14 @@ pub fn cone_nodes(aim: &Aim, rule: ConeRule) -> Vec<(Vec3, f64)> {
 #[derive(Clone, Debug)]
 pub struct FaceShare {
     pub face: usize,
-    /// Σ w·g_e(x)/π per emitter.
+    /// Σ w·g_c(x)/π per light component.
     pub direct: Vec<f64>,
     /// Σ w·F(x → element j) for every element.
     pub indirect: Vec<f64>,
 }
 
 /// The cone's footprint: per face hit, the weighted direct and indirect factors, and the
-/// radiance of any emitter seen directly (per unit s·S(λ), per emitter).
+/// radiance of any emitter seen directly (per unit of each component's spectrum).
 #[derive(Clone, Debug)]
 pub struct Footprint {
     pub shares: Vec<FaceShare>,
@@ -79,13 +80,14 @@ fn hit(faces: &[Face], o: Vec3, d: Vec3) -> Option<(usize, Vec3, f64, f64)> {
 /// `indirect_rule` (the indirect field varies slowly over a 1° spot and is the costly part).
 pub fn footprint(
     scene: &Scene,
+    lights: &Lights,
     faces: &[Face],
     mesh: &Mesh,
     aim: &Aim,
     direct_rule: ConeRule,
     indirect_rule: ConeRule,
 ) -> Footprint {
-    let ne = scene.emitters.len();
+    let ne = lights.len();
     let mut shares: Vec<FaceShare> = Vec::new();
     let mut emission = vec![0.0; ne];
     let share = |face: usize, shares: &mut Vec<FaceShare>| -> usize {
@@ -108,12 +110,15 @@ pub fn footprint(
         let n = faces[fi].rect.normal;
         if let FaceKind::Emitter(e) = faces[fi].kind {
             let em = &scene.emitters[e];
-            let cos = -d.dot(n);
-            emission[e] += w * em.gains[em.tile_at(a, b)] * em.distribution.factor(cos);
+            let tile = em.tile_at(a, b);
+            emission[lights.of_tile(scene, e, tile)] +=
+                w * em.gains[tile] * em.directional(d.times(-1.0));
         }
         let k = share(fi, &mut shares);
-        for (e, em) in scene.emitters.iter().enumerate() {
-            shares[k].direct[e] += w * irradiance_factor(em, x, n) / std::f64::consts::PI;
+        for (c, comp) in lights.comps.iter().enumerate() {
+            let em = &scene.emitters[comp.emitter];
+            shares[k].direct[c] +=
+                w * irradiance_factor(em, &comp.weights, x, n) / std::f64::consts::PI;
         }
     }
     for (d, w) in cone_nodes(aim, indirect_rule) {
@@ -131,10 +136,11 @@ pub fn footprint(
     Footprint { shares, emission }
 }
 
-/// Absolute XYZ (cd/m²) of a footprint given the solution `l[e]` (N × bands per emitter)
+/// Absolute XYZ (cd/m²) of a footprint given the solution `l[c]` (N × bands per component)
 /// and each face's reflectance at 1 nm.
 pub fn reading(
     scene: &Scene,
+    lights: &Lights,
     fp: &Footprint,
     face_refl: &[&[f64]],
     bands: &Bands,
@@ -142,8 +148,8 @@ pub fn reading(
 ) -> [f64; 3] {
     let nb = bands.len();
     let mut radiance = vec![0.0; N_BINS];
-    for (e, em) in scene.emitters.iter().enumerate() {
-        for (r, s) in radiance.iter_mut().zip(&em.radiance) {
+    for (e, comp) in lights.comps.iter().enumerate() {
+        for (r, s) in radiance.iter_mut().zip(comp.spectrum) {
             *r += fp.emission[e] * s;
         }
         for sh in &fp.shares {
@@ -158,7 +164,7 @@ pub fn reading(
             let q = bands.interpolate(&q);
             let rho = face_refl[sh.face];
             for i in 0..N_BINS {
-                radiance[i] += rho[i] * em.radiance[i] * (sh.direct[e] + q[i]);
+                radiance[i] += rho[i] * comp.spectrum[i] * (sh.direct[e] + q[i]);
             }
         }
     }

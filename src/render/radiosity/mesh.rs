@@ -10,6 +10,7 @@
 
 use rayon::prelude::*;
 
+use super::super::deadline::Deadline;
 use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::scene::Scene;
 
@@ -180,16 +181,20 @@ fn splits(len: f64, cuts: &mut Vec<f64>, base: f64, level: usize) -> Vec<f64> {
     out
 }
 
-/// The elements of level `level` (1, 2, 3, …) on base size `base` (m). Faces that reflect
-/// nothing carry no radiosity and are left out (they still absorb: no light reaches them
-/// in the system, and none leaves them).
+/// Most elements of a mesh: the form factors are N² numbers (5,000 → 200 MB).
+pub const MAX_ELEMENTS: usize = 5_000;
+
+/// The elements of level `level` (1, 2, 3, …) on base size `base` (m), or None when there
+/// would be more than `max`. Faces that reflect nothing carry no radiosity and are left out
+/// (they still absorb: no light reaches them in the system, and none leaves them).
 pub fn elements(
     scene: &Scene,
     faces: &[Face],
     decals: &[Vec<usize>],
     base: f64,
     level: usize,
-) -> Vec<Element> {
+    max: usize,
+) -> Option<Vec<Element>> {
     let mut out = Vec::new();
     for (fi, f) in faces.iter().enumerate() {
         if f.reflectance.iter().all(|r| *r == 0.0) {
@@ -222,6 +227,9 @@ pub fn elements(
         }
         let sa = splits(f.rect.edge_u.length(), &mut ca, base, level);
         let sb = splits(f.rect.edge_v.length(), &mut cb, base, level);
+        if (sa.len() - 1).saturating_mul(sb.len() - 1) > max.saturating_mul(4) {
+            return None;
+        }
         for wb in sb.windows(2) {
             for wa in sa.windows(2) {
                 let (am, bm) = ((wa[0] + wa[1]) / 2.0, (wb[0] + wb[1]) / 2.0);
@@ -233,6 +241,9 @@ pub fn elements(
                 }
                 let eu = f.rect.edge_u.times(wa[1] - wa[0]);
                 let ev = f.rect.edge_v.times(wb[1] - wb[0]);
+                if out.len() == max {
+                    return None;
+                }
                 out.push(Element {
                     face: fi,
                     rect: Rect::new(f.rect.point(wa[0], wb[0]), eu, ev),
@@ -241,7 +252,7 @@ pub fn elements(
             }
         }
     }
-    out
+    Some(out)
 }
 
 /// Gauss–Legendre nodes per side for averaging a factor over a receiving element of size
@@ -267,15 +278,18 @@ pub fn average_over(r: &Rect, n: usize, mut f: impl FnMut(Vec3) -> f64) -> f64 {
 }
 
 impl Mesh {
-    /// The mesh and its form factors. Each pair is integrated once, over the smaller of
-    /// the two elements, and the other direction follows by reciprocity (A_i F_ik =
-    /// A_k F_ki); rows of pairs are computed in parallel.
-    pub fn build(elements: Vec<Element>) -> Mesh {
+    /// The mesh and its form factors, or None if the deadline passed first. Each pair is
+    /// integrated once, over the smaller of the two elements, and the other direction
+    /// follows by reciprocity (A_i F_ik = A_k F_ki); rows of pairs are computed in parallel.
+    pub fn build(elements: Vec<Element>, deadline: Deadline) -> Option<Mesh> {
         let n = elements.len();
         let area: Vec<f64> = elements.iter().map(|e| e.rect.area_m2).collect();
         let upper: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
             .map(|i| {
+                if deadline.passed() {
+                    return Vec::new();
+                }
                 let ei = &elements[i];
                 ((i + 1)..n)
                     .map(|k| {
@@ -300,6 +314,9 @@ impl Mesh {
                     .collect()
             })
             .collect();
+        if deadline.passed() {
+            return None;
+        }
         let mut form = vec![0.0; n * n];
         for (i, row) in upper.iter().enumerate() {
             for (off, &f) in row.iter().enumerate() {
@@ -308,6 +325,6 @@ impl Mesh {
                 form[k * n + i] = f * area[i] / area[k];
             }
         }
-        Mesh { elements, form }
+        Some(Mesh { elements, form })
     }
 }

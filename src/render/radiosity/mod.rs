@@ -13,6 +13,7 @@
 pub mod bound;
 pub mod direct;
 pub mod gather;
+pub mod lights;
 pub mod mesh;
 pub mod polygon;
 pub mod probes;
@@ -22,9 +23,11 @@ use std::time::Instant;
 
 use self::bound::extrapolate;
 use self::gather::{footprint, reading, ConeRule};
+use self::lights::Lights;
 pub use self::mesh::NotConvex;
-use self::mesh::{check_convex, elements, faces, Face, FaceKind, Mesh};
-use self::solve::{sources, Bands};
+use self::mesh::{check_convex, elements, faces, Face, FaceKind, Mesh, MAX_ELEMENTS};
+use self::solve::{sources, Bands, SolveFailure};
+use super::deadline::Deadline;
 use super::scene::Scene;
 use super::spot::{patch_aim, SpotError};
 use crate::color::{Lab, Xyz};
@@ -42,11 +45,29 @@ pub enum RadiosityError {
         need: &'static str,
         got: f64,
     },
+    #[error(
+        "the scene is too detailed for the radiosity solver: {what} (at most {max} elements); \
+         the path tracer has no such limit"
+    )]
+    TooDetailed { what: String, max: usize },
+    #[error("no result within the time limit of {seconds} s (the solver needs three mesh levels)")]
+    TimeLimit { seconds: f64 },
+    #[error(
+        "the light in the scene grows without bound after {sweeps} Gauss–Seidel sweeps: its \
+         reflectances return more light than reaches them (a closed box needs an absorbing \
+         surface when reflectances exceed 1)"
+    )]
+    Diverges { sweeps: usize },
+    #[error("the reference white is not lit (Y = {0}): the meter sees no light from patch 19")]
+    DarkWhite(f64),
+    #[error("patch {patch}: the reading is not a finite number ({xyz:?})")]
+    NonFinite { patch: usize, xyz: [f64; 3] },
 }
 
-/// Does the solver apply: Lambertian rectangles in a convex enclosure.
-pub fn qualifies(scene: &Scene) -> Result<(), NotConvex> {
-    check_convex(&faces(scene)).map(|_| ())
+/// Does the solver apply: Lambertian rectangles in a convex enclosure, meshed finely enough
+/// for three levels within [`MAX_ELEMENTS`].
+pub fn qualifies(scene: &Scene) -> Result<(), RadiosityError> {
+    Prepared::for_probes(scene).map(|_| ())
 }
 
 /// Options of a radiosity run.
@@ -133,6 +154,7 @@ pub struct RadiosityResult {
 /// The scene prepared once for all levels.
 pub struct Prepared<'a> {
     pub scene: &'a Scene,
+    pub lights: Lights<'a>,
     pub faces: Vec<Face<'a>>,
     pub decals: Vec<Vec<usize>>,
     /// The face of patch 19, white in the reference scene (None for probes only).
@@ -154,13 +176,29 @@ impl<'a> Prepared<'a> {
     /// For illuminance probes: any convex scene.
     pub fn for_probes(scene: &'a Scene) -> Result<Prepared<'a>, RadiosityError> {
         let faces = faces(scene);
+        // The convexity check compares every pair of faces: bound it first.
+        if faces.len() > MAX_ELEMENTS {
+            return Err(RadiosityError::TooDetailed {
+                what: format!("{} faces", faces.len()),
+                max: MAX_ELEMENTS,
+            });
+        }
         let decals = check_convex(&faces)?;
-        Ok(Prepared {
+        let p = Prepared {
             scene,
+            lights: Lights::new(scene),
             faces,
             decals,
             white_face: None,
-        })
+        };
+        let base = p.base(&RadiosityOptions::default());
+        if elements(scene, &p.faces, &p.decals, base, 3, MAX_ELEMENTS).is_none() {
+            return Err(RadiosityError::TooDetailed {
+                what: "the third mesh level (tiles and decals cut every face)".into(),
+                max: MAX_ELEMENTS,
+            });
+        }
+        Ok(p)
     }
 
     /// The element size of level 1.
@@ -190,13 +228,31 @@ pub fn solve_level(
     opts: &RadiosityOptions,
     level: usize,
     warm: Option<&Solved>,
-) -> Solved {
+    deadline: Deadline,
+) -> Result<Solved, RadiosityError> {
+    let time = || RadiosityError::TimeLimit {
+        seconds: opts.max_seconds,
+    };
     let mesh = match warm {
         Some(w) => Mesh {
             elements: w.mesh.elements.clone(),
             form: w.mesh.form.clone(),
         },
-        None => Mesh::build(elements(p.scene, &p.faces, &p.decals, p.base(opts), level)),
+        None => {
+            let els = elements(
+                p.scene,
+                &p.faces,
+                &p.decals,
+                p.base(opts),
+                level,
+                MAX_ELEMENTS,
+            )
+            .ok_or_else(|| RadiosityError::TooDetailed {
+                what: format!("mesh level {level}"),
+                max: MAX_ELEMENTS,
+            })?;
+            Mesh::build(els, deadline).ok_or_else(time)?
+        }
     };
     let bands = Bands::new(opts.band_nm);
     let nb = bands.len();
@@ -205,23 +261,28 @@ pub fn solve_level(
         .iter()
         .flat_map(|el| bands.bins.iter().map(move |&b| refl[el.face][b]))
         .collect();
-    let src = sources(p.scene, &mesh);
+    let src = sources(p.scene, &p.lights, &mesh, deadline).ok_or_else(time)?;
     let mut sweeps = 0;
     let l = src
         .iter()
         .enumerate()
-        .map(|(e, s)| {
-            let (l, sw) = solve::solve(&mesh, &rho, s, nb, warm.map(|w| w.l[e].as_slice()));
+        .map(|(c, s)| {
+            let warm_c = warm.map(|w| w.l[c].as_slice());
+            let (l, sw) =
+                solve::solve(&mesh, &rho, s, nb, warm_c, deadline).map_err(|f| match f {
+                    SolveFailure::Time => time(),
+                    SolveFailure::Diverges { sweeps } => RadiosityError::Diverges { sweeps },
+                })?;
             sweeps = sweeps.max(sw);
-            l
+            Ok(l)
         })
-        .collect();
-    Solved {
+        .collect::<Result<_, RadiosityError>>()?;
+    Ok(Solved {
         mesh,
         bands,
         l,
         sweeps,
-    }
+    })
 }
 
 /// The 24 readings and the white of one level.
@@ -229,23 +290,37 @@ pub fn run_level(
     p: &Prepared,
     opts: &RadiosityOptions,
     level: usize,
+    deadline: Deadline,
 ) -> Result<Level, RadiosityError> {
     let start = Instant::now();
     let scene = p.scene;
     let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
-    let solved = solve_level(p, &refl, opts, level, None);
+    let solved = solve_level(p, &refl, opts, level, None, deadline)?;
     let mut patches = Vec::with_capacity(24);
     for k in 1..=24 {
+        if deadline.passed() {
+            return Err(RadiosityError::TimeLimit {
+                seconds: opts.max_seconds,
+            });
+        }
         let aim = patch_aim(scene, k)?;
         let fp = footprint(
             scene,
+            &p.lights,
             &p.faces,
             &solved.mesh,
             &aim,
             opts.direct_rule,
             opts.indirect_rule,
         );
-        patches.push(reading(scene, &fp, &refl, &solved.bands, &solved.l));
+        patches.push(reading(
+            scene,
+            &p.lights,
+            &fp,
+            &refl,
+            &solved.bands,
+            &solved.l,
+        ));
     }
     let white = match (opts.white, p.white_face) {
         (Some(w), _) => w,
@@ -254,17 +329,18 @@ pub fn run_level(
             let ones = vec![1.0; refl[wf].len()];
             let mut wrefl = refl.clone();
             wrefl[wf] = &ones;
-            let ws = solve_level(p, &wrefl, opts, level, Some(&solved));
+            let ws = solve_level(p, &wrefl, opts, level, Some(&solved), deadline)?;
             let aim = patch_aim(scene, 19)?;
             let fp = footprint(
                 scene,
+                &p.lights,
                 &p.faces,
                 &ws.mesh,
                 &aim,
                 opts.direct_rule,
                 opts.indirect_rule,
             );
-            reading(scene, &fp, &wrefl, &ws.bands, &ws.l)
+            reading(scene, &p.lights, &fp, &wrefl, &ws.bands, &ws.l)
         }
     };
     Ok(Level {
@@ -285,6 +361,14 @@ pub fn render_spots_radiosity(
     progress: &dyn Fn(&Level),
 ) -> Result<RadiosityResult, RadiosityError> {
     let start = Instant::now();
+    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
+        return Err(RadiosityError::BadOption {
+            what: "the time limit",
+            need: "> 0 s",
+            got: opts.max_seconds,
+        });
+    }
+    let deadline = Deadline::after(opts.max_seconds);
     if opts.target_de.is_nan() || opts.target_de <= 0.0 {
         return Err(RadiosityError::BadOption {
             what: "the ΔE*ab target",
@@ -302,23 +386,53 @@ pub fn render_spots_radiosity(
         }
     }
     if let Some(w) = opts.white {
-        if w[1].is_nan() || w[1] <= 0.0 {
+        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
             return Err(SpotError::BadWhite(w).into());
         }
     }
     let p = Prepared::new(scene)?;
     let mut levels: Vec<Level> = Vec::new();
+    let mut best: Option<(Vec<RadiosityReading>, [f64; 3])> = None;
     loop {
         let level = levels.len() + 1;
-        let l = run_level(&p, opts, level)?;
+        // A finer level that does not fit in time or memory ends the refinement with the
+        // last result; the first three are needed for any result at all.
+        let l = match run_level(&p, opts, level, deadline) {
+            Ok(l) => l,
+            Err(RadiosityError::TimeLimit { .. } | RadiosityError::TooDetailed { .. })
+                if best.is_some() =>
+            {
+                let (patches, white) = best.unwrap_or_default();
+                return Ok(RadiosityResult {
+                    white,
+                    seconds: start.elapsed().as_secs_f64(),
+                    levels,
+                    patches,
+                    converged: false,
+                });
+            }
+            Err(e) => return Err(e),
+        };
+        if !(l.white.iter().all(|x| x.is_finite()) && l.white[1] > 0.0) {
+            return Err(RadiosityError::DarkWhite(l.white[1]));
+        }
         progress(&l);
         levels.push(l);
         if levels.len() < 3 {
             continue;
         }
         let (patches, white) = combine(&levels[levels.len() - 3..], opts);
+        if let Some(r) = patches
+            .iter()
+            .find(|r| !r.xyz.iter().chain(&r.lab).all(|x| x.is_finite()) || r.de_bound.is_nan())
+        {
+            return Err(RadiosityError::NonFinite {
+                patch: r.patch,
+                xyz: r.xyz,
+            });
+        }
         let converged = patches.iter().all(|r| r.de_bound < opts.target_de);
-        let out_of_time = start.elapsed().as_secs_f64() > opts.max_seconds;
+        let out_of_time = deadline.passed();
         if converged || out_of_time || level >= opts.max_level.max(3) {
             return Ok(RadiosityResult {
                 white,
@@ -328,6 +442,7 @@ pub fn render_spots_radiosity(
                 converged,
             });
         }
+        best = Some((patches, white));
     }
 }
 

@@ -5,9 +5,11 @@
 use super::super::geometry::Vec3;
 use super::bound::richardson;
 use super::direct::irradiance_factor;
+use super::lights::Lights;
 use super::polygon::point_to_rect;
 use super::{solve_level, Prepared, RadiosityError, RadiosityOptions, Solved};
 use crate::color::K_M;
+use crate::render::deadline::Deadline;
 use crate::render::scene::Scene;
 
 /// A probe: a point and the unit normal of the surface it measures on.
@@ -28,11 +30,10 @@ pub struct Illuminance {
     pub bound_lux: f64,
 }
 
-/// K_m Σ_λ s·S(λ)·ȳ(λ)·w(λ) for one emitter: lux from a per-wavelength factor.
-fn photometric(scene: &Scene, e: usize, w: impl Fn(usize) -> f64) -> f64 {
-    let em = &scene.emitters[e];
-    K_M * em
-        .radiance
+/// K_m Σ_λ S(λ)·ȳ(λ)·w(λ) for one light component: lux from a per-wavelength factor.
+fn photometric(scene: &Scene, lights: &Lights, c: usize, w: impl Fn(usize) -> f64) -> f64 {
+    K_M * lights.comps[c]
+        .spectrum
         .iter()
         .zip(&scene.cmf[1])
         .enumerate()
@@ -41,17 +42,18 @@ fn photometric(scene: &Scene, e: usize, w: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// Direct illuminance at `x` facing `n` (lux), exact.
-pub fn direct_lux(scene: &Scene, x: Vec3, n: Vec3) -> f64 {
-    (0..scene.emitters.len())
-        .map(|e| {
-            let g = irradiance_factor(&scene.emitters[e], x, n);
-            photometric(scene, e, |_| g)
+pub fn direct_lux(scene: &Scene, lights: &Lights, x: Vec3, n: Vec3) -> f64 {
+    (0..lights.len())
+        .map(|c| {
+            let comp = &lights.comps[c];
+            let g = irradiance_factor(&scene.emitters[comp.emitter], &comp.weights, x, n);
+            photometric(scene, lights, c, |_| g)
         })
         .sum()
 }
 
 /// Indirect illuminance at `x` facing `n` (lux) from a solved level.
-pub fn indirect_lux(scene: &Scene, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
+pub fn indirect_lux(scene: &Scene, lights: &Lights, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
     let nb = solved.bands.len();
     let f: Vec<f64> = solved
         .mesh
@@ -59,7 +61,7 @@ pub fn indirect_lux(scene: &Scene, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
         .iter()
         .map(|el| point_to_rect(x, n, &el.rect))
         .collect();
-    (0..scene.emitters.len())
+    (0..lights.len())
         .map(|e| {
             let mut q = vec![0.0; nb];
             for (j, fj) in f.iter().enumerate() {
@@ -70,7 +72,7 @@ pub fn indirect_lux(scene: &Scene, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
                 }
             }
             let q = solved.bands.interpolate(&q);
-            photometric(scene, e, |i| std::f64::consts::PI * q[i])
+            photometric(scene, lights, e, |i| std::f64::consts::PI * q[i])
         })
         .sum()
 }
@@ -80,7 +82,9 @@ pub fn indirect_lux(scene: &Scene, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
 pub fn element_lux(scene: &Scene, solved: &Solved) -> Vec<(f64, f64, f64)> {
     let n = solved.mesh.elements.len();
     let nb = solved.bands.len();
-    let src = super::solve::sources(scene, &solved.mesh);
+    let lights = Lights::new(scene);
+    let src =
+        super::solve::sources(scene, &lights, &solved.mesh, Deadline::never()).unwrap_or_default();
     (0..n)
         .map(|i| {
             let mut direct = 0.0;
@@ -96,8 +100,8 @@ pub fn element_lux(scene: &Scene, solved: &Solved) -> Vec<(f64, f64, f64)> {
                     }
                 }
                 let q = solved.bands.interpolate(&q);
-                direct += photometric(scene, e, |_| std::f64::consts::PI * src_e[i]);
-                indirect += photometric(scene, e, |k| std::f64::consts::PI * q[k]);
+                direct += photometric(scene, &lights, e, |_| std::f64::consts::PI * src_e[i]);
+                indirect += photometric(scene, &lights, e, |k| std::f64::consts::PI * q[k]);
             }
             (solved.mesh.elements[i].rect.area_m2, direct, indirect)
         })
@@ -113,20 +117,21 @@ pub fn probe_illuminance(
     rel_tolerance: f64,
 ) -> Result<Vec<Illuminance>, RadiosityError> {
     let p = Prepared::for_probes(scene)?;
+    let deadline = Deadline::after(opts.max_seconds);
     let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
     let direct: Vec<f64> = probes
         .iter()
-        .map(|q| direct_lux(scene, q.position, q.normal))
+        .map(|q| direct_lux(scene, &p.lights, q.position, q.normal))
         .collect();
     let mut levels: Vec<Vec<f64>> = Vec::new();
     let base = p.base(opts);
     loop {
         let level = levels.len() + 1;
-        let solved = solve_level(&p, &refl, opts, level, None);
+        let solved = solve_level(&p, &refl, opts, level, None, deadline)?;
         levels.push(
             probes
                 .iter()
-                .map(|q| indirect_lux(scene, &solved, q.position, q.normal))
+                .map(|q| indirect_lux(scene, &p.lights, &solved, q.position, q.normal))
                 .collect(),
         );
         if levels.len() < 3 {

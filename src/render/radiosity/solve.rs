@@ -1,10 +1,15 @@
 //! The radiosity system per wavelength band, solved by Gauss–Seidel.
 //!
-//! Light leaves the emitters with radiance s·S(λ)·(tile gain)·f(ω), and every other bounce
-//! is Lambertian, so the outgoing radiance of element i is L_i(λ) = s·S(λ)·ℓ_i(λ) with
-//! ℓ = ρ(λ) ∘ (g/π + F ℓ), g the element's direct irradiance per unit source radiance.
-//! ℓ depends on λ only through the smooth reflectances, so it is solved on a coarse band
-//! grid and interpolated linearly; the spectra themselves stay at 1 nm.
+//! Light leaves a component's tiles with radiance S(λ)·(tile gain)·f(ω), and every other
+//! bounce is Lambertian, so the outgoing radiance of element i due to that component is
+//! L_i(λ) = S(λ)·ℓ_i(λ) with ℓ = ρ(λ) ∘ (g/π + F ℓ), g the element's direct irradiance
+//! per unit source radiance. ℓ depends on λ only through the smooth reflectances, so it is
+//! solved on a coarse band grid and interpolated linearly; the spectra stay at 1 nm.
+//!
+//! Gauss–Seidel converges when the largest reflectance times the fraction of light that
+//! stays in the scene is below 1; a closed box with reflectances a little above 1 (measured
+//! noise) and an absorbing emitter still qualifies but needs more sweeps, so the sweep
+//! limit is generous and a solution that grows instead of settling is reported.
 
 use rayon::prelude::*;
 
@@ -12,7 +17,9 @@ use super::super::geometry::VecOps;
 
 use super::super::spectral::N_BINS;
 use super::direct::irradiance_factor;
+use super::lights::Lights;
 use super::mesh::{average_over, Mesh};
+use crate::render::deadline::Deadline;
 use crate::render::scene::Scene;
 
 /// The wavelength nodes the system is solved at: every `step` bins from the first.
@@ -54,23 +61,39 @@ impl Bands {
     }
 }
 
-/// g/π per element for each emitter, averaged over the element (more nodes near the light).
-pub fn sources(scene: &Scene, mesh: &Mesh) -> Vec<Vec<f64>> {
-    scene
-        .emitters
+/// g/π per element for each light component, averaged over the element (more nodes near
+/// the light); None if the deadline passed.
+pub fn sources(
+    scene: &Scene,
+    lights: &Lights,
+    mesh: &Mesh,
+    deadline: Deadline,
+) -> Option<Vec<Vec<f64>>> {
+    lights
+        .comps
         .iter()
-        .map(|e| {
+        .map(|c| {
+            let e = &scene.emitters[c.emitter];
+            if deadline.passed() {
+                return None;
+            }
             let ec = e.rect.centre();
             let esize = e.rect.edge_u.length().max(e.rect.edge_v.length());
             mesh.elements
                 .par_iter()
                 .map(|el| {
+                    if deadline.passed() {
+                        return None;
+                    }
                     let dist = el.rect.centre().minus(ec).length();
                     let nodes = ((1.0 + 4.0 * el.size / (dist - esize / 2.0).max(el.size)).ceil()
                         as usize)
                         .clamp(1, 8);
-                    average_over(&el.rect, nodes, |x| irradiance_factor(e, x, el.rect.normal))
-                        / std::f64::consts::PI
+                    Some(
+                        average_over(&el.rect, nodes, |x| {
+                            irradiance_factor(e, &c.weights, x, el.rect.normal)
+                        }) / std::f64::consts::PI,
+                    )
                 })
                 .collect()
         })
@@ -79,6 +102,19 @@ pub fn sources(scene: &Scene, mesh: &Mesh) -> Vec<Vec<f64>> {
 
 /// Relative change below which Gauss–Seidel stops.
 pub const TOLERANCE: f64 = 1e-10;
+
+/// Most Gauss–Seidel sweeps: a scene that loses 1 % of its light per bounce needs about
+/// 2,300 to reach [`TOLERANCE`]; beyond this the reflectances are not physical.
+pub const MAX_SWEEPS: usize = 20_000;
+
+/// Why Gauss–Seidel gave no solution.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SolveFailure {
+    /// The deadline passed.
+    Time,
+    /// The light grows or does not settle: the reflectances return more than they receive.
+    Diverges { sweeps: usize },
+}
 
 /// ℓ (N × bands, row-major) for one emitter's source `src`; `refl` is N × bands. `warm`
 /// starts the iteration from a neighbouring solution (the white scene from the scene's).
@@ -89,7 +125,8 @@ pub fn solve(
     src: &[f64],
     bands: usize,
     warm: Option<&[f64]>,
-) -> (Vec<f64>, usize) {
+    deadline: Deadline,
+) -> Result<(Vec<f64>, usize), SolveFailure> {
     let n = mesh.elements.len();
     // Bands are independent: split them over the cores, each chunk its own Gauss–Seidel.
     let chunk = bands.div_ceil(rayon::current_num_threads().max(1)).max(1);
@@ -97,7 +134,7 @@ pub fn solve(
         .step_by(chunk)
         .map(|b| (b, (b + chunk).min(bands)))
         .collect();
-    let parts: Vec<(Vec<f64>, usize)> = ranges
+    let parts: Vec<Result<(Vec<f64>, usize), SolveFailure>> = ranges
         .par_iter()
         .map(|&(b0, b1)| {
             let k = b1 - b0;
@@ -113,6 +150,9 @@ pub fn solve(
             let mut sweeps = 0;
             loop {
                 sweeps += 1;
+                if deadline.passed() {
+                    return Err(SolveFailure::Time);
+                }
                 let mut change: f64 = 0.0;
                 let mut size: f64 = 0.0;
                 for i in 0..n {
@@ -134,21 +174,25 @@ pub fn solve(
                         *v = new;
                     }
                 }
-                if change <= TOLERANCE * size || sweeps >= 1000 {
+                if change <= TOLERANCE * size {
                     break;
                 }
+                if sweeps >= MAX_SWEEPS || !size.is_finite() || size > 1e30 {
+                    return Err(SolveFailure::Diverges { sweeps });
+                }
             }
-            (l, sweeps)
+            Ok((l, sweeps))
         })
         .collect();
     let mut out = vec![0.0; n * bands];
     let mut sweeps = 0;
-    for ((b0, b1), (l, s)) in ranges.iter().zip(parts) {
+    for ((b0, b1), part) in ranges.iter().zip(parts) {
+        let (l, s) = part?;
         let k = b1 - b0;
         sweeps = sweeps.max(s);
         for i in 0..n {
             out[i * bands + b0..i * bands + b1].copy_from_slice(&l[i * k..(i + 1) * k]);
         }
     }
-    (out, sweeps)
+    Ok((out, sweeps))
 }
