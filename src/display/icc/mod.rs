@@ -46,7 +46,7 @@ const COPYRIGHT: &str = "No copyright: measured data, use freely";
 /// The ICC version to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IccVersion {
-    /// ICC.1:2010 (version 4), text as `multiLocalizedUnicodeType`.
+    /// ICC.1:2010 (version 4.3), text as `multiLocalizedUnicodeType`.
     V4,
     /// ICC.1:2001-04 (version 2.4), for software that reads only version 2; text as
     /// `textDescriptionType` / `textType`.
@@ -57,7 +57,7 @@ impl std::str::FromStr for IccVersion {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s.trim() {
-            "4" | "4.0" | "v4" => Ok(IccVersion::V4),
+            "4" | "4.3" | "v4" => Ok(IccVersion::V4),
             "2" | "2.4" | "v2" | "v2.4" => Ok(IccVersion::V2_4),
             other => Err(format!("unknown ICC version '{other}' (known: 4, 2.4)")),
         }
@@ -67,7 +67,7 @@ impl std::str::FromStr for IccVersion {
 impl std::fmt::Display for IccVersion {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
-            IccVersion::V4 => "4.0",
+            IccVersion::V4 => "4.3",
             IccVersion::V2_4 => "2.4",
         })
     }
@@ -156,7 +156,13 @@ pub fn encode_icc(
     };
     let bytes = icc.encode().map_err(|e| IccError::Encode(e.to_string()))?;
     let bytes = match version {
-        IccVersion::V4 => bytes,
+        // The encoder stamps the newest version it knows (4.4); the tags written are those of
+        // ICC.1:2010 (4.3), which more readers accept.
+        IccVersion::V4 => {
+            let mut bytes = bytes;
+            bytes[8..12].copy_from_slice(&0x0430_0000u32.to_be_bytes());
+            bytes
+        }
         IccVersion::V2_4 => {
             v2::to_version_2(&bytes, description, COPYRIGHT).map_err(IccError::Encode)?
         }
