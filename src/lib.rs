@@ -8,9 +8,11 @@
 
 pub mod color;
 pub mod display;
+pub mod experiment;
 pub mod lab;
 pub mod light;
 pub mod numeric_csv;
+pub mod output;
 pub mod plot;
 pub mod render;
 pub mod rig;

@@ -9,6 +9,7 @@ mod budget;
 mod characterize;
 mod color;
 mod devices;
+mod experiment;
 mod fit;
 mod lab;
 mod render;
@@ -45,6 +46,9 @@ enum Command {
     Characterize(characterize::Args),
     /// Display models' reproduction error against the number of measured patches.
     Budget(budget::Args),
+    /// The paper's whole chain, stage by stage: box, simulation, display, reproduction,
+    /// display spots, validation.
+    Experiment(experiment::Args),
     /// The whole validation chain on the built-in simulated lab: box, simulation, display.
     Lab(lab::Args),
     /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
@@ -76,6 +80,7 @@ pub fn main() -> ExitCode {
         Command::Verify(args) => verify::run(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Characterize(args) => characterize::run(args),
+        Command::Experiment(args) => experiment::run_cli(args),
         Command::Lab(args) => lab::run(args),
         Command::Budget(args) => budget::run(args),
         Command::Simulate(args) => simulate::run(args),

@@ -1,0 +1,182 @@
+//! `metamer experiment`: the paper's whole chain, stage by stage, resumable, each finished
+//! stage re-used while its inputs are unchanged.
+
+use std::cell::RefCell;
+use std::path::PathBuf;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use metamer::display::ModelKind;
+use metamer::experiment::display::DisplayOptions;
+use metamer::experiment::reproduction::ReproductionOptions;
+use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
+use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage};
+use metamer::session::{on_ctrl_c, RunOptions};
+
+use super::{CliError, CliResult};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output directory; each stage writes into its own subdirectory.
+    #[arg(short = 'o', long = "out", value_name = "DIR")]
+    out: PathBuf,
+    /// The box's measured scene (`scene.json` of `metamer measure-box`).
+    #[arg(long, value_name = "SCENE")]
+    box_scene: PathBuf,
+    /// The box's spot readings (`patch,X,Y,Z,sd_X,sd_Y,sd_Z,n`).
+    #[arg(long, value_name = "CSV")]
+    box_spots: PathBuf,
+    /// The monitor that shows the simulation: window:N (a real monitor) or virtual:PRESET.
+    #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
+    display: String,
+    /// The spot meter that reads the display (and, when the box is measured here, the box).
+    #[arg(long, default_value = "sim:cs100a?time_scale=0", value_name = "SPEC")]
+    spot: String,
+    /// Display model (see `metamer fit --help`).
+    #[arg(long, default_value = "lut", value_name = "MODEL")]
+    model: String,
+    /// Out-of-gamut colours: nearest-lab or clip.
+    #[arg(long, default_value = "nearest-lab", value_name = "MAPPING")]
+    gamut: String,
+    /// The simulation's accuracy: every patch's ΔE*ab uncertainty below this.
+    #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
+    target_de: f64,
+    /// Side of the square camera image rendered and reproduced (0: spots only).
+    #[arg(long, default_value_t = 0, value_name = "PIXELS")]
+    image_size: usize,
+    /// Samples per pixel of the image.
+    #[arg(long, default_value_t = 16, value_name = "N")]
+    image_spp: u64,
+    /// Spot readings averaged per patch on the display.
+    #[arg(long, default_value_t = 3, value_name = "K")]
+    repeats: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Run only this stage (again): box, simulation, display, reproduction, display-spots,
+    /// validation.
+    #[arg(long, value_name = "STAGE")]
+    stage: Option<String>,
+    /// Continue an interrupted measuring stage from its journal.
+    #[arg(long)]
+    resume: bool,
+    /// Do not mirror the reproduced image (the paper views the display in a mirror).
+    #[arg(long)]
+    no_mirror: bool,
+}
+
+pub fn run_cli(args: Args) -> CliResult {
+    let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
+    let stage: Option<Stage> = match &args.stage {
+        Some(s) => Some(s.parse().map_err(CliError::Usage)?),
+        None => None,
+    };
+    if !(args.target_de > 0.0 && args.target_de.is_finite()) {
+        return Err(CliError::Usage("--target-de must be above 0".into()));
+    }
+    if args.repeats == 0 {
+        return Err(CliError::Usage("--repeats must be at least 1".into()));
+    }
+    if args.image_size > 8192 {
+        return Err(CliError::Usage("--image-size must be at most 8192".into()));
+    }
+    if args.image_size > 0 && args.image_spp == 0 {
+        return Err(CliError::Usage("--image-spp must be at least 1".into()));
+    }
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(CliError::Usage(format!(
+            "-o {}: exists and is not a directory",
+            args.out.display()
+        )));
+    }
+    let interrupt = on_ctrl_c();
+    let opts = ExperimentOptions {
+        dir: args.out.clone(),
+        box_source: BoxSource::Existing {
+            scene: args.box_scene,
+            spots: args.box_spots,
+        },
+        simulation: SimulationOptions {
+            target_de: args.target_de,
+            seed: args.seed,
+            max_seconds: 600.0,
+            image: (args.image_size > 0).then_some(ImageSpec {
+                size: args.image_size,
+                spp: args.image_spp,
+            }),
+        },
+        display: DisplayOptions {
+            screen: args.display,
+            spot: args.spot,
+            model,
+        },
+        reproduction: ReproductionOptions {
+            gamut: args.gamut,
+            mirror: !args.no_mirror,
+        },
+        repeats: args.repeats,
+        stage,
+        resume: args.resume,
+        unattended: false,
+        run: RunOptions {
+            stop_after: None,
+            interrupt: Some(interrupt),
+        },
+    };
+    let bar: RefCell<Option<ProgressBar>> = RefCell::new(None);
+    let progress = |p: Progress| match p {
+        Progress::Stage { stage, reused } => {
+            if let Some(b) = bar.borrow_mut().take() {
+                b.finish_and_clear();
+            }
+            if reused {
+                eprintln!("{stage}: unchanged inputs, re-used");
+            } else {
+                eprintln!("{stage}: running");
+            }
+        }
+        Progress::Readings { done, total } => {
+            let mut b = bar.borrow_mut();
+            let b = b.get_or_insert_with(|| {
+                let b = ProgressBar::new(total as u64);
+                b.set_style(
+                    ProgressStyle::with_template("  {bar:40} {pos}/{len} readings, {eta} left")
+                        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                );
+                b
+            });
+            b.set_length(total as u64);
+            b.set_position(done as u64);
+        }
+        Progress::Note(text) => match bar.borrow().as_ref() {
+            Some(b) => b.println(format!("  {text}")),
+            None => eprintln!("  {text}"),
+        },
+    };
+    let outcomes = run(&opts, &progress)?;
+    if let Some(b) = bar.borrow_mut().take() {
+        b.finish_and_clear();
+    }
+    for o in &outcomes {
+        println!(
+            "{:<14} {:<8} {:>8.1} s  {}",
+            o.stage.name(),
+            if o.reused { "re-used" } else { "ran" },
+            o.seconds,
+            o.dir.display()
+        );
+    }
+    let validation = args.out.join("validation").join("validation.json");
+    if let Ok(text) = std::fs::read_to_string(&validation) {
+        if let Ok(v) =
+            serde_json::from_str::<metamer::experiment::validate::ValidationResult>(&text)
+        {
+            for c in [
+                &v.display_vs_box,
+                &v.simulation_vs_box,
+                &v.display_vs_simulation,
+            ] {
+                println!("{}", c.summary());
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,265 @@
+//! Stage reuse: a stage's directory holds `stage.json`, the hashes of what the stage read
+//! (upstream files and its own options) and of what it wrote. A stage whose inputs hash as
+//! recorded and whose outputs are still there unchanged is not run again; any change
+//! upstream changes an input hash downstream, so exactly the stages that depend on it run.
+
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+/// The record's file name inside a stage directory.
+pub const RECORD_FILE: &str = "stage.json";
+const RECORD_FORMAT: &str = "metamer-experiment-stage";
+
+/// A stage's record could not be read or written, or an input could not be hashed.
+#[derive(Debug, thiserror::Error)]
+pub enum CacheError {
+    #[error("reading {} to hash it: {source}", file.display())]
+    Hash {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("writing {}: {source}", file.display())]
+    Write {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// What a finished stage read and wrote.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageRecord {
+    pub format: String,
+    pub stage: String,
+    /// Input name → SHA-256 (hex).
+    pub inputs: BTreeMap<String, String>,
+    /// Output file, relative to the stage directory → SHA-256 (hex).
+    pub outputs: BTreeMap<String, String>,
+    /// Wall time of the run that produced the outputs.
+    pub seconds: f64,
+}
+
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// SHA-256 of a file's bytes, streamed.
+pub fn hash_file(path: &Path) -> Result<String, CacheError> {
+    let err = |source| CacheError::Hash {
+        file: path.to_path_buf(),
+        source,
+    };
+    let mut f = std::fs::File::open(path).map_err(err)?;
+    let mut h = Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = f.read(&mut buf).map_err(err)?;
+        if n == 0 {
+            break;
+        }
+        h.update(&buf[..n]);
+    }
+    Ok(hex(&h.finalize()))
+}
+
+/// SHA-256 of a value's canonical JSON (object keys sorted): options hash the same whatever
+/// order their fields are written in.
+pub fn hash_value<T: Serialize>(value: &T) -> String {
+    let canonical = serde_json::to_value(value)
+        .map(|v| v.to_string())
+        .unwrap_or_default();
+    hex(&Sha256::digest(canonical.as_bytes()))
+}
+
+/// The inputs of a stage, by name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Inputs(pub BTreeMap<String, String>);
+
+impl Inputs {
+    pub fn new() -> Inputs {
+        Inputs::default()
+    }
+
+    /// Adds a file's content hash under `name`.
+    pub fn file(mut self, name: &str, path: &Path) -> Result<Inputs, CacheError> {
+        self.0.insert(name.to_string(), hash_file(path)?);
+        Ok(self)
+    }
+
+    /// Adds the hash of a value (options) under `name`.
+    pub fn value<T: Serialize>(mut self, name: &str, v: &T) -> Inputs {
+        self.0.insert(name.to_string(), hash_value(v));
+        self
+    }
+}
+
+/// One stage's directory.
+#[derive(Clone, Debug)]
+pub struct StageDir {
+    pub name: &'static str,
+    pub dir: PathBuf,
+}
+
+impl StageDir {
+    pub fn new(root: &Path, name: &'static str) -> StageDir {
+        StageDir {
+            name,
+            dir: root.join(name),
+        }
+    }
+
+    pub fn path(&self, file: &str) -> PathBuf {
+        self.dir.join(file)
+    }
+
+    /// The record, when the stage finished with exactly these inputs and every output it
+    /// wrote is still there with the content it had.
+    pub fn reusable(&self, inputs: &Inputs) -> Option<StageRecord> {
+        let text = std::fs::read_to_string(self.path(RECORD_FILE)).ok()?;
+        let record: StageRecord = serde_json::from_str(&text).ok()?;
+        if record.format != RECORD_FORMAT || record.stage != self.name || record.inputs != inputs.0
+        {
+            return None;
+        }
+        let intact = record
+            .outputs
+            .iter()
+            .all(|(file, hash)| hash_file(&self.path(file)).ok().as_ref() == Some(hash));
+        intact.then_some(record)
+    }
+
+    /// Forgets an earlier finish, so a stage that is re-run and fails half-way is never
+    /// mistaken for finished.
+    pub fn invalidate(&self) -> Result<(), CacheError> {
+        match std::fs::remove_file(self.path(RECORD_FILE)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(CacheError::Write {
+                file: self.path(RECORD_FILE),
+                source: e,
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    /// Records the stage as finished: the inputs it ran with and the hashes of `outputs`
+    /// (relative to the stage directory). Written to a temporary file and renamed, so a
+    /// crash leaves either the old state (re-run) or the complete record.
+    pub fn finish<S: AsRef<str>>(
+        &self,
+        inputs: &Inputs,
+        outputs: &[S],
+        seconds: f64,
+    ) -> Result<StageRecord, CacheError> {
+        let mut hashes = BTreeMap::new();
+        for f in outputs {
+            let f = f.as_ref();
+            hashes.insert(f.to_string(), hash_file(&self.path(f))?);
+        }
+        let record = StageRecord {
+            format: RECORD_FORMAT.into(),
+            stage: self.name.into(),
+            inputs: inputs.0.clone(),
+            outputs: hashes,
+            seconds,
+        };
+        let text = serde_json::to_string_pretty(&record).unwrap_or_default();
+        write_atomic(&self.path(RECORD_FILE), text.as_bytes())?;
+        Ok(record)
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory, synced and
+/// renamed over the target.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CacheError> {
+    use std::io::Write;
+    let err = |source| CacheError::Write {
+        file: path.to_path_buf(),
+        source,
+    };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(err)?;
+    }
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("metamer-cache-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn known_digest() {
+        // FIPS 180-2 example: SHA-256("abc").
+        let d = scratch("digest");
+        std::fs::write(d.join("abc"), "abc").unwrap();
+        assert_eq!(
+            hash_file(&d.join("abc")).unwrap(),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+
+    #[test]
+    fn reused_only_with_same_inputs_and_intact_outputs() {
+        let root = scratch("reuse");
+        let s = StageDir::new(&root, "simulation");
+        std::fs::create_dir_all(&s.dir).unwrap();
+        std::fs::write(root.join("scene.json"), "{}").unwrap();
+        std::fs::write(s.path("spots.csv"), "1,2,3").unwrap();
+        let inputs = Inputs::new()
+            .file("scene", &root.join("scene.json"))
+            .unwrap()
+            .value("target_de", &0.1);
+        assert!(s.reusable(&inputs).is_none());
+        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        assert!(s.reusable(&inputs).is_some());
+        // Another option value: run again.
+        assert!(s
+            .reusable(&inputs.clone().value("target_de", &0.2))
+            .is_none());
+        // An upstream file changed: run again.
+        std::fs::write(root.join("scene.json"), "{ }").unwrap();
+        let changed = Inputs::new()
+            .file("scene", &root.join("scene.json"))
+            .unwrap()
+            .value("target_de", &0.1);
+        assert!(s.reusable(&changed).is_none());
+        // An output edited or removed: run again.
+        std::fs::write(s.path("spots.csv"), "1,2,4").unwrap();
+        assert!(s.reusable(&inputs).is_none());
+        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        std::fs::remove_file(s.path("spots.csv")).unwrap();
+        assert!(s.reusable(&inputs).is_none());
+        s.invalidate().unwrap();
+        s.invalidate().unwrap();
+    }
+
+    #[test]
+    fn option_hash_ignores_field_order() {
+        let a: serde_json::Value = serde_json::from_str(r#"{"a":1,"b":[2,3]}"#).unwrap();
+        let b: serde_json::Value = serde_json::from_str(r#"{"b":[2,3],"a":1}"#).unwrap();
+        assert_eq!(hash_value(&a), hash_value(&b));
+        assert_ne!(hash_value(&a), hash_value(&1));
+    }
+}

@@ -1,0 +1,190 @@
+//! The display stage: the monitor that will show the simulation, characterized by the
+//! `characterize` session, and its peak luminance checked against the rendering. The paper
+//! uses no tone mapping: it sets the display's maximum luminance so that every rendered
+//! value fits. A simulated monitor is set that way; a real one is measured as it is, and
+//! when it is too dim the user is told what white luminance to set.
+
+use std::path::Path;
+use std::time::Duration;
+
+use metamer_drivers::{open_instrument, Instrument};
+use serde::{Deserialize, Serialize};
+
+use super::{ExperimentError, Progress};
+use crate::display::characterize::{self, default_grid_steps, PlanOptions};
+use crate::display::{ModelKind, Profile};
+use crate::lab::white_luminance_for;
+use crate::rig::{Screen, ScreenSpec, VirtualDisplay, VirtualPanel};
+use crate::session::{RunOptions, ScriptedOperator, StepProgress, TerminalOperator};
+
+/// The monitor and how it is characterized.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DisplayOptions {
+    /// `window:N` or `virtual:PRESET`.
+    pub screen: String,
+    /// The spot meter, as named on the command line.
+    pub spot: String,
+    pub model: ModelKind,
+}
+
+/// What `display/display.json` holds: how the monitor was set, so later stages rebuild a
+/// simulated one exactly, and the luminance check.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DisplaySetting {
+    pub screen: String,
+    /// A simulated monitor's full-white luminance, set for the rendering (cd/m²).
+    pub virtual_white_cd_m2: Option<f64>,
+    /// The measured white, cd/m².
+    pub white_xyz: [f64; 3],
+    /// The lowest full-white luminance at which every rendered patch whose chromaticity the
+    /// display can show fits without clipping (cd/m²).
+    pub needed_white_cd_m2: f64,
+    pub model: ModelKind,
+}
+
+pub const SETTING_FILE: &str = "display.json";
+pub const PROFILE_FILE: &str = "profile.json";
+pub const SUMMARY_FILE: &str = "summary.json";
+
+/// The screen of `spec`, set for `setting` when it is simulated.
+pub fn open_screen(
+    spec: &str,
+    virtual_white_cd_m2: Option<f64>,
+) -> Result<Box<dyn Screen>, ExperimentError> {
+    let parsed = ScreenSpec::parse(spec)?;
+    Ok(match (&parsed, virtual_white_cd_m2) {
+        (ScreenSpec::Virtual(p), Some(w)) => Box::new(VirtualDisplay::new(
+            VirtualPanel::preset(*p).with_white_luminance(w),
+        )),
+        _ => parsed.open()?,
+    })
+}
+
+/// The spot meter aimed at `screen` (a simulated meter sees a simulated screen).
+pub fn open_meter(spec: &str, screen: &dyn Screen) -> Result<Box<dyn Instrument>, ExperimentError> {
+    if spec.starts_with("sim:") && screen.stimulus().is_none() {
+        return Err(ExperimentError::SimulatedMeterOnRealScreen {
+            meter: spec.to_string(),
+            screen: screen.spec(),
+        });
+    }
+    Ok(open_instrument(spec, screen.stimulus())?)
+}
+
+/// The factor by which the display's white must at least be raised so that `target` fits:
+/// the largest scale s ≤ 1 at which s·target is inside the profile's gamut, inverted. None
+/// when no scale brings it inside (a chromaticity the primaries cannot make).
+fn brightness_needed(profile: &Profile, target: [f64; 3]) -> Option<f64> {
+    let inside = |s: f64| !profile.inverse(target.map(|v| v * s)).out_of_gamut;
+    if inside(1.0) {
+        return Some(1.0);
+    }
+    let (mut lo, mut hi) = (1e-3, 1.0);
+    if !inside(lo) {
+        return None;
+    }
+    // 40 halvings: far below any meter's resolution.
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if inside(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(1.0 / lo)
+}
+
+/// The white luminance the rendering needs on the display `profile` describes.
+pub fn needed_white(profile: &Profile, targets: &[[f64; 3]]) -> f64 {
+    let factor = targets
+        .iter()
+        .filter_map(|t| brightness_needed(profile, *t))
+        .fold(1.0, f64::max);
+    profile.white_xyz[1] * factor
+}
+
+/// Characterizes the display into `dir`; `targets` are the rendered readings it must show.
+pub fn characterize_display(
+    dir: &Path,
+    opts: &DisplayOptions,
+    targets: &[[f64; 3]],
+    resume: bool,
+    unattended: bool,
+    progress: &dyn Fn(Progress),
+) -> Result<(DisplaySetting, Vec<&'static str>), ExperimentError> {
+    let spec = ScreenSpec::parse(&opts.screen)?;
+    let virtual_white_cd_m2 = match &spec {
+        ScreenSpec::Virtual(p) => Some(white_luminance_for(&VirtualPanel::preset(*p), targets)),
+        ScreenSpec::Window { .. } => None,
+    };
+    let mut screen = open_screen(&opts.screen, virtual_white_cd_m2)?;
+    let mut meter = open_meter(&opts.spot, screen.as_ref())?;
+    let defaults = PlanOptions::default();
+    let options = characterize::Options {
+        dir: dir.to_path_buf(),
+        plan: PlanOptions {
+            grid_steps: default_grid_steps(opts.model, defaults.ramp_steps),
+            ..defaults
+        },
+        model: opts.model,
+        instrument: opts.spot.clone(),
+        settle: virtual_white_cd_m2.map(|_| Duration::ZERO),
+        resume,
+        run: RunOptions::default(),
+    };
+    let mut scripted = ScriptedOperator::confirming();
+    let mut terminal = TerminalOperator;
+    let operator: &mut dyn crate::session::Operator = if unattended || virtual_white_cd_m2.is_some()
+    {
+        &mut scripted
+    } else {
+        &mut terminal
+    };
+    let mut sink = |p: &StepProgress<'_>| {
+        progress(Progress::Readings {
+            done: p.done,
+            total: p.total,
+        })
+    };
+    let summary = match characterize::run(
+        &options,
+        screen.as_mut(),
+        meter.as_mut(),
+        operator,
+        &mut sink,
+    )? {
+        characterize::Outcome::Finished(summary) => summary,
+        characterize::Outcome::Incomplete {
+            done, total, log, ..
+        } => {
+            return Err(ExperimentError::Incomplete {
+                stage: "display",
+                done,
+                total,
+                journal: log,
+            })
+        }
+    };
+    let profile = Profile::load(&summary.files.profile)?;
+    let needed = needed_white(&profile, targets);
+    let setting = DisplaySetting {
+        screen: opts.screen.clone(),
+        virtual_white_cd_m2,
+        white_xyz: profile.white_xyz,
+        needed_white_cd_m2: needed,
+        model: opts.model,
+    };
+    // A simulated monitor was set for the rendering; a real one that is too dim cannot
+    // show it without tone mapping, which the method forbids.
+    if needed > profile.white_xyz[1] * 1.005 {
+        return Err(ExperimentError::DisplayTooDim {
+            white_cd_m2: profile.white_xyz[1],
+            needed_cd_m2: needed,
+            dir: dir.to_path_buf(),
+        });
+    }
+    let text = serde_json::to_string_pretty(&setting).map_err(ExperimentError::Json)?;
+    super::cache::write_atomic(&dir.join(SETTING_FILE), text.as_bytes())?;
+    Ok((setting, vec![SETTING_FILE, PROFILE_FILE, SUMMARY_FILE]))
+}

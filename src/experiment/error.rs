@@ -1,0 +1,85 @@
+//! Why an experiment stopped.
+
+use std::path::PathBuf;
+
+use metamer_drivers::DriverError;
+
+use super::cache::CacheError;
+use super::readings::ReadingsError;
+use crate::display::characterize::CharacterizeError;
+use crate::display::ProfileError;
+use crate::render::image::ImageError;
+use crate::render::image_io::ImageIoError;
+use crate::render::radiosity::RadiosityError;
+use crate::render::spot::SpotError;
+use crate::render::SceneError;
+use crate::rig::{OpenError, ScreenError};
+use crate::session::SessionError;
+use crate::validation::ValidationError;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Spot(#[from] SpotError),
+    #[error(transparent)]
+    Radiosity(#[from] RadiosityError),
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    #[error(transparent)]
+    ImageIo(#[from] ImageIoError),
+    #[error(transparent)]
+    Instrument(#[from] DriverError),
+    #[error(transparent)]
+    Screen(#[from] ScreenError),
+    #[error(transparent)]
+    OpenScreen(#[from] OpenError),
+    #[error(transparent)]
+    Characterize(#[from] CharacterizeError),
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error(transparent)]
+    Validation(#[from] ValidationError),
+    #[error(transparent)]
+    Cache(#[from] CacheError),
+    #[error(transparent)]
+    Readings(#[from] ReadingsError),
+    #[error("{}: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("writing JSON: {0}")]
+    Json(#[source] serde_json::Error),
+    #[error("{}: {message}", file.display())]
+    BadFile { file: PathBuf, message: String },
+    #[error("{what}: {message}")]
+    Option { what: &'static str, message: String },
+    #[error("{what} is not a finite number")]
+    NotFinite { what: String },
+    #[error("the {stage} stage stopped with {done} of {total} readings taken; they are safe in {}; resume the experiment to take the rest", journal.display())]
+    Incomplete {
+        stage: &'static str,
+        done: usize,
+        total: usize,
+        journal: PathBuf,
+    },
+    #[error("the simulated meter {meter} cannot see the real screen {screen}; use a real meter, or a virtual display")]
+    SimulatedMeterOnRealScreen { meter: String, screen: String },
+    #[error("the display's white is {white_cd_m2:.1} cd/m², but the rendering needs at least {needed_cd_m2:.1} cd/m² to be shown without tone mapping: raise the monitor's brightness (backlight) until full white reads at least that, then move {} aside and run the display stage again", dir.display())]
+    DisplayTooDim {
+        white_cd_m2: f64,
+        needed_cd_m2: f64,
+        dir: PathBuf,
+    },
+    #[error("the {stage} stage needs {}, which an earlier stage writes; run the experiment without choosing a stage first", missing.display())]
+    MissingInput {
+        stage: &'static str,
+        missing: PathBuf,
+    },
+    #[error("the box measurements: {0}")]
+    Box(String),
+}

@@ -1,0 +1,33 @@
+//! The experiment: the paper's whole chain, stage by stage, on a real rig or the simulated
+//! one — the box measured (`box/`), its scene simulated (`simulation/`), the display
+//! characterized (`display/`), the simulation reproduced (`reproduction/`), shown and read
+//! (`display-spots/`), and validated (`validation/`).
+//!
+//! Each stage writes into its own directory and records the hashes of what it read and
+//! wrote ([`cache`]); a second run re-uses every stage whose inputs are unchanged and runs
+//! exactly those downstream of a change. Measuring stages are journalled sessions and
+//! resume after any interruption.
+
+pub mod cache;
+pub mod display;
+pub mod display_spots;
+mod error;
+pub mod readings;
+pub mod reproduction;
+pub mod simulation;
+mod stages;
+pub mod validate;
+
+pub use error::ExperimentError;
+pub use stages::{run, BoxSource, ExperimentOptions, Stage, StageOutcome};
+
+/// Where an experiment is, for a progress display.
+#[derive(Clone, Debug)]
+pub enum Progress {
+    /// A stage begins (or is re-used).
+    Stage { stage: Stage, reused: bool },
+    /// Readings done of a measuring stage.
+    Readings { done: usize, total: usize },
+    /// A line for the user.
+    Note(String),
+}

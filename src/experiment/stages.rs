@@ -1,0 +1,350 @@
+//! The stages in order, what each reads, and when each runs.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::cache::{Inputs, StageDir, RECORD_FILE};
+use super::display::{characterize_display, DisplayOptions, DisplaySetting};
+use super::readings::read_readings;
+use super::reproduction::{reproduce, Reproduction, ReproductionOptions};
+use super::simulation::{simulate, SimulationOptions, SimulationSummary};
+use super::{display, display_spots, reproduction, simulation, validate};
+use super::{ExperimentError, Progress};
+use crate::display::Profile;
+use crate::session::RunOptions;
+
+/// The stages, in the order they run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Stage {
+    Box,
+    Simulation,
+    Display,
+    Reproduction,
+    DisplaySpots,
+    Validation,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 6] = [
+        Stage::Box,
+        Stage::Simulation,
+        Stage::Display,
+        Stage::Reproduction,
+        Stage::DisplaySpots,
+        Stage::Validation,
+    ];
+
+    /// The stage's name and directory.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Box => "box",
+            Stage::Simulation => "simulation",
+            Stage::Display => "display",
+            Stage::Reproduction => "reproduction",
+            Stage::DisplaySpots => "display-spots",
+            Stage::Validation => "validation",
+        }
+    }
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Stage {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Stage, String> {
+        Stage::ALL
+            .into_iter()
+            .find(|st| st.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Stage::ALL.iter().map(|s| s.name()).collect();
+                format!("unknown stage '{s}' (stages: {})", names.join(", "))
+            })
+    }
+}
+
+/// Where the box's measurements come from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum BoxSource {
+    /// Measurements taken earlier or elsewhere: the measured scene and the spot readings.
+    Existing { scene: PathBuf, spots: PathBuf },
+}
+
+/// What an experiment is made of.
+#[derive(Clone, Debug)]
+pub struct ExperimentOptions {
+    pub dir: PathBuf,
+    pub box_source: BoxSource,
+    pub simulation: SimulationOptions,
+    pub display: DisplayOptions,
+    pub reproduction: ReproductionOptions,
+    /// Spot readings averaged per patch on the display.
+    pub repeats: usize,
+    /// Run only this stage (again, even if its inputs are unchanged).
+    pub stage: Option<super::Stage>,
+    /// Continue an interrupted measuring stage's journal.
+    pub resume: bool,
+    /// Nobody at the rig: every operator request counts as done (simulated rigs).
+    pub unattended: bool,
+    pub run: RunOptions,
+}
+
+/// How one stage went.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageOutcome {
+    pub stage: Stage,
+    /// Its inputs were unchanged and its outputs intact: nothing was run.
+    pub reused: bool,
+    pub seconds: f64,
+    pub dir: PathBuf,
+}
+
+fn need(stage: Stage, path: PathBuf) -> Result<PathBuf, ExperimentError> {
+    if path.exists() {
+        Ok(path)
+    } else {
+        Err(ExperimentError::MissingInput {
+            stage: stage.name(),
+            missing: path,
+        })
+    }
+}
+
+fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, ExperimentError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| ExperimentError::BadFile {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// The box's scene and spot readings.
+fn box_files(opts: &ExperimentOptions) -> (PathBuf, PathBuf) {
+    match &opts.box_source {
+        BoxSource::Existing { scene, spots } => (scene.clone(), spots.clone()),
+    }
+}
+
+/// A finished stage whose inputs changed holds measurements of another configuration: it
+/// is moved aside whole (never deleted) so the stage starts afresh.
+fn set_aside_stale(sd: &StageDir) -> Result<Option<PathBuf>, ExperimentError> {
+    if !sd.path(RECORD_FILE).exists() {
+        return Ok(None);
+    }
+    let mut n = 1;
+    let aside = loop {
+        let p = sd.dir.with_file_name(format!("{}.old-{n}", sd.name));
+        if !p.exists() {
+            break p;
+        }
+        n += 1;
+    };
+    std::fs::rename(&sd.dir, &aside).map_err(|source| ExperimentError::Io {
+        file: sd.dir.clone(),
+        source,
+    })?;
+    Ok(Some(aside))
+}
+
+/// Runs the experiment's stages in order, re-using each whose inputs are unchanged.
+pub fn run(
+    opts: &ExperimentOptions,
+    progress: &dyn Fn(Progress),
+) -> Result<Vec<StageOutcome>, ExperimentError> {
+    let root = &opts.dir;
+    let mut outcomes = Vec::new();
+    for stage in Stage::ALL {
+        if opts.stage.is_some_and(|s| s != stage) {
+            continue;
+        }
+        let sd = StageDir::new(root, stage.name());
+        let start = Instant::now();
+        let inputs = inputs_of(stage, opts)?;
+        let forced = opts.stage == Some(stage);
+        if !forced && (stage == Stage::Box || sd.reusable(&inputs).is_some()) {
+            progress(Progress::Stage {
+                stage,
+                reused: true,
+            });
+            outcomes.push(StageOutcome {
+                stage,
+                reused: true,
+                seconds: 0.0,
+                dir: sd.dir.clone(),
+            });
+            continue;
+        }
+        progress(Progress::Stage {
+            stage,
+            reused: false,
+        });
+        if matches!(stage, Stage::Display | Stage::DisplaySpots) {
+            if let Some(aside) = set_aside_stale(&sd)? {
+                progress(Progress::Note(format!(
+                    "the {stage} stage's inputs changed: its earlier measurements are kept in {}",
+                    aside.display()
+                )));
+            }
+        } else {
+            sd.invalidate()?;
+        }
+        let files = run_stage(stage, opts, &sd, progress)?;
+        sd.finish(&inputs, &files, start.elapsed().as_secs_f64())?;
+        outcomes.push(StageOutcome {
+            stage,
+            reused: false,
+            seconds: start.elapsed().as_secs_f64(),
+            dir: sd.dir.clone(),
+        });
+    }
+    Ok(outcomes)
+}
+
+fn stage_path(opts: &ExperimentOptions, stage: Stage, file: &str) -> PathBuf {
+    opts.dir.join(stage.name()).join(file)
+}
+
+/// What `stage` reads, hashed.
+fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, ExperimentError> {
+    let p = |s: Stage, f: &str| need(stage, stage_path(opts, s, f));
+    let (scene, box_spots) = box_files(opts);
+    Ok(match stage {
+        Stage::Box => Inputs::new().value("source", &opts.box_source),
+        Stage::Simulation => Inputs::new()
+            .file("scene", &need(stage, scene)?)?
+            .value("options", &opts.simulation),
+        Stage::Display => {
+            let i = Inputs::new().value("options", &opts.display);
+            // A simulated monitor's white is set for the rendering; a real one is not.
+            if opts.display.screen.starts_with("virtual") {
+                i.file("spots", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
+            } else {
+                i
+            }
+        }
+        Stage::Reproduction => {
+            let mut i = Inputs::new()
+                .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?
+                .file(
+                    "simulation",
+                    &p(Stage::Simulation, simulation::SUMMARY_FILE)?,
+                )?
+                .value("options", &opts.reproduction);
+            let image = stage_path(opts, Stage::Simulation, simulation::IMAGE_FILE);
+            if image.exists() {
+                i = i.file("image", &image)?;
+            }
+            i
+        }
+        Stage::DisplaySpots => Inputs::new()
+            .file("drives", &p(Stage::Reproduction, reproduction::FILE)?)?
+            .file("display", &p(Stage::Display, display::SETTING_FILE)?)?
+            .value("spot", &opts.display.spot)
+            .value("repeats", &opts.repeats),
+        Stage::Validation => Inputs::new()
+            .file("box", &need(stage, box_spots)?)?
+            .file("simulation", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
+            .file(
+                "display",
+                &p(Stage::DisplaySpots, display_spots::SPOTS_FILE)?,
+            )?
+            .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?
+            .file("reproduction", &p(Stage::Reproduction, reproduction::FILE)?)?,
+    })
+}
+
+fn run_stage(
+    stage: Stage,
+    opts: &ExperimentOptions,
+    sd: &StageDir,
+    progress: &dyn Fn(Progress),
+) -> Result<Vec<String>, ExperimentError> {
+    let owned = |v: Vec<&'static str>| v.into_iter().map(String::from).collect::<Vec<_>>();
+    let sim_summary = || -> Result<SimulationSummary, ExperimentError> {
+        read_json(&stage_path(
+            opts,
+            Stage::Simulation,
+            simulation::SUMMARY_FILE,
+        ))
+    };
+    match stage {
+        Stage::Box => Ok(Vec::new()),
+        Stage::Simulation => {
+            let (scene, _) = box_files(opts);
+            let (_, files) = simulate(&scene, &opts.simulation, &sd.dir, progress)?;
+            Ok(owned(files))
+        }
+        Stage::Display => {
+            let targets: Vec<[f64; 3]> = sim_summary()?.spots.iter().map(|s| s.xyz).collect();
+            let (_, files) = characterize_display(
+                &sd.dir,
+                &opts.display,
+                &targets,
+                opts.resume,
+                opts.unattended,
+                progress,
+            )?;
+            Ok(owned(files))
+        }
+        Stage::Reproduction => {
+            let profile = Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
+            let sim = sim_summary()?;
+            let image = sim
+                .image
+                .as_ref()
+                .map(|f| stage_path(opts, Stage::Simulation, f));
+            let (_, files) = reproduce(
+                &sd.dir,
+                &profile,
+                &sim.spots,
+                image.as_deref(),
+                &opts.reproduction,
+            )?;
+            Ok(owned(files))
+        }
+        Stage::DisplaySpots => {
+            let r: Reproduction =
+                read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
+            let setting: DisplaySetting =
+                read_json(&stage_path(opts, Stage::Display, display::SETTING_FILE))?;
+            let (_, files) = display_spots::measure(
+                &sd.dir,
+                &setting,
+                &opts.display.spot,
+                &r.patches,
+                opts.repeats,
+                opts.resume,
+                &opts.run,
+                progress,
+            )?;
+            Ok(owned(files))
+        }
+        Stage::Validation => {
+            let (_, box_spots) = box_files(opts);
+            let profile = Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
+            let r: Reproduction =
+                read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
+            let (_, files) = validate::validate(
+                &sd.dir,
+                profile.white_xyz,
+                &read_readings(&box_spots)?,
+                &read_readings(&stage_path(opts, Stage::Simulation, simulation::SPOTS_FILE))?,
+                &read_readings(&stage_path(
+                    opts,
+                    Stage::DisplaySpots,
+                    display_spots::SPOTS_FILE,
+                ))?,
+                &r.out_of_gamut_patches,
+            )?;
+            Ok(files)
+        }
+    }
+}

@@ -1,0 +1,99 @@
+//! The validation stage: box, display and simulation compared patch by patch in CIELAB
+//! relative to the display's measured white (the paper's choice).
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::cache::write_atomic;
+use super::readings::PatchStat;
+use super::ExperimentError;
+use crate::color::Xyz;
+use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
+
+/// Everything the validation found, as `validation/validation.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ValidationResult {
+    /// CIELAB's reference white, cd/m².
+    pub white: [f64; 3],
+    pub out_of_gamut_patches: Vec<usize>,
+    pub display_vs_box: Comparison,
+    pub simulation_vs_box: Comparison,
+    pub display_vs_simulation: Comparison,
+}
+
+pub const FILE: &str = "validation.json";
+
+/// The readings of `a` and `b` for the patches both have, in patch order; refuses sets
+/// that do not hold the same patches (a stage that lost readings must not pass as valid).
+fn paired(
+    what: (&str, &[PatchStat]),
+    other: (&str, &[PatchStat]),
+) -> Result<(Vec<Xyz>, Vec<Xyz>), ExperimentError> {
+    let mut a: Vec<&PatchStat> = what.1.iter().collect();
+    let mut b: Vec<&PatchStat> = other.1.iter().collect();
+    a.sort_by_key(|p| p.patch);
+    b.sort_by_key(|p| p.patch);
+    let pa: Vec<usize> = a.iter().map(|p| p.patch).collect();
+    let pb: Vec<usize> = b.iter().map(|p| p.patch).collect();
+    if pa != pb {
+        return Err(ExperimentError::Option {
+            what: "readings",
+            message: format!(
+                "the {} readings are of patches {:?} but the {} readings of {:?}",
+                what.0, pa, other.0, pb
+            ),
+        });
+    }
+    let xyz = |v: &[&PatchStat]| v.iter().map(|p| Xyz::from_array(p.xyz)).collect();
+    Ok((xyz(&a), xyz(&b)))
+}
+
+pub fn validate(
+    dir: &Path,
+    white: [f64; 3],
+    box_spots: &[PatchStat],
+    simulation: &[PatchStat],
+    display: &[PatchStat],
+    out_of_gamut: &[usize],
+) -> Result<(ValidationResult, Vec<String>), ExperimentError> {
+    let w = Xyz::from_array(white);
+    let (b, d) = paired(("box", box_spots), ("display", display))?;
+    let display_vs_box = compare("box", &b, "display", &d, w)?;
+    let (b, s) = paired(("box", box_spots), ("simulation", simulation))?;
+    let simulation_vs_box = compare("box", &b, "simulation", &s, w)?;
+    let (s, d) = paired(("simulation", simulation), ("display", display))?;
+    let display_vs_simulation = compare("simulation", &s, "display", &d, w)?;
+    let result = ValidationResult {
+        white,
+        out_of_gamut_patches: out_of_gamut.to_vec(),
+        display_vs_box,
+        simulation_vs_box,
+        display_vs_simulation,
+    };
+    std::fs::create_dir_all(dir).map_err(|source| ExperimentError::Io {
+        file: dir.to_path_buf(),
+        source,
+    })?;
+    let mut files = Vec::new();
+    for (stem, c) in [
+        ("display_vs_box", &result.display_vs_box),
+        ("simulation_vs_box", &result.simulation_vs_box),
+        ("display_vs_simulation", &result.display_vs_simulation),
+    ] {
+        let csv = format!("{stem}.csv");
+        write_atomic(&dir.join(&csv), c.to_csv().as_bytes())?;
+        let svg = format!("{stem}.svg");
+        let shaded: &[usize] = if stem == "simulation_vs_box" {
+            &[]
+        } else {
+            out_of_gamut
+        };
+        write_delta_e_chart_shaded(c, shaded, "outside the display's gamut", &dir.join(&svg))?;
+        files.extend([csv, svg]);
+    }
+    let text = serde_json::to_string_pretty(&result).map_err(ExperimentError::Json)?;
+    write_atomic(&dir.join(FILE), text.as_bytes())?;
+    files.push(FILE.to_string());
+    Ok((result, files))
+}
