@@ -4,10 +4,11 @@
 use std::path::PathBuf;
 
 use super::{CliError, CliResult};
-use metamer::display::icc::{agreement, encode_icc, write_icc, IccVersion};
+use metamer::display::icc::{agreement, encode_icc, IccVersion};
 use metamer::display::{
     fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
 };
+use metamer::output::OutputPolicy;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -76,6 +77,13 @@ pub fn run(args: Args) -> CliResult {
     if args.icc_version.is_some() && args.icc.is_none() {
         return Err(CliError::Usage("--icc-version needs --icc OUT.icc".into()));
     }
+    // The ICC profile follows the output policy: never onto the measurements or the JSON
+    // profile, never over an existing file; checked before the fit so no work is lost.
+    let mut icc_policy = OutputPolicy::new(false);
+    icc_policy.inputs([args.measurements.as_path(), args.output.as_path()]);
+    if let Some(path) = &args.icc {
+        icc_policy.check(path)?;
+    }
     let m = read_measurement_file(&args.measurements)?;
     if !m.absolute {
         eprintln!(
@@ -140,7 +148,7 @@ pub fn run(args: Args) -> CliResult {
             version,
             &format!("metamer {} ({name})", profile.model),
         )?;
-        write_icc(&icc, path)?;
+        icc_policy.write(path, &icc.bytes)?;
         let drives: Vec<[f64; 3]> = m.patches.iter().map(|p| p.rgb).collect();
         let check = agreement(&icc.bytes, &profile, &drives)?;
         println!(

@@ -25,7 +25,7 @@ pub mod budget;
 
 pub use diagnostics::{Diagnostics, Noise, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitOptions};
-pub use icc::{encode_icc, write_icc, IccError, IccForward, IccProfile, IccVersion};
+pub use icc::{encode_icc, IccError, IccForward, IccProfile, IccVersion};
 pub use measurements::{
     read_measurement_file, read_measurements, write_ti3, CalibrationEntry, Measurements,
     MeasurementsError, Spectra,

@@ -68,6 +68,7 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
 }
 
 /// Shows and reads every patch into `dir`.
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     dir: &Path,
     setting: &DisplaySetting,

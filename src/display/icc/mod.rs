@@ -20,8 +20,6 @@ pub mod pcs;
 mod readback;
 mod v2;
 
-use std::path::{Path, PathBuf};
-
 use moxcms::{
     ColorProfile, DataColorSpace, LutDataType, LutStore, LutType, LutWarehouse, Matrix3d,
     ProfileClass, ProfileText, RenderingIntent, ToneReprCurve, Xyzd,
@@ -90,12 +88,6 @@ pub enum IccError {
     Singular,
     #[error("the ICC encoder refused the profile: {0}")]
     Encode(String),
-    #[error("{file}: {source}")]
-    Io {
-        file: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
 }
 
 /// What was written and how well it represents the model.
@@ -175,20 +167,6 @@ pub fn encode_icc(
             clipped_black,
         },
     })
-}
-
-/// Writes the profile through a sibling temporary file and a rename, so an interrupted
-/// write never leaves a truncated profile.
-pub fn write_icc(icc: &IccProfile, path: &Path) -> Result<(), IccError> {
-    let io = |source| IccError::Io {
-        file: path.to_path_buf(),
-        source,
-    };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, &icc.bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
 }
 
 fn xyzd(v: [f64; 3]) -> Xyzd {
