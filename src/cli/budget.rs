@@ -78,16 +78,17 @@ pub fn run(args: Args) -> CliResult {
         indicatif::ProgressStyle::with_template("{bar:30} fit {pos}/{len} · about {eta} left")
             .expect("valid template"),
     );
-    let points = run_budget_study(&presets, &models, args.trials, args.seed, &|done, _| {
+    let points = run_budget_study(&presets, &models, args.trials, args.seed, &|done, total| {
+        bar.set_length(total as u64);
         bar.set_position(done as u64)
     });
     bar.finish_and_clear();
     let points = points?;
     write_budget(&args.out, &points, &out)?;
-    println!("preset            model        patches  mean ΔE00  p95 ΔE00  max ΔE00");
+    println!("preset            model                   patches  mean ΔE00  p95 ΔE00  max ΔE00");
     for p in &points {
         println!(
-            "{:<17} {:<12} {:>7}  {:>9.3}  {:>8.3}  {:>8.3}",
+            "{:<17} {:<23} {:>7}  {:>9.3}  {:>8.3}  {:>8.3}",
             p.preset, p.model, p.patches, p.mean_de00, p.p95_de00, p.max_de00
         );
     }

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use super::{CliError, CliResult};
+use metamer::display::icc::{agreement, encode_icc, IccVersion};
 use metamer::display::{
     fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
 };
@@ -35,6 +36,13 @@ pub struct Args {
     /// Replace the output file if it exists (never one of the inputs).
     #[arg(long)]
     force: bool,
+    /// Also write an ICC display profile: matrix/TRC for the matrix models, lut16
+    /// A2B0/B2A0 tables for lut.
+    #[arg(long, value_name = "OUT.icc")]
+    icc: Option<PathBuf>,
+    /// The ICC version of --icc: 4 (default) or 2.4.
+    #[arg(long, value_name = "4|2.4")]
+    icc_version: Option<IccVersion>,
 }
 
 /// A model by name, or `auto`.
@@ -78,6 +86,16 @@ pub fn run(args: Args) -> CliResult {
                 "--gamma must be a positive number, got {g}"
             )));
         }
+    }
+    if args.icc_version.is_some() && args.icc.is_none() {
+        return Err(CliError::Usage("--icc-version needs --icc OUT.icc".into()));
+    }
+    // The ICC profile follows the output policy: never onto the measurements or the JSON
+    // profile, never over an existing file; checked before the fit so no work is lost.
+    let mut icc_policy = OutputPolicy::new(args.force);
+    icc_policy.inputs([args.measurements.as_path(), args.output.as_path()]);
+    if let Some(path) = &args.icc {
+        icc_policy.check(path)?;
     }
     let m = read_measurement_file(&args.measurements)?;
     if !m.absolute {
@@ -131,5 +149,39 @@ pub fn run(args: Args) -> CliResult {
     println!("{}", profile.diagnostics());
     profile.save(&args.output, &out)?;
     println!("profile written to {}", args.output.display());
+    if let Some(path) = &args.icc {
+        let version = args.icc_version.unwrap_or(IccVersion::V4);
+        let name = args
+            .measurements
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy();
+        let icc = encode_icc(
+            &profile,
+            version,
+            &format!("metamer {} ({name})", profile.model),
+        )?;
+        icc_policy.write(path, &icc.bytes)?;
+        let drives: Vec<[f64; 3]> = m.patches.iter().map(|p| p.rgb).collect();
+        let check = agreement(&icc.bytes, &profile, &drives)?;
+        println!(
+            "ICC {} profile ({}) written to {}; read back, it follows the model to ΔE00 mean \
+             {:.4}, max {:.4} over the {} patches",
+            icc.summary.version,
+            icc.summary.form,
+            path.display(),
+            check.mean_de00,
+            check.max_de00,
+            check.points
+        );
+        let clipped = icc.summary.clipped_black;
+        if clipped.iter().any(|&v| v > 0.0) {
+            println!(
+                "note: the black lies outside the primaries' cone; the ICC curves clip it by \
+                 Y {:.2e} {:.2e} {:.2e} of the white (R, G, B)",
+                clipped[0], clipped[1], clipped[2]
+            );
+        }
+    }
     Ok(())
 }

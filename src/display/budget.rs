@@ -22,6 +22,7 @@ use super::characterize::plan::random_patches;
 use super::characterize::{default_grid_steps, DriveStep, Plan, PlanOptions, Purpose};
 use super::diagnostics::percentile;
 use super::model::Sample;
+use super::scattered::scattered_patches;
 use super::{fit_profile, ModelKind};
 use crate::color::{delta_e2000, Xyz};
 use crate::output::{OutputError, OutputPolicy};
@@ -40,6 +41,15 @@ pub struct Budget {
 /// with that many steps: the ramps, plus for the LUT the grid of the ramps' levels (see
 /// [`default_grid_steps`]), so a model's curve is what a user of that model pays.
 pub const RAMP_STEPS: [usize; 8] = [2, 3, 4, 5, 7, 9, 13, 17];
+
+/// Sizes of the seeded space-filling sets (the cube's corners and a rotated Halton
+/// sequence, like ArgyllCMS's `targen` spreads them) charted for the models that fit any
+/// patch set; they are charted as `MODEL scattered`.
+pub const SCATTERED_SIZES: [usize; 3] = [50, 200, 1000];
+
+/// The models that fit scattered sets: the joint shaper + matrix and the LUT fitted by
+/// regularised least squares (a grid-only model needs the grid, a ramp model ramps).
+pub const SCATTERED_MODELS: [ModelKind; 2] = [ModelKind::ShaperMatrix, ModelKind::Lut];
 
 /// The budget of `model` with `ramp_steps` steps.
 pub fn budget_for(model: ModelKind, ramp_steps: usize) -> Budget {
@@ -107,7 +117,13 @@ pub fn run_budget_study(
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<BudgetPoint>, BudgetError> {
     let targets_rgb = random_patches(200, seed ^ 0xB0D6E7);
-    let total = presets.len() * RAMP_STEPS.len() * models.len();
+    let scattered: Vec<ModelKind> = models
+        .iter()
+        .copied()
+        .filter(|k| SCATTERED_MODELS.contains(k))
+        .collect();
+    let total =
+        presets.len() * (RAMP_STEPS.len() * models.len() + SCATTERED_SIZES.len() * scattered.len());
     let mut done = 0;
     let mut points = Vec::new();
     for &preset in presets {
@@ -117,60 +133,129 @@ pub fn run_budget_study(
         let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
         let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
         let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
+        let mut study = Study {
+            panel: &panel,
+            white,
+            targets: &targets,
+            stimulus: &stimulus,
+            meter: meter.as_mut(),
+            trials: trials.max(1),
+        };
         for &kind in models {
             for steps in RAMP_STEPS {
                 done += 1;
                 let budget = budget_for(kind, steps);
                 let (drive, distinct) = budget_patches(budget);
-                let mut errors = Vec::with_capacity(targets.len() * trials.max(1));
-                let mut fit_ms = 0.0;
-                // Each trial is a fresh set of readings (new meter noise); errors are pooled
-                // so one lucky or unlucky reading of a primary does not make the curve.
-                let mut fitted = true;
-                for _ in 0..trials.max(1) {
-                    let mut patches = Vec::with_capacity(drive.len());
-                    for rgb in &drive {
-                        stimulus.set(panel.xyz(*rgb));
-                        let reading = meter.measure(&Request::default())?;
-                        patches.push(Sample {
-                            rgb: rgb.map(|c| f64::from(c) / 255.0),
-                            xyz: reading.xyz,
-                        });
-                    }
-                    let start = Instant::now();
-                    // A model that needs more patches than the budget has is not charted
-                    // there.
-                    let Ok(profile) = fit_profile(kind, &patches, None) else {
-                        fitted = false;
-                        break;
-                    };
-                    fit_ms += start.elapsed().as_secs_f64() * 1e3;
-                    errors.extend(targets.iter().map(|&t| {
-                        let rgb = profile.inverse(t).rgb;
-                        let shown = Xyz::from_array(panel.xyz_of_drive(rgb));
-                        delta_e2000(shown.to_lab(white), Xyz::from_array(t).to_lab(white))
-                    }));
-                }
+                let outcome = study.measure(kind, &drive)?;
                 progress(done, total);
-                if !fitted {
-                    continue;
+                if let Some((errors, fit_ms)) = outcome {
+                    points.push(point(
+                        preset,
+                        kind.name().to_string(),
+                        distinct,
+                        budget,
+                        errors,
+                        fit_ms,
+                    ));
                 }
-                errors.sort_by(f64::total_cmp);
-                points.push(BudgetPoint {
-                    preset: preset.name().to_string(),
-                    model: kind.name().to_string(),
-                    patches: distinct,
-                    ramp_steps: budget.ramp_steps,
-                    cube: budget.cube,
-                    mean_de00: errors.iter().sum::<f64>() / errors.len() as f64,
-                    p95_de00: percentile(&errors, 0.95),
-                    max_de00: errors[errors.len() - 1],
-                    fit_ms: fit_ms / trials.max(1) as f64,
-                });
+            }
+        }
+        for &kind in &scattered {
+            for n in SCATTERED_SIZES {
+                done += 1;
+                let drive = scattered_patches(n, seed);
+                let outcome = study.measure(kind, &drive)?;
+                progress(done, total);
+                if let Some((errors, fit_ms)) = outcome {
+                    let none = Budget {
+                        ramp_steps: 0,
+                        cube: 0,
+                    };
+                    points.push(point(
+                        preset,
+                        format!("{kind} scattered"),
+                        n,
+                        none,
+                        errors,
+                        fit_ms,
+                    ));
+                }
             }
         }
     }
     Ok(points)
+}
+
+/// One monitor, its meter and the reproduction targets.
+struct Study<'a> {
+    panel: &'a VirtualPanel,
+    white: Xyz,
+    targets: &'a [[f64; 3]],
+    stimulus: &'a SharedWorld,
+    meter: &'a mut dyn metamer_drivers::Instrument,
+    trials: usize,
+}
+
+impl Study<'_> {
+    /// Reads `drive` `trials` times (fresh meter noise each time; errors pooled so one lucky
+    /// or unlucky reading of a primary does not make the curve), fits `kind` to each set and
+    /// returns the reproduction errors and the mean fit time in ms; None when the model
+    /// needs more than the set has.
+    fn measure(
+        &mut self,
+        kind: ModelKind,
+        drive: &[[u8; 3]],
+    ) -> Result<Option<(Vec<f64>, f64)>, BudgetError> {
+        let mut errors = Vec::with_capacity(self.targets.len() * self.trials);
+        let mut fit_ms = 0.0;
+        for _ in 0..self.trials {
+            let mut patches = Vec::with_capacity(drive.len());
+            for rgb in drive {
+                self.stimulus.set(self.panel.xyz(*rgb));
+                let reading = self.meter.measure(&Request::default())?;
+                patches.push(Sample {
+                    rgb: rgb.map(|c| f64::from(c) / 255.0),
+                    xyz: reading.xyz,
+                });
+            }
+            let start = Instant::now();
+            let Ok(profile) = fit_profile(kind, &patches, None) else {
+                return Ok(None);
+            };
+            fit_ms += start.elapsed().as_secs_f64() * 1e3;
+            errors.extend(self.targets.iter().map(|&t| {
+                let rgb = profile.inverse(t).rgb;
+                let shown = Xyz::from_array(self.panel.xyz_of_drive(rgb));
+                delta_e2000(
+                    shown.to_lab(self.white),
+                    Xyz::from_array(t).to_lab(self.white),
+                )
+            }));
+        }
+        Ok(Some((errors, fit_ms / self.trials as f64)))
+    }
+}
+
+fn point(
+    preset: Preset,
+    model: String,
+    patches: usize,
+    budget: Budget,
+    mut errors: Vec<f64>,
+    fit_ms: f64,
+) -> BudgetPoint {
+    errors.sort_by(f64::total_cmp);
+    BudgetPoint {
+        preset: preset.name().to_string(),
+        model,
+        patches,
+        ramp_steps: budget.ramp_steps,
+        cube: budget.cube,
+        mean_de00: errors.iter().sum::<f64>() / errors.len() as f64,
+        p95_de00: percentile(&errors, 0.95),
+        max_de00: errors[errors.len() - 1],
+        fit_ms,
+    }
 }
 
 /// Writes `budget.csv` and one SVG chart per preset (`budget-PRESET.svg`) into `dir`

@@ -14,6 +14,7 @@ pub mod verify;
 
 // Using a profile.
 pub mod gamut;
+pub mod icc;
 pub mod reproduce;
 
 // Measuring a display.
@@ -24,6 +25,7 @@ pub mod budget;
 
 pub use diagnostics::{Diagnostics, Noise, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitOptions};
+pub use icc::{encode_icc, IccError, IccForward, IccProfile, IccVersion};
 pub use measurements::{
     read_measurement_file, read_measurements, write_ti3, CalibrationEntry, Measurements,
     MeasurementsError, Spectra,
