@@ -119,7 +119,7 @@ fn an_exr_says_its_pixels_are_xyz_and_a_truncated_one_is_named_so() {
         pixels: vec![[1.0, 2.0, 3.0]; 4],
     };
     let p = scratch("xyz.exr");
-    write_xyz_image(&p, &img).unwrap();
+    write_xyz_image(&p, &img, &metamer::output::OutputPolicy::new(true)).unwrap();
     let meta = exr::meta::MetaData::read_from_file(&p, false).unwrap();
     let c = meta.headers[0].shared_attributes.chromaticities.unwrap();
     // OpenEXR's XYZ convention: the xy of (1,0,0), (0,1,0), (0,0,1) and (1,1,1).
@@ -267,7 +267,7 @@ fn an_exr_header_claiming_more_pixels_than_its_file_can_hold_is_refused_before_d
         pixels: vec![[1.0, 2.0, 3.0]; 4],
     };
     let p = scratch("small.exr");
-    write_xyz_image(&p, &img).unwrap();
+    write_xyz_image(&p, &img, &metamer::output::OutputPolicy::new(true)).unwrap();
     let mut bytes = std::fs::read(&p).unwrap();
     let name = b"dataWindow\0box2i\0";
     let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;

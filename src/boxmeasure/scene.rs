@@ -201,5 +201,5 @@ pub fn build(value: &Value) -> Result<Scene, BuildError> {
     let file: SceneFile =
         serde_json::from_value(value.clone()).map_err(|e| BuildError(e.to_string()))?;
     Scene::build(&file, std::path::Path::new("."))
-        .map_err(|(path, message)| BuildError(format!("{path}: {message}")))
+        .map_err(|e| BuildError(format!("{}: {}", e.path, e.message)))
 }

@@ -201,7 +201,12 @@ fn print_summary(r: &LabResult) {
         r.options.repeats, r.render_seconds, r.options.target_de
     );
     let scene = r.options.scenario.map_or_else(
-        || r.options.scene.display().to_string(),
+        || {
+            r.options
+                .scene
+                .as_ref()
+                .map_or("the built-in box".into(), |p| p.display().to_string())
+        },
         |s| format!("scenario {}", s.name()),
     );
     println!("box: {scene}");

@@ -186,8 +186,8 @@ fn seed_images(dir: &Path) -> (Vec<u8>, Vec<u8>) {
     };
     let p = dir.join("seed.pfm");
     let e = dir.join("seed.exr");
-    write_xyz_image(&p, &img).unwrap();
-    write_xyz_image(&e, &img).unwrap();
+    write_xyz_image(&p, &img, &metamer::output::OutputPolicy::new(true)).unwrap();
+    write_xyz_image(&e, &img, &metamer::output::OutputPolicy::new(true)).unwrap();
     (std::fs::read(p).unwrap(), std::fs::read(e).unwrap())
 }
 
@@ -198,7 +198,8 @@ fn seed_profiles(dir: &Path) -> Vec<Vec<u8>> {
         .filter_map(|&k| fit_profile(k, &m.patches, None).ok())
         .map(|p| {
             let path = dir.join("seed-profile.json");
-            p.save(&path).unwrap();
+            p.save(&path, &metamer::output::OutputPolicy::new(true))
+                .unwrap();
             std::fs::read(path).unwrap()
         })
         .collect()
