@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use metamer::color::{delta_e76, Lab};
 use metamer::render::deadline::Deadline;
 use metamer::render::radiosity::{render_spots_radiosity, run_level, Prepared, RadiosityOptions};
-use metamer::render::scene::{builtin, Scene, SceneFile};
+use metamer::render::scene::{Scene, SceneFile};
 use metamer::render::{render_spots, SpotOptions};
 use serde_json::{json, Value};
 
@@ -203,7 +203,7 @@ fn reflectance_slightly_above_one_warns_and_converges() {
 /// The built-in box is the file's box.
 #[test]
 fn the_built_in_box_is_the_data_file() {
-    let a = builtin::validation_box().unwrap();
+    let a = Scene::builtin("validation-box").unwrap();
     let b = Scene::load(&data_dir().join("validation-box.json")).unwrap();
     assert_eq!(level_readings(&a, 1), level_readings(&b, 1));
 }

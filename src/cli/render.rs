@@ -14,7 +14,6 @@ use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
 use metamer::render::probes::probe_illuminance_path;
 use metamer::render::radiosity::probes::{probe_illuminance, Illuminance, Probe};
 use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
-use metamer::render::scene::builtin;
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
 #[derive(clap::Args)]
@@ -343,7 +342,7 @@ struct Tagged<'a, T: serde::Serialize> {
 fn load(path: Option<&std::path::Path>) -> Result<Scene, CliError> {
     let scene = match path {
         Some(p) => Scene::load(p)?,
-        None => builtin::validation_box()?,
+        None => Scene::builtin("validation-box")?,
     };
     for w in &scene.warnings {
         eprintln!("warning: {w}");

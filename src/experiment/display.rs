@@ -10,7 +10,8 @@ use std::time::Duration;
 use metamer_drivers::{open_instrument, Instrument};
 use serde::{Deserialize, Serialize};
 
-use super::{ExperimentError, Progress};
+use super::error::ExperimentError;
+use super::progress::Progress;
 use crate::display::characterize::{self, default_grid_steps, PlanOptions};
 use crate::display::{ModelKind, Profile};
 use crate::lab::white_luminance_for;

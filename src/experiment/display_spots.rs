@@ -15,9 +15,10 @@ use metamer_drivers::MeasureMode;
 use serde::{Deserialize, Serialize};
 
 use super::display::{open_meter, open_screen, DisplaySetting};
+use super::error::ExperimentError;
+use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
 use super::reproduction::PatchDrive;
-use super::{ExperimentError, Progress};
 use crate::session::{
     DisplayScreen, InstrumentRecord, Prepare, Rig, RunEnd, RunOptions, ScriptedOperator, Session,
     SessionPlan, Step, StepProgress,

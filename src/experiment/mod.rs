@@ -12,22 +12,15 @@ pub mod cache;
 pub mod display;
 pub mod display_spots;
 mod error;
+mod progress;
 pub mod readings;
 pub mod reproduction;
 pub mod simulation;
+mod stage;
 mod stages;
 pub mod validate;
 
 pub use error::ExperimentError;
-pub use stages::{run, BoxSource, ExperimentOptions, Stage, StageOutcome};
-
-/// Where an experiment is, for a progress display.
-#[derive(Clone, Debug)]
-pub enum Progress {
-    /// A stage begins (or is re-used).
-    Stage { stage: Stage, reused: bool },
-    /// Readings done of a measuring stage.
-    Readings { done: usize, total: usize },
-    /// A line for the user.
-    Note(String),
-}
+pub use progress::Progress;
+pub use stage::Stage;
+pub use stages::{run, BoxSource, ExperimentOptions, StageOutcome};

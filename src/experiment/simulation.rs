@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use super::error::ExperimentError;
+use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
-use super::{ExperimentError, Progress};
 use crate::output::OutputPolicy;
 use crate::render::image::{render_image, ImageOptions};
 use crate::render::image_io::write_xyz_image;

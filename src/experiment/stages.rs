@@ -7,66 +7,15 @@ use serde::Serialize;
 
 use super::cache::{Inputs, StageDir, RECORD_FILE};
 use super::display::{characterize_display, DisplayOptions, DisplaySetting};
+use super::error::ExperimentError;
+use super::progress::Progress;
 use super::readings::read_readings;
 use super::reproduction::{reproduce, Reproduction, ReproductionOptions};
 use super::simulation::{simulate, SimulationOptions, SimulationSummary};
+use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
-use super::{ExperimentError, Progress};
 use crate::display::Profile;
 use crate::session::RunOptions;
-
-/// The stages, in the order they run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum Stage {
-    Box,
-    Simulation,
-    Display,
-    Reproduction,
-    DisplaySpots,
-    Validation,
-}
-
-impl Stage {
-    pub const ALL: [Stage; 6] = [
-        Stage::Box,
-        Stage::Simulation,
-        Stage::Display,
-        Stage::Reproduction,
-        Stage::DisplaySpots,
-        Stage::Validation,
-    ];
-
-    /// The stage's name and directory.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stage::Box => "box",
-            Stage::Simulation => "simulation",
-            Stage::Display => "display",
-            Stage::Reproduction => "reproduction",
-            Stage::DisplaySpots => "display-spots",
-            Stage::Validation => "validation",
-        }
-    }
-}
-
-impl std::fmt::Display for Stage {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Stage {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Stage, String> {
-        Stage::ALL
-            .into_iter()
-            .find(|st| st.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Stage::ALL.iter().map(|s| s.name()).collect();
-                format!("unknown stage '{s}' (stages: {})", names.join(", "))
-            })
-    }
-}
 
 /// Where the box's measurements come from.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -86,7 +35,7 @@ pub struct ExperimentOptions {
     /// Spot readings averaged per patch on the display.
     pub repeats: usize,
     /// Run only this stage (again, even if its inputs are unchanged).
-    pub stage: Option<super::Stage>,
+    pub stage: Option<Stage>,
     /// Continue an interrupted measuring stage's journal.
     pub resume: bool,
     /// Nobody at the rig: every operator request counts as done (simulated rigs).

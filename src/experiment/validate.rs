@@ -6,8 +6,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::cache::write_atomic;
+use super::error::ExperimentError;
 use super::readings::PatchStat;
-use super::ExperimentError;
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};

@@ -204,12 +204,10 @@ pub fn run_lab(
         Some(path) => Scene::load(path)?,
         None => {
             let scenario = opts.scenario.unwrap_or(Scenario::DisplayWhite);
-            crate::render::scene::builtin::scenario_box(scenario.builtin_name()).map_err(
-                |source| SceneError::Invalid {
-                    file: format!("(built-in {} box)", scenario.name()).into(),
-                    source,
-                },
-            )?
+            Scene::builtin(scenario.builtin_name()).map_err(|source| SceneError::Invalid {
+                file: format!("(built-in {} box)", scenario.name()).into(),
+                source,
+            })?
         }
     };
     let spot = SpotOptions {

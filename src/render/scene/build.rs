@@ -7,12 +7,13 @@ use std::sync::Arc;
 
 use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::spectral::{bins, cmf_bins, constant_bins};
+use super::builtin;
 use super::file::{CameraFile, DistributionFile, EmitterFile, SceneFile, SpectrumRef};
-use super::reader::PathError;
-use super::{
-    builtin, Camera, Distribution, Emitter, Scene, Surface, MAX_EMITTERS, MAX_LUMINANCE_CD_M2,
+use super::model::{
+    Camera, Distribution, Emitter, Scene, Surface, MAX_EMITTERS, MAX_LUMINANCE_CD_M2,
     MAX_REFLECTANCE, MAX_SURFACES, MAX_TILES, MAX_TILES_PER_SIDE, MAX_TILE_SPECTRA,
 };
+use super::reader::PathError;
 use crate::color::{ObserverKind, Outside, SpectralTable, Spectrum, K_M};
 
 type R<T> = Result<T, PathError>;

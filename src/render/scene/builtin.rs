@@ -1,8 +1,6 @@
 //! The validation boxes and the data files they name, compiled into the program so that
 //! `metamer lab` and `metamer render` work from any directory.
 
-use super::{build, PathError, Scene};
-
 /// The canonical validation box, lit by the `ips-lcd` display's white as the paper's box
 /// was lit by an LCD, as in `data/scenes/validation-box.json`.
 pub const VALIDATION_BOX: &str = include_str!("../../../data/scenes/validation-box.json");
@@ -36,16 +34,11 @@ pub fn data_file(name: &str) -> Option<&'static str> {
     })
 }
 
-/// The built-in validation box, validated.
-pub fn validation_box() -> Result<Scene, PathError> {
-    build::builtin_scene(VALIDATION_BOX)
-}
-
-/// A built-in box by name (`validation-box`, `validation-box-led-rgb1`).
-pub fn scenario_box(name: &str) -> Result<Scene, PathError> {
-    let text = match name {
+/// The text of a built-in box by name (`validation-box`, `validation-box-led-rgb1`; any
+/// other name is the default box).
+pub fn scene_text(name: &str) -> &'static str {
+    match name {
         "validation-box-led-rgb1" => VALIDATION_BOX_LED_RGB1,
         _ => VALIDATION_BOX,
-    };
-    build::builtin_scene(text)
+    }
 }

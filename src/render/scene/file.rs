@@ -6,9 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::Serialize;
 
-use super::reader;
 use crate::color::Outside;
 use crate::light::CGammaTable;
 
@@ -148,15 +147,6 @@ pub enum WriteError {
 }
 
 impl SceneFile {
-    /// Parses scene JSON; errors name the JSON path of the bad field.
-    pub fn from_json(text: &str) -> Result<SceneFile, reader::PathError> {
-        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| reader::PathError {
-            path: format!("line {} column {}", e.line(), e.column()),
-            message: format!("not JSON: {e}"),
-        })?;
-        reader::scene(&v)
-    }
-
     /// Pretty JSON of the file.
     pub fn to_json(&self) -> Result<String, serde_json::Error> {
         serde_json::to_string_pretty(self)
@@ -197,12 +187,5 @@ impl SceneFile {
             let _ = std::fs::remove_file(&tmp);
         }
         result.map_err(io)
-    }
-}
-
-impl<'de> Deserialize<'de> for SceneFile {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = serde_json::Value::deserialize(d)?;
-        reader::scene(&v).map_err(serde::de::Error::custom)
     }
 }
