@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use metamer::display::ModelKind;
+use metamer::experiment::box_stage::BoxMeasure;
 use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
@@ -19,16 +20,27 @@ pub struct Args {
     /// Output directory; each stage writes into its own subdirectory.
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: PathBuf,
-    /// The box's measured scene (`scene.json` of `metamer measure-box`).
-    #[arg(long, value_name = "SCENE")]
-    box_scene: PathBuf,
-    /// The box's spot readings (`patch,X,Y,Z,sd_X,sd_Y,sd_Z,n`).
-    #[arg(long, value_name = "CSV")]
-    box_spots: PathBuf,
+    /// The spectral instrument that measures the box's light tiles and materials (the box
+    /// stage is the `measure-box` session; sim:i1pro measures the simulated box).
+    #[arg(long, value_name = "SPEC", required_unless_present = "box_scene")]
+    spectral: Option<String>,
+    /// The box measurement plan (see `metamer measure-box --help`); default: the paper's.
+    #[arg(long, value_name = "PLAN.json")]
+    plan: Option<PathBuf>,
+    /// Readings per target in the box (default: the plan's).
+    #[arg(long, value_name = "N")]
+    box_repeats: Option<usize>,
+    /// Instead of measuring the box here: its measured scene (`scene.json` of
+    /// `metamer measure-box`) …
+    #[arg(long, value_name = "SCENE", requires = "box_spots", conflicts_with = "spectral")]
+    box_scene: Option<PathBuf>,
+    /// … and its spot readings (`patch,X,Y,Z,sd_X,sd_Y,sd_Z,n`).
+    #[arg(long, value_name = "CSV", requires = "box_scene")]
+    box_spots: Option<PathBuf>,
     /// The monitor that shows the simulation: window:N (a real monitor) or virtual:PRESET.
     #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
     display: String,
-    /// The spot meter that reads the display (and, when the box is measured here, the box).
+    /// The spot meter that reads the box (fall-off, spots) and the display.
     #[arg(long, default_value = "sim:cs100a?time_scale=0", value_name = "SPEC")]
     spot: String,
     /// Display model (see `metamer fit --help`).
@@ -90,9 +102,20 @@ pub fn run_cli(args: Args) -> CliResult {
     let interrupt = on_ctrl_c();
     let opts = ExperimentOptions {
         dir: args.out.clone(),
-        box_source: BoxSource::Existing {
-            scene: args.box_scene,
-            spots: args.box_spots,
+        box_source: match (args.box_scene, args.box_spots, args.spectral) {
+            (Some(scene), Some(spots), _) => BoxSource::Existing { scene, spots },
+            (_, _, Some(spectral)) => BoxSource::Measure(BoxMeasure {
+                spectral,
+                spot: args.spot.clone(),
+                plan: args.plan,
+                repeats: args.box_repeats,
+                seed: args.seed,
+            }),
+            _ => {
+                return Err(CliError::Usage(
+                    "give --spectral (measure the box) or --box-scene with --box-spots".into(),
+                ))
+            }
         },
         simulation: SimulationOptions {
             target_de: args.target_de,
@@ -105,7 +128,7 @@ pub fn run_cli(args: Args) -> CliResult {
         },
         display: DisplayOptions {
             screen: args.display,
-            spot: args.spot,
+            spot: args.spot.clone(),
             model,
         },
         reproduction: ReproductionOptions {

@@ -8,6 +8,7 @@
 //! exactly those downstream of a change. Measuring stages are journalled sessions and
 //! resume after any interruption.
 
+pub mod box_stage;
 pub mod cache;
 pub mod display;
 pub mod display_spots;

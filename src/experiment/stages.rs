@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::box_stage::{self, BoxMeasure};
 use super::cache::{Inputs, StageDir, RECORD_FILE};
 use super::display::{characterize_display, DisplayOptions, DisplaySetting};
 use super::error::ExperimentError;
@@ -20,6 +21,8 @@ use crate::session::RunOptions;
 /// Where the box's measurements come from.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum BoxSource {
+    /// Measured here, by the `measure-box` session into `box/`.
+    Measure(BoxMeasure),
     /// Measurements taken earlier or elsewhere: the measured scene and the spot readings.
     Existing { scene: PathBuf, spots: PathBuf },
 }
@@ -79,6 +82,10 @@ fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Experimen
 fn box_files(opts: &ExperimentOptions) -> (PathBuf, PathBuf) {
     match &opts.box_source {
         BoxSource::Existing { scene, spots } => (scene.clone(), spots.clone()),
+        BoxSource::Measure(_) => {
+            let d = opts.dir.join(Stage::Box.name());
+            (d.join(box_stage::SCENE_FILE), d.join(box_stage::SPOTS_FILE))
+        }
     }
 }
 
@@ -118,7 +125,8 @@ pub fn run(
         let start = Instant::now();
         let inputs = inputs_of(stage, opts)?;
         let forced = opts.stage == Some(stage);
-        if !forced && (stage == Stage::Box || sd.reusable(&inputs).is_some()) {
+        let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
+        if !forced && ((stage == Stage::Box && given_box) || sd.reusable(&inputs).is_some()) {
             progress(Progress::Stage {
                 stage,
                 reused: true,
@@ -135,7 +143,7 @@ pub fn run(
             stage,
             reused: false,
         });
-        if matches!(stage, Stage::Display | Stage::DisplaySpots) {
+        if matches!(stage, Stage::Box | Stage::Display | Stage::DisplaySpots) {
             if let Some(aside) = set_aside_stale(&sd)? {
                 progress(Progress::Note(format!(
                     "the {stage} stage's inputs changed: its earlier measurements are kept in {}",
@@ -166,7 +174,15 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
     let p = |s: Stage, f: &str| need(stage, stage_path(opts, s, f));
     let (scene, box_spots) = box_files(opts);
     Ok(match stage {
-        Stage::Box => Inputs::new().value("source", &opts.box_source),
+        Stage::Box => {
+            let i = Inputs::new().value("source", &opts.box_source);
+            match &opts.box_source {
+                BoxSource::Measure(BoxMeasure {
+                    plan: Some(plan), ..
+                }) => i.file("plan", plan)?,
+                _ => i,
+            }
+        }
         Stage::Simulation => Inputs::new()
             .file("scene", &need(stage, scene)?)?
             .value("options", &opts.simulation),
@@ -225,7 +241,10 @@ fn run_stage(
         ))
     };
     match stage {
-        Stage::Box => Ok(Vec::new()),
+        Stage::Box => match &opts.box_source {
+            BoxSource::Measure(m) => box_stage::measure(&sd.dir, m, opts.resume, &opts.run, progress),
+            BoxSource::Existing { .. } => Ok(Vec::new()),
+        },
         Stage::Simulation => {
             let (scene, _) = box_files(opts);
             let (_, files) = simulate(&scene, &opts.simulation, &sd.dir, progress)?;

@@ -1,0 +1,169 @@
+//! The box stage: the `measure-box` session into the experiment's `box/` directory, on the
+//! simulated truth box when both instruments are simulated, on the real box otherwise; its
+//! measured scene and spot readings are what the later stages read.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use metamer_drivers::{open_instrument, Instrument, SharedWorld, View};
+use serde::Serialize;
+
+use super::error::ExperimentError;
+use super::progress::Progress;
+use super::readings::{write_readings, PatchStat};
+use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome};
+use crate::output::OutputPolicy;
+use crate::rig::sim_scene_box::{BoxOperator, TruthBox};
+use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator};
+
+/// How the box is measured.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BoxMeasure {
+    /// The spectral instrument (tiles, materials) and the spot meter (fall-off, spots).
+    pub spectral: String,
+    pub spot: String,
+    /// A plan file; None: the paper's plan.
+    pub plan: Option<PathBuf>,
+    pub repeats: Option<usize>,
+    /// The simulated box's seed (and its instruments').
+    pub seed: u64,
+}
+
+pub const SCENE_FILE: &str = "scene.json";
+pub const SPOTS_FILE: &str = "spots.csv";
+
+fn seeded(spec: &str, seed: u64) -> String {
+    if spec.contains("seed=") {
+        spec.to_string()
+    } else if spec.contains('?') {
+        format!("{spec}&seed={seed}")
+    } else {
+        format!("{spec}?seed={seed}")
+    }
+}
+
+fn bad(message: impl std::fmt::Display) -> ExperimentError {
+    ExperimentError::Box(message.to_string())
+}
+
+/// Measures the box into `dir`; returns the files the later stages read.
+pub fn measure(
+    dir: &Path,
+    m: &BoxMeasure,
+    resume: bool,
+    run: &RunOptions,
+    progress: &dyn Fn(Progress),
+) -> Result<Vec<String>, ExperimentError> {
+    let mut plan = match &m.plan {
+        Some(p) => BoxPlan::load(p).map_err(bad)?,
+        None => BoxPlan::default(),
+    };
+    if let Some(n) = m.repeats {
+        plan.repeats = n;
+    }
+    plan.validate().map_err(bad)?;
+    let simulated = [&m.spectral, &m.spot].map(|s| s.starts_with("sim:"));
+    if simulated[0] != simulated[1] {
+        return Err(bad(
+            "the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
+        ));
+    }
+    let mut rig_options = BTreeMap::new();
+    let (mut spectral, mut spot, mut operator): (
+        Box<dyn Instrument>,
+        Box<dyn Instrument>,
+        Box<dyn Operator>,
+    ) = if simulated[0] {
+        rig_options.insert("seed".to_string(), m.seed.to_string());
+        progress(Progress::Note(format!("simulating the box (seed {})", m.seed)));
+        let truth = TruthBox::new(&plan, m.seed).map_err(bad)?;
+        let world = Arc::new(SharedWorld::new(View::Capped));
+        let spectral = open_instrument(&seeded(&m.spectral, m.seed), Some(world.clone()))?;
+        let spot = open_instrument(
+            &seeded(&m.spot, m.seed.wrapping_add(1)),
+            Some(world.clone()),
+        )?;
+        (spectral, spot, Box::new(BoxOperator::new(truth, world)))
+    } else {
+        (
+            open_instrument(&m.spectral, None)?,
+            open_instrument(&m.spot, None)?,
+            Box::new(TerminalOperator),
+        )
+    };
+    let mut output = OutputPolicy::new(true);
+    if let Some(p) = &m.plan {
+        output.input(p);
+    }
+    let options = Options {
+        output,
+        dir: dir.to_path_buf(),
+        plan,
+        stage: None,
+        resume,
+        rig_options,
+        details: BoxDetails {
+            spectral: m.spectral.clone(),
+            spot: m.spot.clone(),
+        },
+        run: run.clone(),
+    };
+    let mut sink = |p: &StepProgress<'_>| {
+        progress(Progress::Readings {
+            done: p.done,
+            total: p.total,
+        })
+    };
+    let outcome = boxmeasure::run(
+        &options,
+        Instruments {
+            spectral: spectral.as_mut(),
+            spot: spot.as_mut(),
+        },
+        operator.as_mut(),
+        &mut sink,
+    )
+    .map_err(bad)?;
+    let summary = match outcome {
+        Outcome::Finished(summary) => summary,
+        Outcome::Incomplete {
+            done, total, log, ..
+        } => {
+            return Err(ExperimentError::Incomplete {
+                stage: "box",
+                done,
+                total,
+                journal: log,
+            })
+        }
+        Outcome::StagesMissing(stages) => {
+            let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
+            return Err(bad(format!("stage(s) {} not measured", names.join(", "))));
+        }
+    };
+    // The reduction keeps Y's spread; X and Z are given the same relative spread.
+    let stats: Vec<PatchStat> = summary
+        .spot_xyz
+        .iter()
+        .zip(summary.spots.iter())
+        .map(|((patch, xyz), r)| {
+            let rel = if xyz[1] > 0.0 {
+                r.stats.sd_y / xyz[1]
+            } else {
+                0.0
+            };
+            PatchStat {
+                patch: *patch,
+                xyz: *xyz,
+                sd: xyz.map(|v| v * rel),
+                n: r.stats.n - r.stats.outliers.len(),
+            }
+        })
+        .collect();
+    write_readings(&dir.join(SPOTS_FILE), &stats)?;
+    Ok(["scene.json", "light.json", "summary.json", SPOTS_FILE]
+        .into_iter()
+        .map(String::from)
+        .collect())
+}
