@@ -87,7 +87,7 @@ fn stages_run_once_and_rerun_only_downstream_of_a_change() {
         assert_eq!(how(&first, s), "ran", "{s}");
     }
     let v: ValidationResult = serde_json::from_str(
-        &std::fs::read_to_string(out.join("validation/validation.json")).unwrap(),
+        &std::fs::read_to_string(out.join("validation/comparisons.json")).unwrap(),
     )
     .unwrap();
     // Box and simulation are the same deterministic render here.
@@ -188,6 +188,6 @@ fn a_killed_display_characterization_resumes() {
     let whole = before - 1;
     assert_eq!(&after[..whole], &journalled[..whole]);
     assert!(after.len() > before);
-    assert!(out.join("validation/validation.json").exists());
+    assert!(out.join("validation/comparisons.json").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -187,7 +187,7 @@ pub fn run_cli(args: Args) -> CliResult {
             o.dir.display()
         );
     }
-    let validation = args.out.join("validation").join("validation.json");
+    let validation = args.out.join("validation").join("comparisons.json");
     if let Ok(text) = std::fs::read_to_string(&validation) {
         if let Ok(v) =
             serde_json::from_str::<metamer::experiment::validate::ValidationResult>(&text)

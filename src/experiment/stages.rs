@@ -299,19 +299,23 @@ fn run_stage(
             let profile = Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
             let r: Reproduction =
                 read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
-            let (_, files) = validate::validate(
+            let sim_spots = stage_path(opts, Stage::Simulation, simulation::SPOTS_FILE);
+            let display_spots = stage_path(opts, Stage::DisplaySpots, display_spots::SPOTS_FILE);
+            let files = validate::ReadingFiles {
+                box_spots: &box_spots,
+                simulation: &sim_spots,
+                display: &display_spots,
+            };
+            let (_, written) = validate::validate(
                 &sd.dir,
                 profile.white_xyz,
+                &files,
                 &read_readings(&box_spots)?,
-                &read_readings(&stage_path(opts, Stage::Simulation, simulation::SPOTS_FILE))?,
-                &read_readings(&stage_path(
-                    opts,
-                    Stage::DisplaySpots,
-                    display_spots::SPOTS_FILE,
-                ))?,
+                &read_readings(&sim_spots)?,
+                &read_readings(&display_spots)?,
                 &r.out_of_gamut_patches,
             )?;
-            Ok(files)
+            Ok(written)
         }
     }
 }

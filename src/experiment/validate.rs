@@ -10,7 +10,10 @@ use super::error::ExperimentError;
 use super::readings::PatchStat;
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
-use crate::validation::{compare, write_delta_e_chart_shaded, Comparison};
+use crate::validation::{
+    assess, compare, read_readings, write_delta_e_chart_shaded, write_report_files, AssessOptions,
+    Comparison, ReportInput,
+};
 
 /// Everything the validation found, as `validation/validation.json`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -23,7 +26,7 @@ pub struct ValidationResult {
     pub display_vs_simulation: Comparison,
 }
 
-pub const FILE: &str = "validation.json";
+pub const FILE: &str = "comparisons.json";
 
 /// The readings of `a` and `b` for the patches both have, in patch order; refuses sets
 /// that do not hold the same patches (a stage that lost readings must not pass as valid).
@@ -50,9 +53,55 @@ fn paired(
     Ok((xyz(&a), xyz(&b)))
 }
 
+/// The stage's readings files, for the report (which reads them with their uncertainties).
+pub struct ReadingFiles<'a> {
+    pub box_spots: &'a Path,
+    pub simulation: &'a Path,
+    pub display: &'a Path,
+}
+
+/// The validation report (Figs. 4–6, uncertainty intervals, verdict) of the readings.
+fn report(
+    dir: &Path,
+    white: [f64; 3],
+    files: &ReadingFiles<'_>,
+    out_of_gamut: &[usize],
+) -> Result<Vec<String>, ExperimentError> {
+    let read = |p: &Path| {
+        read_readings(p).map_err(|e| ExperimentError::BadFile {
+            file: p.to_path_buf(),
+            message: e.to_string(),
+        })
+    };
+    let (b, s, d) = (read(files.box_spots)?, read(files.simulation)?, read(files.display)?);
+    let w = Xyz::from_array(white);
+    let o = AssessOptions::default();
+    let mark = |mut a: crate::validation::Assessment| {
+        for p in &mut a.patches {
+            p.out_of_gamut |= out_of_gamut.contains(&p.patch);
+        }
+        a
+    };
+    let input = ReportInput {
+        title: "metamer experiment".into(),
+        white_source: "the display's measured white (the paper's choice)".into(),
+        box_vs_display: Some(mark(assess("box", &b, "display", &d, w, &o)?)),
+        box_vs_simulation: Some(assess("box", &b, "simulation", &s, w, &o)?),
+        display_vs_simulation: Some(mark(assess("simulation", &s, "display", &d, w, &o)?)),
+        out_of_gamut: out_of_gamut.to_vec(),
+        ..ReportInput::default()
+    };
+    let written = write_report_files(dir, &input, &OutputPolicy::new(true))?;
+    Ok(written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect())
+}
+
 pub fn validate(
     dir: &Path,
     white: [f64; 3],
+    inputs: &ReadingFiles<'_>,
     box_spots: &[PatchStat],
     simulation: &[PatchStat],
     display: &[PatchStat],
@@ -103,5 +152,6 @@ pub fn validate(
     let text = serde_json::to_string_pretty(&result).map_err(ExperimentError::Json)?;
     write_atomic(&dir.join(FILE), text.as_bytes())?;
     files.push(FILE.to_string());
+    files.extend(report(dir, white, inputs, out_of_gamut)?);
     Ok((result, files))
 }
