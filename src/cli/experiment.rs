@@ -32,7 +32,12 @@ pub struct Args {
     box_repeats: Option<usize>,
     /// Instead of measuring the box here: its measured scene (`scene.json` of
     /// `metamer measure-box`) …
-    #[arg(long, value_name = "SCENE", requires = "box_spots", conflicts_with = "spectral")]
+    #[arg(
+        long,
+        value_name = "SCENE",
+        requires = "box_spots",
+        conflicts_with = "spectral"
+    )]
     box_scene: Option<PathBuf>,
     /// … and its spot readings (`patch,X,Y,Z,sd_X,sd_Y,sd_Z,n`).
     #[arg(long, value_name = "CSV", requires = "box_scene")]

@@ -76,7 +76,10 @@ pub fn measure(
         Box<dyn Operator>,
     ) = if simulated[0] {
         rig_options.insert("seed".to_string(), m.seed.to_string());
-        progress(Progress::Note(format!("simulating the box (seed {})", m.seed)));
+        progress(Progress::Note(format!(
+            "simulating the box (seed {})",
+            m.seed
+        )));
         let truth = TruthBox::new(&plan, m.seed).map_err(bad)?;
         let world = Arc::new(SharedWorld::new(View::Capped));
         let spectral = open_instrument(&seeded(&m.spectral, m.seed), Some(world.clone()))?;

@@ -242,7 +242,9 @@ fn run_stage(
     };
     match stage {
         Stage::Box => match &opts.box_source {
-            BoxSource::Measure(m) => box_stage::measure(&sd.dir, m, opts.resume, &opts.run, progress),
+            BoxSource::Measure(m) => {
+                box_stage::measure(&sd.dir, m, opts.resume, &opts.run, progress)
+            }
             BoxSource::Existing { .. } => Ok(Vec::new()),
         },
         Stage::Simulation => {

@@ -73,7 +73,11 @@ fn report(
             message: e.to_string(),
         })
     };
-    let (b, s, d) = (read(files.box_spots)?, read(files.simulation)?, read(files.display)?);
+    let (b, s, d) = (
+        read(files.box_spots)?,
+        read(files.simulation)?,
+        read(files.display)?,
+    );
     let w = Xyz::from_array(white);
     let o = AssessOptions::default();
     let mark = |mut a: crate::validation::Assessment| {
