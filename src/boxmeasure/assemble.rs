@@ -411,8 +411,19 @@ pub fn assemble(
         ldt: dir.join("light.ldt"),
         summary: dir.join("summary.json"),
     };
-    // Every file is made before any is written, so a fault leaves no half set.
+    // Every file is made and every target checked before any is written, so a fault or a
+    // refusal leaves no half set.
     let light_texts = light_files(&light, g, &date[..10])?;
+    for path in [
+        &files.scene,
+        &files.light,
+        &files.light_chart,
+        &files.ies,
+        &files.ldt,
+    ] {
+        policy.check(path)?;
+    }
+    policy.check(&files.summary)?;
     write_json(&policy, &files.scene, &scene)?;
     write_json(&policy, &files.light, &light)?;
     for (name, text) in &light_texts {
