@@ -9,9 +9,11 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use metamer::boxmeasure::compare::{compare_readings, render_scene};
-use metamer::boxmeasure::scene::{scene_json, BoxContents, DistributionJson};
+use metamer::boxmeasure::scene::{scene_json, BoxContents};
 use metamer::boxmeasure::BoxPlan;
 use metamer::color::{luminance, Outside, Spectrum, Xyz};
+use metamer::light::CGammaTable;
+use metamer::render::scene::DistributionFile;
 use metamer::rig::sim_scene_box::TruthBox;
 use serde_json::Value;
 
@@ -96,9 +98,10 @@ fn band_limited(truth: &TruthBox, plan: &BoxPlan) -> Value {
                 .iter()
                 .map(|t| bands(t, Outside::Zero))
                 .collect(),
-            distribution: DistributionJson::CosPower {
-                exponent: truth.render_exponent,
+            distribution: DistributionFile::CGamma {
+                table: truth.table.clone(),
             },
+            provenance: None,
         },
     )
 }
@@ -143,31 +146,41 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     }
     let wall = spectrum(&surfaces[0]["reflectance"]);
     assert!((wall.value_at(550.0) - truth.wall.value_at(550.0)).abs() < 0.008);
-    // Fall-off: the scene's cosᵐ is the truth's (fitted to the same angles) within the
-    // meter's noise: m moves by ~σ/ln(cos 80°) per point, far less than 0.02.
-    let m = scene["emitters"][0]["distribution"]["exponent"]
-        .as_f64()
-        .unwrap();
-    assert!(
-        (m - truth.render_exponent).abs() < 0.02,
-        "{m} vs {}",
-        truth.render_exponent
-    );
-    // The light's C-γ table keeps the asymmetry: towards the front (C = 180°, cos^0.6)
-    // brighter than downwards (C = 90°, cos^1.4) at 60°.
+    // One emitter, its 9 tiles each with its own spectrum, the fitted C-γ table.
+    let emitters = scene["emitters"].as_array().unwrap();
+    assert_eq!(emitters.len(), 1);
+    assert_eq!(emitters[0]["tiles"].as_array().unwrap().len(), 9);
+    assert_eq!(emitters[0]["distribution"]["kind"], "c_gamma");
+    let table: CGammaTable =
+        serde_json::from_value(emitters[0]["distribution"]["table"].clone()).unwrap();
+    // Fall-off: in each measured half-plane the fitted table is the truth's cos power
+    // within the meter's noise (0.1 % of each reading, relative to a 0.07 %-noisy normal)
+    // plus the fit's own misfit: 0.01 is many σ.
+    for (c, m) in [(0.0, 0.9), (90.0, 1.4), (180.0, 0.6), (270.0, 1.1)] {
+        for g in [20.0, 40.0, 60.0] {
+            let want = f64::cos(f64::to_radians(g)).powf(m);
+            let got = table.at(c, g);
+            assert!((got - want).abs() < 0.01, "C {c} γ {g}: {got} vs {want}");
+        }
+    }
+    // light.json is the fit that made it; the chart and the photometric files are written.
     let light = json(&out.join("light.json"));
-    let row = |c: usize| light["table"]["values"][c].as_array().unwrap().clone();
-    let gammas = light["table"]["gamma_deg"].as_array().unwrap();
-    let at60 = gammas
-        .iter()
-        .position(|g| g.as_f64() == Some(60.0))
-        .unwrap();
-    let (down, front) = (
-        row(1)[at60].as_f64().unwrap(),
-        row(2)[at60].as_f64().unwrap(),
+    assert_eq!(light["table"], emitters[0]["distribution"]["table"]);
+    assert!(std::fs::read_to_string(out.join("light.svg"))
+        .unwrap()
+        .contains("<svg"));
+    assert!(std::fs::read_to_string(out.join("light.ies"))
+        .unwrap()
+        .starts_with("IES:LM-63"));
+    assert!(
+        std::fs::read_to_string(out.join("light.ldt"))
+            .unwrap()
+            .lines()
+            .count()
+            > 20
     );
-    assert!((front - 0.5f64.powf(0.6)).abs() < 0.01, "{front}");
-    assert!((down - 0.5f64.powf(1.4)).abs() < 0.01, "{down}");
+    // The scene carries its provenance: every journal hashed.
+    assert_eq!(scene["provenance"]["journals"].as_array().unwrap().len(), 4);
 
     // The measured scene rendered against the box's spot readings. What it can differ by:
     // (a) the instrument's bands (the i1Pro sees 36 bands of 10 nm from 380 to 730 nm),
@@ -221,7 +234,7 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
         "{stdout}"
     );
 
-    // The nominal scene (data/ spectra and gains, cos^m guessed from the nominal fall-off).
+    // The nominal scene (data/ spectra and gains, the nominal LDC).
     let nominal = Command::new(env!("CARGO_BIN_EXE_metamer"))
         .args([
             "render",
@@ -326,7 +339,8 @@ fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("continue it with --resume"), "{e}");
 
-    run(&dir, &[&quiet[..], &["--resume"]].concat());
+    // A resume must use the instruments the journal was started with (pace included).
+    run(&dir, &[&slow[..], &["--resume"]].concat());
     let after = entries(&tiles);
     assert_eq!(after.len(), 18);
     assert_eq!(
@@ -334,10 +348,15 @@ fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
         &before[..],
         "readings before the kill are kept"
     );
-    // Noise is off: the same readings, so the same scene.
-    let a = std::fs::read_to_string(whole.join("out/scene.json")).unwrap();
-    let b = std::fs::read_to_string(dir.join("out/scene.json")).unwrap();
-    assert_eq!(a, b);
+    // Noise is off: the same readings, so the same scene; only the provenance (journal
+    // paths and hashes, date, the instruments' pace) tells the two sessions apart.
+    let scene = |d: &Path| {
+        let mut v = json(&d.join("out/scene.json"));
+        assert!(v["provenance"]["journals"].is_array());
+        v.as_object_mut().unwrap().remove("provenance");
+        v
+    };
+    assert_eq!(scene(&whole), scene(&dir));
     std::fs::remove_dir_all(&whole).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,7 +1,9 @@
 //! From the four stages' readings to the measured scene: per-tile mean spectra, the light's
 //! distribution, the measured materials, the spot readings; checked for outliers and
-//! spread; written as `scene.json` (the renderers' format), `light.json` (the distribution
-//! and its fit) and `summary.json` (everything reduced, with the provenance: journals'
+//! spread; written as `scene.json` (the renderers' format: one emitter with per-tile
+//! absolute spectra and the fitted C-γ table, the provenance inside), `light.json` (the LDC
+//! fit), `light.svg` (its chart), `light.ies` and `light.ldt` (the panel's photometry) and
+//! `summary.json` (everything reduced, with the provenance: journals'
 //! SHA-256, date, instruments with serial numbers, fit residuals, outliers). The measured
 //! scene is then rendered (radiosity) and compared with the box's own spot readings
 //! ([`super::compare`]).
@@ -13,12 +15,14 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use super::compare::{compare_render, CompareError, RenderComparison};
-use super::falloff::{distribution, FalloffError, LightDistribution, PlaneReadings};
-use super::plan::{BoxPlan, BoxStep, Plane, Stage, Target};
-use super::scene::{scene_json, BoxContents, DistributionJson};
+use super::falloff::{fit_light, light_files, LightFilesError};
+use super::plan::{BoxPlan, BoxStep, Stage, Target};
+use super::scene::{scene_json, BoxContents};
 use super::stats::{group, mean_spectrum, GroupStats, Noise, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
+use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
+use crate::render::scene::DistributionFile;
 use crate::session::{Entry, InstrumentRecord};
 
 /// What each stage journal's header says besides its plan.
@@ -72,7 +76,7 @@ pub struct Provenance {
     /// By role, with model, serial number, firmware and connection.
     pub instruments: BTreeMap<String, InstrumentRecord>,
     pub instrument_specs: BoxDetails,
-    /// The cosᵐ exponent the scene's emitters carry, its residual RMS and per angle.
+    /// The LDC model the scene's emitter carries, why, its residual RMS and per angle.
     pub distribution_fit: DistributionFit,
     pub outliers: Vec<Flagged>,
     /// ColorChecker patches the plan did not measure, taken from the nominal data.
@@ -86,9 +90,11 @@ pub struct Provenance {
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DistributionFit {
-    pub cos_power: f64,
-    pub rms: f64,
-    pub residuals: Vec<super::falloff::Residual>,
+    pub model: LdcModel,
+    pub why: String,
+    /// RMS of the relative-luminance residuals over every off-normal angle.
+    pub rms: Option<f64>,
+    pub residuals: Vec<Residual>,
 }
 
 /// The files written.
@@ -96,6 +102,9 @@ pub struct DistributionFit {
 pub struct Files {
     pub scene: PathBuf,
     pub light: PathBuf,
+    pub light_chart: PathBuf,
+    pub ies: PathBuf,
+    pub ldt: PathBuf,
     pub summary: PathBuf,
 }
 
@@ -108,7 +117,7 @@ pub struct Summary {
     pub spots: Vec<Reduced>,
     /// Mean spot reading of each patch in the plan's order, cd/m².
     pub spot_xyz: Vec<(usize, [f64; 3])>,
-    pub light: LightDistribution,
+    pub light: LdcFit,
     /// The measured scene rendered against the box's spot readings.
     pub render: RenderComparison,
     pub provenance: Provenance,
@@ -124,8 +133,10 @@ pub enum AssembleError {
         #[source]
         source: StatsError,
     },
+    #[error("the light's fall-off: {0}")]
+    Falloff(#[from] LdcError),
     #[error(transparent)]
-    Falloff(#[from] FalloffError),
+    LightFiles(#[from] LightFilesError),
     #[error("the {0} stage's readings are missing")]
     Missing(Stage),
     #[error("{}: {source}", path.display())]
@@ -302,19 +313,16 @@ pub fn assemble(
     let materials = reduce(Stage::Materials, get(Stage::Materials)?, true, &mut flags)?;
     let spots = reduce(Stage::Spots, get(Stage::Spots)?, false, &mut flags)?;
 
-    let mut planes = [Plane::Horizontal, Plane::Vertical].map(|plane| PlaneReadings {
-        plane,
-        angles_deg: Vec::new(),
-        luminance: Vec::new(),
-    });
-    for (t, r) in falloff.targets.iter().zip(&falloff.reduced) {
-        if let Target::Falloff { plane, angle_deg } = t {
-            let p = &mut planes[usize::from(*plane == Plane::Vertical)];
-            p.angles_deg.push(*angle_deg);
-            p.luminance.push(r.stats.xyz[1]);
-        }
-    }
-    let light = distribution(&planes[0], &planes[1])?;
+    let readings: Vec<_> = falloff
+        .targets
+        .iter()
+        .zip(&falloff.reduced)
+        .filter_map(|(t, r)| match t {
+            Target::Falloff { plane, angle_deg } => Some((*plane, *angle_deg, r.stats.xyz[1])),
+            _ => None,
+        })
+        .collect();
+    let light = fit_light(&readings)?;
 
     let g = &plan.geometry;
     let mut clamped_values = 0;
@@ -350,17 +358,45 @@ pub fn assemble(
         .zip(nominal)
         .map(|(m, n)| m.unwrap_or(n))
         .collect();
+    let mut journals = Vec::new();
+    for (stage, (path, _)) in &entries.stages {
+        journals.push(JournalDigest {
+            stage: *stage,
+            file: path.clone(),
+            sha256: sha256_file(path)?,
+        });
+    }
+    let date = iso_date(metamer_drivers::instrument::now_s());
+    let provenance = Provenance {
+        date: date.clone(),
+        journals,
+        instruments: instruments.clone(),
+        instrument_specs: details.clone(),
+        distribution_fit: DistributionFit {
+            model: light.model,
+            why: light.why.clone(),
+            rms: light.chosen().and_then(|c| c.rms),
+            residuals: light.residuals.clone(),
+        },
+        outliers: flags,
+        nominal_patches,
+        clamped_values,
+        nominal_frame_reflectance: super::scene::FRAME_REFLECTANCE,
+    };
     let contents = BoxContents {
         wall,
         patches,
         tiles: tile_spectra,
-        distribution: DistributionJson::CosPower {
-            exponent: light.cos_power,
+        distribution: DistributionFile::CGamma {
+            table: light.table.clone(),
         },
+        provenance: Some(
+            serde_json::to_value(&provenance).map_err(|e| io(dir)(std::io::Error::other(e)))?,
+        ),
     };
     let scene = scene_json(
         "measured validation box",
-        "The validation box as measured by metamer measure-box: per-tile spectra, the fitted fall-off, measured materials.",
+        "The validation box as measured by metamer measure-box: per-tile spectra, the fitted light distribution, measured materials.",
         g,
         &contents,
     );
@@ -370,10 +406,29 @@ pub fn assemble(
     let files = Files {
         scene: dir.join("scene.json"),
         light: dir.join("light.json"),
+        light_chart: dir.join("light.svg"),
+        ies: dir.join("light.ies"),
+        ldt: dir.join("light.ldt"),
         summary: dir.join("summary.json"),
     };
+    // Every file is made and every target checked before any is written, so a fault or a
+    // refusal leaves no half set.
+    let light_texts = light_files(&light, g, &date[..10])?;
+    for path in [
+        &files.scene,
+        &files.light,
+        &files.light_chart,
+        &files.ies,
+        &files.ldt,
+    ] {
+        policy.check(path)?;
+    }
+    policy.check(&files.summary)?;
     write_json(&policy, &files.scene, &scene)?;
     write_json(&policy, &files.light, &light)?;
+    for (name, text) in &light_texts {
+        policy.write(&dir.join(name), text.as_bytes())?;
+    }
 
     let spot_xyz: Vec<(usize, [f64; 3])> = spots
         .targets
@@ -386,29 +441,6 @@ pub fn assemble(
         .collect();
     let render = compare_render(&scene, &spot_xyz)?;
 
-    let mut journals = Vec::new();
-    for (stage, (path, _)) in &entries.stages {
-        journals.push(JournalDigest {
-            stage: *stage,
-            file: path.clone(),
-            sha256: sha256_file(path)?,
-        });
-    }
-    let provenance = Provenance {
-        date: iso_date(metamer_drivers::instrument::now_s()),
-        journals,
-        instruments: instruments.clone(),
-        instrument_specs: details.clone(),
-        distribution_fit: DistributionFit {
-            cos_power: light.cos_power,
-            rms: light.rms,
-            residuals: light.residuals.clone(),
-        },
-        outliers: flags,
-        nominal_patches,
-        clamped_values,
-        nominal_frame_reflectance: super::scene::FRAME_REFLECTANCE,
-    };
     let summary = Summary {
         tiles: tiles.reduced,
         falloff: falloff.reduced,

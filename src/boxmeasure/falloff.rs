@@ -1,227 +1,146 @@
-//! The light's angular distribution from the fall-off readings: luminance of one tile seen
-//! from signed angles in the horizontal and the vertical plane.
+//! The light's angular distribution from the fall-off readings: the mean luminance of one
+//! tile at each signed angle of the horizontal and the vertical plane, handed to the
+//! library's LDC fit ([`crate::light::fit`]), which picks the model per half-plane and
+//! writes the C-γ table the scene, the light files and the chart carry.
 //!
-//! Two forms are made from the same readings:
-//! - a C-γ table of the measured points themselves (C = 0°, 90°, 180°, 270°: the four
-//!   half-planes, γ at every measured angle), each value the reading divided by the
-//!   normal luminance, linear between measured angles and extrapolated linearly from the
-//!   last two angles out to γ = 90° (clamped to [0, the last value]); this is what the
-//!   light files carry;
-//! - the exponent m of cosᵐγ fitted to every off-normal point by least squares on
-//!   ln f = m·ln cos γ (closed form: m = Σ ln f·ln cos γ / Σ (ln cos γ)²), the rotationally
-//!   symmetric form the renderers read; its residual at each angle is reported.
+//! The plan's planes are the fit's: horizontal = C0–C180 (positive towards the emitter's
+//! `edge_u`, the box's back), vertical = C90–C270 (positive towards `edge_v`, down).
 
-use serde::{Deserialize, Serialize};
+use super::plan::{Geometry, Plane};
+use crate::light::chart::ldc_chart_svg;
+use crate::light::fit::{fit, Falloff, LdcError, LdcFit, ModelChoice, PlaneData};
+use crate::light::ies::{self, IesInfo};
+use crate::light::ldt::{self, LdtInfo};
+use crate::light::{Panel, PhotometryError};
 
-use super::plan::Plane;
-use crate::light::{CGammaError, CGammaTable};
-
-/// The mean luminance at each measured angle of one plane.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PlaneReadings {
-    pub plane: Plane,
-    /// Signed angles, increasing.
-    pub angles_deg: Vec<f64>,
-    /// cd/m² at each angle.
-    pub luminance: Vec<f64>,
-}
-
-/// One point's misfit of the cosᵐ curve.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Residual {
-    pub plane: Plane,
-    pub angle_deg: f64,
-    /// Measured relative luminance.
-    pub measured: f64,
-    /// cosᵐγ.
-    pub fitted: f64,
-}
-
-/// The distribution made from the readings.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct LightDistribution {
-    /// Normal luminance: the mean of both planes' 0° readings, cd/m².
-    pub normal_luminance: f64,
-    pub table: CGammaTable,
-    pub cos_power: f64,
-    pub residuals: Vec<Residual>,
-    /// RMS of the residuals.
-    pub rms: f64,
-}
-
-/// Readings that make no distribution.
-#[derive(Debug, thiserror::Error)]
-pub enum FalloffError {
-    #[error(
-        "the {0} plane has no reading at 0° (the normal, which the distribution is relative to)"
-    )]
-    NoNormal(&'static str),
-    #[error("the {plane} plane's reading at {angle_deg}° is {value} cd/m²: luminance must be finite and > 0 on the normal, ≥ 0 elsewhere")]
-    Bad {
-        plane: &'static str,
-        angle_deg: f64,
-        value: f64,
-    },
-    #[error("the distribution table: {0}")]
-    Table(#[from] CGammaError),
-}
-
-/// One half-plane's relative values on `gammas` (0 … 90): measured points on that side,
-/// linear between them, the normal 1, extrapolated to 90°.
-fn half_plane(points: &[(f64, f64)], gammas: &[f64]) -> Vec<f64> {
-    // points: (γ, f) with γ ≥ 0 increasing, starting (0, 1).
-    gammas
-        .iter()
-        .map(|&g| {
-            let k = points.partition_point(|p| p.0 <= g);
-            if k == points.len() {
-                let n = points.len();
-                if n < 2 {
-                    return 1.0;
-                }
-                let ((ga, fa), (gb, fb)) = (points[n - 2], points[n - 1]);
-                let slope = (fb - fa) / (gb - ga);
-                (fb + slope * (g - gb)).clamp(0.0, fb)
-            } else {
-                let ((ga, fa), (gb, fb)) = (points[k - 1], points[k]);
-                fa + (fb - fa) * (g - ga) / (gb - ga)
-            }
-        })
-        .collect()
-}
-
-/// The distribution of `horizontal` and `vertical` readings.
-pub fn distribution(
-    horizontal: &PlaneReadings,
-    vertical: &PlaneReadings,
-) -> Result<LightDistribution, FalloffError> {
-    for p in [horizontal, vertical] {
-        for (&a, &l) in p.angles_deg.iter().zip(&p.luminance) {
-            let ok = l.is_finite() && if a == 0.0 { l > 0.0 } else { l >= 0.0 };
-            if !ok {
-                return Err(FalloffError::Bad {
-                    plane: p.plane.name(),
-                    angle_deg: a,
-                    value: l,
-                });
-            }
-        }
-    }
-    let normal = |p: &PlaneReadings| {
-        p.angles_deg
+/// The fall-off readings in the fit's form: `readings` are (plane, signed angle, cd/m²) in
+/// any order; each plane's angles come out increasing.
+pub fn falloff(readings: &[(Plane, f64, f64)]) -> Falloff {
+    let plane = |which: Plane| {
+        let mut points: Vec<(f64, f64)> = readings
             .iter()
-            .position(|&a| a == 0.0)
-            .map(|i| p.luminance[i])
-            .ok_or(FalloffError::NoNormal(p.plane.name()))
-    };
-    let l0 = 0.5 * (normal(horizontal)? + normal(vertical)?);
-    let mut gammas: Vec<f64> = vec![0.0, 90.0];
-    for p in [horizontal, vertical] {
-        gammas.extend(p.angles_deg.iter().map(|a| a.abs()));
-    }
-    gammas.sort_by(f64::total_cmp);
-    gammas.dedup();
-    // Half-planes in C order 0, 90, 180, 270: (plane, side).
-    let halves = [
-        (horizontal, 1.0),
-        (vertical, 1.0),
-        (horizontal, -1.0),
-        (vertical, -1.0),
-    ];
-    let mut values = Vec::new();
-    let mut residuals = Vec::new();
-    let (mut num, mut den) = (0.0, 0.0);
-    for (p, side) in halves {
-        let mut points: Vec<(f64, f64)> = vec![(0.0, 1.0)];
-        for (&a, &l) in p.angles_deg.iter().zip(&p.luminance) {
-            if a * side > 0.0 {
-                points.push((a.abs(), l / l0));
-            }
-        }
+            .filter(|r| r.0 == which)
+            .map(|r| (r.1, r.2))
+            .collect();
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for &(g, f) in &points[1..] {
-            let lc = g.to_radians().cos().ln();
-            if f > 0.0 {
-                num += f.ln() * lc;
-                den += lc * lc;
-            }
+        PlaneData {
+            angles_deg: points.iter().map(|p| p.0).collect(),
+            luminance: points.iter().map(|p| p.1).collect(),
         }
-        values.push(half_plane(&points, &gammas));
+    };
+    Falloff {
+        horizontal: plane(Plane::Horizontal),
+        vertical: plane(Plane::Vertical),
     }
-    let cos_power = if den > 0.0 { (num / den).max(0.0) } else { 0.0 };
-    for p in [horizontal, vertical] {
-        for (&a, &l) in p.angles_deg.iter().zip(&p.luminance) {
-            residuals.push(Residual {
-                plane: p.plane,
-                angle_deg: a,
-                measured: l / l0,
-                fitted: a.to_radians().cos().powf(cos_power),
-            });
-        }
-    }
-    let rms = (residuals
-        .iter()
-        .map(|r| (r.measured - r.fitted).powi(2))
-        .sum::<f64>()
-        / residuals.len().max(1) as f64)
-        .sqrt();
-    let table = CGammaTable::new(vec![0.0, 90.0, 180.0, 270.0], gammas, values)?;
-    Ok(LightDistribution {
-        normal_luminance: l0,
-        table,
-        cos_power,
-        residuals,
-        rms,
-    })
+}
+
+/// The LDC fitted to `readings` with the model chosen by cross-validation.
+pub fn fit_light(readings: &[(Plane, f64, f64)]) -> Result<LdcFit, LdcError> {
+    fit(&falloff(readings), ModelChoice::Auto)
+}
+
+/// The light files could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum LightFilesError {
+    #[error("the light's chart: {0}")]
+    Chart(#[from] LdcError),
+    #[error("the light panel of the plan: {0}")]
+    Panel(#[from] PhotometryError),
+}
+
+/// The fitted light as files: (`light.svg`, `light.ies`, `light.ldt`) texts, for the plan's
+/// light opening (width along the columns, height along the rows) at the measured normal
+/// luminance. `date` is `YYYY-MM-DD`.
+pub fn light_files(
+    fit: &LdcFit,
+    g: &Geometry,
+    date: &str,
+) -> Result<[(&'static str, String); 3], LightFilesError> {
+    let [y0, y1, z0, z1] = g.light_m;
+    let panel = Panel::new(z1 - z0, y1 - y0, fit.normal_luminance)?;
+    let luminaire = format!(
+        "validation box light {:.3} m x {:.3} m, {} distribution fitted to measure-box fall-off",
+        panel.width_m, panel.height_m, fit.model
+    );
+    let ies_info = IesInfo {
+        test: "metamer measure-box".into(),
+        issue_date: date.into(),
+        luminaire: luminaire.clone(),
+        generation: format!("metamer measure-box, model {}", fit.model),
+    };
+    let ldt_info = LdtInfo {
+        luminaire,
+        file_name: "light.ldt".into(),
+        date_user: format!("{date} metamer measure-box"),
+    };
+    Ok([
+        ("light.svg", ldc_chart_svg(fit)?),
+        ("light.ies", ies::to_string(&fit.table, &panel, &ies_info)),
+        ("light.ldt", ldt::to_string(&fit.table, &panel, &ldt_info)),
+    ])
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn plane(plane: Plane, f: impl Fn(f64) -> f64) -> PlaneReadings {
-        let angles_deg: Vec<f64> = (-4..=4).map(|k| 20.0 * f64::from(k)).collect();
-        PlaneReadings {
-            plane,
-            luminance: angles_deg.iter().map(|&a| 80.0 * f(a)).collect(),
-            angles_deg,
+    fn readings(f: impl Fn(Plane, f64) -> f64) -> Vec<(Plane, f64, f64)> {
+        let mut out = Vec::new();
+        for plane in [Plane::Vertical, Plane::Horizontal] {
+            for k in (-4..=4).rev() {
+                let a = 20.0 * f64::from(k);
+                out.push((plane, a, 80.0 * f(plane, a)));
+            }
         }
+        out
     }
 
     #[test]
-    fn a_cos_power_light_gives_its_exponent_and_the_table_holds_the_points() {
-        let cos = |a: f64, m: f64| a.to_radians().cos().powf(m);
-        let d = distribution(
-            &plane(Plane::Horizontal, |a| cos(a, 1.5)),
-            &plane(Plane::Vertical, |a| cos(a, 1.5)),
-        )
-        .unwrap();
-        assert!((d.cos_power - 1.5).abs() < 1e-12, "{}", d.cos_power);
-        assert!(d.rms < 1e-12);
-        assert_eq!(d.normal_luminance, 80.0);
-        // A measured point, and halfway between 20° and 40° on the C = 270° side.
-        assert!((d.table.at(0.0, 60.0) - cos(60.0, 1.5)).abs() < 1e-12);
-        let mid = 0.5 * (cos(20.0, 1.5) + cos(40.0, 1.5));
-        assert!((d.table.at(270.0, 30.0) - mid).abs() < 1e-12);
-        // 90°: the 60°→80° line carried on, clamped at 0.
-        let (f60, f80) = (cos(60.0, 1.5), cos(80.0, 1.5));
-        let want = (f80 + (f80 - f60) / 2.0).max(0.0);
-        assert!((d.table.at(90.0, 90.0) - want).abs() < 1e-12);
+    fn readings_become_sorted_planes_in_the_fits_convention() {
+        let f = falloff(&readings(|p, a| {
+            if p == Plane::Horizontal {
+                1.0 + a / 1000.0
+            } else {
+                2.0
+            }
+        }));
+        assert_eq!(f.horizontal.angles_deg[0], -80.0);
+        assert_eq!(f.horizontal.angles_deg[8], 80.0);
+        assert!((f.horizontal.luminance[8] - 80.0 * 1.08).abs() < 1e-12);
+        assert!(f.vertical.luminance.iter().all(|&l| l == 160.0));
     }
 
     #[test]
-    fn asymmetric_planes_stay_apart_and_bad_readings_are_named() {
-        let h = plane(Plane::Horizontal, |a| if a > 0.0 { 0.5 } else { 1.0 });
-        let v = plane(Plane::Vertical, |_| 1.0);
-        let d = distribution(&h, &v).unwrap();
-        assert_eq!(d.table.at(0.0, 40.0), 0.5);
-        assert_eq!(d.table.at(180.0, 40.0), 1.0);
-        let mut bad = v.clone();
-        bad.luminance[4] = 0.0;
-        let e = distribution(&h, &bad).unwrap_err().to_string();
-        assert!(
-            e.contains("vertical plane's reading at 0° is 0 cd/m²"),
-            "{e}"
-        );
+    fn asymmetric_cos_power_light_is_recovered_per_half_plane() {
+        // cos^0.9 towards C0, cos^1.4 towards C90, cos^0.6 towards C180, cos^1.1 towards
+        // C270: each half-plane is one cos power, so the fit reproduces it exactly at the
+        // measured angles, and the table at C = 0° (a measured plane) is the curve itself.
+        let m = |p: Plane, a: f64| match (p, a >= 0.0) {
+            (Plane::Horizontal, true) => 0.9,
+            (Plane::Vertical, true) => 1.4,
+            (Plane::Horizontal, false) => 0.6,
+            (Plane::Vertical, false) => 1.1,
+        };
+        let fit = fit_light(&readings(|p, a| a.to_radians().cos().powf(m(p, a)))).unwrap();
+        assert_eq!(fit.normal_luminance, 80.0);
+        for (c, exp) in [(0.0, 0.9), (90.0, 1.4), (180.0, 0.6), (270.0, 1.1)] {
+            let want = 40f64.to_radians().cos().powf(exp);
+            let got = fit.table.at(c, 40.0);
+            assert!((got - want).abs() < 2e-3, "C {c}: {got} vs {want}");
+        }
+        let worst = fit
+            .residuals
+            .iter()
+            .map(|r| r.residual.abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 2e-3, "{worst}");
+    }
+
+    #[test]
+    fn a_dark_normal_is_refused_by_the_fit() {
+        let e = fit_light(&readings(|_, a| if a == 0.0 { 0.0 } else { 1.0 }))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("reads 0 at the normal"), "{e}");
     }
 }

@@ -3,15 +3,17 @@
 //! plan's [`Geometry`]. The simulated box and the measured scene are both built here, so
 //! they differ only in what was measured.
 //!
-//! Each light tile is written as its own one-tile emitter carrying its spectral radiance
-//! (W·sr⁻¹·m⁻²·nm⁻¹ along the normal) with `luminance_cd_m2` set to that spectrum's own
-//! luminance, so the renderer's scale factor is 1 and the tile emits exactly the spectrum.
+//! The light is one emitter over the opening whose tiles carry their own absolute spectral
+//! radiance (W·sr⁻¹·m⁻²·nm⁻¹ along the normal, gain 1): tile (0, 0) at the top front
+//! corner, `edge_u` along the columns towards the back (C = 0°), `edge_v` along the rows
+//! downwards (C = 90°), so the normal points into the box and the fall-off planes are the
+//! distribution's C planes.
 
 use serde_json::{json, Value};
 
 use super::plan::Geometry;
-use crate::color::{luminance, Outside, Spectrum};
-use crate::render::scene::SceneFile;
+use crate::color::{Outside, Spectrum};
+use crate::render::scene::{DistributionFile, SceneFile};
 use crate::render::Scene;
 
 /// The chart's frame (mm): 204 wide (along z) × 291 high, 1 mm off the wall.
@@ -25,14 +27,6 @@ const PATCH_OFF_M: f64 = 0.0015;
 /// The frame's flat reflectance (docs/validation-box.md); not measured.
 pub const FRAME_REFLECTANCE: f64 = 0.03;
 
-/// The emitter's angular distribution as the scene file states it.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum DistributionJson {
-    Lambertian,
-    CosPower { exponent: f64 },
-}
-
 /// What fills the box.
 #[derive(Clone, Debug)]
 pub struct BoxContents {
@@ -42,7 +36,9 @@ pub struct BoxContents {
     pub patches: Vec<Spectrum>,
     /// Each tile's spectral radiance along the normal, row-major (row 0 at the top).
     pub tiles: Vec<Spectrum>,
-    pub distribution: DistributionJson,
+    pub distribution: DistributionFile,
+    /// Where the contents come from (any JSON object), carried into the file.
+    pub provenance: Option<Value>,
 }
 
 fn inline(s: &Spectrum) -> Value {
@@ -156,28 +152,28 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
         p["patch"] = json!(i + 1);
         surfaces.push(p);
     }
-    let (h, w) = ((y1 - y0) / g.rows as f64, (z1 - z0) / g.cols as f64);
-    let emitters: Vec<Value> = c
+    let tiles: Vec<Value> = c
         .tiles
         .iter()
         .enumerate()
         .map(|(i, spectrum)| {
-            let (row, col) = ((i / g.cols) as f64, (i % g.cols) as f64);
-            json!({
-                "corner": [0.0, y1 - row * h, z0 + col * w],
-                "edge_u": [0.0, 0.0, w],
-                "edge_v": [0.0, -h, 0.0],
-                "spectrum": inline(spectrum),
-                "luminance_cd_m2": luminance(spectrum),
-                "distribution": c.distribution,
-            })
+            json!({"row": i / g.cols, "col": i % g.cols, "gain": 1.0, "spectrum": inline(spectrum)})
         })
         .collect();
-    json!({
+    let emitter = json!({
+        "corner": [0.0, y1, z0],
+        "edge_u": [0.0, 0.0, z1 - z0],
+        "edge_v": [0.0, y0 - y1, 0.0],
+        "rows": g.rows,
+        "cols": g.cols,
+        "tiles": tiles,
+        "distribution": c.distribution,
+    });
+    let mut file = json!({
         "name": name,
         "description": description,
         "surfaces": surfaces,
-        "emitters": emitters,
+        "emitters": [emitter],
         "camera": {
             "position": g.viewpoint_m,
             "look_at": centre,
@@ -187,7 +183,11 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
             "height": 1014,
         },
         "meter": {"acceptance_deg": g.acceptance_deg},
-    })
+    });
+    if let Some(p) = &c.provenance {
+        file["provenance"] = p.clone();
+    }
+    file
 }
 
 /// A scene file that does not make a scene: a fault of this module, said with the JSON

@@ -21,7 +21,8 @@ use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Output directory: the stage journals, scene.json, light.json, summary.json.
+    /// Output directory: the stage journals, scene.json, light.json/.svg/.ies/.ldt,
+    /// summary.json.
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: PathBuf,
     /// The spectral instrument: i1pro, i1pro:SERIAL, replay:FILE.jsonl or sim:i1pro.
@@ -46,7 +47,7 @@ pub struct Args {
     /// Seed of the simulated box's truth and of its instruments' noise (sim: only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     seed: u64,
-    /// Replace an existing scene.json, light.json or summary.json in DIR.
+    /// Replace an existing scene.json, light.json/.svg/.ies/.ldt or summary.json in DIR.
     #[arg(long)]
     force: bool,
     /// Stop after N new readings, as if interrupted (tests; splitting a long session).
@@ -240,11 +241,14 @@ fn print_summary(s: &Summary) -> CliResult {
     let c = &s.render.comparison;
     writeln!(
         out,
-        "tiles: {} · fall-off: {} angles, cos^{:.3} (rms {:.4}) · materials: {} · spots: {}",
+        "tiles: {} · fall-off: {} angles, {} LDC (rms {}) · materials: {} · spots: {}",
         s.tiles.len(),
         s.falloff.len(),
-        s.light.cos_power,
-        s.light.rms,
+        s.light.model,
+        s.provenance
+            .distribution_fit
+            .rms
+            .map_or("n/a".into(), |r| format!("{r:.4}")),
         s.materials.len(),
         s.spots.len()
     )?;
@@ -279,12 +283,16 @@ fn print_summary(s: &Summary) -> CliResult {
         c.below_jnd,
         c.patches.len()
     )?;
+    let f = &s.files;
     writeln!(
         out,
-        "wrote {}, {}, {}",
-        s.files.scene.display(),
-        s.files.light.display(),
-        s.files.summary.display()
+        "wrote {}, {}, {}, {}, {}, {}",
+        f.scene.display(),
+        f.light.display(),
+        f.light_chart.display(),
+        f.ies.display(),
+        f.ldt.display(),
+        f.summary.display()
     )?;
     Ok(())
 }

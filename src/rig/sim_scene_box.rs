@@ -18,10 +18,8 @@
 //! What the instruments see: on a tile, its spectral radiance; on a material, its
 //! reflectance under the instrument's lamp; at a fall-off angle, the fall-off tile's
 //! radiance times f(C, γ); aimed at a patch from the viewpoint, the patch's light as the
-//! radiosity solver renders the truth box. The renderers read only rotationally symmetric
-//! distributions, so the truth box is rendered with the cosᵐ a noiseless meter would fit to
-//! the truth's fall-off at the plan's angles; the fall-off readings themselves see the
-//! asymmetric table.
+//! radiosity solver renders the truth box with its asymmetric C-γ table (the same table the
+//! fall-off readings see).
 
 use std::collections::HashMap;
 use std::sync::{Arc, OnceLock};
@@ -29,13 +27,13 @@ use std::sync::{Arc, OnceLock};
 use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 
 use crate::boxmeasure::compare::{render_scene, CompareError};
-use crate::boxmeasure::falloff::{distribution, FalloffError, PlaneReadings};
-use crate::boxmeasure::plan::{BoxPlan, Plane, Stage, Target};
-use crate::boxmeasure::scene::{scene_json, BoxContents, DistributionJson};
+use crate::boxmeasure::plan::{BoxPlan, Stage, Target};
+use crate::boxmeasure::scene::{scene_json, BoxContents};
 use crate::color::{
     colorchecker, luminance, paper_white, ColorCheckerSet, Illuminant, Outside, Spectrum,
 };
 use crate::light::{CGammaError, CGammaTable};
+use crate::render::scene::DistributionFile;
 use crate::session::{Answer, Operator, OperatorError};
 use metamer_drivers::noise::SplitMix64;
 
@@ -44,8 +42,6 @@ use metamer_drivers::noise::SplitMix64;
 pub enum SimSceneBoxError {
     #[error("the simulated box's distribution: {0}")]
     Table(#[from] CGammaError),
-    #[error("the simulated box's fall-off: {0}")]
-    Falloff(#[from] FalloffError),
     #[error("rendering the simulated box: {0}")]
     Render(#[from] CompareError),
     #[error("the simulated box: {0}")]
@@ -68,8 +64,6 @@ pub struct TruthBox {
     /// first needed ([`TruthBox::spots`]), since only the spots stage needs it.
     spots: OnceLock<Vec<[f64; 3]>>,
     plan: BoxPlan,
-    /// The cosᵐ the truth box is rendered with.
-    pub render_exponent: f64,
     falloff_tile: usize,
 }
 
@@ -148,29 +142,12 @@ impl TruthBox {
             .collect::<Result<Vec<_>, _>>()?;
         let [fr, fc] = plan.falloff_tile();
         let falloff_tile = fr * g.cols + fc;
-        // The exponent a noiseless meter would fit at the plan's angles.
-        let l0 = luminance(&tiles[falloff_tile]);
-        let plane = |plane: Plane| PlaneReadings {
-            plane,
-            angles_deg: plan.falloff_angles_deg.clone(),
-            luminance: plan
-                .falloff_angles_deg
-                .iter()
-                .map(|&a| {
-                    let (c, gamma) = plane.c_gamma(a);
-                    l0 * table.at(c, gamma)
-                })
-                .collect(),
-        };
-        let render_exponent =
-            distribution(&plane(Plane::Horizontal), &plane(Plane::Vertical))?.cos_power;
         Ok(TruthBox {
             tiles,
             table,
             wall,
             patches,
             spots: OnceLock::new(),
-            render_exponent,
             falloff_tile,
             plan: plan.clone(),
         })
@@ -188,7 +165,7 @@ impl TruthBox {
             .get_or_init(|| rendered.iter().map(|r| r.1).collect()))
     }
 
-    /// The truth as a scene file (with the rotationally symmetric stand-in distribution).
+    /// The truth as a scene file.
     pub fn scene_json(&self) -> serde_json::Value {
         let plan = &self.plan;
         scene_json(
@@ -199,9 +176,10 @@ impl TruthBox {
                 wall: self.wall.clone(),
                 patches: self.patches.clone(),
                 tiles: self.tiles.clone(),
-                distribution: DistributionJson::CosPower {
-                    exponent: self.render_exponent,
+                distribution: DistributionFile::CGamma {
+                    table: self.table.clone(),
                 },
+                provenance: None,
             },
         )
     }
