@@ -7,7 +7,9 @@
 //! The `metamer` binary is a thin command line over this library.
 
 pub mod boxmeasure;
+pub mod calendar;
 pub mod color;
+pub mod digest;
 pub mod display;
 pub mod experiment;
 pub mod lab;

@@ -10,7 +10,7 @@ use metamer::boxmeasure::{
     Summary,
 };
 use metamer::output::OutputPolicy;
-use metamer::rig::sim_scene_box::{BoxOperator, TruthBox};
+use metamer::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use metamer::session::{
     on_ctrl_c, BarProgress, JournalError, Operator, RunEnd, RunOptions, SessionError,
     TerminalOperator,
@@ -60,16 +60,6 @@ fn usage(e: impl std::fmt::Display) -> CliError {
 }
 
 /// A simulated instrument's spec with the session's seed unless it names its own.
-fn seeded(spec: &str, seed: u64) -> String {
-    if spec.contains("seed=") {
-        spec.to_string()
-    } else if spec.contains('?') {
-        format!("{spec}&seed={seed}")
-    } else {
-        format!("{spec}?seed={seed}")
-    }
-}
-
 fn open(spec: &str, world: Option<Arc<dyn World>>) -> Result<Box<dyn Instrument>, CliError> {
     open_instrument(spec, world).map_err(|e| match e {
         DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => usage(e),

@@ -14,7 +14,7 @@ use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
 use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome};
 use crate::output::OutputPolicy;
-use crate::rig::sim_scene_box::{BoxOperator, TruthBox};
+use crate::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator};
 
 /// How the box is measured.
@@ -32,16 +32,6 @@ pub struct BoxMeasure {
 
 pub const SCENE_FILE: &str = "scene.json";
 pub const SPOTS_FILE: &str = "spots.csv";
-
-fn seeded(spec: &str, seed: u64) -> String {
-    if spec.contains("seed=") {
-        spec.to_string()
-    } else if spec.contains('?') {
-        format!("{spec}&seed={seed}")
-    } else {
-        format!("{spec}?seed={seed}")
-    }
-}
 
 fn bad(message: impl std::fmt::Display) -> ExperimentError {
     ExperimentError::Box(message.to_string())

@@ -4,11 +4,12 @@
 //! upstream changes an input hash downstream, so exactly the stages that depend on it run.
 
 use std::collections::BTreeMap;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
+
+use crate::digest::{hex, sha256_file};
 
 /// The record's file name inside a stage directory.
 pub const RECORD_FILE: &str = "stage.json";
@@ -42,27 +43,12 @@ pub struct StageRecord {
     pub seconds: f64,
 }
 
-fn hex(digest: &[u8]) -> String {
-    digest.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// SHA-256 of a file's bytes, streamed.
+/// SHA-256 of a file's bytes.
 pub fn hash_file(path: &Path) -> Result<String, CacheError> {
-    let err = |source| CacheError::Hash {
+    sha256_file(path).map_err(|source| CacheError::Hash {
         file: path.to_path_buf(),
         source,
-    };
-    let mut f = std::fs::File::open(path).map_err(err)?;
-    let mut h = Sha256::new();
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = f.read(&mut buf).map_err(err)?;
-        if n == 0 {
-            break;
-        }
-        h.update(&buf[..n]);
-    }
-    Ok(hex(&h.finalize()))
+    })
 }
 
 /// SHA-256 of a value's canonical JSON (object keys sorted): options hash the same whatever

@@ -333,6 +333,25 @@ pub fn scene(v: &Value) -> Result<SceneFile, PathError> {
     })
 }
 
+// Parsing is this file's job, so the file types' JSON entry points live here.
+impl SceneFile {
+    /// Parses scene JSON; errors name the JSON path of the bad field.
+    pub fn from_json(text: &str) -> Result<SceneFile, PathError> {
+        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| PathError {
+            path: format!("line {} column {}", e.line(), e.column()),
+            message: format!("not JSON: {e}"),
+        })?;
+        scene(&v)
+    }
+}
+
+impl<'de> Deserialize<'de> for SceneFile {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = serde_json::Value::deserialize(d)?;
+        scene(&v).map_err(serde::de::Error::custom)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -384,24 +403,5 @@ mod tests {
             scene(&v).unwrap_err().path,
             "emitters[0].distribution.table"
         );
-    }
-}
-
-// Parsing is this file's job, so the file types' JSON entry points live here.
-impl SceneFile {
-    /// Parses scene JSON; errors name the JSON path of the bad field.
-    pub fn from_json(text: &str) -> Result<SceneFile, PathError> {
-        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| PathError {
-            path: format!("line {} column {}", e.line(), e.column()),
-            message: format!("not JSON: {e}"),
-        })?;
-        scene(&v)
-    }
-}
-
-impl<'de> Deserialize<'de> for SceneFile {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = serde_json::Value::deserialize(d)?;
-        scene(&v).map_err(serde::de::Error::custom)
     }
 }
