@@ -493,6 +493,25 @@ fn emitter(
             Distribution::CosPower(*exponent)
         }
         DistributionFile::CGamma { table } => Distribution::Table(Arc::new(table.clone())),
+        DistributionFile::Ies { file } | DistributionFile::Ldt { file } => {
+            let Files::Dir(dir) = loader.files else {
+                return err(
+                    format!("{dp}.file"),
+                    "built-in scenes name no photometric file",
+                );
+            };
+            let path = dir.join(file);
+            let read = if matches!(e.distribution, DistributionFile::Ies { .. }) {
+                crate::light::ies::read(&path)
+            } else {
+                crate::light::ldt::read(&path)
+            };
+            let (table, _) = read.map_err(|e| PathError {
+                path: format!("{dp}.file"),
+                message: e.to_string(),
+            })?;
+            Distribution::Table(Arc::new(table))
+        }
     };
     let reflectance = match &e.reflectance {
         Some(r) => loader.reflectance(&format!("{p}.reflectance"), r, warnings)?,

@@ -57,6 +57,11 @@ pub enum DistributionFile {
     CosPower { exponent: f64 },
     /// A measured table f(C, γ), C from the emitter's edge_u towards edge_v.
     CGamma { table: CGammaTable },
+    /// The distribution of an IES LM-63 file (path relative to the scene file); its
+    /// candela values give the shape only, the luminance comes from the emitter.
+    Ies { file: String },
+    /// The same from a EULUMDAT (.ldt) file.
+    Ldt { file: String },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -202,8 +202,9 @@ fn surface(p: &str, v: &Value) -> Result<SurfaceFile, PathError> {
 }
 
 const DISTRIBUTION_SHAPES: &str = "{\"kind\": \"lambertian\"}, \
-    {\"kind\": \"cos_power\", \"exponent\": m} or \
-    {\"kind\": \"c_gamma\", \"table\": {\"c_deg\": […], \"gamma_deg\": […], \"values\": [[…]…]}}";
+    {\"kind\": \"cos_power\", \"exponent\": m}, \
+    {\"kind\": \"c_gamma\", \"table\": {\"c_deg\": […], \"gamma_deg\": […], \"values\": [[…]…]}}, \
+    {\"kind\": \"ies\", \"file\": \"light.ies\"} or {\"kind\": \"ldt\", \"file\": \"light.ldt\"}";
 
 fn distribution(p: &str, v: &Value) -> Result<DistributionFile, PathError> {
     let k = match v.get("kind") {
@@ -231,6 +232,15 @@ fn distribution(p: &str, v: &Value) -> Result<DistributionFile, PathError> {
                         "a C-γ table {\"c_deg\": […], \"gamma_deg\": [0 … 90], \"values\": [[1, …], …]}",
                     )
                 })?,
+            })
+        }
+        "ies" | "ldt" => {
+            let o = Obj::new(p, v, &["kind", "file"])?;
+            let file: String = o.req("file", |p, v| leaf(p, v, "a file name"))?;
+            Ok(if k == "ies" {
+                DistributionFile::Ies { file }
+            } else {
+                DistributionFile::Ldt { file }
             })
         }
         other => err(
