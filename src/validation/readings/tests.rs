@@ -1,0 +1,109 @@
+//! The readers of every readings format, on small inputs with hand-checked values.
+
+use super::*;
+
+fn parse(text: &str) -> Result<ReadingSet, ReadingsError> {
+    parse_readings(text, Path::new("r.csv"))
+}
+
+#[test]
+fn csv_repeats_give_the_standard_error_of_their_mean() {
+    // Rows 10, 12, 14 in Y: mean 12, s = 2, standard error 2/√3 = 1.1547005.
+    let s = parse("patch,X,Y,Z\n1,1,10,1\n1,1,12,1\n1,1,14,1\nwhite,95,100,108\n").unwrap();
+    assert_eq!(s.format, Format::Csv);
+    let p = &s.patches[&1];
+    assert_eq!(p.xyz, [1.0, 12.0, 1.0]);
+    assert!((p.u_xyz[1] - 1.154_700_5).abs() < 1e-6);
+    assert_eq!(p.u_xyz[0], 0.0);
+    assert_eq!((p.n, p.source), (3, UncertaintySource::Repeats));
+    assert_eq!(s.white.unwrap().xyz, [95.0, 100.0, 108.0]);
+}
+
+#[test]
+fn csv_given_sd_and_n() {
+    // sd 0.4 over n = 4 readings: u = 0.2; two such rows: √(0.2² + 0.2²)/2 = 0.1414214.
+    let s = parse("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n2,1,2,3,0.4,0.4,0.4,4\n2,1,2,3,0.4,0.4,0.4,4\n")
+        .unwrap();
+    let p = &s.patches[&2];
+    assert!((p.u_xyz[2] - 0.141_421_4).abs() < 1e-6);
+    assert_eq!((p.n, p.source), (8, UncertaintySource::Given));
+}
+
+#[test]
+fn csv_errors_name_the_line() {
+    let e = parse("patch,X,Y,Z\n1,1,2,3\n25,1,2,3\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("r.csv:3:") && e.contains("'25'"), "{e}");
+    let e = parse("patch,X,Y\n1,1,2\n").unwrap_err().to_string();
+    assert!(e.contains("r.csv:1:") && e.contains("'Z'"), "{e}");
+    let e = parse("patch,X,Y,Z\n1,1,x,3\n").unwrap_err().to_string();
+    assert!(e.contains("r.csv:2:") && e.contains("'x'"), "{e}");
+}
+
+#[test]
+fn spot_lines_unnumbered_are_patches_in_order_or_repeats() {
+    let line = |y: f64| {
+        format!(
+            "{{\"XYZ\":[1,{y},1],\"xyY\":[0.3,0.3,{y}],\"flags\":[],\"instrument\":\"cs100a\"}}\n"
+        )
+    };
+    let two: String = [1.0, 2.0].iter().map(|y| line(*y)).collect();
+    let s = parse(&two).unwrap();
+    assert_eq!(s.format, Format::SpotJson);
+    assert_eq!(s.patches[&2].xyz[1], 2.0);
+    assert_eq!(s.instruments, ["cs100a"]);
+    let rep: String = (0..48).map(|i| line(i as f64)).collect();
+    let s = parse(&rep).unwrap();
+    assert_eq!(s.patches.len(), 24);
+    assert_eq!(s.patches[&24].xyz[1], 46.5);
+    let bad: String = (0..25).map(|i| line(i as f64)).collect();
+    assert!(parse(&bad)
+        .unwrap_err()
+        .to_string()
+        .contains("25 unnumbered"));
+    let null = "{\"XYZ\":[null,1,null],\"xyY\":[null,null,1]}\n";
+    let e = parse(null).unwrap_err().to_string();
+    assert!(
+        e.contains("r.csv:1:") && e.contains("did not measure"),
+        "{e}"
+    );
+}
+
+#[test]
+fn journal_entries_by_patch_number_or_colorchecker_label() {
+    let header = r#"{"type":"header","format":"metamer-session-journal","version":2,"kind":"measure-box","fingerprint":"x","options":{},"steps":3,"started_s":0,"data":{"instruments":{"spot":{"info":{"model":"cs100a","serial":"7"},"options":{}}},"details":null}}"#;
+    let entry = |patch: &str, y: f64| {
+        format!(
+            r#"{{"type":"entry","index":0,"label":"p","role":"spot","mode":"emissive","data":{{"patch":{patch}}},"reading":{{"xyz":[1,{y},1],"xyy":[0,0,0],"spectrum":null,"flags":[],"integration_s":null,"instrument":"cs100a","timestamp_s":0}}}}"#
+        )
+    };
+    let text = format!(
+        "{header}\n{}\n{}\n{}\n{{\"type\":\"ent",
+        entry("3", 1.0),
+        entry("3", 3.0),
+        entry("\"white\"", 9.0)
+    );
+    let s = parse(&text).unwrap();
+    assert_eq!(s.format, Format::Journal);
+    assert_eq!(s.patches[&3].xyz[1], 2.0);
+    assert_eq!(s.white.as_ref().unwrap().xyz[1], 9.0);
+    assert_eq!(s.instruments, ["spot: cs100a #7"]);
+    assert!(s.notes.iter().any(|n| n.contains("torn")));
+    // characterize journals number drive colours; ColorChecker ones are known by label.
+    let text = text
+        .replace("measure-box", "characterize")
+        .replace(r#""label":"p""#, r#""label":"ColorChecker orange""#);
+    let s = parse(&text).unwrap();
+    assert_eq!(s.patches.keys().collect::<Vec<_>>(), [&7]);
+}
+
+#[test]
+fn render_json_carries_its_confidence() {
+    let text = r#"{"method":"radiosity","white":[1,1,1],"patches":[{"patch":5,"XYZ":[1,2,3],"de_bound":0.0279548}]}"#;
+    let s = parse(text).unwrap();
+    assert_eq!(s.format, Format::RenderJson);
+    let p = &s.patches[&5];
+    assert_eq!(p.source, UncertaintySource::Render);
+    assert!((p.u_lab - 0.01).abs() < 1e-6);
+}
