@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::digest::{hex, sha256_file};
+use crate::output::{OutputError, OutputPolicy};
 
 /// The record's file name inside a stage directory.
 pub const RECORD_FILE: &str = "stage.json";
@@ -23,6 +24,8 @@ pub enum CacheError {
         file: PathBuf,
         source: std::io::Error,
     },
+    #[error("{0}")]
+    Output(#[from] OutputError),
     #[error("writing {}: {source}", file.display())]
     Write {
         file: PathBuf,
@@ -156,32 +159,17 @@ impl StageDir {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory, synced and
-/// renamed over the target.
+/// Writes `bytes` to `path` by the project's output policy (a temporary sibling, synced and
+/// renamed over the target), creating the stage directory first. A stage's directory is
+/// its own, so earlier files in it are replaced.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CacheError> {
-    use std::io::Write;
-    let err = |source| CacheError::Write {
-        file: path.to_path_buf(),
-        source,
-    };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(err)?;
+        std::fs::create_dir_all(dir).map_err(|source| CacheError::Write {
+            file: path.to_path_buf(),
+            source,
+        })?;
     }
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(err)
+    Ok(OutputPolicy::new(true).write(path, bytes)?)
 }
 
 #[cfg(test)]

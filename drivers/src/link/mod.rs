@@ -179,6 +179,9 @@ impl<L: SerialLink + ?Sized> SerialLink for Box<L> {
     fn describe(&self) -> String {
         (**self).describe()
     }
+    fn report_panic(&mut self, message: &str) {
+        (**self).report_panic(message)
+    }
 }
 
 /// Finds `needle` in `haystack`; the index just past it.
