@@ -15,6 +15,7 @@ use metamer::color::{luminance, Outside, Spectrum, Xyz};
 use metamer::light::CGammaTable;
 use metamer::render::scene::DistributionFile;
 use metamer::rig::sim_scene_box::TruthBox;
+use metamer::rig::Scenario;
 use serde_json::Value;
 
 const SPECTRAL: &str = "sim:i1pro?time_scale=0";
@@ -118,7 +119,7 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     let summary = json(&out.join("summary.json"));
     let scene = json(&out.join("scene.json"));
     let plan: BoxPlan = serde_json::from_str(PLAN).unwrap();
-    let truth = TruthBox::new(&plan, 7).unwrap();
+    let truth = TruthBox::new(&plan, 7, Scenario::DisplayWhite).unwrap();
 
     // Tiles: the mean of n = 2 readings with 0.1 % (1σ) noise each, within 4σ/√2, plus the
     // i1Pro's 1e-4 conversion error (its emulator's noiseless accuracy).

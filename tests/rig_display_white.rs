@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use metamer::color::{radiance_to_xyz, ObserverKind, SpectralTable};
-use metamer::lab::white_luminance_for;
+use metamer::experiment::display::white_luminance_for;
 use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
 use metamer::render::Scene;
 use metamer::rig::virtual_display::spectral::to_csv;

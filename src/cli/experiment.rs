@@ -2,7 +2,7 @@
 //! stage re-used while its inputs are unchanged.
 
 use std::cell::RefCell;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use metamer::display::ModelKind;
@@ -10,7 +10,7 @@ use metamer::experiment::box_stage::BoxMeasure;
 use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
-use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage};
+use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::{CliError, CliResult};
@@ -63,6 +63,11 @@ pub struct Args {
     /// Samples per pixel of the image.
     #[arg(long, default_value_t = 16, value_name = "N")]
     image_spp: u64,
+    /// The simulated box's light (simulated instruments only; default display-white):
+    /// display-white (the ips-lcd display's white, as the paper's box was lit by an LCD)
+    /// or led-rgb1 (CIE LED-RGB1, whose saturated colours no virtual display can show).
+    #[arg(long, value_name = "LIGHT", conflicts_with = "box_scene")]
+    scenario: Option<String>,
     /// Spot readings averaged per patch on the display.
     #[arg(long, default_value_t = 3, value_name = "K")]
     repeats: usize,
@@ -109,13 +114,22 @@ pub fn run_cli(args: Args) -> CliResult {
         dir: args.out.clone(),
         box_source: match (args.box_scene, args.box_spots, args.spectral) {
             (Some(scene), Some(spots), _) => BoxSource::Existing { scene, spots },
-            (_, _, Some(spectral)) => BoxSource::Measure(BoxMeasure {
-                spectral,
-                spot: args.spot.clone(),
-                plan: args.plan,
-                repeats: args.box_repeats,
-                seed: args.seed,
-            }),
+            (_, _, Some(spectral)) => {
+                let simulated = spectral.starts_with("sim:") && args.spot.starts_with("sim:");
+                let light = super::measure_box::box_light(args.scenario.as_deref(), simulated)?;
+                BoxSource::Measure(BoxMeasure {
+                    spectral,
+                    spot: args.spot.clone(),
+                    plan: args.plan,
+                    repeats: args.box_repeats,
+                    seed: args.seed,
+                    light: if simulated {
+                        Some(light.unwrap_or_default())
+                    } else {
+                        light
+                    },
+                })
+            }
             _ => {
                 return Err(CliError::Usage(
                     "give --spectral (measure the box) or --box-scene with --box-spots".into(),
@@ -149,41 +163,61 @@ pub fn run_cli(args: Args) -> CliResult {
             interrupt: Some(interrupt),
         },
     };
-    let bar: RefCell<Option<ProgressBar>> = RefCell::new(None);
-    let progress = |p: Progress| match p {
-        Progress::Stage { stage, reused } => {
-            if let Some(b) = bar.borrow_mut().take() {
-                b.finish_and_clear();
+    let shown = StageProgress::default();
+    let outcomes = run(&opts, &|p| shown.show(p));
+    shown.finish();
+    print_outcomes(&outcomes?);
+    print_comparisons(&args.out);
+    Ok(())
+}
+
+/// The experiment's progress on the terminal: a line per stage, a bar while measuring.
+#[derive(Default)]
+pub(super) struct StageProgress {
+    bar: RefCell<Option<ProgressBar>>,
+}
+
+impl StageProgress {
+    pub(super) fn show(&self, p: Progress) {
+        match p {
+            Progress::Stage { stage, reused } => {
+                self.finish();
+                if reused {
+                    eprintln!("{stage}: unchanged inputs, re-used");
+                } else {
+                    eprintln!("{stage}: running");
+                }
             }
-            if reused {
-                eprintln!("{stage}: unchanged inputs, re-used");
-            } else {
-                eprintln!("{stage}: running");
+            Progress::Readings { done, total } => {
+                let mut b = self.bar.borrow_mut();
+                let b = b.get_or_insert_with(|| {
+                    let b = ProgressBar::new(total as u64);
+                    b.set_style(
+                        ProgressStyle::with_template("  {bar:40} {pos}/{len} readings, {eta} left")
+                            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                    );
+                    b
+                });
+                b.set_length(total as u64);
+                b.set_position(done as u64);
             }
+            Progress::Note(text) => match self.bar.borrow().as_ref() {
+                Some(b) => b.println(format!("  {text}")),
+                None => eprintln!("  {text}"),
+            },
         }
-        Progress::Readings { done, total } => {
-            let mut b = bar.borrow_mut();
-            let b = b.get_or_insert_with(|| {
-                let b = ProgressBar::new(total as u64);
-                b.set_style(
-                    ProgressStyle::with_template("  {bar:40} {pos}/{len} readings, {eta} left")
-                        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-                );
-                b
-            });
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-        }
-        Progress::Note(text) => match bar.borrow().as_ref() {
-            Some(b) => b.println(format!("  {text}")),
-            None => eprintln!("  {text}"),
-        },
-    };
-    let outcomes = run(&opts, &progress)?;
-    if let Some(b) = bar.borrow_mut().take() {
-        b.finish_and_clear();
     }
-    for o in &outcomes {
+
+    pub(super) fn finish(&self) {
+        if let Some(b) = self.bar.borrow_mut().take() {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// One line per stage: ran or re-used, how long, where.
+pub(super) fn print_outcomes(outcomes: &[StageOutcome]) {
+    for o in outcomes {
         println!(
             "{:<14} {:<8} {:>8.1} s  {}",
             o.stage.name(),
@@ -192,7 +226,11 @@ pub fn run_cli(args: Args) -> CliResult {
             o.dir.display()
         );
     }
-    let validation = args.out.join("validation").join("comparisons.json");
+}
+
+/// The validation's three comparisons in a line each, when the validation stage has run.
+pub(super) fn print_comparisons(dir: &Path) {
+    let validation = dir.join("validation").join("comparisons.json");
     if let Ok(text) = std::fs::read_to_string(&validation) {
         if let Ok(v) =
             serde_json::from_str::<metamer::experiment::validate::ValidationResult>(&text)
@@ -206,5 +244,4 @@ pub fn run_cli(args: Args) -> CliResult {
             }
         }
     }
-    Ok(())
 }

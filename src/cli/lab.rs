@@ -1,34 +1,27 @@
-//! `metamer lab`: the whole validation chain on the built-in simulated lab.
+//! `metamer lab`: the experiment on the simulated rig, nothing to connect and nobody at it.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
-use metamer::lab::{
-    finished_run, result_files, run_lab, LabError, LabOptions, LabProgress, LabResult, Scenario,
-    DISPLAY_DIR, LAB_FILE,
-};
-use metamer::output::OutputPolicy;
-use metamer::rig::Preset;
-use metamer::validation::Comparison;
+use metamer::lab::{run_lab, LabOptions, LabSummary, LAB_FILE};
+use metamer::rig::{Preset, Scenario};
+use metamer::session::{on_ctrl_c, RunOptions};
 
+use super::experiment::{print_outcomes, StageProgress};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Output directory: lab.json, the three comparisons (CSV + SVG), display/ (the display
-    /// characterization: log, profile, .ti3, report).
+    /// Output directory: the experiment's stage directories (box/, simulation/, display/,
+    /// reproduction/, display-spots/, validation/ with report.html) and lab.json.
     #[arg(short = 'o', long = "out", value_name = "DIR")]
     out: PathBuf,
-    /// The box: display-white (lit by the ips-lcd display's white, as the paper's box was
-    /// lit by an LCD; data/scenes/validation-box.json) or led-rgb1 (lit by CIE LED-RGB1, a
-    /// warm light whose saturated colours no virtual display can show;
-    /// data/scenes/validation-box-led-rgb1.json).
-    #[arg(long, default_value = "display-white", value_name = "NAME")]
+    /// The box's light: display-white (the ips-lcd display's white, as the paper's box was
+    /// lit by an LCD) or led-rgb1 (CIE LED-RGB1, a warm light whose saturated colours no
+    /// virtual display can show).
+    #[arg(long, default_value = "display-white", value_name = "LIGHT")]
     scenario: String,
-    /// Another box scene file instead of a named scenario.
-    #[arg(long, value_name = "SCENE", conflicts_with = "scenario")]
-    scene: Option<PathBuf>,
     /// The simulated monitor: ideal-crt, ips-lcd or wide-gamut-ccfl.
     #[arg(long, default_value = "ips-lcd", value_name = "PRESET")]
     display: String,
@@ -42,189 +35,111 @@ pub struct Args {
     /// The simulation's accuracy: 95 % half-width of every patch's ΔE*ab.
     #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
     target_de: f64,
-    /// Meter readings averaged per patch.
+    /// Spot readings averaged per patch on the display.
     #[arg(long, default_value_t = 3, value_name = "K")]
     repeats: usize,
+    /// Readings of each tile and spot in the box (default: the box plan's 5).
+    #[arg(long, value_name = "N")]
+    box_repeats: Option<usize>,
+    /// Seed of the simulated box and of its instruments' noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// The simulated meter's speed: 1 = the CS-100A's real ≈100 ms per reading.
-    #[arg(long, default_value_t = 0.05, value_name = "F")]
+    /// The simulated instruments' pace: 1 = their real pace (the CS-100A ≈100 ms per reading), 0 = at once.
+    #[arg(long, default_value_t = 0.0, value_name = "F")]
     time_scale: f64,
-    /// Continue an interrupted run in DIR (the display characterization resumes from its log).
+    /// Continue an interrupted measuring stage from its journal.
     #[arg(long)]
     resume: bool,
+    /// Run every stage again, even those whose inputs are unchanged (earlier measurements
+    /// are moved aside, never deleted).
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: Args) -> CliResult {
+    let scenario: Scenario = args.scenario.parse().map_err(CliError::Usage)?;
     let display: Preset = args.display.parse().map_err(CliError::Usage)?;
-    let (scene, scenario) = match args.scene {
-        Some(scene) => (Some(scene), None),
-        None => {
-            let scenario: Scenario = args.scenario.parse().map_err(CliError::Usage)?;
-            (None, Some(scenario))
-        }
-    };
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
     let gamut: GamutMapping = args.gamut.parse().map_err(CliError::Usage)?;
-    if args.target_de.is_nan() || args.target_de <= 0.0 {
+    if !(args.target_de > 0.0 && args.target_de.is_finite()) {
         return Err(CliError::Usage("--target-de must be above 0".into()));
     }
     if args.repeats == 0 {
         return Err(CliError::Usage("--repeats must be at least 1".into()));
     }
-    if args.time_scale.is_nan() || args.time_scale < 0.0 {
+    if args.box_repeats == Some(0) {
+        return Err(CliError::Usage("--box-repeats must be at least 1".into()));
+    }
+    if !(args.time_scale >= 0.0 && args.time_scale.is_finite()) {
         return Err(CliError::Usage("--time-scale must be 0 or more".into()));
     }
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(CliError::Usage(format!(
+            "-o {}: exists and is not a directory",
+            args.out.display()
+        )));
+    }
     let options = LabOptions {
-        scene,
         scenario,
         display,
         model,
         gamut,
         target_de: args.target_de,
         repeats: args.repeats,
+        box_repeats: args.box_repeats,
         seed: args.seed,
         time_scale: args.time_scale,
     };
-    if args.resume {
-        if let Some(json) = finished_run(&args.out, &options).map_err(translate)? {
-            return print_finished(&json);
-        }
-    }
-    let earlier = args.out.join(LAB_FILE).exists() || args.out.join(DISPLAY_DIR).exists();
-    if !args.resume && earlier {
-        return Err(translate(LabError::Exists { dir: args.out }));
-    }
-    // A resumed run replaces the files it wrote itself; a new one replaces nothing.
-    let mut out = OutputPolicy::new(args.resume);
-    if let Some(s) = &options.scene {
-        out.input(s);
-    }
-    out.dir(&args.out)?;
-    for f in result_files(&args.out) {
-        out.check(&f)?;
-    }
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {prefix}: {msg} ({elapsed})")
-            .expect("valid template"),
-    );
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    let result = run_lab(&args.out, &options, args.resume, &|p| match p {
-        LabProgress::Stage(name) => {
-            bar.set_prefix(name.to_string());
-            bar.set_message("");
-        }
-        LabProgress::Render(r) => bar.set_message(format!(
-            "{} of 24 patches at target, worst ±{:.3} ΔE*ab",
-            r.converged, r.worst_de
-        )),
-        LabProgress::Readings { done, total } => {
-            bar.set_message(format!("reading {done} of {total}"))
-        }
+    let run = RunOptions {
+        stop_after: None,
+        interrupt: Some(on_ctrl_c()),
+    };
+    let shown = StageProgress::default();
+    let summary = run_lab(&args.out, &options, args.resume, args.force, run, &|p| {
+        shown.show(p)
     });
-    bar.finish_and_clear();
-    let result = result.map_err(translate)?;
-    let written = result.write(&args.out, &out)?;
-    print_summary(&result);
+    shown.finish();
+    let (outcomes, summary) = summary?;
+    print_outcomes(&outcomes);
+    print_summary(&summary);
     println!(
-        "wrote {} and the display characterization in {}",
-        written
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-        args.out.join(DISPLAY_DIR).display()
+        "report: {}; summary: {}",
+        args.out.join(&summary.report).display(),
+        args.out.join(LAB_FILE).display()
     );
     Ok(())
 }
 
-/// A finished run resumed: its results, read back; nothing is rendered or measured.
-fn print_finished(json: &Path) -> CliResult {
-    let text = std::fs::read_to_string(json)?;
-    let lab: serde_json::Value = serde_json::from_str(&text)?;
+fn print_summary(s: &LabSummary) {
     println!(
-        "{} holds the finished run with these options; nothing to resume",
-        json.display()
+        "box lit by {}; display virtual:{}, model {}; {} of 24 simulated colours out of its gamut{}",
+        s.options.scenario,
+        s.options.display.name(),
+        s.options.model,
+        s.out_of_gamut_patches.len(),
+        if s.out_of_gamut_patches.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " (patches {}; {} mapping)",
+                s.out_of_gamut_patches
+                    .iter()
+                    .map(|p| p.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                s.options.gamut
+            )
+        }
     );
-    for name in [
-        "display_vs_box",
-        "simulation_vs_box",
-        "display_vs_simulation",
+    for c in [
+        &s.display_vs_box,
+        &s.simulation_vs_box,
+        &s.display_vs_simulation,
     ] {
-        let c: Comparison = serde_json::from_value(lab[name].clone())?;
-        println!("{name}: {}", c.summary());
+        println!(
+            "{} vs {}: {} of {} below the JND; ΔE*ab mean {:.2} max {:.2}; ΔE00 mean {:.2} max {:.2}",
+            c.test, c.reference, c.below_jnd, c.patches, c.mean_de76, c.max_de76, c.mean_de00, c.max_de00
+        );
     }
-    Ok(())
-}
-
-/// The library's errors in the words of this command's flags.
-fn translate(e: LabError) -> CliError {
-    match e {
-        // The library says what to do; here that is a flag.
-        LabError::Exists { dir } => CliError::Failed(
-            format!(
-                "{} holds an earlier lab run; choose another directory or add --resume",
-                dir.display()
-            )
-            .into(),
-        ),
-        LabError::Incomplete { missing } => CliError::Failed(
-            format!(
-                "the display characterization stopped with {missing} readings missing; run \
-                 the same command with --resume"
-            )
-            .into(),
-        ),
-        LabError::OptionDiffers {
-            dir,
-            option,
-            logged,
-            now,
-        } => CliError::Failed(
-            format!(
-                "{} holds a finished lab run whose --{} is {logged}, this one's is {now}; run \
-                 with the options it was made with, or choose another directory",
-                dir.display(),
-                option.replace('_', "-")
-            )
-            .into(),
-        ),
-        e => CliError::from(e),
-    }
-}
-
-fn print_summary(r: &LabResult) {
-    let v = &r.display_characterization.verification;
-    println!(
-        "box: {} readings per patch; simulation: {:.1} s of rendering to ΔE*ab ±{} (95 %)",
-        r.options.repeats, r.render_seconds, r.options.target_de
-    );
-    let scene = r.options.scenario.map_or_else(
-        || {
-            r.options
-                .scene
-                .as_ref()
-                .map_or("the built-in box".into(), |p| p.display().to_string())
-        },
-        |s| format!("scenario {}", s.name()),
-    );
-    println!("box: {scene}");
-    println!(
-        "display: virtual:{} at {:.1} cd/m² white, model {} (held-out ΔE00 mean {:.2}, max {:.2}); {}",
-        r.options.display.name(),
-        r.display_white_cd_m2,
-        r.options.model,
-        v.mean,
-        v.max,
-        r.display_characterization.verdict
-    );
-    println!(
-        "{} of 24 simulated colours out of the display's gamut ({} mapping)",
-        r.out_of_gamut, r.options.gamut
-    );
-    for (name, c) in r.comparisons() {
-        println!("{name}: {}", c.summary());
-    }
-    println!("total {:.1} s", r.seconds);
+    println!("total {:.1} s", s.seconds);
 }

@@ -11,6 +11,7 @@ use metamer::boxmeasure::{
 };
 use metamer::output::OutputPolicy;
 use metamer::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
+use metamer::rig::Scenario;
 use metamer::session::{
     on_ctrl_c, BarProgress, JournalError, Operator, RunEnd, RunOptions, SessionError,
     TerminalOperator,
@@ -47,6 +48,11 @@ pub struct Args {
     /// Seed of the simulated box's truth and of its instruments' noise (sim: only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     seed: u64,
+    /// The simulated box's light (sim: only; default display-white): display-white (the
+    /// ips-lcd display's white, as the paper's box was lit by an LCD) or led-rgb1 (CIE
+    /// LED-RGB1, a warm light whose saturated colours no virtual display can show).
+    #[arg(long, value_name = "LIGHT")]
+    scenario: Option<String>,
     /// Replace an existing scene.json, light.json/.svg/.ies/.ldt or summary.json in DIR.
     #[arg(long)]
     force: bool,
@@ -65,6 +71,18 @@ fn open(spec: &str, world: Option<Arc<dyn World>>) -> Result<Box<dyn Instrument>
         DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => usage(e),
         e => CliError::from(e),
     })
+}
+
+/// The simulated box's light named by `--scenario`; refused with real instruments, whose
+/// box is lit by whatever light it has.
+pub(super) fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, CliError> {
+    match (name, simulated) {
+        (None, _) => Ok(None),
+        (Some(n), true) => n.parse().map(Some).map_err(usage),
+        (Some(_), false) => Err(usage(
+            "--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light",
+        )),
+    }
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -96,11 +114,14 @@ pub fn run(args: Args) -> CliResult {
             "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
         ));
     }
+    let light = box_light(args.scenario.as_deref(), simulated[0])?;
     let mut rig_options = BTreeMap::new();
     let (mut spectral, mut spot, mut operator): (_, _, Box<dyn Operator>) = if simulated[0] {
+        let light = light.unwrap_or_default();
         rig_options.insert("seed".to_string(), args.seed.to_string());
-        eprintln!("simulating the box (seed {})…", args.seed);
-        let truth = TruthBox::new(&plan, args.seed)?;
+        rig_options.insert("light".to_string(), light.name().to_string());
+        eprintln!("simulating the box (seed {}, lit by {light})…", args.seed);
+        let truth = TruthBox::new(&plan, args.seed, light)?;
         let world = Arc::new(SharedWorld::new(View::Capped));
         let spectral = open(&seeded(&args.spectral, args.seed), Some(world.clone()))?;
         let spot = open(

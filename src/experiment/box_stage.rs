@@ -15,6 +15,7 @@ use super::readings::{write_readings, PatchStat};
 use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome};
 use crate::output::OutputPolicy;
 use crate::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
+use crate::rig::Scenario;
 use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator};
 
 /// How the box is measured.
@@ -28,6 +29,11 @@ pub struct BoxMeasure {
     pub repeats: Option<usize>,
     /// The simulated box's seed (and its instruments').
     pub seed: u64,
+    /// The simulated box's light (None: the default). A real box has its own light, so it
+    /// is refused with real instruments; left out of the stage's hash when None, so a real
+    /// rig's box stage stays valid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub light: Option<Scenario>,
 }
 
 pub const SCENE_FILE: &str = "scene.json";
@@ -65,12 +71,14 @@ pub fn measure(
         Box<dyn Instrument>,
         Box<dyn Operator>,
     ) = if simulated[0] {
+        let light = m.light.unwrap_or_default();
         rig_options.insert("seed".to_string(), m.seed.to_string());
+        rig_options.insert("light".to_string(), light.name().to_string());
         progress(Progress::Note(format!(
-            "simulating the box (seed {})",
+            "simulating the box (seed {}, lit by {light})",
             m.seed
         )));
-        let truth = TruthBox::new(&plan, m.seed).map_err(bad)?;
+        let truth = TruthBox::new(&plan, m.seed, light).map_err(bad)?;
         let world = Arc::new(SharedWorld::new(View::Capped));
         let spectral = open_instrument(&seeded(&m.spectral, m.seed), Some(world.clone()))?;
         let spot = open_instrument(
@@ -79,6 +87,11 @@ pub fn measure(
         )?;
         (spectral, spot, Box::new(BoxOperator::new(truth, world)))
     } else {
+        if let Some(light) = m.light {
+            return Err(bad(format!(
+                "the light '{light}' is the simulated box's; real instruments measure the real box, lit by its own light"
+            )));
+        }
         (
             open_instrument(&m.spectral, None)?,
             open_instrument(&m.spot, None)?,

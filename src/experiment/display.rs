@@ -8,13 +8,13 @@ use std::path::Path;
 use std::time::Duration;
 
 use metamer_drivers::{open_instrument, Instrument};
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::error::ExperimentError;
 use super::progress::Progress;
 use crate::display::characterize::{self, default_grid_steps, PlanOptions};
 use crate::display::{ModelKind, Profile};
-use crate::lab::white_luminance_for;
 use crate::rig::{Screen, ScreenSpec, VirtualDisplay, VirtualPanel};
 use crate::session::{RunOptions, ScriptedOperator, StepProgress, TerminalOperator};
 
@@ -59,6 +59,39 @@ pub fn open_screen(
         )),
         _ => parsed.open()?,
     })
+}
+
+/// Headroom above the brightest in-gamut target, so no channel sits at its very end.
+const LUMINANCE_HEADROOM: f64 = 1.05;
+
+/// The full-white luminance (cd/m²) at which every target the panel's primaries can show
+/// fits below full drive: the paper sets the display's maximum luminance so that no tone
+/// mapping is needed. The panel's own primaries at its nominal setting give the linear
+/// drives (paper Eq. 9 without the TRC); targets outside the primaries' triangle need gamut
+/// mapping whatever the luminance, so they do not raise it.
+pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
+    let black = Vector3::from(panel.xyz([0; 3]));
+    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb)) - black;
+    let m = Matrix3::from_columns(&[
+        column([255, 0, 0]),
+        column([0, 255, 0]),
+        column([0, 0, 255]),
+    ]);
+    let nominal_white = panel.xyz([255; 3])[1];
+    let Some(inv) = m.try_inverse() else {
+        return nominal_white;
+    };
+    let needed = targets
+        .iter()
+        .map(|t| inv * Vector3::from(*t))
+        .filter(|lin| lin.iter().all(|&c| c >= 0.0))
+        .map(|lin| lin.max())
+        .fold(0.0, f64::max);
+    if needed > 0.0 {
+        nominal_white * needed * LUMINANCE_HEADROOM
+    } else {
+        nominal_white
+    }
 }
 
 /// The spot meter aimed at `screen` (a simulated meter sees a simulated screen).
@@ -190,4 +223,28 @@ pub fn characterize_display(
     let text = serde_json::to_string_pretty(&setting).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SETTING_FILE), text.as_bytes())?;
     Ok((setting, vec![SETTING_FILE, PROFILE_FILE, SUMMARY_FILE]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rig::Preset;
+
+    /// Doubling the luminance a target asks for doubles the white luminance chosen, and a
+    /// target on the nominal white needs the nominal white (plus headroom).
+    #[test]
+    fn white_luminance_scales_with_the_targets() {
+        let panel = VirtualPanel::preset(Preset::IdealCrt);
+        let white = panel.xyz([255; 3]);
+        let black = panel.xyz([0; 3]);
+        let w_minus_k = [0, 1, 2].map(|k| white[k] - black[k]);
+        let at = |s: f64| w_minus_k.map(|c| c * s);
+        let one = white_luminance_for(&panel, &[at(1.0)]);
+        assert!((one - white[1] * LUMINANCE_HEADROOM).abs() < 1e-9 * white[1]);
+        let two = white_luminance_for(&panel, &[at(1.0), at(2.0)]);
+        assert!((two / one - 2.0).abs() < 1e-9);
+        // Beyond the primaries: ignored.
+        let outside = white_luminance_for(&panel, &[at(1.0), [-5.0, 80.0, 0.0]]);
+        assert!((outside - one).abs() < 1e-9);
+    }
 }

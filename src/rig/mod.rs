@@ -2,14 +2,15 @@
 //! uniform colours to be measured (a full-screen window on a monitor, or a simulated
 //! monitor); display mathematics (models, fitting, reproduction) stays in `display`.
 
+pub mod scenario;
 pub mod screen;
-pub mod sim_box;
 pub mod sim_meter;
 pub mod sim_scene_box;
 pub mod spec;
 pub mod virtual_display;
 pub mod window;
 
+pub use scenario::Scenario;
 pub use screen::{Screen, ScreenError};
 pub use spec::{OpenError, ScreenSpec};
 pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};

@@ -3,12 +3,22 @@
 //! see for each step, so a whole box measurement runs with `sim:i1pro` and `sim:cs100a`
 //! and nobody at the rig.
 //!
+//! The box's light is a [`Scenario`]: by default the `ips-lcd` virtual display's white, as
+//! the paper's box was lit by an LCD showing white, or CIE LED-RGB1.
+//!
 //! How the truth differs from the nominal box (all seeded):
-//! - each tile's spectrum is LED-RGB1 at 100 cd/m² times a gain that falls off towards the
+//! - each tile's spectrum is the light at 100 cd/m² times a gain that falls off towards the
 //!   panel's edges (6 % at the corners), tilts across it (+4 % towards the back, −3 %
 //!   towards the top) and varies 1 % (1σ) from tile to tile, times a spectral tilt
 //!   1 + k·(λ − 560 nm)/220 nm with k from −0.09 to +0.09 across the panel: a
-//!   colour-temperature gradient;
+//!   colour-temperature gradient. Every patch sees the whole panel, so the gradient
+//!   averages out at the patches: under the display's white, dropping it moves no patch's
+//!   linear drives on the `ips-lcd` by more than 2·10⁻⁴ of full drive (seeds 1–3), and it
+//!   is kept. What does put two patches on the edge of that display's gamut is physics,
+//!   not the tilt: a surface filters each primary's spectrum, and a filtered primary need
+//!   not lie inside the primaries' triangle — the yellow patch (16) lies just past its
+//!   red–green edge (linear blue drive −0.001 to −0.005 of full, seeds 1–3), the cyan (18)
+//!   just inside it but beyond what the panel's crosstalk leaves reachable;
 //! - the light's distribution is asymmetric: cos^0.9 γ towards the back (C = 0°), cos^1.4
 //!   downwards (C = 90°), cos^0.6 towards the front (C = 180°), cos^1.1 upwards (C = 270°);
 //! - the wall paper and the 24 ColorChecker patches are the `data/` reflectances times
@@ -29,11 +39,10 @@ use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 use crate::boxmeasure::compare::{render_scene, CompareError};
 use crate::boxmeasure::plan::{BoxPlan, Stage, Target};
 use crate::boxmeasure::scene::{scene_json, BoxContents};
-use crate::color::{
-    colorchecker, luminance, paper_white, ColorCheckerSet, Illuminant, Outside, Spectrum,
-};
+use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum};
 use crate::light::{CGammaError, CGammaTable};
 use crate::render::scene::DistributionFile;
+use crate::rig::Scenario;
 use crate::session::{Answer, Operator, OperatorError};
 use metamer_drivers::noise::SplitMix64;
 
@@ -50,6 +59,9 @@ pub enum SimSceneBoxError {
 
 /// The exponents of the truth's four half-planes, C = 0°, 90°, 180°, 270°.
 pub const TRUTH_EXPONENTS: [f64; 4] = [0.9, 1.4, 0.6, 1.1];
+
+/// A tile's luminance before its gain, cd/m², whatever the light.
+pub const TILE_CD_M2: f64 = 100.0;
 
 /// The box as it really is (in the simulation).
 #[derive(Clone, Debug)]
@@ -102,12 +114,13 @@ fn perturbed(base: &Spectrum, rng: &mut SplitMix64) -> Result<Spectrum, SimScene
 }
 
 impl TruthBox {
-    /// The truth box of `plan`'s geometry, perturbed by `seed`, with its spots rendered.
-    pub fn new(plan: &BoxPlan, seed: u64) -> Result<TruthBox, SimSceneBoxError> {
+    /// The truth box of `plan`'s geometry lit by `light`, perturbed by `seed` (the same
+    /// seed perturbs every light alike).
+    pub fn new(plan: &BoxPlan, seed: u64, light: Scenario) -> Result<TruthBox, SimSceneBoxError> {
         let g = &plan.geometry;
         let mut rng = SplitMix64::new(seed ^ 0x6d62_6f78);
-        let led = Illuminant::LedRgb1.spectrum();
-        let led = led.scaled(100.0 / luminance(&led));
+        let source = light.spectrum();
+        let source = source.scaled(TILE_CD_M2 / luminance(&source));
         let half = |n: usize| ((n as f64 - 1.0) / 2.0).max(1.0);
         let mut tiles = Vec::new();
         for row in 0..g.rows {
@@ -119,7 +132,7 @@ impl TruthBox {
                     * (1.0 + 0.01 * rng.normal());
                 let k = 0.06 * u + 0.03 * v;
                 tiles.push(on_grid(
-                    |l| led.value_at(l) * gain * (1.0 + k * (l - 560.0) / 220.0),
+                    |l| source.value_at(l) * gain * (1.0 + k * (l - 560.0) / 220.0),
                     Outside::Zero,
                 )?);
             }
