@@ -54,7 +54,7 @@ enum Command {
     /// The paper's whole chain, stage by stage: box, simulation, display, reproduction,
     /// display spots, validation.
     Experiment(experiment::Args),
-    /// The whole validation chain on the built-in simulated lab: box, simulation, display.
+    /// The experiment on the simulated rig: the box measured, simulated, shown, validated.
     Lab(lab::Args),
     /// The light source's distribution: fit it to fall-off readings, export and read IES/LDT.
     Light(light::Args),
