@@ -74,6 +74,10 @@ fn render_convergence_with_no_or_endless_time_is_refused_before_the_reference_ru
             "{seconds}: no output directory is made"
         );
     }
+    let d = scratch("conv-target");
+    let out = d.join("c").display().to_string();
+    let (_, _, err) = refused(&["render", "convergence", "-o", &out, "--reference-de", "0"]);
+    assert!(err.contains("the ΔE*ab target must be > 0, got 0"), "{err}");
     let d = scratch("conv-dir");
     let file = a_file(&d);
     let (_, _, err) = refused(&["render", "convergence", "-o", &file, "--seconds", "1"]);
