@@ -67,7 +67,7 @@ pub enum ConvergenceError {
     Output(#[from] OutputError),
     #[error(
         "the time budget per strategy must be more than 0 s and at most {MAX_SECONDS_PER_STRATEGY} \
-         s (a day), got {seconds} s"
+         s (a day), got {seconds:?} s"
     )]
     Seconds { seconds: f64 },
 }
