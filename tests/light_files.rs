@@ -158,3 +158,58 @@ fn cos_power_panel_flux_is_two_pi_l_a_over_n_plus_two() {
     let want = 2.0 * PI * 300.0 * 0.1 / 3.7;
     assert!((flux_lm(&f.table, &panel) - want).abs() < 2e-4 * want);
 }
+
+/// Found by the fuzz harness: a count of 2³² horizontal angles made the IES reader ask for
+/// 34 GB before it found the file holds a few hundred numbers.
+#[test]
+fn an_ies_count_larger_than_the_file_ends_at_the_end_of_the_file() {
+    let panel = Panel::new(0.3, 0.2, 1500.0).unwrap();
+    let text = ies::to_string(&asymmetric_table(), &panel, &ies_info());
+    let lines: Vec<&str> = text.split("\r\n").collect();
+    let tilt = lines.iter().position(|l| *l == "TILT=NONE").unwrap();
+    let mut fields: Vec<&str> = lines[tilt + 1].split_whitespace().collect();
+    fields[4] = "4294967296";
+    let counts = fields.join(" ");
+    let mut broken = lines.clone();
+    broken[tilt + 1] = &counts;
+    let e = ies::parse(&broken.join("\r\n"), Path::new("big.ies"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the file ends before"), "{e}");
+}
+
+/// Found by the fuzz harness: EULUMDAT numbers that are not finite (an opening of `inf` mm,
+/// a lamp flux of 1e308 lm) were accepted into the photometry.
+#[test]
+fn an_ldt_with_a_non_finite_opening_or_overflowing_intensities_is_refused() {
+    let panel = Panel::new(0.3, 0.2, 1500.0).unwrap();
+    let text = ldt::to_string(&asymmetric_table(), &panel, &ldt_info());
+    let with_lines = |edits: &[(usize, &str)]| {
+        let mut lines: Vec<&str> = text.split("\r\n").collect();
+        for &(k, value) in edits {
+            lines[k - 1] = value;
+        }
+        lines.join("\r\n")
+    };
+    for (line, value) in [(17, "inf"), (16, "NaN"), (17, "-inf")] {
+        let e = ldt::parse(&with_lines(&[(line, value)]), Path::new("o.ldt"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("not a finite size"),
+            "line {line} = {value}: {e}"
+        );
+    }
+    // Line 29: the one lamp set's flux, and line 24 the conversion factor, which scale
+    // every cd/klm value.
+    let e = ldt::parse(
+        &with_lines(&[(24, "1000"), (29, "1e308")]),
+        Path::new("f.ldt"),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("too large to use") || e.contains("must be finite"),
+        "{e}"
+    );
+}

@@ -310,3 +310,51 @@ fn ies_and_ldt_files_are_emitter_distributions() {
     let e = Scene::build(&f, data_dir()).unwrap_err();
     assert_eq!(e.path, "emitters[0].distribution.file");
 }
+
+/// A scene saved by an editor that puts a UTF-8 byte-order mark first loads as without it.
+#[test]
+fn a_scene_with_a_byte_order_mark_loads() {
+    let d = temp_dir("bom");
+    std::fs::create_dir_all(d.join("scenes")).unwrap();
+    for csv in [
+        "colorchecker_babelcolor_average.csv",
+        "display_white_ips_lcd.csv",
+        "paper_white_reflectance.csv",
+    ] {
+        std::fs::copy(data_dir().join("..").join(csv), d.join(csv)).unwrap();
+    }
+    let text = std::fs::read_to_string(data_dir().join("validation-box.json")).unwrap();
+    let (plain, bom) = (d.join("scenes/plain.json"), d.join("scenes/bom.json"));
+    std::fs::write(&plain, &text).unwrap();
+    std::fs::write(&bom, format!("\u{feff}{text}")).unwrap();
+    let a = Scene::load(&bom).unwrap();
+    let b = Scene::load(&plain).unwrap();
+    assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// A megabyte in a key, a value or a file name is quoted to 80 characters, not whole.
+#[test]
+fn a_megabyte_field_is_not_echoed_whole_in_a_scene_error() {
+    let big = "y".repeat(1 << 20);
+    let d = temp_dir("echo");
+    let mut key = box_json("validation-box.json");
+    key["surfaces"][0][big.as_str()] = json!(1);
+    let mut value = box_json("validation-box.json");
+    value["surfaces"][0]["reflectance"] = json!({ "nm": [400, 700], "values": big });
+    let mut file = box_json("validation-box.json");
+    file["surfaces"][0]["reflectance"] = json!({ "file": big });
+    for (what, v, words) in [
+        ("key", key, "surfaces[0].yyy"),
+        ("value", value, "surfaces[0].reflectance.values"),
+        ("file", file, "surfaces[0].reflectance.file"),
+    ] {
+        let p = d.join(format!("{what}.json"));
+        std::fs::write(&p, v.to_string()).unwrap();
+        let e = Scene::load(&p).unwrap_err().to_string();
+        assert!(e.len() < 1000, "{what}: {} bytes: {}", e.len(), &e[..1000]);
+        assert!(e.contains(words), "{what}: {e}");
+        assert!(e.contains('…'), "{what}: {e}");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}

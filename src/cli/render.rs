@@ -307,6 +307,8 @@ pub fn run(args: Args) -> CliResult {
             seed,
             force,
         } => {
+            convergence::check_seconds(seconds)
+                .map_err(|e| CliError::Usage(format!("--seconds: {e}")))?;
             let mut out = OutputPolicy::new(force);
             if let Some(s) = &scene {
                 out.input(s);

@@ -114,6 +114,13 @@ pub fn run(args: Args) -> CliResult {
         }
         e => CliError::from(e),
     })?;
+    // Before measuring: a colorimeter's readings would be taken and then have no spectrum.
+    if args.spectrum.is_some() && !instrument.capabilities().spectral {
+        return Err(CliError::Usage(format!(
+            "--spectrum: the {} measures no spectrum (a colorimeter); leave --spectrum out",
+            instrument.info().model
+        )));
+    }
     if let Some(speed) = args.speed {
         let speed = match speed {
             SpeedArg::Fast => Speed::Fast,
@@ -155,7 +162,7 @@ pub fn run(args: Args) -> CliResult {
     if let Some(path) = &args.spectrum {
         let csv = spectra_csv(&readings).ok_or_else(|| {
             CliError::Usage(format!(
-                "--spectrum: the {} measures no spectrum (a colorimeter); leave --spectrum out",
+                "--spectrum: the {} returned readings without a spectrum",
                 info.model
             ))
         })?;

@@ -166,7 +166,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
                 format!("the number of tilt angles {n} is not a count"),
             ));
         }
-        for _ in 0..(2 * n as usize) {
+        for _ in 0..(n as usize).saturating_mul(2) {
             next("the tilt table")?;
         }
     }
@@ -212,8 +212,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     next("the ballast factor")?;
     next("the file generation type")?;
     next("the input watts")?;
+    // The counts are the file's word: the lists grow with the numbers actually there, so a
+    // count of 4294967296 ends at the end of the file, not in a 34 GB allocation.
     let mut read_n = |n: usize, what: &str| -> Result<(usize, Vec<f64>), PhotometryError> {
-        let mut v = Vec::with_capacity(n);
+        let mut v = Vec::new();
         let mut first_line = 0;
         for k in 0..n {
             let (line, x) = next(what)?;
@@ -226,7 +228,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     };
     let (_, gammas) = read_n(n_vertical, "the vertical angles")?;
     let (h_line, horizontal) = read_n(n_horizontal, "the horizontal angles")?;
-    let mut rows = Vec::with_capacity(n_horizontal);
+    let mut rows = Vec::new();
     for &c in &horizontal {
         let (_, row) = read_n(n_vertical, &format!("the candela values of C-plane {c}°"))?;
         rows.push(

@@ -169,6 +169,18 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
             "no lamp sets: the cd/klm values cannot be scaled to candela".into(),
         ));
     }
+    // Six lines per lamp set follow: a count the file cannot hold is a corrupt header (and
+    // must not overflow the line arithmetic below).
+    if sets > lines.len() {
+        return Err(fmt_err(
+            26,
+            format!(
+                "{sets} lamp sets need {} more lines, but the file has {} lines",
+                sets.saturating_mul(6),
+                lines.len()
+            ),
+        ));
+    }
     // Lines 27 … 26 + 6n: lamp counts, types, fluxes, colours, colour rendering, wattages.
     let mut total_flux = 0.0;
     for k in 0..sets {

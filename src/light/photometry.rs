@@ -287,6 +287,18 @@ pub(crate) fn finish(
     planes: Vec<(f64, Vec<f64>)>,
     gamma_deg: &[f64],
 ) -> Result<(CGammaTable, Photometry), String> {
+    // A file may state any number; what it says must still be a usable opening.
+    for (what, v) in [
+        ("width", opening.width_m),
+        ("height", opening.height_m),
+        ("area", opening.area_m2),
+    ] {
+        if !v.is_finite() {
+            return Err(format!(
+                "the luminous opening's {what} is {v}, not a finite size"
+            ));
+        }
+    }
     if gamma_deg.first() != Some(&0.0) {
         return Err(format!(
             "the γ angles start at {}°: a flat emitter's distribution needs γ from 0° (its normal)",
@@ -340,6 +352,13 @@ pub(crate) fn finish(
     }
     let (table, i0) = candela_to_table(c_deg, gammas, &candela)?;
     let flux_lm = i0 * projected_solid_angle(&table);
+    // Finite intensities can still sum past the largest number (1e308 cd in a file).
+    if !(i0.is_finite() && flux_lm.is_finite()) {
+        return Err(format!(
+            "the intensities are too large to use: the intensity along the normal is {i0} cd, \
+             the flux {flux_lm} lm"
+        ));
+    }
     let photometry = Photometry {
         format,
         width_m: opening.width_m,

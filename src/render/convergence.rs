@@ -65,6 +65,26 @@ pub enum ConvergenceError {
     Chart(String),
     #[error("{0}")]
     Output(#[from] OutputError),
+    #[error(
+        "the time budget per strategy must be more than 0 s and at most {MAX_SECONDS_PER_STRATEGY} \
+         s (a day), got {seconds:?} s"
+    )]
+    Seconds { seconds: f64 },
+}
+
+/// Longest time budget per strategy: a day. Beyond it a budget is a mistake (1e308 would
+/// run for ever), not a longer chart.
+pub const MAX_SECONDS_PER_STRATEGY: f64 = 86_400.0;
+
+/// Whether `seconds` can be a time budget per strategy. [`run`] checks it before its
+/// reference run, which alone takes tens of seconds (with no time per strategy there would
+/// be nothing to chart); callers that create outputs first can check it sooner.
+pub fn check_seconds(seconds: f64) -> Result<(), ConvergenceError> {
+    if seconds > 0.0 && seconds <= MAX_SECONDS_PER_STRATEGY {
+        Ok(())
+    } else {
+        Err(ConvergenceError::Seconds { seconds })
+    }
 }
 
 /// Runs every strategy with doubling sample counts until `seconds_per_strategy` is spent.
@@ -76,6 +96,7 @@ pub fn run(
     seed: u64,
     log: &dyn Fn(&str),
 ) -> Result<(Vec<Point>, [f64; 3]), ConvergenceError> {
+    check_seconds(seconds_per_strategy)?;
     let reference = render_spots(
         scene,
         &SpotOptions {

@@ -11,11 +11,14 @@
 //! when they carry these chromaticities or none (metamer wrote none before).
 //!
 //! Every reader refuses what would make the rest of the chain lie or stall: sizes whose
-//! pixel count overflows or exceeds [`MAX_PIXELS`], and NaN or infinite pixels.
+//! pixel count overflows or exceeds [`MAX_PIXELS`], an OpenEXR file whose header, offset
+//! table or chunk sizes do not fit its length (checked before the `exr` crate decodes, see
+//! `exr_layout`), and NaN or infinite pixels.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
+use super::exr_layout;
 use crate::output::{OutputError, OutputPolicy};
 
 /// An XYZ image, rows top to bottom.
@@ -36,9 +39,9 @@ impl XyzImage {
 /// the camera's 1014 × 1014, so a corrupt header cannot ask for an unbounded allocation.
 pub const MAX_PIXELS: usize = 1 << 26;
 
-/// Most pixels one byte of EXR can decode to: ZIP's deflate compresses at most about
-/// 1032 : 1 and a pixel is at least 6 bytes (three half floats), so 172; 256 leaves room.
-const EXR_PIXELS_PER_BYTE: u64 = 256;
+/// Largest EXR file read: [`MAX_PIXELS`] of four float channels uncompressed, and room for
+/// the header and offset table.
+const MAX_EXR_BYTES: u64 = (MAX_PIXELS as u64) * 16 + (1 << 20);
 
 /// XYZ stored in R, G, B (see the module comment).
 fn xyz_chromaticities() -> exr::meta::attribute::Chromaticities {
@@ -201,62 +204,67 @@ pub fn write_xyz_image(
 pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
     match ext(path).as_str() {
         "pfm" => read_pfm(path),
-        "exr" => {
-            use exr::prelude::*;
-            // The header first, so a corrupt size is refused before any pixel is allocated.
-            let meta = MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
-            let file_len = std::fs::metadata(path).map_err(io(path))?.len();
-            for header in meta.headers.iter() {
-                let size = header.layer_size;
-                let pixels = pixel_count(path, size.width(), size.height())?;
-                // The decoder allocates its whole image before it finds the data missing:
-                // a size no compression can fit into the file is a corrupt header.
-                if pixels as u64 > file_len.saturating_mul(EXR_PIXELS_PER_BYTE).max(4096) {
-                    return Err(ImageIoError::Exr {
-                        file: path.to_path_buf(),
-                        message: format!(
-                            "the header says {}×{} pixels, more than a file of {file_len} bytes \
-                             can hold: the header is corrupt",
-                            size.width(),
-                            size.height()
-                        ),
-                    });
-                }
-                let xyz = xyz_chromaticities();
-                if let Some(c) = header.shared_attributes.chromaticities {
-                    if c != xyz {
-                        return Err(ImageIoError::Exr {
-                            file: path.to_path_buf(),
-                            message: format!(
-                                "holds RGB with primaries R {:?}, G {:?}, B {:?} (white {:?}), \
-                                 not XYZ (R (1,0), G (0,1), B (0,0), white (1/3,1/3))",
-                                c.red, c.green, c.blue, c.white
-                            ),
-                        });
-                    }
-                }
-            }
-            let image = read_first_rgba_layer_from_file(
-                path,
-                |res, _| XyzImage {
-                    width: res.width(),
-                    height: res.height(),
-                    pixels: vec![[0.0; 3]; res.width() * res.height()],
-                },
-                |img: &mut XyzImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                    let w = img.width;
-                    img.pixels[pos.y() * w + pos.x()] = [r, g, b];
-                },
-            )
-            .map_err(|e| exr_error(path, e))?;
-            let img = image.layer_data.channel_data.pixels;
-            check_finite(path, &img)?;
-            Ok(img)
-        }
+        "exr" => read_exr(path),
         _ => Err(ImageIoError::UnknownType {
             file: path.to_path_buf(),
         }),
     }
+}
+
+/// Reads an OpenEXR file whose layout [`exr_layout::check`] found safe to decode.
+fn read_exr(path: &Path) -> Result<XyzImage, ImageIoError> {
+    use exr::prelude::*;
+    let bad = |message: String| ImageIoError::Exr {
+        file: path.to_path_buf(),
+        message,
+    };
+    let file_len = std::fs::metadata(path).map_err(io(path))?.len();
+    if file_len > MAX_EXR_BYTES {
+        return Err(bad(format!(
+            "{file_len} bytes is more than an image this reader accepts can take \
+             ({MAX_EXR_BYTES} bytes)"
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(io(path))?;
+    // Our own reading of the layout first: the crate sizes buffers by what the file says.
+    exr_layout::check(&bytes).map_err(bad)?;
+    let meta = MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
+        .map_err(|e| exr_error(path, e))?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        pixel_count(path, size.width(), size.height())?;
+        let xyz = xyz_chromaticities();
+        if let Some(c) = header.shared_attributes.chromaticities {
+            if c != xyz {
+                return Err(bad(format!(
+                    "holds RGB with primaries R {:?}, G {:?}, B {:?} (white {:?}), not XYZ \
+                     (R (1,0), G (0,1), B (0,0), white (1/3,1/3))",
+                    c.red, c.green, c.blue, c.white
+                )));
+            }
+        }
+    }
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _| XyzImage {
+                width: res.width(),
+                height: res.height(),
+                pixels: vec![[0.0; 3]; res.width() * res.height()],
+            },
+            |img: &mut XyzImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                let w = img.width;
+                img.pixels[pos.y() * w + pos.x()] = [r, g, b];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(&bytes))
+        .map_err(|e| exr_error(path, e))?;
+    let img = image.layer_data.channel_data.pixels;
+    check_finite(path, &img)?;
+    Ok(img)
 }
 
 fn pfm_bytes(img: &XyzImage) -> Vec<u8> {

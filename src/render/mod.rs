@@ -22,6 +22,7 @@ pub use spot::{
 };
 pub mod convergence;
 pub mod deadline;
+mod exr_layout;
 pub mod image;
 pub mod image_io;
 pub mod probes;

@@ -13,6 +13,7 @@ use std::io::{Read, Seek, SeekFrom, Write};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 
+use metamer_color::text::{echo, echo_message, strip_bom};
 use metamer_drivers::{CalibrationCondition, MeasureMode};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,11 @@ pub struct CalibrationRecord {
     pub condition: CalibrationCondition,
     /// The step it was done before (0-based plan index).
     pub before_step: usize,
+    /// The step whose calibration noise a simulated instrument drew for it: `before_step`,
+    /// or for a calibration made again on resuming, that of the calibration it stands for
+    /// (absent in journals written before it was recorded: then `before_step`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_step: Option<usize>,
     /// When, seconds since the Unix epoch.
     pub time_s: f64,
 }
@@ -85,14 +91,14 @@ pub enum JournalError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}, line {line}: {message}", path.display())]
+    #[error("{}, line {line}: {}", path.display(), echo_message(message))]
     Bad {
         path: PathBuf,
         line: usize,
         message: String,
     },
     /// The journal belongs to a plan made from other options.
-    #[error("{} was written by another session: its option {option} is {logged}, this one's is {now}; resume with the options it was started with, or choose another output directory", path.display())]
+    #[error("{} was written by another session: its option {} is {}, this one's is {}; resume with the options it was started with, or choose another output directory", path.display(), echo(option), echo(logged), echo(now))]
     OptionDiffers {
         path: PathBuf,
         option: String,
@@ -100,7 +106,7 @@ pub enum JournalError {
         now: String,
     },
     /// The same options, yet other steps: the program that plans them changed.
-    #[error("{} was written by another session: every option is the same but its steps differ (plan {logged}, this one {now}); it was planned by another version of this program", path.display())]
+    #[error("{} was written by another session: every option is the same but its steps differ (plan {}, this one {now}); it was planned by another version of this program", path.display(), echo(logged))]
     StepsDiffer {
         path: PathBuf,
         logged: String,
@@ -110,7 +116,7 @@ pub enum JournalError {
     /// while it was being written. Nothing was measured into it.
     #[error("{} holds no session to continue: {what}; resuming sets it aside and starts afresh", path.display())]
     Broken { path: PathBuf, what: String },
-    #[error("{} was written by a {logged} session, not a {now} session", path.display())]
+    #[error("{} was written by a {} session, not a {now} session", path.display(), echo(logged))]
     KindDiffers {
         path: PathBuf,
         logged: String,
@@ -206,7 +212,13 @@ where
         let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
         let tail = &bytes[complete..];
         // A tail that parses is a whole line that lost only its newline: keep it.
-        let tail_is_whole = !tail.is_empty() && serde_json::from_slice::<Line<H, E>>(tail).is_ok();
+        let tail_json = if complete == 0 {
+            without_bom(tail)
+        } else {
+            tail
+        };
+        let tail_is_whole =
+            !tail.is_empty() && serde_json::from_slice::<Line<H, E>>(tail_json).is_ok();
         let bad = |line: usize, message: String| JournalError::Bad {
             path: path.to_path_buf(),
             line,
@@ -221,7 +233,8 @@ where
             bad(line, "not UTF-8 text".into())
         })?;
         // Blank lines carry nothing (an editor's trailing newline, a line a tool added): skip.
-        let mut lines = text
+        // A byte-order mark (an editor's) is not part of the header line.
+        let mut lines = strip_bom(text)
             .lines()
             .enumerate()
             .map(|(i, l)| (i + 1, l))
@@ -238,7 +251,8 @@ where
                         n,
                         format!(
                             "format {} version {} is not {JOURNAL_FORMAT} version {JOURNAL_VERSION}",
-                            v["format"], v["version"]
+                            echo(&v["format"].to_string()),
+                            echo(&v["version"].to_string())
                         ),
                     ));
                 }
@@ -391,6 +405,7 @@ fn existing(path: &Path) -> JournalError {
 /// off before its end (the crash came while the header was written). None when there is a
 /// header line to read (whether it is a valid one is for [`Journal::resume`] to say).
 fn broken(bytes: &[u8]) -> Option<String> {
+    let bytes = without_bom(bytes);
     let Some(start) = bytes.iter().position(|b| !b.is_ascii_whitespace()) else {
         return Some(if bytes.is_empty() {
             "it is empty".into()
@@ -407,6 +422,11 @@ fn broken(bytes: &[u8]) -> Option<String> {
         ));
     }
     None
+}
+
+/// The bytes after a UTF-8 byte-order mark, if they start with one.
+fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes)
 }
 
 /// Moves the journal at `path` aside to `PATH.broken-N` (the first N free) and returns

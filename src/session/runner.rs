@@ -22,11 +22,9 @@ use super::step::{Rig, StepFailure, StepTaker};
 /// The session could not start or go on.
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
-    #[error("creating the directory {}: {source}", dir.display())]
-    Dir {
-        dir: PathBuf,
-        source: std::io::Error,
-    },
+    /// The journal's directory cannot be made or used (a file stands where it should be).
+    #[error(transparent)]
+    Dir(#[from] crate::output::OutputError),
     #[error(transparent)]
     Journal(#[from] JournalError),
     #[error("the plan's steps do not serialize to JSON: {0}")]
@@ -107,6 +105,8 @@ pub struct Session<H, D> {
     journal: SessionJournal<H, D>,
     entries: Vec<Option<Entry<D>>>,
     calibrations: Vec<CalibrationRecord>,
+    /// Calibrations found in the journal when the session was resumed.
+    earlier_calibrations: usize,
     /// Entries found in the journal when the session was resumed.
     pub recovered: usize,
     /// Bytes of a torn last line set aside on resuming (0 if none).
@@ -131,10 +131,7 @@ where
         resume: bool,
     ) -> Result<Self, SessionError> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|source| SessionError::Dir {
-                dir: dir.to_path_buf(),
-                source,
-            })?;
+            crate::output::OutputPolicy::new(false).dir(dir)?;
         }
         let header = Header {
             format: JOURNAL_FORMAT.into(),
@@ -171,6 +168,7 @@ where
                 journal,
                 entries,
                 calibrations: Vec::new(),
+                earlier_calibrations: 0,
                 recovered: 0,
                 torn_bytes: 0,
                 set_aside,
@@ -221,6 +219,7 @@ where
             plan,
             journal,
             entries,
+            earlier_calibrations: recovered.calibrations.len(),
             calibrations: recovered.calibrations,
             recovered: n,
             torn_bytes: recovered.torn_bytes,
@@ -349,6 +348,7 @@ where
                 rig,
                 journal: &mut self.journal,
                 calibrations: &mut self.calibrations,
+                earlier_calibrations: self.earlier_calibrations,
                 progress,
             };
             let reading = match taker.take().map_err(fail)? {

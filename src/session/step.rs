@@ -72,6 +72,10 @@ pub enum StepFailure {
     Journal(#[from] JournalError),
 }
 
+/// Noise streams with this bit set are calibrations' (see [`StepTaker::calibrate`]); plan
+/// indices never reach it.
+const CALIBRATION_NOISE: u64 = 1 << 63;
+
 /// One step being taken, with what it needs borrowed from the session.
 pub(super) struct StepTaker<'s, 'r, 'a, H, D> {
     pub(super) index: usize,
@@ -79,6 +83,8 @@ pub(super) struct StepTaker<'s, 'r, 'a, H, D> {
     pub(super) rig: &'r mut Rig<'a>,
     pub(super) journal: &'s mut SessionJournal<H, D>,
     pub(super) calibrations: &'s mut Vec<CalibrationRecord>,
+    /// How many of `calibrations` were journalled by earlier runs of the session.
+    pub(super) earlier_calibrations: usize,
     pub(super) progress: &'s mut dyn ProgressSink,
 }
 
@@ -129,11 +135,51 @@ where
 
     /// Negotiates the calibration the step's instrument asks for, if any, or else the one
     /// a failed measurement `asked` for; false when the operator aborted.
+    ///
+    /// A simulated instrument's calibration draws its noise from a stream of its own, keyed
+    /// by the step of the calibration it stands for, and the step's reading then draws from
+    /// the step's stream as if no calibration had come before it. A resumed session must
+    /// calibrate again (a new process has a new device) and stands for the calibration in
+    /// force when the earlier run stopped: so it calibrates, and then reads, exactly as the
+    /// uninterrupted session did.
     fn calibrate(&mut self, asked: Option<CalibrationCondition>) -> Result<bool, StepFailure> {
-        let (role, mode) = (self.step.role.clone(), self.step.mode);
-        let Some(mut condition) = self.instrument()?.calibration_needed(mode)?.or(asked) else {
+        let mode = self.step.mode;
+        let Some(condition) = self.instrument()?.calibration_needed(mode)?.or(asked) else {
             return Ok(true);
         };
+        let noise_step = self.calibration_noise_step();
+        self.instrument()?
+            .seek_noise(CALIBRATION_NOISE | noise_step as u64);
+        let done = self.negotiate(condition, noise_step);
+        let index = self.index as u64;
+        self.instrument()?.seek_noise(index);
+        done
+    }
+
+    /// The step whose calibration noise a calibration now draws: this step's, unless this
+    /// run has not yet calibrated the role's instrument for the mode and an earlier run
+    /// did — then the one that earlier run's last such calibration drew.
+    fn calibration_noise_step(&self) -> usize {
+        let (role, mode) = (&self.step.role, self.step.mode);
+        let same = |c: &&CalibrationRecord| &c.role == role && c.mode == mode;
+        let (earlier, this_run) = self.calibrations.split_at(self.earlier_calibrations);
+        if this_run.iter().any(|c| same(&c)) {
+            return self.index;
+        }
+        earlier
+            .iter()
+            .rev()
+            .find(same)
+            .map_or(self.index, |c| c.noise_step.unwrap_or(c.before_step))
+    }
+
+    /// Has the operator set up each condition the calibration asks for and journals it.
+    fn negotiate(
+        &mut self,
+        mut condition: CalibrationCondition,
+        noise_step: usize,
+    ) -> Result<bool, StepFailure> {
+        let (role, mode) = (self.step.role.clone(), self.step.mode);
         for _ in 0..CALIBRATION_ATTEMPTS {
             let model = self.instrument()?.info().model;
             let prompt = format!(
@@ -150,6 +196,7 @@ where
                 mode,
                 condition: condition.clone(),
                 before_step: self.index,
+                noise_step: Some(noise_step),
                 time_s: metamer_drivers::instrument::now_s(),
             };
             self.journal.append_calibration(&record)?;

@@ -22,6 +22,21 @@ static LARGEST: AtomicUsize = AtomicUsize::new(0);
 static INPUT: AtomicPtr<u8> = AtomicPtr::new(std::ptr::null_mut());
 static INPUT_LEN: AtomicUsize = AtomicUsize::new(0);
 
+std::thread_local! {
+    /// The largest request made by this thread since [`reset_thread_largest`].
+    static THREAD_LARGEST: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// Starts measuring this thread's largest request afresh (other tests run beside it).
+pub fn reset_thread_largest() {
+    THREAD_LARGEST.with(|c| c.set(0));
+}
+
+/// This thread's largest request since [`reset_thread_largest`].
+pub fn thread_largest() -> usize {
+    THREAD_LARGEST.with(|c| c.get())
+}
+
 /// Registers the input about to run, for the message a breached cap writes.
 pub fn set_input(bytes: &[u8]) {
     INPUT_LEN.store(bytes.len(), Ordering::SeqCst);
@@ -74,6 +89,9 @@ unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         let size = layout.size();
         LARGEST.fetch_max(size, Ordering::Relaxed);
+        // A const-initialised Cell has no destructor: safe to touch from the allocator, and
+        // try_with leaves a thread being torn down alone.
+        let _ = THREAD_LARGEST.try_with(|c| c.set(c.get().max(size)));
         let live = LIVE.fetch_add(size, Ordering::Relaxed) + size;
         if size > SINGLE_CAP || live > LIVE_CAP {
             LIVE.fetch_sub(size, Ordering::Relaxed);

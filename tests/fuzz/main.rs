@@ -9,6 +9,7 @@
 //! (`METAMER_FUZZ_SEED` changes the inputs, `METAMER_FUZZ_ONLY` picks parsers by name).
 
 mod alloc;
+mod exr_class;
 mod mutate;
 mod targets;
 
@@ -166,6 +167,34 @@ fn every_parser_survives_a_long_run_of_mutated_inputs() {
     let only: String = env_or("METAMER_FUZZ_ONLY", String::new());
     let report = fuzz(iterations, seed, &only);
     assert_clean(&report);
+}
+
+/// The class of the EXR finding: small files whose header, offset table or chunks state
+/// sizes the file cannot hold are refused in words about the file, before the `exr` crate
+/// decodes them, and reading one allocates no more than a small multiple of its size.
+#[test]
+fn corrupt_exr_layouts_are_refused_in_our_words_within_the_memory_cap() {
+    let dir = std::env::temp_dir().join(format!("metamer-exr-class-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let valid = exr_class::valid(&dir, 3, 2);
+    for (what, bytes, words) in exr_class::corrupt(&valid) {
+        let path = dir.join("corrupt.exr");
+        std::fs::write(&path, &bytes).unwrap();
+        alloc::reset_thread_largest();
+        let e = metamer::render::image_io::read_xyz_image(&path)
+            .expect_err(what)
+            .to_string();
+        let largest = alloc::thread_largest();
+        assert!(e.contains(words), "{what}: {e}");
+        assert!(e.starts_with(&path.display().to_string()), "{what}: {e}");
+        assert!(!e.contains("missing bytes"), "{what}: {e}");
+        assert!(
+            largest < 64 * 1024,
+            "{what}: an allocation of {largest} bytes for a file of {} bytes",
+            bytes.len()
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The LUT fit of a large scattered patch set once asked for 177 GB; its memory must grow

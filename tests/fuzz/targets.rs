@@ -176,6 +176,92 @@ fn eeprom(bytes: &[u8], _: &Path) -> Check {
     Ok(())
 }
 
+/// What a photometric file reader accepted must be a usable distribution: finite, ≥ 0
+/// everywhere it is asked, and finite photometry.
+fn photometric(
+    read: &Result<
+        (metamer::light::CGammaTable, metamer::light::Photometry),
+        metamer::light::PhotometryError,
+    >,
+) -> Check {
+    let Ok((table, photometry)) = read else {
+        return Ok(());
+    };
+    for c in [0.0, 45.0, 90.0, 135.0, 180.0, 270.0, 359.9] {
+        for g in [0.0, 30.0, 60.0, 89.9, 90.0] {
+            let v = table.at(c, g);
+            if !v.is_finite() || v < 0.0 {
+                return Err(format!("a distribution of {v} at C {c}°, γ {g}"));
+            }
+        }
+    }
+    let p = photometry;
+    for v in [p.width_m, p.height_m, p.area_m2, p.normal_intensity_cd] {
+        if !v.is_finite() {
+            return Err(format!("photometry accepted with a value of {v}"));
+        }
+    }
+    Ok(())
+}
+
+fn ies(bytes: &[u8], _: &Path) -> Check {
+    photometric(&metamer::light::ies::parse(
+        &String::from_utf8_lossy(bytes),
+        Path::new("fuzz.ies"),
+    ))
+}
+
+fn ldt(bytes: &[u8], _: &Path) -> Check {
+    photometric(&metamer::light::ldt::parse(
+        &String::from_utf8_lossy(bytes),
+        Path::new("fuzz.ldt"),
+    ))
+}
+
+/// IES and EULUMDAT text as the program writes them: a symmetric cos-power panel and an
+/// asymmetric table of four C-planes.
+fn seed_photometric() -> (Vec<Vec<u8>>, Vec<Vec<u8>>) {
+    use metamer::light::ies::IesInfo;
+    use metamer::light::ldt::LdtInfo;
+    use metamer::light::{CGammaTable, Panel};
+    let gamma: Vec<f64> = (0..=18).map(|i| 5.0 * i as f64).collect();
+    let cos = |n: f64| -> Vec<f64> { gamma.iter().map(|g| g.to_radians().cos().powf(n)).collect() };
+    let symmetric = CGammaTable::symmetric(gamma.clone(), cos(0.7)).unwrap();
+    let asymmetric = CGammaTable::new(
+        vec![0.0, 90.0, 180.0, 270.0],
+        gamma.clone(),
+        vec![cos(0.9), cos(1.4), cos(0.6), cos(1.1)],
+    )
+    .unwrap();
+    let panel = Panel {
+        width_m: 0.3,
+        height_m: 0.3,
+        normal_luminance_cd_m2: 1000.0,
+    };
+    let ies_info = IesInfo {
+        test: "fuzz seed".into(),
+        issue_date: "2026-12-01".into(),
+        luminaire: "panel".into(),
+        generation: "metamer".into(),
+    };
+    let ldt_info = LdtInfo {
+        luminaire: "panel".into(),
+        file_name: "seed.ldt".into(),
+        date_user: "2026-12-01 fuzz".into(),
+    };
+    let tables = [symmetric, asymmetric];
+    (
+        tables
+            .iter()
+            .map(|t| metamer::light::ies::to_string(t, &panel, &ies_info).into_bytes())
+            .collect(),
+        tables
+            .iter()
+            .map(|t| metamer::light::ldt::to_string(t, &panel, &ldt_info).into_bytes())
+            .collect(),
+    )
+}
+
 fn seed_images(dir: &Path) -> (Vec<u8>, Vec<u8>) {
     let img = XyzImage {
         width: 3,
@@ -208,6 +294,7 @@ fn seed_profiles(dir: &Path) -> Vec<Vec<u8>> {
 /// Every target with its seeds; `dir` is scratch space for seeds that are written files.
 pub fn all(dir: &Path) -> Vec<Target> {
     let (pfm_seed, exr_seed) = seed_images(dir);
+    let (ies_seeds, ldt_seeds) = seed_photometric();
     let mut transcripts = files_in("protocols/cs100a/transcripts", "jsonl");
     transcripts.extend(files_in("protocols/i1pro/transcripts", "jsonl"));
     vec![
@@ -274,7 +361,13 @@ pub fn all(dir: &Path) -> Vec<Target> {
         },
         Target {
             name: "EXR",
-            seeds: vec![exr_seed],
+            seeds: std::iter::once(exr_seed.clone())
+                .chain(
+                    crate::exr_class::corrupt(&exr_seed)
+                        .into_iter()
+                        .map(|c| c.1),
+                )
+                .collect(),
             run: exr,
         },
         Target {
@@ -284,6 +377,16 @@ pub fn all(dir: &Path) -> Vec<Target> {
                 eeprom_image(Revision::E, &[]).unwrap(),
             ],
             run: eeprom,
+        },
+        Target {
+            name: "IES",
+            seeds: ies_seeds,
+            run: ies,
+        },
+        Target {
+            name: "LDT",
+            seeds: ldt_seeds,
+            run: ldt,
         },
     ]
 }

@@ -2,6 +2,7 @@
 //! by its JSON path (`surfaces[3].reflectance.outside`) with the shapes that are accepted,
 //! rather than by serde's line and column inside an untagged enum.
 
+use metamer_color::text::{echo, echo_message, strip_bom};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
@@ -11,9 +12,10 @@ use super::file::{
     TileFile,
 };
 
-/// A field of the scene file that is not what the format allows.
+/// A field of the scene file that is not what the format allows. Shown with the path and
+/// message cut to a readable length: both may quote the file (a key, a file name, a value).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{path}: {message}")]
+#[error("{}: {}", echo(path), echo_message(message))]
 pub struct PathError {
     /// JSON path of the field, e.g. `emitters[0].tiles[3].gain`.
     pub path: String,
@@ -345,12 +347,14 @@ pub fn scene(v: &Value) -> Result<SceneFile, PathError> {
 
 // Parsing is this file's job, so the file types' JSON entry points live here.
 impl SceneFile {
-    /// Parses scene JSON; errors name the JSON path of the bad field.
+    /// Parses scene JSON (a UTF-8 byte-order mark, as some editors save, is skipped);
+    /// errors name the JSON path of the bad field.
     pub fn from_json(text: &str) -> Result<SceneFile, PathError> {
-        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| PathError {
-            path: format!("line {} column {}", e.line(), e.column()),
-            message: format!("not JSON: {e}"),
-        })?;
+        let v: serde_json::Value =
+            serde_json::from_str(strip_bom(text)).map_err(|e| PathError {
+                path: format!("line {} column {}", e.line(), e.column()),
+                message: format!("not JSON: {e}"),
+            })?;
         scene(&v)
     }
 }

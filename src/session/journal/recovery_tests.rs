@@ -106,3 +106,93 @@ fn setting_aside_numbers_the_copies_and_deletes_nothing() {
         "second"
     );
 }
+
+/// An editor that saved the journal with a byte-order mark: the header still reads, for a
+/// journal of several lines and for one whose only line lost its newline.
+#[test]
+fn a_byte_order_mark_before_the_header_is_skipped() {
+    let h = header();
+    for with_entry in [true, false] {
+        let path = temp(&format!("bom-{with_entry}"));
+        let mut j = Journal::<String, Item>::create(&path, &h).unwrap();
+        if with_entry {
+            j.append(&Item { n: 7 }).unwrap();
+        }
+        drop(j);
+        let mut bytes = "\u{feff}".as_bytes().to_vec();
+        let written = std::fs::read(&path).unwrap();
+        bytes.extend_from_slice(if with_entry {
+            &written
+        } else {
+            written.strip_suffix(b"\n").unwrap()
+        });
+        std::fs::write(&path, &bytes).unwrap();
+        let (_, r) = Journal::<String, Item>::resume(&path, &h).unwrap();
+        assert_eq!(r.header, h);
+        let expected = if with_entry {
+            vec![(2, Item { n: 7 })]
+        } else {
+            vec![]
+        };
+        assert_eq!(r.entries, expected);
+        assert_eq!(r.torn_bytes, 0);
+    }
+}
+
+/// A megabyte in a field is cut to its first 80 characters in every message that quotes it.
+#[test]
+fn a_megabyte_field_is_not_echoed_whole() {
+    let big = "x".repeat(1 << 20);
+    let h = header();
+    // A format name of a megabyte.
+    let path = temp("big-format");
+    let line = serde_json::json!({"type": "header", "format": big, "version": 1});
+    std::fs::write(&path, format!("{line}\n")).unwrap();
+    let e = Journal::<String, Item>::resume(&path, &h)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.len() < 600, "{} bytes: {}", e.len(), &e[..600]);
+    assert!(e.contains("line 1: format \"xxx"), "{e}");
+    assert!(
+        e.ends_with("is not metamer-session-journal version 2"),
+        "{e}"
+    );
+    // An option value of a megabyte, logged by the journal's session.
+    let path = temp("big-option");
+    let mut logged = header();
+    logged.fingerprint = "other".into();
+    logged.options.insert("seed".into(), big.clone());
+    drop(Journal::<String, Item>::create(&path, &logged).unwrap());
+    let mut now = header();
+    now.options.insert("seed".into(), "1".into());
+    let e = Journal::<String, Item>::resume(&path, &now)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.len() < 600, "{} bytes", e.len());
+    assert!(e.contains("its option seed is xxx"), "{e}");
+    assert!(
+        e.contains("(1048576 characters in all), this one's is 1"),
+        "{e}"
+    );
+    // An entry whose field is a megabyte string where a number belongs.
+    let path = temp("big-entry");
+    drop(Journal::<String, Item>::create(&path, &h).unwrap());
+    append_line(&path, &format!("{{\"type\":\"entry\",\"n\":\"{big}\"}}\n"));
+    let e = Journal::<String, Item>::resume(&path, &h)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.len() < 600, "{} bytes", e.len());
+    assert!(e.contains("line 2: not an entry or calibration"), "{e}");
+}
+
+fn append_line(path: &Path, line: &str) {
+    OpenOptions::new()
+        .append(true)
+        .open(path)
+        .unwrap()
+        .write_all(line.as_bytes())
+        .unwrap();
+}

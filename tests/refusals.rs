@@ -1,0 +1,184 @@
+//! Options that cannot work are refused before the work: each command below is given one,
+//! and must say what is wrong (naming the option or the path) and exit within two seconds —
+//! long before the work it would otherwise have started (renders, characterizations and
+//! sessions take tens of seconds to minutes).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+const FAST: Duration = Duration::from_secs(2);
+
+fn scratch(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("metamer-refusals-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A regular file where a command needs its output directory.
+fn a_file(dir: &Path) -> String {
+    let f = dir.join("not-a-directory");
+    std::fs::write(&f, "a file").unwrap();
+    f.display().to_string()
+}
+
+/// Runs metamer with `args`; returns (exit code, stdout, stderr) after checking it was fast.
+fn refused(args: &[&str]) -> (Option<i32>, String, String) {
+    let start = Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    );
+    assert!(!o.status.success(), "{args:?} succeeded: {out}");
+    assert!(took < FAST, "{args:?} took {took:?} to refuse: {err}");
+    (o.status.code(), out, err)
+}
+
+#[test]
+fn budget_with_no_trials_is_refused() {
+    let d = scratch("budget");
+    let out = d.join("b").display().to_string();
+    let (code, _, err) = refused(&["budget", "--trials", "0", "-o", &out]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("--trials must be at least 1"), "{err}");
+    assert!(!d.join("b").exists(), "nothing is created");
+}
+
+#[test]
+fn render_spots_with_no_time_is_refused() {
+    let (code, _, err) = refused(&["render", "spots", "--max-seconds", "0"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("--max-seconds must be > 0"), "{err}");
+}
+
+#[test]
+fn render_convergence_with_no_or_endless_time_is_refused_before_the_reference_run() {
+    for seconds in ["0", "1e308", "NaN"] {
+        let d = scratch(&format!("conv-{seconds}"));
+        let out = d.join("c").display().to_string();
+        let (code, _, err) = refused(&["render", "convergence", "-o", &out, "--seconds", seconds]);
+        assert_eq!(code, Some(2), "{seconds}: {err}");
+        assert!(
+            err.contains("--seconds: the time budget per strategy must be more than 0 s"),
+            "{seconds}: {err}"
+        );
+        assert!(
+            !d.join("c").exists(),
+            "{seconds}: no output directory is made"
+        );
+    }
+    let d = scratch("conv-target");
+    let out = d.join("c").display().to_string();
+    let (_, _, err) = refused(&["render", "convergence", "-o", &out, "--reference-de", "0"]);
+    assert!(err.contains("the ΔE*ab target must be > 0, got 0"), "{err}");
+    let d = scratch("conv-dir");
+    let file = a_file(&d);
+    let (_, _, err) = refused(&["render", "convergence", "-o", &file, "--seconds", "1"]);
+    assert!(
+        err.contains(&format!("cannot use {file} as an output directory")),
+        "{err}"
+    );
+}
+
+#[test]
+fn reproduce_with_bits_and_xyz_is_refused() {
+    let d = scratch("bits");
+    let out = d.join("drive.csv").display().to_string();
+    let (code, _, err) = refused(&[
+        "reproduce",
+        "--profile",
+        "no-such-profile.json",
+        "--xyz",
+        "no-such-targets.csv",
+        "--bits",
+        "16",
+        "-o",
+        &out,
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.contains("--bits sets the PNG depth of --image"),
+        "{err}"
+    );
+}
+
+/// Every command that writes into a directory refuses a file given as `-o`, naming it.
+#[test]
+fn an_output_directory_that_is_a_file_is_refused_by_every_command() {
+    let d = scratch("dirs");
+    let file = a_file(&d);
+    let sim = ["sim:i1pro?time_scale=0", "sim:cs100a?time_scale=0"];
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["lab", "-o", &file],
+        vec![
+            "experiment",
+            "-o",
+            &file,
+            "--spectral",
+            sim[0],
+            "--spot",
+            sim[1],
+            "--display",
+            "virtual:ips-lcd",
+        ],
+        vec![
+            "measure-box",
+            "-o",
+            &file,
+            "--spectral",
+            sim[0],
+            "--spot",
+            sim[1],
+        ],
+        vec![
+            "characterize",
+            "-o",
+            &file,
+            "--display",
+            "virtual:ips-lcd",
+            "--instrument",
+            sim[1],
+        ],
+        vec!["budget", "-o", &file],
+    ];
+    for args in cases {
+        let (_, _, err) = refused(&args);
+        assert!(err.contains(file.as_str()), "{args:?}: {err}");
+        assert!(
+            err.contains("not a directory") || err.contains("is a file"),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("os error"), "{args:?}: {err}");
+    }
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "a file");
+}
+
+/// A colorimeter has no spectrum to write: refused before the first reading is taken.
+#[test]
+fn spot_spectrum_on_a_colorimeter_is_refused_before_measuring() {
+    let d = scratch("spot");
+    let csv = d.join("s.csv");
+    let (code, out, err) = refused(&[
+        "spot",
+        "--instrument",
+        "sim:cs100a",
+        "--count",
+        "3",
+        "--spectrum",
+        &csv.display().to_string(),
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.contains("--spectrum: the cs100a measures no spectrum"),
+        "{err}"
+    );
+    assert!(!out.contains("#1"), "a reading was taken first: {out}");
+    assert!(!csv.exists());
+}
