@@ -8,11 +8,12 @@ use serde::{Deserialize, Serialize};
 use super::cache::write_atomic;
 use super::error::ExperimentError;
 use super::readings::PatchStat;
+use super::report_sections::{gather, Layout};
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::validation::{
     assess, compare, read_readings, write_delta_e_chart_shaded, write_report_files, AssessOptions,
-    Comparison, ReportInput,
+    Comparison, ReadingSet, ReportInput,
 };
 
 /// Everything the validation found, as `validation/validation.json`.
@@ -60,24 +61,46 @@ pub struct ReadingFiles<'a> {
     pub display: &'a Path,
 }
 
-/// The validation report (Figs. 4–6, uncertainty intervals, verdict) of the readings.
-fn report(
+/// The report's input from the stages' files: the three comparisons with every side's
+/// uncertainty (the meters' repeatability from their repeats, the render's per-patch
+/// confidence on the simulation's side) and every optional section the earlier stages'
+/// files allow, each missing one noted. `dir` is the validation stage's directory inside
+/// the experiment's.
+pub fn report_input(
     dir: &Path,
     white: [f64; 3],
     files: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
-) -> Result<Vec<String>, ExperimentError> {
+) -> Result<ReportInput, ExperimentError> {
     let read = |p: &Path| {
         read_readings(p).map_err(|e| ExperimentError::BadFile {
             file: p.to_path_buf(),
             message: e.to_string(),
         })
     };
-    let (b, s, d) = (
+    let (b, mut s, d) = (
         read(files.box_spots)?,
         read(files.simulation)?,
         read(files.display)?,
     );
+    let root = dir.parent().unwrap_or(dir);
+    let layout = Layout::of(root, files.box_spots);
+    let sections = gather(
+        &layout,
+        &[
+            ("box", files.box_spots, b.patches.len()),
+            ("simulation", files.simulation, s.patches.len()),
+            ("display", files.display, d.patches.len()),
+        ],
+    );
+    let mut uncertainty = Vec::new();
+    if let Some(u) = &sections.render_uncertainty {
+        u.apply(&mut s);
+        uncertainty.push(("simulation".to_string(), u.description.clone()));
+    }
+    for (side, set) in [("box", &b), ("display", &d)] {
+        uncertainty.push((side.to_string(), repeatability(set)));
+    }
     let w = Xyz::from_array(white);
     let o = AssessOptions::default();
     let mark = |mut a: crate::validation::Assessment| {
@@ -86,15 +109,60 @@ fn report(
         }
         a
     };
-    let input = ReportInput {
+    let mut notes = sections.notes;
+    for set in [&b, &s, &d] {
+        for n in &set.notes {
+            notes.push(format!("{}: {n}", set.file.display()));
+        }
+    }
+    Ok(ReportInput {
         title: "metamer experiment".into(),
         white_source: "the display's measured white (the paper's choice)".into(),
         box_vs_display: Some(mark(assess("box", &b, "display", &d, w, &o)?)),
         box_vs_simulation: Some(assess("box", &b, "simulation", &s, w, &o)?),
         display_vs_simulation: Some(mark(assess("simulation", &s, "display", &d, w, &o)?)),
+        display_model: sections.display_model,
+        light_fit: sections.light_fit,
+        render_confidence: sections.render_confidence,
+        instruments: sections.instruments,
         out_of_gamut: out_of_gamut.to_vec(),
-        ..ReportInput::default()
+        inputs: sections.inputs,
+        uncertainty,
+        notes,
+    })
+}
+
+/// What a meter's readings' intervals contain: the standard error of the mean of each
+/// patch's repeats, or nothing where a patch was read once.
+fn repeatability(set: &ReadingSet) -> String {
+    let ns: Vec<usize> = set.patches.values().map(|p| p.n).collect();
+    let (lo, hi) = (
+        ns.iter().copied().min().unwrap_or(0),
+        ns.iter().copied().max().unwrap_or(0),
+    );
+    let k = if lo == hi {
+        format!("{lo}")
+    } else {
+        format!("{lo}–{hi}")
     };
+    if hi <= 1 {
+        "single readings: the meter's repeatability is unknown and not in the interval".into()
+    } else {
+        format!(
+            "the meter's repeatability, the standard error of the mean of {k} repeats per patch (their scatter in X, Y, Z kept together)"
+        )
+    }
+}
+
+/// The validation report (Figs. 4–6, uncertainty intervals, verdict, every section) of
+/// the readings.
+fn report(
+    dir: &Path,
+    white: [f64; 3],
+    files: &ReadingFiles<'_>,
+    out_of_gamut: &[usize],
+) -> Result<Vec<String>, ExperimentError> {
+    let input = report_input(dir, white, files, out_of_gamut)?;
     let written = write_report_files(dir, &input, &OutputPolicy::new(true))?;
     Ok(written
         .iter()

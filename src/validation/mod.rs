@@ -14,6 +14,8 @@ pub mod figures;
 pub mod propagate;
 pub mod readings;
 pub mod report;
+mod report_sections;
+pub mod verdict;
 
 use serde::{Deserialize, Serialize};
 
