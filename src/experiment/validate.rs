@@ -227,3 +227,86 @@ pub fn validate(
     files.extend(report(dir, white, inputs, out_of_gamut)?);
     Ok((result, files))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::report_sections::RenderUncertainty;
+    use crate::validation::propagate::{render_lab_sigma, Propagation, RenderStatement};
+    use crate::validation::readings::{parse_readings, UncertaintySource};
+
+    /// One grey patch: the box at L* 50 read 4 times, the meter's repeats scaling X, Y and
+    /// Z together by 1 ± ε (ε = 0.2·√3/Y, so the mean's standard error in Y is
+    /// √(4·(εY)²/12) = 0.2 and a*, b* stay 0); the simulation at L* 60 with the path
+    /// tracer's half-width 0.5. By hand: dL*/dY = (116/3)·(116/66)²/100 = 1.194441 at
+    /// Y = 18.418652, so the box's σ(L*) = 0.238888; the render's σ per axis is
+    /// 0.5/(1.96·√3) = 0.147286. ΔE of greys that differ in L* only moves, to first order,
+    /// with ΔL* alone: σ(ΔE) = √(0.238888² + 0.147286²) = 0.280643, the interval
+    /// 10 ± 1.96·0.280643 = [9.44995, 10.55005].
+    #[test]
+    fn render_and_meter_uncertainty_add_as_by_hand() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let grey = |y: f64| format!("{},{y},{}", 0.950_47 * y, 1.088_83 * y);
+        let y = 18.418_652;
+        let eps = 0.2 * 3f64.sqrt() / y;
+        let b = parse_readings(
+            &format!(
+                "patch,X,Y,Z\n7,{}\n7,{}\n7,{}\n7,{}\n",
+                grey(y * (1.0 + eps)),
+                grey(y * (1.0 - eps)),
+                grey(y * (1.0 + eps)),
+                grey(y * (1.0 - eps))
+            ),
+            Path::new("box.csv"),
+        )
+        .unwrap();
+        assert_eq!(b.patches[&7].source, UncertaintySource::Repeats);
+        assert!((b.patches[&7].u_xyz[1] - 0.2).abs() < 1e-9);
+        let sim = || {
+            parse_readings(
+                &format!(
+                    "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n7,{},0,0,0,1\n",
+                    grey(28.123_334)
+                ),
+                Path::new("sim.csv"),
+            )
+            .unwrap()
+        };
+        let mut s = sim();
+        let u = RenderUncertainty {
+            sigma_lab: [(7, render_lab_sigma(0.5, RenderStatement::HalfWidth95))].into(),
+            description: String::new(),
+        };
+        u.apply(&mut s);
+        assert_eq!(s.patches[&7].source, UncertaintySource::Render);
+        let linear = AssessOptions {
+            propagation: Propagation::Linear,
+            ..AssessOptions::default()
+        };
+        let a = assess("box", &b, "simulation", &s, white, &linear).unwrap();
+        let i = a.patches[0].de76_interval;
+        assert!((a.patches[0].de76 - 10.0).abs() < 1e-5);
+        assert!((i.lo - 9.449_95).abs() < 1e-4, "{i:?}");
+        assert!((i.hi - 10.550_05).abs() < 1e-4, "{i:?}");
+        // Without the render's term the interval is the meter's alone: 10 ± 1.96·0.238888.
+        let a = assess("box", &b, "simulation", &sim(), white, &linear).unwrap();
+        let i = a.patches[0].de76_interval;
+        assert!((i.hi - 10.468_21).abs() < 1e-4, "{i:?}");
+        // Monte Carlo agrees (the render's a*, b* terms lengthen ΔE by σ²/ΔE ≈ 0.002; a
+        // 2.5 % quantile of 4000 draws is good to about 0.02).
+        let mc = assess(
+            "box",
+            &b,
+            "simulation",
+            &s,
+            white,
+            &AssessOptions::default(),
+        )
+        .unwrap();
+        let m = mc.patches[0].de76_interval;
+        assert!(
+            (m.lo - 9.45).abs() < 0.03 && (m.hi - 10.55).abs() < 0.03,
+            "{m:?}"
+        );
+    }
+}

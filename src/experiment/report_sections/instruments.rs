@@ -27,7 +27,26 @@ pub fn journals(dir: &Path) -> Vec<PathBuf> {
 #[derive(Default)]
 struct Seen {
     used: InstrumentUsed,
-    sessions: Vec<String>,
+    /// Session kind → (journal names, earliest start).
+    sessions: BTreeMap<String, (Vec<String>, Option<f64>)>,
+}
+
+impl Seen {
+    /// Its calibrations in time order, then one line per session kind.
+    fn finish(mut self) -> InstrumentUsed {
+        // ISO times sort as text.
+        self.used.calibrations.sort();
+        for (kind, (names, start)) in self.sessions {
+            self.used.calibrations.push(format!(
+                "{kind} session ({}){}",
+                names.join(", "),
+                start
+                    .map(|t| format!(", started {}", iso_date(t)))
+                    .unwrap_or_default()
+            ));
+        }
+        self.used
+    }
 }
 
 /// The instruments of every journal under `stages` ((name, directory)), one per stage and
@@ -52,14 +71,7 @@ pub fn used(stages: &[(&str, &Path)]) -> (Vec<InstrumentUsed>, Vec<String>) {
                 ));
             }
         }
-        for (_, mut seen) in by_role {
-            if !seen.sessions.is_empty() {
-                seen.used
-                    .calibrations
-                    .push(format!("sessions: {}", seen.sessions.join("; ")));
-            }
-            out.push(seen.used);
-        }
+        out.extend(by_role.into_values().map(Seen::finish));
     }
     (out, notes)
 }
@@ -92,11 +104,8 @@ fn read_journal(
         match v["type"].as_str() {
             Some("header") => {
                 header_seen = true;
-                let kind = v["kind"].as_str().unwrap_or("session");
-                let started = v["started_s"]
-                    .as_f64()
-                    .map(|t| format!(" started {}", iso_date(t)))
-                    .unwrap_or_default();
+                let kind = v["kind"].as_str().unwrap_or("measuring");
+                let started = v["started_s"].as_f64();
                 let Some(instruments) = v["data"]["instruments"].as_object() else {
                     return Err(format!("line {}: the header names no instruments", i + 1));
                 };
@@ -111,9 +120,14 @@ fn read_journal(
                             connection: text(&info["connection"]),
                             calibrations: Vec::new(),
                         },
-                        sessions: Vec::new(),
+                        sessions: BTreeMap::new(),
                     });
-                    seen.sessions.push(format!("{kind} {name}{started}"));
+                    let (names, first) = seen.sessions.entry(kind.to_string()).or_default();
+                    names.push(name.clone());
+                    *first = match (*first, started) {
+                        (Some(a), Some(b)) => Some(a.min(b)),
+                        (a, b) => a.or(b),
+                    };
                 }
             }
             Some("calibration") => {
@@ -174,7 +188,7 @@ mod tests {
             i1.calibrations,
             [
                 "2026-12-01T22:53:53Z: emissive mode, on white tile (tiles)",
-                "sessions: measure-box tiles started 2026-12-01T22:53:53Z"
+                "measure-box session (tiles), started 2026-12-01T22:53:53Z"
             ]
         );
         let spot = &list[1];
