@@ -22,6 +22,8 @@ pub use render::RenderUncertainty;
 /// Where the stages' files are.
 #[derive(Clone, Debug)]
 pub struct Layout {
+    /// The experiment's directory.
+    pub root: PathBuf,
     /// The box's directory: its spot readings' and, when measured here, its scene's.
     pub box_dir: PathBuf,
     pub simulation_dir: PathBuf,
@@ -36,6 +38,7 @@ impl Layout {
     pub fn of(root: &Path, box_spots: &Path) -> Layout {
         let stage = |s: super::Stage| root.join(s.name());
         Layout {
+            root: root.to_path_buf(),
             box_dir: box_spots
                 .parent()
                 .map(Path::to_path_buf)
@@ -160,6 +163,13 @@ fn inputs(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Vec<InputFile> 
             files.push(input(role, &journal, "session journal", 0));
         }
     }
+    // Inside the experiment a path is shown from its directory, so the report reads the
+    // same wherever the directory is moved.
+    for f in &mut files {
+        if let Ok(rel) = Path::new(&f.path).strip_prefix(&layout.root) {
+            f.path = rel.display().to_string();
+        }
+    }
     files
 }
 
@@ -236,6 +246,7 @@ mod tests {
             Some("ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad")
         );
         assert_eq!(files[0].patches, 24);
+        assert_eq!(files[0].path, "box/spots.csv");
         std::fs::remove_dir_all(&root).ok();
     }
 }
