@@ -189,7 +189,12 @@ fn experiment_report_has_every_section_in_headless_chromium() {
         dom.contains("18 of 24 patches are below the JND"),
         "verdict"
     );
-    assert!(dom.contains("6 outside the display's gamut (7, 11, 12, 14, 15, 16)"));
+    assert!(dom.contains(
+        "6 outside the display's gamut (7 orange, 11 yellow green, 12 orange yellow, 14 green, 15 red, 16 yellow)"
+    ));
+    assert!(dom.contains(
+        "In all 6 the simulation is within 0.4 of the box: the error arises on the display."
+    ));
     // The i1Pro's two calibrations (emissive for the tiles, reflective for the materials).
     assert_eq!(dom.matches("on white tile").count(), 2);
     // The render's bound enters the simulation's intervals.

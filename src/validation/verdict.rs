@@ -19,63 +19,108 @@ const DARK_L: f64 = 30.0;
 /// times as wide as the median patch's.
 const WIDE_FACTOR: f64 = 2.0;
 
-/// Why a patch may be above the JND or undecided, as short clauses. `others` are the
-/// box-vs-simulation and simulation-vs-display assessments, when the report has them.
+/// Where a patch's error arises, told by the simulation's two comparisons.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Origin {
+    /// The simulation is within the JND of the box and the display misses it by more.
+    Display,
+    /// The simulation itself misses the box by at least the JND.
+    Simulation,
+    /// Neither alone: both differ by comparable amounts.
+    Shared,
+}
+
+/// Why a patch may be above the JND or undecided, as far as the input tells.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Why {
+    pub out_of_gamut: bool,
+    /// Dark, its interval widened by the readings' noise ("L* 20, interval 1.7 wide
+    /// against a median 0.3").
+    pub dark: Option<String>,
+    /// Not dark, yet its readings scatter: the same detail.
+    pub scatter: Option<String>,
+    pub straddles: bool,
+    /// (where, simulation vs box ΔE*ab, display vs simulation ΔE*ab).
+    pub origin: Option<(Origin, f64, f64)>,
+    pub unknown_uncertainty: bool,
+}
+
+impl Why {
+    /// The clauses of a patch's own details (the group it falls in is said elsewhere).
+    fn details(&self, p: &PatchAssessment) -> Vec<String> {
+        let mut v = Vec::new();
+        if let Some(d) = self.dark.as_ref().or(self.scatter.as_ref()) {
+            v.push(d.clone());
+        }
+        if self.straddles {
+            v.push("straddles the JND".into());
+        }
+        if let Some((o, s, d)) = self.origin {
+            v.push(match o {
+                Origin::Display => format!("display vs simulation {d:.1}"),
+                Origin::Simulation => format!("simulation vs box {s:.1}"),
+                Origin::Shared => {
+                    format!("simulation vs box {s:.1}, display vs simulation {d:.1}")
+                }
+            });
+        }
+        if self.unknown_uncertainty {
+            v.push("uncertainty unknown: single readings".into());
+        }
+        v
+    }
+}
+
+/// Why `p` may be above the JND or undecided. `others` are the box-vs-simulation and
+/// simulation-vs-display assessments, when the report has them.
 pub fn reasons(
     p: &PatchAssessment,
     out_of_gamut: &[usize],
     median_width: f64,
     others: (Option<&Assessment>, Option<&Assessment>),
-) -> Vec<String> {
-    let mut why = Vec::new();
-    if p.out_of_gamut || out_of_gamut.contains(&p.patch) {
-        why.push("outside the display's gamut".to_string());
-    }
+) -> Why {
     let width = p.de76_interval.hi - p.de76_interval.lo;
     let wide = width > WIDE_FACTOR * median_width && width > 0.0;
+    let detail = |l: Option<f64>| {
+        format!(
+            "{}interval {width:.1} wide against a median {median_width:.1}",
+            l.map(|l| format!("L* {l:.0}, ")).unwrap_or_default()
+        )
+    };
     let dark = p.reference.lab[0] < DARK_L;
-    if dark && wide {
-        why.push(format!(
-            "dark (L* {:.0}), where the meter's noise dominates: its interval is {:.1} wide against a median {:.1}",
-            p.reference.lab[0], width, median_width
-        ));
-    } else if wide {
-        why.push(format!(
-            "its readings scatter: the interval is {width:.1} wide against a median {median_width:.1}"
-        ));
-    }
-    if p.jnd == JndVerdict::Undecided {
-        why.push(format!(
-            "its interval [{:.1}, {:.1}] straddles the JND",
-            p.de76_interval.lo, p.de76_interval.hi
-        ));
-    }
-    if let (Some(sim), Some(disp)) = others {
-        let find = |a: &Assessment| {
-            a.patches
-                .iter()
-                .find(|q| q.patch == p.patch)
-                .map(|q| q.de76)
-        };
-        if let (Some(s), Some(d)) = (find(sim), find(disp)) {
-            let whose = if s >= JND_DE76 && s >= d {
-                "the simulation already misses the box"
-            } else if d >= s {
-                "the error arises on the display"
-            } else {
-                "simulation and display share the error"
+    let origin = match others {
+        (Some(sim), Some(disp)) => {
+            let find = |a: &Assessment| {
+                a.patches
+                    .iter()
+                    .find(|q| q.patch == p.patch)
+                    .map(|q| q.de76)
             };
-            why.push(format!(
-                "{whose} (simulation vs box {s:.1}, display vs simulation {d:.1})"
-            ));
+            match (find(sim), find(disp)) {
+                (Some(s), Some(d)) => {
+                    let o = if s >= JND_DE76 && s >= d {
+                        Origin::Simulation
+                    } else if d > s && s < JND_DE76 {
+                        Origin::Display
+                    } else {
+                        Origin::Shared
+                    };
+                    Some((o, s, d))
+                }
+                _ => None,
+            }
         }
+        _ => None,
+    };
+    Why {
+        out_of_gamut: p.out_of_gamut || out_of_gamut.contains(&p.patch),
+        dark: (dark && wide).then(|| detail(Some(p.reference.lab[0]))),
+        scatter: (!dark && wide).then(|| detail(None)),
+        straddles: p.jnd == JndVerdict::Undecided,
+        origin,
+        unknown_uncertainty: p.reference.uncertainty == UncertaintySource::Unknown
+            || p.test.uncertainty == UncertaintySource::Unknown,
     }
-    if p.reference.uncertainty == UncertaintySource::Unknown
-        || p.test.uncertainty == UncertaintySource::Unknown
-    {
-        why.push("uncertainty unknown (single readings)".to_string());
-    }
-    why
 }
 
 /// The median width of the patches' ΔE*ab intervals.
@@ -133,96 +178,112 @@ fn verdict_with(
         a.max_de76.value
     );
     let median = median_width(a);
-    let mut causes = Causes::default();
-    for (verdict, label) in [
-        (JndVerdict::Above, "Above the JND"),
-        (JndVerdict::Undecided, "Undecided"),
-    ] {
-        let list: Vec<String> = a
-            .patches
-            .iter()
-            .filter(|p| p.jnd == verdict)
-            .map(|p| {
-                let why = reasons(p, out_of_gamut, median, others);
-                causes.count(p, &why);
-                format!(
-                    "{} {} (ΔE*ab {:.1} [{:.1}, {:.1}]{})",
-                    p.patch,
-                    esc(&p.name),
-                    p.de76,
-                    p.de76_interval.lo,
-                    p.de76_interval.hi,
-                    if why.is_empty() {
-                        String::new()
-                    } else {
-                        format!(": {}", esc(&why.join("; ")))
-                    }
-                )
-            })
-            .collect();
-        if !list.is_empty() {
-            let _ = write!(s, " {label}: {}.", list.join(". "));
-        }
-    }
-    if a.jnd.above == 0 && a.jnd.undecided == 0 {
-        s.push_str(" Every patch is reproduced within the JND.");
-    } else if let Some(summary) = causes.sentence(a.jnd.above + a.jnd.undecided) {
-        s.push(' ');
-        s.push_str(&summary);
-    }
-    s
-}
-
-/// Patches above or undecided, grouped by the first reason that explains them.
-#[derive(Default)]
-struct Causes {
-    gamut: Vec<usize>,
-    dark: Vec<usize>,
-    straddle: Vec<usize>,
-    other: Vec<usize>,
-}
-
-impl Causes {
-    fn count(&mut self, p: &PatchAssessment, why: &[String]) {
-        let has = |w: &str| why.iter().any(|c| c.starts_with(w));
-        if has("outside the display's gamut") {
-            self.gamut.push(p.patch);
-        } else if has("dark") {
-            self.dark.push(p.patch);
-        } else if p.jnd == JndVerdict::Undecided {
-            self.straddle.push(p.patch);
-        } else {
-            self.other.push(p.patch);
-        }
-    }
-
-    fn sentence(&self, total: usize) -> Option<String> {
-        let list = |v: &[usize]| {
-            v.iter()
-                .map(usize::to_string)
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        let parts: Vec<String> = [
-            (&self.gamut, "outside the display's gamut"),
-            (&self.dark, "dark, where the meter's noise dominates"),
-            (&self.straddle, "within noise of the JND"),
-            (
-                &self.other,
-                "in gamut and clear of noise: the display model's error",
-            ),
-        ]
-        .into_iter()
-        .filter(|(v, _)| !v.is_empty())
-        .map(|(v, what)| format!("{} {what} ({})", v.len(), list(v)))
+    let failing: Vec<(&PatchAssessment, Why)> = a
+        .patches
+        .iter()
+        .filter(|p| p.jnd != JndVerdict::Below)
+        .map(|p| (p, reasons(p, out_of_gamut, median, others)))
         .collect();
-        (!parts.is_empty()).then(|| {
+    if failing.is_empty() {
+        s.push_str(" Every patch is reproduced within the JND.");
+        return s;
+    }
+    let named = |v: &[&PatchAssessment]| {
+        v.iter()
+            .map(|p| format!("{} {}", p.patch, esc(&p.name)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    // Each patch in the group of the first cause that explains it.
+    let mut groups: [(Vec<&PatchAssessment>, &str); 4] = [
+        (Vec::new(), "outside the display's gamut"),
+        (Vec::new(), "dark, where the meter's noise dominates"),
+        (Vec::new(), "within noise of the JND"),
+        (
+            Vec::new(),
+            "in gamut and clear of noise: the display model's error",
+        ),
+    ];
+    for (p, why) in &failing {
+        let g = if why.out_of_gamut {
+            0
+        } else if why.dark.is_some() {
+            1
+        } else if why.straddles {
+            2
+        } else {
+            3
+        };
+        groups[g].0.push(p);
+    }
+    let parts: Vec<String> = groups
+        .iter()
+        .filter(|(v, _)| !v.is_empty())
+        .map(|(v, what)| format!("{} {what} ({})", v.len(), named(v)))
+        .collect();
+    let _ = write!(
+        s,
+        " Of the {} not shown to be below the JND: {}.",
+        failing.len(),
+        parts.join("; ")
+    );
+    // Where the errors arise, when the simulation tells.
+    let by = |o: Origin| -> Vec<&PatchAssessment> {
+        failing
+            .iter()
+            .filter(|(_, w)| w.origin.is_some_and(|x| x.0 == o))
+            .map(|(p, _)| *p)
+            .collect()
+    };
+    let on_display = by(Origin::Display);
+    if on_display.len() == failing.len() {
+        let worst = failing
+            .iter()
+            .filter_map(|(_, w)| w.origin.map(|o| o.1))
+            .fold(0.0, f64::max);
+        let which = if failing.len() == 1 {
+            "it".to_string()
+        } else {
+            format!("all {}", failing.len())
+        };
+        let _ = write!(
+            s,
+            " In {which} the simulation is within {worst:.1} of the box: the error arises on the display."
+        );
+    } else {
+        for (v, what) in [
+            (on_display, "the error arises on the display"),
+            (
+                by(Origin::Simulation),
+                "the simulation already misses the box",
+            ),
+            (by(Origin::Shared), "simulation and display share the error"),
+        ] {
+            if !v.is_empty() {
+                let _ = write!(s, " In {}: {what}.", named(&v));
+            }
+        }
+    }
+    let list: Vec<String> = failing
+        .iter()
+        .map(|(p, why)| {
+            let d = why.details(p);
             format!(
-                "Of the {total} not shown to be below the JND: {}.",
-                parts.join("; ")
+                "{} {:.1} [{:.1}, {:.1}]{}",
+                p.patch,
+                p.de76,
+                p.de76_interval.lo,
+                p.de76_interval.hi,
+                if d.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", esc(&d.join("; ")))
+                }
             )
         })
-    }
+        .collect();
+    let _ = write!(s, " ΔE*ab with 95 % interval: {}.", list.join("; "));
+    s
 }
 
 #[cfg(test)]
@@ -286,12 +347,13 @@ mod tests {
             v.starts_with("display vs box: 1 of 4 patches are below the JND"),
             "{v}"
         );
-        assert!(v.contains("2 light skin (ΔE*ab 6.0"), "{v}");
-        assert!(v.contains("outside the display's gamut"), "{v}");
-        assert!(v.contains("24 black") && v.contains("dark (L* 20)"), "{v}");
-        assert!(v.contains("straddles the JND"), "{v}");
         assert!(
-            v.contains("Of the 3 not shown to be below the JND: 1 outside the display's gamut (2); 1 dark, where the meter's noise dominates (24); 1 in gamut and clear of noise: the display model's error (1)."),
+            v.contains("Of the 3 not shown to be below the JND: 1 outside the display's gamut (2 light skin); 1 dark, where the meter's noise dominates (24 black 2); 1 in gamut and clear of noise: the display model's error (1 dark skin)."),
+            "{v}"
+        );
+        assert!(v.contains("2 6.0 [6.0, 6.0] (uncertainty unknown"), "{v}");
+        assert!(
+            v.contains("24 1.1 [0.1, 4.9] (L* 20, interval 4.8 wide against a median 0.0; straddles the JND;"),
             "{v}"
         );
     }
@@ -309,10 +371,21 @@ mod tests {
         let bs = assess("box", &b, "simulation", &s, WHITE, &o).unwrap();
         let sd = assess("simulation", &s, "display", &d, WHITE, &o).unwrap();
         let why = reasons(&bd.patches[0], &[], 0.0, (Some(&bs), Some(&sd)));
+        let (origin, s, d) = why.origin.unwrap();
+        assert_eq!(origin, Origin::Display);
+        assert!((s - 0.5).abs() < 1e-9 && (d - 4.5).abs() < 1e-9, "{s} {d}");
+        let input = ReportInput {
+            box_vs_display: Some(bd),
+            box_vs_simulation: Some(bs),
+            display_vs_simulation: Some(sd),
+            ..ReportInput::default()
+        };
+        let v = verdict_paragraph(&input).unwrap();
         assert!(
-            why.iter().any(|w| w
-                == "the error arises on the display (simulation vs box 0.5, display vs simulation 4.5)"),
-            "{why:?}"
+            v.contains(
+                "In it the simulation is within 0.5 of the box: the error arises on the display."
+            ),
+            "{v}"
         );
     }
 }
