@@ -136,17 +136,22 @@ pub fn render_section(h: &mut String, r: &RenderConfidenceSection) {
         let worst = r.per_patch.iter().map(|p| p.1).fold(0.0, f64::max);
         let _ = write!(
             h,
-            "<p>Per patch, the render's {} (largest {worst:.3}):</p><table><tr><th>patch</th>",
+            "<p>Per patch, the render's {} (largest {worst:.3}):</p><table>",
             esc(measure)
         );
-        for (p, _) in &r.per_patch {
-            let _ = write!(h, "<th>{p}</th>");
+        // Rows of 12 patches, one ColorChecker row pair each, to fit the page.
+        for chunk in r.per_patch.chunks(12) {
+            h.push_str("<tr><th>patch</th>");
+            for (p, _) in chunk {
+                let _ = write!(h, "<th>{p}</th>");
+            }
+            h.push_str("</tr><tr><td>ΔE*ab</td>");
+            for (_, d) in chunk {
+                let _ = write!(h, "<td>{d:.3}</td>");
+            }
+            h.push_str("</tr>");
         }
-        h.push_str("</tr><tr><td>ΔE*ab</td>");
-        for (_, d) in &r.per_patch {
-            let _ = write!(h, "<td>{d:.3}</td>");
-        }
-        h.push_str("</tr></table>\n");
+        h.push_str("</table>\n");
     }
 }
 

@@ -47,7 +47,7 @@ pub struct Why {
 
 impl Why {
     /// The clauses of a patch's own details (the group it falls in is said elsewhere).
-    fn details(&self, p: &PatchAssessment) -> Vec<String> {
+    fn details(&self) -> Vec<String> {
         let mut v = Vec::new();
         if let Some(d) = self.dark.as_ref().or(self.scatter.as_ref()) {
             v.push(d.clone());
@@ -267,7 +267,7 @@ fn verdict_with(
     let list: Vec<String> = failing
         .iter()
         .map(|(p, why)| {
-            let d = why.details(p);
+            let d = why.details();
             format!(
                 "{} {:.1} [{:.1}, {:.1}]{}",
                 p.patch,
