@@ -7,7 +7,7 @@ use std::fmt::Write;
 use super::assess::Assessment;
 use super::figures::esc;
 use super::readings::UncertaintySource;
-use super::report::{
+use super::report_input::{
     DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
     ReportInput,
 };

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::{read_json, unusable};
+use super::files::{read_json, unusable};
 use crate::experiment::display::SUMMARY_FILE;
 use crate::validation::report::DisplayModelSection;
 
@@ -119,7 +119,7 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testdir;
+    use super::super::files::testdir;
     use super::*;
 
     #[test]

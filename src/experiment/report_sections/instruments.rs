@@ -157,7 +157,7 @@ fn read_journal(
 
 #[cfg(test)]
 mod tests {
-    use super::super::testdir;
+    use super::super::files::testdir;
     use super::*;
 
     #[test]

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use super::{read_json, unusable};
+use super::files::{read_json, unusable};
 use crate::validation::report::LightFitSection;
 
 const WHAT: &str = "light distribution fit";
@@ -186,7 +186,7 @@ fn provenance(p: &Value, rows: &mut Vec<(String, String)>) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testdir;
+    use super::super::files::testdir;
     use super::*;
 
     const LIGHT: &str = r#"{"model":"cos-power",

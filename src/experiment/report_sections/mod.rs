@@ -6,6 +6,7 @@
 //! out with a note saying which file and why; it never fails the report.
 
 mod display;
+mod files;
 mod instruments;
 mod light;
 mod render;
@@ -62,23 +63,6 @@ pub struct Sections {
     pub instruments: Vec<InstrumentUsed>,
     pub inputs: Vec<InputFile>,
     pub notes: Vec<String>,
-}
-
-/// A file a section needs could not be used: which, and why.
-pub(crate) fn unusable(what: &str, file: &Path, why: impl std::fmt::Display) -> String {
-    format!("no {what} section: {} {why}", file.display())
-}
-
-/// Reads a JSON file, or says why not (for the section's note).
-pub(crate) fn read_json(file: &Path) -> Result<serde_json::Value, String> {
-    let text = std::fs::read_to_string(file).map_err(|e| {
-        if e.kind() == std::io::ErrorKind::NotFound {
-            "does not exist".to_string()
-        } else {
-            format!("cannot be read: {e}")
-        }
-    })?;
-    serde_json::from_str(&text).map_err(|e| format!("is not JSON: {e}"))
 }
 
 /// Gathers every section from the files under `layout`.
@@ -184,25 +168,8 @@ fn input(role: &str, path: &Path, format: &str, patches: usize) -> InputFile {
 }
 
 #[cfg(test)]
-pub(crate) mod testdir {
-    use std::path::{Path, PathBuf};
-
-    /// A fresh directory for one test.
-    pub fn fresh(name: &str) -> PathBuf {
-        let d =
-            std::env::temp_dir().join(format!("metamer-sections-{name}-{}", std::process::id()));
-        std::fs::remove_dir_all(&d).ok();
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    }
-
-    pub fn write(dir: &Path, name: &str, text: &str) {
-        std::fs::write(dir.join(name), text).unwrap();
-    }
-}
-
-#[cfg(test)]
 mod tests {
+    use super::files::testdir;
     use super::*;
 
     #[test]

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::{read_json, unusable};
+use super::files::{read_json, unusable};
 use crate::experiment::simulation::{SimulationSummary, SUMMARY_FILE};
 use crate::validation::propagate::{render_lab_sigma, RenderStatement};
 use crate::validation::readings::{ReadingSet, UncertaintySource};
@@ -106,7 +106,7 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
 
 #[cfg(test)]
 mod tests {
-    use super::super::testdir;
+    use super::super::files::testdir;
     use super::*;
 
     #[test]
