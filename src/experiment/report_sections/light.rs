@@ -42,7 +42,30 @@ fn params(p: &Value) -> String {
 /// The section and notes on what it lacks, or the note saying why there is none.
 pub fn section(box_dir: &Path) -> Result<(LightFitSection, Vec<String>), String> {
     let file = box_dir.join("light.json");
-    let v = read_json(&file).map_err(|why| unusable(WHAT, &file, why))?;
+    let scene_file = box_dir.join("scene.json");
+    let scene = read_json(&scene_file);
+    let mut notes = Vec::new();
+    // Without light.json (a box given as its scene and readings) the scene's provenance
+    // still records the chosen model, why, and its residuals.
+    let (v, file) = match read_json(&file) {
+        Ok(v) => (v, file),
+        Err(why) => match scene
+            .as_ref()
+            .ok()
+            .map(|s| &s["provenance"]["distribution_fit"])
+            .filter(|f| f.is_object())
+        {
+            Some(fit) => {
+                notes.push(format!(
+                    "{} {why}: the light fit is shown as {} records it (no half-plane parameters or candidates)",
+                    file.display(),
+                    scene_file.display()
+                ));
+                (fit.clone(), scene_file.clone())
+            }
+            None => return Err(unusable(WHAT, &file, why)),
+        },
+    };
     let model = v["model"]
         .as_str()
         .ok_or_else(|| unusable(WHAT, &file, "names no chosen \"model\""))?;
@@ -120,12 +143,11 @@ pub fn section(box_dir: &Path) -> Result<(LightFitSection, Vec<String>), String>
         }
         rows.push((format!("candidate {name}"), s));
     }
-    let mut notes = Vec::new();
-    match read_json(&box_dir.join("scene.json")) {
+    match &scene {
         Ok(scene) => provenance(&scene["provenance"], &mut rows),
         Err(why) => notes.push(format!(
             "the light fit's section has no measurement details: {} {why}",
-            box_dir.join("scene.json").display()
+            scene_file.display()
         )),
     }
     let chart = box_dir.join("light.svg");
@@ -240,6 +262,29 @@ mod tests {
         let (l, notes) = section(&dir).unwrap();
         assert!(l.chart_svg.is_none());
         assert!(notes[0].contains("light.svg does not exist"), "{notes:?}");
+
+        // Without light.json the scene's provenance still names the model and residuals.
+        std::fs::remove_file(dir.join("light.json")).unwrap();
+        testdir::write(
+            &dir,
+            "scene.json",
+            r#"{"provenance":{"date":"2026-12-01T22:54:03Z","distribution_fit":{"model":"cos-power","why":"lowest","rms":0.0004,
+              "residuals":[{"plane":"horizontal","angle_deg":0.0,"measured":1.0,"fitted":1.0003,"residual":-0.0003}]}}}"#,
+        );
+        let (l, notes) = section(&dir).unwrap();
+        assert_eq!(
+            l.summary[0],
+            ("chosen model".to_string(), "cos-power".to_string())
+        );
+        assert!(l.summary.iter().any(|(k, v)| k.starts_with("residuals")
+            && v == "1 readings, RMS 0.00030, largest -0.00030 at horizontal 0°"));
+        assert!(
+            notes[0].contains("light.json does not exist: the light fit is shown as"),
+            "{notes:?}"
+        );
+        std::fs::write(dir.join("scene.json"), "{}").unwrap();
+        let e = section(&dir).unwrap_err();
+        assert!(e.ends_with("light.json does not exist"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }
