@@ -51,45 +51,30 @@ fn headless(browser: &Path, dir: &Path, extra: &[&str], page: &Path) -> std::pro
         .expect("chromium runs")
 }
 
-#[test]
-fn report_renders_in_headless_chromium_without_console_errors() {
-    let Some(browser) = chromium() else {
+fn browser() -> Option<PathBuf> {
+    let found = chromium();
+    if found.is_none() {
         assert!(
             std::env::var_os("CI").is_none(),
             "CI is set but no chromium binary is installed (.ci/run installs Debian's chromium)"
         );
         eprintln!("skipped: no chromium binary on PATH (apt-get install chromium)");
-        return;
-    };
-    let dir = std::env::temp_dir().join(format!("metamer-report-browser-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    let out = Command::new(env!("CARGO_BIN_EXE_metamer"))
-        .args(["validate", "--reference"])
-        .arg(data("box.csv"))
-        .arg("--test")
-        .arg(data("display.csv"))
-        .arg("--simulation")
-        .arg(data("box.csv"))
-        .args(["--out-of-gamut", "7,12", "-o"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let page = dir.join("report.html");
+    }
+    found
+}
 
+/// Loads `page` in headless Chromium: no console error, a screenshot of 1100 × 2400 that is
+/// not blank (kept at `$keep_env` when that is set); returns the DOM.
+fn load(browser: &Path, dir: &Path, page: &Path, keep_env: &str) -> String {
     let shot = dir.join("report.png");
     let run = headless(
-        &browser,
-        &dir,
+        browser,
+        dir,
         &[
             &format!("--screenshot={}", shot.display()),
             "--window-size=1100,2400",
         ],
-        &page,
+        page,
     );
     let log = String::from_utf8_lossy(&run.stderr);
     // Chromium logs page console messages as `CONSOLE(line)` / `Console` entries; an
@@ -114,12 +99,38 @@ fn report_renders_in_headless_chromium_without_console_errors() {
         "screenshot of {} bytes looks empty",
         png.len()
     );
-    if let Ok(keep) = std::env::var("METAMER_KEEP_SCREENSHOT") {
+    if let Ok(keep) = std::env::var(keep_env) {
         std::fs::copy(&shot, keep).unwrap();
     }
+    let dom = headless(browser, dir, &["--dump-dom"], page);
+    String::from_utf8_lossy(&dom.stdout).into_owned()
+}
 
-    let dom = headless(&browser, &dir, &["--dump-dom"], &page);
-    let dom = String::from_utf8_lossy(&dom.stdout);
+#[test]
+fn report_renders_in_headless_chromium_without_console_errors() {
+    let Some(browser) = browser() else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("metamer-report-browser-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    let out = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(["validate", "--reference"])
+        .arg(data("box.csv"))
+        .arg("--test")
+        .arg(data("display.csv"))
+        .arg("--simulation")
+        .arg(data("box.csv"))
+        .args(["--out-of-gamut", "7,12", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let page = dir.join("report.html");
+    let dom = load(&browser, &dir, &page, "METAMER_KEEP_SCREENSHOT");
     for id in ["fig4", "fig5", "fig6", "fig7", "verdict"] {
         assert!(dom.contains(&format!("id=\"{id}\"")), "the DOM lacks #{id}");
     }
@@ -127,5 +138,66 @@ fn report_renders_in_headless_chromium_without_console_errors() {
     assert_eq!(dom.matches("class=\"bar\"").count(), 3 * 24);
     assert_eq!(dom.matches("class=\"arrow\"").count(), 2 * 24);
     assert_eq!(dom.matches("class=\"oog\"").count(), 3 * 2);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The experiment's report with every section, built from a small experiment directory
+/// (`tests/data/report/`), in a real browser: no console error, every section in the DOM,
+/// the light chart inlined without scripts.
+#[test]
+fn experiment_report_has_every_section_in_headless_chromium() {
+    use metamer::experiment::validate::{report_input, ReadingFiles};
+    use metamer::output::OutputPolicy;
+    use metamer::validation::write_report_files;
+
+    let Some(browser) = browser() else {
+        return;
+    };
+    let exp = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/report/experiment");
+    let dir =
+        std::env::temp_dir().join(format!("metamer-report-experiment-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    let files = ReadingFiles {
+        box_spots: &exp.join("box/spots.csv"),
+        simulation: &exp.join("simulation/spots.csv"),
+        display: &exp.join("display-spots/spots.csv"),
+    };
+    let white = [29.424_122_518_279_695, 31.015, 34.538_708_337_905_01];
+    let oog = [1, 4, 7, 9, 11, 12, 14, 15, 16];
+    let input = report_input(&exp.join("validation"), white, &files, &oog).unwrap();
+    write_report_files(&dir, &input, &OutputPolicy::new(true)).unwrap();
+    let page = dir.join("report.html");
+    let dom = load(&browser, &dir, &page, "METAMER_KEEP_EXPERIMENT_SCREENSHOT");
+    for id in [
+        "verdict",
+        "fig4",
+        "fig6",
+        "uncertainty",
+        "display-model",
+        "display-verification",
+        "light-fit",
+        "light-chart",
+        "render-confidence",
+        "instruments",
+        "inputs",
+    ] {
+        assert!(dom.contains(&format!("id=\"{id}\"")), "the DOM lacks #{id}");
+    }
+    assert!(!dom.contains("<script"), "the page must run no code");
+    // The verdict names the six patches above the JND and why.
+    assert!(
+        dom.contains("18 of 24 patches are below the JND"),
+        "verdict"
+    );
+    assert!(dom.contains(
+        "6 outside the display's gamut (7 orange, 11 yellow green, 12 orange yellow, 14 green, 15 red, 16 yellow)"
+    ));
+    assert!(dom.contains(
+        "In all 6 the simulation is within 0.4 of the box: the error arises on the display."
+    ));
+    // The i1Pro's two calibrations (emissive for the tiles, reflective for the materials).
+    assert_eq!(dom.matches("on white tile").count(), 2);
+    // The render's bound enters the simulation's intervals.
+    assert!(dom.contains("radiosity solver's per-patch error bound"));
     std::fs::remove_dir_all(&dir).ok();
 }

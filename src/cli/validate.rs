@@ -151,12 +151,13 @@ pub fn run(args: Args) -> CliResult {
             path: set.file.display().to_string(),
             format: set.format.name().into(),
             patches: set.patches.len(),
+            sha256: metamer::digest::sha256_file(&set.file).ok(),
         });
         for name in &set.instruments {
             input.instruments.push(InstrumentUsed {
                 role: role.into(),
                 model: name.clone(),
-                calibrations: Vec::new(),
+                ..InstrumentUsed::default()
             });
         }
         for note in &set.notes {
@@ -218,6 +219,8 @@ fn render_confidence(set: &ReadingSet) -> metamer::validation::report::RenderCon
             .filter(|(_, p)| p.u_lab > 0.0)
             .map(|(k, p)| (*k, p.u_lab * CHI3_95))
             .collect(),
+        measure: "95 % ΔE*ab half-width or error bound".into(),
+        ..Default::default()
     }
 }
 

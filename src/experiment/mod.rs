@@ -15,6 +15,7 @@ pub mod display_spots;
 mod error;
 mod progress;
 pub mod readings;
+pub mod report_sections;
 pub mod reproduction;
 pub mod simulation;
 mod stage;

@@ -8,11 +8,12 @@ use serde::{Deserialize, Serialize};
 use super::cache::write_atomic;
 use super::error::ExperimentError;
 use super::readings::PatchStat;
+use super::report_sections::{gather, Layout};
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::validation::{
     assess, compare, read_readings, write_delta_e_chart_shaded, write_report_files, AssessOptions,
-    Comparison, ReportInput,
+    Comparison, ReadingSet, ReportInput,
 };
 
 /// Everything the validation found, as `validation/validation.json`.
@@ -60,24 +61,46 @@ pub struct ReadingFiles<'a> {
     pub display: &'a Path,
 }
 
-/// The validation report (Figs. 4–6, uncertainty intervals, verdict) of the readings.
-fn report(
+/// The report's input from the stages' files: the three comparisons with every side's
+/// uncertainty (the meters' repeatability from their repeats, the render's per-patch
+/// confidence on the simulation's side) and every optional section the earlier stages'
+/// files allow, each missing one noted. `dir` is the validation stage's directory inside
+/// the experiment's.
+pub fn report_input(
     dir: &Path,
     white: [f64; 3],
     files: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
-) -> Result<Vec<String>, ExperimentError> {
+) -> Result<ReportInput, ExperimentError> {
     let read = |p: &Path| {
         read_readings(p).map_err(|e| ExperimentError::BadFile {
             file: p.to_path_buf(),
             message: e.to_string(),
         })
     };
-    let (b, s, d) = (
+    let (b, mut s, d) = (
         read(files.box_spots)?,
         read(files.simulation)?,
         read(files.display)?,
     );
+    let root = dir.parent().unwrap_or(dir);
+    let layout = Layout::of(root, files.box_spots);
+    let sections = gather(
+        &layout,
+        &[
+            ("box", files.box_spots, b.patches.len()),
+            ("simulation", files.simulation, s.patches.len()),
+            ("display", files.display, d.patches.len()),
+        ],
+    );
+    let mut uncertainty = Vec::new();
+    if let Some(u) = &sections.render_uncertainty {
+        u.apply(&mut s);
+        uncertainty.push(("simulation".to_string(), u.description.clone()));
+    }
+    for (side, set) in [("box", &b), ("display", &d)] {
+        uncertainty.push((side.to_string(), repeatability(set)));
+    }
     let w = Xyz::from_array(white);
     let o = AssessOptions::default();
     let mark = |mut a: crate::validation::Assessment| {
@@ -86,15 +109,60 @@ fn report(
         }
         a
     };
-    let input = ReportInput {
+    let mut notes = sections.notes;
+    for set in [&b, &s, &d] {
+        for n in &set.notes {
+            notes.push(format!("{}: {n}", set.file.display()));
+        }
+    }
+    Ok(ReportInput {
         title: "metamer experiment".into(),
         white_source: "the display's measured white (the paper's choice)".into(),
         box_vs_display: Some(mark(assess("box", &b, "display", &d, w, &o)?)),
         box_vs_simulation: Some(assess("box", &b, "simulation", &s, w, &o)?),
         display_vs_simulation: Some(mark(assess("simulation", &s, "display", &d, w, &o)?)),
+        display_model: sections.display_model,
+        light_fit: sections.light_fit,
+        render_confidence: sections.render_confidence,
+        instruments: sections.instruments,
         out_of_gamut: out_of_gamut.to_vec(),
-        ..ReportInput::default()
+        inputs: sections.inputs,
+        uncertainty,
+        notes,
+    })
+}
+
+/// What a meter's readings' intervals contain: the standard error of the mean of each
+/// patch's repeats, or nothing where a patch was read once.
+fn repeatability(set: &ReadingSet) -> String {
+    let ns: Vec<usize> = set.patches.values().map(|p| p.n).collect();
+    let (lo, hi) = (
+        ns.iter().copied().min().unwrap_or(0),
+        ns.iter().copied().max().unwrap_or(0),
+    );
+    let k = if lo == hi {
+        format!("{lo}")
+    } else {
+        format!("{lo}–{hi}")
     };
+    if hi <= 1 {
+        "single readings: the meter's repeatability is unknown and not in the interval".into()
+    } else {
+        format!(
+            "the meter's repeatability, the standard error of the mean of {k} repeats per patch (their scatter in X, Y, Z kept together)"
+        )
+    }
+}
+
+/// The validation report (Figs. 4–6, uncertainty intervals, verdict, every section) of
+/// the readings.
+fn report(
+    dir: &Path,
+    white: [f64; 3],
+    files: &ReadingFiles<'_>,
+    out_of_gamut: &[usize],
+) -> Result<Vec<String>, ExperimentError> {
+    let input = report_input(dir, white, files, out_of_gamut)?;
     let written = write_report_files(dir, &input, &OutputPolicy::new(true))?;
     Ok(written
         .iter()
@@ -158,4 +226,87 @@ pub fn validate(
     files.push(FILE.to_string());
     files.extend(report(dir, white, inputs, out_of_gamut)?);
     Ok((result, files))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::report_sections::RenderUncertainty;
+    use crate::validation::propagate::{render_lab_sigma, Propagation, RenderStatement};
+    use crate::validation::readings::{parse_readings, UncertaintySource};
+
+    /// One grey patch: the box at L* 50 read 4 times, the meter's repeats scaling X, Y and
+    /// Z together by 1 ± ε (ε = 0.2·√3/Y, so the mean's standard error in Y is
+    /// √(4·(εY)²/12) = 0.2 and a*, b* stay 0); the simulation at L* 60 with the path
+    /// tracer's half-width 0.5. By hand: dL*/dY = (116/3)·(116/66)²/100 = 1.194441 at
+    /// Y = 18.418652, so the box's σ(L*) = 0.238888; the render's σ per axis is
+    /// 0.5/(1.96·√3) = 0.147286. ΔE of greys that differ in L* only moves, to first order,
+    /// with ΔL* alone: σ(ΔE) = √(0.238888² + 0.147286²) = 0.280643, the interval
+    /// 10 ± 1.96·0.280643 = [9.44995, 10.55005].
+    #[test]
+    fn render_and_meter_uncertainty_add_as_by_hand() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let grey = |y: f64| format!("{},{y},{}", 0.950_47 * y, 1.088_83 * y);
+        let y = 18.418_652;
+        let eps = 0.2 * 3f64.sqrt() / y;
+        let b = parse_readings(
+            &format!(
+                "patch,X,Y,Z\n7,{}\n7,{}\n7,{}\n7,{}\n",
+                grey(y * (1.0 + eps)),
+                grey(y * (1.0 - eps)),
+                grey(y * (1.0 + eps)),
+                grey(y * (1.0 - eps))
+            ),
+            Path::new("box.csv"),
+        )
+        .unwrap();
+        assert_eq!(b.patches[&7].source, UncertaintySource::Repeats);
+        assert!((b.patches[&7].u_xyz[1] - 0.2).abs() < 1e-9);
+        let sim = || {
+            parse_readings(
+                &format!(
+                    "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n7,{},0,0,0,1\n",
+                    grey(28.123_334)
+                ),
+                Path::new("sim.csv"),
+            )
+            .unwrap()
+        };
+        let mut s = sim();
+        let u = RenderUncertainty {
+            sigma_lab: [(7, render_lab_sigma(0.5, RenderStatement::HalfWidth95))].into(),
+            description: String::new(),
+        };
+        u.apply(&mut s);
+        assert_eq!(s.patches[&7].source, UncertaintySource::Render);
+        let linear = AssessOptions {
+            propagation: Propagation::Linear,
+            ..AssessOptions::default()
+        };
+        let a = assess("box", &b, "simulation", &s, white, &linear).unwrap();
+        let i = a.patches[0].de76_interval;
+        assert!((a.patches[0].de76 - 10.0).abs() < 1e-5);
+        assert!((i.lo - 9.449_95).abs() < 1e-4, "{i:?}");
+        assert!((i.hi - 10.550_05).abs() < 1e-4, "{i:?}");
+        // Without the render's term the interval is the meter's alone: 10 ± 1.96·0.238888.
+        let a = assess("box", &b, "simulation", &sim(), white, &linear).unwrap();
+        let i = a.patches[0].de76_interval;
+        assert!((i.hi - 10.468_21).abs() < 1e-4, "{i:?}");
+        // Monte Carlo agrees (the render's a*, b* terms lengthen ΔE by σ²/ΔE ≈ 0.002; a
+        // 2.5 % quantile of 4000 draws is good to about 0.02).
+        let mc = assess(
+            "box",
+            &b,
+            "simulation",
+            &s,
+            white,
+            &AssessOptions::default(),
+        )
+        .unwrap();
+        let m = mc.patches[0].de76_interval;
+        assert!(
+            (m.lo - 9.45).abs() < 0.03 && (m.hi - 10.55).abs() < 0.03,
+            "{m:?}"
+        );
+    }
 }

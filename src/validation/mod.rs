@@ -14,6 +14,9 @@ pub mod figures;
 pub mod propagate;
 pub mod readings;
 pub mod report;
+mod report_input;
+mod report_sections;
+pub mod verdict;
 
 use serde::{Deserialize, Serialize};
 

@@ -1,87 +1,24 @@
 //! The validation report: one self-contained HTML page (inline CSS and SVG, no scripts, no
 //! network) with the paper's figures, the per-patch table and a verdict, plus the optional
 //! sections the experiment pipeline fills (display model, light distribution fit, render
-//! confidence, instruments, gamut flags). Each optional section is drawn when present.
+//! confidence, instruments, gamut flags; [`super::report_sections`]). Each optional section
+//! is drawn when present.
 
 use std::fmt::Write;
 
-use serde::{Deserialize, Serialize};
-
-use super::assess::JND_DE76;
-use super::assess::{Assessment, JndVerdict, PatchAssessment};
+use super::assess::{Assessment, JND_DE76};
 use super::figures::{delta_e_bars, esc, lab_planes, srgb_swatch};
 use super::readings::UncertaintySource;
+use super::report_sections::{
+    display_section, inputs_section, instruments_section, light_section, render_section,
+    uncertainty_section,
+};
+use super::verdict::verdict_paragraph;
 
-/// Everything a report can show. `box_vs_display` is the paper's result and always there;
-/// the rest is drawn when given.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ReportInput {
-    pub title: String,
-    /// How CIELAB's white was chosen (for the reader).
-    pub white_source: String,
-    /// Fig. 4 and 5: the box against the display showing the rendering.
-    pub box_vs_display: Option<Assessment>,
-    /// Fig. 6: the box against the simulation.
-    pub box_vs_simulation: Option<Assessment>,
-    pub display_vs_simulation: Option<Assessment>,
-    pub display_model: Option<DisplayModelSection>,
-    pub light_fit: Option<LightFitSection>,
-    pub render_confidence: Option<RenderConfidenceSection>,
-    pub instruments: Vec<InstrumentUsed>,
-    /// 1-based patches whose colour the display cannot show (beyond what the readings say).
-    pub out_of_gamut: Vec<usize>,
-    /// The input files and what they held.
-    pub inputs: Vec<InputFile>,
-    pub notes: Vec<String>,
-}
-
-/// The display's characterization: the model, its diagnostics and its verification.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct DisplayModelSection {
-    pub model: String,
-    /// The fit's verdict in words ("PLCC's assumptions hold within ΔE00 0.5 …").
-    pub verdict: String,
-    /// Diagnostics as (what, value) rows.
-    pub diagnostics: Vec<(String, String)>,
-    /// Held-out verification ΔE00 (mean, p95, max) and the patch count.
-    pub verification_de00: Option<[f64; 3]>,
-    pub verification_patches: usize,
-}
-
-/// The light distribution (LDC) fit.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct LightFitSection {
-    pub summary: Vec<(String, String)>,
-    /// An SVG chart of the fit, drawn inline (scripts are removed).
-    pub chart_svg: Option<String>,
-}
-
-/// The renderer's confidence.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct RenderConfidenceSection {
-    pub method: String,
-    /// The target 95 % ΔE*ab half-width.
-    pub target_de: Option<f64>,
-    /// Per patch: (patch, 95 % ΔE*ab half-width or bound).
-    pub per_patch: Vec<(usize, f64)>,
-}
-
-/// An instrument used, with its calibrations.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct InstrumentUsed {
-    pub role: String,
-    pub model: String,
-    pub calibrations: Vec<String>,
-}
-
-/// An input file.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct InputFile {
-    pub role: String,
-    pub path: String,
-    pub format: String,
-    pub patches: usize,
-}
+pub use super::report_input::{
+    DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
+    ReportInput,
+};
 
 const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color:#111;background:#fff}\
 h1{font-size:1.5em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}\
@@ -104,12 +41,8 @@ pub fn render_html(input: &ReportInput) -> String {
         esc(title),
         esc(title)
     );
-    if let Some(a) = &input.box_vs_display {
-        let _ = writeln!(
-            h,
-            "<p class=\"verdict\" id=\"verdict\">{}</p>",
-            verdict(a, &input.out_of_gamut)
-        );
+    if let Some(v) = verdict_paragraph(input) {
+        let _ = writeln!(h, "<p class=\"verdict\" id=\"verdict\">{v}</p>");
     }
     let _ = writeln!(
         h,
@@ -176,6 +109,7 @@ pub fn render_html(input: &ReportInput) -> String {
     {
         table(&mut h, a);
     }
+    uncertainty_section(&mut h, input);
     if let Some(d) = &input.display_model {
         display_section(&mut h, d);
     }
@@ -186,30 +120,10 @@ pub fn render_html(input: &ReportInput) -> String {
         render_section(&mut h, r);
     }
     if !input.instruments.is_empty() {
-        h.push_str("<h2 id=\"instruments\">Instruments and calibrations</h2>\n<ul>");
-        for i in &input.instruments {
-            let _ = write!(h, "<li>{}: {}", esc(&i.role), esc(&i.model));
-            if !i.calibrations.is_empty() {
-                let list: Vec<String> = i.calibrations.iter().map(|c| esc(c)).collect();
-                let _ = write!(h, " — calibrated: {}", list.join("; "));
-            }
-            h.push_str("</li>");
-        }
-        h.push_str("</ul>\n");
+        instruments_section(&mut h, &input.instruments);
     }
     if !input.inputs.is_empty() {
-        h.push_str("<h2 id=\"inputs\">Inputs</h2>\n<table><tr><th>role</th><th>file</th><th>format</th><th>patches</th></tr>");
-        for f in &input.inputs {
-            let _ = write!(
-                h,
-                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td></tr>",
-                esc(&f.role),
-                esc(&f.path),
-                esc(&f.format),
-                f.patches
-            );
-        }
-        h.push_str("</table>\n");
+        inputs_section(&mut h, &input.inputs);
     }
     if !input.notes.is_empty() {
         h.push_str("<h2>Notes</h2>\n<ul>");
@@ -251,75 +165,6 @@ fn summary_line(a: &Assessment) -> String {
         a.max_de00.value,
         i(&a.max_de00)
     )
-}
-
-/// Why a patch may fail, where the input lets us know.
-fn reasons(p: &PatchAssessment, out_of_gamut: &[usize]) -> Vec<&'static str> {
-    let mut why = Vec::new();
-    if p.out_of_gamut || out_of_gamut.contains(&p.patch) {
-        why.push("out of the display's gamut");
-    }
-    let width = p.de76_interval.hi - p.de76_interval.lo;
-    if p.reference.lab[0] < 30.0 && width > 1.0 {
-        why.push("a dark patch, where the readings' uncertainty is large");
-    } else if width > 2.0 {
-        why.push("a wide interval: the readings scatter");
-    }
-    if p.reference.uncertainty == UncertaintySource::Unknown
-        || p.test.uncertainty == UncertaintySource::Unknown
-    {
-        why.push("uncertainty unknown (single readings)");
-    }
-    why
-}
-
-/// The one-paragraph verdict: how many patches pass, which fail or cannot be decided, and
-/// why where the input says.
-pub fn verdict(a: &Assessment, out_of_gamut: &[usize]) -> String {
-    let n = a.patches.len();
-    let mut s = format!(
-        "{} vs {}: {} of {n} patches are below the JND (ΔE*ab {JND_DE76}) with 95 % confidence, {} above and {} undecided; ΔE*ab mean {:.2}, max {:.2}.",
-        esc(&a.test),
-        esc(&a.reference),
-        a.jnd.below,
-        a.jnd.above,
-        a.jnd.undecided,
-        a.mean_de76.value,
-        a.max_de76.value
-    );
-    for (verdict, label) in [
-        (JndVerdict::Above, "Above the JND"),
-        (JndVerdict::Undecided, "Undecided"),
-    ] {
-        let list: Vec<String> = a
-            .patches
-            .iter()
-            .filter(|p| p.jnd == verdict)
-            .map(|p| {
-                let why = reasons(p, out_of_gamut);
-                format!(
-                    "{} {} ({:.1} [{:.1}, {:.1}]{})",
-                    p.patch,
-                    esc(&p.name),
-                    p.de76,
-                    p.de76_interval.lo,
-                    p.de76_interval.hi,
-                    if why.is_empty() {
-                        String::new()
-                    } else {
-                        format!("; {}", why.join(", "))
-                    }
-                )
-            })
-            .collect();
-        if !list.is_empty() {
-            let _ = write!(s, " {label}: {}.", list.join("; "));
-        }
-    }
-    if a.jnd.above == 0 && a.jnd.undecided == 0 {
-        s.push_str(" Every patch is reproduced within the JND.");
-    }
-    s
 }
 
 fn table(h: &mut String, a: &Assessment) {
@@ -380,79 +225,6 @@ fn source_name(s: UncertaintySource) -> &'static str {
     }
 }
 
-fn rows(h: &mut String, rows: &[(String, String)]) {
-    h.push_str("<table>");
-    for (k, v) in rows {
-        let _ = write!(
-            h,
-            "<tr><th class=\"l\">{}</th><td class=\"l\">{}</td></tr>",
-            esc(k),
-            esc(v)
-        );
-    }
-    h.push_str("</table>\n");
-}
-
-fn display_section(h: &mut String, d: &DisplayModelSection) {
-    let _ = writeln!(
-        h,
-        "<h2 id=\"display-model\">Display model: {}</h2>\n<p>{}</p>",
-        esc(&d.model),
-        esc(&d.verdict)
-    );
-    if let Some([mean, p95, max]) = d.verification_de00 {
-        let _ = writeln!(
-            h,
-            "<p>Verification on {} held-out patches: ΔE00 mean {mean:.2}, p95 {p95:.2}, max {max:.2}.</p>",
-            d.verification_patches
-        );
-    }
-    rows(h, &d.diagnostics);
-}
-
-fn light_section(h: &mut String, l: &LightFitSection) {
-    h.push_str("<h2 id=\"light-fit\">Light distribution fit</h2>\n");
-    rows(h, &l.summary);
-    if let Some(svg) = &l.chart_svg {
-        let _ = writeln!(h, "<figure>{}</figure>", inline_svg(svg));
-    }
-}
-
-/// An SVG document made fit to inline: its XML prolog removed; anything scripted is refused
-/// (the page must run no code).
-fn inline_svg(svg: &str) -> String {
-    let lower = svg.to_ascii_lowercase();
-    if lower.contains("<script") || has_handler(&lower) {
-        return "<p>(the chart holds scripts and is not shown)</p>".into();
-    }
-    let start = svg.find("<svg").unwrap_or(0);
-    svg[start..].to_string()
-}
-
-fn has_handler(lower: &str) -> bool {
-    ["onload=", "onclick=", "onerror=", "onmouseover="]
-        .iter()
-        .any(|h| lower.contains(h))
-}
-
-fn render_section(h: &mut String, r: &RenderConfidenceSection) {
-    let _ = writeln!(
-        h,
-        "<h2 id=\"render-confidence\">Render confidence</h2>\n<p>{}{}</p>",
-        esc(&r.method),
-        r.target_de
-            .map(|t| format!("; target 95 % ΔE*ab half-width {t}"))
-            .unwrap_or_default()
-    );
-    if !r.per_patch.is_empty() {
-        h.push_str("<table><tr><th>patch</th><th>95 % ΔE*ab</th></tr>");
-        for (p, d) in &r.per_patch {
-            let _ = write!(h, "<tr><td>{p}</td><td>{d:.3}</td></tr>");
-        }
-        h.push_str("</table>\n");
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -493,7 +265,7 @@ mod tests {
         assert!(bare.contains("id=\"fig4\"") && bare.contains("id=\"fig5\""));
         assert!(!bare.contains("id=\"fig6\"") && !bare.contains("display-model"));
         assert!(!bare.contains("<script"));
-        assert!(bare.contains("2 light skin (") && bare.contains("out of the display's gamut"));
+        assert!(bare.contains("outside the display's gamut (2 light skin)"));
         input.box_vs_simulation = Some(a);
         input.display_model = Some(DisplayModelSection {
             model: "lut".into(),

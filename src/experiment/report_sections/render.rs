@@ -1,0 +1,137 @@
+//! The renders' confidence from `simulation/simulation.json`: the method, its per-patch
+//! ΔE*ab statement (the path tracer's 95 % half-width, the radiosity solver's bound), the
+//! time, and the same statement as a CIELAB standard uncertainty for the comparisons.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::files::{read_json, unusable};
+use crate::experiment::simulation::{SimulationSummary, SUMMARY_FILE};
+use crate::validation::propagate::{render_lab_sigma, RenderStatement};
+use crate::validation::readings::{ReadingSet, UncertaintySource};
+use crate::validation::report::RenderConfidenceSection;
+
+const WHAT: &str = "render confidence";
+
+/// The simulation's uncertainty per patch, to enter the comparisons' intervals.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderUncertainty {
+    /// Patch → per-axis CIELAB standard uncertainty.
+    pub sigma_lab: BTreeMap<usize, f64>,
+    /// What it is, for the report.
+    pub description: String,
+}
+
+impl RenderUncertainty {
+    /// Gives each simulated patch of `set` the render's uncertainty (its XYZ carry none
+    /// of their own: the stage writes one rendered value per patch).
+    pub fn apply(&self, set: &mut ReadingSet) {
+        for (k, p) in set.patches.iter_mut() {
+            if let Some(s) = self.sigma_lab.get(k) {
+                p.u_lab = (p.u_lab.powi(2) + s.powi(2)).sqrt();
+                if p.u_factors.is_empty() {
+                    p.source = UncertaintySource::Render;
+                }
+            }
+        }
+    }
+}
+
+/// The section and the uncertainty, or the note saying why there are none.
+pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty), String> {
+    let file = dir.join(SUMMARY_FILE);
+    let v = read_json(&file).map_err(|why| unusable(WHAT, &file, why))?;
+    let s: SimulationSummary = serde_json::from_value(v)
+        .map_err(|e| unusable(WHAT, &file, format!("is not a render summary: {e}")))?;
+    let (how, measure, method) = if s.method == "radiosity" {
+        (
+            RenderStatement::Bound,
+            "ΔE*ab error bound (finest level against the level before)",
+            "deterministic radiosity solver",
+        )
+    } else {
+        (
+            RenderStatement::HalfWidth95,
+            "95 % ΔE*ab half-width",
+            "spectral path tracer",
+        )
+    };
+    if let Some(bad) = s
+        .spots
+        .iter()
+        .find(|p| !(p.de_uncertainty.is_finite() && p.de_uncertainty >= 0.0))
+    {
+        return Err(unusable(
+            WHAT,
+            &file,
+            format!(
+                "gives patch {} the uncertainty {}",
+                bad.patch, bad.de_uncertainty
+            ),
+        ));
+    }
+    let per_patch: Vec<(usize, f64)> = s
+        .spots
+        .iter()
+        .map(|p| (p.patch, p.de_uncertainty))
+        .collect();
+    let sigma_lab = per_patch
+        .iter()
+        .map(|&(k, d)| (k, render_lab_sigma(d, how)))
+        .collect();
+    let worst = per_patch.iter().map(|p| p.1).fold(0.0, f64::max);
+    let description = match how {
+        RenderStatement::Bound => format!(
+            "the radiosity solver's per-patch error bound b (largest {worst:.3} ΔE*ab), taken as the 95th percentile of an isotropic CIELAB error: σ = b/2.795 per axis"
+        ),
+        RenderStatement::HalfWidth95 => format!(
+            "the path tracer's per-patch 95 % half-width h (largest {worst:.3} ΔE*ab), as isotropic CIELAB noise: σ = h/(1.96·√3) per axis"
+        ),
+    };
+    Ok((
+        RenderConfidenceSection {
+            method: format!("{method} ({})", s.method),
+            target_de: None,
+            per_patch,
+            measure: measure.into(),
+            converged: Some(s.converged),
+            seconds: Some(s.seconds),
+        },
+        RenderUncertainty {
+            sigma_lab,
+            description,
+        },
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::files::testdir;
+    use super::*;
+
+    #[test]
+    fn half_widths_and_bounds_become_cielab_sigmas() {
+        let dir = testdir::fresh("render");
+        let summary = |method: &str| {
+            format!(
+                r#"{{"method":"{method}","white":[17.4,15.6,4.2],"converged":true,"seconds":21.1,
+                "spots":[{{"patch":1,"XYZ":[2.26,1.62,0.24],"de_uncertainty":0.5}},{{"patch":2,"XYZ":[8.0,5.9,1.0],"de_uncertainty":0.0}}],"image":null}}"#
+            )
+        };
+        testdir::write(&dir, SUMMARY_FILE, &summary("path tracer"));
+        let (r, u) = section(&dir).unwrap();
+        assert_eq!(r.per_patch, vec![(1, 0.5), (2, 0.0)]);
+        assert_eq!((r.converged, r.seconds), (Some(true), Some(21.1)));
+        // 0.5 / (1.959964 · 1.7320508) = 0.1472859.
+        assert!((u.sigma_lab[&1] - 0.147_285_9).abs() < 1e-6, "{u:?}");
+        testdir::write(&dir, SUMMARY_FILE, &summary("radiosity"));
+        let (r, u) = section(&dir).unwrap();
+        assert!(r.measure.contains("bound"));
+        // 0.5 / √7.81473 = 0.1788600.
+        assert!((u.sigma_lab[&1] - 0.178_860_0).abs() < 1e-6, "{u:?}");
+        testdir::write(&dir, SUMMARY_FILE, "{\"method\":\"radiosity\"}");
+        let e = section(&dir).unwrap_err();
+        assert!(e.contains("is not a render summary"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

@@ -1,0 +1,102 @@
+//! What a validation report shows, as data: the comparisons and the optional sections a
+//! caller fills (the experiment fills them all, `validate` what its files hold).
+
+use serde::{Deserialize, Serialize};
+
+use super::assess::Assessment;
+
+/// Everything a report can show. `box_vs_display` is the paper's result and always there;
+/// the rest is drawn when given.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ReportInput {
+    pub title: String,
+    /// How CIELAB's white was chosen (for the reader).
+    pub white_source: String,
+    /// Fig. 4 and 5: the box against the display showing the rendering.
+    pub box_vs_display: Option<Assessment>,
+    /// Fig. 6: the box against the simulation.
+    pub box_vs_simulation: Option<Assessment>,
+    pub display_vs_simulation: Option<Assessment>,
+    pub display_model: Option<DisplayModelSection>,
+    pub light_fit: Option<LightFitSection>,
+    pub render_confidence: Option<RenderConfidenceSection>,
+    pub instruments: Vec<InstrumentUsed>,
+    /// 1-based patches whose colour the display cannot show (beyond what the readings say).
+    pub out_of_gamut: Vec<usize>,
+    /// The input files and what they held.
+    pub inputs: Vec<InputFile>,
+    /// What each side's interval contains, by side ("box", "simulation", "display");
+    /// a side not named here is described from its readings' uncertainty source.
+    #[serde(default)]
+    pub uncertainty: Vec<(String, String)>,
+    pub notes: Vec<String>,
+}
+
+/// The display's characterization: the model, its diagnostics and its verification.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DisplayModelSection {
+    pub model: String,
+    /// The fit's verdict in words ("PLCC's assumptions hold within ΔE00 0.5 …").
+    pub verdict: String,
+    /// Diagnostics as (what, value) rows.
+    pub diagnostics: Vec<(String, String)>,
+    /// Held-out verification ΔE00 (mean, p95, max) and the patch count.
+    pub verification_de00: Option<[f64; 3]>,
+    pub verification_patches: usize,
+}
+
+/// The light distribution (LDC) fit.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LightFitSection {
+    pub summary: Vec<(String, String)>,
+    /// An SVG chart of the fit, drawn inline (scripts are removed).
+    pub chart_svg: Option<String>,
+}
+
+/// The renderer's confidence.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RenderConfidenceSection {
+    pub method: String,
+    /// The target 95 % ΔE*ab half-width.
+    pub target_de: Option<f64>,
+    /// Per patch: (patch, 95 % ΔE*ab half-width or bound).
+    pub per_patch: Vec<(usize, f64)>,
+    /// What the per-patch numbers are ("95 % half-width", "error bound").
+    #[serde(default)]
+    pub measure: String,
+    /// Whether every patch reached the target.
+    #[serde(default)]
+    pub converged: Option<bool>,
+    /// Wall time of the render, seconds.
+    #[serde(default)]
+    pub seconds: Option<f64>,
+}
+
+/// An instrument used, with its calibrations.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InstrumentUsed {
+    pub role: String,
+    pub model: String,
+    /// Serial number and firmware where the instrument reports them.
+    #[serde(default)]
+    pub serial: Option<String>,
+    #[serde(default)]
+    pub firmware: Option<String>,
+    /// How it was connected (`/dev/ttyUSB0`, `sim:cs100a`, …).
+    #[serde(default)]
+    pub connection: Option<String>,
+    /// Each calibration with its time ("2026-12-01T22:54:03Z emissive, on_white_tile").
+    pub calibrations: Vec<String>,
+}
+
+/// An input file.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InputFile {
+    pub role: String,
+    pub path: String,
+    pub format: String,
+    pub patches: usize,
+    /// SHA-256 of its bytes (hex), where known.
+    #[serde(default)]
+    pub sha256: Option<String>,
+}
