@@ -207,7 +207,11 @@ pub fn simulate(
             files.push(IMAGE_FILE);
             Some(IMAGE_FILE.to_string())
         }
-        None => None,
+        None => {
+            // An image of an earlier run with other options is not this run's.
+            remove_stale(&dir.join(IMAGE_FILE))?;
+            None
+        }
     };
     let summary = SimulationSummary {
         method: method.into(),
@@ -269,4 +273,14 @@ fn patches_in_image(
         });
     }
     Ok(out)
+}
+
+fn remove_stale(path: &Path) -> Result<(), ExperimentError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(ExperimentError::Io {
+            file: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
 }

@@ -71,7 +71,9 @@ impl RgbImage {
             .output_buffer_size()
             .ok_or_else(|| bad(format!("{w}×{h} pixels is too large")))?;
         let mut buf = vec![0; size];
-        let frame = reader.next_frame(&mut buf).map_err(|e| bad(e.to_string()))?;
+        let frame = reader
+            .next_frame(&mut buf)
+            .map_err(|e| bad(e.to_string()))?;
         let pixels = buf[..frame.buffer_size()]
             .chunks_exact(3)
             .map(|p| [p[0], p[1], p[2]])
@@ -89,7 +91,10 @@ impl RgbImage {
     pub fn colours_in(&self, spot: Option<super::screen::ScreenSpot>) -> Vec<([u8; 3], usize)> {
         let mut counts: std::collections::BTreeMap<[u8; 3], usize> = Default::default();
         match spot {
-            None => self.pixels.iter().for_each(|p| *counts.entry(*p).or_default() += 1),
+            None => self
+                .pixels
+                .iter()
+                .for_each(|p| *counts.entry(*p).or_default() += 1),
             Some(s) => {
                 let (cx, cy) = (s.x * self.width as f64, s.y * self.height as f64);
                 let r = s.radius * self.height as f64;

@@ -209,7 +209,12 @@ impl VirtualPanel {
                 *v += *n as f64 * x;
             }
         }
-        radiance(values.into_iter().map(|v| v / total.max(1) as f64).collect())
+        radiance(
+            values
+                .into_iter()
+                .map(|v| v / total.max(1) as f64)
+                .collect(),
+        )
     }
 
     /// The drive values 0–1 (continuous, before quantisation) at which the panel emits

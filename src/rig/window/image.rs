@@ -53,17 +53,33 @@ impl WindowDisplay {
                     self.format.bits_per_pixel
                 ),
             })?;
-        let pixmap = self.conn.generate_id().map_err(perr(d, "allocating an id"))?;
+        let pixmap = self
+            .conn
+            .generate_id()
+            .map_err(perr(d, "allocating an id"))?;
         self.conn
-            .create_pixmap(self.depth, pixmap, self.root, self.monitor.width, self.monitor.height)
+            .create_pixmap(
+                self.depth,
+                pixmap,
+                self.root,
+                self.monitor.width,
+                self.monitor.height,
+            )
             .map_err(perr(d, "CreatePixmap"))?;
-        let gc = self.conn.generate_id().map_err(perr(d, "allocating an id"))?;
+        let gc = self
+            .conn
+            .generate_id()
+            .map_err(perr(d, "allocating an id"))?;
         self.conn
             .create_gc(gc, pixmap, &CreateGCAux::new())
             .map_err(perr(d, "CreateGC"))?;
         // One request holds at most the server's maximum: send the image in bands of rows.
         let stride = self.format.stride(mw);
-        let max_bytes = self.conn.maximum_request_bytes().saturating_sub(64).max(stride);
+        let max_bytes = self
+            .conn
+            .maximum_request_bytes()
+            .saturating_sub(64)
+            .max(stride);
         let rows = (max_bytes / stride).clamp(1, mh);
         for (band, chunk) in data.chunks(rows * stride).enumerate() {
             let y = band * rows;
