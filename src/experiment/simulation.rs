@@ -106,13 +106,13 @@ pub fn simulate(
     let start = Instant::now();
     let scene = Scene::load(scene_file)?;
     let scene = &scene;
-    let (method, white, converged, spots, render) = if radiosity::qualifies(&scene).is_ok() {
+    let (method, white, converged, spots, render) = if radiosity::qualifies(scene).is_ok() {
         let ropts = RadiosityOptions {
             target_de: opts.target_de,
             max_seconds: opts.max_seconds,
             ..RadiosityOptions::default()
         };
-        let (r, solved) = render_spots_radiosity_solved(&scene, &ropts, &|l| {
+        let (r, solved) = render_spots_radiosity_solved(scene, &ropts, &|l| {
             progress(Progress::Note(format!(
                 "radiosity level {}: {} elements, {:.2} s",
                 l.level, l.elements, l.seconds
@@ -143,7 +143,7 @@ pub fn simulate(
             seed: opts.seed,
             ..SpotOptions::default()
         };
-        let r = render_spots_with_progress(&scene, &sopts, &|p| {
+        let r = render_spots_with_progress(scene, &sopts, &|p| {
             progress(Progress::Note(format!(
                 "path tracing: worst 95 % half-width {:.3} ΔE*ab",
                 p.worst_de
