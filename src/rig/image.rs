@@ -2,6 +2,16 @@
 
 use std::path::{Path, PathBuf};
 
+/// Where a spot meter is aimed on a screen (or an image filling it): the centre as
+/// fractions of the width and height from the top-left corner, and the spot's radius as a
+/// fraction of the height.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenSpot {
+    pub x: f64,
+    pub y: f64,
+    pub radius: f64,
+}
+
 /// Rows top to bottom, each pixel's drive values.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RgbImage {
@@ -88,7 +98,7 @@ impl RgbImage {
     /// How many pixels of each colour lie inside `spot` (fractions of this image; pixel
     /// centres inside the disc), or of the whole image without one. A spot smaller than a
     /// pixel counts the pixel under its centre.
-    pub fn colours_in(&self, spot: Option<super::screen::ScreenSpot>) -> Vec<([u8; 3], usize)> {
+    pub fn colours_in(&self, spot: Option<ScreenSpot>) -> Vec<([u8; 3], usize)> {
         let mut counts: std::collections::BTreeMap<[u8; 3], usize> = Default::default();
         match spot {
             None => self

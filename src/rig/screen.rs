@@ -9,16 +9,7 @@ use std::time::Duration;
 
 use metamer_drivers::World;
 
-pub use super::image::{ImageError, RgbImage};
-
-/// Where a spot meter is aimed on a screen: the centre as fractions of the screen's width
-/// and height from its top-left corner, and the spot's radius as a fraction of its height.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ScreenSpot {
-    pub x: f64,
-    pub y: f64,
-    pub radius: f64,
-}
+pub use super::image::{ImageError, RgbImage, ScreenSpot};
 
 /// Where an image landed on a screen, as fractions of the screen's width and height: its
 /// left and top edges and its width and height (the whole screen, or less when the image
