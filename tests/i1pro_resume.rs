@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use metamer::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome, Stage};
 use metamer::output::OutputPolicy;
+use metamer::rig::scenario::Scenario;
 use metamer::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use metamer::session::{NoProgress, RunEnd, RunOptions};
 use metamer_drivers::{open_instrument, SharedWorld, View};
@@ -33,7 +34,7 @@ fn plan() -> BoxPlan {
 /// Runs the tiles stage in `dir` with instruments opened afresh, as a new process would.
 fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
     let plan = plan();
-    let truth = TruthBox::new(&plan, SEED).unwrap();
+    let truth = TruthBox::new(&plan, SEED, Scenario::default()).unwrap();
     let world = Arc::new(SharedWorld::new(View::Capped));
     let mut spectral = open_instrument(&seeded(SPECTRAL, SEED), Some(world.clone())).unwrap();
     let mut spot = open_instrument(&seeded(SPOT, SEED + 1), Some(world.clone())).unwrap();

@@ -26,7 +26,8 @@ fn temp_dir(tag: &str) -> PathBuf {
     d
 }
 
-/// A fast lab: ΔE 0.5 renders, one reading per box target and per display patch.
+/// A fast lab: ΔE 0.5 renders, a 256² image, one reading per box target and per display
+/// patch.
 fn quick_lab(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "lab",
@@ -38,6 +39,8 @@ fn quick_lab(dir: &Path, extra: &[&str]) -> Output {
         "1",
         "--box-repeats",
         "1",
+        "--image-size",
+        "256",
     ];
     args.extend_from_slice(extra);
     let o = metamer(&args);

@@ -8,8 +8,9 @@ use std::io::BufRead;
 use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
+use metamer::rig::screen::RgbImage;
 use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
-use metamer::rig::Screen;
+use metamer::rig::{Placement, Screen};
 
 struct Xvfb {
     child: Child,
@@ -107,6 +108,43 @@ fn screenshot_shows_exactly_the_requested_rgb() {
     }
     assert_eq!(window.spec(), "window:0");
     assert!(window.describe().contains(&x.display));
+}
+
+/// A 2×2 image on a 640×480 monitor, scaled to fit: 480×480 at 80 from the left, each
+/// source pixel a 240×240 block, black bars either side; a colour shown afterwards covers
+/// everything again.
+#[test]
+fn an_image_is_shown_whole_scaled_to_fit() {
+    let Some(x) = xvfb(640, 480) else { return };
+    let mut window = WindowDisplay::open(Some(&x.display), 0).unwrap();
+    let (a, b, c, d) = ([255, 0, 0], [0, 255, 0], [0, 0, 255], [10, 20, 30]);
+    let image = RgbImage::new(2, 2, vec![a, b, c, d]).unwrap();
+    let placement = window.show_image(&image).unwrap();
+    assert_eq!(
+        placement,
+        Placement {
+            left: 80.0 / 640.0,
+            top: 0.0,
+            width: 480.0 / 640.0,
+            height: 1.0
+        }
+    );
+    let pixels = window.screenshot().unwrap();
+    let want = |x: usize, y: usize| match (x, y) {
+        (x, _) if !(80..560).contains(&x) => [0, 0, 0],
+        (x, y) => match (x < 320, y < 240) {
+            (true, true) => a,
+            (false, true) => b,
+            (true, false) => c,
+            (false, false) => d,
+        },
+    };
+    let wrong = (0..640 * 480)
+        .filter(|&i| pixels[i] != want(i % 640, i / 640))
+        .count();
+    assert_eq!(wrong, 0, "{wrong} pixels differ");
+    window.show([7, 8, 9]).unwrap();
+    assert!(window.screenshot().unwrap().iter().all(|&p| p == [7, 8, 9]));
 }
 
 #[test]

@@ -57,10 +57,13 @@ pub struct Args {
     /// The simulation's accuracy: every patch's ΔE*ab uncertainty below this.
     #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
     target_de: f64,
-    /// Side of the square camera image rendered and reproduced (0: spots only).
-    #[arg(long, default_value_t = 0, value_name = "PIXELS")]
+    /// Side of the square camera image rendered, reproduced and shown on the display for
+    /// the spot readings (the paper's 1014; 0: spots only, each patch's colour shown
+    /// full-screen instead).
+    #[arg(long, default_value_t = 1014, value_name = "PIXELS")]
     image_size: usize,
-    /// Samples per pixel of the image.
+    /// Samples per pixel of the image when the path tracer renders it (the radiosity image
+    /// is noise-free).
     #[arg(long, default_value_t = 16, value_name = "N")]
     image_spp: u64,
     /// The simulated box's light (simulated instruments only; default display-white):

@@ -47,6 +47,10 @@ pub struct Args {
     /// The simulated instruments' pace: 1 = their real pace (the CS-100A ≈100 ms per reading), 0 = at once.
     #[arg(long, default_value_t = 0.0, value_name = "F")]
     time_scale: f64,
+    /// The camera image's side in pixels (the paper's 1014), reproduced and shown whole on
+    /// the simulated monitor for the spot readings; 0: none, each patch shown full-screen.
+    #[arg(long, default_value_t = 1014, value_name = "PIXELS")]
+    image_size: usize,
     /// Continue an interrupted measuring stage from its journal.
     #[arg(long)]
     resume: bool,
@@ -73,6 +77,9 @@ pub fn run(args: Args) -> CliResult {
     if !(args.time_scale >= 0.0 && args.time_scale.is_finite()) {
         return Err(CliError::Usage("--time-scale must be 0 or more".into()));
     }
+    if args.image_size > 8192 {
+        return Err(CliError::Usage("--image-size must be at most 8192".into()));
+    }
     if args.out.exists() && !args.out.is_dir() {
         return Err(CliError::Usage(format!(
             "-o {}: exists and is not a directory",
@@ -89,6 +96,7 @@ pub fn run(args: Args) -> CliResult {
         box_repeats: args.box_repeats,
         seed: args.seed,
         time_scale: args.time_scale,
+        image_size: args.image_size,
     };
     let run = RunOptions {
         stop_after: None,

@@ -12,6 +12,7 @@ use metamer::render::geometry::{Vec3, VecOps};
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
 use metamer::render::probes::probe_illuminance_path;
+use metamer::render::radiosity::image::{render_image_radiosity, RadiosityImageOptions};
 use metamer::render::radiosity::probes::{probe_illuminance, Illuminance, Probe};
 use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
@@ -58,9 +59,18 @@ enum Cmd {
     Image {
         /// The scene file (default: the built-in validation box).
         scene: Option<PathBuf>,
-        /// Samples per pixel.
+        /// Samples per pixel (radiosity: a √spp × √spp grid of rays, spp rounded down to a
+        /// square).
         #[arg(long)]
         spp: u64,
+        /// path: the path tracer; radiosity: the deterministic solver's reflected radiance
+        /// at every ray's first hit (convex scenes of Lambertian rectangles).
+        #[arg(long, value_enum, default_value_t = Method::Path)]
+        method: Method,
+        /// Radiosity: the finest mesh level (the indirect light is extrapolated from it and
+        /// the level before, as the spot readings are).
+        #[arg(long, default_value_t = 3)]
+        level: usize,
         /// Output size (default: the scene's, 1014×1014); the field of view is kept.
         #[arg(long)]
         width: Option<usize>,
@@ -211,6 +221,8 @@ pub fn run(args: Args) -> CliResult {
         Cmd::Image {
             scene,
             spp,
+            method,
+            level,
             width,
             height,
             output,
@@ -267,12 +279,33 @@ pub fn run(args: Args) -> CliResult {
                 window: None,
             };
             let t = std::time::Instant::now();
-            let img = render_image(&scene, &opts, &|n| bar.inc(n as u64))?;
+            let radiosity = match method {
+                Method::Radiosity => true,
+                Method::Path => false,
+                Method::Auto => radiosity::qualifies(&scene).is_ok(),
+            };
+            let img = if radiosity {
+                let iopts = RadiosityImageOptions {
+                    width,
+                    height,
+                    level,
+                    subpixels: (spp as f64).sqrt().floor().max(1.0) as usize,
+                    ..RadiosityImageOptions::default()
+                };
+                render_image_radiosity(&scene, &RadiosityOptions::default(), &iopts)?
+            } else {
+                render_image(&scene, &opts, &|n| bar.inc(n as u64))?
+            };
             bar.finish_and_clear();
             let secs = t.elapsed().as_secs_f64();
             write_xyz_image(&output, &img, &out)?;
             eprintln!(
-                "{width}×{height} at {spp} spp in {secs:.1} s ({:.0} samples/s), wrote {}",
+                "{width}×{height} at {spp} spp by {} in {secs:.1} s ({:.0} samples/s), wrote {}",
+                if radiosity {
+                    "radiosity"
+                } else {
+                    "the path tracer"
+                },
                 (width * height) as f64 * spp as f64 / secs,
                 output.display()
             );

@@ -1,12 +1,14 @@
-//! The display-spots stage: each patch's reproduced drive values shown over the whole
-//! measured area of the monitor and read with the spot meter, `repeats` times, as a
-//! journalled session (resumable after any interruption).
+//! The display-spots stage: the reproduced image shown whole on the monitor, as in the
+//! paper, and each patch read with the spot meter `repeats` times, the operator guided
+//! patch by patch to where the patch lies on the screen (mirrored with the image); a
+//! journalled session, resumable after any interruption.
 //!
-//! The paper shows the whole reproduced image and aims the meter at each patch. A patch
-//! region of the image is uniform where the meter's 1° spot falls, so showing that colour
-//! full-screen puts the same light in front of the meter; it also spares the operator 24
-//! aimings. What it leaves out is the display's dependence on the rest of the picture
-//! (power-supply loading, backlight dimming), which the report names as a limit.
+//! A simulated meter aimed at a simulated screen sees the mean emission under its spot, so
+//! a wrong mirror or a non-uniform screen shows in its readings. Without an image (none
+//! rendered) each patch's drive values are shown over the whole screen instead: a patch
+//! region is uniform where the 1° spot falls, so that puts the same light in front of the
+//! meter, but leaves out the display's dependence on the rest of the picture (power-supply
+//! loading, backlight dimming). `display-spots.json` records which was shown.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -18,10 +20,12 @@ use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
-use super::reproduction::PatchDrive;
+use super::reproduction::{PatchDrive, PatchRegion};
+use crate::rig::image::RgbImage;
+use crate::rig::{MeterAim, Placement, ScreenSpot};
 use crate::session::{
-    DisplayScreen, InstrumentRecord, Prepare, Rig, RunEnd, RunOptions, ScriptedOperator, Session,
-    SessionPlan, Step, StepProgress,
+    Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, Prepare, Rig, RunEnd,
+    RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, TerminalOperator,
 };
 
 /// A display-spot step's own data in the journal.
@@ -40,6 +44,95 @@ pub struct SpotHeader {
 
 pub const JOURNAL_FILE: &str = "journal.jsonl";
 pub const SPOTS_FILE: &str = "spots.csv";
+/// What was shown and where the meter was aimed.
+pub const RECORD_FILE: &str = "display-spots.json";
+
+/// Where the operator aims the meter for one patch.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PatchAim {
+    pub patch: usize,
+    /// The spot on the screen (fractions of its width and height from the top-left).
+    pub x: f64,
+    pub y: f64,
+    pub radius: f64,
+    pub prompt: String,
+}
+
+/// What `display-spots.json` holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpotRecord {
+    /// `image` (the reproduced image, the meter aimed patch by patch) or `patch colours`
+    /// (each patch's drive values full-screen).
+    pub shown: String,
+    /// Why, when it is not the image.
+    pub note: Option<String>,
+    pub aims: Vec<PatchAim>,
+}
+
+/// The operator's request for patch `r` at `spot` on the screen.
+pub fn aim_prompt(r: &PatchRegion, spot: ScreenSpot) -> String {
+    format!(
+        "aim the meter at patch {} (row {}, column {}) — at {:.1} % from the left, {:.1} % \
+         from the top of the screen",
+        r.patch,
+        r.row,
+        r.column,
+        100.0 * spot.x,
+        100.0 * spot.y
+    )
+}
+
+/// The plan on the whole image: every patch, `repeats` times; the meter is aimed before
+/// each patch's first reading and stays there for the rest.
+pub fn image_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
+    let mut steps = Vec::new();
+    for a in aims {
+        for repeat in 1..=repeats {
+            steps.push(Step {
+                label: format!("patch {} reading {repeat}", a.patch),
+                role: "spot".into(),
+                mode: MeasureMode::Emissive,
+                prepare: if repeat == 1 {
+                    Prepare::Operator {
+                        prompt: a.prompt.clone(),
+                    }
+                } else {
+                    Prepare::None
+                },
+                settle: std::time::Duration::ZERO,
+                data: SpotStep {
+                    patch: a.patch,
+                    repeat,
+                },
+            });
+        }
+    }
+    let mut options = BTreeMap::new();
+    options.insert("repeats".to_string(), repeats.to_string());
+    options.insert("shown".to_string(), "image".to_string());
+    SessionPlan {
+        kind: "display-spots".into(),
+        options,
+        steps,
+    }
+}
+
+/// Passes every request on to the operator; on a simulated screen it also aims the
+/// simulated meter where an aiming request says.
+struct Aiming<'a> {
+    aims: BTreeMap<String, ScreenSpot>,
+    meter: Option<MeterAim>,
+    inner: &'a mut dyn Operator,
+}
+
+impl Operator for Aiming<'_> {
+    fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
+        if let (Some(meter), Some(spot)) = (&self.meter, self.aims.get(prompt)) {
+            meter.set(Some(*spot));
+        }
+        self.inner.ask(prompt)
+    }
+}
 
 /// The plan: every patch, `repeats` times, in patch order.
 pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
@@ -68,20 +161,28 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
     }
 }
 
+/// The reproduced image and each patch's spot on it.
+pub struct ShownImage<'a> {
+    pub file: &'a Path,
+    pub regions: &'a [PatchRegion],
+}
+
 /// What the display-spots session reads, and how.
 pub struct SpotSession<'a> {
     pub setting: &'a DisplaySetting,
     /// The spot meter as named by the user.
     pub spot_spec: &'a str,
     pub drives: &'a [PatchDrive],
+    /// None: each patch's colour full-screen.
+    pub image: Option<ShownImage<'a>>,
     pub repeats: usize,
     pub resume: bool,
+    /// Nobody at the rig: every request counts as done.
+    pub unattended: bool,
     pub run: &'a RunOptions,
 }
 
 /// Shows and reads every patch into `dir`.
-// Eight plain inputs of one stage; bundling them would only move the list into a struct.
-#[allow(clippy::too_many_arguments)]
 pub fn measure(
     dir: &Path,
     s: &SpotSession<'_>,
@@ -94,6 +195,7 @@ pub fn measure(
         repeats,
         resume,
         run,
+        ..
     } = *s;
     let mut screen = open_screen(&setting.screen, setting.virtual_white_cd_m2)?;
     let mut meter = open_meter(spot_spec, screen.as_ref())?;
@@ -103,7 +205,34 @@ pub fn measure(
     } else {
         screen.default_settle()
     };
-    let mut plan = plan(drives, repeats.max(1));
+    let (mut plan, record) = match &s.image {
+        Some(shown) => {
+            let image = RgbImage::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
+                file: shown.file.to_path_buf(),
+                message: e.to_string(),
+            })?;
+            let placement = screen.show_image(&image)?;
+            let aims = aims_on(&placement, shown.regions);
+            let plan = image_plan(&aims, repeats.max(1));
+            let record = SpotRecord {
+                shown: "image".into(),
+                note: None,
+                aims,
+            };
+            (plan, record)
+        }
+        None => {
+            let note = "no image was rendered: each patch's drive values were shown over the \
+                        whole screen instead of the reproduced image";
+            progress(Progress::Note(note.into()));
+            let record = SpotRecord {
+                shown: "patch colours".into(),
+                note: Some(note.into()),
+                aims: Vec::new(),
+            };
+            (plan(drives, repeats.max(1)), record)
+        }
+    };
     plan.steps.iter_mut().for_each(|s| s.settle = settle);
     let mut instruments = BTreeMap::new();
     instruments.insert("spot".to_string(), InstrumentRecord::of(meter.as_ref()));
@@ -118,10 +247,51 @@ pub fn measure(
         instruments,
         resume,
     )?;
-    let mut operator = ScriptedOperator::confirming();
+    let mut scripted = ScriptedOperator::confirming();
+    let mut terminal = TerminalOperator;
+    let inner: &mut dyn Operator = if s.unattended || setting.virtual_white_cd_m2.is_some() {
+        &mut scripted
+    } else {
+        &mut terminal
+    };
+    let mut operator = Aiming {
+        aims: record
+            .aims
+            .iter()
+            .map(|a| {
+                let spot = ScreenSpot {
+                    x: a.x,
+                    y: a.y,
+                    radius: a.radius,
+                };
+                (a.prompt.clone(), spot)
+            })
+            .collect(),
+        meter: screen.meter_aim(),
+        inner,
+    };
+    // A resumed session may continue mid-patch, after that patch's aiming request.
+    let next = session.done();
+    if let Some(step) = session.plan().steps.get(next) {
+        if step.data.repeat > 1 {
+            if let Some(a) = record.aims.iter().find(|a| a.patch == step.data.patch) {
+                if operator.ask(&a.prompt)? == Answer::Abort {
+                    return Err(ExperimentError::Incomplete {
+                        stage: "display-spots",
+                        done: next,
+                        total: session.plan().steps.len(),
+                        journal,
+                    });
+                }
+            }
+        }
+    }
     let mut shown = DisplayScreen(screen.as_mut());
     let mut rig = Rig {
-        screen: Some(&mut shown),
+        screen: s
+            .image
+            .is_none()
+            .then_some(&mut shown as &mut dyn crate::session::Screen),
         instruments: vec![("spot".to_string(), meter.as_mut())],
         operator: &mut operator,
     };
@@ -145,5 +315,28 @@ pub fn measure(
         entries.iter().map(|e| (e.data.patch, &e.reading)).collect();
     let stats = PatchStat::group(&readings);
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
-    Ok((stats, vec![JOURNAL_FILE, SPOTS_FILE]))
+    let text = serde_json::to_string_pretty(&record).map_err(ExperimentError::Json)?;
+    super::cache::write_atomic(&dir.join(RECORD_FILE), text.as_bytes())?;
+    Ok((stats, vec![JOURNAL_FILE, SPOTS_FILE, RECORD_FILE]))
+}
+
+/// Each patch's aim on the screen, for the image placed at `placement`.
+pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> {
+    regions
+        .iter()
+        .map(|r| {
+            let spot = placement.on_screen(ScreenSpot {
+                x: r.x,
+                y: r.y,
+                radius: r.radius,
+            });
+            PatchAim {
+                patch: r.patch,
+                x: spot.x,
+                y: spot.y,
+                radius: spot.radius,
+                prompt: aim_prompt(r, spot),
+            }
+        })
+        .collect()
 }

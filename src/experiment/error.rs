@@ -14,7 +14,7 @@ use crate::render::radiosity::RadiosityError;
 use crate::render::spot::SpotError;
 use crate::render::SceneError;
 use crate::rig::{OpenError, ScreenError};
-use crate::session::SessionError;
+use crate::session::{OperatorError, SessionError};
 use crate::validation::ValidationError;
 
 #[derive(Debug, thiserror::Error)]
@@ -41,6 +41,8 @@ pub enum ExperimentError {
     Profile(#[from] ProfileError),
     #[error(transparent)]
     Session(#[from] SessionError),
+    #[error(transparent)]
+    Operator(#[from] OperatorError),
     #[error(transparent)]
     Validation(#[from] ValidationError),
     #[error(transparent)]

@@ -1,6 +1,9 @@
 //! The simulation stage: the measured scene's 24 spot readings rendered to a ΔE*ab target
 //! (the deterministic radiosity solver where the scene qualifies, the path tracer where it
-//! does not) and, optionally, the camera's image for the display.
+//! does not) and the camera's image for the display: from the same radiosity solution
+//! when the spots came from one (a few seconds at the paper's 1014²), else by the path
+//! tracer. Each patch's spot footprint in the image is read back and compared with its
+//! spot reading, and its place in the image recorded for aiming the meter at the display.
 
 use std::path::Path;
 use std::time::Instant;
@@ -10,10 +13,13 @@ use serde::{Deserialize, Serialize};
 use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
+use crate::color::{delta_e76, Xyz};
 use crate::output::OutputPolicy;
-use crate::render::image::{render_image, ImageOptions};
-use crate::render::image_io::write_xyz_image;
-use crate::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
+use crate::render::image::{render_image, spot_mean, Frame, ImageOptions};
+use crate::render::image_io::{write_xyz_image, XyzImage};
+use crate::render::radiosity::image::{render_image_from, RadiosityImageOptions};
+use crate::render::radiosity::{self, render_spots_radiosity_solved, RadiosityOptions};
+use crate::render::spot::patch_aim;
 use crate::render::{render_spots_with_progress, Scene, SpotOptions, Strategy};
 
 /// What the simulation stage renders.
@@ -33,7 +39,28 @@ pub struct SimulationOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ImageSpec {
     pub size: usize,
+    /// Samples per pixel of the path tracer (the radiosity image takes one ray per pixel:
+    /// it has no noise to average).
     pub spp: u64,
+}
+
+/// Where a patch lies in the image and what the image shows there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImagePatch {
+    pub patch: usize,
+    /// The meter's aim (the patch's centre) as fractions of the image's width and height
+    /// from its top-left corner, as rendered (not mirrored).
+    pub x: f64,
+    pub y: f64,
+    /// The radius of the meter's spot as a fraction of the image's height.
+    pub radius: f64,
+    /// Pixels inside the spot.
+    pub pixels: usize,
+    /// The image's mean over the spot (solid-angle weighted), cd/m².
+    #[serde(rename = "XYZ")]
+    pub xyz: [f64; 3],
+    /// ΔE*ab of that mean against the patch's spot reading (the scene's reference white).
+    pub de_vs_spot: f64,
 }
 
 /// One rendered spot reading.
@@ -57,6 +84,12 @@ pub struct SimulationSummary {
     pub spots: Vec<SimSpot>,
     /// `image.exr` when an image was rendered.
     pub image: Option<String>,
+    /// How the image was rendered (`radiosity`, `path tracer`).
+    #[serde(default)]
+    pub image_method: Option<String>,
+    /// The patches' spots in the image, when an image was rendered.
+    #[serde(default)]
+    pub image_patches: Vec<ImagePatch>,
 }
 
 pub const SPOTS_FILE: &str = "spots.csv";
@@ -72,13 +105,14 @@ pub fn simulate(
 ) -> Result<(SimulationSummary, Vec<&'static str>), ExperimentError> {
     let start = Instant::now();
     let scene = Scene::load(scene_file)?;
-    let (method, white, converged, spots) = if radiosity::qualifies(&scene).is_ok() {
+    let scene = &scene;
+    let (method, white, converged, spots, render) = if radiosity::qualifies(scene).is_ok() {
         let ropts = RadiosityOptions {
             target_de: opts.target_de,
             max_seconds: opts.max_seconds,
             ..RadiosityOptions::default()
         };
-        let r = render_spots_radiosity(&scene, &ropts, &|l| {
+        let (r, solved) = render_spots_radiosity_solved(scene, &ropts, &|l| {
             progress(Progress::Note(format!(
                 "radiosity level {}: {} elements, {:.2} s",
                 l.level, l.elements, l.seconds
@@ -93,7 +127,15 @@ pub fn simulate(
                 de_uncertainty: p.de_bound,
             })
             .collect::<Vec<_>>();
-        ("radiosity", r.white, r.converged, spots)
+        let image = Box::new(move |spec: ImageSpec| {
+            let io = RadiosityImageOptions {
+                width: spec.size,
+                height: spec.size,
+                ..RadiosityImageOptions::default()
+            };
+            render_image_from(scene, &solved, &ropts, &io).map_err(ExperimentError::from)
+        }) as Box<dyn Fn(ImageSpec) -> Result<XyzImage, ExperimentError> + '_>;
+        ("radiosity", r.white, r.converged, spots, image)
     } else {
         let sopts = SpotOptions {
             target_de: opts.target_de,
@@ -101,7 +143,7 @@ pub fn simulate(
             seed: opts.seed,
             ..SpotOptions::default()
         };
-        let r = render_spots_with_progress(&scene, &sopts, &|p| {
+        let r = render_spots_with_progress(scene, &sopts, &|p| {
             progress(Progress::Note(format!(
                 "path tracing: worst 95 % half-width {:.3} ΔE*ab",
                 p.worst_de
@@ -116,7 +158,19 @@ pub fn simulate(
                 de_uncertainty: p.de_ci95,
             })
             .collect::<Vec<_>>();
-        ("path tracer", r.white, r.converged, spots)
+        let seed = opts.seed;
+        let image = Box::new(move |spec: ImageSpec| {
+            let io = ImageOptions {
+                width: spec.size,
+                height: spec.size,
+                spp: spec.spp,
+                seed,
+                strategy: Strategy::default(),
+                window: None,
+            };
+            render_image(scene, &io, &|_| {}).map_err(ExperimentError::from)
+        }) as Box<dyn Fn(ImageSpec) -> Result<XyzImage, ExperimentError> + '_>;
+        ("path tracer", r.white, r.converged, spots, image)
     };
     if let Some(bad) = spots.iter().find(|s| !s.xyz.iter().all(|v| v.is_finite())) {
         return Err(ExperimentError::NotFinite {
@@ -133,27 +187,31 @@ pub fn simulate(
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
     let mut files = vec![SPOTS_FILE, SUMMARY_FILE];
+    let mut image_patches = Vec::new();
     let image = match opts.image {
         Some(spec) => {
-            progress(Progress::Note(format!(
-                "rendering the {0}×{0} image at {1} samples per pixel",
-                spec.size, spec.spp
-            )));
-            let io = ImageOptions {
-                width: spec.size,
-                height: spec.size,
-                spp: spec.spp,
-                seed: opts.seed,
-                strategy: Strategy::default(),
-                window: None,
-            };
-            let img = render_image(&scene, &io, &|_| {})?;
+            progress(Progress::Note(match method {
+                "radiosity" => format!(
+                    "rendering the {0}×{0} image from the radiosity solution",
+                    spec.size
+                ),
+                _ => format!(
+                    "rendering the {0}×{0} image at {1} samples per pixel",
+                    spec.size, spec.spp
+                ),
+            }));
+            let img = render(spec)?;
+            image_patches = patches_in_image(scene, &img, &spots, white)?;
             // The stage directory is the stage's own: a re-run replaces its files.
             write_xyz_image(&dir.join(IMAGE_FILE), &img, &OutputPolicy::new(true))?;
             files.push(IMAGE_FILE);
             Some(IMAGE_FILE.to_string())
         }
-        None => None,
+        None => {
+            // An image of an earlier run with other options is not this run's.
+            remove_stale(&dir.join(IMAGE_FILE))?;
+            None
+        }
     };
     let summary = SimulationSummary {
         method: method.into(),
@@ -161,9 +219,68 @@ pub fn simulate(
         converged,
         seconds: start.elapsed().as_secs_f64(),
         spots,
+        image_method: image.as_ref().map(|_| method.to_string()),
         image,
+        image_patches,
     };
     let text = serde_json::to_string_pretty(&summary).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SUMMARY_FILE), text.as_bytes())?;
     Ok((summary, files))
+}
+
+/// Each patch's spot in `img`: where the meter aims, and the image's mean there against the
+/// spot reading.
+fn patches_in_image(
+    scene: &Scene,
+    img: &XyzImage,
+    spots: &[SimSpot],
+    white: [f64; 3],
+) -> Result<Vec<ImagePatch>, ExperimentError> {
+    let cam = scene
+        .camera
+        .ok_or(crate::render::spot::SpotError::NoCamera)?;
+    let frame = Frame::of(&cam, img.width, img.height);
+    let w = Xyz::from_array(white);
+    let mut out = Vec::with_capacity(spots.len());
+    for s in spots {
+        let aim = patch_aim(scene, s.patch)?;
+        let (cx, cy) = frame
+            .project(aim.axis)
+            .ok_or_else(|| ExperimentError::BadFile {
+                file: std::path::PathBuf::from(IMAGE_FILE),
+                message: format!("patch {} is behind the camera", s.patch),
+            })?;
+        let (xyz, pixels) =
+            spot_mean(img, &frame, &aim).ok_or_else(|| ExperimentError::Option {
+                what: "image size",
+                message: format!(
+                    "a {}×{} image has no pixel inside patch {}'s 1° spot; render a larger one",
+                    img.width, img.height, s.patch
+                ),
+            })?;
+        let de = delta_e76(
+            Xyz::from_array(xyz).to_lab(w),
+            Xyz::from_array(s.xyz).to_lab(w),
+        );
+        out.push(ImagePatch {
+            patch: s.patch,
+            x: cx / img.width as f64,
+            y: cy / img.height as f64,
+            radius: (aim.acceptance_deg.to_radians() / 2.0).tan() / (2.0 * frame.half_h),
+            pixels,
+            xyz,
+            de_vs_spot: de,
+        });
+    }
+    Ok(out)
+}
+
+fn remove_stale(path: &Path) -> Result<(), ExperimentError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(ExperimentError::Io {
+            file: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
 }

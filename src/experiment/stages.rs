@@ -209,11 +209,19 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
             }
             i
         }
-        Stage::DisplaySpots => Inputs::new()
-            .file("drives", &p(Stage::Reproduction, reproduction::FILE)?)?
-            .file("display", &p(Stage::Display, display::SETTING_FILE)?)?
-            .value("spot", &opts.display.spot)
-            .value("repeats", &opts.repeats),
+        Stage::DisplaySpots => {
+            let i = Inputs::new()
+                .file("drives", &p(Stage::Reproduction, reproduction::FILE)?)?
+                .file("display", &p(Stage::Display, display::SETTING_FILE)?)?
+                .value("spot", &opts.display.spot)
+                .value("repeats", &opts.repeats);
+            let image = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
+            if image.exists() {
+                i.file("image", &image)?
+            } else {
+                i
+            }
+        }
         Stage::Validation => Inputs::new()
             .file("box", &need(stage, box_spots)?)?
             .file("simulation", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
@@ -275,7 +283,7 @@ fn run_stage(
                 &sd.dir,
                 &profile,
                 &sim.spots,
-                image.as_deref(),
+                image.as_deref().map(|p| (p, sim.image_patches.as_slice())),
                 &opts.reproduction,
             )?;
             Ok(owned(files))
@@ -285,12 +293,20 @@ fn run_stage(
                 read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
             let setting: DisplaySetting =
                 read_json(&stage_path(opts, Stage::Display, display::SETTING_FILE))?;
+            let png = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
             let session = display_spots::SpotSession {
                 setting: &setting,
                 spot_spec: &opts.display.spot,
                 drives: &r.patches,
+                image: (png.exists() && !r.image_patches.is_empty()).then(|| {
+                    display_spots::ShownImage {
+                        file: &png,
+                        regions: &r.image_patches,
+                    }
+                }),
                 repeats: opts.repeats,
                 resume: opts.resume,
+                unattended: opts.unattended,
                 run: &opts.run,
             };
             let (_, files) = display_spots::measure(&sd.dir, &session, progress)?;

@@ -19,7 +19,7 @@ use crate::display::ModelKind;
 use crate::experiment::box_stage::BoxMeasure;
 use crate::experiment::display::DisplayOptions;
 use crate::experiment::reproduction::ReproductionOptions;
-use crate::experiment::simulation::SimulationOptions;
+use crate::experiment::simulation::{ImageSpec, SimulationOptions};
 use crate::experiment::validate::{ValidationResult, FILE as COMPARISONS_FILE};
 use crate::experiment::{self, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
 use crate::output::OutputPolicy;
@@ -48,7 +48,14 @@ pub struct LabOptions {
     pub seed: u64,
     /// The simulated instruments' time scale (1 = their real pace).
     pub time_scale: f64,
+    /// The camera image's side in pixels, shown whole on the display for the spot
+    /// readings; 0: no image (each patch's colour is shown full-screen instead).
+    pub image_size: usize,
 }
+
+/// Samples per pixel of the image where the path tracer renders it (scenes the radiosity
+/// solver does not take); the experiment's default.
+const IMAGE_SPP: u64 = 16;
 
 fn preset_name<S: serde::Serializer>(p: &Preset, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(p.name())
@@ -97,7 +104,10 @@ impl LabOptions {
                 target_de: self.target_de,
                 seed: self.seed,
                 max_seconds: MAX_RENDER_SECONDS,
-                image: None,
+                image: (self.image_size > 0).then_some(ImageSpec {
+                    size: self.image_size,
+                    spp: IMAGE_SPP,
+                }),
             },
             display: DisplayOptions {
                 screen: format!("virtual:{}", self.display.name()),

@@ -6,7 +6,8 @@
 //! reflectance and a tiled spectral emitter. The path tracer uses hero wavelengths; both
 //! project on the CIE 1931 observer with K_m = 683 lm/W (paper Eq. 8), so their output is
 //! absolute XYZ in cd/m². Spot mode simulates the 1° meter; image mode is the paper's
-//! idealised film (Eq. 2–3).
+//! idealised film (Eq. 2–3), rendered by either (`radiosity::image`: the solution seen
+//! from the camera, noise-free).
 
 pub mod geometry;
 pub mod integrator;

@@ -62,7 +62,7 @@ pub struct Footprint {
 }
 
 /// Nearest front-facing face along a ray, or None (a back side is black).
-fn hit(faces: &[Face], o: Vec3, d: Vec3) -> Option<(usize, Vec3, f64, f64)> {
+pub(super) fn hit(faces: &[Face], o: Vec3, d: Vec3) -> Option<(usize, Vec3, f64, f64)> {
     let mut best: Option<(usize, f64, f64, f64, bool)> = None;
     for (i, f) in faces.iter().enumerate() {
         let t_max = best.map_or(f64::INFINITY, |b| b.1);

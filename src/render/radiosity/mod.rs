@@ -13,6 +13,7 @@
 pub mod bound;
 pub mod direct;
 pub mod gather;
+pub mod image;
 pub mod lights;
 pub mod mesh;
 pub mod polygon;
@@ -292,6 +293,16 @@ pub fn run_level(
     level: usize,
     deadline: Deadline,
 ) -> Result<Level, RadiosityError> {
+    run_level_solved(p, opts, level, deadline).map(|(l, _)| l)
+}
+
+/// [`run_level`] with the level's solution, for an image of the same light.
+fn run_level_solved(
+    p: &Prepared,
+    opts: &RadiosityOptions,
+    level: usize,
+    deadline: Deadline,
+) -> Result<(Level, Solved), RadiosityError> {
     let start = Instant::now();
     let scene = p.scene;
     let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
@@ -343,7 +354,7 @@ pub fn run_level(
             reading(scene, &p.lights, &fp, &wrefl, &ws.bands, &ws.l)
         }
     };
-    Ok(Level {
+    let l = Level {
         level,
         h_m: p.base(opts) / level as f64,
         elements: solved.mesh.elements.len(),
@@ -351,7 +362,8 @@ pub fn run_level(
         seconds: start.elapsed().as_secs_f64(),
         patches,
         white,
-    })
+    };
+    Ok((l, solved))
 }
 
 /// The 24 readings, refined until every patch's bound is below the target.
@@ -360,6 +372,19 @@ pub fn render_spots_radiosity(
     opts: &RadiosityOptions,
     progress: &dyn Fn(&Level),
 ) -> Result<RadiosityResult, RadiosityError> {
+    render_spots_radiosity_solved(scene, opts, progress).map(|(r, _)| r)
+}
+
+/// The solutions of the last two levels a reading came from, with their element sizes
+/// (m), coarser first: what [`image::render_image_from`] extrapolates as the readings do.
+pub type LastLevels = Vec<(Solved, f64)>;
+
+/// [`render_spots_radiosity`] keeping the solutions its readings came from.
+pub fn render_spots_radiosity_solved(
+    scene: &Scene,
+    opts: &RadiosityOptions,
+    progress: &dyn Fn(&Level),
+) -> Result<(RadiosityResult, LastLevels), RadiosityError> {
     let start = Instant::now();
     if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
         return Err(RadiosityError::BadOption {
@@ -393,23 +418,35 @@ pub fn render_spots_radiosity(
     let p = Prepared::new(scene)?;
     let mut levels: Vec<Level> = Vec::new();
     let mut best: Option<(Vec<RadiosityReading>, [f64; 3])> = None;
+    // The solutions of the last two levels (coarser first), and of the two before the
+    // last level when that one has to be dropped.
+    let mut solutions: LastLevels = Vec::new();
     loop {
         let level = levels.len() + 1;
         // A finer level that does not fit in time or memory ends the refinement with the
         // last result; the first three are needed for any result at all.
-        let l = match run_level(&p, opts, level, deadline) {
-            Ok(l) => l,
+        let l = match run_level_solved(&p, opts, level, deadline) {
+            Ok((l, solved)) => {
+                solutions.push((solved, l.h_m));
+                if solutions.len() > 2 {
+                    solutions.remove(0);
+                }
+                l
+            }
             Err(RadiosityError::TimeLimit { .. } | RadiosityError::TooDetailed { .. })
                 if best.is_some() =>
             {
                 let (patches, white) = best.unwrap_or_default();
-                return Ok(RadiosityResult {
-                    white,
-                    seconds: start.elapsed().as_secs_f64(),
-                    levels,
-                    patches,
-                    converged: false,
-                });
+                return Ok((
+                    RadiosityResult {
+                        white,
+                        seconds: start.elapsed().as_secs_f64(),
+                        levels,
+                        patches,
+                        converged: false,
+                    },
+                    solutions,
+                ));
             }
             Err(e) => return Err(e),
         };
@@ -434,13 +471,16 @@ pub fn render_spots_radiosity(
         let converged = patches.iter().all(|r| r.de_bound < opts.target_de);
         let out_of_time = deadline.passed();
         if converged || out_of_time || level >= opts.max_level.max(3) {
-            return Ok(RadiosityResult {
-                white,
-                seconds: start.elapsed().as_secs_f64(),
-                levels,
-                patches,
-                converged,
-            });
+            return Ok((
+                RadiosityResult {
+                    white,
+                    seconds: start.elapsed().as_secs_f64(),
+                    levels,
+                    patches,
+                    converged,
+                },
+                solutions,
+            ));
         }
         best = Some((patches, white));
     }

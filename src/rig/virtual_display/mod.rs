@@ -40,22 +40,46 @@ use metamer_drivers::{Light, View, World};
 pub use panel::{quantize, VirtualPanel};
 pub use presets::{PanelParams, Preset, Trc};
 
-use super::screen::{Screen, ScreenError};
+use super::screen::{MeterAim, Placement, RgbImage, Screen, ScreenError, ScreenSpot};
 
-/// The panel plus what it shows now; this is what a simulated meter looks at.
+/// What the panel shows: one colour everywhere, or an image filling the screen.
+#[derive(Clone)]
+enum Shown {
+    Colour([u8; 3]),
+    Image(Arc<RgbImage>),
+}
+
+/// The panel plus what it shows now and where the meter looks; this is what a simulated
+/// meter looks at.
 struct LitPanel {
     panel: VirtualPanel,
-    shown: RwLock<[u8; 3]>,
+    shown: RwLock<Shown>,
+    aim: MeterAim,
 }
 
 impl World for LitPanel {
     fn view(&self) -> View {
-        let shown = *self.shown.read().unwrap_or_else(|e| e.into_inner());
-        View::Emissive(Light::Radiance(self.panel.spectrum(shown)))
+        let shown = self.shown.read().unwrap_or_else(|e| e.into_inner()).clone();
+        let spectrum = match shown {
+            Shown::Colour(rgb) => self.panel.spectrum(rgb),
+            // The meter's spot averages the light of every pixel inside it; the panel's
+            // response is not linear in the drive values, so spectra are averaged, not
+            // drive values.
+            Shown::Image(img) => {
+                let counts = img.colours_in(self.aim.get());
+                if counts.is_empty() {
+                    self.panel.spectrum([0; 3])
+                } else {
+                    self.panel.mean_spectrum(&counts)
+                }
+            }
+        };
+        View::Emissive(Light::Radiance(spectrum))
     }
 }
 
-/// A simulated monitor as a [`Screen`]; it starts black.
+/// A simulated monitor as a [`Screen`]; it starts black. An image is shown pixel for pixel
+/// over the whole screen (the simulated screen takes the image's size).
 pub struct VirtualDisplay {
     lit: Arc<LitPanel>,
 }
@@ -65,7 +89,8 @@ impl VirtualDisplay {
         VirtualDisplay {
             lit: Arc::new(LitPanel {
                 panel,
-                shown: RwLock::new([0; 3]),
+                shown: RwLock::new(Shown::Colour([0; 3])),
+                aim: MeterAim::default(),
             }),
         }
     }
@@ -83,9 +108,22 @@ impl VirtualDisplay {
         &self.lit.panel
     }
 
-    /// The drive values shown now.
+    /// The drive values shown now: the colour, or the image's pixel under the meter's aim
+    /// (its centre when not aimed).
     pub fn shown(&self) -> [u8; 3] {
-        *self.lit.shown.read().unwrap_or_else(|e| e.into_inner())
+        match &*self.lit.shown.read().unwrap_or_else(|e| e.into_inner()) {
+            Shown::Colour(rgb) => *rgb,
+            Shown::Image(img) => {
+                let s = self.lit.aim.get().unwrap_or(ScreenSpot {
+                    x: 0.5,
+                    y: 0.5,
+                    radius: 0.0,
+                });
+                let px = ((s.x * img.width as f64) as usize).min(img.width - 1);
+                let py = ((s.y * img.height as f64) as usize).min(img.height - 1);
+                img.at(px, py)
+            }
+        }
     }
 }
 
@@ -107,8 +145,14 @@ impl Screen for VirtualDisplay {
     }
 
     fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
-        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = rgb;
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Colour(rgb);
         Ok(())
+    }
+
+    fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) =
+            Shown::Image(Arc::new(image.clone()));
+        Ok(Placement::WHOLE)
     }
 
     /// The simulated panel changes instantly.
@@ -118,5 +162,9 @@ impl Screen for VirtualDisplay {
 
     fn stimulus(&self) -> Option<Arc<dyn World>> {
         Some(self.lit.clone())
+    }
+
+    fn meter_aim(&self) -> Option<MeterAim> {
+        Some(self.lit.aim.clone())
     }
 }

@@ -198,6 +198,25 @@ impl VirtualPanel {
         radiance(values)
     }
 
+    /// The mean emission of pixels showing each colour `count` times (what a meter whose
+    /// spot covers them sees).
+    pub fn mean_spectrum(&self, counts: &[([u8; 3], usize)]) -> Spectrum {
+        let total: usize = counts.iter().map(|(_, n)| n).sum();
+        let mut values = vec![0.0; SAMPLES];
+        for (rgb, n) in counts {
+            let s = self.spectrum(*rgb);
+            for (v, x) in values.iter_mut().zip(s.values()) {
+                *v += *n as f64 * x;
+            }
+        }
+        radiance(
+            values
+                .into_iter()
+                .map(|v| v / total.max(1) as f64)
+                .collect(),
+        )
+    }
+
     /// The drive values 0–1 (continuous, before quantisation) at which the panel emits
     /// `xyz`, or None when no drive values in 0–1 do: the colour is outside its gamut.
     pub fn drive_for(&self, xyz: [f64; 3]) -> Option<[f64; 3]> {

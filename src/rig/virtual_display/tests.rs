@@ -366,3 +366,53 @@ fn the_simulated_spectrometer_sees_the_spectrum() {
     }
     assert!((r.xyz[1] / 200.0 - 1.0).abs() < 0.01, "{:?}", r.xyz);
 }
+
+/// An image shown whole: a meter aimed inside the left half sees the left colour's
+/// emission, one not aimed sees the mean of both halves' spectra (equal pixel counts),
+/// and one whose spot straddles the edge sees the pixel-count-weighted mean.
+#[test]
+fn an_aimed_meter_sees_the_mean_emission_under_its_spot() {
+    let (red, blue) = ([255, 0, 0], [0, 0, 255]);
+    // 4×2: the left two columns red, the right two blue.
+    let pixels = (0..8).map(|i| if i % 4 < 2 { red } else { blue }).collect();
+    let image = RgbImage::new(4, 2, pixels).unwrap();
+    let mut display = VirtualDisplay::preset(Preset::IpsLcd);
+    assert_eq!(display.show_image(&image).unwrap(), Placement::WHOLE);
+    let world = display.stimulus().unwrap();
+    let aim = display.meter_aim().unwrap();
+    let seen = || match world.view() {
+        View::Emissive(Light::Radiance(s)) => s.values().to_vec(),
+        _ => panic!("a display emits"),
+    };
+    let (r, b) = (
+        display.panel().spectrum(red).values().to_vec(),
+        display.panel().spectrum(blue).values().to_vec(),
+    );
+    let near = |a: &[f64], want: &[f64]| a.iter().zip(want).all(|(x, y)| (x - y).abs() <= 1e-12);
+    aim.set(Some(ScreenSpot {
+        x: 0.25,
+        y: 0.5,
+        radius: 0.3,
+    }));
+    assert!(near(&seen(), &r));
+    assert_eq!(display.shown(), red);
+    aim.set(None);
+    let mean: Vec<f64> = r.iter().zip(&b).map(|(x, y)| (x + y) / 2.0).collect();
+    assert!(near(&seen(), &mean));
+    // Centred on the corner (2, 1) of four pixels with radius 0.3 of the height = 0.6 px:
+    // their centres lie 0.707 px away, so the disc holds none and the pixel under the
+    // centre, column 2 (blue), stands for it.
+    aim.set(Some(ScreenSpot {
+        x: 0.5,
+        y: 0.5,
+        radius: 0.3,
+    }));
+    assert!(near(&seen(), &b));
+    // Radius 0.4 of the height = 0.8 px: all four centres, two red and two blue.
+    aim.set(Some(ScreenSpot {
+        x: 0.5,
+        y: 0.5,
+        radius: 0.4,
+    }));
+    assert!(near(&seen(), &mean));
+}

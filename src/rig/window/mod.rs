@@ -9,6 +9,7 @@
 //! Colour management (a compositor's ICC transform, night-light filters) must be off for
 //! the panel itself to be measured; that is outside what an X client can check.
 
+mod image;
 mod pixels;
 
 use std::time::Duration;
@@ -24,7 +25,7 @@ use x11rb::wrapper::ConnectionExt as _;
 
 pub use pixels::PixelFormat;
 
-use super::screen::{Screen, ScreenError};
+use super::screen::{Placement, RgbImage, Screen, ScreenError};
 
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]
@@ -93,6 +94,8 @@ pub struct WindowDisplay {
     monitor_index: usize,
     monitor: Monitor,
     format: PixelFormat,
+    /// The root window's depth, which the window has (its pixmaps need it too).
+    depth: u8,
     shown: [u8; 3],
 }
 
@@ -197,6 +200,7 @@ impl WindowDisplay {
             monitor_index: index,
             monitor,
             format,
+            depth: screen.root_depth,
             shown: [0; 3],
         };
         this.show_rgb([0; 3])?;
@@ -365,6 +369,13 @@ impl Screen for WindowDisplay {
 
     fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
         self.show_rgb(rgb).map_err(|e| ScreenError::Backend {
+            screen: self.spec(),
+            source: Box::new(e),
+        })
+    }
+
+    fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {
+        self.show_scaled(image).map_err(|e| ScreenError::Backend {
             screen: self.spec(),
             source: Box::new(e),
         })

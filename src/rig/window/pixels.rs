@@ -55,6 +55,30 @@ impl PixelFormat {
         (width * usize::from(self.bits_per_pixel)).div_ceil(pad) * pad / 8
     }
 
+    /// A ZPixmap image of `pixels` (rows of `width`), the inverse of
+    /// [`PixelFormat::decode_image`]; None when the pixel size is not a whole number of
+    /// bytes.
+    pub fn encode_image(&self, pixels: &[[u8; 3]], width: usize) -> Option<Vec<u8>> {
+        if self.bits_per_pixel % 8 != 0 || self.bits_per_pixel > 32 || width == 0 {
+            return None;
+        }
+        let bytes = usize::from(self.bits_per_pixel / 8);
+        let stride = self.stride(width);
+        let mut out = Vec::with_capacity(stride * pixels.len().div_ceil(width));
+        for row in pixels.chunks(width) {
+            let start = out.len();
+            for &p in row {
+                let v = self.encode(p);
+                for k in 0..bytes {
+                    let shift = if self.big_endian { bytes - 1 - k } else { k } * 8;
+                    out.push((v >> shift) as u8);
+                }
+            }
+            out.resize(start + stride, 0);
+        }
+        Some(out)
+    }
+
     /// The 8-bit RGB of every pixel of a `width × height` ZPixmap image, row by row.
     /// None if `data` is too short or the pixel size is not a whole number of bytes.
     pub fn decode_image(&self, data: &[u8], width: usize, height: usize) -> Option<Vec<[u8; 3]>> {
@@ -141,5 +165,12 @@ mod tests {
             vec![[1, 2, 3]]
         );
         assert!(RGB888.decode_image(&[0; 7], 2, 1).is_none());
+        // Encoding is the inverse, padding included (the same bytes with zero padding).
+        let pixels = [[1, 2, 3], [4, 5, 6], [7, 8, 9], [10, 11, 12]];
+        let encoded = packed24.encode_image(&pixels, 2).unwrap();
+        assert_eq!(encoded.len(), 16);
+        assert_eq!(&encoded[..6], &data[..6]);
+        assert_eq!(packed24.decode_image(&encoded, 2, 2).unwrap(), pixels);
+        assert_eq!(msb.encode_image(&[[1, 2, 3]], 1).unwrap(), vec![0, 1, 2, 3]);
     }
 }

@@ -1,0 +1,128 @@
+//! An 8-bit RGB image for a screen, read from the PNG the reproduction writes.
+
+use std::path::{Path, PathBuf};
+
+/// Where a spot meter is aimed on a screen (or an image filling it): the centre as
+/// fractions of the width and height from the top-left corner, and the spot's radius as a
+/// fraction of the height.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenSpot {
+    pub x: f64,
+    pub y: f64,
+    pub radius: f64,
+}
+
+/// Rows top to bottom, each pixel's drive values.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RgbImage {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<[u8; 3]>,
+}
+
+/// Why an image cannot be shown.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("reading {}: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: not a PNG image a screen can show: {message}", file.display())]
+    Png { file: PathBuf, message: String },
+    #[error("an image of {width}×{height} pixels needs {need} pixel values, got {got}")]
+    Size {
+        width: usize,
+        height: usize,
+        need: usize,
+        got: usize,
+    },
+}
+
+impl RgbImage {
+    pub fn new(width: usize, height: usize, pixels: Vec<[u8; 3]>) -> Result<RgbImage, ImageError> {
+        if width == 0 || height == 0 || pixels.len() != width * height {
+            return Err(ImageError::Size {
+                width,
+                height,
+                need: width * height,
+                got: pixels.len(),
+            });
+        }
+        Ok(RgbImage {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// An 8-bit RGB PNG (the reproduction's drive values).
+    pub fn read_png(path: &Path) -> Result<RgbImage, ImageError> {
+        let bad = |message: String| ImageError::Png {
+            file: path.to_path_buf(),
+            message,
+        };
+        let file = std::fs::File::open(path).map_err(|source| ImageError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .map_err(|e| bad(e.to_string()))?;
+        let info = reader.info();
+        if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Eight {
+            return Err(bad(format!(
+                "{:?} at {:?} bits per channel; drive values are 8-bit RGB",
+                info.color_type, info.bit_depth
+            )));
+        }
+        let (w, h) = (info.width as usize, info.height as usize);
+        let size = reader
+            .output_buffer_size()
+            .ok_or_else(|| bad(format!("{w}×{h} pixels is too large")))?;
+        let mut buf = vec![0; size];
+        let frame = reader
+            .next_frame(&mut buf)
+            .map_err(|e| bad(e.to_string()))?;
+        let pixels = buf[..frame.buffer_size()]
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
+        RgbImage::new(w, h, pixels)
+    }
+
+    pub fn at(&self, x: usize, y: usize) -> [u8; 3] {
+        self.pixels[y * self.width + x]
+    }
+
+    /// How many pixels of each colour lie inside `spot` (fractions of this image; pixel
+    /// centres inside the disc), or of the whole image without one. A spot smaller than a
+    /// pixel counts the pixel under its centre.
+    pub fn colours_in(&self, spot: Option<ScreenSpot>) -> Vec<([u8; 3], usize)> {
+        let mut counts: std::collections::BTreeMap<[u8; 3], usize> = Default::default();
+        match spot {
+            None => self
+                .pixels
+                .iter()
+                .for_each(|p| *counts.entry(*p).or_default() += 1),
+            Some(s) => {
+                let (cx, cy) = (s.x * self.width as f64, s.y * self.height as f64);
+                let r = s.radius * self.height as f64;
+                let (y0, y1) = ((cy - r).floor().max(0.0), (cy + r).ceil());
+                let (x0, x1) = ((cx - r).floor().max(0.0), (cx + r).ceil());
+                for y in y0 as usize..(y1 as usize).min(self.height) {
+                    for x in x0 as usize..(x1 as usize).min(self.width) {
+                        let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+                        if dx * dx + dy * dy <= r * r {
+                            *counts.entry(self.at(x, y)).or_default() += 1;
+                        }
+                    }
+                }
+                if counts.is_empty() && (0.0..1.0).contains(&s.x) && (0.0..1.0).contains(&s.y) {
+                    counts.insert(self.at(cx as usize, cy as usize), 1);
+                }
+            }
+        }
+        counts.into_iter().collect()
+    }
+}
