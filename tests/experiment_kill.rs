@@ -43,7 +43,7 @@ fn lab(dir: &Path, resume: bool) -> Command {
             "--box-repeats",
             "1",
             "--image-size",
-            "192",
+            "96",
             "--time-scale",
             "0.02",
         ])
@@ -161,6 +161,7 @@ fn killed_in_every_stage_and_resumed_it_ends_as_an_uninterrupted_run() {
             }
         }
     }
+    eprintln!("where each kill landed (stage, before the stage finished): {landed:?}");
     // The measuring stages are slow enough that each kill lands inside them; the quick
     // stages may finish before the signal arrives, and then the kill lands in the next.
     for (stage, inside) in &landed {
