@@ -146,7 +146,10 @@ fn killed_in_every_stage_and_resumed_it_ends_as_an_uninterrupted_run() {
     let killed = root.join("killed");
     let mut landed = Vec::new();
     for (i, stage) in STAGES.iter().enumerate() {
-        let before: Vec<_> = STAGES.iter().flat_map(|s| journal_lines(&killed.join(s))).collect();
+        let before: Vec<_> = STAGES
+            .iter()
+            .flat_map(|s| journal_lines(&killed.join(s)))
+            .collect();
         let (mut child, lines) = spawn(&killed, i > 0);
         landed.push((stage, kill_in(&mut child, &lines, &killed, stage)));
         // Nothing journalled before this run was lost or changed by it: each journal that
@@ -181,7 +184,11 @@ fn killed_in_every_stage_and_resumed_it_ends_as_an_uninterrupted_run() {
     assert_eq!(a, b, "the resumed run's comparisons differ");
     // The readings themselves, not only their summary: the measured scene's spot readings
     // and the display's.
-    for f in ["box/spots.csv", "display-spots/spots.csv", "simulation/spots.csv"] {
+    for f in [
+        "box/spots.csv",
+        "display-spots/spots.csv",
+        "simulation/spots.csv",
+    ] {
         assert_eq!(
             std::fs::read_to_string(whole.join(f)).unwrap(),
             std::fs::read_to_string(killed.join(f)).unwrap(),

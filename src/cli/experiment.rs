@@ -243,7 +243,7 @@ pub(super) fn print_comparisons(dir: &Path) {
                 &v.simulation_vs_box,
                 &v.display_vs_simulation,
             ] {
-                println!("{}", c.summary());
+                println!("{} vs {}: {}", c.test, c.reference, c.summary());
             }
         }
     }
