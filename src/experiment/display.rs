@@ -138,6 +138,20 @@ pub fn needed_white(profile: &Profile, targets: &[[f64; 3]]) -> f64 {
     profile.white_xyz[1] * factor
 }
 
+/// A simulated monitor was set for the rendering; a real one that is too dim cannot show it
+/// without tone mapping, which the method forbids. Half a percent of slack: the meter's
+/// repeatability on the white.
+fn check_bright_enough(profile: &Profile, needed: f64, dir: &Path) -> Result<(), ExperimentError> {
+    if needed > profile.white_xyz[1] * 1.005 {
+        return Err(ExperimentError::DisplayTooDim {
+            white_cd_m2: profile.white_xyz[1],
+            needed_cd_m2: needed,
+            dir: dir.to_path_buf(),
+        });
+    }
+    Ok(())
+}
+
 /// Characterizes the display into `dir`; `targets` are the rendered readings it must show.
 pub fn characterize_display(
     dir: &Path,
@@ -211,15 +225,7 @@ pub fn characterize_display(
         needed_white_cd_m2: needed,
         model: opts.model,
     };
-    // A simulated monitor was set for the rendering; a real one that is too dim cannot
-    // show it without tone mapping, which the method forbids.
-    if needed > profile.white_xyz[1] * 1.005 {
-        return Err(ExperimentError::DisplayTooDim {
-            white_cd_m2: profile.white_xyz[1],
-            needed_cd_m2: needed,
-            dir: dir.to_path_buf(),
-        });
-    }
+    check_bright_enough(&profile, needed, dir)?;
     let text = serde_json::to_string_pretty(&setting).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SETTING_FILE), text.as_bytes())?;
     Ok((setting, vec![SETTING_FILE, PROFILE_FILE, SUMMARY_FILE]))
@@ -246,5 +252,59 @@ mod tests {
         // Beyond the primaries: ignored.
         let outside = white_luminance_for(&panel, &[at(1.0), [-5.0, 80.0, 0.0]]);
         assert!((outside - one).abs() < 1e-9);
+    }
+
+    /// A profile of the ideal CRT at its nominal white, fitted from a 5³ grid of its exact
+    /// emissions: additive, so the matrix model holds it exactly.
+    fn crt_profile() -> (VirtualPanel, Profile) {
+        let panel = VirtualPanel::preset(Preset::IdealCrt);
+        let level = |i: u8| i * 63 + i / 4 * 3;
+        let mut patches = Vec::new();
+        for r in 0..5 {
+            for g in 0..5 {
+                for b in 0..5 {
+                    let rgb = [level(r), level(g), level(b)];
+                    patches.push(crate::display::Sample {
+                        rgb: rgb.map(|c| f64::from(c) / 255.0),
+                        xyz: panel.xyz(rgb),
+                    });
+                }
+            }
+        }
+        let profile = crate::display::fit_profile(ModelKind::MatrixLsq, &patches, None).unwrap();
+        (panel, profile)
+    }
+
+    /// A rendering twice as bright as the display's white needs twice its luminance; the
+    /// display is refused with the luminance to set, and a rendering it can show passes.
+    #[test]
+    fn a_display_too_dim_for_the_rendering_is_refused_with_the_white_to_set() {
+        let (panel, profile) = crt_profile();
+        let white = panel.xyz([255; 3]);
+        let black = panel.xyz([0; 3]);
+        // Black plus twice (white − black): the display's own colour, twice as bright.
+        let twice = [0, 1, 2].map(|k| black[k] + 2.0 * (white[k] - black[k]));
+        let half = [0, 1, 2].map(|k| black[k] + 0.5 * (white[k] - black[k]));
+        let needed = needed_white(&profile, &[half, twice]);
+        // s·twice is inside while s·(black + 2(w − b)) ≤ w, i.e. s ≤ 1/(2 − k/w) with k
+        // the black's Y: that scale, inverted, times the white.
+        let exact = white[1] * (2.0 - black[1] / white[1]);
+        assert!(
+            (needed - exact).abs() < 1e-3 * exact,
+            "needed {needed}, exact {exact}"
+        );
+        let dir = Path::new("/exp/display");
+        let e = check_bright_enough(&profile, needed, dir).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&format!("{:.1} cd/m²", profile.white_xyz[1]))
+                && msg.contains(&format!("{needed:.1} cd/m²"))
+                && msg.contains("/exp/display"),
+            "{msg}"
+        );
+        // What the display shows as it is: no refusal.
+        let fits = needed_white(&profile, &[half]);
+        assert!((fits - profile.white_xyz[1]).abs() < 1e-9);
+        check_bright_enough(&profile, fits, dir).unwrap();
     }
 }
