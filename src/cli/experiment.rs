@@ -11,6 +11,7 @@ use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
 use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
+use metamer::render::scene::Scene;
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::{CliError, CliResult};
@@ -112,6 +113,7 @@ pub fn run_cli(args: Args) -> CliResult {
             args.out.display()
         )));
     }
+    check_inputs(&args)?;
     let interrupt = on_ctrl_c();
     let opts = ExperimentOptions {
         dir: args.out.clone(),
@@ -171,6 +173,19 @@ pub fn run_cli(args: Args) -> CliResult {
     shown.finish();
     print_outcomes(&outcomes?);
     print_comparisons(&args.out);
+    Ok(())
+}
+
+/// What the stages would read or open only after minutes of rendering and measuring: a
+/// given box's scene and readings, and the instruments' specs, checked before any work.
+fn check_inputs(args: &Args) -> CliResult {
+    if let (Some(scene), Some(spots)) = (&args.box_scene, &args.box_spots) {
+        Scene::load(scene)?;
+        metamer::experiment::readings::read_readings(spots)?;
+    }
+    for spec in std::iter::once(&args.spot).chain(&args.spectral) {
+        metamer_drivers::check_spec(spec)?;
+    }
     Ok(())
 }
 
