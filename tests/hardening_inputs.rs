@@ -583,3 +583,36 @@ fn a_device_that_never_ends_is_refused_as_an_input_file() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_billion_repeats_is_refused_before_measuring() {
+    let dir = scratch("repeats");
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    let spots = root().join("tests/data/report/experiment/box/spots.csv");
+    let scene = root().join("data/scenes/validation-box.json");
+    let given = [
+        "--box-scene",
+        scene.to_str().unwrap(),
+        "--box-spots",
+        spots.to_str().unwrap(),
+    ];
+    for args in [
+        &["lab", "-o", out, "--repeats", "1000000000"][..],
+        &[
+            &["experiment", "-o", out, "--repeats", "1000000000"][..],
+            &given,
+        ]
+        .concat(),
+    ] {
+        let o = metamer(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("--repeats must be from 1 to 100, got 1000000000"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!Path::new(out).exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
