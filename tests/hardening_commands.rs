@@ -201,9 +201,22 @@ fn the_experiment_checks_a_given_box_and_its_instruments_before_any_work() {
             .replacen("\n1,", "\n1,NaN", 1),
     )
     .unwrap();
+    let huge_spots = dir.join("huge.csv");
+    let first = std::fs::read_to_string(&spots).unwrap();
+    let row = first.lines().nth(1).unwrap();
+    let cells: Vec<&str> = row.split(',').collect();
+    let bad_row = format!("{},-1e308,{}", cells[0], cells[2..].join(","));
+    std::fs::write(&huge_spots, first.replacen(row, &bad_row, 1)).unwrap();
     let out = dir.join("out");
     let s = |p: &Path| p.to_str().unwrap().to_string();
     for (scene, spots, extra, words) in [
+        // Every stage ran, then the validation drew an infinite ΔE.
+        (
+            &scene,
+            &huge_spots,
+            None,
+            "huge.csv: patch 1: not a measurement: XYZ [-1e308",
+        ),
         (
             &dark_scene,
             &spots,
