@@ -53,7 +53,7 @@ pub enum CsvError {
 impl NumericCsv {
     /// Reads a file whose header must be exactly `expected` (case-insensitive, spaces ignored).
     pub fn read(path: &Path, expected: &[&str]) -> Result<Self, CsvError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CsvError::Io {
+        let text = metamer_color::text::read_text(path).map_err(|source| CsvError::Io {
             file: path.to_path_buf(),
             source,
         })?;

@@ -258,3 +258,52 @@ fn characterize_refuses_to_overwrite_a_profile_in_a_directory_without_a_log() {
         .unwrap()
         .contains("metamer-display-profile"));
 }
+
+#[test]
+fn reproduce_refuses_its_image_as_output_and_a_failed_conversion_keeps_the_old_png() {
+    let s = Scratch::new("reproduce-image");
+    let m = s.measurements();
+    assert!(fit(&m, &s.s("p.json"), &[]).status.success());
+    // A 2×1 PFM: one finite pixel, then one NaN pixel.
+    let pfm = |second: f32| {
+        let mut b = b"PF\n2 1\n-1.0\n".to_vec();
+        for v in [20.0f32, 21.0, 22.0, second, 21.0, 22.0] {
+            b.extend(v.to_le_bytes());
+        }
+        b
+    };
+    std::fs::write(s.path("img.pfm"), pfm(20.0)).unwrap();
+    let image = std::fs::read(s.path("img.pfm")).unwrap();
+    let reproduce = |img: &str, out: &str| {
+        metamer(&[
+            "reproduce",
+            "--profile",
+            &s.s("p.json"),
+            "--image",
+            &s.s(img),
+            "-o",
+            &s.s(out),
+            "--force",
+        ])
+    };
+    let o = reproduce("img.pfm", "img.pfm");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o.stderr).contains("it is the input"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(std::fs::read(s.path("img.pfm")).unwrap(), image);
+    // A good conversion, then a failed one onto the same PNG: the first stays whole.
+    assert!(reproduce("img.pfm", "out.png").status.success());
+    let png = std::fs::read(s.path("out.png")).unwrap();
+    std::fs::write(s.path("nan.pfm"), pfm(f32::NAN)).unwrap();
+    let o = reproduce("nan.pfm", "out.png");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o.stderr).contains("not a finite XYZ"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(std::fs::read(s.path("out.png")).unwrap(), png);
+}

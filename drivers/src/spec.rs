@@ -46,6 +46,41 @@ pub fn open_instrument_with(
     open_in(registry::MODELS, spec, options)
 }
 
+/// Whether `spec` names an instrument that could be opened, without opening it: the form,
+/// the model and a simulation's options. A command that opens its instruments only after
+/// minutes of other work checks them first, so a typo fails at once. A real instrument's
+/// port and a transcript's content are only looked at when opened.
+pub fn check_spec(spec: &str) -> Result<(), DriverError> {
+    check_in(registry::MODELS, spec)
+}
+
+fn check_in(models: &[Model], spec: &str) -> Result<(), DriverError> {
+    let unknown = || DriverError::UnknownSpec {
+        spec: spec.to_string(),
+        expected: registry::spec_forms(),
+    };
+    let (kind, rest) = spec.split_once(':').unwrap_or((spec, ""));
+    match kind {
+        REPLAY_PREFIX if !rest.is_empty() => Ok(()),
+        SIM_PREFIX => {
+            let (model, query) = rest.split_once('?').unwrap_or((rest, ""));
+            let row = models
+                .iter()
+                .find(|m| m.name == model && m.sim.is_some())
+                .ok_or_else(unknown)?;
+            sim_settings(spec, query, row.sim_options).map(drop)
+        }
+        prefix => match models
+            .iter()
+            .find(|m| m.spec_prefixes.contains(&prefix))
+            .and_then(|m| m.real)
+        {
+            Some(real) if !rest.is_empty() || !real.address_required => Ok(()),
+            _ => Err(unknown()),
+        },
+    }
+}
+
 /// Opens `spec` from the rows of `models` (the registry's, or a test's own).
 fn open_in(
     models: &[Model],
@@ -205,6 +240,30 @@ mod tests {
             e.to_string().starts_with("the cs100a cannot do reflective"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_spec_is_checked_as_opening_would_check_it() {
+        for good in [
+            "sim:cs100a?time_scale=0&seed=3",
+            "sim:i1pro?rev=e",
+            "replay:x.jsonl",
+        ] {
+            check_spec(good).unwrap_or_else(|e| panic!("{good}: {e}"));
+        }
+        for bad in [
+            "sim:cs100a?time_scale=1e308",
+            "sim:cs100a?noise=maybe",
+            "sim:cs100a?rev=e",
+            "sim:nothing",
+            "cs100a",
+            "nonsense:x",
+        ] {
+            let checked = check_spec(bad).err().map(|e| e.to_string());
+            let opened = open_instrument(bad, None).err().map(|e| e.to_string());
+            assert!(checked.is_some(), "{bad} passed the check");
+            assert_eq!(checked, opened, "{bad}");
+        }
     }
 
     #[test]

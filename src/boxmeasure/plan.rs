@@ -229,14 +229,29 @@ pub const MAX_REPEATS: usize = 100;
 impl BoxPlan {
     /// Reads and validates a plan file.
     pub fn load(path: &Path) -> Result<BoxPlan, PlanError> {
-        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
+        let text = metamer_color::text::read_text(path).map_err(|source| PlanError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let plan: BoxPlan = serde_json::from_str(&text).map_err(|source| PlanError::Json {
+        let json = |source| PlanError::Json {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(metamer_color::text::strip_bom(&text)).map_err(json)?;
+        // serde reads a struct from an array too, field by field in order: `[1, 2, 3]`
+        // would be three repeat counts and everything else left at its default.
+        if !value.is_object() {
+            return Err(json(serde::de::Error::custom(
+                "a plan is a JSON object of named fields",
+            )));
+        }
+        if value.get("geometry").is_some_and(|g| !g.is_object()) {
+            return Err(json(serde::de::Error::custom(
+                "geometry is a JSON object of named fields",
+            )));
+        }
+        let plan: BoxPlan = serde_json::from_value(value).map_err(json)?;
         plan.validate()?;
         Ok(plan)
     }
@@ -262,7 +277,7 @@ impl BoxPlan {
         if let Some(v) = a.iter().find(|v| !(v.is_finite() && v.abs() < 90.0)) {
             return Err(invalid(
                 "falloff_angles_deg",
-                format!("{v} is not an angle off the normal: each must lie in (−90°, 90°)"),
+                format!("{v:?} is not an angle off the normal: each must lie in (−90°, 90°)"),
             ));
         }
         if let Some(w) = a.windows(2).find(|w| w[1] <= w[0]) {
@@ -316,7 +331,7 @@ impl BoxPlan {
             return Err(invalid(
                 "geometry.size_m",
                 format!(
-                    "must be between 0.3 m (the chart must fit) and 5 m, got {}",
+                    "must be between 0.3 m (the chart must fit) and 5 m, got {:?}",
                     g.size_m
                 ),
             ));
@@ -345,7 +360,7 @@ impl BoxPlan {
         if !(g.acceptance_deg > 0.0 && g.acceptance_deg <= 10.0) {
             return Err(invalid(
                 "geometry.acceptance_deg",
-                format!("must be in (0°, 10°], got {}", g.acceptance_deg),
+                format!("must be in (0°, 10°], got {:?}", g.acceptance_deg),
             ));
         }
         Ok(())
@@ -543,7 +558,22 @@ mod tests {
             "plan: repeats: must be between 1 and 100, got 0",
         );
         check(r#"{"falloff_angles_deg":[-20,20]}"#, "must contain 0");
-        check(r#"{"falloff_angles_deg":[0,95]}"#, "95 is not an angle");
+        check(r#"{"falloff_angles_deg":[0,95]}"#, "95.0 is not an angle");
+        // A number no one can read in 309 digits.
+        check(
+            r#"{"falloff_angles_deg":[0,1e308]}"#,
+            "falloff_angles_deg: 1e308 is not an angle",
+        );
+        check(r#"{"geometry":{"size_m":1e308}}"#, "and 5 m, got 1e308");
+        // serde would read an array as the fields in order: three repeat counts.
+        check(
+            "[1, 2, 3]",
+            "not a valid plan: a plan is a JSON object of named fields",
+        );
+        check(
+            r#"{"geometry": [0.5]}"#,
+            "not a valid plan: geometry is a JSON object of named fields",
+        );
         check(r#"{"falloff_angles_deg":[0,20,10]}"#, "10 follows 20");
         check(r#"{"patches":[1,25]}"#, "25 is not a patch number");
         check(r#"{"patches":[3,3]}"#, "patch 3 is listed twice");

@@ -11,6 +11,7 @@ use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
 use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
+use metamer::render::scene::Scene;
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::{CliError, CliResult};
@@ -97,8 +98,14 @@ pub fn run_cli(args: Args) -> CliResult {
     if !(args.target_de > 0.0 && args.target_de.is_finite()) {
         return Err(CliError::Usage("--target-de must be above 0".into()));
     }
-    if args.repeats == 0 {
-        return Err(CliError::Usage("--repeats must be at least 1".into()));
+    // As many as a box plan allows a reading of one thing; a billion was accepted and
+    // measured for days.
+    let most = metamer::boxmeasure::plan::MAX_REPEATS;
+    if !(1..=most).contains(&args.repeats) {
+        return Err(CliError::Usage(format!(
+            "--repeats must be from 1 to {most}, got {}",
+            args.repeats
+        )));
     }
     if args.image_size > 8192 {
         return Err(CliError::Usage("--image-size must be at most 8192".into()));
@@ -112,6 +119,7 @@ pub fn run_cli(args: Args) -> CliResult {
             args.out.display()
         )));
     }
+    check_inputs(&args)?;
     let interrupt = on_ctrl_c();
     let opts = ExperimentOptions {
         dir: args.out.clone(),
@@ -171,6 +179,41 @@ pub fn run_cli(args: Args) -> CliResult {
     shown.finish();
     print_outcomes(&outcomes?);
     print_comparisons(&args.out);
+    Ok(())
+}
+
+/// What the stages would read or open only after minutes of rendering and measuring: a
+/// given box's scene and readings, and the instruments' specs, checked before any work.
+fn check_inputs(args: &Args) -> CliResult {
+    if let (Some(scene), Some(spots)) = (&args.box_scene, &args.box_spots) {
+        Scene::load(scene)?;
+        // The experiment's reader takes any finite number; X = −1e308 made every stage
+        // run and the validation draw an infinite colour difference.
+        for p in metamer::experiment::readings::read_readings(spots)? {
+            let bad = metamer_color::check_xyz(p.xyz)
+                .err()
+                .map(|e| e.to_string())
+                .or_else(|| {
+                    (!p.sd
+                        .iter()
+                        .all(|s| (0.0..=metamer_color::MAX_CD_M2).contains(s)))
+                    .then(|| format!("a standard deviation of {:?}", p.sd))
+                });
+            if let Some(why) = bad {
+                return Err(CliError::Failed(
+                    format!(
+                        "{}: patch {}: not a measurement: {why}",
+                        spots.display(),
+                        p.patch
+                    )
+                    .into(),
+                ));
+            }
+        }
+    }
+    for spec in std::iter::once(&args.spot).chain(&args.spectral) {
+        metamer_drivers::check_spec(spec)?;
+    }
     Ok(())
 }
 

@@ -68,8 +68,14 @@ pub fn run(args: Args) -> CliResult {
     if !(args.target_de > 0.0 && args.target_de.is_finite()) {
         return Err(CliError::Usage("--target-de must be above 0".into()));
     }
-    if args.repeats == 0 {
-        return Err(CliError::Usage("--repeats must be at least 1".into()));
+    // As many as a box plan allows a reading of one thing; a billion was accepted and
+    // measured for days.
+    let most = metamer::boxmeasure::plan::MAX_REPEATS;
+    if !(1..=most).contains(&args.repeats) {
+        return Err(CliError::Usage(format!(
+            "--repeats must be from 1 to {most}, got {}",
+            args.repeats
+        )));
     }
     if args.box_repeats == Some(0) {
         return Err(CliError::Usage("--box-repeats must be at least 1".into()));

@@ -103,10 +103,44 @@ fn run_fit(a: FitArgs) -> CliResult {
         a.ldt.as_ref(),
         a.chart.as_ref(),
     ];
-    for out in outputs.into_iter().flatten() {
+    let outputs: Vec<&PathBuf> = outputs.into_iter().flatten().collect();
+    for (i, out) in outputs.iter().enumerate() {
+        // Two outputs on one path: the second would be refused as existing, after the
+        // first was written over it.
+        if outputs[..i].iter().any(|o| same_path(o, out)) {
+            return Err(CliError::Usage(format!(
+                "{} is given for two outputs; each needs its own file",
+                out.display()
+            )));
+        }
         policy.check(out).map_err(output_error)?;
     }
     let falloff = Falloff::read_csv(&a.falloff)?;
+    // The panel and its luminance are checked before anything is fitted or written, so a
+    // bad --width-m does not leave the fit written and the light files missing.
+    let panel = match panel_size {
+        None => None,
+        Some((w, h)) => {
+            let l0 = match a.luminance {
+                Some(l) => l,
+                None => {
+                    let normal = falloff.validate().map_err(|e| {
+                        CliError::Failed(format!("{}: {e}", a.falloff.display()).into())
+                    })?;
+                    let l0 = (normal[0] + normal[1]) / 2.0;
+                    if l0 == 1.0 {
+                        return Err(CliError::Usage(
+                            "the readings are relative (1 at the normal): give the panel's \
+                             luminance with --luminance CD_M2"
+                                .into(),
+                        ));
+                    }
+                    l0
+                }
+            };
+            Some(Panel::new(w, h, l0).map_err(|e| CliError::Usage(e.to_string()))?)
+        }
+    };
     let fit = fit(&falloff, a.model)
         .map_err(|e| CliError::Failed(format!("{}: {e}", a.falloff.display()).into()))?;
     print_fit(&a.falloff, &fit);
@@ -120,19 +154,8 @@ fn run_fit(a: FitArgs) -> CliResult {
         policy.write(chart, svg.as_bytes()).map_err(output_error)?;
         println!("chart written to {}", chart.display());
     }
-    if let Some((w, h)) = panel_size {
-        let l0 = match a.luminance {
-            Some(l) => l,
-            None if fit.normal_luminance == 1.0 => {
-                return Err(CliError::Usage(
-                    "the readings are relative (1 at the normal): give the panel's luminance \
-                     with --luminance CD_M2"
-                        .into(),
-                ))
-            }
-            None => fit.normal_luminance,
-        };
-        let panel = Panel::new(w, h, l0).map_err(|e| CliError::Usage(e.to_string()))?;
+    if let Some(panel) = panel {
+        let (w, h, l0) = (panel.width_m, panel.height_m, panel.normal_luminance_cd_m2);
         let flux = flux_lm(&fit.table, &panel);
         println!(
             "panel {w} m × {h} m at {l0} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
@@ -171,6 +194,16 @@ fn run_fit(a: FitArgs) -> CliResult {
         }
     }
     Ok(())
+}
+
+/// Whether two output paths name one file: spelled alike, or (when it exists) the same
+/// file by another name.
+fn same_path(a: &std::path::Path, b: &std::path::Path) -> bool {
+    a == b
+        || matches!(
+            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
+            (Ok(x), Ok(y)) if x == y
+        )
 }
 
 fn print_fit(source: &std::path::Path, fit: &LdcFit) {

@@ -25,6 +25,11 @@ enum PropagationArg {
     Linear,
 }
 
+/// Most Monte Carlo draws per patch.
+const MAX_DRAWS: usize = 10_000_000;
+/// Largest model term: CIELAB's whole gamut spans a few hundred ΔE*ab.
+const MAX_MODEL_TERM: f64 = 1000.0;
+
 #[derive(clap::Args)]
 pub struct Args {
     /// The box's readings: a session journal (.jsonl), `metamer spot --json` output, or a
@@ -79,9 +84,16 @@ pub fn run(args: Args) -> CliResult {
             "--draws must be at least 100 for a 95 % interval".into(),
         ));
     }
-    if !(args.model_term >= 0.0 && args.model_term.is_finite()) {
+    // Draws are held in memory per patch; ten million already take minutes.
+    if args.draws > MAX_DRAWS {
         return Err(CliError::Usage(format!(
-            "--model-term {}: must be a ΔE*ab ≥ 0",
+            "--draws {}: at most {MAX_DRAWS} (10⁵ give the 95 % interval to a few per cent)",
+            args.draws
+        )));
+    }
+    if !(0.0..=MAX_MODEL_TERM).contains(&args.model_term) {
+        return Err(CliError::Usage(format!(
+            "--model-term {:?}: must be a ΔE*ab from 0 to {MAX_MODEL_TERM}",
             args.model_term
         )));
     }
@@ -98,6 +110,8 @@ pub fn run(args: Args) -> CliResult {
         "reference" => reference.white_or_brightest(),
         s => {
             let v = parse_triple(s).map_err(|e| CliError::Usage(format!("--white: {e}")))?;
+            metamer_color::check_xyz(v)
+                .map_err(|e| CliError::Usage(format!("--white: not a white: {e}")))?;
             (Xyz::from_array(v), "given on the command line".to_string())
         }
     };

@@ -86,7 +86,7 @@ impl Profile {
 
     pub fn load(path: &Path) -> Result<Profile, ProfileError> {
         let file = path.to_path_buf();
-        let text = std::fs::read_to_string(path).map_err(|source| ProfileError::Io {
+        let text = metamer_color::text::read_text(path).map_err(|source| ProfileError::Io {
             file: file.clone(),
             source,
         })?;

@@ -21,6 +21,8 @@
 
 use std::path::Path;
 
+use metamer_color::text::{echo, strip_bom};
+
 use super::cgamma::CGammaTable;
 use super::photometry::{
     candela_grid, finish, format_sig, mirror_planes, tokens, Opening, Panel, Photometry,
@@ -110,7 +112,7 @@ fn one_line(s: &str) -> String {
 
 /// Reads an IES file: the distribution as a C-γ table (front hemisphere) and its photometry.
 pub fn read(path: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
-    let text = std::fs::read_to_string(path).map_err(|source| PhotometryError::Io {
+    let text = metamer_color::text::read_text(path).map_err(|source| PhotometryError::Io {
         file: path.to_path_buf(),
         source,
     })?;
@@ -124,7 +126,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         line,
         message,
     };
-    let lines: Vec<&str> = text.lines().collect();
+    let lines: Vec<&str> = strip_bom(text).lines().collect();
     let first = lines.iter().position(|l| !l.trim().is_empty()).unwrap_or(0);
     let version = lines
         .get(first)
@@ -153,7 +155,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         pos += 1;
         t.parse::<f64>()
             .map(|v| (*line, v))
-            .map_err(|_| fmt_err(*line, format!("{what}: '{t}' is not a number")))
+            .map_err(|_| fmt_err(*line, format!("{what}: '{}' is not a number", echo(t))))
     };
     if tilt_value == "INCLUDE" {
         // Lamp-to-luminaire geometry, the number of tilt angles, the angles, the factors:

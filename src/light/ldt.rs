@@ -22,6 +22,8 @@
 
 use std::path::Path;
 
+use metamer_color::text::{echo, strip_bom};
+
 use super::cgamma::CGammaTable;
 use super::photometry::{
     candela_grid, finish, flux_lm, format_sig, mirror_planes, tokens, Opening, Panel, Photometry,
@@ -108,7 +110,7 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &LdtInfo) -> String {
 
 /// Reads an EULUMDAT file: the distribution as a C-γ table and its photometry.
 pub fn read(path: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
-    let bytes = std::fs::read(path).map_err(|source| PhotometryError::Io {
+    let bytes = metamer_color::text::read_bytes(path).map_err(|source| PhotometryError::Io {
         file: path.to_path_buf(),
         source,
     })?;
@@ -124,7 +126,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         line,
         message,
     };
-    let lines: Vec<&str> = text.lines().collect();
+    let lines: Vec<&str> = strip_bom(text).lines().collect();
     let line_of = |k: usize| -> Result<&str, PhotometryError> {
         lines.get(k - 1).copied().ok_or_else(|| {
             fmt_err(
@@ -140,7 +142,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         let raw = line_of(k)?.trim();
         raw.replace(',', ".")
             .parse::<f64>()
-            .map_err(|_| fmt_err(k, format!("{what}: '{raw}' is not a number")))
+            .map_err(|_| fmt_err(k, format!("{what}: '{}' is not a number", echo(raw))))
     };
     let count = |k: usize, what: &str| -> Result<usize, PhotometryError> {
         let v = number(k, what)?;
@@ -206,7 +208,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         };
         pos += 1;
         t.parse::<f64>()
-            .map_err(|_| fmt_err(*line, format!("{what}: '{t}' is not a number")))
+            .map_err(|_| fmt_err(*line, format!("{what}: '{}' is not a number", echo(t))))
     };
     for _ in 0..10 {
         next("the direct ratios")?;

@@ -18,11 +18,19 @@ pub struct Panel {
     pub normal_luminance_cd_m2: f64,
 }
 
+/// Largest panel side, metres.
+pub const MAX_PANEL_M: f64 = 1000.0;
+
 /// Why a panel, or a photometric file, cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum PhotometryError {
-    #[error("panel {what} must be a positive finite number, got {value}")]
-    BadPanel { what: &'static str, value: f64 },
+    #[error("panel {what} must be a positive number of at most {max:e} {unit}, got {value:?}")]
+    BadPanel {
+        what: &'static str,
+        value: f64,
+        max: f64,
+        unit: &'static str,
+    },
     #[error("{file}: cannot read: {source}")]
     Io {
         file: PathBuf,
@@ -46,13 +54,25 @@ impl Panel {
         height_m: f64,
         normal_luminance_cd_m2: f64,
     ) -> Result<Panel, PhotometryError> {
-        for (what, value) in [
-            ("width", width_m),
-            ("height", height_m),
-            ("normal luminance", normal_luminance_cd_m2),
+        // A kilometre-wide panel or one brighter than the sun's disc is a typo; past them
+        // the photometry overflows into tables of 300-digit candela.
+        for (what, value, max, unit) in [
+            ("width", width_m, MAX_PANEL_M, "m"),
+            ("height", height_m, MAX_PANEL_M, "m"),
+            (
+                "normal luminance",
+                normal_luminance_cd_m2,
+                metamer_color::MAX_CD_M2,
+                "cd/m²",
+            ),
         ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(PhotometryError::BadPanel { what, value });
+            if !(value > 0.0 && value <= max) {
+                return Err(PhotometryError::BadPanel {
+                    what,
+                    value,
+                    max,
+                    unit,
+                });
             }
         }
         Ok(Panel {
@@ -428,5 +448,13 @@ mod tests {
         assert!(Panel::new(0.0, 1.0, 1.0).is_err());
         assert!(Panel::new(1.0, f64::NAN, 1.0).is_err());
         assert!(Panel::new(1.0, 1.0, -3.0).is_err());
+        // Once accepted: the IES table of such a panel held 300-digit candela.
+        let e = Panel::new(0.3, 0.3, 1e308).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "panel normal luminance must be a positive number of at most 1e10 cd/m², got 1e308"
+        );
+        assert!(Panel::new(1e308, 0.3, 100.0).is_err());
+        assert!(Panel::new(1000.0, 1000.0, 1e10).is_ok());
     }
 }

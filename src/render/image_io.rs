@@ -225,7 +225,7 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageIoError> {
              ({MAX_EXR_BYTES} bytes)"
         )));
     }
-    let bytes = std::fs::read(path).map_err(io(path))?;
+    let bytes = metamer_color::text::read_bytes_at_most(path, MAX_EXR_BYTES).map_err(io(path))?;
     // Our own reading of the layout first: the crate sizes buffers by what the file says.
     exr_layout::check(&bytes).map_err(bad)?;
     let meta = MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)

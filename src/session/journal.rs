@@ -9,7 +9,7 @@
 
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::{Seek, SeekFrom, Write};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 
@@ -196,13 +196,12 @@ where
         path: &Path,
         expected: &Header<H>,
     ) -> Result<(Self, Recovered<H, E>), JournalError> {
+        let bytes = metamer_color::text::read_bytes(path).map_err(io(path))?;
         let mut file = OpenOptions::new()
             .read(true)
             .append(true)
             .open(path)
             .map_err(io(path))?;
-        let mut bytes = Vec::new();
-        file.read_to_end(&mut bytes).map_err(io(path))?;
         if let Some(what) = broken(&bytes) {
             return Err(JournalError::Broken {
                 path: path.to_path_buf(),
@@ -389,7 +388,11 @@ pub fn refuse_existing(path: &Path) -> Result<(), JournalError> {
 /// Why the existing journal at `path` cannot be started anew: it holds a session, or it
 /// holds nothing usable (and can be set aside).
 fn existing(path: &Path) -> JournalError {
-    match std::fs::read(path).ok().as_deref().and_then(broken) {
+    match metamer_color::text::read_bytes(path)
+        .ok()
+        .as_deref()
+        .and_then(broken)
+    {
         Some(what) => JournalError::Broken {
             path: path.to_path_buf(),
             what,
@@ -451,7 +454,7 @@ pub fn set_aside(path: &Path) -> Result<PathBuf, JournalError> {
 
 /// Entry lines in an existing journal (for the "exists" message; 0 if unreadable).
 fn count_entries(path: &Path) -> usize {
-    std::fs::read_to_string(path)
+    metamer_color::text::read_text(path)
         .map(|t| {
             t.lines()
                 .filter(|l| l.starts_with("{\"type\":\"entry\""))

@@ -210,6 +210,24 @@ where
                     ),
                 ));
             }
+            // A journal is a file anyone can edit: a reading no instrument can have taken
+            // (1e308, or one that overflowed to it) is refused here rather than failing the
+            // fit later in words about its matrices. A small negative component is left to
+            // the caller: a spectrometer's dark readings have them, and this journal was
+            // written from readings the instrument gave.
+            if let Err(
+                e @ (metamer_color::Implausible::NotFinite(_)
+                | metamer_color::Implausible::TooBright { .. }),
+            ) = metamer_color::check_xyz(entry.reading.xyz)
+            {
+                return Err(bad(
+                    line,
+                    format!(
+                        "step {} ({}): not a measurement: {e}",
+                        entry.index, entry.label
+                    ),
+                ));
+            }
             let i = entry.index;
             if entries[i].replace(entry).is_some() {
                 return Err(bad(line, format!("step {i} is journalled twice")));

@@ -53,6 +53,12 @@ fn draw(
         .map(|p| p.de76.max(p.de00))
         .fold(JND_DE76, f64::max)
         * 1.15;
+    // plotters looks for axis ticks on an infinite range without end.
+    if !top.is_finite() {
+        return Err(chart_err(&format!(
+            "a colour difference of {top} cannot be drawn: a reading is not a colour"
+        )));
+    }
     let root = SVGBackend::with_string(svg, (900, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| chart_err(&e))?;
     let caption = format!(

@@ -88,6 +88,25 @@ fn tick_step(span: f64, n: f64) -> f64 {
     }
 }
 
+/// Most ticks on an axis; a readable axis has a dozen.
+const MAX_TICKS: usize = 100;
+
+/// Tick values from `start` by `step` up to `end`: none when the range is not finite, and
+/// at most [`MAX_TICKS`], so an infinite bound or a step lost to rounding beside a huge one
+/// cannot loop (and write SVG) without end.
+fn ticks(start: f64, end: f64, step: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    if !(start.is_finite() && end.is_finite() && step.is_finite() && step > 0.0) {
+        return out;
+    }
+    let mut v = start;
+    while v <= end && out.len() < MAX_TICKS {
+        out.push(v);
+        v += step;
+    }
+    out
+}
+
 /// Fig. 4 (and 6): ΔE*ab per patch as bars coloured by the JND verdict, the 95 % interval
 /// as an error bar, ΔE00 as a dot, the JND line, colours outside the display's gamut on a
 /// grey band, and under each bar the two readings' swatches (reference above, test below).
@@ -130,8 +149,7 @@ pub fn delta_e_bars(a: &Assessment, id: &str, title: &str) -> String {
         }
     }
     let step = tick_step(ymax, 6.0);
-    let mut v = 0.0;
-    while v <= ymax {
+    for v in ticks(0.0, ymax, step) {
         let y = y_of(v);
         let _ = write!(
             s,
@@ -141,7 +159,6 @@ pub fn delta_e_bars(a: &Assessment, id: &str, title: &str) -> String {
             y + 4.0,
             trim(v)
         );
-        v += step;
     }
     let bw = slot * 0.55;
     for (i, p) in a.patches.iter().enumerate() {
@@ -330,8 +347,7 @@ fn plane(
         bx + pl
     );
     let step = tick_step(xmax - xmin, 6.0);
-    let mut v = (xmin / step).ceil() * step;
-    while v <= xmax {
+    for v in ticks((xmin / step).ceil() * step, xmax, step) {
         let _ = write!(
             s,
             r##"<line x1="{x:.1}" x2="{x:.1}" y1="{by}" y2="{:.1}" stroke="{}"/><text x="{x:.1}" y="{:.1}" text-anchor="middle" font-size="10" font-family="sans-serif">{}</text>"##,
@@ -341,11 +357,9 @@ fn plane(
             trim(v),
             x = px(v)
         );
-        v += step;
     }
     let step = tick_step(ymax - ymin, 6.0);
-    let mut v = (ymin / step).ceil() * step;
-    while v <= ymax {
+    for v in ticks((ymin / step).ceil() * step, ymax, step) {
         let _ = write!(
             s,
             r##"<line x1="{:.1}" x2="{:.1}" y1="{y:.1}" y2="{y:.1}" stroke="{}"/><text x="{:.1}" y="{:.1}" text-anchor="end" font-size="10" font-family="sans-serif">{}</text>"##,
@@ -361,7 +375,6 @@ fn plane(
             trim(v),
             y = py(v)
         );
-        v += step;
     }
     let _ = write!(
         s,
@@ -403,6 +416,16 @@ fn plane(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_axis_of_unbounded_or_huge_range_has_few_ticks_and_ends() {
+        assert_eq!(ticks(0.0, 1.0, 0.25), [0.0, 0.25, 0.5, 0.75, 1.0]);
+        // An infinite maximum once made `v += step` stay at inf, writing SVG forever.
+        assert!(ticks(0.0, f64::INFINITY, tick_step(f64::INFINITY, 6.0)).is_empty());
+        assert!(ticks(f64::NAN, 1.0, 0.1).is_empty());
+        // A step lost to rounding beside a huge start never moves v.
+        assert_eq!(ticks(1e300, 2e300, 1.0).len(), MAX_TICKS);
+    }
 
     #[test]
     fn swatches_of_white_black_and_an_impossible_colour() {

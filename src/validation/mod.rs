@@ -193,6 +193,27 @@ mod chart_tests {
     use super::*;
 
     #[test]
+    fn a_chart_of_an_infinite_difference_is_refused_at_once() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let x = Xyz::new(10.0, 11.0, 12.0);
+        let mut c = compare("box", &[x], "display", &[x], white).unwrap();
+        // The experiment's box readings of X = −1e308 gave this, and plotters then
+        // searched an infinite axis for ticks without end.
+        c.patches[0].de76 = f64::INFINITY;
+        let file = std::env::temp_dir().join(format!("metamer-inf-{}.svg", std::process::id()));
+        let start = std::time::Instant::now();
+        let e = write_delta_e_chart(&c, &file, &crate::output::OutputPolicy::new(true))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a colour difference of inf cannot be drawn"),
+            "{e}"
+        );
+        assert!(start.elapsed().as_secs() < 5);
+        assert!(!file.exists());
+    }
+
+    #[test]
     fn chart_has_two_bars_per_patch_and_the_jnd_line() {
         let white = Xyz::new(95.047, 100.0, 108.883);
         let reference: Vec<Xyz> = (0..24)

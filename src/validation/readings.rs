@@ -9,6 +9,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use metamer_color::text::{echo, echo_message, strip_bom};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -149,6 +150,9 @@ enum PatchId {
     White,
 }
 
+/// Largest 95 % ΔE*ab bound a renderer may state: CIELAB's whole gamut spans a few hundred.
+const MAX_DE95: f64 = 1000.0;
+
 /// One reading or row before the repeats of a patch are combined.
 #[derive(Clone, Debug)]
 struct Row {
@@ -167,7 +171,7 @@ struct Row {
 
 /// Reads `file`, sniffing its format.
 pub fn read_readings(file: &Path) -> Result<ReadingSet, ReadingsError> {
-    let text = std::fs::read_to_string(file).map_err(|source| ReadingsError::Io {
+    let text = metamer_color::text::read_text(file).map_err(|source| ReadingsError::Io {
         file: file.to_path_buf(),
         source,
     })?;
@@ -176,6 +180,7 @@ pub fn read_readings(file: &Path) -> Result<ReadingSet, ReadingsError> {
 
 /// Parses readings from `text`; `file` names it in errors.
 pub fn parse_readings(text: &str, file: &Path) -> Result<ReadingSet, ReadingsError> {
+    let text = strip_bom(text);
     let first = text
         .lines()
         .map(str::trim)
@@ -245,7 +250,8 @@ impl Parsed {
                 self.bad(
                     line,
                     format!(
-                        "{name} is {x}: the instrument did not measure it (a reading without chromaticity cannot be compared)"
+                        "{name} is {}: the instrument did not measure it (a reading without chromaticity cannot be compared)",
+                        echo(&x.to_string())
                     ),
                 )
             })?;
@@ -280,7 +286,12 @@ impl Parsed {
                     ));
                     continue;
                 }
-                Err(e) => return Err(self.bad(line, format!("not a JSON line: {e}"))),
+                Err(e) => {
+                    return Err(self.bad(
+                        line,
+                        format!("not a JSON line: {}", echo_message(&e.to_string())),
+                    ))
+                }
             };
             match v["type"].as_str() {
                 Some("header") => {
@@ -336,8 +347,12 @@ impl Parsed {
             if raw.is_empty() || raw.starts_with('#') {
                 continue;
             }
-            let v: Value = serde_json::from_str(raw)
-                .map_err(|e| self.bad(line, format!("not a JSON line: {e}")))?;
+            let v: Value = serde_json::from_str(raw).map_err(|e| {
+                self.bad(
+                    line,
+                    format!("not a JSON line: {}", echo_message(&e.to_string())),
+                )
+            })?;
             let xyz = self.xyz_of(&v, "XYZ", line)?;
             if let Some(name) = v["instrument"].as_str() {
                 self.note_instrument(name);
@@ -345,7 +360,13 @@ impl Parsed {
             let patch = match v.get("patch") {
                 None => None,
                 Some(p) => Some(patch_id(p).ok_or_else(|| {
-                    self.bad(line, format!("\"patch\": {p} is not 1–24 or \"white\""))
+                    self.bad(
+                        line,
+                        format!(
+                            "\"patch\": {} is not 1–24 or \"white\"",
+                            echo(&p.to_string())
+                        ),
+                    )
                 })?),
             };
             let row = Row {
@@ -452,7 +473,8 @@ impl Parsed {
                 self.bad(
                     hline,
                     format!(
-                        "the header '{header}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, n, out_of_gamut)"
+                        "the header '{}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, n, out_of_gamut)",
+                        echo(header)
                     ),
                 )
             })
@@ -484,7 +506,7 @@ impl Parsed {
                     .ok_or_else(|| {
                         self.bad(
                             line,
-                            format!("{}: '{}' is not a number", names[c], cells[c]),
+                            format!("{}: '{}' is not a number", names[c], echo(cells[c])),
                         )
                     })
             };
@@ -493,7 +515,7 @@ impl Parsed {
                     line,
                     format!(
                         "patch '{}' is not 1–24, a ColorChecker name or 'white'",
-                        cells[cp]
+                        echo(cells[cp])
                     ),
                 )
             })?;
@@ -513,7 +535,7 @@ impl Parsed {
                     if v < 1.0 || v.fract() != 0.0 {
                         return Err(self.bad(
                             line,
-                            format!("n: '{}' must be a whole number ≥ 1", cells[c]),
+                            format!("n: '{}' must be a whole number ≥ 1", echo(cells[c])),
                         ));
                     }
                     v as usize
@@ -525,7 +547,10 @@ impl Parsed {
                     "1" | "true" | "yes" => true,
                     "0" | "false" | "no" | "" => false,
                     other => {
-                        return Err(self.bad(line, format!("out_of_gamut: '{other}' is not 0 or 1")))
+                        return Err(self.bad(
+                            line,
+                            format!("out_of_gamut: '{}' is not 0 or 1", echo(other)),
+                        ))
                     }
                 },
                 None => false,
@@ -544,6 +569,39 @@ impl Parsed {
         Ok(())
     }
 
+    /// A row no instrument or renderer can have produced (X = −1e308, a spread of 1e308)
+    /// is refused where it enters: downstream it becomes an infinite CIELAB and a figure
+    /// whose axis never ends.
+    fn plausible(&self, r: &Row) -> Result<(), ReadingsError> {
+        metamer_color::check_xyz(r.xyz)
+            .map_err(|e| self.bad(r.line, format!("not a measurement: {e}")))?;
+        for (what, spread) in [("standard deviation", r.sd), ("standard error", r.stderr)] {
+            if let Some(v) = spread {
+                if !v
+                    .iter()
+                    .all(|s| (0.0..=metamer_color::MAX_CD_M2).contains(s))
+                {
+                    return Err(self.bad(
+                        r.line,
+                        format!(
+                            "a {what} of {v:?}: must be ≥ 0 and at most {:e}",
+                            metamer_color::MAX_CD_M2
+                        ),
+                    ));
+                }
+            }
+        }
+        if let Some(de) = r.de95 {
+            if !(0.0..=MAX_DE95).contains(&de) {
+                return Err(self.bad(
+                    r.line,
+                    format!("a 95 % ΔE*ab bound of {de:?}: must be ≥ 0 and at most {MAX_DE95}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     fn finish(self, format: Format) -> Result<ReadingSet, ReadingsError> {
         if self.rows.is_empty() {
             return Err(ReadingsError::Empty {
@@ -553,6 +611,9 @@ impl Parsed {
                     format.name()
                 ),
             });
+        }
+        for r in &self.rows {
+            self.plausible(r)?;
         }
         let mut groups: BTreeMap<usize, Vec<&Row>> = BTreeMap::new();
         let mut white = Vec::new();

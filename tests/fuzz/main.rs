@@ -12,6 +12,7 @@ mod alloc;
 mod exr_class;
 mod mutate;
 mod targets;
+mod targets_session;
 
 use std::sync::mpsc;
 use std::time::{Duration, Instant};

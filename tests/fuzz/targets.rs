@@ -32,7 +32,7 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn read(rel: &str) -> Vec<u8> {
+pub fn read(rel: &str) -> Vec<u8> {
     std::fs::read(root().join(rel)).unwrap_or_else(|e| panic!("seed {rel}: {e}"))
 }
 
@@ -47,7 +47,7 @@ fn files_in(rel: &str, ext: &str) -> Vec<Vec<u8>> {
 }
 
 /// Writes the input to a file named `name` in the scratch directory.
-fn scratch(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+pub fn scratch(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, bytes).unwrap();
     p
@@ -389,4 +389,7 @@ pub fn all(dir: &Path) -> Vec<Target> {
             run: ldt,
         },
     ]
+    .into_iter()
+    .chain(crate::targets_session::all(dir))
+    .collect()
 }

@@ -23,7 +23,7 @@ impl Transcript {
     /// Reads and parses a transcript file.
     pub fn load(path: &Path) -> Result<Transcript, DriverError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| DriverError::File {
+        let text = metamer_color::text::read_text(path).map_err(|source| DriverError::File {
             file: file.clone(),
             source,
         })?;

@@ -24,7 +24,7 @@ pub struct SpectralTable {
 impl SpectralTable {
     /// Reads and parses a file.
     pub fn read(path: &Path) -> Result<Self, ColorError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ColorError::Io {
+        let text = crate::text::read_text(path).map_err(|source| ColorError::Io {
             file: path.to_path_buf(),
             source,
         })?;

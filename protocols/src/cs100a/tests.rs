@@ -132,6 +132,19 @@ fn malformed_replies_are_named() {
         parse_reply(b"OK00,123.4 , .3127, .3290\r\n"),
         Err(ReplyError::BadNumber { field: "Y", .. })
     ));
+    // Rust's float parser takes these; a meter's reply never holds them.
+    for reply in [
+        &b"OK00,    NaN, .3127, .3290\r\n"[..],
+        b"OK00,    inf, .3127, .3290\r\n",
+        b"OK00,  1e308, .3127, .3290\r\n",
+        b"OK00,  123.4,   NaN, .3290\r\n",
+    ] {
+        assert!(
+            matches!(parse_reply(reply), Err(ReplyError::BadNumber { .. })),
+            "{:?}",
+            String::from_utf8_lossy(reply)
+        );
+    }
 }
 
 #[test]

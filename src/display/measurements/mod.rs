@@ -113,7 +113,7 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
             calibration: None,
         });
     }
-    let text = std::fs::read_to_string(path).map_err(|source| MeasurementsError::Io {
+    let text = metamer_color::text::read_text(path).map_err(|source| MeasurementsError::Io {
         file: path.to_path_buf(),
         source,
     })?;

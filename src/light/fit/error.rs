@@ -37,7 +37,7 @@ pub enum LdcError {
         previous: f64,
         angle: f64,
     },
-    #[error("the {plane} plane at {angle}°: luminance {value} must be finite and ≥ 0")]
+    #[error("the {plane} plane at {angle}°: luminance {value:?} must be finite, ≥ 0 and at most 1e10 (brighter than the sun's disc)")]
     BadLuminance {
         plane: Plane,
         angle: f64,

@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use metamer_color::text::{echo, strip_bom};
 use serde::{Deserialize, Serialize};
 
 use super::error::LdcError;
@@ -33,7 +34,7 @@ impl Falloff {
     /// given alone stands for both: the source is then taken to fall off alike in both
     /// planes. '#' lines are comments.
     pub fn read_csv(path: &Path) -> Result<Falloff, LdcError> {
-        let text = std::fs::read_to_string(path).map_err(|source| LdcError::Io {
+        let text = metamer_color::text::read_text(path).map_err(|source| LdcError::Io {
             file: path.to_path_buf(),
             source,
         })?;
@@ -50,7 +51,7 @@ impl Falloff {
         let mut columns: Option<Vec<Option<Plane>>> = None;
         let mut out = Falloff::default();
         let mut last_line = 0;
-        for (index, raw) in text.lines().enumerate() {
+        for (index, raw) in strip_bom(text).lines().enumerate() {
             let line = index + 1;
             last_line = line;
             let trimmed = raw.trim();
@@ -70,7 +71,7 @@ impl Falloff {
             }
             let number = |cell: &str, what: &str| -> Result<f64, LdcError> {
                 cell.parse::<f64>()
-                    .map_err(|_| err(line, format!("{what}: '{cell}' is not a number")))
+                    .map_err(|_| err(line, format!("{what}: '{}' is not a number", echo(cell))))
             };
             let angle = number(cells[0], "angle_deg")?;
             for (cell, plane) in cells[1..].iter().zip(cols) {
@@ -139,7 +140,7 @@ fn header(cells: &[&str]) -> Result<Vec<Option<Plane>>, String> {
     let expected =
         "expected the header 'angle_deg,horizontal,vertical' (either plane may be left out)";
     if cells.len() < 2 || !cells[0].eq_ignore_ascii_case("angle_deg") {
-        return Err(format!("{expected}, found '{}'", cells.join(",")));
+        return Err(format!("{expected}, found '{}'", echo(&cells.join(","))));
     }
     let mut cols = Vec::new();
     for c in &cells[1..] {
@@ -148,10 +149,10 @@ fn header(cells: &[&str]) -> Result<Vec<Option<Plane>>, String> {
         } else if c.eq_ignore_ascii_case("vertical") {
             Plane::Vertical
         } else {
-            return Err(format!("{expected}, found column '{c}'"));
+            return Err(format!("{expected}, found column '{}'", echo(c)));
         };
         if cols.contains(&Some(p)) {
-            return Err(format!("column '{c}' appears twice"));
+            return Err(format!("column '{}' appears twice", echo(c)));
         }
         cols.push(Some(p));
     }
@@ -181,7 +182,9 @@ fn validate_plane(plane: Plane, data: &PlaneData) -> Result<f64, LdcError> {
                 angle,
             });
         }
-        if !value.is_finite() || value < 0.0 {
+        // Any unit, but no reading in any unit is brighter than the sun's disc in cd/m²:
+        // 1e300 was fitted and written as a 300-digit candela table.
+        if !(0.0..=metamer_color::MAX_CD_M2).contains(&value) {
             return Err(LdcError::BadLuminance {
                 plane,
                 angle,

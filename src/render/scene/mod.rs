@@ -80,7 +80,7 @@ impl Scene {
                 max: MAX_SCENE_BYTES,
             });
         }
-        let text = std::fs::read_to_string(path).map_err(io)?;
+        let text = metamer_color::text::read_text(path).map_err(io)?;
         let invalid = |source| SceneError::Invalid {
             file: path.to_path_buf(),
             source,
