@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-const FAST: Duration = Duration::from_secs(2);
+const FAST: Duration = Duration::from_secs(4);
 
 fn scratch(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("metamer-refusals-{tag}-{}", std::process::id()));

@@ -113,11 +113,21 @@ impl StageDir {
         {
             return None;
         }
-        let intact = record
-            .outputs
-            .iter()
-            .all(|(file, hash)| hash_file(&self.path(file)).ok().as_ref() == Some(hash));
+        let intact = record.outputs.iter().all(|(file, hash)| {
+            self.own_file(file) && hash_file(&self.path(file)).ok().as_ref() == Some(hash)
+        });
         intact.then_some(record)
+    }
+
+    /// Whether `name` is a regular file inside the stage directory, as every output a stage
+    /// writes is. A record edited to name `/dev/zero`, `../elsewhere` or a link would
+    /// otherwise be hashed wherever it points (a device, for ever).
+    fn own_file(&self, name: &str) -> bool {
+        let plain = !name.is_empty()
+            && Path::new(name)
+                .components()
+                .all(|c| matches!(c, std::path::Component::Normal(_)));
+        plain && std::fs::symlink_metadata(self.path(name)).is_ok_and(|m| m.file_type().is_file())
     }
 
     /// Forgets an earlier finish, so a stage that is re-run and fails half-way is never
@@ -227,6 +237,36 @@ mod tests {
         assert!(s.reusable(&inputs).is_none());
         s.invalidate().unwrap();
         s.invalidate().unwrap();
+    }
+
+    /// A record whose outputs name a device, a path outside the stage or a link is not
+    /// re-used, and saying so takes no time (hashing /dev/zero would never end).
+    #[test]
+    fn a_record_naming_files_outside_the_stage_is_not_reused() {
+        let root = scratch("outside");
+        let s = StageDir::new(&root, "display");
+        std::fs::create_dir_all(&s.dir).unwrap();
+        std::fs::write(root.join("elsewhere"), "x").unwrap();
+        std::fs::write(s.path("profile.json"), "{}").unwrap();
+        let inputs = Inputs::new().value("model", &"lut");
+        let good = s.finish(&inputs, &["profile.json"], 1.0).unwrap();
+        assert!(s.reusable(&inputs).is_some());
+        let x_hash = hash_file(&root.join("elsewhere")).unwrap();
+        std::os::unix::fs::symlink(root.join("elsewhere"), s.path("link")).unwrap();
+        for (name, hash) in [
+            ("/dev/zero", good.outputs["profile.json"].clone()),
+            ("../elsewhere", x_hash.clone()),
+            ("link", x_hash),
+            ("", good.outputs["profile.json"].clone()),
+        ] {
+            let mut edited = good.clone();
+            edited.outputs.insert(name.to_string(), hash);
+            let text = serde_json::to_string(&edited).unwrap();
+            std::fs::write(s.path(RECORD_FILE), text).unwrap();
+            let start = std::time::Instant::now();
+            assert!(s.reusable(&inputs).is_none(), "{name:?} was trusted");
+            assert!(start.elapsed() < std::time::Duration::from_secs(1));
+        }
     }
 
     #[test]

@@ -82,6 +82,8 @@ pub enum ExperimentError {
         stage: &'static str,
         missing: PathBuf,
     },
+    #[error("the box's {what} {} does not exist (given as measured earlier or elsewhere)", file.display())]
+    GivenBoxMissing { what: &'static str, file: PathBuf },
     #[error("the box measurements: {0}")]
     Box(String),
 }

@@ -95,10 +95,12 @@ pub fn write_readings(path: &Path, stats: &[PatchStat]) -> Result<(), ReadingsEr
 }
 
 pub fn read_readings(path: &Path) -> Result<Vec<PatchStat>, ReadingsError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ReadingsError::Io {
+    let text = metamer_color::text::read_text(path).map_err(|source| ReadingsError::Io {
         file: path.to_path_buf(),
         source,
     })?;
+    // A spreadsheet that saved the file as "UTF-8 with BOM" puts it before the header.
+    let text = metamer_color::text::strip_bom(&text);
     let bad = |line: usize, message: String| ReadingsError::Parse {
         file: path.to_path_buf(),
         line,
@@ -130,12 +132,24 @@ pub fn read_readings(path: &Path) -> Result<Vec<PatchStat>, ReadingsError> {
         let n = f[7]
             .parse::<usize>()
             .map_err(|_| bad(i + 1, "n is not a whole number".into()))?;
-        out.push(PatchStat {
-            patch,
-            xyz: [num(1)?, num(2)?, num(3)?],
-            sd: [num(4)?, num(5)?, num(6)?],
-            n,
-        });
+        let xyz = [num(1)?, num(2)?, num(3)?];
+        // A reading no instrument can take (X = −1e308) would become an infinite CIELAB
+        // and a chart without end downstream: refused here, where it enters.
+        metamer_color::check_xyz(xyz).map_err(|e| bad(i + 1, format!("not a measurement: {e}")))?;
+        let sd = [num(4)?, num(5)?, num(6)?];
+        if !sd
+            .iter()
+            .all(|v| (0.0..=metamer_color::MAX_CD_M2).contains(v))
+        {
+            return Err(bad(
+                i + 1,
+                format!(
+                    "a standard deviation of {sd:?}: must be ≥ 0 and at most {:e}",
+                    metamer_color::MAX_CD_M2
+                ),
+            ));
+        }
+        out.push(PatchStat { patch, xyz, sd, n });
     }
     Ok(out)
 }
@@ -168,5 +182,20 @@ mod tests {
         std::fs::write(&p, format!("{HEADER}\n1,0,1,NaN,0,0,0,1\n")).unwrap();
         let e = read_readings(&p).unwrap_err().to_string();
         assert!(e.contains("line 2") && e.contains("field 4"), "{e}");
+        // Saved with a byte-order mark: the same readings.
+        write_readings(&p, &stats).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        std::fs::write(&p, format!("\u{feff}{text}")).unwrap();
+        assert_eq!(read_readings(&p).unwrap(), stats);
+        // Finite but impossible: refused with the line.
+        for row in [
+            "1,-1e308,1,1,0,0,0,1",
+            "1,1,1e300,1,0,0,0,1",
+            "1,1,1,1,0,-1,0,2",
+        ] {
+            std::fs::write(&p, format!("{HEADER}\n{row}\n")).unwrap();
+            let e = read_readings(&p).unwrap_err().to_string();
+            assert!(e.contains("line 2"), "{row}: {e}");
+        }
     }
 }

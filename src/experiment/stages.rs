@@ -116,6 +116,16 @@ pub fn run(
     progress: &dyn Fn(Progress),
 ) -> Result<Vec<StageOutcome>, ExperimentError> {
     let root = &opts.dir;
+    if let BoxSource::Existing { scene, spots } = &opts.box_source {
+        for (what, file) in [("scene", scene), ("spot readings", spots)] {
+            if !file.exists() {
+                return Err(ExperimentError::GivenBoxMissing {
+                    what,
+                    file: file.clone(),
+                });
+            }
+        }
+    }
     let mut outcomes = Vec::new();
     for stage in Stage::ALL {
         if opts.stage.is_some_and(|s| s != stage) {
@@ -127,10 +137,18 @@ pub fn run(
         let forced = opts.stage == Some(stage);
         let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
         if !forced && ((stage == Stage::Box && given_box) || sd.reusable(&inputs).is_some()) {
-            progress(Progress::Stage {
-                stage,
-                reused: true,
-            });
+            if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
+                progress(Progress::Note(format!(
+                    "box: given, measured earlier or elsewhere ({} and {})",
+                    scene.display(),
+                    spots.display()
+                )));
+            } else {
+                progress(Progress::Stage {
+                    stage,
+                    reused: true,
+                });
+            }
             outcomes.push(StageOutcome {
                 stage,
                 reused: true,
@@ -335,5 +353,69 @@ fn run_stage(
             )?;
             Ok(written)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::display::ModelKind;
+
+    fn given(dir: &Path, scene: PathBuf, spots: PathBuf) -> ExperimentOptions {
+        ExperimentOptions {
+            dir: dir.to_path_buf(),
+            box_source: BoxSource::Existing { scene, spots },
+            simulation: SimulationOptions {
+                target_de: 0.5,
+                seed: 1,
+                max_seconds: 60.0,
+                image: None,
+            },
+            display: DisplayOptions {
+                screen: "virtual:ips-lcd".into(),
+                spot: "sim:cs100a?time_scale=0".into(),
+                model: ModelKind::MatrixLsq,
+            },
+            reproduction: ReproductionOptions {
+                gamut: "clip".into(),
+                mirror: true,
+            },
+            repeats: 1,
+            stage: None,
+            resume: false,
+            unattended: true,
+            run: RunOptions::default(),
+        }
+    }
+
+    /// A box given as files that are not there is named as the user's file, before any
+    /// stage runs (not as a file "an earlier stage writes").
+    #[test]
+    fn a_given_box_that_does_not_exist_is_named_before_any_stage() {
+        let dir = std::env::temp_dir().join(format!("metamer-stages-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = dir.join("scene.json");
+        std::fs::write(&scene, "{}").unwrap();
+        let missing = dir.join("nope.csv");
+        let e = run(
+            &given(&dir.join("exp"), scene.clone(), missing.clone()),
+            &|_| {},
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("spot readings") && e.contains("nope.csv") && e.contains("does not exist"),
+            "{e}"
+        );
+        let e = run(
+            &given(&dir.join("exp"), dir.join("gone.json"), missing),
+            &|_| {},
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("scene") && e.contains("gone.json"), "{e}");
+        assert!(!dir.join("exp").exists(), "nothing was started");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
