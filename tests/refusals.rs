@@ -1,5 +1,5 @@
 //! Options that cannot work are refused before the work: each command below is given one,
-//! and must say what is wrong (naming the option or the path) and exit within two seconds —
+//! and must say what is wrong (naming the option or the path) and exit within four seconds —
 //! long before the work it would otherwise have started (renders, characterizations and
 //! sessions take tens of seconds to minutes).
 
