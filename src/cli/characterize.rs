@@ -197,11 +197,11 @@ fn translate(e: CharacterizeError) -> CliError {
         CharacterizeError::Session(SessionError::InstrumentDiffers {
             path, logged, now, ..
         }) => Some(format!(
-            "{} was measured with a {logged}, this session has a {now}: resume with the instrument it was started with (--instrument), or choose another output directory",
+            "{} was measured with the instrument {logged}, this session has {now}: resume with the instrument it was started with (--instrument), or choose another output directory",
             path.display()
         )),
         CharacterizeError::Session(SessionError::InstrumentSettingDiffers(d)) => Some(format!(
-            "{} was measured with a {} whose {} was {}, this session's is {}: resume with the settings it was started with, or choose another output directory",
+            "{} was measured with the {} whose {} was {}, this session's is {}: resume with the settings it was started with, or choose another output directory",
             d.path.display(),
             d.model,
             setting_flag(&d.setting),
