@@ -151,7 +151,7 @@ fn a_journal_edited_to_hold_an_impossible_reading_is_refused_on_resume() {
             &["--speed", "slow"],
             "--speed was fast, this session's is slow",
         ),
-        ("sim:i1pro?time_scale=0", &[], "this session has a i1pro"),
+        ("sim:i1pro?time_scale=0", &[], "this session has i1pro"),
     ] {
         let o = characterize(&fresh, instrument, &[&["--resume"], extra].concat());
         assert_eq!(o.status.code(), Some(1), "{instrument}: {}", stderr(&o));
@@ -215,7 +215,7 @@ fn the_experiment_checks_a_given_box_and_its_instruments_before_any_work() {
             &scene,
             &huge_spots,
             None,
-            "huge.csv: patch 1: not a measurement: XYZ [-1e308",
+            "huge.csv, line 2: not a measurement: XYZ [-1e308",
         ),
         (
             &dark_scene,
