@@ -11,6 +11,7 @@
 //!    the domain of its stage-1 power law (so the start is exactly stage 1), whose knot
 //!    values are free but monotone by construction: the root-domain value at knot k is the
 //!    normalised cumulative sum of positive increments e^tⱼ.
+//!
 //! Stage 1 is stage 2 with all increments equal. Which of the two is returned is decided by
 //! cross-validation: on a display whose curves are power laws the knots would only follow
 //! the meter's noise, while on most LCDs they are what makes the fit.
