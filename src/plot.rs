@@ -72,34 +72,39 @@ fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
         .y_desc(chart.y_desc)
         .draw()
         .map_err(|e| err(&e))?;
-    let colours = [
-        BLACK,
-        RED,
-        BLUE,
-        GREEN,
-        MAGENTA,
-        CYAN,
-        RGBColor(230, 140, 0),
-    ];
     for (i, s) in chart.series.iter().enumerate() {
-        let colour = colours[i % colours.len()];
+        let look = SeriesLook::of(i);
+        let line = look.colour.stroke_width(2);
+        let fill = look.colour.filled();
         let pts: Vec<(f64, f64)> = s
             .points
             .iter()
             .copied()
             .filter(|p| p.0 > 0.0 && p.1 > 0.0)
             .collect();
-        c.draw_series(PointSeries::of_element(
-            pts.clone(),
-            3,
-            colour.filled(),
-            &|p, size, style| Circle::new(p, size, style),
-        ))
+        let outline = look.marker.outline();
+        c.draw_series(
+            pts.iter()
+                .map(|&p| EmptyElement::at(p) + Polygon::new(outline.clone(), fill)),
+        )
         .map_err(|e| err(&e))?;
-        c.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+        let drawn = if look.dashed {
+            c.draw_series(DashedLineSeries::new(pts, 8, 5, line))
+        } else {
+            c.draw_series(LineSeries::new(pts, line))
+        };
+        // The legend repeats the marker on the line, and shows a dash as a gap.
+        let gap = if look.dashed { 4 } else { 0 };
+        let legend_mark: Vec<(i32, i32)> = outline.iter().map(|&(x, y)| (x + 12, y)).collect();
+        drawn
             .map_err(|e| err(&e))?
             .label(s.name.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+            .legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (12 - gap, 0)], line)
+                    + PathElement::new(vec![(12 + gap, 0), (24, 0)], line)
+                    + Polygon::new(legend_mark.clone(), fill)
+            });
     }
     if let Some((t, label)) = chart.target {
         c.draw_series(LineSeries::new(
@@ -118,6 +123,75 @@ fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
         .map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+/// Ten colours that stay apart for the common colour-vision deficiencies (P. Tol's "muted"
+/// scheme, with black first), so a chart needs neither colour names nor good eyes.
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(0, 0, 0),
+    RGBColor(204, 102, 119),
+    RGBColor(51, 34, 136),
+    RGBColor(221, 204, 119),
+    RGBColor(17, 119, 51),
+    RGBColor(136, 204, 238),
+    RGBColor(136, 34, 85),
+    RGBColor(68, 170, 153),
+    RGBColor(153, 153, 51),
+    RGBColor(170, 68, 153),
+];
+
+/// Point markers, drawn as filled polygons in pixels around the point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Marker {
+    Circle,
+    Triangle,
+    Square,
+    Diamond,
+}
+
+impl Marker {
+    const ALL: [Marker; 4] = [
+        Marker::Circle,
+        Marker::Triangle,
+        Marker::Square,
+        Marker::Diamond,
+    ];
+
+    fn outline(self) -> Vec<(i32, i32)> {
+        match self {
+            Marker::Circle => (0..12)
+                .map(|k| {
+                    let a = f64::from(k) * std::f64::consts::PI / 6.0;
+                    (
+                        (4.0 * a.cos()).round() as i32,
+                        (4.0 * a.sin()).round() as i32,
+                    )
+                })
+                .collect(),
+            Marker::Triangle => vec![(0, -5), (5, 4), (-5, 4)],
+            Marker::Square => vec![(-4, -4), (4, -4), (4, 4), (-4, 4)],
+            Marker::Diamond => vec![(0, -5), (5, 0), (0, 5), (-5, 0)],
+        }
+    }
+}
+
+/// How series `i` is drawn: colour and marker cycle together (10 and 4, so 20 series get
+/// distinct pairs), and the next 20 are dashed, so no two of the first 40 look alike.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SeriesLook {
+    colour: RGBColor,
+    marker: Marker,
+    dashed: bool,
+}
+
+impl SeriesLook {
+    fn of(i: usize) -> SeriesLook {
+        SeriesLook {
+            colour: PALETTE[i % PALETTE.len()],
+            marker: Marker::ALL[i % Marker::ALL.len()],
+            dashed: (i / 20) % 2 == 1,
+        }
+    }
 }
 
 /// A tick label without spurious decimals: 10, 0.5, 0.02.
@@ -172,5 +246,20 @@ mod tests {
             ..chart
         };
         assert!(log_log_svg(&empty).is_err());
+    }
+
+    /// Forty series (the budget chart has more than the seven colours there once were)
+    /// must all be told apart, and the palette must have ten different colours.
+    #[test]
+    fn series_looks_are_all_different() {
+        let looks: Vec<SeriesLook> = (0..40).map(SeriesLook::of).collect();
+        for i in 0..looks.len() {
+            for j in 0..i {
+                assert_ne!(looks[i], looks[j], "series {i} and {j} look alike");
+            }
+        }
+        for (i, a) in PALETTE.iter().enumerate() {
+            assert!(PALETTE[..i].iter().all(|b| b != a), "colour {i} repeats");
+        }
     }
 }

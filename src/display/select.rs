@@ -6,6 +6,11 @@
 //! stay in every training set: the ramp and primary models cannot be fitted without them,
 //! and a profile is always fitted with them. Every other patch is held out exactly once.
 //! CIELAB is relative to the training set's white, as the fitted profile's would be.
+//!
+//! The held-out readings carry the meter's noise, so two models whose scores differ by
+//! less than that noise allows are not told apart by them: then the simpler model is
+//! chosen (the one-standard-error rule), since the one with more freedom is as likely to
+//! have followed the noise. The standard error is that of the paired per-patch differences.
 
 use super::fit::{check_samples, fit_params, FitOptions};
 use super::model::samples::{SortedSamples, SAME_DRIVE};
@@ -18,12 +23,17 @@ pub struct Candidate {
     pub model: ModelKind,
     /// Mean ΔE00 over every held-out patch.
     pub cv_mean_de00: Result<f64, String>,
+    /// Each held-out patch's ΔE00, in the order of the rotating patches (empty if not fitted).
+    pub held_out_de00: Vec<f64>,
 }
 
 /// The chosen model and every candidate's score, in [`ModelKind::ALL`] order.
 #[derive(Clone, Debug)]
 pub struct Selection {
     pub model: ModelKind,
+    /// The model with the lowest cross-validated mean, when a simpler one within one
+    /// standard error of it was chosen instead.
+    pub lowest: Option<ModelKind>,
     pub folds: usize,
     pub held_out: usize,
     pub candidates: Vec<Candidate>,
@@ -44,11 +54,19 @@ impl std::fmt::Display for Selection {
                 Err(why) => writeln!(f, "  {:<14} not fitted: {why}", c.model.name())?,
             }
         }
-        write!(
-            f,
-            "chose {}: the lowest cross-validated mean ΔE00",
-            self.model
-        )
+        match self.lowest {
+            Some(lowest) => write!(
+                f,
+                "chose {}: simpler than {lowest}, whose lower cross-validated mean ΔE00 is \
+                 within one standard error of the paired differences",
+                self.model
+            ),
+            None => write!(
+                f,
+                "chose {}: the lowest cross-validated mean ΔE00",
+                self.model
+            ),
+        }
     }
 }
 
@@ -81,9 +99,11 @@ pub fn select_model(
     let fold = |i: usize| fold_of(i) % folds;
     let mut candidates = Vec::new();
     for kind in ModelKind::ALL {
+        let scores = cross_validate(kind, patches, &rotating, folds, &fold, options);
         candidates.push(Candidate {
             model: kind,
-            cv_mean_de00: cross_validate(kind, patches, &rotating, folds, &fold, options),
+            cv_mean_de00: scores.as_ref().map(|s| s.0).map_err(Clone::clone),
+            held_out_de00: scores.map(|s| s.1).unwrap_or_default(),
         });
     }
     let best = candidates
@@ -105,12 +125,56 @@ pub fn select_model(
                     .join("; ")
             ),
         })?;
+    let chosen = simplest_within_one_se(&candidates, best.0);
     Ok(Selection {
-        model: best.0,
+        model: chosen,
+        lowest: (chosen != best.0).then_some(best.0),
         folds,
         held_out: rotating.len(),
         candidates,
     })
+}
+
+/// Fewest free parameters first: a power law, gain-offset-gamma (two, three per channel),
+/// the ramp-interpolating TRCs with the primaries' or a fitted matrix, the knotted shapers,
+/// and the LUT with thousands of nodes.
+fn complexity(kind: ModelKind) -> usize {
+    match kind {
+        ModelKind::PlccGamma => 0,
+        ModelKind::Gog => 1,
+        ModelKind::Gogo => 2,
+        ModelKind::Plcc => 3,
+        ModelKind::MatrixLsq => 4,
+        ModelKind::ShaperMatrix => 5,
+        ModelKind::Lut => 6,
+    }
+}
+
+/// The simplest candidate whose held-out errors exceed the best's by less than one
+/// standard error of their paired differences; `best` if none is simpler.
+fn simplest_within_one_se(candidates: &[Candidate], best: ModelKind) -> ModelKind {
+    let Some(top) = candidates.iter().find(|c| c.model == best) else {
+        return best;
+    };
+    let n = top.held_out_de00.len();
+    let mut pick = best;
+    for c in candidates {
+        if complexity(c.model) >= complexity(pick) || c.held_out_de00.len() != n || n < 2 {
+            continue;
+        }
+        let d: Vec<f64> = c
+            .held_out_de00
+            .iter()
+            .zip(&top.held_out_de00)
+            .map(|(a, b)| a - b)
+            .collect();
+        let mean = d.iter().sum::<f64>() / n as f64;
+        let var = d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        if mean <= (var / n as f64).sqrt() {
+            pick = c.model;
+        }
+    }
+    pick
 }
 
 fn cross_validate(
@@ -120,7 +184,8 @@ fn cross_validate(
     folds: usize,
     fold: &dyn Fn(usize) -> usize,
     options: &FitOptions,
-) -> Result<f64, String> {
+) -> Result<(f64, Vec<f64>), String> {
+    let mut per_patch = vec![f64::NAN; patches.len()];
     let mut held_out = vec![false; patches.len()];
     let mut sum = 0.0;
     let mut count = 0usize;
@@ -139,18 +204,52 @@ fn cross_validate(
         let params = fit_params(kind, &set, &train, options).map_err(|e| e.to_string())?;
         let model = params.model();
         let white = Xyz::from_array(set.white.unwrap_or_else(|| model.forward([1.0; 3])));
-        for (p, _) in patches.iter().zip(&held_out).filter(|(_, h)| **h) {
-            sum += delta_e2000(
+        for (i, p) in patches.iter().enumerate().filter(|(i, _)| held_out[*i]) {
+            let e = delta_e2000(
                 Xyz::from_array(model.forward(p.rgb)).to_lab(white),
                 Xyz::from_array(p.xyz).to_lab(white),
             );
+            per_patch[i] = e;
+            sum += e;
             count += 1;
         }
     }
     let mean = sum / count.max(1) as f64;
     if mean.is_finite() {
-        Ok(mean)
+        Ok((mean, rotating.iter().map(|&i| per_patch[i]).collect()))
     } else {
         Err("its predictions are not finite".into())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn candidate(model: ModelKind, de: &[f64]) -> Candidate {
+        Candidate {
+            model,
+            cv_mean_de00: Ok(de.iter().sum::<f64>() / de.len() as f64),
+            held_out_de00: de.to_vec(),
+        }
+    }
+
+    /// By hand: shaper-matrix minus lut per patch is 0.01, −0.01, 0.02: mean 0.00667,
+    /// sample variance 0.000233, standard error √(0.000233/3) = 0.0088 > 0.00667, so the
+    /// simpler shaper-matrix is chosen. With differences of 0.4 each (no scatter) the lut
+    /// is kept.
+    #[test]
+    fn the_simpler_model_wins_only_within_one_standard_error() {
+        let lut = candidate(ModelKind::Lut, &[0.1, 0.2, 0.3]);
+        let close = candidate(ModelKind::ShaperMatrix, &[0.11, 0.19, 0.32]);
+        assert_eq!(
+            simplest_within_one_se(&[lut.clone(), close], ModelKind::Lut),
+            ModelKind::ShaperMatrix
+        );
+        let far = candidate(ModelKind::ShaperMatrix, &[0.5, 0.6, 0.7]);
+        assert_eq!(
+            simplest_within_one_se(&[lut, far], ModelKind::Lut),
+            ModelKind::Lut
+        );
     }
 }

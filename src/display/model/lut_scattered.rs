@@ -18,7 +18,7 @@
 //! what the grid LUT of [`super::fit_lut`] stores.
 
 use super::error::FitError;
-use super::samples::{Sample, SortedSamples};
+use super::samples::{fold_of, Sample, SortedSamples};
 use super::shaper_matrix::{default_knots, fit_shaper_matrix};
 use super::{DisplayModel, Lut3d, ModelKind};
 use crate::color::{delta_e2000, Xyz};
@@ -148,15 +148,6 @@ pub fn fit_lut_scattered(
         .collect();
     let lut = Lut3d::from_parts(levels, base.trc, nodes).map_err(failed)?;
     Ok(ScatteredLut { lut, lambda, cv })
-}
-
-/// A seeded scramble of patch indices, so folds do not follow the file's order (files
-/// list ramps and greys in blocks).
-pub fn fold_of(i: usize) -> usize {
-    let mut x = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    (x ^ (x >> 31)) as usize
 }
 
 /// One patch in the normal equations.

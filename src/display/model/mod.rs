@@ -24,11 +24,11 @@ pub use gog::{fit_gog, fit_gog_curve, gog_curve, gog_problem, GogProblem};
 pub use kind::ModelKind;
 pub use least_squares::levenberg_marquardt;
 pub use lut::{fit_lut, has_full_grid, Lut3d};
-pub use lut_scattered::{default_grid, fit_lut_scattered, fold_of, ScatteredLut, LAMBDAS};
+pub use lut_scattered::{default_grid, fit_lut_scattered, ScatteredLut, LAMBDAS};
 pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma};
-pub use samples::Sample;
+pub use samples::{fold_of, Sample};
 pub use shaper_matrix::{default_knots, fit_shaper_matrix};
 pub use trc::{fit_power_gamma, FastInverse, Trc};
 

@@ -101,6 +101,15 @@ impl SortedSamples {
 
 pub const CHANNEL_NAMES: [&str; 3] = ["red", "green", "blue"];
 
+/// A seeded scramble of patch indices, so folds do not follow the file's order (files
+/// list ramps and greys in blocks).
+pub fn fold_of(i: usize) -> usize {
+    let mut x = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (x ^ (x >> 31)) as usize
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
