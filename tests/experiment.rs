@@ -77,6 +77,18 @@ fn stages_run_once_and_rerun_only_downstream_of_a_change() {
     let spots = box_spots(&dir);
     let out = dir.join("exp");
     let first = run(&out, &spots, &[]);
+    // The box was measured elsewhere: said so, with its readings' file, not "re-used".
+    let said = String::from_utf8_lossy(&first.stdout);
+    let box_line = said.lines().find(|l| l.starts_with("box ")).unwrap_or("");
+    assert!(
+        box_line.contains("given") && box_line.contains("box-spots.csv"),
+        "{said}"
+    );
+    let told = String::from_utf8_lossy(&first.stderr);
+    assert!(
+        told.contains("box: given, measured earlier or elsewhere"),
+        "{told}"
+    );
     for s in [
         "simulation",
         "display",

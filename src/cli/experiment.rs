@@ -177,7 +177,11 @@ pub fn run_cli(args: Args) -> CliResult {
     let shown = StageProgress::default();
     let outcomes = run(&opts, &|p| shown.show(p));
     shown.finish();
-    print_outcomes(&outcomes?);
+    let given = match &opts.box_source {
+        BoxSource::Existing { spots, .. } => Some(spots.as_path()),
+        BoxSource::Measure(_) => None,
+    };
+    print_outcomes(&outcomes?, given);
     print_comparisons(&args.out);
     Ok(())
 }
@@ -241,15 +245,20 @@ impl StageProgress {
     }
 }
 
-/// One line per stage: ran or re-used, how long, where.
-pub(super) fn print_outcomes(outcomes: &[StageOutcome]) {
+/// One line per stage: ran, re-used or (a box measured earlier or elsewhere) given, how
+/// long, where.
+pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>) {
     for o in outcomes {
+        let (how, dir) = match given_box {
+            Some(spots) if o.stage == Stage::Box => ("given", spots),
+            _ => (if o.reused { "re-used" } else { "ran" }, o.dir.as_path()),
+        };
         println!(
             "{:<14} {:<8} {:>8.1} s  {}",
             o.stage.name(),
-            if o.reused { "re-used" } else { "ran" },
+            how,
             o.seconds,
-            o.dir.display()
+            dir.display()
         );
     }
 }

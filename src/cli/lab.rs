@@ -114,7 +114,7 @@ pub fn run(args: Args) -> CliResult {
     });
     shown.finish();
     let (outcomes, summary) = summary?;
-    print_outcomes(&outcomes);
+    print_outcomes(&outcomes, None);
     print_summary(&summary);
     println!(
         "report: {}; summary: {}",
