@@ -137,10 +137,7 @@ pub fn read_readings(path: &Path) -> Result<Vec<PatchStat>, ReadingsError> {
         // and a chart without end downstream: refused here, where it enters.
         metamer_color::check_xyz(xyz).map_err(|e| bad(i + 1, format!("not a measurement: {e}")))?;
         let sd = [num(4)?, num(5)?, num(6)?];
-        if !sd
-            .iter()
-            .all(|v| (0.0..=metamer_color::MAX_CD_M2).contains(v))
-        {
+        if !metamer_color::plausible_spread(sd) {
             return Err(bad(
                 i + 1,
                 format!(

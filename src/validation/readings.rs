@@ -273,10 +273,7 @@ impl Parsed {
             .map_err(|e| self.bad(r.line, format!("not a measurement: {e}")))?;
         for (what, spread) in [("standard deviation", r.sd), ("standard error", r.stderr)] {
             if let Some(v) = spread {
-                if !v
-                    .iter()
-                    .all(|s| (0.0..=metamer_color::MAX_CD_M2).contains(s))
-                {
+                if !metamer_color::plausible_spread(v) {
                     return Err(self.bad(
                         r.line,
                         format!(

@@ -20,7 +20,7 @@ pub use coords::{Lab, Lch, XyY, Xyz, D65_XY};
 pub use delta_e::{delta_e2000, delta_e76};
 pub use describe::{describe, Description};
 pub use error::ColorError;
-pub use plausible::{check_xyz, check_yxy, Implausible, MAX_CD_M2};
+pub use plausible::{check_xyz, check_yxy, plausible_spread, Implausible, MAX_CD_M2};
 pub use spectrum::{Outside, Quantity, Spectrum};
 pub use table::SpectralTable;
 pub use tables::{

@@ -43,6 +43,12 @@ pub fn check_xyz(xyz: [f64; 3]) -> Result<(), Implausible> {
     Ok(())
 }
 
+/// Whether a per-component spread (a standard deviation or standard error of XYZ) can
+/// belong to readings: finite, not negative and no larger than the brightest reading.
+pub fn plausible_spread(spread: [f64; 3]) -> bool {
+    spread.iter().all(|s| (0.0..=MAX_CD_M2).contains(s))
+}
+
 /// Checks a luminance and chromaticity as a meter reports them (Y in cd/m², x, y).
 pub fn check_yxy(luminance: f64, x: f64, y: f64) -> Result<(), Implausible> {
     let xyz = [luminance, x, y];
@@ -69,6 +75,14 @@ mod tests {
         check_xyz([95.047, 100.0, 108.883]).unwrap();
         check_xyz([0.004, -0.003, 0.002]).unwrap();
         check_yxy(100.0, 0.3127, 0.3290).unwrap();
+    }
+
+    #[test]
+    fn spreads_are_finite_non_negative_and_bounded() {
+        assert!(plausible_spread([0.0, 0.2, 1e10]));
+        assert!(!plausible_spread([0.0, -0.1, 0.0]));
+        assert!(!plausible_spread([f64::NAN, 0.0, 0.0]));
+        assert!(!plausible_spread([1e308, 0.0, 0.0]));
     }
 
     #[test]
