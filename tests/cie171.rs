@@ -97,7 +97,9 @@ fn area_source_over_a_plane() {
         .iter()
         .map(|&[x, z]| probe([x, 0.0, z], [0.0, 1.0, 0.0]))
         .collect();
-    let got = probe_illuminance(&scene, &probes, &RadiosityOptions::default(), 1e-3).unwrap();
+    let got = probe_illuminance(&scene, &probes, &RadiosityOptions::default(), 1e-3, &|_| {})
+        .unwrap()
+        .probes;
     for ([x, z], e) in points.iter().zip(&got) {
         let want = PI * L * parallel(-0.5 - x, 0.5 - x, -0.5 - z, 0.5 - z, 2.0);
         assert!(
@@ -132,7 +134,9 @@ fn area_source_in_a_black_room() {
             .iter()
             .map(|&[y, z]| probe([0.0, y, z], [1.0, 0.0, 0.0])),
     );
-    let got = probe_illuminance(&scene, &probes, &RadiosityOptions::default(), 1e-3).unwrap();
+    let got = probe_illuminance(&scene, &probes, &RadiosityOptions::default(), 1e-3, &|_| {})
+        .unwrap()
+        .probes;
     let ph = h - 0.001;
     for (i, [x, z]) in floor_pts.iter().enumerate() {
         let want = PI * L * parallel(cx - 0.5 - x, cx + 0.5 - x, cz - 0.5 - z, cz + 0.5 - z, ph);
@@ -173,7 +177,9 @@ fn uniformly_lit_floor_to_wall_and_ceiling() {
         wall.iter()
             .map(|&[y, z]| probe([0.0, y, z], [1.0, 0.0, 0.0])),
     );
-    let got = probe_illuminance(&scene, &probes, &RadiosityOptions::default(), 1e-3).unwrap();
+    let got = probe_illuminance(&scene, &probes, &RadiosityOptions::default(), 1e-3, &|_| {})
+        .unwrap()
+        .probes;
     for (i, [x, z]) in ceiling.iter().enumerate() {
         let want = PI * L * parallel(-x, w - x, -z, d - z, h);
         assert!(

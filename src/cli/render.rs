@@ -11,9 +11,9 @@ use metamer::render::convergence;
 use metamer::render::geometry::{Vec3, VecOps};
 use metamer::render::image::{render_image, ImageOptions};
 use metamer::render::image_io::{write_srgb_preview, write_xyz_image};
-use metamer::render::probes::probe_illuminance_path;
+use metamer::render::probes::{illuminance as probe_illuminance_any, ProbeMethod, ProbeOptions};
 use metamer::render::radiosity::image::{render_image_radiosity, RadiosityImageOptions};
-use metamer::render::radiosity::probes::{probe_illuminance, Illuminance, Probe};
+use metamer::render::radiosity::probes::{Illuminance, Probe, ProbeProgress};
 use metamer::render::radiosity::{self, render_spots_radiosity, RadiosityOptions};
 use metamer::render::{reference_white, render_spots_with_progress, Scene, SpotOptions, Strategy};
 
@@ -103,6 +103,9 @@ enum Cmd {
         samples: u64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Wall-clock limit (s): what finished by then is reported, marked not converged.
+        #[arg(long, default_value_t = 600.0)]
+        max_seconds: f64,
         #[arg(long)]
         json: bool,
     },
@@ -330,8 +333,22 @@ pub fn run(args: Args) -> CliResult {
             rel_tolerance,
             samples,
             seed,
+            max_seconds,
             json,
-        } => probes(&scene, &points, method, rel_tolerance, samples, seed, json),
+        } => {
+            let opts = ProbeOptions {
+                method: match method {
+                    Method::Auto => ProbeMethod::Auto,
+                    Method::Radiosity => ProbeMethod::Radiosity,
+                    Method::Path => ProbeMethod::Path,
+                },
+                rel_tolerance,
+                samples,
+                seed,
+                max_seconds,
+            };
+            probes(&scene, &points, opts, json)
+        }
         Cmd::Convergence {
             scene,
             output,
@@ -467,21 +484,7 @@ fn spots_radiosity(
     Ok(())
 }
 
-fn probes(
-    scene: &std::path::Path,
-    points: &std::path::Path,
-    method: Method,
-    rel_tolerance: f64,
-    samples: u64,
-    seed: u64,
-    json: bool,
-) -> CliResult {
-    if rel_tolerance.is_nan() || rel_tolerance <= 0.0 {
-        return Err(CliError::Usage("--rel-tolerance must be > 0".into()));
-    }
-    if samples < 2 {
-        return Err(CliError::Usage("--samples must be ≥ 2".into()));
-    }
+fn probes(scene: &std::path::Path, points: &std::path::Path, opts: ProbeOptions, json: bool) -> CliResult {
     let scene = load(Some(scene))?;
     let csv = NumericCsv::read(points, &["x", "y", "z", "nx", "ny", "nz"])?;
     let mut probes = Vec::with_capacity(csv.rows.len());
@@ -497,27 +500,40 @@ fn probes(
             normal: normal.normalized(),
         });
     }
-    let use_radiosity = uses_radiosity(method, &scene)?;
-    let t = std::time::Instant::now();
-    let out = if use_radiosity {
-        probe_illuminance(&scene, &probes, &RadiosityOptions::default(), rel_tolerance)?
-    } else {
-        probe_illuminance_path(&scene, &probes, samples, seed)
-    };
-    let method = if use_radiosity { "radiosity" } else { "path" };
-    if let Some((i, _)) = out.iter().enumerate().find(|(_, e)| {
-        ![e.direct_lux, e.indirect_lux, e.total_lux, e.bound_lux]
+    // Progress on stderr (hidden when it is not a terminal).
+    let bar = indicatif::ProgressBar::new(probes.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} points, {elapsed}")
+            .map_err(|e| CliError::Failed(e.to_string().into()))?,
+    );
+    let r = probe_illuminance_any(&scene, &probes, &opts, &|p| match p {
+        ProbeProgress::Solved { level, elements } => {
+            bar.set_message(format!("level {level} ({elements} elements)"));
+            bar.set_position(0);
+        }
+        ProbeProgress::Evaluated { done, .. } => bar.set_position(done as u64),
+        ProbeProgress::Estimated { .. } => {}
+    })
+    .map_err(|e| CliError::Failed(format!("{}: {e}", points.display()).into()))?;
+    bar.finish_and_clear();
+    if let Some(why) = &r.method_reason {
+        eprintln!("using the path tracer: {why}");
+    }
+    if !r.converged {
+        let worst = r
+            .probes
             .iter()
-            .all(|x| x.is_finite())
-    }) {
-        return Err(CliError::Failed(
-            format!(
-                "{}: probe {} has no finite illuminance",
-                points.display(),
-                i + 1
-            )
-            .into(),
-        ));
+            .map(|e| e.bound_lux / e.total_lux.abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "warning: not converged: {}; the largest bound is {worst:.3e} of its total{}",
+            r.stopped.as_deref().unwrap_or("stopped early"),
+            if r.method == "radiosity" {
+                format!(" (tolerance {:e})", opts.rel_tolerance)
+            } else {
+                String::new()
+            }
+        );
     }
     if json {
         #[derive(serde::Serialize)]
@@ -529,22 +545,21 @@ fn probes(
         }
         let rows: Vec<Row> = probes
             .iter()
-            .zip(&out)
+            .zip(&r.probes)
             .map(|(p, lux)| Row {
                 point: p.position.to_array(),
                 normal: p.normal.to_array(),
                 lux,
             })
             .collect();
-        println!(
-            "{}",
-            serde_json::json!({"method": method, "seconds": t.elapsed().as_secs_f64(), "probes": rows})
-        );
+        let mut v = serde_json::to_value(&r)?;
+        v["probes"] = serde_json::to_value(rows)?;
+        println!("{v}");
         return Ok(());
     }
-    eprintln!("{method}: {:.2} s", t.elapsed().as_secs_f64());
+    eprintln!("{}: {:.2} s", r.method, r.seconds);
     println!("x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux,bound_lux");
-    for (p, e) in probes.iter().zip(&out) {
+    for (p, e) in probes.iter().zip(&r.probes) {
         let [x, y, z] = p.position.to_array();
         let [a, b, c] = p.normal.to_array();
         println!(

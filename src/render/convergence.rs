@@ -186,11 +186,11 @@ pub fn radiosity_points(
         done.push(l);
     }
     let n = done.len();
-    let (finest, fw) = combine(&done[n - 3..], &opts);
+    let (finest, fw) = combine(&done, &opts);
     let lab = |x: [f64; 3], w: [f64; 3]| Xyz::from_array(x).to_lab(Xyz::from_array(w));
     let mut points = Vec::new();
     for m in 3..n {
-        let (r, w) = combine(&done[m - 3..m], &opts);
+        let (r, w) = combine(&done[..m], &opts);
         let errors: Vec<f64> = r
             .iter()
             .zip(&finest)

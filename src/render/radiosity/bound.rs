@@ -1,10 +1,20 @@
-//! The error bound: readings on three successive refinements, Richardson extrapolation
-//! from each consecutive pair, and their disagreement as ΔE*ab.
+//! The error bound: readings on successive refinements, Richardson extrapolation, and the
+//! distance to an alternative extrapolation as the bound.
 //!
 //! With element size h ∝ 1/level, a reading behaves like R(h) = R∞ + C·hᵖ once the mesh
-//! resolves the light. Extrapolating the pairs (m−2, m−1) and (m−1, m) gives two estimates
-//! of R∞; if the model holds they agree to a higher order, and their difference is a
-//! bound for the error left in the finer one.
+//! resolves the light, p = 2 for a smooth field. Near the room's concave edges the radiosity
+//! has a logarithmic slope, and the readings then converge like h²·ln h: more slowly than
+//! h², so that extrapolating with p = 2 stops short of R∞, and the two extrapolations of
+//! consecutive pairs (the classical bound) agree with each other better than with R∞. So
+//! the order is measured from the last three levels: where they converge more slowly than
+//! assumed, the estimate is extrapolated with the observed order and the bound is its
+//! distance from the assumed order's extrapolation (the truth lies between them, or close
+//! beyond the observed one's side, as long as the effective order keeps rising towards p);
+//! where they converge as fast or faster, the classical bound stands. With a fourth level
+//! the previous estimate is a further alternative: the bound is at least the step between
+//! them. Levels that do not converge monotonically are not yet in the asymptotic range
+//! (a point closer to an edge than the elements are small): the estimate is then marked
+//! irregular, and its bound is only a rough figure.
 
 use crate::color::{delta_e76, Xyz};
 
@@ -26,37 +36,168 @@ pub fn richardson3(
     std::array::from_fn(|k| richardson(coarse[k], h_coarse, fine[k], h_fine, p))
 }
 
-/// One patch's estimate from three levels (coarsest first) of the patch and the white.
+/// The lowest order an extrapolation is trusted with: below it, (h₁/h₂)^q − 1 is so small
+/// that the extrapolation amplifies every error in the readings.
+pub const MIN_ORDER: f64 = 0.5;
+
+/// The order q at which R∞ + C·h^q passes through the three readings (coarsest first), or
+/// None when they do not converge monotonically.
+pub fn observed_order(v: [f64; 3], h: [f64; 3]) -> Option<f64> {
+    let (d1, d2) = (v[1] - v[0], v[2] - v[1]);
+    if !(d1 * d2 > 0.0) {
+        return None;
+    }
+    let ratio = d1 / d2;
+    // (h₀^q − h₁^q)/(h₁^q − h₂^q) grows with q; bisect in [1/64, 16].
+    let f = |q: f64| (h[0].powf(q) - h[1].powf(q)) / (h[1].powf(q) - h[2].powf(q));
+    let (mut lo, mut hi) = (1.0 / 64.0, 16.0);
+    if ratio <= f(lo) {
+        return Some(lo);
+    }
+    if ratio >= f(hi) {
+        return Some(hi);
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < ratio {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// One quantity's estimate from its last levels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    pub value: f64,
+    /// The alternative extrapolation whose distance is the bound.
+    pub alt: f64,
+    /// The previous levels' estimate, when there were four levels.
+    pub previous: Option<f64>,
+    /// The last three levels converge monotonically at an order of at least [`MIN_ORDER`].
+    pub regular: bool,
+}
+
+impl Estimate {
+    /// The bound of a scalar: the larger distance to an alternative.
+    pub fn bound(&self) -> f64 {
+        let b = (self.value - self.alt).abs();
+        self.previous.map_or(b, |p| b.max((self.value - p).abs()))
+    }
+}
+
+/// The estimate from the last three of `v` (coarsest first, element sizes `h`), order `p`
+/// assumed; with four or more, the estimate of the three before it too.
+pub fn estimate(v: &[f64], h: &[f64], p: f64) -> Estimate {
+    let n = v.len();
+    debug_assert!(n >= 3 && h.len() == n);
+    let last = |k: usize| -> Estimate {
+        let (v3, h3) = ([v[k - 3], v[k - 2], v[k - 1]], [h[k - 3], h[k - 2], h[k - 1]]);
+        let fine = richardson(v3[1], h3[1], v3[2], h3[2], p);
+        let coarse = richardson(v3[0], h3[0], v3[1], h3[1], p);
+        // Readings equal to rounding need no order.
+        let settled = (v3[2] - v3[1]).abs().max((v3[1] - v3[0]).abs())
+            <= 1e-12 * v3[2].abs().max(f64::MIN_POSITIVE);
+        match observed_order(v3, h3) {
+            Some(q) if q < p => {
+                let q_used = q.max(MIN_ORDER);
+                Estimate {
+                    value: richardson(v3[1], h3[1], v3[2], h3[2], q_used),
+                    alt: fine,
+                    previous: None,
+                    regular: q >= MIN_ORDER,
+                }
+            }
+            Some(_) => Estimate {
+                value: fine,
+                alt: coarse,
+                previous: None,
+                regular: true,
+            },
+            None => Estimate {
+                value: fine,
+                alt: coarse,
+                previous: None,
+                regular: settled,
+            },
+        }
+    };
+    let mut e = last(n);
+    if n >= 4 {
+        e.previous = Some(last(n - 1).value);
+    }
+    e
+}
+
+/// A scalar's estimate and bound from its levels (see [`estimate`]); `abs_err` is an
+/// absolute error each level's reading may carry besides the discretization (the stopped
+/// iteration), which the extrapolation can amplify.
+pub fn extrapolated_with_bound(v: &[f64], h: &[f64], p: f64, abs_err: f64) -> (f64, f64, bool) {
+    let e = estimate(v, h, p);
+    // The extrapolation's weights sum in magnitude to (a + b)/(a − b) ≤ 1 + 2/((h₁/h₂)ᵖ − 1).
+    let n = h.len();
+    let r = (h[n - 2] / h[n - 1]).powf(MIN_ORDER.min(p));
+    let gain = 1.0 + 2.0 / (r - 1.0);
+    (e.value, e.bound() + gain * abs_err, e.regular)
+}
+
+/// One patch's estimate from its levels (coarsest first) of the patch and the white.
 #[derive(Clone, Copy, Debug)]
 pub struct Extrapolated {
     pub xyz: [f64; 3],
     pub white: [f64; 3],
-    /// ΔE*ab between the two extrapolations, each against its own white.
+    /// ΔE*ab between the estimate and its furthest alternative, each against its own white.
     pub de_bound: f64,
+    /// Every component converged regularly (see [`estimate`]).
+    pub regular: bool,
 }
 
-/// Extrapolates levels `h[0] > h[1] > h[2]`; with `fixed_white` the white is not refined.
+/// Extrapolates the patch and the white over levels of sizes `h` (decreasing, at least
+/// three); with `fixed_white` the white is not refined.
 pub fn extrapolate(
-    patch: [[f64; 3]; 3],
-    white: [[f64; 3]; 3],
-    h: [f64; 3],
+    patch: &[[f64; 3]],
+    white: &[[f64; 3]],
+    h: &[f64],
     p: f64,
     fixed_white: Option<[f64; 3]>,
 ) -> Extrapolated {
-    let fine = richardson3(patch[1], h[1], patch[2], h[2], p);
-    let coarse = richardson3(patch[0], h[0], patch[1], h[1], p);
-    let (wf, wc) = match fixed_white {
-        Some(w) => (w, w),
-        None => (
-            richardson3(white[1], h[1], white[2], h[2], p),
-            richardson3(white[0], h[0], white[1], h[1], p),
-        ),
+    let comps = |levels: &[[f64; 3]]| -> [Estimate; 3] {
+        std::array::from_fn(|k| {
+            let v: Vec<f64> = levels.iter().map(|x| x[k]).collect();
+            estimate(&v, h, p)
+        })
+    };
+    let pe = comps(patch);
+    let we = match fixed_white {
+        Some(w) => w.map(|x| Estimate {
+            value: x,
+            alt: x,
+            previous: Some(x),
+            regular: true,
+        }),
+        None => comps(white),
+    };
+    let pick = |e: &[Estimate; 3], f: &dyn Fn(&Estimate) -> f64| -> [f64; 3] {
+        std::array::from_fn(|k| f(&e[k]))
     };
     let lab = |x: [f64; 3], w: [f64; 3]| Xyz::from_array(x).to_lab(Xyz::from_array(w));
+    let value = lab(pick(&pe, &|e| e.value), pick(&we, &|e| e.value));
+    let alt = lab(pick(&pe, &|e| e.alt), pick(&we, &|e| e.alt));
+    let mut de_bound = delta_e76(value, alt);
+    if pe.iter().chain(&we).all(|e| e.previous.is_some()) {
+        let prev = lab(
+            pick(&pe, &|e| e.previous.unwrap_or(e.value)),
+            pick(&we, &|e| e.previous.unwrap_or(e.value)),
+        );
+        de_bound = de_bound.max(delta_e76(value, prev));
+    }
     Extrapolated {
-        xyz: fine,
-        white: wf,
-        de_bound: delta_e76(lab(fine, wf), lab(coarse, wc)),
+        xyz: pick(&pe, &|e| e.value),
+        white: pick(&we, &|e| e.value),
+        de_bound,
+        regular: pe.iter().chain(&we).all(|e| e.regular),
     }
 }
 
@@ -72,6 +213,18 @@ mod tests {
         assert!((r - 3.0).abs() < 1e-14, "{r}");
     }
 
+    /// The order of R∞ + C·h^q is found for q on either side of the assumed 2.
+    #[test]
+    fn observed_order_is_the_model_order() {
+        let h = [1.0, 0.5, 1.0 / 3.0];
+        for q in [0.7, 1.0, 1.5, 2.0, 3.0] {
+            let v = h.map(|x: f64| 5.0 - 2.0 * x.powf(q));
+            let got = observed_order(v, h).unwrap();
+            assert!((got - q).abs() < 1e-9, "{q}: {got}");
+        }
+        assert_eq!(observed_order([1.0, 2.0, 1.5], h), None);
+    }
+
     /// With R = R∞ + C·h² + D·h³ the two extrapolations differ by O(h³), and the finer
     /// one is closer to R∞ than that difference: the bound holds.
     #[test]
@@ -79,10 +232,49 @@ mod tests {
         let f = |h: f64| [10.0 + 2.0 * h * h + 3.0 * h.powi(3), 10.0, 10.0];
         let h = [1.0, 0.5, 1.0 / 3.0];
         let w = [[100.0; 3]; 3];
-        let e = extrapolate([f(h[0]), f(h[1]), f(h[2])], w, h, 2.0, None);
+        let e = extrapolate(&[f(h[0]), f(h[1]), f(h[2])], &w, &h, 2.0, None);
         let truth = Xyz::from_array([10.0, 10.0, 10.0]).to_lab(Xyz::from_array([100.0; 3]));
         let got = Xyz::from_array(e.xyz).to_lab(Xyz::from_array(e.white));
         let err = delta_e76(truth, got);
         assert!(err < e.de_bound, "error {err} vs bound {}", e.de_bound);
+        assert!(e.regular);
+    }
+
+    /// Readings converging like h²·ln h — what a room's concave edges give — on levels 1
+    /// to 14: the assumed-order extrapolation's classical bound fails from level 4 on, the
+    /// observed-order estimate's bound holds at every level.
+    #[test]
+    fn bound_holds_for_a_logarithmic_term() {
+        let r = |h: f64| 1.0 + 0.3 * h * h * (1.0 - 2.0 * h.ln()) - 0.1 * h.powi(3);
+        let levels: Vec<f64> = (1..=14).map(|k| 0.5 / k as f64).collect();
+        let v: Vec<f64> = levels.iter().map(|&h| r(h)).collect();
+        for m in 3..=levels.len() {
+            let (vs, hs) = (&v[..m], &levels[..m]);
+            let classical = (richardson(vs[m - 2], hs[m - 2], vs[m - 1], hs[m - 1], 2.0)
+                - richardson(vs[m - 3], hs[m - 3], vs[m - 2], hs[m - 2], 2.0))
+            .abs();
+            let classical_err =
+                (richardson(vs[m - 2], hs[m - 2], vs[m - 1], hs[m - 1], 2.0) - 1.0).abs();
+            if m >= 4 {
+                assert!(classical_err > classical, "level {m}: the classical bound held");
+            }
+            let (value, bound, regular) = extrapolated_with_bound(vs, hs, 2.0, 0.0);
+            assert!(regular);
+            assert!(
+                (value - 1.0).abs() <= bound,
+                "level {m}: error {} vs bound {bound}",
+                (value - 1.0).abs()
+            );
+        }
+    }
+
+    /// Readings that turn back are irregular.
+    #[test]
+    fn a_turning_sequence_is_irregular() {
+        let h = [1.0, 0.5, 1.0 / 3.0];
+        let e = estimate(&[1.0, 1.2, 1.1], &h, 2.0);
+        assert!(!e.regular);
+        let e = estimate(&[1.0, 1.0, 1.0], &h, 2.0);
+        assert!(e.regular && e.bound() == 0.0);
     }
 }

@@ -8,6 +8,7 @@
 use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::scene::{Distribution, Emitter};
 
+use super::form::form_factor;
 use super::polygon::{gauss_legendre, point_to_rect};
 
 /// The tile (row, col) of an emitter as a rectangle.
@@ -222,4 +223,23 @@ mod tests {
         let ratio = at(0.0) / at(180.0);
         assert!((ratio - 0.9 / 0.7).abs() < 1e-5, "{ratio}");
     }
+}
+
+/// The mean of g/π over a receiving rectangle, exactly, for a Lambertian emitter: the
+/// element-to-tile form factors weighted by the tiles' gains. None for a directional
+/// emitter, or when a tile straddles the element's plane (a point rule with clipping does).
+pub fn mean_factor_over(e: &Emitter, weights: &[f64], el: &Rect) -> Option<f64> {
+    if e.distribution != Distribution::Lambertian {
+        return None;
+    }
+    let mut total = 0.0;
+    for row in 0..e.rows {
+        for col in 0..e.cols {
+            let gain = weights[row * e.cols + col];
+            if gain != 0.0 {
+                total += gain * form_factor(el, &tile_rect(e, row, col), true)?;
+            }
+        }
+    }
+    Some(total)
 }

@@ -283,6 +283,7 @@ pub fn render_image_from(
         if deadline.passed() {
             return Err(RadiosityError::TimeLimit {
                 seconds: ropts.max_seconds,
+                during: "while drawing the image".into(),
             });
         }
         grids.push(visible[fi].then(|| {

@@ -12,6 +12,7 @@
 
 pub mod bound;
 pub mod direct;
+pub mod form;
 pub mod gather;
 pub mod image;
 pub mod lights;
@@ -51,8 +52,11 @@ pub enum RadiosityError {
          the path tracer has no such limit"
     )]
     TooDetailed { what: String, max: usize },
-    #[error("no result within the time limit of {seconds} s (the solver needs three mesh levels)")]
-    TimeLimit { seconds: f64 },
+    #[error(
+        "no result within the time limit of {seconds} s: it ran out {during} (a result \
+         needs three mesh levels; give more time with --max-seconds)"
+    )]
+    TimeLimit { seconds: f64, during: String },
     #[error(
         "the light in the scene grows without bound after {sweeps} Gauss–Seidel sweeps: its \
          reflectances return more light than reaches them (a closed box needs an absorbing \
@@ -137,8 +141,10 @@ pub struct RadiosityReading {
     pub xyz: [f64; 3],
     #[serde(rename = "Lab")]
     pub lab: [f64; 3],
-    /// ΔE*ab between the extrapolations of the last two level pairs.
+    /// ΔE*ab between the estimate and its alternatives (see [`bound`]).
     pub de_bound: f64,
+    /// The last levels converged monotonically: false means the bound is a rough figure.
+    pub regular: bool,
 }
 
 /// All readings of a radiosity run.
@@ -220,6 +226,8 @@ pub struct Solved {
     pub bands: Bands,
     pub l: Vec<Vec<f64>>,
     pub sweeps: usize,
+    /// The largest relative error the stopped iteration leaves in ℓ (an estimate).
+    pub algebraic: f64,
 }
 
 /// Meshes and solves one level with the given reflectance per face (1 nm).
@@ -233,6 +241,7 @@ pub fn solve_level(
 ) -> Result<Solved, RadiosityError> {
     let time = || RadiosityError::TimeLimit {
         seconds: opts.max_seconds,
+        during: format!("on mesh level {level}"),
     };
     let mesh = match warm {
         Some(w) => Mesh {
@@ -264,18 +273,19 @@ pub fn solve_level(
         .collect();
     let src = sources(p.scene, &p.lights, &mesh, deadline).ok_or_else(time)?;
     let mut sweeps = 0;
+    let mut algebraic: f64 = 0.0;
     let l = src
         .iter()
         .enumerate()
         .map(|(c, s)| {
             let warm_c = warm.map(|w| w.l[c].as_slice());
-            let (l, sw) =
-                solve::solve(&mesh, &rho, s, nb, warm_c, deadline).map_err(|f| match f {
-                    SolveFailure::Time => time(),
-                    SolveFailure::Diverges { sweeps } => RadiosityError::Diverges { sweeps },
-                })?;
-            sweeps = sweeps.max(sw);
-            Ok(l)
+            let sol = solve::solve(&mesh, &rho, s, nb, warm_c, deadline).map_err(|f| match f {
+                SolveFailure::Time => time(),
+                SolveFailure::Diverges { sweeps } => RadiosityError::Diverges { sweeps },
+            })?;
+            sweeps = sweeps.max(sol.sweeps);
+            algebraic = algebraic.max(sol.rel_err);
+            Ok(sol.l)
         })
         .collect::<Result<_, RadiosityError>>()?;
     Ok(Solved {
@@ -283,6 +293,7 @@ pub fn solve_level(
         bands,
         l,
         sweeps,
+        algebraic,
     })
 }
 
@@ -312,6 +323,7 @@ fn run_level_solved(
         if deadline.passed() {
             return Err(RadiosityError::TimeLimit {
                 seconds: opts.max_seconds,
+                during: format!("on mesh level {level}"),
             });
         }
         let aim = patch_aim(scene, k)?;
@@ -458,7 +470,7 @@ pub fn render_spots_radiosity_solved(
         if levels.len() < 3 {
             continue;
         }
-        let (patches, white) = combine(&levels[levels.len() - 3..], opts);
+        let (patches, white) = combine(&levels, opts);
         if let Some(r) = patches
             .iter()
             .find(|r| !r.xyz.iter().chain(&r.lab).all(|x| x.is_finite()) || r.de_bound.is_nan())
@@ -486,24 +498,16 @@ pub fn render_spots_radiosity_solved(
     }
 }
 
-/// Readings and bounds from three consecutive levels.
-pub fn combine(three: &[Level], opts: &RadiosityOptions) -> (Vec<RadiosityReading>, [f64; 3]) {
-    let h = [three[0].h_m, three[1].h_m, three[2].h_m];
-    let whites = [three[0].white, three[1].white, three[2].white];
-    let mut white = three[2].white;
+/// Readings and bounds from the last levels (three, or four for the step check).
+pub fn combine(levels: &[Level], opts: &RadiosityOptions) -> (Vec<RadiosityReading>, [f64; 3]) {
+    let last = &levels[levels.len().saturating_sub(4)..];
+    let h: Vec<f64> = last.iter().map(|l| l.h_m).collect();
+    let whites: Vec<[f64; 3]> = last.iter().map(|l| l.white).collect();
+    let mut white = last[last.len() - 1].white;
     let patches = (0..24)
         .map(|k| {
-            let e = extrapolate(
-                [
-                    three[0].patches[k],
-                    three[1].patches[k],
-                    three[2].patches[k],
-                ],
-                whites,
-                h,
-                opts.order,
-                opts.white,
-            );
+            let patch: Vec<[f64; 3]> = last.iter().map(|l| l.patches[k]).collect();
+            let e = extrapolate(&patch, &whites, &h, opts.order, opts.white);
             white = e.white;
             let lab: Lab = Xyz::from_array(e.xyz).to_lab(Xyz::from_array(e.white));
             RadiosityReading {
@@ -511,6 +515,7 @@ pub fn combine(three: &[Level], opts: &RadiosityOptions) -> (Vec<RadiosityReadin
                 xyz: e.xyz,
                 lab: lab.to_array(),
                 de_bound: e.de_bound,
+                regular: e.regular,
             }
         })
         .collect();

@@ -3,7 +3,7 @@
 //! for checks of the whole field (flux balance).
 
 use super::super::geometry::Vec3;
-use super::bound::richardson;
+use super::bound::extrapolated_with_bound;
 use super::direct::irradiance_factor;
 use super::lights::Lights;
 use super::polygon::point_to_rect;
@@ -108,66 +108,230 @@ pub fn element_lux(scene: &Scene, solved: &Solved) -> Vec<(f64, f64, f64)> {
         .collect()
 }
 
+/// One refinement level of a probe run.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ProbeLevel {
+    pub level: usize,
+    /// Element size (m).
+    pub h_m: f64,
+    pub elements: usize,
+    pub seconds: f64,
+    /// The largest bound over the probes after this level, relative to its total (from
+    /// level 3 on).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_relative_bound: Option<f64>,
+}
+
+/// Illuminance at every probe, with the levels it came from and whether every bound met
+/// the tolerance.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ProbeRun {
+    pub probes: Vec<Illuminance>,
+    pub levels: Vec<ProbeLevel>,
+    /// Every probe's bound is within the tolerance of its total.
+    pub converged: bool,
+    /// Why refinement ended without convergence: the finest level, the element limit or the
+    /// time limit; the result is then the last level that finished.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
+}
+
+/// What a probe run reports while it works.
+#[derive(Clone, Copy, Debug)]
+pub enum ProbeProgress<'a> {
+    /// A level was meshed and solved; its probes are being evaluated.
+    Solved { level: usize, elements: usize },
+    /// Probes evaluated so far on the current level (or, path tracing, samples so far).
+    Evaluated { done: usize, of: usize },
+    /// The estimates after a level (from the third on), as they would be reported if the
+    /// refinement stopped there.
+    Estimated {
+        level: usize,
+        probes: &'a [Illuminance],
+    },
+}
+
+/// Probes are evaluated in chunks of this many, between which the deadline is checked.
+const CHUNK: usize = 4096;
+
+/// Indirect lux at every probe from one solved level, or None when the deadline passed.
+fn evaluate(
+    scene: &Scene,
+    lights: &Lights,
+    solved: &Solved,
+    probes: &[Probe],
+    deadline: Deadline,
+    progress: &(dyn Fn(ProbeProgress) + Sync),
+) -> Option<Vec<f64>> {
+    use rayon::prelude::*;
+    let mut out = Vec::with_capacity(probes.len());
+    for chunk in probes.chunks(CHUNK) {
+        if deadline.passed() {
+            return None;
+        }
+        out.par_extend(
+            chunk
+                .par_iter()
+                .map(|q| indirect_lux(scene, lights, solved, q.position, q.normal)),
+        );
+        progress(ProbeProgress::Evaluated {
+            done: out.len(),
+            of: probes.len(),
+        });
+    }
+    Some(out)
+}
+
 /// Illuminance at every probe: levels 1, 2, 3 (then finer while any bound exceeds
 /// `rel_tolerance` of its total, up to `opts.max_level`), the indirect part extrapolated.
+/// A finer level that runs out of time or elements ends the refinement with the last
+/// finished result, marked not converged; the first three levels are needed for any.
 pub fn probe_illuminance(
     scene: &Scene,
     probes: &[Probe],
     opts: &RadiosityOptions,
     rel_tolerance: f64,
-) -> Result<Vec<Illuminance>, RadiosityError> {
+    progress: &(dyn Fn(ProbeProgress) + Sync),
+) -> Result<ProbeRun, RadiosityError> {
     let p = Prepared::for_probes(scene)?;
     let deadline = Deadline::after(opts.max_seconds);
+    let time = |level: usize| RadiosityError::TimeLimit {
+        seconds: opts.max_seconds,
+        during: if level == 0 {
+            "while computing the direct light".into()
+        } else {
+            format!("on mesh level {level}")
+        },
+    };
     let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
-    let direct: Vec<f64> = probes
-        .iter()
-        .map(|q| direct_lux(scene, &p.lights, q.position, q.normal))
-        .collect();
-    let mut levels: Vec<Vec<f64>> = Vec::new();
-    let base = p.base(opts);
-    loop {
-        let level = levels.len() + 1;
-        let solved = solve_level(&p, &refl, opts, level, None, deadline)?;
-        levels.push(
-            probes
+    let mut direct = Vec::with_capacity(probes.len());
+    for chunk in probes.chunks(CHUNK) {
+        if deadline.passed() {
+            return Err(time(0));
+        }
+        direct.extend(
+            chunk
                 .iter()
-                .map(|q| indirect_lux(scene, &p.lights, &solved, q.position, q.normal))
-                .collect(),
+                .map(|q| direct_lux(scene, &p.lights, q.position, q.normal)),
         );
-        if levels.len() < 3 {
+    }
+    let mut raw: Vec<Vec<f64>> = Vec::new();
+    let mut levels_alg: Vec<f64> = Vec::new();
+    let mut levels: Vec<ProbeLevel> = Vec::new();
+    let mut best: Option<Vec<Illuminance>> = None;
+    let base = p.base(opts);
+    let finest = opts.max_level.max(3);
+    loop {
+        let level = raw.len() + 1;
+        let start = std::time::Instant::now();
+        let stop = |why: String, best: Option<Vec<Illuminance>>, levels: Vec<ProbeLevel>| match best
+        {
+            Some(probes) => Ok(ProbeRun {
+                probes,
+                levels,
+                converged: false,
+                stopped: Some(why),
+            }),
+            None => Err(time(level)),
+        };
+        let solved = match solve_level(&p, &refl, opts, level, None, deadline) {
+            Ok(s) => s,
+            Err(RadiosityError::TimeLimit { .. }) => {
+                let why = format!(
+                    "the time limit of {} s ran out while solving level {level}",
+                    opts.max_seconds
+                );
+                return stop(why, best, levels);
+            }
+            Err(RadiosityError::TooDetailed { max, .. }) if best.is_some() => {
+                let why = format!("level {level} would need more than {max} elements");
+                return stop(why, best, levels);
+            }
+            Err(e) => return Err(e),
+        };
+        progress(ProbeProgress::Solved {
+            level,
+            elements: solved.mesh.elements.len(),
+        });
+        let Some(values) = evaluate(scene, &p.lights, &solved, probes, deadline, progress) else {
+            let why = format!(
+                "the time limit of {} s ran out while evaluating the probes on level {level}",
+                opts.max_seconds
+            );
+            return stop(why, best, levels);
+        };
+        raw.push(values);
+        levels_alg.push(solved.algebraic);
+        levels.push(ProbeLevel {
+            level,
+            h_m: base / level as f64,
+            elements: solved.mesh.elements.len(),
+            seconds: start.elapsed().as_secs_f64(),
+            worst_relative_bound: None,
+        });
+        if raw.len() < 3 {
             continue;
         }
-        let m = levels.len();
-        let h = |k: usize| base / k as f64;
+        let m = raw.len();
+        let first = m.saturating_sub(4);
+        let hs: Vec<f64> = (first + 1..=m).map(|k| base / k as f64).collect();
+        // What the stopped iteration may leave, in lux, at the finest level.
+        let algebraic = levels_alg.iter().skip(first).fold(0.0f64, |a, &b| a.max(b));
+        let mut irregular = 0;
         let out: Vec<Illuminance> = (0..probes.len())
             .map(|i| {
-                let fine = richardson(
-                    levels[m - 2][i],
-                    h(m - 1),
-                    levels[m - 1][i],
-                    h(m),
-                    opts.order,
-                );
-                let coarse = richardson(
-                    levels[m - 3][i],
-                    h(m - 2),
-                    levels[m - 2][i],
-                    h(m - 1),
-                    opts.order,
-                );
+                let v: Vec<f64> = raw[first..].iter().map(|r| r[i]).collect();
+                let abs_err = algebraic * (v[v.len() - 1].abs() + direct[i].abs());
+                let (fine, bound, regular) = extrapolated_with_bound(&v, &hs, opts.order, abs_err);
+                irregular += usize::from(!regular);
                 Illuminance {
                     direct_lux: direct[i],
                     indirect_lux: fine,
                     total_lux: direct[i] + fine,
-                    bound_lux: (fine - coarse).abs(),
+                    bound_lux: bound,
                 }
             })
             .collect();
-        let done = out
+        progress(ProbeProgress::Estimated {
+            level,
+            probes: &out,
+        });
+        let worst = out
             .iter()
-            .all(|r| r.bound_lux <= rel_tolerance * r.total_lux.abs());
-        if done || level >= opts.max_level.max(3) {
-            return Ok(out);
+            .map(|r| r.bound_lux / r.total_lux.abs())
+            .fold(0.0, f64::max);
+        if let Some(l) = levels.last_mut() {
+            l.worst_relative_bound = Some(worst);
         }
+        let done = irregular == 0
+            && out
+                .iter()
+                .all(|r| r.bound_lux <= rel_tolerance * r.total_lux.abs());
+        if done {
+            return Ok(ProbeRun {
+                probes: out,
+                levels,
+                converged: true,
+                stopped: None,
+            });
+        }
+        if level >= finest {
+            return Ok(ProbeRun {
+                probes: out,
+                levels,
+                converged: false,
+                stopped: Some(if irregular > 0 {
+                    format!(
+                        "level {level} is the finest the solver tries, and at {irregular} \
+                         probe(s) the last levels still do not converge monotonically (a point \
+                         nearer an edge than the elements are small): their bound is a rough \
+                         figure"
+                    )
+                } else {
+                    format!("level {level} is the finest the solver tries")
+                }),
+            });
+        }
+        best = Some(out);
     }
 }

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use super::super::geometry::VecOps;
 
 use super::super::spectral::N_BINS;
-use super::direct::irradiance_factor;
+use super::direct::{irradiance_factor, mean_factor_over};
 use super::lights::Lights;
 use super::mesh::{average_over, Mesh};
 use crate::render::deadline::Deadline;
@@ -85,6 +85,11 @@ pub fn sources(
                     if deadline.passed() {
                         return None;
                     }
+                    // Exact where the tiles are Lambertian: a point rule's error would
+                    // differ between components and levels and spoil the extrapolation.
+                    if let Some(f) = mean_factor_over(e, &c.weights, &el.rect) {
+                        return Some(f);
+                    }
                     let dist = el.rect.centre().minus(ec).length();
                     let nodes = ((1.0 + 4.0 * el.size / (dist - esize / 2.0).max(el.size)).ceil()
                         as usize)
@@ -107,6 +112,14 @@ pub const TOLERANCE: f64 = 1e-10;
 /// 2,300 to reach [`TOLERANCE`]; beyond this the reflectances are not physical.
 pub const MAX_SWEEPS: usize = 20_000;
 
+/// ℓ on the band grid (N × bands, row-major), the sweeps it took (the slowest band chunk)
+/// and an estimate of its largest relative error left by stopping the iteration.
+pub struct Solution {
+    pub l: Vec<f64>,
+    pub sweeps: usize,
+    pub rel_err: f64,
+}
+
 /// Why Gauss–Seidel gave no solution.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SolveFailure {
@@ -118,7 +131,9 @@ pub enum SolveFailure {
 
 /// ℓ (N × bands, row-major) for one emitter's source `src`; `refl` is N × bands. `warm`
 /// starts the iteration from a neighbouring solution (the white scene from the scene's).
-/// Returns the solution and the number of sweeps.
+/// Returns the solution and the number of sweeps. Bands whose reflectances are the same on
+/// every element have the same solution, so each distinct band is solved once (a grey
+/// room is one system, not 81).
 pub fn solve(
     mesh: &Mesh,
     refl: &[f64],
@@ -126,7 +141,45 @@ pub fn solve(
     bands: usize,
     warm: Option<&[f64]>,
     deadline: Deadline,
-) -> Result<(Vec<f64>, usize), SolveFailure> {
+) -> Result<Solution, SolveFailure> {
+    let n = mesh.elements.len();
+    let column = |b: usize| (0..n).map(move |i| refl[i * bands + b]);
+    let mut distinct: Vec<usize> = Vec::new();
+    let mut of_band = Vec::with_capacity(bands);
+    for b in 0..bands {
+        match distinct.iter().position(|&d| column(d).eq(column(b))) {
+            Some(k) => of_band.push(k),
+            None => {
+                of_band.push(distinct.len());
+                distinct.push(b);
+            }
+        }
+    }
+    if distinct.len() == bands {
+        return solve_bands(mesh, refl, src, bands, warm, deadline);
+    }
+    let nd = distinct.len();
+    let pick = |m: &[f64]| -> Vec<f64> {
+        (0..n)
+            .flat_map(|i| distinct.iter().map(move |&b| m[i * bands + b]))
+            .collect()
+    };
+    let warm_d = warm.map(pick);
+    let sol = solve_bands(mesh, &pick(refl), src, nd, warm_d.as_deref(), deadline)?;
+    let l = (0..n)
+        .flat_map(|i| of_band.iter().map(|&k| sol.l[i * nd + k]).collect::<Vec<_>>())
+        .collect();
+    Ok(Solution { l, ..sol })
+}
+
+fn solve_bands(
+    mesh: &Mesh,
+    refl: &[f64],
+    src: &[f64],
+    bands: usize,
+    warm: Option<&[f64]>,
+    deadline: Deadline,
+) -> Result<Solution, SolveFailure> {
     let n = mesh.elements.len();
     // Bands are independent: split them over the cores, each chunk its own Gauss–Seidel.
     let chunk = bands.div_ceil(rayon::current_num_threads().max(1)).max(1);
@@ -134,7 +187,7 @@ pub fn solve(
         .step_by(chunk)
         .map(|b| (b, (b + chunk).min(bands)))
         .collect();
-    let parts: Vec<Result<(Vec<f64>, usize), SolveFailure>> = ranges
+    let parts: Vec<Result<(Vec<f64>, usize, f64), SolveFailure>> = ranges
         .par_iter()
         .map(|&(b0, b1)| {
             let k = b1 - b0;
@@ -148,6 +201,8 @@ pub fn solve(
             }
             let mut acc = vec![0.0; k];
             let mut sweeps = 0;
+            let mut last_change = f64::INFINITY;
+            let rel_err;
             loop {
                 sweeps += 1;
                 if deadline.passed() {
@@ -175,24 +230,43 @@ pub fn solve(
                     }
                 }
                 if change <= TOLERANCE * size {
+                    // What the sweeps not taken would still add: a contraction by q per
+                    // sweep leaves change·q/(1 − q), q from the last two sweeps.
+                    let q = if last_change.is_finite() && last_change > 0.0 {
+                        (change / last_change).min(0.999)
+                    } else {
+                        0.999
+                    };
+                    rel_err = if size > 0.0 {
+                        change / size * q / (1.0 - q)
+                    } else {
+                        0.0
+                    };
                     break;
                 }
+                last_change = change;
                 if sweeps >= MAX_SWEEPS || !size.is_finite() || size > 1e30 {
                     return Err(SolveFailure::Diverges { sweeps });
                 }
             }
-            Ok((l, sweeps))
+            Ok((l, sweeps, rel_err))
         })
         .collect();
     let mut out = vec![0.0; n * bands];
     let mut sweeps = 0;
+    let mut rel_err: f64 = 0.0;
     for ((b0, b1), part) in ranges.iter().zip(parts) {
-        let (l, s) = part?;
+        let (l, s, e) = part?;
         let k = b1 - b0;
         sweeps = sweeps.max(s);
+        rel_err = rel_err.max(e);
         for i in 0..n {
             out[i * bands + b0..i * bands + b1].copy_from_slice(&l[i * k..(i + 1) * k]);
         }
     }
-    Ok((out, sweeps))
+    Ok(Solution {
+        l: out,
+        sweeps,
+        rel_err,
+    })
 }

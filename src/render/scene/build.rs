@@ -255,6 +255,7 @@ pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
         provenance: file.provenance.clone(),
         warnings,
     };
+    super::hidden::check(&scene.surfaces, &scene.emitters)?;
     let intensity = scene.intensity_cd();
     if !(intensity > 0.0 && intensity.is_finite()) {
         return err(

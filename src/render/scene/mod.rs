@@ -33,6 +33,7 @@
 //! light is refused: every reading of it would be 0/0.
 
 mod build;
+mod hidden;
 pub mod builtin;
 pub mod file;
 mod model;
