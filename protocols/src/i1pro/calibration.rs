@@ -49,6 +49,57 @@ pub mod caps_e {
     pub const UV_FILTER: i32 = 0x20;
 }
 
+/// What an EEPROM's ambient table (key 0x044E) holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AmbientTable {
+    /// No such key.
+    Missing,
+    /// −1 in every band: what units without the diffuser store.
+    NoAmbientMarker,
+    /// A factor that is zero, negative or not a number, in `band` (from 0, 380 nm).
+    Unusable { band: usize, value: f64 },
+    /// Every factor a positive number.
+    Usable,
+}
+
+impl AmbientTable {
+    /// Judges a table (None: the key is missing).
+    pub fn of(table: Option<&Spectrum>) -> AmbientTable {
+        let Some(t) = table else {
+            return AmbientTable::Missing;
+        };
+        if t.iter().all(|&v| v == -1.0) {
+            return AmbientTable::NoAmbientMarker;
+        }
+        match t.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            Some(band) => AmbientTable::Unusable {
+                band,
+                value: t[band],
+            },
+            None => AmbientTable::Usable,
+        }
+    }
+
+    /// Judges the table of a parsed EEPROM; a table of the wrong length or type counts as
+    /// unusable in its first band.
+    pub fn in_eeprom(e: &Eeprom) -> AmbientTable {
+        match e.get(key::AMBIENT) {
+            None => AmbientTable::Missing,
+            Some(Value::Floats(v)) if v.len() == BANDS => {
+                let mut s = [0.0; BANDS];
+                for (o, &x) in s.iter_mut().zip(v) {
+                    *o = f64::from(x);
+                }
+                AmbientTable::of(Some(&s))
+            }
+            Some(_) => AmbientTable::Unusable {
+                band: 0,
+                value: f64::NAN,
+            },
+        }
+    }
+}
+
 /// A calibration item that is missing or malformed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CalibrationError {
@@ -244,14 +295,19 @@ impl Calibration {
         }
     }
 
-    /// Whether the unit has the ambient diffuser (and its calibration).
-    pub fn has_ambient(&self) -> bool {
-        let caps = self.capabilities & CAPS_AMBIENT != 0
+    /// Whether the EEPROM's capability bits say the unit has the ambient diffuser (0x0BC2 &
+    /// 0x6000, or Rev E 0x2EE2 & 0x01), whatever its ambient table holds.
+    pub fn claims_ambient(&self) -> bool {
+        self.capabilities & CAPS_AMBIENT != 0
             || self
                 .rev_e
                 .as_ref()
-                .is_some_and(|e| e.capabilities & caps_e::AMBIENT != 0);
-        caps && self.ambient.is_some()
+                .is_some_and(|e| e.capabilities & caps_e::AMBIENT != 0)
+    }
+
+    /// Whether the unit has the ambient diffuser and a usable calibration for it.
+    pub fn has_ambient(&self) -> bool {
+        self.claims_ambient() && self.ambient.is_some()
     }
 
     /// Whether a UV-cut filter is fitted.
@@ -295,13 +351,16 @@ impl Calibration {
         };
         let caps_e_ambient =
             model.revision() == Revision::E && r.int(key::CAPABILITIES_E)? & caps_e::AMBIENT != 0;
-        let ambient = if capabilities & CAPS_AMBIENT != 0 || caps_e_ambient {
+        // A unit that claims the diffuser must carry the table (ArgyllCMS refuses one that
+        // does not); whether it claims it or not, a table that is the "no ambient" marker
+        // (−1 in every band) or holds a factor that is not a positive number calibrates
+        // nothing: the unit has no ambient mode (see `ambient_table`).
+        let table = if capabilities & CAPS_AMBIENT != 0 || caps_e_ambient {
             Some(r.spectrum(key::AMBIENT)?)
         } else {
-            // Units without the diffuser store −1 in every band, or nothing.
             r.optional_spectrum(key::AMBIENT)?
-                .filter(|a| a.iter().any(|&v| v != -1.0))
         };
+        let ambient = table.filter(|a| AmbientTable::of(Some(a)) == AmbientTable::Usable);
         let rev_e = match model.revision() {
             Revision::AToD => None,
             Revision::E => {
