@@ -59,7 +59,7 @@ pub enum I1ProError {
     #[error("the i1Pro's sensor saturated at the fixed integration time of {integration_s} s; set a shorter integration time or let the instrument choose it (auto)")]
     SaturatedAtFixedTime { integration_s: f64 },
     /// No light distinguishable from the sensor's noise even at the longest integration time.
-    #[error("too dark for the i1Pro: even at its longest integration time of {max_s:.3} s the light gives {signal:.0} counts over all cells, within the sensor's noise ({floor:.0} counts, 5σ); check that the instrument faces the light source and nothing covers it")]
+    #[error("too dark for the i1Pro: even at its longest integration time of {max_s:.3} s the light gives {:.0} counts over all cells, within the sensor's noise ({floor:.0} counts, 5σ); check that the instrument faces the light source and nothing covers it", whole(.signal))]
     TooDark { max_s: f64, signal: f64, floor: f64 },
     /// A dark calibration saw light.
     #[error("the dark calibration saw light (mean {mean:.0} counts/s, limit {limit:.0}): place the instrument on its white tile, which covers the sensor, and calibrate again")]
@@ -79,6 +79,11 @@ pub enum I1ProError {
     /// The white-tile reading saturated or was too dim.
     #[error("the white-tile reading was {problem}: make sure the instrument sits flat on its own white tile and calibrate again")]
     BadWhite { problem: &'static str },
+}
+
+/// Rounded counts as they print, without a "-0" for a sum that is a hair below zero.
+fn whole(c: &f64) -> f64 {
+    c.round() + 0.0
 }
 
 fn ms(s: &f64) -> f64 {

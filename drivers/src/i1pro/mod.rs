@@ -479,4 +479,6 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
 }
 
 #[cfg(test)]
+mod real_unit_tests;
+#[cfg(test)]
 mod tests;
