@@ -451,8 +451,8 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
         }
         // The clock's limits, shown as the round numbers they stand for (the longest is
         // 2 s on a whole number of clocks, a little over).
-        let min = engine::shortest(&self.wire).map_err(I1ProError::from)?;
-        let max = engine::longest(&self.wire, &self.cal).map_err(I1ProError::from)?;
+        let min = engine::shortest(&self.wire)?;
+        let max = engine::longest(&self.wire, &self.cal)?;
         let (low, high) = ((min * 1e6).round() / 1e6, (max * 1e3).round() / 1e3);
         match value.trim().parse::<f64>() {
             Ok(t) if t.is_finite() && (low..=max.max(high)).contains(&t) => {
