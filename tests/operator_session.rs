@@ -243,7 +243,7 @@ fn a_reading_the_meter_does_not_repeat_is_read_again_when_the_operator_re_aims()
     };
     let ran = run(&path, false, &mut meter, &mut hands);
     assert_eq!(ran.end, RunEnd::Complete);
-    assert_eq!(hands.doubted, ["reading 3 of A #3 differs"]);
+    assert_eq!(hands.doubted, ["reading 3/3 (A #3) differs"]);
     // Shown flagged, then read again within the noise; asked for each target once.
     assert_eq!(
         ran.shown[..4],

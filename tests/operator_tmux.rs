@@ -196,7 +196,7 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     tmux.keys(&["Enter"]);
     tmux.wait_for(&patch(2, "light skin"), 1);
     tmux.keys(&["Enter"]);
-    let doubt = "reading 2 of spot 2 #2 differs: re-aim and press Enter to read it again, k then Enter to keep it (q to stop)";
+    let doubt = "reading 2/3 (spot 2 #2) differs: re-aim and press Enter to read it again, k then Enter to keep it (q to stop)";
     tmux.wait_for(doubt, 1);
     tmux.keys(&["Enter"]);
     tmux.wait_for("EXIT2=0", 1);
@@ -206,6 +206,9 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     tmux.keys(&["q", "Enter"]);
     let screen = tmux.wait_for("EXIT3=", 1);
 
+    if std::env::var_os("SHOW_SCREEN").is_some() {
+        eprintln!("{screen}");
+    }
     let count = |s: &str| screen.matches(s).count();
     // Asked once per placement, every reading shown.
     for prompt in [
@@ -254,9 +257,12 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     );
     assert_eq!(count("calibrated the spectral instrument for emissive:"), 0);
     // `q`: stopped, how to go on, exit 0; nothing measured.
-    assert!(screen.contains(
-        "stopped at your request: stage falloff: 4 of 4 readings still to take; the others are safe in"
-    ) && screen.contains("continue with --resume\nEXIT3=0"), "{screen}");
+    assert!(
+        screen.contains(
+            "stopped at your request: stage falloff: none of its 4 readings taken yet: continue with --resume\nEXIT3=0"
+        ),
+        "{screen}"
+    );
     assert_eq!(
         light.views.load(Ordering::SeqCst),
         7,

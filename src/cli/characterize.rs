@@ -173,6 +173,12 @@ pub fn run(args: Args) -> CliResult {
                     )
                     .into(),
                 )),
+                RunEnd::Aborted { .. } if done == 0 => {
+                    println!(
+                        "stopped at your request before any of the {total} readings: continue with --resume (log: {log})"
+                    );
+                    Ok(())
+                }
                 RunEnd::Aborted { .. } => {
                     println!(
                         "stopped at your request with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"

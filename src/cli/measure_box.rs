@@ -194,9 +194,15 @@ pub fn run(args: Args) -> CliResult {
         } => {
             let missing = total - done;
             let log = log.display();
-            let text = format!(
-                "stage {stage}: {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
-            );
+            let text = if done == 0 {
+                format!(
+                    "stage {stage}: none of its {total} readings taken yet: continue with --resume"
+                )
+            } else {
+                format!(
+                    "stage {stage}: {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
+                )
+            };
             match end {
                 RunEnd::Stopped { .. } | RunEnd::Complete => {
                     println!("stopped: {text}");

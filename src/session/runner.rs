@@ -412,11 +412,15 @@ where
                 if deviation.is_none() {
                     break reading;
                 }
-                let why = format!(
-                    "reading {} of {} differs",
-                    placement.as_ref().map_or(1, |r| index - r.start + 1),
-                    step.label
-                );
+                let why = match &placement {
+                    Some(r) => format!(
+                        "reading {}/{} ({}) differs",
+                        index - r.start + 1,
+                        r.len(),
+                        step.label
+                    ),
+                    None => format!("{} differs", step.label),
+                };
                 let operator = &mut *rig.operator;
                 let mut answer = Ok(Recheck::Keep);
                 progress.suspend(&mut || answer = operator.recheck(&why));
