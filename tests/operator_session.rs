@@ -5,7 +5,7 @@
 //! to the operator: read again (the doubtful reading is not journalled), kept, or stop.
 
 use std::collections::{BTreeMap, VecDeque};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use metamer::session::operator::placement_prompt;
 use metamer::session::{
@@ -150,7 +150,7 @@ struct Ran {
     journalled: Vec<Option<f64>>,
 }
 
-fn run(path: &PathBuf, resume: bool, meter: &mut Meter, hands: &mut Hands) -> Ran {
+fn run(path: &Path, resume: bool, meter: &mut Meter, hands: &mut Hands) -> Ran {
     let records = [("spot".to_string(), InstrumentRecord::of(&*meter))].into();
     let mut session: Session<String, String> =
         Session::open(path, plan(), String::new(), records, resume).unwrap();

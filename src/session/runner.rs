@@ -1,6 +1,8 @@
 //! Taking a plan's steps: for each step the journal lacks, in plan order, take it (calibrate
-//! if due, prepare, settle, measure: [`super::step`]), append the entry, report progress;
-//! stop before the next step on an interrupt.
+//! if due, prepare — the operator asked once per placement —, settle, measure:
+//! [`super::step`]), report it, put a reading its instrument cannot have repeated to the
+//! operator ([`super::repeats`]: read again, keep, stop), append the entry; stop before the
+//! next step on an interrupt.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -336,7 +338,7 @@ where
         let mut new = 0usize;
         let start = Instant::now();
         let journal_path = self.journal.path().to_path_buf();
-        for index in 0..total {
+        for (index, placement) in placements.into_iter().enumerate() {
             if self.entries[index].is_some() {
                 continue;
             }
@@ -352,7 +354,6 @@ where
                 return Ok(RunEnd::Stopped { missing });
             }
             let step = &self.plan.steps[index];
-            let placement = placements[index].clone();
             let fail = |source: StepFailure| SessionError::Step {
                 index,
                 total,
