@@ -1,7 +1,7 @@
 //! Sprague's (1880) interpolation of evenly spaced data, the method CIE 167:2005 §9.2.4
 //! recommends for spectral data on a uniform grid. Facts used (CIE 167:2005 Table V and
 //! Eq. 6–7, as restated by Westland, Ripamonti & Cheung, *Computational Colour Science
-//! Using MATLAB*, 2nd ed., 2012, §4.3):
+//! Using MATLAB*, 2nd ed., 2012, ch. 4):
 //!
 //! - the data are first extended by two points at each end, each a fixed combination of the
 //!   six nearest samples with weights /209 ([`EXTEND`]);
