@@ -261,7 +261,11 @@ fn xyz_of_10nm_readings_is_colour_science_integration_and_near_astm_e308() {
     assert_eq!(ours.len(), 25);
     // Written into the test from colour-science 0.4.7 (`Integration`, as above) so the
     // comparison holds where the library is missing: the white.
-    let white = [190.203_348_864_693_23, 199.999_957_762_433_9, 223.418_284_255_467_63];
+    let white = [
+        190.203_348_864_693_23,
+        199.999_957_762_433_9,
+        223.418_284_255_467_63,
+    ];
     for k in 0..3 {
         assert!((ours[0][k] / white[k] - 1.0).abs() < 1e-9, "{:?}", ours[0]);
     }
@@ -271,7 +275,10 @@ fn xyz_of_10nm_readings_is_colour_science_integration_and_near_astm_e308() {
     let astm = colour_science(&csv, "ASTM E308").unwrap();
     for ((m, i), a) in ours.iter().zip(&integration).zip(&astm) {
         for k in 0..3 {
-            assert!((m[k] / i[k] - 1.0).abs() < 1e-9, "{m:?} vs Integration {i:?}");
+            assert!(
+                (m[k] / i[k] - 1.0).abs() < 1e-9,
+                "{m:?} vs Integration {i:?}"
+            );
             assert!((m[k] / a[k] - 1.0).abs() < 3e-4, "{m:?} vs ASTM E308 {a:?}");
         }
     }

@@ -171,9 +171,17 @@ fn lut_profiles_carry_the_model_in_a2b0_and_invert_it_in_b2a0() {
         let pcs = profile_pcs(&profile).unwrap();
         let worst = drives
             .iter()
-            .map(|&d| delta_e2000(lab_d50(pcs.to_pcs(profile.forward(d))), lab_d50(m.pcs_xyz(d))))
+            .map(|&d| {
+                delta_e2000(
+                    lab_d50(pcs.to_pcs(profile.forward(d))),
+                    lab_d50(m.pcs_xyz(d)),
+                )
+            })
             .fold(0.0, f64::max);
-        assert!(worst < 3.0, "matrix/TRC tags of the LUT profile: max ΔE00 {worst}");
+        assert!(
+            worst < 3.0,
+            "matrix/TRC tags of the LUT profile: max ΔE00 {worst}"
+        );
         eprintln!("lut {version}: A2B0 {a:?}, B2A0 {b:?}, matrix/TRC tags max ΔE00 {worst:.3}");
         check_layout(&icc.bytes, true);
     }

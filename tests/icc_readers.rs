@@ -43,7 +43,9 @@ fn transicc_installed() -> bool {
             std::env::var_os("CI").is_none(),
             "CI is set but transicc is not installed (.ci/run installs liblcms2-utils)"
         );
-        eprintln!("skipped: LittleCMS `transicc` is not installed (apt-get install liblcms2-utils)");
+        eprintln!(
+            "skipped: LittleCMS `transicc` is not installed (apt-get install liblcms2-utils)"
+        );
     }
     found
 }
@@ -102,7 +104,12 @@ struct Reading {
     inverse_max: f64,
 }
 
-fn read_with_lcms(profile: &Profile, held_out: &[Sample], version: IccVersion, dir: &Path) -> Reading {
+fn read_with_lcms(
+    profile: &Profile,
+    held_out: &[Sample],
+    version: IccVersion,
+    dir: &Path,
+) -> Reading {
     let icc = encode_icc(profile, version, "metamer test display").unwrap();
     let path = dir.join(format!("{}-{version}.icc", profile.model));
     std::fs::write(&path, &icc.bytes).unwrap();
@@ -129,7 +136,10 @@ fn read_with_lcms(profile: &Profile, held_out: &[Sample], version: IccVersion, d
         .filter(|&x| !profile.inverse(x).out_of_gamut)
         .collect();
     let ours = reproduce_targets(profile, &targets, GamutMapping::Clip);
-    let pcs_in: Vec<[f64; 3]> = targets.iter().map(|&x| pcs.to_pcs(x).map(|v| v * 100.0)).collect();
+    let pcs_in: Vec<[f64; 3]> = targets
+        .iter()
+        .map(|&x| pcs.to_pcs(x).map(|v| v * 100.0))
+        .collect();
     let back = transicc(&["-i", "*XYZ", "-o", file], &pcs_in);
     let (mut r, mut inv, mut inv_max) = (0.0, 0.0, 0.0f64);
     for ((x, d), b) in targets.iter().zip(&ours).zip(&back) {

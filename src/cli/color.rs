@@ -137,13 +137,7 @@ fn xyz(a: XyzArgs) -> CliResult {
             MethodArg::Cie15 => spectrum.with_outside(outside).as_measured(),
             MethodArg::Linear => spectrum.with_outside(outside),
         };
-        let d = describe(
-            &spectrum,
-            quantity,
-            &illuminant,
-            a.observer,
-            white,
-        );
+        let d = describe(&spectrum, quantity, &illuminant, a.observer, white);
         let mut numbers: Vec<f64> = d.xyz.to_array().into();
         numbers.extend(d.xyy.to_array());
         numbers.extend(d.lab.map(|l| l.to_array()).into_iter().flatten());

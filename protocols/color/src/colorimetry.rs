@@ -164,10 +164,38 @@ mod tests {
         // aligns the data to the CMFs' 360–830 nm at 1 nm: Sprague interpolation,
         // constant extrapolation). Printed by protocols/color/reference/sampled_xyz.py.
         let cases = [
-            (None, [190.203_348_864_693_23, 199.999_957_762_433_9, 223.418_284_255_467_63]),
-            (Some(12), [17.815_135_994_453_716, 11.142_920_780_062_05, 64.327_536_341_559_82]),
-            (Some(14), [40.143_482_662_556_04, 23.663_426_324_471_985, 10.411_157_770_599_122]),
-            (Some(18), [172.924_506_605_701_57, 182.524_758_473_718_26, 197.792_869_369_667_47]),
+            (
+                None,
+                [
+                    190.203_348_864_693_23,
+                    199.999_957_762_433_9,
+                    223.418_284_255_467_63,
+                ],
+            ),
+            (
+                Some(12),
+                [
+                    17.815_135_994_453_716,
+                    11.142_920_780_062_05,
+                    64.327_536_341_559_82,
+                ],
+            ),
+            (
+                Some(14),
+                [
+                    40.143_482_662_556_04,
+                    23.663_426_324_471_985,
+                    10.411_157_770_599_122,
+                ],
+            ),
+            (
+                Some(18),
+                [
+                    172.924_506_605_701_57,
+                    182.524_758_473_718_26,
+                    197.792_869_369_667_47,
+                ],
+            ),
         ];
         for (patch, want) in cases {
             let got = radiance_to_xyz(&i1pro_reading(patch), ObserverKind::Cie1931).to_array();
@@ -191,7 +219,10 @@ mod tests {
         for (patch, want) in argyll {
             let got = radiance_to_xyz(&i1pro_reading(patch), ObserverKind::Cie1931).to_array();
             for k in 0..3 {
-                assert!(((got[k] - want[k]) / want[k]).abs() < 2.5e-4, "{got:?} vs {want:?}");
+                assert!(
+                    ((got[k] - want[k]) / want[k]).abs() < 2.5e-4,
+                    "{got:?} vs {want:?}"
+                );
             }
         }
         // The same samples read linearly and zero beyond 730 nm (what metamer did before)
@@ -200,8 +231,14 @@ mod tests {
         let s = i1pro_reading(None);
         let linear = Spectrum::from_grid(380.0, 10.0, s.values().to_vec()).unwrap();
         let lin = radiance_to_xyz(&linear, ObserverKind::Cie1931);
-        assert!((lin.z / sprague.z - 1.0 + 0.008_06).abs() < 1e-4, "{lin:?} {sprague:?}");
-        assert!((lin.x / sprague.x - 1.0 + 0.002_05).abs() < 1e-4, "{lin:?} {sprague:?}");
+        assert!(
+            (lin.z / sprague.z - 1.0 + 0.008_06).abs() < 1e-4,
+            "{lin:?} {sprague:?}"
+        );
+        assert!(
+            (lin.x / sprague.x - 1.0 + 0.002_05).abs() < 1e-4,
+            "{lin:?} {sprague:?}"
+        );
     }
 
     #[test]
@@ -213,7 +250,9 @@ mod tests {
         let fine = Spectrum::constant(380.0, 780.0, 0.01);
         assert_eq!(fine.clone().as_measured(), fine);
         assert_eq!(summation_range(&fine), START_NM..=END_NM);
-        assert_eq!(summation_range(&i1pro_reading(None)), CIE_START_NM..=CIE_END_NM);
+        assert_eq!(
+            summation_range(&i1pro_reading(None)),
+            CIE_START_NM..=CIE_END_NM
+        );
     }
 }
-

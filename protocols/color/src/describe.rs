@@ -2,8 +2,8 @@
 //! `metamer color xyz` prints.
 
 use crate::{
-    illuminant_white_over, radiance_to_xyz, reflectance_to_xyz, summation_range, Lab,
-    ObserverKind, Quantity, Spectrum, XyY, Xyz,
+    illuminant_white_over, radiance_to_xyz, reflectance_to_xyz, summation_range, Lab, ObserverKind,
+    Quantity, Spectrum, XyY, Xyz,
 };
 
 /// The colorimetry of one spectrum.

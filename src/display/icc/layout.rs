@@ -11,15 +11,20 @@ fn be32(bytes: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_be_bytes(bytes.get(at..at + 4)?.try_into().ok()?))
 }
 
-/// The tags of a profile in table order: (signature, data).
-pub fn tags(profile: &[u8]) -> Result<Vec<([u8; 4], Vec<u8>)>, String> {
+/// One tag: its signature and its data.
+pub type Tag = ([u8; 4], Vec<u8>);
+
+/// The tags of a profile in table order.
+pub fn tags(profile: &[u8]) -> Result<Vec<Tag>, String> {
     let count = be32(profile, HEADER).ok_or("the encoded profile has no tag table")? as usize;
     let mut out = Vec::with_capacity(count);
     for t in 0..count {
         let at = HEADER + 4 + t * ENTRY;
-        let (Some(sig), Some(offset), Some(size)) =
-            (profile.get(at..at + 4), be32(profile, at + 4), be32(profile, at + 8))
-        else {
+        let (Some(sig), Some(offset), Some(size)) = (
+            profile.get(at..at + 4),
+            be32(profile, at + 4),
+            be32(profile, at + 8),
+        ) else {
             return Err(format!("tag {t} of the encoded profile is cut off"));
         };
         let sig: [u8; 4] = sig.try_into().expect("four bytes");
@@ -43,7 +48,9 @@ pub fn relayout(
     version: u32,
     replace: impl Fn(&[u8; 4]) -> Option<Vec<u8>>,
 ) -> Result<Vec<u8>, String> {
-    let header = profile.get(..HEADER).ok_or("the encoded profile has no header")?;
+    let header = profile
+        .get(..HEADER)
+        .ok_or("the encoded profile has no header")?;
     let tags = tags(profile)?;
     let start = HEADER + 4 + tags.len() * ENTRY;
     let mut table = Vec::with_capacity(4 + tags.len() * ENTRY);

@@ -25,15 +25,19 @@ use super::pcs::{self, Mat3, Pcs};
 use super::{unit_u16, xyz_u16, IccError, CURVE_ENTRIES};
 use crate::display::model::{DisplayModel, Lut3d};
 
-/// Most CLUT nodes per axis the subdivision aims at (33³ × 3 × 2 bytes ≈ 215 kB).
+/// Most CLUT nodes per axis A2B0's subdivision aims at (33³ × 3 × 2 bytes ≈ 215 kB): its
+/// nodes hold the model exactly, so more buy nothing from a tetrahedral reader.
 const TARGET_POINTS: usize = 33;
+/// The same for B2A0, whose CLUT samples the model's inverse (smooth, but not piecewise
+/// linear on this grid): a denser grid is more accurate (49³ × 3 × 2 bytes ≈ 706 kB).
+const B2A_TARGET_POINTS: usize = 49;
 /// lut16Type allows at most 255 grid points per axis (one byte).
 const MAX_POINTS: usize = 255;
 /// B2A0's CLUT holds shaped coordinates from −MARGIN to 1 + MARGIN of the channel's range.
-const MARGIN: f64 = 0.125;
-/// Output table entries of B2A0: with MARGIN 1/8 the ends of the valid range fall on
-/// entries 409 and 3681 exactly, so the clip is a corner of the table, not a ramp.
-const OUTPUT_ENTRIES: usize = 4091;
+const MARGIN: f64 = 0.25;
+/// Output table entries of B2A0: with MARGIN 1/4 the ends of the valid range fall on
+/// entries 682 and 3410 exactly, so the clip is a corner of the table, not a ramp.
+const OUTPUT_ENTRIES: usize = 4093;
 /// Samples per cube edge when finding how far the model's gamut reaches past its primaries.
 const SURFACE_SAMPLES: usize = 17;
 
@@ -134,14 +138,19 @@ fn place(nodes: &[f64], s: f64) -> f64 {
     (i as f64 + f) / (n - 1) as f64
 }
 
-/// The A2B0 node positions of each axis (normalised shaped coordinates).
-fn a2b_nodes(axes: &[Axis; 3]) -> [Vec<f64>; 3] {
+/// Node positions of each axis (normalised shaped coordinates): every model level, each
+/// cell split to reach about `target` nodes.
+fn a2b_nodes(axes: &[Axis; 3], target: usize) -> [Vec<f64>; 3] {
     let levels: [Vec<f64>; 3] = std::array::from_fn(|c| axes[c].levels());
-    let (n, split) = parts(levels.clone().map(|l| l.len()), TARGET_POINTS);
+    let (n, split) = parts(levels.clone().map(|l| l.len()), target);
     std::array::from_fn(|c| {
         if split[c].is_empty() {
             (0..n)
-                .map(|i| levels[c][0] + (levels[c][levels[c].len() - 1] - levels[c][0]) * i as f64 / (n - 1) as f64)
+                .map(|i| {
+                    levels[c][0]
+                        + (levels[c][levels[c].len() - 1] - levels[c][0]) * i as f64
+                            / (n - 1) as f64
+                })
                 .collect()
         } else {
             subdivide(&levels[c], &split[c])
@@ -179,7 +188,7 @@ fn unit(i: usize, n: usize) -> f64 {
 /// A2B0: drive → PCS XYZ with nodes on the model's levels.
 pub(super) fn a2b(lut: &Lut3d, pcs: &Pcs) -> LutWarehouse {
     let axes: [Axis; 3] = std::array::from_fn(|c| Axis::new(lut, c));
-    let nodes = a2b_nodes(&axes);
+    let nodes = a2b_nodes(&axes, TARGET_POINTS);
     let n = nodes[0].len();
     let mut input = Vec::with_capacity(3 * CURVE_ENTRIES);
     for (axis, at) in axes.iter().zip(&nodes) {
@@ -259,8 +268,9 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<LutWarehouse, IccError> {
             (lo.min(l), hi.max(l))
         })
     });
-    // Node positions: A2B0's, plus one beyond each end the gamut reaches past.
-    let inner = a2b_nodes(&axes);
+    // Node positions: on the model's levels like A2B0's (denser), plus one beyond each end
+    // the gamut reaches past.
+    let inner = a2b_nodes(&axes, B2A_TARGET_POINTS - 2);
     let nodes: [Vec<f64>; 3] = std::array::from_fn(|c| {
         let (lo, hi) = reach[c];
         let mut v = Vec::with_capacity(inner[c].len() + 2);
@@ -386,7 +396,13 @@ mod tests {
         assert_eq!(n, 33);
         assert!(split.iter().all(|s| s == &vec![4; 8]));
         let nodes = subdivide(&[0.0, 0.01, 0.1, 1.0], &[2, 2, 2]);
-        assert_eq!(nodes, vec![0.0, 0.005, 0.01, 0.055, 0.1, 0.55, 1.0]);
+        let want = [0.0, 0.005, 0.01, 0.055, 0.1, 0.55, 1.0];
+        assert_eq!(nodes.len(), want.len());
+        for (a, b) in nodes.iter().zip(want) {
+            assert!((a - b).abs() < 1e-15, "{nodes:?}");
+        }
+        // The levels themselves are nodes, bit for bit.
+        assert_eq!((nodes[2], nodes[4], nodes[6]), (0.01, 0.1, 1.0));
         let (n, split) = parts([13, 13, 13], 33);
         assert_eq!((n, split[0].len(), split[0][0]), (25, 12, 2));
         let (n, _) = parts([40, 40, 40], 33);
@@ -406,9 +422,9 @@ mod tests {
     #[test]
     fn place_is_linear_between_nodes_and_clipped_outside() {
         let nodes = [0.0, 0.1, 1.0];
-        assert_eq!(place(&nodes, 0.05), 0.25);
+        assert!((place(&nodes, 0.05) - 0.25).abs() < 1e-15);
         assert_eq!(place(&nodes, 0.1), 0.5);
-        assert_eq!(place(&nodes, 0.55), 0.75);
+        assert!((place(&nodes, 0.55) - 0.75).abs() < 1e-15);
         assert_eq!(place(&nodes, -1.0), 0.0);
         assert_eq!(place(&nodes, 2.0), 1.0);
     }

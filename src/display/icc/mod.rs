@@ -35,9 +35,7 @@ use moxcms::{
 use super::model::ModelParams;
 use super::profile::Profile;
 pub use pcs::Pcs;
-pub use readback::{
-    agreement, inverse_agreement, Agreement, IccForward, IccInverse, IccReadError,
-};
+pub use readback::{agreement, inverse_agreement, Agreement, IccForward, IccInverse, IccReadError};
 
 /// Entries of each matrix/TRC curve and of each lut16 input table: with linear
 /// interpolation between them a γ 2.2 curve is off by < 10⁻⁷ of full output.
