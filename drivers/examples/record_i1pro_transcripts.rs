@@ -131,7 +131,7 @@ fn light() -> View {
 
 /// The XYZ of the light on the instrument's 36 bands.
 fn exact(s: &Spectrum) -> [f64; 3] {
-    let grid = Spectrum::from_grid(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
+    let grid = Spectrum::measured(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
     radiance_to_xyz(&grid, ObserverKind::Cie1931).to_array()
 }
 

@@ -235,7 +235,7 @@ impl<L: UsbLink> I1Pro<L> {
     }
 
     fn reading(&self, values: Vec<f64>, quantity: Quantity, integration_s: f64) -> Reading {
-        let spectrum = Spectrum::from_grid(START_NM, STEP_NM, values)
+        let spectrum = Spectrum::measured(START_NM, STEP_NM, values)
             .expect("36 bands on an even grid")
             .with_quantity(quantity);
         let xyz: Xyz = match quantity {

@@ -53,7 +53,7 @@ fn calibrate(m: &mut dyn Instrument, mode: MeasureMode) {
 
 /// The light sampled on the instrument's 36 bands, as the CSV the CLI writes holds it.
 fn on_grid(s: &Spectrum) -> Spectrum {
-    Spectrum::from_grid(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap()
+    Spectrum::measured(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap()
 }
 
 fn rel(a: f64, b: f64) -> f64 {
