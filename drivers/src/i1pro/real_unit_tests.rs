@@ -48,10 +48,10 @@ fn light(cd_m2: f64) -> View {
     View::radiance(default_light().scaled(cd_m2 / 100.0)).unwrap()
 }
 
-/// The light's XYZ on the instrument's 36 bands.
+/// The light's XYZ on the instrument's 36 bands, integrated as CIE 15 does (what the driver reports).
 fn exact(cd_m2: f64) -> [f64; 3] {
     let s = default_light().scaled(cd_m2 / 100.0);
-    let grid = Spectrum::from_grid(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
+    let grid = Spectrum::measured(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
     radiance_to_xyz(&grid, ObserverKind::Cie1931).to_array()
 }
 

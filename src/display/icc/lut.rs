@@ -21,8 +21,8 @@
 
 use moxcms::{LutDataType, LutStore, LutType, LutWarehouse, Matrix3d};
 
+use super::encode::{unit_u16, xyz_u16, IccError, CURVE_ENTRIES};
 use super::pcs::{self, Mat3, Pcs};
-use super::{unit_u16, xyz_u16, IccError, CURVE_ENTRIES};
 use crate::display::model::{DisplayModel, Lut3d};
 
 /// Most CLUT nodes per axis A2B0's subdivision aims at (33³ × 3 × 2 bytes ≈ 215 kB): its

@@ -21,6 +21,7 @@
 //! B2A0 tags ([`lut`]), which both ICC versions accept, plus matrix/TRC tags that
 //! approximate the model for readers that use nothing else.
 
+mod encode;
 pub mod layout;
 mod lut;
 pub mod pcs;
@@ -34,12 +35,10 @@ use moxcms::{
 
 use super::model::ModelParams;
 use super::profile::Profile;
+pub use encode::IccError;
+use encode::{unit_u16, CURVE_ENTRIES};
 pub use pcs::Pcs;
 pub use readback::{agreement, inverse_agreement, Agreement, IccForward, IccInverse, IccReadError};
-
-/// Entries of each matrix/TRC curve and of each lut16 input table: with linear
-/// interpolation between them a γ 2.2 curve is off by < 10⁻⁷ of full output.
-const CURVE_ENTRIES: usize = 4096;
 
 const COPYRIGHT: &str = "No copyright: measured data, use freely";
 
@@ -71,25 +70,6 @@ impl std::fmt::Display for IccVersion {
             IccVersion::V2_4 => "2.4",
         })
     }
-}
-
-/// Why an ICC profile could not be made or written.
-#[derive(Debug, thiserror::Error)]
-pub enum IccError {
-    #[error(
-        "the display white has no positive luminance (Y = {0}): an ICC profile is relative to it"
-    )]
-    White(f64),
-    #[error(
-        "the {channel} channel gives no output at full drive: its ICC curve cannot be normalised"
-    )]
-    DeadChannel { channel: &'static str },
-    #[error(
-        "the model's matrix cannot be inverted, so its black offset cannot be put into the curves"
-    )]
-    Singular,
-    #[error("the ICC encoder refused the profile: {0}")]
-    Encode(String),
 }
 
 /// What was written and how well it represents the model.
@@ -231,15 +211,4 @@ fn matrix_trc(
     icc.green_trc = trcs.next();
     icc.blue_trc = trcs.next();
     Ok(clipped)
-}
-
-/// 0–1 as a 16-bit fraction (curveType, lut16 tables and device values).
-fn unit_u16(v: f64) -> u16 {
-    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
-}
-
-/// PCS XYZ in the 16-bit encoding of lut16Type: 1.0 is 0x8000 (ICC.1:2010 Table 12 and
-/// 10.9).
-fn xyz_u16(v: f64) -> u16 {
-    (v * 32768.0).round().clamp(0.0, 65535.0) as u16
 }
