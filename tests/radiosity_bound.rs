@@ -26,8 +26,11 @@ fn rect(name: &str, c: [f64; 3], u: [f64; 3], v: [f64; 3], rho: f64) -> Value {
     json!({"name": name, "corner": c, "edge_u": u, "edge_v": v, "reflectance": rho})
 }
 
-/// The inward faces of the cube [0, a]³ (y up) as (name, corner, edge_u, edge_v).
-fn cube_faces(a: f64) -> Vec<(&'static str, [f64; 3], [f64; 3], [f64; 3])> {
+/// A face as (name, corner, edge_u, edge_v).
+type Face = (&'static str, [f64; 3], [f64; 3], [f64; 3]);
+
+/// The inward faces of the cube [0, a]³ (y up).
+fn cube_faces(a: f64) -> Vec<Face> {
     vec![
         ("floor", [0.0; 3], [0.0, 0.0, a], [a, 0.0, 0.0]),
         ("ceiling", [0.0, a, 0.0], [a, 0.0, 0.0], [0.0, 0.0, a]),
@@ -191,8 +194,8 @@ fn panel_room_references() {
         );
     }
     let h = [12.0, 13.0, 14.0].map(|k| base / k);
-    for i in 0..probes.len() {
-        let v = [raw[11][i], raw[12][i], raw[13][i]];
+    for (i, ((a, b), c)) in raw[11].iter().zip(&raw[12]).zip(&raw[13]).enumerate() {
+        let v = [*a, *b, *c];
         let q = observed_order(v, h).unwrap();
         let observed = richardson(v[1], h[1], v[2], h[2], q);
         // R∞ + h²(A + B ln h) through the three levels.
@@ -202,7 +205,9 @@ fn panel_room_references() {
             _ => h[r] * h[r] * h[r].ln(),
         });
         let log_model = m.lu().solve(&nalgebra::Vector3::from(v)).unwrap()[0];
-        println!("probe {i}: order {q:.3}, observed-order {observed:.6}, h² ln h model {log_model:.6}");
+        println!(
+            "probe {i}: order {q:.3}, observed-order {observed:.6}, h² ln h model {log_model:.6}"
+        );
     }
 }
 
@@ -222,7 +227,10 @@ fn write_room(dir: &Path, v: &Value) -> String {
 }
 
 fn temp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("metamer-radiosity-bound-{name}-{}", std::process::id()));
+    let d = std::env::temp_dir().join(format!(
+        "metamer-radiosity-bound-{name}-{}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&d);
     d
 }
@@ -238,16 +246,27 @@ fn an_emitter_hidden_in_its_ceiling_is_refused() {
         .collect();
     let panel = json!({"corner": [0.9, 2.0, 0.9], "edge_u": [0.2, 0.0, 0.0],
         "edge_v": [0.0, 0.0, 0.2], "luminance_cd_m2": 1000.0});
-    let room = write_room(&dir, &json!({"name": "r", "surfaces": surfaces, "emitters": [panel]}));
+    let room = write_room(
+        &dir,
+        &json!({"name": "r", "surfaces": surfaces, "emitters": [panel]}),
+    );
     let points = dir.join("points.csv");
     for method in ["radiosity", "path"] {
         let out = metamer(&[
-            "render", "probes", &room, "--points", points.to_str().unwrap(), "--method", method,
+            "render",
+            "probes",
+            &room,
+            "--points",
+            points.to_str().unwrap(),
+            "--method",
+            method,
         ]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{method}: {err}");
         assert!(
-            err.contains("emitters[0]") && err.contains("'ceiling'") && err.contains("cut that surface"),
+            err.contains("emitters[0]")
+                && err.contains("'ceiling'")
+                && err.contains("cut that surface"),
             "{err}"
         );
     }
@@ -261,8 +280,16 @@ fn an_unmet_tolerance_is_flagged() {
     let room = write_room(&dir, &panel_room_json());
     let points = dir.join("points.csv");
     let out = metamer(&[
-        "render", "probes", &room, "--points", points.to_str().unwrap(), "--rel-tolerance",
-        "1e-12", "--max-seconds", "6", "--json",
+        "render",
+        "probes",
+        &room,
+        "--points",
+        points.to_str().unwrap(),
+        "--rel-tolerance",
+        "1e-12",
+        "--max-seconds",
+        "6",
+        "--json",
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
@@ -285,8 +312,18 @@ fn path_tracing_probes_end_at_the_time_limit() {
     let points = dir.join("points.csv");
     let t = std::time::Instant::now();
     let out = metamer(&[
-        "render", "probes", &room, "--points", points.to_str().unwrap(), "--method", "path",
-        "--samples", "18446744073709551615", "--max-seconds", "2", "--json",
+        "render",
+        "probes",
+        &room,
+        "--points",
+        points.to_str().unwrap(),
+        "--method",
+        "path",
+        "--samples",
+        "18446744073709551615",
+        "--max-seconds",
+        "2",
+        "--json",
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
@@ -306,10 +343,34 @@ fn panel_room_json() -> Value {
         .map(|(n, c, u, v)| rect(n, c, u, v, rho))
         .collect();
     surfaces.extend([
-        rect("ceiling a", [0.0, h, 0.0], [0.9, 0.0, 0.0], [0.0, 0.0, h], rho),
-        rect("ceiling b", [1.1, h, 0.0], [0.9, 0.0, 0.0], [0.0, 0.0, h], rho),
-        rect("ceiling c", [0.9, h, 0.0], [0.2, 0.0, 0.0], [0.0, 0.0, 0.9], rho),
-        rect("ceiling d", [0.9, h, 1.1], [0.2, 0.0, 0.0], [0.0, 0.0, 0.9], rho),
+        rect(
+            "ceiling a",
+            [0.0, h, 0.0],
+            [0.9, 0.0, 0.0],
+            [0.0, 0.0, h],
+            rho,
+        ),
+        rect(
+            "ceiling b",
+            [1.1, h, 0.0],
+            [0.9, 0.0, 0.0],
+            [0.0, 0.0, h],
+            rho,
+        ),
+        rect(
+            "ceiling c",
+            [0.9, h, 0.0],
+            [0.2, 0.0, 0.0],
+            [0.0, 0.0, 0.9],
+            rho,
+        ),
+        rect(
+            "ceiling d",
+            [0.9, h, 1.1],
+            [0.2, 0.0, 0.0],
+            [0.0, 0.0, 0.9],
+            rho,
+        ),
     ]);
     let panel = json!({"corner": [0.9, h, 0.9], "edge_u": [0.2, 0.0, 0.0],
         "edge_v": [0.0, 0.0, 0.2], "luminance_cd_m2": 1000.0, "reflectance": rho});

@@ -484,7 +484,12 @@ fn spots_radiosity(
     Ok(())
 }
 
-fn probes(scene: &std::path::Path, points: &std::path::Path, opts: ProbeOptions, json: bool) -> CliResult {
+fn probes(
+    scene: &std::path::Path,
+    points: &std::path::Path,
+    opts: ProbeOptions,
+    json: bool,
+) -> CliResult {
     let scene = load(Some(scene))?;
     let csv = NumericCsv::read(points, &["x", "y", "z", "nx", "ny", "nz"])?;
     let mut probes = Vec::with_capacity(csv.rows.len());

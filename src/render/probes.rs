@@ -116,7 +116,7 @@ pub fn illuminance(
             got: opts.rel_tolerance,
         });
     }
-    if !(opts.max_seconds > 0.0) {
+    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
         return Err(ProbeError::BadOption {
             what: "the time limit",
             need: "> 0 s",
@@ -219,6 +219,9 @@ struct Sums {
 /// leaves every probe with about the same paths; Err((paths, probes done, of)) when even the
 /// first round did not finish. Each path's random numbers depend only on the seed, the
 /// probe and the path's index, so the result does not depend on how the rounds fall.
+/// The path-traced probes, the paths per probe, and why the rounds stopped early (if they did).
+type PathProbes = (Vec<Illuminance>, u64, Option<String>);
+
 fn path_probes(
     scene: &Scene,
     probes: &[Probe],
@@ -226,7 +229,7 @@ fn path_probes(
     seed: u64,
     deadline: Deadline,
     progress: &(dyn Fn(ProbeProgress) + Sync),
-) -> Result<(Vec<Illuminance>, u64, Option<String>), (u64, usize, usize)> {
+) -> Result<PathProbes, (u64, usize, usize)> {
     let total = Tracer::new(scene, Strategy::default());
     let mut first = Tracer::new(scene, Strategy::default());
     first.max_depth = Some(0);
@@ -340,7 +343,14 @@ pub fn probe_illuminance_path(
     samples: u64,
     seed: u64,
 ) -> Vec<Illuminance> {
-    path_probes(scene, probes, samples.max(2), seed, Deadline::never(), &|_| {})
-        .map(|(out, _, _)| out)
-        .unwrap_or_default()
+    path_probes(
+        scene,
+        probes,
+        samples.max(2),
+        seed,
+        Deadline::never(),
+        &|_| {},
+    )
+    .map(|(out, _, _)| out)
+    .unwrap_or_default()
 }

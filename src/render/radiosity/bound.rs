@@ -44,7 +44,7 @@ pub const MIN_ORDER: f64 = 0.5;
 /// None when they do not converge monotonically.
 pub fn observed_order(v: [f64; 3], h: [f64; 3]) -> Option<f64> {
     let (d1, d2) = (v[1] - v[0], v[2] - v[1]);
-    if !(d1 * d2 > 0.0) {
+    if d1 * d2 <= 0.0 || (d1 * d2).is_nan() {
         return None;
     }
     let ratio = d1 / d2;
@@ -94,7 +94,10 @@ pub fn estimate(v: &[f64], h: &[f64], p: f64) -> Estimate {
     let n = v.len();
     debug_assert!(n >= 3 && h.len() == n);
     let last = |k: usize| -> Estimate {
-        let (v3, h3) = ([v[k - 3], v[k - 2], v[k - 1]], [h[k - 3], h[k - 2], h[k - 1]]);
+        let (v3, h3) = (
+            [v[k - 3], v[k - 2], v[k - 1]],
+            [h[k - 3], h[k - 2], h[k - 1]],
+        );
         let fine = richardson(v3[1], h3[1], v3[2], h3[2], p);
         let coarse = richardson(v3[0], h3[0], v3[1], h3[1], p);
         // Readings equal to rounding need no order.
@@ -256,7 +259,10 @@ mod tests {
             let classical_err =
                 (richardson(vs[m - 2], hs[m - 2], vs[m - 1], hs[m - 1], 2.0) - 1.0).abs();
             if m >= 4 {
-                assert!(classical_err > classical, "level {m}: the classical bound held");
+                assert!(
+                    classical_err > classical,
+                    "level {m}: the classical bound held"
+                );
             }
             let (value, bound, regular) = extrapolated_with_bound(vs, hs, 2.0, 0.0);
             assert!(regular);

@@ -81,6 +81,25 @@ fn quadrature(e: &Emitter, tile: &Rect, x: Vec3, n: Vec3) -> f64 {
     s * tile.area_m2
 }
 
+/// The mean of g/π over a receiving rectangle, exactly, for a Lambertian emitter: the
+/// element-to-tile form factors weighted by the tiles' gains. None for a directional
+/// emitter, or when a tile straddles the element's plane (a point rule with clipping does).
+pub fn mean_factor_over(e: &Emitter, weights: &[f64], el: &Rect) -> Option<f64> {
+    if e.distribution != Distribution::Lambertian {
+        return None;
+    }
+    let mut total = 0.0;
+    for row in 0..e.rows {
+        for col in 0..e.cols {
+            let gain = weights[row * e.cols + col];
+            if gain != 0.0 {
+                total += gain * form_factor(el, &tile_rect(e, row, col), true)?;
+            }
+        }
+    }
+    Some(total)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,23 +242,4 @@ mod tests {
         let ratio = at(0.0) / at(180.0);
         assert!((ratio - 0.9 / 0.7).abs() < 1e-5, "{ratio}");
     }
-}
-
-/// The mean of g/π over a receiving rectangle, exactly, for a Lambertian emitter: the
-/// element-to-tile form factors weighted by the tiles' gains. None for a directional
-/// emitter, or when a tile straddles the element's plane (a point rule with clipping does).
-pub fn mean_factor_over(e: &Emitter, weights: &[f64], el: &Rect) -> Option<f64> {
-    if e.distribution != Distribution::Lambertian {
-        return None;
-    }
-    let mut total = 0.0;
-    for row in 0..e.rows {
-        for col in 0..e.cols {
-            let gain = weights[row * e.cols + col];
-            if gain != 0.0 {
-                total += gain * form_factor(el, &tile_rect(e, row, col), true)?;
-            }
-        }
-    }
-    Some(total)
 }

@@ -162,7 +162,11 @@ fn g2(u: f64, d: f64) -> f64 {
     if r2 == 0.0 {
         return 0.0;
     }
-    let at = if d == 0.0 { 0.0 } else { d * u * (u / d).atan() };
+    let at = if d == 0.0 {
+        0.0
+    } else {
+        d * u * (u / d).atan()
+    };
     0.25 * (u * u - d * d) * r2.ln() - 0.75 * u * u + at
 }
 
@@ -170,7 +174,11 @@ fn g2(u: f64, d: f64) -> f64 {
 fn g1(u: f64, d: f64) -> f64 {
     let r2 = u * u + d * d;
     let lg = if r2 == 0.0 { 0.0 } else { u * r2.ln() };
-    let at = if d == 0.0 { 0.0 } else { 2.0 * d * (u / d).atan() };
+    let at = if d == 0.0 {
+        0.0
+    } else {
+        2.0 * d * (u / d).atan()
+    };
     0.5 * (lg - 2.0 * u + at)
 }
 
@@ -186,7 +194,17 @@ fn skew(p0: Vec3, ua: Vec3, la: f64, q0: Vec3, ub: Vec3, lb: f64) -> f64 {
         g1(lb - m, d) - g1(-m, d)
     };
     // Panels [0, 1/64], [1/64, 1/16], … graded geometrically towards each end.
-    let cuts = [0.0, 1.0 / 64.0, 1.0 / 16.0, 0.25, 0.5, 0.75, 15.0 / 16.0, 63.0 / 64.0, 1.0];
+    let cuts = [
+        0.0,
+        1.0 / 64.0,
+        1.0 / 16.0,
+        0.25,
+        0.5,
+        0.75,
+        15.0 / 16.0,
+        63.0 / 64.0,
+        1.0,
+    ];
     let q = gauss_legendre(12);
     let mut total = 0.0;
     for w in cuts.windows(2) {
@@ -216,7 +234,9 @@ mod tests {
         let above = Rect::new(v(0.0, 0.0, 1.0), v(0.0, 1.0, 0.0), v(1.0, 0.0, 0.0));
         let (x, y) = (1.0f64, 1.0f64);
         let want = 2.0 / (std::f64::consts::PI * x * y)
-            * (((1.0 + x * x) * (1.0 + y * y) / (1.0 + x * x + y * y)).sqrt().ln()
+            * (((1.0 + x * x) * (1.0 + y * y) / (1.0 + x * x + y * y))
+                .sqrt()
+                .ln()
                 + x * (1.0 + y * y).sqrt() * (x / (1.0 + y * y).sqrt()).atan()
                 + y * (1.0 + x * x).sqrt() * (y / (1.0 + x * x).sqrt()).atan()
                 - x * x.atan()

@@ -167,10 +167,18 @@ pub fn solve(
     let warm_d = warm.map(pick);
     let sol = solve_bands(mesh, &pick(refl), src, nd, warm_d.as_deref(), deadline)?;
     let l = (0..n)
-        .flat_map(|i| of_band.iter().map(|&k| sol.l[i * nd + k]).collect::<Vec<_>>())
+        .flat_map(|i| {
+            of_band
+                .iter()
+                .map(|&k| sol.l[i * nd + k])
+                .collect::<Vec<_>>()
+        })
         .collect();
     Ok(Solution { l, ..sol })
 }
+
+/// One chunk of bands solved: its radiosities, its sweeps and its algebraic error estimate.
+type BandChunk = (Vec<f64>, usize, f64);
 
 fn solve_bands(
     mesh: &Mesh,
@@ -187,7 +195,7 @@ fn solve_bands(
         .step_by(chunk)
         .map(|b| (b, (b + chunk).min(bands)))
         .collect();
-    let parts: Vec<Result<(Vec<f64>, usize, f64), SolveFailure>> = ranges
+    let parts: Vec<Result<BandChunk, SolveFailure>> = ranges
         .par_iter()
         .map(|&(b0, b1)| {
             let k = b1 - b0;

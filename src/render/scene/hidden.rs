@@ -56,8 +56,20 @@ pub fn coplanar_overlap(a: &Rect, b: &Rect) -> f64 {
         let d = p.minus(a.corner);
         [d.dot(eu), d.dot(ev)]
     };
-    let poly_a = [a.corner, a.point(1.0, 0.0), a.point(1.0, 1.0), a.point(0.0, 1.0)].map(to2);
-    let poly_b = [b.corner, b.point(1.0, 0.0), b.point(1.0, 1.0), b.point(0.0, 1.0)].map(to2);
+    let poly_a = [
+        a.corner,
+        a.point(1.0, 0.0),
+        a.point(1.0, 1.0),
+        a.point(0.0, 1.0),
+    ]
+    .map(to2);
+    let poly_b = [
+        b.corner,
+        b.point(1.0, 0.0),
+        b.point(1.0, 1.0),
+        b.point(0.0, 1.0),
+    ]
+    .map(to2);
     area(&clip(&poly_a, &poly_b))
 }
 

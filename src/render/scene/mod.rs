@@ -33,9 +33,9 @@
 //! light is refused: every reading of it would be 0/0.
 
 mod build;
-mod hidden;
 pub mod builtin;
 pub mod file;
+mod hidden;
 mod model;
 pub mod reader;
 
