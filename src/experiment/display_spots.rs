@@ -24,8 +24,9 @@ use super::reproduction::{PatchDrive, PatchRegion};
 use crate::rig::image::RgbImage;
 use crate::rig::{MeterAim, Placement, ScreenSpot};
 use crate::session::{
-    Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, Prepare, Rig, RunEnd,
-    RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, TerminalOperator,
+    Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, Prepare, Readings, Recheck,
+    Rig, RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress,
+    TerminalOperator,
 };
 
 /// A display-spot step's own data in the journal.
@@ -131,6 +132,19 @@ impl Operator for Aiming<'_> {
             meter.set(Some(*spot));
         }
         self.inner.ask(prompt)
+    }
+
+    // The operator's own placement prompt (with its reading count) and re-aim question,
+    // not the plain defaults a wrapper would otherwise fall back to.
+    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+        if let (Some(meter), Some(spot)) = (&self.meter, self.aims.get(what)) {
+            meter.set(Some(*spot));
+        }
+        self.inner.ask_placement(what, readings)
+    }
+
+    fn recheck(&mut self, why: &str) -> Result<Recheck, OperatorError> {
+        self.inner.recheck(why)
     }
 }
 
@@ -339,4 +353,42 @@ pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> 
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A recheck that stops must reach the session: a wrapper that answered for the
+    /// operator would keep a reading the operator wanted gone.
+    struct Stopper;
+    impl Operator for Stopper {
+        fn ask(&mut self, _: &str) -> Result<Answer, OperatorError> {
+            Ok(Answer::Confirmed)
+        }
+        fn recheck(&mut self, _: &str) -> Result<Recheck, OperatorError> {
+            Ok(Recheck::Stop)
+        }
+    }
+
+    #[test]
+    fn the_aiming_wrapper_passes_on_the_reading_count_and_the_recheck() {
+        let mut scripted = ScriptedOperator::confirming();
+        let mut aiming = Aiming {
+            aims: BTreeMap::new(),
+            meter: None,
+            inner: &mut scripted,
+        };
+        let readings = Readings { first: 1, of: 5 };
+        aiming.ask_placement("aim at patch 3", readings).unwrap();
+        assert_eq!(scripted.prompts, vec!["aim at patch 3 — 5 readings"]);
+
+        let mut stopper = Stopper;
+        let mut aiming = Aiming {
+            aims: BTreeMap::new(),
+            meter: None,
+            inner: &mut stopper,
+        };
+        assert_eq!(aiming.recheck("Y differs").unwrap(), Recheck::Stop);
+    }
 }

@@ -164,7 +164,8 @@ pub const RADIOSITY_TRUE: &str = "radiosity: true error";
 
 /// Levels 1…`levels`: at each level from the third on, the seconds spent on all levels so
 /// far (the bound needs them all), the largest bound, and the largest ΔE*ab against the
-/// extrapolation of the finest three levels (each against its own white).
+/// extrapolation of the finest levels (each against its own white), up to two levels below
+/// the finest.
 pub fn radiosity_points(
     scene: &Scene,
     levels: usize,
@@ -175,7 +176,7 @@ pub fn radiosity_points(
     let mut done = Vec::new();
     let mut spent = Vec::new();
     let mut total = 0.0;
-    for level in 1..=levels.max(4) {
+    for level in 1..=levels.max(5) {
         let l = run_level(&prepared, &opts, level, super::deadline::Deadline::never())?;
         total += l.seconds;
         log(&format!(
@@ -187,9 +188,15 @@ pub fn radiosity_points(
     }
     let n = done.len();
     let (finest, fw) = combine(&done, &opts);
+    let reference_bound = finest.iter().map(|a| a.de_bound).fold(0.0, f64::max);
+    log(&format!(
+        "radiosity reference: levels 1–{n}, its own bound ΔE*ab {reference_bound:.5}"
+    ));
     let lab = |x: [f64; 3], w: [f64; 3]| Xyz::from_array(x).to_lab(Xyz::from_array(w));
     let mut points = Vec::new();
-    for m in 3..n {
+    // A level's error is measured against a reference two or more levels finer: one level
+    // finer, the reference's own error (its bound) is as large as the error it measures.
+    for m in 3..n - 1 {
         let (r, w) = combine(&done[..m], &opts);
         let errors: Vec<f64> = r
             .iter()
