@@ -150,6 +150,10 @@ pub fn run(
         let mut session = open_stage(options, stage, &records, options.resume)?;
         let total = session.plan().steps.len();
         if session.done() == total {
+            // Nothing to run, so the session does not report what resuming repaired.
+            for note in &session.notes {
+                progress.note(note);
+            }
             continue;
         }
         if session.recovered > 0 || session.torn_bytes > 0 {

@@ -13,6 +13,7 @@ pub mod cache;
 pub mod display;
 pub mod display_spots;
 mod error;
+mod preflight;
 mod progress;
 pub mod readings;
 pub mod report_sections;

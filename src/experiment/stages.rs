@@ -68,7 +68,7 @@ fn need(stage: Stage, path: PathBuf) -> Result<PathBuf, ExperimentError> {
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, ExperimentError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
+    let text = metamer_color::text::read_text(path).map_err(|source| ExperimentError::Io {
         file: path.to_path_buf(),
         source,
     })?;
@@ -126,6 +126,16 @@ pub fn run(
             }
         }
     }
+    super::preflight::check(opts)?;
+    // The user's box files are this run's inputs: no stage may write onto them, by any
+    // name (a link, a hard link), whatever policy it writes with.
+    let _given = match &opts.box_source {
+        BoxSource::Existing { scene, spots } => Some(crate::output::guard_inputs([
+            scene.as_path(),
+            spots.as_path(),
+        ])),
+        BoxSource::Measure(_) => None,
+    };
     let mut outcomes = Vec::new();
     for stage in Stage::ALL {
         if opts.stage.is_some_and(|s| s != stage) {
@@ -136,7 +146,10 @@ pub fn run(
         let inputs = inputs_of(stage, opts)?;
         let forced = opts.stage == Some(stage);
         let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
-        if !forced && ((stage == Stage::Box && given_box) || sd.reusable(&inputs).is_some()) {
+        if !forced
+            && ((stage == Stage::Box && given_box)
+                || sd.reusable(&inputs, stage.products()).is_some())
+        {
             if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
                 progress(Progress::Note(format!(
                     "box: given, measured earlier or elsewhere ({} and {})",

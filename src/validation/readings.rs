@@ -95,6 +95,10 @@ pub struct ReadingSet {
     pub instruments: Vec<String>,
     /// Things the reader should know (skipped entries, a torn last line).
     pub notes: Vec<String>,
+    /// How the readings were taken when the file says they are not luminances (a journal
+    /// of reflective-mode entries): see [`super::plausible`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_as: Option<String>,
 }
 
 impl ReadingSet {
@@ -219,7 +223,9 @@ pub fn parse_readings(text: &str, file: &Path) -> Result<ReadingSet, ReadingsErr
         p.csv(text)?;
         Format::Csv
     };
-    p.finish(format)
+    let mut set = p.finish(format)?;
+    set.measured_as = super::plausible::not_luminance(text, format);
+    Ok(set)
 }
 
 struct Parsed {
@@ -327,6 +333,7 @@ impl Parsed {
             white: (!white.is_empty()).then(|| combine(&white)),
             instruments: self.instruments,
             notes: self.notes,
+            measured_as: None,
         })
     }
 }

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use metamer::boxmeasure::{BoxPlan, Stage};
-use metamer::experiment::cache::{Inputs, StageDir};
+use metamer::experiment::cache::{Inputs, Product, StageDir};
 use metamer::light::{fit, Falloff, ModelChoice};
 use metamer::session::{Header, Journal};
 use metamer::validation::readings::parse_readings;
@@ -100,13 +100,24 @@ fn journal_header(seed: &[u8]) -> Header<Value> {
 fn journal(bytes: &[u8], dir: &Path, expected: &Header<Value>) -> Check {
     let path = scratch(dir, "log.jsonl", bytes);
     let _ = std::fs::remove_file(metamer::session::torn_path(&path));
+    let _ = std::fs::remove_file(metamer::session::duplicates_path(&path));
     if let Ok((_, recovered)) = Journal::<Value, Value>::resume(&path, expected) {
         let kept = std::fs::metadata(&path).map_err(|e| e.to_string())?.len() as usize;
-        if kept + recovered.torn_bytes < bytes.len() {
+        let aside = recovered.torn_bytes + recovered.duplicate_bytes;
+        if kept + aside < bytes.len() {
             return Err(format!(
                 "{} bytes of the journal neither kept nor set aside",
-                bytes.len() - kept - recovered.torn_bytes
+                bytes.len() - kept - aside
             ));
+        }
+        // Every step is in what was kept once: the later entries were set aside.
+        let mut steps = std::collections::BTreeSet::new();
+        for (line, e) in &recovered.entries {
+            if let Some(step) = e.get("index").and_then(Value::as_u64) {
+                if !steps.insert(step) {
+                    return Err(format!("step {step} kept twice (line {line})"));
+                }
+            }
         }
     }
     Ok(())
@@ -131,7 +142,15 @@ fn stage_record(bytes: &[u8], dir: &Path) -> Check {
     std::fs::create_dir_all(&stage.dir).map_err(|e| e.to_string())?;
     std::fs::write(stage.path("stage.json"), bytes).map_err(|e| e.to_string())?;
     std::fs::write(stage.path("out.txt"), b"output\n").map_err(|e| e.to_string())?;
-    let _ = stage.reusable(&Inputs::new().value("options", &1));
+    let products = [Product {
+        file: "out.txt",
+        always: true,
+    }];
+    if let Some(record) = stage.reusable(&Inputs::new().value("options", &1), &products) {
+        if !record.outputs.contains_key("out.txt") {
+            return Err("a record that leaves its product out was trusted".into());
+        }
+    }
     Ok(())
 }
 
@@ -143,8 +162,12 @@ fn seed_stage_record(dir: &Path) -> Vec<u8> {
     let inputs = Inputs::new().value("options", &1);
     stage.finish(&inputs, &["out.txt"], 1.5).unwrap();
     let bytes = std::fs::read(stage.path("stage.json")).unwrap();
+    let products = [Product {
+        file: "out.txt",
+        always: true,
+    }];
     assert!(
-        stage.reusable(&inputs).is_some(),
+        stage.reusable(&inputs, &products).is_some(),
         "the seed record is reusable"
     );
     std::fs::remove_dir_all(&stage.dir).unwrap();
@@ -165,7 +188,7 @@ pub fn all(dir: &Path) -> Vec<Target> {
             seeds: vec![
                 br#"{"repeats": 2, "geometry": {"rows": 3, "cols": 3}}"#.to_vec(),
                 br#"{"repeats": 3, "material_repeats": 2, "falloff_repeats": 2,
-                     "falloff_angles_deg": [0, 20, 40, 60], "falloff_tile": [1, 1],
+                     "falloff_angles_deg": [-40, 0, 20, 60], "falloff_tile": [1, 1],
                      "patches": [1, 2, 19, 24],
                      "geometry": {"size_m": 0.5, "rows": 5, "cols": 5,
                                   "light_m": [0.1, 0.1, 0.3, 0.3],
