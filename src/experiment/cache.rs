@@ -371,7 +371,8 @@ mod tests {
         assert!(s.reusable(&inputs, &[]).is_some());
         let record = s.path(RECORD_FILE);
         let c = std::ffi::CString::new(record.as_os_str().as_encoded_bytes()).unwrap();
-        let make: [(&str, Box<dyn Fn()>); 3] = [
+        type Make<'a> = (&'a str, Box<dyn Fn() + 'a>);
+        let make: [Make; 3] = [
             (
                 "a FIFO",
                 // SAFETY: a NUL-terminated path and a mode.

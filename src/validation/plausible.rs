@@ -135,13 +135,14 @@ pub fn check_white_against(white: Xyz, sets: &[&ReadingSet]) -> Result<(), Impla
             lstar: l,
             hint,
         };
-        if !(l <= MAX_LSTAR) {
+        // NaN (a white of Y = 0) fails both.
+        if l.is_nan() || l > MAX_LSTAR {
             return Err(scale(
                 "brightest",
                 "the white and the readings are in different units (a relative white such as 0.95,1,1.09 or Y = 100 against readings in cd/m²?); give the white in the readings' unit, or `test` / `reference` for a file's own white",
             ));
         }
-        if !(l >= MIN_LSTAR) {
+        if l < MIN_LSTAR {
             return Err(scale(
                 "brightest",
                 "every reading is black against this white: the white and the readings are in different units (a white in cd/m² against readings relative to 1?)",

@@ -69,11 +69,13 @@ pub fn reading_problem(reading: &Reading) -> Option<String> {
         .iter()
         .chain(&reading.xyz)
         .fold(0.0f64, |m, v| m.max(v.abs()));
-    let apart = reading
-        .xyz
-        .iter()
-        .zip(&from_spectrum)
-        .any(|(a, b)| !((a - b).abs() <= SPECTRUM_TOLERANCE * scale + 1e-12));
+    // A spectrum of 1e308s gives no finite XYZ (and a tolerance of infinity): apart.
+    let apart = !scale.is_finite()
+        || reading
+            .xyz
+            .iter()
+            .zip(&from_spectrum)
+            .any(|(a, b)| (a - b).abs() > SPECTRUM_TOLERANCE * scale + 1e-12);
     apart.then(|| {
         format!(
             "its X, Y, Z = {:?} do not follow from its spectrum, which gives {:?}: the line was edited or damaged; restore it, or delete the line to measure the step again",
