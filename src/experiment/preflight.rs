@@ -6,9 +6,9 @@ use std::path::Path;
 
 use super::box_stage::BoxMeasure;
 use super::error::ExperimentError;
+use super::options::{BoxSource, ExperimentOptions};
 use super::readings::read_readings;
 use super::stage::Stage;
-use super::stages::{BoxSource, ExperimentOptions};
 use crate::boxmeasure::BoxPlan;
 use crate::render::Scene;
 

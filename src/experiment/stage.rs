@@ -2,20 +2,6 @@
 
 use serde::Serialize;
 
-use super::cache::Product;
-use super::{box_stage, display, display_spots, reproduction, simulation, validate};
-
-const fn always(file: &'static str) -> Product {
-    Product { file, always: true }
-}
-
-const fn sometimes(file: &'static str) -> Product {
-    Product {
-        file,
-        always: false,
-    }
-}
-
 /// The stages, in the order they run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Stage {
@@ -46,43 +32,6 @@ impl Stage {
             Stage::Reproduction => "reproduction",
             Stage::DisplaySpots => "display-spots",
             Stage::Validation => "validation",
-        }
-    }
-
-    /// The files of the stage that later stages, the report or the command read: a stage
-    /// record that does not vouch for each of them is not trusted.
-    pub fn products(self) -> &'static [Product] {
-        const BOX: &[Product] = &[
-            always(box_stage::SCENE_FILE),
-            always(box_stage::SPOTS_FILE),
-            sometimes("light.json"),
-        ];
-        const SIMULATION: &[Product] = &[
-            always(simulation::SPOTS_FILE),
-            always(simulation::SUMMARY_FILE),
-            sometimes(simulation::IMAGE_FILE),
-        ];
-        const DISPLAY: &[Product] = &[
-            always(display::PROFILE_FILE),
-            always(display::SETTING_FILE),
-            sometimes(display::SUMMARY_FILE),
-        ];
-        const REPRODUCTION: &[Product] = &[
-            always(reproduction::FILE),
-            sometimes(reproduction::IMAGE_FILE),
-        ];
-        const DISPLAY_SPOTS: &[Product] = &[
-            always(display_spots::SPOTS_FILE),
-            sometimes(display_spots::RECORD_FILE),
-        ];
-        const VALIDATION: &[Product] = &[always(validate::FILE)];
-        match self {
-            Stage::Box => BOX,
-            Stage::Simulation => SIMULATION,
-            Stage::Display => DISPLAY,
-            Stage::Reproduction => REPRODUCTION,
-            Stage::DisplaySpots => DISPLAY_SPOTS,
-            Stage::Validation => VALIDATION,
         }
     }
 }

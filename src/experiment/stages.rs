@@ -7,44 +7,16 @@ use serde::Serialize;
 
 use super::box_stage::{self, BoxMeasure};
 use super::cache::{Inputs, StageDir, RECORD_FILE};
-use super::display::{characterize_display, DisplayOptions, DisplaySetting};
+use super::display::{characterize_display, DisplaySetting};
 use super::error::ExperimentError;
+use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
 use super::readings::read_readings;
-use super::reproduction::{reproduce, Reproduction, ReproductionOptions};
-use super::simulation::{simulate, SimulationOptions, SimulationSummary};
+use super::reproduction::{reproduce, Reproduction};
+use super::simulation::{simulate, SimulationSummary};
 use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
 use crate::display::Profile;
-use crate::session::RunOptions;
-
-/// Where the box's measurements come from.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub enum BoxSource {
-    /// Measured here, by the `measure-box` session into `box/`.
-    Measure(BoxMeasure),
-    /// Measurements taken earlier or elsewhere: the measured scene and the spot readings.
-    Existing { scene: PathBuf, spots: PathBuf },
-}
-
-/// What an experiment is made of.
-#[derive(Clone, Debug)]
-pub struct ExperimentOptions {
-    pub dir: PathBuf,
-    pub box_source: BoxSource,
-    pub simulation: SimulationOptions,
-    pub display: DisplayOptions,
-    pub reproduction: ReproductionOptions,
-    /// Spot readings averaged per patch on the display.
-    pub repeats: usize,
-    /// Run only this stage (again, even if its inputs are unchanged).
-    pub stage: Option<Stage>,
-    /// Continue an interrupted measuring stage's journal.
-    pub resume: bool,
-    /// Nobody at the rig: every operator request counts as done (simulated rigs).
-    pub unattended: bool,
-    pub run: RunOptions,
-}
 
 /// How one stage went.
 #[derive(Clone, Debug, Serialize)]
@@ -148,7 +120,9 @@ pub fn run(
         let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
         if !forced
             && ((stage == Stage::Box && given_box)
-                || sd.reusable(&inputs, stage.products()).is_some())
+                || sd
+                    .reusable(&inputs, super::products::products(stage))
+                    .is_some())
         {
             if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
                 progress(Progress::Note(format!(

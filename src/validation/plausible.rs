@@ -9,9 +9,7 @@
 //! (a display whose readings are ten times the box's) is said as a note, since a display
 //! that far off is also a result.
 
-use serde_json::Value;
-
-use super::readings::{Format, ReadingSet};
+use super::readings::ReadingSet;
 use crate::color::{Xyz, COLORCHECKER_NAMES};
 
 /// A white against which some set's brightest reading lies above this L* is in other
@@ -44,30 +42,6 @@ pub enum Implausible {
         lstar: f64,
         hint: &'static str,
     },
-}
-
-/// How readings in `text` (a journal) were taken, when not as light from the scene: the
-/// first entry in reflective or ambient mode, with its line. Other formats do not say.
-pub fn not_luminance(text: &str, format: Format) -> Option<String> {
-    if format != Format::Journal {
-        return None;
-    }
-    for (i, line) in text.lines().enumerate() {
-        let Ok(v) = serde_json::from_str::<Value>(line) else {
-            continue;
-        };
-        if v["type"] != "entry" {
-            continue;
-        }
-        let mode = v["mode"].as_str().unwrap_or_default();
-        let what = match mode {
-            "reflective" => "of surfaces on the instrument's lamp (reflectance, white = 100)",
-            "ambient" => "as illuminance through the instrument's diffuser (lux)",
-            _ => continue,
-        };
-        return Some(format!("in {mode} mode, {what} (line {})", i + 1));
-    }
-    None
 }
 
 /// Refuses a set whose file says its readings are not luminances.
@@ -180,7 +154,7 @@ pub fn scale_note(reference: &ReadingSet, test: &ReadingSet) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::validation::readings::parse_readings;
+    use crate::validation::readings::{not_luminance, parse_readings, Format};
     use std::path::Path;
 
     fn csv(rows: &[(usize, f64)]) -> ReadingSet {

@@ -224,8 +224,32 @@ pub fn parse_readings(text: &str, file: &Path) -> Result<ReadingSet, ReadingsErr
         Format::Csv
     };
     let mut set = p.finish(format)?;
-    set.measured_as = super::plausible::not_luminance(text, format);
+    set.measured_as = not_luminance(text, format);
     Ok(set)
+}
+
+/// How readings in `text` (a journal) were taken, when not as light from the scene: the
+/// first entry in reflective or ambient mode, with its line. Other formats do not say.
+pub fn not_luminance(text: &str, format: Format) -> Option<String> {
+    if format != Format::Journal {
+        return None;
+    }
+    for (i, line) in text.lines().enumerate() {
+        let Ok(v) = serde_json::from_str::<Value>(line) else {
+            continue;
+        };
+        if v["type"] != "entry" {
+            continue;
+        }
+        let mode = v["mode"].as_str().unwrap_or_default();
+        let what = match mode {
+            "reflective" => "of surfaces on the instrument's lamp (reflectance, white = 100)",
+            "ambient" => "as illuminance through the instrument's diffuser (lux)",
+            _ => continue,
+        };
+        return Some(format!("in {mode} mode, {what} (line {})", i + 1));
+    }
+    None
 }
 
 struct Parsed {

@@ -2,10 +2,7 @@
 //! entry of a step is another session's work) and whether its reading is one an
 //! instrument gave.
 
-use metamer_color::text::echo;
 use metamer_drivers::Reading;
-
-use crate::session::record::Entry;
 
 /// What the journal checks of an entry it reads back. Both have defaults: an entry that
 /// names no step is never a duplicate, and one with nothing to check has no problem.
@@ -18,19 +15,6 @@ pub trait JournalEntry {
     /// Why the entry cannot be what a session wrote (a reading edited or damaged), if so.
     fn problem(&self) -> Option<String> {
         None
-    }
-}
-
-/// Entries of a session journal: the step is the plan index, and the reading must be one
-/// an instrument can have given.
-impl<D> JournalEntry for Entry<D> {
-    fn step(&self) -> Option<usize> {
-        Some(self.index)
-    }
-
-    fn problem(&self) -> Option<String> {
-        reading_problem(&self.reading)
-            .map(|p| format!("step {} ({}): {p}", self.index, echo(&self.label)))
     }
 }
 

@@ -5,7 +5,7 @@ use std::fs::{File, OpenOptions};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
-use super::{io, sync_dir, JournalError};
+use super::error::{io, JournalError};
 use crate::output::owned_file;
 
 /// Takes the journal's advisory lock without waiting: held until the file is closed (the
@@ -121,4 +121,14 @@ pub(super) fn rewrite(path: &Path, old: &File, bytes: &[u8]) -> Result<File, Jou
     }
     sync_dir(path)?;
     Ok(file)
+}
+
+/// Makes a new file's directory entry durable too (POSIX: fsync of the file alone does
+/// not guarantee its name survives a crash).
+pub(super) fn sync_dir(path: &Path) -> Result<(), JournalError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    File::open(dir).and_then(|d| d.sync_all()).map_err(io(dir))
 }
