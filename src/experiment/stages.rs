@@ -347,6 +347,10 @@ fn run_stage(
 mod tests {
     use super::*;
     use crate::display::ModelKind;
+    use crate::experiment::display::DisplayOptions;
+    use crate::experiment::reproduction::ReproductionOptions;
+    use crate::experiment::simulation::SimulationOptions;
+    use crate::session::RunOptions;
 
     fn given(dir: &Path, scene: PathBuf, spots: PathBuf) -> ExperimentOptions {
         ExperimentOptions {
