@@ -15,16 +15,26 @@
 //!   is what a careless `rename` does to `/dev/null` as root). Writing in place is not
 //!   atomic, and nothing else is possible for a stream. A block device is refused: no
 //!   command's output is a disk image.
+//!   A FIFO waits for its reader at most [`FIFO_READER_WAIT`]: one that nothing reads is
+//!   an error, not a command that hangs in `open`.
 //! * **Never onto an input.** An output that is one of the command's inputs — same canonical
 //!   path, or same device and inode (hard links, bind mounts) — is refused, naming both.
+//!   Inputs registered with [`guard_inputs`] are refused by every policy of the process
+//!   while the guard lives: a command whose outputs are written by many parts (the
+//!   experiment's stages) registers a user's files once.
 //! * **Never onto an existing file unless forced.** `force` is the command's `--force` (or
 //!   its documented resume option for the files it owns). Devices and FIFOs are streams,
 //!   not files with content to lose, so they need no force.
+//!
+//! Files a command owns and reads back (a journal it appends to, a stage record) are
+//! checked with [`owned_file`] before they are opened: a FIFO would block the read for ever
+//! and a device never ends, so only a regular file (or a link to one) is read.
 
 use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// Why an output was not written.
 #[derive(Debug, thiserror::Error)]
@@ -43,6 +53,13 @@ pub enum OutputError {
     NoDirectory { path: PathBuf, dir: PathBuf },
     #[error("cannot write {path}: too many levels of symbolic links")]
     SymlinkLoop { path: PathBuf },
+    #[error("cannot write {path}: it is a named pipe (FIFO) that nothing is reading")]
+    NoReader { path: PathBuf },
+    /// A file the command owns (a journal, a record) is something else.
+    #[error("{path} is {what}, not a file this program wrote: move it away, or choose another output directory")]
+    NotAFile { path: PathBuf, what: &'static str },
+    #[error("{path} is a symbolic link to {target}, which does not exist: remove the link, or point it at the file")]
+    DanglingLink { path: PathBuf, target: PathBuf },
     #[error("cannot write {path}: {action}: {source}")]
     Io {
         path: PathBuf,
@@ -108,12 +125,7 @@ impl OutputPolicy {
     /// Registers a file the command reads; no output may be written onto it. A path that
     /// does not exist (yet) is remembered as given.
     pub fn input(&mut self, p: &Path) {
-        let meta = std::fs::metadata(p).ok();
-        self.inputs.push(Input {
-            given: p.to_path_buf(),
-            canonical: std::fs::canonicalize(p).ok(),
-            id: meta.as_ref().map(file_id),
-        });
+        self.inputs.push(Input::of(p));
     }
 
     /// Registers several inputs.
@@ -150,10 +162,12 @@ impl OutputPolicy {
                         source,
                     }
                 };
-                let file = OpenOptions::new()
-                    .write(true)
-                    .open(out)
-                    .map_err(io_err("open"))?;
+                let file = open_stream(out).map_err(|e| match e.raw_os_error() {
+                    Some(libc::ENXIO) => OutputError::NoReader {
+                        path: out.to_path_buf(),
+                    },
+                    _ => io_err("open")(e),
+                })?;
                 let mut w = BufWriter::new(file);
                 f(&mut w).map_err(io_err("write"))?;
                 w.flush().map_err(io_err("write"))
@@ -202,7 +216,7 @@ impl OutputPolicy {
         if let Some(input) = self.input_matching(&path, meta.as_ref()) {
             return Err(OutputError::IsInput {
                 output: out.to_path_buf(),
-                input: input.given.clone(),
+                input: input.given,
             });
         }
         let Some(meta) = meta else {
@@ -231,15 +245,163 @@ impl OutputPolicy {
         }
     }
 
-    fn input_matching(&self, out: &Path, meta: Option<&std::fs::Metadata>) -> Option<&Input> {
+    fn input_matching(&self, out: &Path, meta: Option<&std::fs::Metadata>) -> Option<Input> {
         let canonical = canonical_even_if_missing(out);
         let id = meta.map(file_id);
-        self.inputs.iter().find(|i| {
+        let matches = |i: &&Input| {
             (i.canonical.is_some() && i.canonical == canonical)
                 || (i.id.is_some() && i.id == id)
                 || (i.canonical.is_none() && absolute(&i.given) == absolute(out))
-        })
+        };
+        if let Some(i) = self.inputs.iter().find(matches) {
+            return Some(i.clone());
+        }
+        let guarded = GUARDED.lock().unwrap_or_else(|e| e.into_inner());
+        guarded.iter().map(|(_, i)| i).find(matches).cloned()
     }
+}
+
+impl Input {
+    fn of(p: &Path) -> Input {
+        let meta = std::fs::metadata(p).ok();
+        Input {
+            given: p.to_path_buf(),
+            canonical: std::fs::canonicalize(p).ok(),
+            id: meta.as_ref().map(file_id),
+        }
+    }
+}
+
+/// Inputs every policy of the process refuses to write onto, with the guard that put them
+/// there.
+static GUARDED: Mutex<Vec<(u64, Input)>> = Mutex::new(Vec::new());
+
+/// While it lives, no [`OutputPolicy`] of this process writes onto the files it was made
+/// with ([`guard_inputs`]).
+#[must_use = "the inputs are guarded only while the guard lives"]
+pub struct InputGuard {
+    id: u64,
+}
+
+/// Registers `paths` as inputs of every output policy of the process until the returned
+/// guard is dropped: for a command whose outputs are written by parts that each make their
+/// own policy, so a user's file cannot be replaced by any of them.
+pub fn guard_inputs<'a>(paths: impl IntoIterator<Item = &'a Path>) -> InputGuard {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let id = NEXT.fetch_add(1, Ordering::Relaxed);
+    let mut guarded = GUARDED.lock().unwrap_or_else(|e| e.into_inner());
+    guarded.extend(paths.into_iter().map(|p| (id, Input::of(p))));
+    InputGuard { id }
+}
+
+impl Drop for InputGuard {
+    fn drop(&mut self) {
+        let mut guarded = GUARDED.lock().unwrap_or_else(|e| e.into_inner());
+        guarded.retain(|(id, _)| *id != self.id);
+    }
+}
+
+/// What stands at the path of a file a command owns and reads back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Owned {
+    /// Nothing: the command may create it.
+    Absent,
+    /// A regular file, or a symbolic link to one.
+    File,
+}
+
+/// Checks the path of a file the command owns (a journal it appends to, a record it
+/// re-reads) as an input is checked, before anything opens it: only nothing or a regular
+/// file (through links) will do. A FIFO would block the open for ever, a device never
+/// ends, a directory is no file, and a dangling link would make the program create a file
+/// wherever it points (or report an empty file that is not there).
+pub fn owned_file(path: &Path) -> Result<Owned, OutputError> {
+    match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Owned::Absent),
+        Err(source) => {
+            return Err(OutputError::Io {
+                path: path.to_path_buf(),
+                action: "inspect",
+                source,
+            })
+        }
+        Ok(_) => {}
+    }
+    let target = follow_links(path)?;
+    let meta = match std::fs::metadata(&target) {
+        Ok(m) => m,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            return Err(OutputError::DanglingLink {
+                path: path.to_path_buf(),
+                target,
+            })
+        }
+        Err(source) => {
+            return Err(OutputError::Io {
+                path: path.to_path_buf(),
+                action: "inspect",
+                source,
+            })
+        }
+    };
+    use std::os::unix::fs::FileTypeExt;
+    let t = meta.file_type();
+    let what = if t.is_file() {
+        return Ok(Owned::File);
+    } else if t.is_dir() {
+        "a directory"
+    } else if t.is_fifo() {
+        "a named pipe (FIFO)"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a regular file"
+    };
+    Err(OutputError::NotAFile {
+        path: path.to_path_buf(),
+        what,
+    })
+}
+
+/// How long a FIFO output may wait for its reader: one started with the command (`cat
+/// pipe &`) has opened it long before; one that never comes is an error, not a command
+/// waiting in `open` for ever.
+pub const FIFO_READER_WAIT: std::time::Duration = std::time::Duration::from_secs(3);
+
+/// Opens a device or FIFO for writing. A FIFO's blocking open waits for a reader for
+/// ever; opened without waiting, one that has none fails (ENXIO), which is tried again
+/// for [`FIFO_READER_WAIT`]. The writes then block as a pipe's do.
+fn open_stream(out: &Path) -> io::Result<File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    use std::os::unix::io::AsRawFd;
+    let start = std::time::Instant::now();
+    let file = loop {
+        match OpenOptions::new()
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(out)
+        {
+            Err(e)
+                if e.raw_os_error() == Some(libc::ENXIO) && start.elapsed() < FIFO_READER_WAIT =>
+            {
+                std::thread::sleep(std::time::Duration::from_millis(20))
+            }
+            r => break r?,
+        }
+    };
+    // SAFETY: fcntl on a descriptor this function owns, with integer arguments only.
+    unsafe {
+        let fd = file.as_raw_fd();
+        let flags = libc::fcntl(fd, libc::F_GETFL);
+        if flags < 0 || libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) < 0 {
+            return Err(io::Error::last_os_error());
+        }
+    }
+    Ok(file)
 }
 
 enum Kind {

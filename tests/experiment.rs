@@ -127,6 +127,70 @@ fn stages_run_once_and_rerun_only_downstream_of_a_change() {
         stages(&second)
     );
 
+    // A stage record is trusted only as far as it vouches, and read only when it is a
+    // small regular file: a link to /dev/zero, a 6 GB sparse file or a FIFO is not read
+    // (it once was read whole, or waited for a writer), and one that leaves its product out
+    // (`"outputs": {}`) does not let an edited product pass as the stage's work. Each
+    // re-runs the stage, at once, and restores what it writes.
+    let record = out.join("validation/stage.json");
+    let comparisons = out.join("validation/comparisons.json");
+    let good = std::fs::read(&comparisons).unwrap();
+    let vouched = std::fs::read_to_string(&record).unwrap();
+    let mut empty: serde_json::Value = serde_json::from_str(&vouched).unwrap();
+    empty["outputs"] = serde_json::json!({});
+    type Damage<'a> = (&'a str, Box<dyn Fn() + 'a>);
+    let damages: [Damage; 4] = [
+        (
+            "a link to /dev/zero",
+            Box::new(|| std::os::unix::fs::symlink("/dev/zero", &record).unwrap()),
+        ),
+        (
+            "a 6 GB sparse file",
+            Box::new(|| {
+                std::fs::File::create(&record)
+                    .unwrap()
+                    .set_len(6 << 30)
+                    .unwrap()
+            }),
+        ),
+        (
+            "a FIFO",
+            Box::new(|| {
+                let c = std::ffi::CString::new(record.as_os_str().as_encoded_bytes()).unwrap();
+                // SAFETY: a NUL-terminated path and a mode.
+                assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+            }),
+        ),
+        (
+            "outputs {} and an edited product",
+            Box::new(|| {
+                std::fs::write(&record, empty.to_string()).unwrap();
+                std::fs::write(&comparisons, b"{\"edited\": true}").unwrap();
+            }),
+        ),
+    ];
+    for (what, damage) in damages {
+        std::fs::remove_file(&record).unwrap();
+        damage();
+        let start = Instant::now();
+        let again = run(&out, &spots, &[]);
+        assert!(start.elapsed() < Duration::from_secs(60), "{what}");
+        assert_eq!(how(&again, "validation"), "ran", "{what}");
+        assert_eq!(how(&again, "display-spots"), "re-used", "{what}");
+        assert!(
+            std::fs::symlink_metadata(&record)
+                .unwrap()
+                .file_type()
+                .is_file(),
+            "{what}"
+        );
+        assert!(
+            std::fs::metadata(&record).unwrap().len() < 1 << 20,
+            "{what}"
+        );
+        assert_eq!(std::fs::read(&comparisons).unwrap(), good, "{what}");
+    }
+
     // More repeats on the display: only the display readings and what follows them.
     let third = run(&out, &spots, &["--repeats", "2"]);
     for (s, expect) in [

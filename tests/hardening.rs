@@ -279,3 +279,33 @@ fn an_exr_header_claiming_more_pixels_than_its_file_can_hold_is_refused_before_d
     let e = read_xyz_image(&big).unwrap_err().to_string();
     assert!(e.contains("8192×8192 pixels, more than a file of"), "{e}");
 }
+
+/// A profile whose tone curve ends at 1e300 predicted colours no display shows, and
+/// `verify` printed "ΔE00 mean NaN … max 3.649" with exit 0 (the maximum hid the NaN
+/// patch). The first such patch is now an error naming it, and nothing prints NaN.
+#[test]
+fn verify_refuses_a_profile_whose_predictions_are_no_colours() {
+    let mut json = profile_json();
+    let trc = &mut json["parameters"]["trc"][0];
+    assert_eq!(trc["type"], "table", "{trc}");
+    let last = trc["value"].as_array().unwrap().len() - 1;
+    trc["value"][last] = serde_json::json!(1e300);
+    let path = scratch("trc-1e300.json");
+    std::fs::write(&path, json.to_string()).unwrap();
+    let o = metamer(&[
+        "verify",
+        "--profile",
+        path.to_str().unwrap(),
+        "--measurements",
+        dispread().to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("the profile predicts X, Y, Z")
+            && e.contains("which is not a colour a display shows"),
+        "{e}"
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(!out.contains("NaN") && !e.contains("NaN"), "{out}{e}");
+}

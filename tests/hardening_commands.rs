@@ -451,3 +451,72 @@ fn a_billion_repeats_is_refused_before_measuring() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A white in other units than the readings (`--white 0.95,1,1.09` against cd/m²: L* 290)
+/// or of 1e-300 gave NaN and infinite colour differences with exit 0; readings taken on the
+/// instrument's lamp (reflectance, white = 100) were compared as light without a word.
+/// Each is refused before anything is written, naming the file or the option.
+#[test]
+fn validate_refuses_a_white_or_readings_in_other_units() {
+    let d = root().join("tests/data/validate");
+    let dir = scratch("units");
+    let out = dir.join("out");
+    let display = d.join("display.csv");
+    let validate = |reference: &Path, extra: &[&str]| {
+        let args = [
+            &[
+                "validate",
+                "--reference",
+                reference.to_str().unwrap(),
+                "--test",
+                display.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ][..],
+            extra,
+        ]
+        .concat();
+        metamer(&args)
+    };
+    // The readings here are relative to a white of Y = 100.
+    let box_csv = d.join("box.csv");
+    for (white, words) in [
+        ("0.95,1,1.09", "different units (a relative white"),
+        ("1e-300,1e-300,1e-300", "different units"),
+        ("1e-300,1,1", "is not a white: its chromaticity"),
+        (
+            "1e6,1.05e6,1.1e6",
+            "every reading is black against this white",
+        ),
+    ] {
+        let o = validate(&box_csv, &["--white", white]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{white}: {e}");
+        assert!(e.contains("--white: ") && e.contains(words), "{white}: {e}");
+        assert!(!e.contains("NaN") && !e.contains("inf"), "{e}");
+        assert!(!out.exists(), "nothing written");
+    }
+    // A box journal of reflectances (the materials stage) as the box's readings.
+    let header = r#"{"type":"header","format":"metamer-session-journal","version":2,"kind":"measure-box","fingerprint":"x","options":{},"steps":24,"started_s":0,"data":{"instruments":{},"details":null}}"#;
+    let mut journal = String::from(header) + "\n";
+    for patch in 1..=24 {
+        journal += &format!(
+            r#"{{"type":"entry","index":{i},"label":"reflectance {patch} #1","role":"spectral","mode":"reflective","data":{{"stage":"materials","target":"patch","patch":{patch},"repeat":0}},"reading":{{"xyz":[30,31,32],"xyy":[0.32,0.33,31],"spectrum":null,"flags":[],"integration_s":null,"instrument":"i1pro","timestamp_s":0}}}}"#,
+            i = patch - 1
+        );
+        journal.push('\n');
+    }
+    let materials = dir.join("materials.jsonl");
+    std::fs::write(&materials, journal).unwrap();
+    let o = validate(&materials, &[]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("materials.jsonl: its readings were taken in reflective mode")
+            && e.contains("line 2")
+            && e.contains("not luminances"),
+        "{e}"
+    );
+    assert!(!out.exists(), "nothing written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -198,3 +198,54 @@ fn readings_no_instrument_can_have_taken_are_refused_where_they_enter() {
     let ok = parse_readings("patch,X,Y,Z\n1,0.004,-0.003,0.002\n", Path::new("r.csv")).unwrap();
     assert_eq!(ok.patches[&1].xyz, [0.004, -0.003, 0.002]);
 }
+
+/// A scene whose light table reaches 1e300 was accepted, and the renderer then blamed the
+/// reflectances ("its reflectances return more light than reaches them") and named no
+/// file. The scene reader names the file and the table's value, and says why.
+#[test]
+fn a_light_table_brighter_than_any_light_is_named_in_the_scene_file() {
+    let dir = scratch("table");
+    let scenes = root().join("data/scenes");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&text("data/scenes/validation-box.json")).unwrap();
+    // Spectrum files are relative to the scene's directory.
+    fn absolute(v: &mut serde_json::Value, base: &Path) {
+        match v {
+            serde_json::Value::Object(m) => {
+                for (k, x) in m.iter_mut() {
+                    match (k.as_str(), x.as_str()) {
+                        ("file", Some(f)) => *x = base.join(f).to_str().unwrap().into(),
+                        _ => absolute(x, base),
+                    }
+                }
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(|x| absolute(x, base)),
+            _ => {}
+        }
+    }
+    absolute(&mut v, &scenes);
+    let gamma: Vec<f64> = (0..=90).map(f64::from).collect();
+    let mut values: Vec<f64> = gamma.iter().map(|g| g.to_radians().cos()).collect();
+    values[89] = 1e300;
+    v["emitters"][0]["distribution"] = serde_json::json!({
+        "kind": "c_gamma",
+        "table": {"c_deg": [0], "gamma_deg": gamma, "values": [values]},
+    });
+    let scene = dir.join("bright.json");
+    std::fs::write(&scene, v.to_string()).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(["render", "spots"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("bright.json")
+            && e.contains("emitters[0].distribution.table.values[0][89]")
+            && e.contains("1e300 (C 0°, γ 89°) makes a tile")
+            && e.contains("above the 1e15 cd/m² a scene may hold"),
+        "{e}"
+    );
+    assert!(!e.contains("reflectances"), "{e}");
+}

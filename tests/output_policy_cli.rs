@@ -307,3 +307,28 @@ fn reproduce_refuses_its_image_as_output_and_a_failed_conversion_keeps_the_old_p
     );
     assert_eq!(std::fs::read(s.path("out.png")).unwrap(), png);
 }
+
+/// An output that is a FIFO nothing reads made the command wait in `open` for ever; it is
+/// an error at once, and one with a reader gets the file.
+#[test]
+fn fit_onto_a_fifo_without_a_reader_fails_at_once() {
+    let s = Scratch::new("fifo");
+    let m = s.measurements();
+    let fifo = s.path("p.json");
+    let c = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a NUL-terminated path and a mode.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+    let start = std::time::Instant::now();
+    let o = fit(&m, &s.s("p.json"), &[]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("p.json: it is a named pipe (FIFO) that nothing is reading"),
+        "{e}"
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(30));
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+}

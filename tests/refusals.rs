@@ -188,6 +188,67 @@ fn spot_spectrum_on_a_colorimeter_is_refused_before_measuring() {
     assert!(!csv.exists());
 }
 
+/// The simulated meter served on a pseudo-terminal took `--time-scale 1e308` (a reading
+/// would never end); the bound is that of every simulated instrument.
+#[test]
+fn simulate_refuses_a_time_scale_beyond_the_simulated_instruments_bound() {
+    for scale in ["1e308", "1000.5", "-1", "NaN"] {
+        let option = format!("--time-scale={scale}");
+        let (code, _, err) = refused(&["simulate", "cs100a", "--pty", &option]);
+        assert_eq!(code, Some(2), "{scale}: {err}");
+        assert!(
+            err.contains("--time-scale") && err.contains("is not a number from 0 to 1000"),
+            "{scale}: {err}"
+        );
+    }
+}
+
+/// Once a client had asked for a reading, Ctrl-C printed "stopped by signal 2" and the
+/// process never exited (the emulator slept through the reading's delay, and the main
+/// thread waited for it). At 1000 times the real pace a reading takes minutes: the process
+/// must still end at once.
+#[test]
+fn simulate_ends_at_ctrl_c_while_a_slow_reading_is_under_way() {
+    use std::io::{BufRead, BufReader, Write};
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(["simulate", "cs100a", "--pty", "--time-scale", "1000"])
+        .args(["--noise", "off"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut device = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut device)
+        .unwrap();
+    let mut port = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(device.trim())
+        .unwrap();
+    port.write_all(b"MES\r\n").unwrap();
+    // The emulator takes the command and starts its minutes-long delay.
+    std::thread::sleep(Duration::from_millis(500));
+    // SAFETY: kill with a child's pid and a signal number.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGINT) }, 0);
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > Duration::from_secs(5) {
+            let _ = child.kill();
+            panic!("still running 5 s after Ctrl-C");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "{status}");
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(err.contains("stopped by signal 2"), "{err}");
+}
+
 /// A real instrument with nobody at it: every guided command, its stdin not a terminal and
 /// without `--unattended`, refuses before any reading, naming `--unattended`. The meter is a
 /// live CS-100A emulator on a pseudo-terminal that counts what it is asked to measure:

@@ -169,6 +169,28 @@ impl Reading {
             timestamp_s: now_s(),
         }
     }
+
+    /// The XYZ a spectral instrument reports with `spectrum` (the i1Pro's rule): 683·∫S·x̄ȳz̄
+    /// with the CIE 1931 observer for a radiance (cd/m²) or an irradiance (lux); for a
+    /// reflectance, the XYZ under D65 with white at Y = 100, the spectrum's ends held.
+    /// None for a spectrum that does not say what it measures. A reading read back from a
+    /// file whose XYZ is not this was edited or damaged.
+    pub fn xyz_of_spectrum(spectrum: &Spectrum) -> Option<[f64; 3]> {
+        use metamer_color::{
+            radiance_to_xyz, reflectance_to_xyz, Illuminant, ObserverKind, Outside, Quantity,
+        };
+        let xyz = match spectrum.quantity()? {
+            Quantity::Reflectance => reflectance_to_xyz(
+                &spectrum.clone().with_outside(Outside::HoldEnds),
+                &Illuminant::D65.spectrum(),
+                ObserverKind::Cie1931,
+            ),
+            Quantity::Radiance | Quantity::Irradiance => {
+                radiance_to_xyz(spectrum, ObserverKind::Cie1931)
+            }
+        };
+        Some(xyz.to_array())
+    }
 }
 
 /// Seconds since the Unix epoch (0 if the clock is before it).

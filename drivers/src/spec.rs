@@ -199,7 +199,7 @@ fn sim_settings(
 /// Slowest simulated pace: 1000 times the real instrument's already makes one CS-100A
 /// reading take minutes; beyond it a scale can only be a typo, and the emulator's delays
 /// would overflow.
-const MAX_TIME_SCALE: f64 = 1000.0;
+pub const MAX_TIME_SCALE: f64 = 1000.0;
 const SCALE_RANGE: &str = "is not a number from 0 to 1000 (1 = the real instrument's pace)";
 
 fn parse_scale(v: &str) -> Option<f64> {

@@ -292,6 +292,24 @@ impl BoxPlan {
                 "must contain 0 (the normal: the distribution is relative to it)",
             ));
         }
+        // The fit gives each half-plane (C0 and C90 on the positive side, C180 and C270
+        // on the negative) a curve of its own, and even the simplest model needs one
+        // reading off the normal in each: without it the fit fails after every stage has
+        // been measured.
+        if !(a.iter().any(|&v| v < 0.0) && a.iter().any(|&v| v > 0.0)) {
+            let missing = if a.iter().any(|&v| v > 0.0) {
+                "negative"
+            } else {
+                "positive"
+            };
+            return Err(invalid(
+                "falloff_angles_deg",
+                format!(
+                    "needs an angle on each side of the normal, and has no {missing} one: the fall-off fit makes a curve for each half-plane (positive angles are C0 and C90, negative ones C180 and C270), so {:?} cannot be fitted",
+                    a
+                ),
+            ));
+        }
         if self.patches.is_empty() {
             return Err(invalid("patches", "needs at least one patch"));
         }
@@ -572,6 +590,9 @@ fn label(target: &Target, repeat: usize) -> String {
 }
 
 #[cfg(test)]
+mod angle_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -639,6 +660,14 @@ mod tests {
             "not a valid plan: geometry is a JSON object of named fields",
         );
         check(r#"{"falloff_angles_deg":[0,20,10]}"#, "10 follows 20");
+        check(
+            r#"{"falloff_angles_deg":[0,20,40,60]}"#,
+            "falloff_angles_deg: needs an angle on each side of the normal, and has no negative one",
+        );
+        check(
+            r#"{"falloff_angles_deg":[-60,-30,0]}"#,
+            "has no positive one",
+        );
         check(r#"{"patches":[1,25]}"#, "25 is not a patch number");
         check(r#"{"patches":[3,3]}"#, "patch 3 is listed twice");
         check(

@@ -151,6 +151,10 @@ pub fn run(
         let mut session = open_stage(options, stage, &records, options.resume)?;
         let total = session.plan().steps.len();
         if session.done() == total {
+            // Nothing to run, so the session does not report what resuming repaired.
+            for note in &session.notes {
+                progress.note(note);
+            }
             continue;
         }
         let number = Stage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;

@@ -37,7 +37,8 @@ struct Cs100aArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1, value_name = "N")]
     seed: u64,
-    /// Multiplies the meter's delays: 1 is the real pace (≈100 ms per reading), 0 none.
+    /// Multiplies the meter's delays: 1 is the real pace (≈100 ms per reading), 0 none,
+    /// at most 1000.
     #[arg(long, default_value_t = 1.0, value_name = "F")]
     time_scale: f64,
     /// The light the meter sees, cd/m² (default: 100 cd/m² of CIE LED-RGB1).

@@ -8,6 +8,7 @@ use clap::ValueEnum;
 use metamer::color::Xyz;
 use metamer::output::OutputPolicy;
 use metamer::validation::export::{comparisons, to_json};
+use metamer::validation::plausible;
 use metamer::validation::readings::Format;
 use metamer::validation::report::{InputFile, InstrumentUsed};
 use metamer::validation::{
@@ -105,6 +106,10 @@ pub fn run(args: Args) -> CliResult {
     let reference = read_readings(&args.reference)?;
     let test = read_readings(&args.test)?;
     let simulation = args.simulation.as_deref().map(read_readings).transpose()?;
+    let sets: Vec<&ReadingSet> = [&reference, &test].into_iter().chain(&simulation).collect();
+    for set in &sets {
+        plausible::check_luminance(set)?;
+    }
     let (white, white_source) = match args.white.as_str() {
         "test" => test.white_or_brightest(),
         "reference" => reference.white_or_brightest(),
@@ -112,9 +117,16 @@ pub fn run(args: Args) -> CliResult {
             let v = parse_triple(s).map_err(|e| CliError::Usage(format!("--white: {e}")))?;
             metamer_color::check_xyz(v)
                 .map_err(|e| CliError::Usage(format!("--white: not a white: {e}")))?;
-            (Xyz::from_array(v), "given on the command line".to_string())
+            let white = Xyz::from_array(v);
+            plausible::check_given_white(white)
+                .and_then(|()| plausible::check_white_against(white, &sets))
+                .map_err(|e| CliError::Usage(format!("--white: {e}")))?;
+            (white, "given on the command line".to_string())
         }
     };
+    if args.white == "test" || args.white == "reference" {
+        plausible::check_white_against(white, &sets)?;
+    }
     let opts = AssessOptions {
         propagation: match args.propagation {
             PropagationArg::MonteCarlo => Propagation::MonteCarlo {
@@ -154,6 +166,7 @@ pub fn run(args: Args) -> CliResult {
         out_of_gamut: args.out_of_gamut.clone(),
         ..ReportInput::default()
     };
+    input.notes.extend(plausible::scale_note(&reference, &test));
     for (role, set) in [
         ("box", Some(&reference)),
         ("display", Some(&test)),

@@ -61,6 +61,15 @@ pub enum VerifyError {
     NoSamples,
     #[error("patch {index} (r,g,b = {rgb:?}) has a drive value outside 0–1 or an XYZ that is not finite")]
     BadSample { index: usize, rgb: [f64; 3] },
+    /// The profile's prediction is no colour: a ΔE of it would be NaN or infinite, and a
+    /// mean over it NaN while the maximum hides it.
+    #[error("the profile predicts X, Y, Z = {predicted:?} for patch {index} (r,g,b = {rgb:?}), which is not a colour a display shows ({why}): is the profile's tone curve or matrix damaged?")]
+    BadPrediction {
+        index: usize,
+        rgb: [f64; 3],
+        predicted: [f64; 3],
+        why: String,
+    },
 }
 
 /// Predicts every patch with `profile` and compares with what was measured.
@@ -80,17 +89,36 @@ pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verificat
             });
         }
         let predicted = profile.forward(p.rgb);
+        let bad = |why: String| VerifyError::BadPrediction {
+            index: i + 1,
+            rgb: p.rgb,
+            predicted,
+            why,
+        };
+        // A model may predict a little below zero near black: that is an error it makes,
+        // which the ΔE shows. Only what is no number, or brighter than any display, is not.
+        if let Err(
+            e @ (metamer_color::Implausible::NotFinite(_)
+            | metamer_color::Implausible::TooBright { .. }),
+        ) = metamer_color::check_xyz(predicted)
+        {
+            return Err(bad(e.to_string()));
+        }
         let (a, b) = (
             Xyz::from_array(predicted).to_lab(white),
             Xyz::from_array(p.xyz).to_lab(white),
         );
+        let (de00, de76) = (delta_e2000(a, b), delta_e76(a, b));
+        if !(de00.is_finite() && de76.is_finite()) {
+            return Err(bad(format!("its ΔE00 is {de00}, its ΔE*ab {de76}")));
+        }
         errors.push(PatchError {
             index: i + 1,
             rgb: p.rgb,
             measured_xyz: p.xyz,
             predicted_xyz: predicted,
-            de00: delta_e2000(a, b),
-            de76: delta_e76(a, b),
+            de00,
+            de76,
         });
     }
     let de00: Vec<f64> = errors.iter().map(|e| e.de00).collect();

@@ -2,6 +2,12 @@
 //! (upstream files and its own options) and of what it wrote. A stage whose inputs hash as
 //! recorded and whose outputs are still there unchanged is not run again; any change
 //! upstream changes an input hash downstream, so exactly the stages that depend on it run.
+//!
+//! A record is trusted only as far as it vouches: it must list every product of the stage
+//! (the files later stages read, [`Product`]), a file it lists must be a regular file inside
+//! the stage, and the record itself must be a small regular file (read through a bounded
+//! reader: one that is a FIFO, a link to `/dev/zero` or a huge sparse file is simply not
+//! trusted, and the stage runs again).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -14,6 +20,17 @@ use crate::output::{OutputError, OutputPolicy};
 
 /// The record's file name inside a stage directory.
 pub const RECORD_FILE: &str = "stage.json";
+/// Largest record read: a record is a few kilobytes of hashes.
+const MAX_RECORD_BYTES: u64 = 1 << 20;
+
+/// A file a stage writes for later stages (or the command) to read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Product {
+    pub file: &'static str,
+    /// Written by every run of the stage; otherwise only by some (an image when one is
+    /// rendered), and then vouched for when it is there.
+    pub always: bool,
+}
 const RECORD_FORMAT: &str = "metamer-experiment-stage";
 
 /// A stage's record could not be read or written, or an input could not be hashed.
@@ -46,12 +63,35 @@ pub struct StageRecord {
     pub seconds: f64,
 }
 
-/// SHA-256 of a file's bytes.
+/// SHA-256 of a file's bytes. Only a regular file (or a link to one) is hashed: a FIFO
+/// would wait for a writer and a device never ends.
 pub fn hash_file(path: &Path) -> Result<String, CacheError> {
+    crate::output::owned_file(path)?;
     sha256_file(path).map_err(|source| CacheError::Hash {
         file: path.to_path_buf(),
         source,
     })
+}
+
+/// The bytes of the record at `path` when it is a regular file of at most
+/// [`MAX_RECORD_BYTES`], else None. Opened without following a link and without waiting
+/// (a FIFO's open would wait for a writer), then checked on the open file.
+fn read_record(path: &Path) -> Option<Vec<u8>> {
+    use std::io::Read;
+    use std::os::unix::fs::OpenOptionsExt;
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_NOFOLLOW)
+        .open(path)
+        .ok()?;
+    if !file.metadata().ok()?.is_file() {
+        return None;
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_RECORD_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .ok()?;
+    (bytes.len() as u64 <= MAX_RECORD_BYTES).then_some(bytes)
 }
 
 /// SHA-256 of a value's canonical JSON (object keys sorted): options hash the same whatever
@@ -104,13 +144,24 @@ impl StageDir {
         self.dir.join(file)
     }
 
-    /// The record, when the stage finished with exactly these inputs and every output it
-    /// wrote is still there with the content it had.
-    pub fn reusable(&self, inputs: &Inputs) -> Option<StageRecord> {
-        let text = std::fs::read_to_string(self.path(RECORD_FILE)).ok()?;
-        let record: StageRecord = serde_json::from_str(&text).ok()?;
+    /// The record, when the stage finished with exactly these inputs, the record vouches
+    /// for each of the stage's `products` (every one that is always written, and every
+    /// other one that is there), and every output it lists is still there with the
+    /// content it had.
+    pub fn reusable(&self, inputs: &Inputs, products: &[Product]) -> Option<StageRecord> {
+        let bytes = read_record(&self.path(RECORD_FILE))?;
+        let record: StageRecord = serde_json::from_slice(&bytes).ok()?;
         if record.format != RECORD_FORMAT || record.stage != self.name || record.inputs != inputs.0
         {
+            return None;
+        }
+        // A record that leaves a product out (`"outputs": {}`) would let an edited file
+        // pass as this stage's work.
+        let vouched = products.iter().all(|p| {
+            record.outputs.contains_key(p.file)
+                || (!p.always && std::fs::symlink_metadata(self.path(p.file)).is_err())
+        });
+        if !vouched {
             return None;
         }
         let intact = record.outputs.iter().all(|(file, hash)| {
@@ -215,12 +266,16 @@ mod tests {
             .file("scene", &root.join("scene.json"))
             .unwrap()
             .value("target_de", &0.1);
-        assert!(s.reusable(&inputs).is_none());
+        let products = [Product {
+            file: "spots.csv",
+            always: true,
+        }];
+        assert!(s.reusable(&inputs, &products).is_none());
         s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
-        assert!(s.reusable(&inputs).is_some());
+        assert!(s.reusable(&inputs, &products).is_some());
         // Another option value: run again.
         assert!(s
-            .reusable(&inputs.clone().value("target_de", &0.2))
+            .reusable(&inputs.clone().value("target_de", &0.2), &products)
             .is_none());
         // An upstream file changed: run again.
         std::fs::write(root.join("scene.json"), "{ }").unwrap();
@@ -228,13 +283,13 @@ mod tests {
             .file("scene", &root.join("scene.json"))
             .unwrap()
             .value("target_de", &0.1);
-        assert!(s.reusable(&changed).is_none());
+        assert!(s.reusable(&changed, &products).is_none());
         // An output edited or removed: run again.
         std::fs::write(s.path("spots.csv"), "1,2,4").unwrap();
-        assert!(s.reusable(&inputs).is_none());
+        assert!(s.reusable(&inputs, &products).is_none());
         s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
         std::fs::remove_file(s.path("spots.csv")).unwrap();
-        assert!(s.reusable(&inputs).is_none());
+        assert!(s.reusable(&inputs, &products).is_none());
         s.invalidate().unwrap();
         s.invalidate().unwrap();
     }
@@ -250,7 +305,7 @@ mod tests {
         std::fs::write(s.path("profile.json"), "{}").unwrap();
         let inputs = Inputs::new().value("model", &"lut");
         let good = s.finish(&inputs, &["profile.json"], 1.0).unwrap();
-        assert!(s.reusable(&inputs).is_some());
+        assert!(s.reusable(&inputs, &[]).is_some());
         let x_hash = hash_file(&root.join("elsewhere")).unwrap();
         std::os::unix::fs::symlink(root.join("elsewhere"), s.path("link")).unwrap();
         for (name, hash) in [
@@ -264,9 +319,91 @@ mod tests {
             let text = serde_json::to_string(&edited).unwrap();
             std::fs::write(s.path(RECORD_FILE), text).unwrap();
             let start = std::time::Instant::now();
-            assert!(s.reusable(&inputs).is_none(), "{name:?} was trusted");
+            assert!(s.reusable(&inputs, &[]).is_none(), "{name:?} was trusted");
             assert!(start.elapsed() < std::time::Duration::from_secs(1));
         }
+    }
+
+    /// A record that leaves a product out vouches for nothing: an edited file that a
+    /// later stage reads must not pass as the stage's work. A product only some runs write
+    /// is vouched for when it is there.
+    #[test]
+    fn a_record_that_leaves_a_product_out_is_not_reused() {
+        let root = scratch("products");
+        let s = StageDir::new(&root, "simulation");
+        std::fs::create_dir_all(&s.dir).unwrap();
+        std::fs::write(s.path("spots.csv"), "1,2,3").unwrap();
+        let inputs = Inputs::new().value("seed", &1);
+        let products = [
+            Product {
+                file: "spots.csv",
+                always: true,
+            },
+            Product {
+                file: "image.exr",
+                always: false,
+            },
+        ];
+        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        assert!(s.reusable(&inputs, &products).is_some());
+        s.finish(&inputs, &[] as &[&str], 1.0).unwrap();
+        assert!(s.reusable(&inputs, &products).is_none(), "outputs {{}}");
+        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        std::fs::write(s.path("image.exr"), "an image no record vouches for").unwrap();
+        assert!(
+            s.reusable(&inputs, &products).is_none(),
+            "an unrecorded image"
+        );
+        s.finish(&inputs, &["spots.csv", "image.exr"], 1.0).unwrap();
+        assert!(s.reusable(&inputs, &products).is_some());
+    }
+
+    /// The record itself is read only when it is a small regular file: a FIFO (whose open
+    /// would wait for a writer), a link to /dev/zero and a sparse file of 6 GB are not
+    /// trusted, at once and without reading them.
+    #[test]
+    fn a_record_that_is_no_small_regular_file_is_not_read() {
+        let root = scratch("record-kinds");
+        let s = StageDir::new(&root, "display");
+        std::fs::create_dir_all(&s.dir).unwrap();
+        let inputs = Inputs::new().value("model", &"lut");
+        s.finish(&inputs, &[] as &[&str], 1.0).unwrap();
+        assert!(s.reusable(&inputs, &[]).is_some());
+        let record = s.path(RECORD_FILE);
+        let c = std::ffi::CString::new(record.as_os_str().as_encoded_bytes()).unwrap();
+        type Make<'a> = (&'a str, Box<dyn Fn() + 'a>);
+        let make: [Make; 3] = [
+            (
+                "a FIFO",
+                // SAFETY: a NUL-terminated path and a mode.
+                Box::new(|| assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0)),
+            ),
+            (
+                "a link to /dev/zero",
+                Box::new(|| std::os::unix::fs::symlink("/dev/zero", &record).unwrap()),
+            ),
+            (
+                "a 6 GB sparse file",
+                Box::new(|| {
+                    std::fs::File::create(&record)
+                        .unwrap()
+                        .set_len(6 << 30)
+                        .unwrap()
+                }),
+            ),
+        ];
+        for (what, make) in make {
+            let _ = std::fs::remove_file(&record);
+            make();
+            let start = std::time::Instant::now();
+            assert!(s.reusable(&inputs, &[]).is_none(), "{what} was trusted");
+            assert!(
+                start.elapsed() < std::time::Duration::from_secs(1),
+                "{what}: {:?}",
+                start.elapsed()
+            );
+        }
+        let _ = std::fs::remove_file(&record);
     }
 
     #[test]

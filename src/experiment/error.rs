@@ -86,4 +86,19 @@ pub enum ExperimentError {
     GivenBoxMissing { what: &'static str, file: PathBuf },
     #[error("the box measurements: {0}")]
     Box(String),
+    /// A user's file lies where a stage of this run writes (or moves its directory aside).
+    #[error("the box's {what} {} lie in the {stage} stage's directory {}, which the experiment replaces: copy them elsewhere and give that copy", file.display(), dir.display())]
+    GivenInStage {
+        what: &'static str,
+        file: PathBuf,
+        stage: &'static str,
+        dir: PathBuf,
+    },
+    #[error("the box's spot readings {} are of patches {read:?}, but its scene {} has patches {in_scene:?}: the simulation renders the scene's patches and the validation compares each with the box's reading, so both must list the same", spots.display(), scene.display())]
+    GivenPatchesDiffer {
+        spots: PathBuf,
+        read: Vec<usize>,
+        scene: PathBuf,
+        in_scene: Vec<usize>,
+    },
 }

@@ -13,6 +13,9 @@ pub mod cache;
 pub mod display;
 pub mod display_spots;
 mod error;
+mod options;
+mod preflight;
+mod products;
 mod progress;
 pub mod readings;
 pub mod report_sections;
@@ -23,6 +26,7 @@ mod stages;
 pub mod validate;
 
 pub use error::ExperimentError;
+pub use options::{BoxSource, ExperimentOptions};
 pub use progress::Progress;
 pub use stage::Stage;
-pub use stages::{run, BoxSource, ExperimentOptions, StageOutcome};
+pub use stages::{run, StageOutcome};

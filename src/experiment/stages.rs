@@ -7,44 +7,16 @@ use serde::Serialize;
 
 use super::box_stage::{self, BoxMeasure};
 use super::cache::{Inputs, StageDir, RECORD_FILE};
-use super::display::{characterize_display, DisplayOptions, DisplaySetting};
+use super::display::{characterize_display, DisplaySetting};
 use super::error::ExperimentError;
+use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
 use super::readings::read_readings;
-use super::reproduction::{reproduce, Reproduction, ReproductionOptions};
-use super::simulation::{simulate, SimulationOptions, SimulationSummary};
+use super::reproduction::{reproduce, Reproduction};
+use super::simulation::{simulate, SimulationSummary};
 use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
 use crate::display::Profile;
-use crate::session::RunOptions;
-
-/// Where the box's measurements come from.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub enum BoxSource {
-    /// Measured here, by the `measure-box` session into `box/`.
-    Measure(BoxMeasure),
-    /// Measurements taken earlier or elsewhere: the measured scene and the spot readings.
-    Existing { scene: PathBuf, spots: PathBuf },
-}
-
-/// What an experiment is made of.
-#[derive(Clone, Debug)]
-pub struct ExperimentOptions {
-    pub dir: PathBuf,
-    pub box_source: BoxSource,
-    pub simulation: SimulationOptions,
-    pub display: DisplayOptions,
-    pub reproduction: ReproductionOptions,
-    /// Spot readings averaged per patch on the display.
-    pub repeats: usize,
-    /// Run only this stage (again, even if its inputs are unchanged).
-    pub stage: Option<Stage>,
-    /// Continue an interrupted measuring stage's journal.
-    pub resume: bool,
-    /// Nobody at the rig: every operator request counts as done (simulated rigs).
-    pub unattended: bool,
-    pub run: RunOptions,
-}
 
 /// How one stage went.
 #[derive(Clone, Debug, Serialize)]
@@ -68,7 +40,7 @@ fn need(stage: Stage, path: PathBuf) -> Result<PathBuf, ExperimentError> {
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, ExperimentError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
+    let text = metamer_color::text::read_text(path).map_err(|source| ExperimentError::Io {
         file: path.to_path_buf(),
         source,
     })?;
@@ -126,6 +98,16 @@ pub fn run(
             }
         }
     }
+    super::preflight::check(opts)?;
+    // The user's box files are this run's inputs: no stage may write onto them, by any
+    // name (a link, a hard link), whatever policy it writes with.
+    let _given = match &opts.box_source {
+        BoxSource::Existing { scene, spots } => Some(crate::output::guard_inputs([
+            scene.as_path(),
+            spots.as_path(),
+        ])),
+        BoxSource::Measure(_) => None,
+    };
     let mut outcomes = Vec::new();
     for stage in Stage::ALL {
         if opts.stage.is_some_and(|s| s != stage) {
@@ -136,7 +118,12 @@ pub fn run(
         let inputs = inputs_of(stage, opts)?;
         let forced = opts.stage == Some(stage);
         let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
-        if !forced && ((stage == Stage::Box && given_box) || sd.reusable(&inputs).is_some()) {
+        if !forced
+            && ((stage == Stage::Box && given_box)
+                || sd
+                    .reusable(&inputs, super::products::products(stage))
+                    .is_some())
+        {
             if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
                 progress(Progress::Note(format!(
                     "box: given, measured earlier or elsewhere ({} and {})",
@@ -360,6 +347,10 @@ fn run_stage(
 mod tests {
     use super::*;
     use crate::display::ModelKind;
+    use crate::experiment::display::DisplayOptions;
+    use crate::experiment::reproduction::ReproductionOptions;
+    use crate::experiment::simulation::SimulationOptions;
+    use crate::session::RunOptions;
 
     fn given(dir: &Path, scene: PathBuf, spots: PathBuf) -> ExperimentOptions {
         ExperimentOptions {

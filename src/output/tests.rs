@@ -290,3 +290,80 @@ fn a_full_disk_leaves_nothing_behind() {
     assert_eq!(left, ["big.bin"]);
     assert_eq!(old.unwrap(), "old");
 }
+
+fn mkfifo(path: &Path) {
+    let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a NUL-terminated path and a mode.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+}
+
+/// A FIFO that nothing reads made `open` wait for ever: it is an error once the reader
+/// has had its time; a reader that comes late within it gets the bytes.
+#[test]
+fn a_fifo_without_a_reader_is_an_error_and_a_late_reader_gets_the_bytes() {
+    let s = Scratch::new("fifo-reader");
+    let fifo = s.path("out.json");
+    mkfifo(&fifo);
+    let start = std::time::Instant::now();
+    let e = OutputPolicy::new(false).write(&fifo, b"x").unwrap_err();
+    let took = start.elapsed();
+    assert!(matches!(e, OutputError::NoReader { .. }), "{e}");
+    assert!(e.to_string().contains("that nothing is reading"), "{e}");
+    assert!(
+        took >= FIFO_READER_WAIT && took < FIFO_READER_WAIT * 3,
+        "{took:?}"
+    );
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            std::thread::sleep(std::time::Duration::from_millis(300));
+            std::fs::read(&fifo).unwrap()
+        })
+    };
+    OutputPolicy::new(false).write(&fifo, b"hello").unwrap();
+    assert_eq!(reader.join().unwrap(), b"hello");
+}
+
+/// What may stand where a command keeps a file it reads back: nothing or a regular file
+/// (through a link); each other kind is named.
+#[test]
+fn an_owned_file_must_be_absent_or_a_regular_file() {
+    let s = Scratch::new("owned");
+    assert_eq!(owned_file(&s.path("none")).unwrap(), Owned::Absent);
+    std::fs::write(s.path("file"), "x").unwrap();
+    assert_eq!(owned_file(&s.path("file")).unwrap(), Owned::File);
+    std::os::unix::fs::symlink(s.path("file"), s.path("link")).unwrap();
+    assert_eq!(owned_file(&s.path("link")).unwrap(), Owned::File);
+    mkfifo(&s.path("fifo"));
+    std::fs::create_dir(s.path("dir")).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", s.path("zero")).unwrap();
+    std::os::unix::fs::symlink(s.path("gone"), s.path("dangling")).unwrap();
+    for (name, words) in [
+        (
+            "fifo",
+            "is a named pipe (FIFO), not a file this program wrote",
+        ),
+        ("dir", "is a directory"),
+        ("zero", "is a character device"),
+        ("dangling", "is a symbolic link to"),
+    ] {
+        let e = owned_file(&s.path(name)).unwrap_err().to_string();
+        assert!(e.contains(words) && e.contains(name), "{name}: {e}");
+    }
+}
+
+/// Inputs guarded for the process are refused by a policy that never registered them,
+/// until the guard is dropped.
+#[test]
+fn guarded_inputs_are_refused_by_every_policy_while_the_guard_lives() {
+    let s = Scratch::new("guard");
+    let given = s.path("spots.csv");
+    std::fs::write(&given, "given").unwrap();
+    let guard = guard_inputs([given.as_path()]);
+    let e = OutputPolicy::new(true).write(&given, b"x").unwrap_err();
+    assert!(matches!(e, OutputError::IsInput { .. }), "{e}");
+    assert_eq!(std::fs::read_to_string(&given).unwrap(), "given");
+    drop(guard);
+    OutputPolicy::new(true).write(&given, b"x").unwrap();
+    assert_eq!(std::fs::read_to_string(&given).unwrap(), "x");
+}

@@ -39,7 +39,7 @@ impl Default for PtyMeterOptions {
 pub enum PtyMeterError {
     #[error("the light X, Y, Z = {xyz:?} is not a light: each must be a finite number ≥ 0")]
     NotALight { xyz: [f64; 3] },
-    #[error("the time scale {0} is not a finite number ≥ 0")]
+    #[error("the time scale {0:?} is not a number from 0 to {max} (1 = the real meter's pace)", max = metamer_drivers::MAX_TIME_SCALE)]
     BadTimeScale(f64),
     #[error("cannot serve the simulated CS-100A: {0}")]
     Start(#[from] DriverError),
@@ -56,7 +56,9 @@ impl PtyMeter {
     /// Starts the meter on a new pseudo-terminal; it answers from another thread.
     pub fn start(options: &PtyMeterOptions) -> Result<PtyMeter, PtyMeterError> {
         check_light(options.xyz)?;
-        if !(options.time_scale.is_finite() && options.time_scale >= 0.0) {
+        // The bound every simulated instrument has: beyond it one reading takes days, a
+        // typo rather than a pace, and the emulator's delays would overflow.
+        if !(0.0..=metamer_drivers::MAX_TIME_SCALE).contains(&options.time_scale) {
             return Err(PtyMeterError::BadTimeScale(options.time_scale));
         }
         let light = Arc::new(SharedWorld::new(options.xyz));
@@ -108,12 +110,46 @@ mod tests {
             let e = PtyMeter::start(&options).err().unwrap();
             assert!(e.to_string().contains("is not a light"), "{e}");
         }
+        for (scale, shown) in [(-0.5, "-0.5"), (1e308, "1e308"), (f64::NAN, "NaN")] {
+            let options = PtyMeterOptions {
+                time_scale: scale,
+                ..PtyMeterOptions::default()
+            };
+            let e = PtyMeter::start(&options).err().unwrap().to_string();
+            assert!(
+                e.contains(&format!(
+                    "time scale {shown} is not a number from 0 to 1000"
+                )),
+                "{e}"
+            );
+        }
+    }
+
+    /// A stop asked for while the meter takes a slow reading (1000 times the real pace:
+    /// minutes) ends the emulator at once: dropping the meter joins its thread.
+    #[test]
+    fn dropping_the_meter_mid_reading_returns_at_once() {
         let options = PtyMeterOptions {
-            time_scale: -0.5,
+            noise: false,
+            time_scale: 1000.0,
             ..PtyMeterOptions::default()
         };
-        let e = PtyMeter::start(&options).err().unwrap();
-        assert!(e.to_string().contains("time scale -0.5"), "{e}");
+        let meter = PtyMeter::start(&options).unwrap();
+        let port = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(meter.path())
+            .unwrap();
+        (&port).write_all(b"MES\r\n").unwrap();
+        // Let the emulator take the command and start its delay.
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        let start = std::time::Instant::now();
+        drop(meter);
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(2),
+            "{:?}",
+            start.elapsed()
+        );
     }
 
     /// Raw reads and writes on the device path, as any program would make them: a light of

@@ -4,6 +4,14 @@
 //! at most the line being written; [`Journal::resume`] reads the file back, sets aside a
 //! torn last line and refuses a journal of another plan, naming the option that differs.
 //!
+//! An open journal holds an advisory lock (`flock`) on its file, which the system releases
+//! when the process ends however it ends: a second session on the same file is refused
+//! while the first runs. A journal that two sessions wrote at once (before there was a
+//! lock, or over a network file system that ignores it) is recovered on resuming: the
+//! first entry of each step is kept, the later ones are moved to a side file
+//! ([`duplicates_path`]). The file itself is checked as an input is: a FIFO, a device or a
+//! dangling link where the journal should be is an error naming what stands there.
+//!
 //! The header's and the entries' contents are the caller's (`H`, `E`, through serde), so
 //! every kind of session shares one file discipline.
 
@@ -13,10 +21,21 @@ use std::io::{Seek, SeekFrom, Write};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 
-use metamer_color::text::{echo, echo_message, strip_bom};
+use metamer_color::text::{echo, strip_bom};
 use metamer_drivers::{CalibrationCondition, MeasureMode};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+
+use crate::output::owned_file;
+
+mod entry;
+mod error;
+mod file;
+
+pub use entry::{reading_problem, JournalEntry};
+use error::io;
+pub use error::JournalError;
+use file::{keep_aside, lock, open_locked, read_all, rewrite, sync_dir};
 
 /// `format` of every journal's header line.
 pub const JOURNAL_FORMAT: &str = "metamer-session-journal";
@@ -80,50 +99,6 @@ enum LineRef<'a, H, E> {
     Calibration(&'a CalibrationRecord),
 }
 
-/// The journal could not be written, read or resumed.
-#[derive(Debug, thiserror::Error)]
-pub enum JournalError {
-    /// A new session was asked for where one already is.
-    #[error("{} exists with {entries} entries of an earlier session: resume that session, or choose another output directory", path.display())]
-    Exists { path: PathBuf, entries: usize },
-    #[error("{}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{}, line {line}: {}", path.display(), echo_message(message))]
-    Bad {
-        path: PathBuf,
-        line: usize,
-        message: String,
-    },
-    /// The journal belongs to a plan made from other options.
-    #[error("{} was written by another session: its option {} is {}, this one's is {}; resume with the options it was started with, or choose another output directory", path.display(), echo(option), echo(logged), echo(now))]
-    OptionDiffers {
-        path: PathBuf,
-        option: String,
-        logged: String,
-        now: String,
-    },
-    /// The same options, yet other steps: the program that plans them changed.
-    #[error("{} was written by another session: every option is the same but its steps differ (plan {}, this one {now}); it was planned by another version of this program", path.display(), echo(logged))]
-    StepsDiffer {
-        path: PathBuf,
-        logged: String,
-        now: String,
-    },
-    /// The file holds no session to continue: empty, or its header was cut off by a crash
-    /// while it was being written. Nothing was measured into it.
-    #[error("{} holds no session to continue: {what}; resuming sets it aside and starts afresh", path.display())]
-    Broken { path: PathBuf, what: String },
-    #[error("{} was written by a {} session, not a {now} session", path.display(), echo(logged))]
-    KindDiffers {
-        path: PathBuf,
-        logged: String,
-        now: String,
-    },
-}
-
 /// What resuming found: every line after the header with its 1-based line number.
 #[derive(Debug, PartialEq)]
 pub struct Recovered<H, E> {
@@ -133,6 +108,10 @@ pub struct Recovered<H, E> {
     pub calibrations: Vec<CalibrationRecord>,
     /// Bytes of a torn last line moved to the side file ([`torn_path`]); 0 if none.
     pub torn_bytes: usize,
+    /// Entries of a step already journalled (line, step), moved to [`duplicates_path`].
+    pub duplicates: Vec<(usize, usize)>,
+    /// Bytes of those lines, newlines included.
+    pub duplicate_bytes: usize,
 }
 
 /// An open journal, appending.
@@ -142,32 +121,21 @@ pub struct Journal<H, E> {
     _types: PhantomData<fn(H, E)>,
 }
 
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> JournalError + '_ {
-    move |source| JournalError::Io {
-        path: path.to_path_buf(),
-        source,
-    }
-}
-
 /// Where a torn last line of the journal at `path` is kept: `log.jsonl` → `log.torn.txt`.
 pub fn torn_path(path: &Path) -> PathBuf {
     path.with_extension("torn.txt")
 }
 
-/// Makes a new file's directory entry durable too (POSIX: fsync of the file alone does
-/// not guarantee its name survives a crash).
-fn sync_dir(path: &Path) -> Result<(), JournalError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    File::open(dir).and_then(|d| d.sync_all()).map_err(io(dir))
+/// Where the later entries of a step journalled twice are kept: `log.jsonl` →
+/// `log.duplicates.jsonl`.
+pub fn duplicates_path(path: &Path) -> PathBuf {
+    path.with_extension("duplicates.jsonl")
 }
 
 impl<H, E> Journal<H, E>
 where
     H: Serialize + DeserializeOwned,
-    E: Serialize + DeserializeOwned,
+    E: Serialize + DeserializeOwned + JournalEntry,
 {
     /// Starts a new journal at `path` with `header`; an existing file is never overwritten.
     pub fn create(path: &Path, header: &Header<H>) -> Result<Self, JournalError> {
@@ -178,6 +146,7 @@ where
             }
             Err(e) => return Err(io(path)(e)),
         };
+        lock(&file, path)?;
         let mut journal = Journal {
             path: path.to_path_buf(),
             file,
@@ -190,18 +159,16 @@ where
 
     /// Opens the journal at `path` to continue it: checks it was written for a plan with
     /// `expected`'s kind, fingerprint and options, and returns what it holds. A last line
-    /// cut off by a crash is moved to [`torn_path`] and removed from the journal; any other
-    /// damage is an error naming the line that leaves the file untouched.
+    /// cut off by a crash is moved to [`torn_path`] and removed from the journal; later
+    /// entries of a step journalled twice are moved to [`duplicates_path`]; any other
+    /// damage is an error naming the line that leaves the file untouched. The journal is
+    /// locked from the moment it is opened: another session holding it is an error.
     pub fn resume(
         path: &Path,
         expected: &Header<H>,
     ) -> Result<(Self, Recovered<H, E>), JournalError> {
-        let bytes = metamer_color::text::read_bytes(path).map_err(io(path))?;
-        let mut file = OpenOptions::new()
-            .read(true)
-            .append(true)
-            .open(path)
-            .map_err(io(path))?;
+        let mut file = open_locked(path)?;
+        let bytes = read_all(&file, path)?;
         if let Some(what) = broken(&bytes) {
             return Err(JournalError::Broken {
                 path: path.to_path_buf(),
@@ -231,16 +198,27 @@ where
                 .count();
             bad(line, "not UTF-8 text".into())
         })?;
-        // Blank lines carry nothing (an editor's trailing newline, a line a tool added): skip.
-        // A byte-order mark (an editor's) is not part of the header line.
-        let mut lines = strip_bom(text)
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l))
-            .filter(|(_, l)| !l.trim().is_empty());
+        // Each line with its 1-based number and byte range. Blank lines carry nothing (an
+        // editor's trailing newline, a line a tool added): skipped. A byte-order mark (an
+        // editor's) is not part of the header line.
+        let mut at = 0;
+        let mut lines = Vec::new();
+        for (i, raw) in text.split_inclusive('\n').enumerate() {
+            let range = at..at + raw.len();
+            at = range.end;
+            let mut l = raw.strip_suffix('\n').unwrap_or(raw);
+            l = l.strip_suffix('\r').unwrap_or(l);
+            if i == 0 {
+                l = strip_bom(l);
+            }
+            if !l.trim().is_empty() {
+                lines.push((i + 1, range, l));
+            }
+        }
+        let mut lines = lines.into_iter();
         let header = match lines.next() {
             None => return Err(bad(1, "empty journal: no header line".into())),
-            Some((n, l)) => {
+            Some((n, _, l)) => {
                 // The header's fixed fields first, so a journal of another format or
                 // version says so rather than failing on the caller's part.
                 let v: serde_json::Value = serde_json::from_str(l)
@@ -265,35 +243,71 @@ where
         check_same_plan(path, &header, expected)?;
         let mut entries = Vec::new();
         let mut calibrations = Vec::new();
-        for (n, l) in lines {
+        let mut steps = std::collections::BTreeSet::new();
+        let mut duplicates = Vec::new();
+        let mut duplicate_ranges = Vec::new();
+        for (n, range, l) in lines {
             match serde_json::from_str::<Line<H, E>>(l) {
-                Ok(Line::Entry(e)) => entries.push((n, e)),
+                Ok(Line::Entry(e)) => {
+                    if let Some(message) = e.problem() {
+                        return Err(JournalError::Entry {
+                            path: path.to_path_buf(),
+                            line: n,
+                            message,
+                        });
+                    }
+                    match e.step() {
+                        // A second session's reading of a step the first had taken.
+                        Some(step) if !steps.insert(step) => {
+                            duplicates.push((n, step));
+                            duplicate_ranges.push(range);
+                        }
+                        _ => entries.push((n, e)),
+                    }
+                }
                 Ok(Line::Calibration(c)) => calibrations.push(c),
                 Ok(Line::Header(_)) => return Err(bad(n, "a second header line".into())),
                 Err(e) => return Err(bad(n, format!("not an entry or calibration: {e}"))),
             }
         }
         let mut torn_bytes = 0;
-        if tail_is_whole {
+        if !tail.is_empty() && !tail_is_whole {
+            // Keep the fragment before cutting it off: nothing measured is thrown away.
+            let mut kept = tail.to_vec();
+            kept.push(b'\n');
+            keep_aside(&torn_path(path), &kept)?;
+            torn_bytes = tail.len();
+        }
+        let mut duplicate_bytes = 0;
+        if !duplicate_ranges.is_empty() {
+            // Set aside first: if the rewrite fails, the journal is unchanged and the side
+            // file holds copies, never the only ones.
+            let mut aside = Vec::new();
+            let mut kept = Vec::with_capacity(text_end);
+            let mut from = 0;
+            for r in &duplicate_ranges {
+                kept.extend_from_slice(&bytes[from..r.start]);
+                aside.extend_from_slice(&bytes[r.clone()]);
+                if !aside.ends_with(b"\n") {
+                    aside.push(b'\n');
+                }
+                from = r.end;
+            }
+            kept.extend_from_slice(&bytes[from..text_end]);
+            if !kept.ends_with(b"\n") {
+                kept.push(b'\n');
+            }
+            keep_aside(&duplicates_path(path), &aside)?;
+            duplicate_bytes = duplicate_ranges.iter().map(|r| r.len()).sum();
+            file = rewrite(path, &file, &kept)?;
+        } else if tail_is_whole {
             file.write_all(b"\n").map_err(io(path))?;
             file.sync_data().map_err(io(path))?;
         } else if !tail.is_empty() {
-            // Keep the fragment before cutting it off: nothing measured is thrown away.
-            let side = torn_path(path);
-            let mut torn = OpenOptions::new()
-                .create(true)
-                .append(true)
-                .open(&side)
-                .map_err(io(&side))?;
-            torn.write_all(tail)
-                .and_then(|()| torn.write_all(b"\n"))
-                .and_then(|()| torn.sync_data())
-                .map_err(io(&side))?;
             file.set_len(complete as u64).map_err(io(path))?;
-            file.seek(SeekFrom::End(0)).map_err(io(path))?;
             file.sync_data().map_err(io(path))?;
-            torn_bytes = tail.len();
         }
+        file.seek(SeekFrom::End(0)).map_err(io(path))?;
         let journal = Journal {
             path: path.to_path_buf(),
             file,
@@ -306,6 +320,8 @@ where
                 entries,
                 calibrations,
                 torn_bytes,
+                duplicates,
+                duplicate_bytes,
             },
         ))
     }
@@ -379,7 +395,8 @@ fn check_same_plan<H>(
 /// The error [`Journal::create`] would give for `path`, checked before anything is opened
 /// (a full-screen window, an instrument).
 pub fn refuse_existing(path: &Path) -> Result<(), JournalError> {
-    if path.exists() {
+    // A dangling link is something there too: it is named, not created through.
+    if std::fs::symlink_metadata(path).is_ok() {
         return Err(existing(path));
     }
     Ok(())
@@ -388,6 +405,16 @@ pub fn refuse_existing(path: &Path) -> Result<(), JournalError> {
 /// Why the existing journal at `path` cannot be started anew: it holds a session, or it
 /// holds nothing usable (and can be set aside).
 fn existing(path: &Path) -> JournalError {
+    // What stands there first: reading a FIFO would wait for ever.
+    if let Err(e) = owned_file(path) {
+        return e.into();
+    }
+    // A session measuring into it now is the reason, whatever the file holds yet.
+    if let Ok(f) = File::open(path) {
+        if let Err(e @ JournalError::InUse { .. }) = lock(&f, path) {
+            return e;
+        }
+    }
     match metamer_color::text::read_bytes(path)
         .ok()
         .as_deref()
@@ -465,108 +492,5 @@ fn count_entries(path: &Path) -> usize {
 
 #[cfg(test)]
 mod recovery_tests;
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[derive(Debug, PartialEq, Serialize, Deserialize)]
-    struct Item {
-        n: u32,
-    }
-
-    fn header(options: &[(&str, &str)], fingerprint: &str) -> Header<String> {
-        Header {
-            format: JOURNAL_FORMAT.into(),
-            version: JOURNAL_VERSION,
-            kind: "test".into(),
-            fingerprint: fingerprint.into(),
-            options: options
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.to_string()))
-                .collect(),
-            steps: 3,
-            started_s: 1.0,
-            data: "rig".into(),
-        }
-    }
-
-    fn temp(tag: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("metamer-journal-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join("j.jsonl")
-    }
-
-    fn append_raw(path: &Path, bytes: &[u8]) {
-        OpenOptions::new()
-            .append(true)
-            .open(path)
-            .unwrap()
-            .write_all(bytes)
-            .unwrap();
-    }
-
-    #[test]
-    fn a_line_that_lost_only_its_newline_is_kept() {
-        let path = temp("newline");
-        let h = header(&[("a", "1")], "f1");
-        let mut j = Journal::<String, Item>::create(&path, &h).unwrap();
-        j.append(&Item { n: 1 }).unwrap();
-        drop(j);
-        append_raw(&path, br#"{"type":"entry","n":2}"#);
-        let (mut j, rec) = Journal::<String, Item>::resume(&path, &h).unwrap();
-        assert_eq!(rec.torn_bytes, 0);
-        assert_eq!(rec.entries, vec![(2, Item { n: 1 }), (3, Item { n: 2 })]);
-        assert_eq!(rec.header, h);
-        j.append(&Item { n: 3 }).unwrap();
-        drop(j);
-        let (_, rec) = Journal::<String, Item>::resume(&path, &h).unwrap();
-        assert_eq!(rec.entries.len(), 3);
-        assert!(!torn_path(&path).exists());
-        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
-    }
-
-    #[test]
-    fn the_differing_option_is_named_and_other_damage_refused() {
-        let path = temp("refuse");
-        let h = header(&[("a", "1"), ("b", "2")], "f1");
-        drop(Journal::<String, Item>::create(&path, &h).unwrap());
-        let before = std::fs::read(&path).unwrap();
-        let resume = |h: &Header<String>| {
-            Journal::<String, Item>::resume(&path, h)
-                .err()
-                .unwrap()
-                .to_string()
-        };
-        // An option missing from one side is named too.
-        let e = resume(&header(&[("a", "1"), ("b", "2"), ("c", "3")], "f2"));
-        assert!(
-            e.contains("its option c is (not set), this one's is 3"),
-            "{e}"
-        );
-        let e = resume(&header(&[("a", "1"), ("b", "5")], "f2"));
-        assert!(e.contains("its option b is 2, this one's is 5"), "{e}");
-        let e = resume(&header(&[("a", "1"), ("b", "2")], "f2"));
-        assert!(
-            e.contains("every option is the same but its steps differ"),
-            "{e}"
-        );
-        let mut other_kind = h.clone();
-        other_kind.kind = "measure-box".into();
-        assert!(resume(&other_kind).contains("written by a test session, not a measure-box"));
-        assert_eq!(std::fs::read(&path).unwrap(), before);
-        // A second header, and a journal of another format.
-        append_raw(&path, &before);
-        let e = resume(&h);
-        assert!(e.contains("j.jsonl, line 2: a second header line"), "{e}");
-        std::fs::write(&path, b"{\"format\":\"other\",\"version\":1}\n").unwrap();
-        let e = resume(&h);
-        assert!(
-            e.contains("line 1: format \"other\" version 1 is not metamer-session-journal"),
-            "{e}"
-        );
-        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
-    }
-}
+mod tests;

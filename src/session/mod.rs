@@ -18,7 +18,10 @@ pub mod screen;
 pub mod step;
 
 pub use interrupt::on_ctrl_c;
-pub use journal::{refuse_existing, torn_path, CalibrationRecord, Header, Journal, JournalError};
+pub use journal::{
+    duplicates_path, reading_problem, refuse_existing, torn_path, CalibrationRecord, Header,
+    Journal, JournalEntry, JournalError,
+};
 pub use operator::{
     attendance, Answer, Attendance, NobodyAtTheRig, Operator, OperatorError, Readings, Recheck,
     ScriptedOperator, TerminalOperator, Unattended,

@@ -3,10 +3,11 @@
 
 use std::collections::BTreeMap;
 
+use metamer_color::text::echo;
 use metamer_drivers::{Instrument, InstrumentInfo, MeasureMode, Reading};
 use serde::{Deserialize, Serialize};
 
-use super::journal::Journal;
+use super::journal::{reading_problem, Journal, JournalEntry};
 
 /// One measured step as journalled.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -18,6 +19,19 @@ pub struct Entry<D> {
     pub mode: MeasureMode,
     pub data: D,
     pub reading: Reading,
+}
+
+/// Entries of a session journal: the step is the plan index, and the reading must be one
+/// an instrument can have given.
+impl<D> JournalEntry for Entry<D> {
+    fn step(&self) -> Option<usize> {
+        Some(self.index)
+    }
+
+    fn problem(&self) -> Option<String> {
+        reading_problem(&self.reading)
+            .map(|p| format!("step {} ({}): {p}", self.index, echo(&self.label)))
+    }
 }
 
 /// The header's caller part the engine adds to: the instruments by role.

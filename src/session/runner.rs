@@ -118,6 +118,9 @@ pub struct Session<H, D> {
     pub torn_bytes: usize,
     /// Where a journal that held no session (empty, torn header) was moved on resuming.
     pub set_aside: Option<PathBuf>,
+    /// What resuming repaired that the operator should know (readings of a second session
+    /// set aside); [`Session::run`] reports them first.
+    pub notes: Vec<String>,
 }
 
 impl<H, D> Session<H, D>
@@ -177,6 +180,7 @@ where
                 recovered: 0,
                 torn_bytes: 0,
                 set_aside,
+                notes: Vec::new(),
             });
         };
         let journal: SessionJournal<H, D> = journal;
@@ -215,28 +219,25 @@ where
                     ),
                 ));
             }
-            // A journal is a file anyone can edit: a reading no instrument can have taken
-            // (1e308, or one that overflowed to it) is refused here rather than failing the
-            // fit later in words about its matrices. A small negative component is left to
-            // the caller: a spectrometer's dark readings have them, and this journal was
-            // written from readings the instrument gave.
-            if let Err(
-                e @ (metamer_color::Implausible::NotFinite(_)
-                | metamer_color::Implausible::TooBright { .. }),
-            ) = metamer_color::check_xyz(entry.reading.xyz)
-            {
-                return Err(bad(
-                    line,
-                    format!(
-                        "step {} ({}): not a measurement: {e}",
-                        entry.index, entry.label
-                    ),
-                ));
-            }
+            // The journal has refused readings no instrument gave and set aside a step's
+            // later entries (see JournalEntry), so each step is here once.
             let i = entry.index;
-            if entries[i].replace(entry).is_some() {
-                return Err(bad(line, format!("step {i} is journalled twice")));
-            }
+            entries[i] = Some(entry);
+        }
+        let mut notes = Vec::new();
+        if !recovered.duplicates.is_empty() {
+            let lines: Vec<String> = recovered
+                .duplicates
+                .iter()
+                .map(|(line, step)| format!("line {line} (step {step})"))
+                .collect();
+            notes.push(format!(
+                "{} held {} reading(s) of steps it already had, written by a second session at the same time: the first of each is kept, the others were moved to {} ({})",
+                path.display(),
+                lines.len(),
+                super::journal::duplicates_path(path).display(),
+                lines.join(", ")
+            ));
         }
         Ok(Session {
             plan,
@@ -247,6 +248,7 @@ where
             recovered: n,
             torn_bytes: recovered.torn_bytes,
             set_aside: None,
+            notes,
         })
     }
 
@@ -281,6 +283,9 @@ where
         progress: &mut dyn ProgressSink,
     ) -> Result<RunEnd, SessionError> {
         self.check_rig(rig)?;
+        for note in std::mem::take(&mut self.notes) {
+            progress.note(&note);
+        }
         let total = self.plan.steps.len();
         progress.start(self.done(), total);
         let result = self.run_steps(rig, options, progress);

@@ -11,6 +11,7 @@ mod chart;
 mod error;
 pub mod export;
 pub mod figures;
+pub mod plausible;
 pub mod propagate;
 pub mod readings;
 pub mod report;

@@ -95,6 +95,10 @@ pub struct ReadingSet {
     pub instruments: Vec<String>,
     /// Things the reader should know (skipped entries, a torn last line).
     pub notes: Vec<String>,
+    /// How the readings were taken when the file says they are not luminances (a journal
+    /// of reflective-mode entries): see [`super::plausible`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_as: Option<String>,
 }
 
 impl ReadingSet {
@@ -219,7 +223,33 @@ pub fn parse_readings(text: &str, file: &Path) -> Result<ReadingSet, ReadingsErr
         p.csv(text)?;
         Format::Csv
     };
-    p.finish(format)
+    let mut set = p.finish(format)?;
+    set.measured_as = not_luminance(text, format);
+    Ok(set)
+}
+
+/// How readings in `text` (a journal) were taken, when not as light from the scene: the
+/// first entry in reflective or ambient mode, with its line. Other formats do not say.
+pub fn not_luminance(text: &str, format: Format) -> Option<String> {
+    if format != Format::Journal {
+        return None;
+    }
+    for (i, line) in text.lines().enumerate() {
+        let Ok(v) = serde_json::from_str::<Value>(line) else {
+            continue;
+        };
+        if v["type"] != "entry" {
+            continue;
+        }
+        let mode = v["mode"].as_str().unwrap_or_default();
+        let what = match mode {
+            "reflective" => "of surfaces on the instrument's lamp (reflectance, white = 100)",
+            "ambient" => "as illuminance through the instrument's diffuser (lux)",
+            _ => continue,
+        };
+        return Some(format!("in {mode} mode, {what} (line {})", i + 1));
+    }
+    None
 }
 
 struct Parsed {
@@ -327,6 +357,7 @@ impl Parsed {
             white: (!white.is_empty()).then(|| combine(&white)),
             instruments: self.instruments,
             notes: self.notes,
+            measured_as: None,
         })
     }
 }

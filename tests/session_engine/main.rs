@@ -266,6 +266,8 @@ fn calibrations_are_asked_for_when_due_and_everything_is_journalled() {
 
     // The journal on disk holds the same: resuming it finds every entry and calibration
     // and measures nothing.
+    // A session holds its journal's lock until it is dropped.
+    drop(ran);
     let again = run(
         open(&path, plan(TILES, Duration::ZERO), true),
         vec![],
@@ -358,6 +360,7 @@ fn a_changed_option_is_refused_by_name_and_the_journal_left_alone() {
         },
     );
     assert_eq!(first.end, RunEnd::Stopped { missing: 4 });
+    drop(first);
     let before = std::fs::read(&path).unwrap();
     let e = Session::<String, Target>::open(
         &path,
@@ -418,6 +421,7 @@ fn a_torn_last_line_is_set_aside_and_the_step_measured_again() {
         },
     );
     assert_eq!(first.end, RunEnd::Stopped { missing: 5 });
+    drop(first);
     // A crash in the middle of writing the fourth entry.
     let fragment = "{\"type\":\"entry\",\"index\":3,\"label\":\"gr";
     let mut bytes = std::fs::read(&path).unwrap();
@@ -444,6 +448,7 @@ fn a_torn_last_line_is_set_aside_and_the_step_measured_again() {
         .all(|l| serde_json::from_str::<serde_json::Value>(l).is_ok()));
     assert_eq!(resumed.progress.first(), Some(&(4, 8, 3)));
     assert_eq!(entries(&resumed.session).len(), 8);
+    drop(resumed);
 
     // Damage before the last line is no crash: an error naming file and line.
     let mut damaged = whole.clone();

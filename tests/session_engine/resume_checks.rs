@@ -23,6 +23,7 @@ fn another_setting_or_unit_of_the_same_model_is_refused_by_name() {
         },
     );
     assert_eq!(first.end, RunEnd::Stopped { missing: 6 });
+    drop(first);
     let before = std::fs::read(&path).unwrap();
     let reopen = |changed: &Change| {
         let mut now = instruments();

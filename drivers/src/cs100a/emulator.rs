@@ -180,7 +180,17 @@ impl Cs100aEmulator {
                     let mut full = std::mem::take(&mut pending);
                     full.extend_from_slice(&line);
                     let (reply, delay) = self.respond(&full);
-                    std::thread::sleep(delay);
+                    // The meter's delay, in slices: a stop asked for while it "measures"
+                    // ends the thread now, not when a slow scale's reading would be done.
+                    let until = Instant::now() + delay.min(Duration::from_secs(86_400 * 365));
+                    while Instant::now() < until {
+                        if stop.load(Ordering::Relaxed) {
+                            return;
+                        }
+                        std::thread::sleep(
+                            slice.min(until.saturating_duration_since(Instant::now())),
+                        );
+                    }
                     // The meter ignores requests that arrive while it measures (LS-100 manual
                     // p.13 [C]; the CS-100A is assumed alike [I]).
                     pending.clear();

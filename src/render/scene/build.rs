@@ -473,8 +473,10 @@ fn emitter(
             scale,
         )
     };
+    let mut brightest_tile: f64 = 0.0;
     for (k, g) in gains.iter().enumerate() {
         let lum = g * luminance(&spectra[tile_spectrum[k] as usize], ybar);
+        brightest_tile = brightest_tile.max(lum);
         if lum.is_nan() || lum > MAX_LUMINANCE_CD_M2 {
             return err(
                 format!("{p}.tiles[{}].gain", given[k].unwrap_or(0)),
@@ -514,6 +516,9 @@ fn emitter(
             Distribution::Table(Arc::new(table))
         }
     };
+    if let Distribution::Table(table) = &distribution {
+        check_table_peak(&dp, &e.distribution, table, brightest_tile)?;
+    }
     let reflectance = match &e.reflectance {
         Some(r) => loader.reflectance(&format!("{p}.reflectance"), r, warnings)?,
         None => constant_bins(0.0),
@@ -531,6 +536,45 @@ fn emitter(
         distribution,
         reflectance,
     })
+}
+
+/// A light table is relative to the normal's luminance, so its largest value times the
+/// brightest tile's luminance is the brightest the emitter looks from any side: above
+/// [`MAX_LUMINANCE_CD_M2`] the renderers' sums overflow (and the solver then blamed the
+/// reflectances). Said of the table's value, where it is, or of its file.
+fn check_table_peak(
+    dp: &str,
+    file: &DistributionFile,
+    table: &crate::light::CGammaTable,
+    brightest_tile: f64,
+) -> R<()> {
+    let mut peak = (0.0f64, 0, 0);
+    for (c, row) in table.values().iter().enumerate() {
+        for (g, &v) in row.iter().enumerate() {
+            if v > peak.0 {
+                peak = (v, c, g);
+            }
+        }
+    }
+    let (f, c, g) = peak;
+    let seen = f * brightest_tile;
+    if seen <= MAX_LUMINANCE_CD_M2 {
+        return Ok(());
+    }
+    let (c_deg, g_deg) = (table.c_deg()[c], table.gamma_deg()[g]);
+    // Short: a path error's message is cut past 120 characters.
+    let what = format!(
+        "{f:e} (C {c_deg}°, γ {g_deg}°) makes a tile {seen:.1e} cd/m² there, above the \
+         {MAX_LUMINANCE_CD_M2:e} cd/m² a scene may hold"
+    );
+    match file {
+        DistributionFile::CGamma { .. } => err(format!("{dp}.table.values[{c}][{g}]"), what),
+        DistributionFile::Ies { file } | DistributionFile::Ldt { file } => err(
+            format!("{dp}.file"),
+            format!("{file}: its relative luminance {what}"),
+        ),
+        _ => err(dp.to_string(), what),
+    }
 }
 
 /// A built-in scene from its text.

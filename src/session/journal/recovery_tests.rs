@@ -8,6 +8,8 @@ struct Item {
     n: u32,
 }
 
+impl JournalEntry for Item {}
+
 fn header() -> Header<String> {
     Header {
         format: JOURNAL_FORMAT.into(),
@@ -195,4 +197,71 @@ fn append_line(path: &Path, line: &str) {
         .unwrap()
         .write_all(line.as_bytes())
         .unwrap();
+}
+
+/// The lock: while one journal is open (created or resumed), opening it again is refused
+/// as in use, by resume and by a new session alike; closing it lets the next one in.
+#[test]
+fn a_journal_open_elsewhere_is_in_use() {
+    let path = temp("lock");
+    let h = header();
+    let in_use = |r: Result<(), JournalError>| matches!(r, Err(JournalError::InUse { .. }));
+    let first = Journal::<String, Item>::create(&path, &h).unwrap();
+    assert!(in_use(Journal::<String, Item>::resume(&path, &h).map(drop)));
+    assert!(in_use(refuse_existing(&path)));
+    drop(first);
+    let (second, _) = Journal::<String, Item>::resume(&path, &h).unwrap();
+    let e = Journal::<String, Item>::resume(&path, &h).err().unwrap();
+    assert!(
+        e.to_string().contains("is in use by another session"),
+        "{e}"
+    );
+    drop(second);
+    assert!(Journal::<String, Item>::resume(&path, &h).is_ok());
+}
+
+/// Two sessions that wrote one journal: the first entry of each step is kept in its
+/// place, the later ones go to the side file byte for byte, and the journal goes on.
+#[test]
+fn later_entries_of_a_step_are_set_aside_and_the_first_kept() {
+    use serde_json::{json, Value};
+    let path = temp("twice");
+    let h = header();
+    drop(Journal::<String, Value>::create(&path, &h).unwrap());
+    let line = |i: u32, v: &str| format!("{{\"type\":\"entry\",\"index\":{i},\"v\":\"{v}\"}}");
+    let later = [line(1, "c"), line(0, "d")];
+    append_line(
+        &path,
+        &format!(
+            "{}\n{}\n{}\n{}\n{}",
+            line(0, "a"),
+            line(1, "b"),
+            later[0],
+            later[1],
+            line(2, "e")
+        ),
+    );
+    let (mut j, r) = Journal::<String, Value>::resume(&path, &h).unwrap();
+    assert_eq!(r.duplicates, vec![(4, 1), (5, 0)]);
+    assert_eq!(r.duplicate_bytes, later[0].len() + later[1].len() + 2);
+    let kept: Vec<&str> = r
+        .entries
+        .iter()
+        .map(|(_, e)| e["v"].as_str().unwrap())
+        .collect();
+    assert_eq!(kept, ["a", "b", "e"]);
+    assert_eq!(
+        std::fs::read_to_string(duplicates_path(&path)).unwrap(),
+        later.join("\n") + "\n"
+    );
+    j.append(&json!({"index": 3, "v": "f"})).unwrap();
+    drop(j);
+    let (_, r) = Journal::<String, Value>::resume(&path, &h).unwrap();
+    assert!(r.duplicates.is_empty());
+    let kept: Vec<&str> = r
+        .entries
+        .iter()
+        .map(|(_, e)| e["v"].as_str().unwrap())
+        .collect();
+    assert_eq!(kept, ["a", "b", "e", "f"]);
 }

@@ -1,0 +1,41 @@
+//! What an experiment is made of: the options every stage and the checks before the first
+//! stage read.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use super::box_stage::BoxMeasure;
+use super::display::DisplayOptions;
+use super::reproduction::ReproductionOptions;
+use super::simulation::SimulationOptions;
+use super::stage::Stage;
+use crate::session::RunOptions;
+
+/// Where the box's measurements come from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum BoxSource {
+    /// Measured here, by the `measure-box` session into `box/`.
+    Measure(BoxMeasure),
+    /// Measurements taken earlier or elsewhere: the measured scene and the spot readings.
+    Existing { scene: PathBuf, spots: PathBuf },
+}
+
+/// What an experiment is made of.
+#[derive(Clone, Debug)]
+pub struct ExperimentOptions {
+    pub dir: PathBuf,
+    pub box_source: BoxSource,
+    pub simulation: SimulationOptions,
+    pub display: DisplayOptions,
+    pub reproduction: ReproductionOptions,
+    /// Spot readings averaged per patch on the display.
+    pub repeats: usize,
+    /// Run only this stage (again, even if its inputs are unchanged).
+    pub stage: Option<Stage>,
+    /// Continue an interrupted measuring stage's journal.
+    pub resume: bool,
+    /// Nobody at the rig: every operator request counts as done (simulated rigs).
+    pub unattended: bool,
+    pub run: RunOptions,
+}

@@ -1,0 +1,99 @@
+//! What an experiment can know before its first reading or rendering, checked first: a
+//! plan the fall-off fit or the validation cannot use, and a user's files that a stage
+//! would replace, fail now with the reason instead of after hours of measuring.
+
+use std::path::Path;
+
+use super::box_stage::BoxMeasure;
+use super::error::ExperimentError;
+use super::options::{BoxSource, ExperimentOptions};
+use super::readings::read_readings;
+use super::stage::Stage;
+use crate::boxmeasure::BoxPlan;
+use crate::render::Scene;
+
+/// Every check, in the order a user would fix them.
+pub fn check(opts: &ExperimentOptions) -> Result<(), ExperimentError> {
+    given_files_outside_stages(opts)?;
+    match &opts.box_source {
+        BoxSource::Measure(m) => measured_box(m),
+        BoxSource::Existing { scene, spots } => given_box(scene, spots),
+    }
+}
+
+/// A given box's files may not lie in a stage directory the run writes or moves aside:
+/// the stage would replace them (`--box-spots ex/simulation/spots.csv --stage simulation`
+/// overwrote the box's readings with simulated ones).
+fn given_files_outside_stages(opts: &ExperimentOptions) -> Result<(), ExperimentError> {
+    let BoxSource::Existing { scene, spots } = &opts.box_source else {
+        return Ok(());
+    };
+    for stage in Stage::ALL {
+        // A given box's own stage runs only when asked for by name.
+        if stage == Stage::Box && opts.stage != Some(Stage::Box) {
+            continue;
+        }
+        let Ok(dir) = std::fs::canonicalize(opts.dir.join(stage.name())) else {
+            continue;
+        };
+        for (what, file) in [("scene", scene), ("spot readings", spots)] {
+            if std::fs::canonicalize(file).is_ok_and(|f| f.starts_with(&dir)) {
+                return Err(ExperimentError::GivenInStage {
+                    what,
+                    file: file.clone(),
+                    stage: stage.name(),
+                    dir: opts.dir.join(stage.name()),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The plan's own rules (the fall-off angles the fit needs among them), and the patches:
+/// the measured scene holds the whole chart, so the simulation renders all 24 patches,
+/// the display shows them, and the validation compares the box's spots with each.
+fn measured_box(m: &BoxMeasure) -> Result<(), ExperimentError> {
+    let bad = |e: &dyn std::fmt::Display| ExperimentError::Box(e.to_string());
+    let mut plan = match &m.plan {
+        Some(p) => BoxPlan::load(p).map_err(|e| bad(&e))?,
+        None => BoxPlan::default(),
+    };
+    if let Some(n) = m.repeats {
+        plan.repeats = n;
+    }
+    plan.validate().map_err(|e| bad(&e))?;
+    let mut patches = plan.patches.clone();
+    patches.sort_unstable();
+    if patches != (1..=24).collect::<Vec<_>>() {
+        return Err(ExperimentError::Box(format!(
+            "plan{}: patches: the experiment validates every patch of the chart (the simulation renders all 24 and the display shows them, and each is compared with the box's spot reading), but the plan reads the spots of only {patches:?}: list all 24 patches, or leave `patches` out of the plan",
+            shown(m.plan.as_deref())
+        )));
+    }
+    Ok(())
+}
+
+fn shown(plan: Option<&Path>) -> String {
+    plan.map(|p| format!(" {}", p.display()))
+        .unwrap_or_default()
+}
+
+/// A given box's readings must hold the patches its scene has, which are those the
+/// simulation renders and the validation compares.
+fn given_box(scene: &Path, spots: &Path) -> Result<(), ExperimentError> {
+    let s = Scene::load(scene)?;
+    let in_scene: Vec<usize> = (1..=24).filter(|&k| s.patch_surface(k).is_some()).collect();
+    let mut read: Vec<usize> = read_readings(spots)?.iter().map(|p| p.patch).collect();
+    read.sort_unstable();
+    read.dedup();
+    if read != in_scene {
+        return Err(ExperimentError::GivenPatchesDiffer {
+            spots: spots.to_path_buf(),
+            read,
+            scene: scene.to_path_buf(),
+            in_scene,
+        });
+    }
+    Ok(())
+}
