@@ -7,7 +7,7 @@
 use std::fmt::Write;
 
 use super::assess::{Assessment, JndVerdict, PatchAssessment, JND_DE76};
-use super::figures::esc;
+use super::figures::{decisive, esc, interval_text};
 use super::readings::UncertaintySource;
 use super::report_input::ReportInput;
 
@@ -269,11 +269,10 @@ fn verdict_with(
         .map(|(p, why)| {
             let d = why.details();
             format!(
-                "{} {:.1} [{:.1}, {:.1}]{}",
+                "{} {} {}{}",
                 p.patch,
-                p.de76,
-                p.de76_interval.lo,
-                p.de76_interval.hi,
+                decisive(p.de76, JND_DE76),
+                interval_text(p.de76_interval.lo, p.de76_interval.hi, JND_DE76),
                 if d.is_empty() {
                     String::new()
                 } else {
