@@ -129,15 +129,16 @@ pub fn render_html(input: &ReportInput) -> String {
 }
 
 /// A bar chart in its wide and narrow drawing; the caption opens with the figure's number
-/// ("Fig. 4.") where it has one.
+/// ("Fig. 4."), or its head where it has none.
 fn bars(h: &mut String, a: &Assessment, id: &str, head: &str) {
-    let number = head.split(" — ").next().filter(|_| head.contains(" — "));
+    // "Fig. 4" of "Fig. 4 — display vs box"; a figure without a number is led by its head.
+    let lead = head.split(" — ").next().unwrap_or(head);
     let _ = writeln!(
         h,
         "<figure id=\"{id}-figure\">{}{}<figcaption>{}{}</figcaption></figure>",
         delta_e_bars(a, id, head),
         delta_e_rows(a, &format!("{id}-rows"), head),
-        number.map(|n| format!("<b>{}.</b> ", esc(n))).unwrap_or_default(),
+        format!("<b>{}.</b> ", esc(lead)),
         esc(&summary_line(a))
     );
 }

@@ -76,7 +76,8 @@ fn open_svg(s: &mut String, id: &str, class: &str, w: f64, h: f64, title: &str) 
 /// `head` starts its title ("Fig. 4 — display vs box").
 pub fn delta_e_bars(a: &Assessment, id: &str, head: &str) -> String {
     let (w, h) = (960.0, 456.0);
-    let (left, right, top_y, ph) = (62.0, 16.0, 44.0, 280.0);
+    // The right margin holds the JND line's label, clear of the bars.
+    let (left, right, top_y, ph) = (62.0, 56.0, 44.0, 280.0);
     let n = a.patches.len().max(1) as f64;
     let ymax = top(a);
     let pw = w - left - right;
@@ -145,10 +146,10 @@ pub fn delta_e_bars(a: &Assessment, id: &str, head: &str) -> String {
     let jy = y_of(JND_DE76);
     let _ = write!(
         s,
-        r##"<line class="jnd" x1="{left}" x2="{}" y1="{jy:.1}" y2="{jy:.1}" stroke="#000" stroke-dasharray="6 4" stroke-width="1.3"/><text x="{}" y="{:.1}" text-anchor="end" font-size="12" font-family="sans-serif">JND {JND_DE76}</text>"##,
+        r##"<line class="jnd" x1="{left}" x2="{}" y1="{jy:.1}" y2="{jy:.1}" stroke="#000" stroke-dasharray="6 4" stroke-width="1.3"/><text x="{}" y="{:.1}" font-size="12" font-family="sans-serif">JND {JND_DE76}</text>"##,
         w - right,
-        w - right - 4.0,
-        jy - 4.0
+        w - right + 4.0,
+        jy + 4.0
     );
     let _ = write!(
         s,

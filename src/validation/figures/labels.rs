@@ -95,7 +95,11 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
             .count()
     };
     order.sort_by_key(|&i| (std::cmp::Reverse(crowd(i)), i));
+    // What a label's box must keep clear of: the marks, then each placed label and leader.
     let mut taken: Vec<Rect> = obstacles.to_vec();
+    // What a leader must not cross: the placed labels (leaders may cross each other, as
+    // those of one crowded cluster all start at it).
+    let mut label_boxes: Vec<Rect> = Vec::new();
     let mut placed: Vec<Option<Placed>> = vec![None; labels.len()];
     // Up, upper right, right, …: 16 directions, the preferred first.
     let angles: Vec<f64> = {
@@ -135,9 +139,8 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
                 let mut hits = taken.iter().filter(|t| t.overlaps(&padded)).count();
                 if let Some((a, b)) = leader {
                     let line = segment_boxes(a, b, 0.5);
-                    hits += taken
+                    hits += label_boxes
                         .iter()
-                        .skip(obstacles.len())
                         .filter(|t| line.iter().any(|s| s.overlaps(t)))
                         .count();
                 }
@@ -163,12 +166,14 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
             rect: Rect::around(l.at.0, l.at.1, half_w, half_h),
             leader: None,
         });
-        taken.push(Rect::around(
+        let own = Rect::around(
             (p.rect.x0 + p.rect.x1) / 2.0,
             (p.rect.y0 + p.rect.y1) / 2.0,
             half_w + PAD,
             half_h + PAD,
-        ));
+        );
+        taken.push(own);
+        label_boxes.push(own);
         if let Some((a, b)) = p.leader {
             taken.extend(segment_boxes(a, b, 0.5));
         }
@@ -223,6 +228,23 @@ mod tests {
             // A label's box is 0.64 em per digit wide and 1.17 em tall.
             assert!((p.rect.x1 - p.rect.x0 - 2.0 * 0.64 * 13.0).abs() < 1e-9);
             assert!((p.rect.y1 - p.rect.y0 - 1.17 * 13.0).abs() < 1e-9);
+        }
+        // Twenty markers on one spot (readings that coincide): every label still finds a
+        // place of its own, each with a leader.
+        let texts: Vec<String> = (1..=20).map(|k| k.to_string()).collect();
+        let same: Vec<Label> = texts
+            .iter()
+            .map(|text| Label {
+                text,
+                at: (100.0, 100.0),
+                radius: 5.0,
+            })
+            .collect();
+        let fan = place(&same, 13.0, &markers[..3], frame);
+        for (i, p) in fan.iter().enumerate() {
+            for q in &fan[i + 1..] {
+                assert!(!p.rect.overlaps(&q.rect), "{p:?} {q:?}");
+            }
         }
         // The first, alone on its ring, sits just off its marker without a leader.
         let lone = place(&labels[..1], 13.0, &markers[..3], frame);
