@@ -400,8 +400,9 @@ impl Image {
         }
     }
 
+    /// The pixel that holds the point (x, y) of the page.
     fn at(&self, x: f64, y: f64) -> [u8; 3] {
-        let (x, y) = (x.round() as usize, y.round() as usize);
+        let (x, y) = (x.floor() as usize, y.floor() as usize);
         assert!(x < self.width && y < self.height, "({x}, {y}) is off the screenshot");
         let i = (y * self.width + x) * self.channels;
         [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]

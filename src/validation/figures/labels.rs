@@ -83,8 +83,9 @@ pub struct Label<'a> {
 }
 
 /// Places every label in `labels` (font size `font`) inside `frame`, clear of `obstacles`
-/// and of each other. A label that finds no free place (only in a frame too small for
-/// them all) goes where it overlaps least.
+/// and of each other. A label that finds no free place goes where it overlaps least:
+/// with its leader across other labels if it must, on a mark or a label only in a frame
+/// too small for them all.
 pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Vec<Placed> {
     let half_h = HEIGHT_EM * font / 2.0;
     let mut order: Vec<usize> = (0..labels.len()).collect();
@@ -101,9 +102,9 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
     // those of one crowded cluster all start at it).
     let mut label_boxes: Vec<Rect> = Vec::new();
     let mut placed: Vec<Option<Placed>> = vec![None; labels.len()];
-    // Up, upper right, right, …: 16 directions, the preferred first.
+    // 32 directions, upper right first, then those nearest it.
     let angles: Vec<f64> = {
-        let mut a: Vec<f64> = (0..16).map(|k| k as f64 * std::f64::consts::TAU / 16.0).collect();
+        let mut a: Vec<f64> = (0..32).map(|k| k as f64 * std::f64::consts::TAU / 32.0).collect();
         let pref = -std::f64::consts::FRAC_PI_4;
         let dist = |x: f64| {
             let d = (x - pref).rem_euclid(std::f64::consts::TAU);
@@ -136,7 +137,10 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
                     let start = (l.at.0 + l.radius * c, l.at.1 + l.radius * s);
                     (start, nearest_point(&rect, start))
                 });
-                let mut hits = taken.iter().filter(|t| t.overlaps(&padded)).count();
+                // A box over a mark or a label costs far more than a leader across a label,
+                // so a label walled in by its cluster's others crosses them with its leader
+                // rather than sit on one.
+                let mut hits = 1000 * taken.iter().filter(|t| t.overlaps(&padded)).count();
                 if let Some((a, b)) = leader {
                     let line = segment_boxes(a, b, 0.5);
                     hits += label_boxes
