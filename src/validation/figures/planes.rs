@@ -27,8 +27,10 @@ const DISC: f64 = 5.0;
 const RING: f64 = 3.4;
 /// A displacement drawn shorter than the ring's radius leaves the ring on its disc.
 pub const MIN_DRAWN: f64 = RING;
-/// The longest displacement, magnified, is drawn at most this share of the plot's side.
-const LONGEST_SHARE: f64 = 0.25;
+/// The longest displacement, magnified, is drawn at most this share of the plot's side: a
+/// factor that shows small displacements, while the longest line crosses no more than
+/// part of the plane.
+const LONGEST_SHARE: f64 = 0.4;
 
 /// Fig. 5 as HTML, and what its caption must say.
 #[derive(Clone, Debug, PartialEq)]
