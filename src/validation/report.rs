@@ -22,13 +22,16 @@ pub use super::report_input::{
     ReportInput,
 };
 
-/// The page's style: readable from a 390 px phone to print. Tables scroll inside their own
+/// The page's style: readable from a 390 px phone to print. Text runs at most 1000 px wide,
+/// figures and tables to 1148 (an inlined 1100-unit chart with 9.7-unit text fits whole
+/// at 10 px on a 1280 px screen). Tables scroll inside their own
 /// box, so the page itself never scrolls sideways; each bar chart comes in a wide and a
 /// narrow drawing and the page shows the one that keeps its text at 10 px or more (the wide
 /// one's smallest text is 12 units in 960, so from 840 px up); in print every figure stays
 /// on one page and colours print as shown.
 const STYLE: &str = "*{box-sizing:border-box}\
-body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color:#111;background:#fff;line-height:1.35}\
+body{font-family:sans-serif;max-width:1180px;margin:1em auto;padding:0 1em;color:#111;background:#fff;line-height:1.35}\
+p,ul,h1,h2,figcaption{max-width:1000px}\
 h1{font-size:1.5em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #ccc}\
 p,li,figcaption{overflow-wrap:anywhere}\
 .scroll{overflow-x:auto;max-width:100%}\
@@ -37,7 +40,7 @@ th{background:#f0f0f0}th.g{text-align:center}td.l,th.l{text-align:left}.sw{displ
 .clip{outline:2px dashed #000}.below{color:#2d7a2d}.above{color:#b03020;font-weight:bold}.undecided{color:#b06a00}\
 figure{margin:1.2em 0}figcaption{font-size:0.9em;color:#333;margin-top:0.3em}svg.figure{max-width:100%;height:auto;display:block}\
 svg.narrow{display:none;width:100%;max-width:540px;margin:0 auto}\
-.planes{display:flex;flex-wrap:wrap;gap:8px;justify-content:center;align-items:flex-start}.planes svg.figure{flex:1 1 340px;max-width:480px}\
+.planes{display:flex;flex-wrap:wrap;gap:8px;align-items:flex-start}.planes svg.figure{flex:1 1 340px;max-width:480px}\
 .key{vertical-align:-2px}\
 .verdict{background:#f7f7f0;padding:0.6em 1em;border-left:4px solid #999}\
 .sw,svg,.verdict,th{-webkit-print-color-adjust:exact;print-color-adjust:exact}\
@@ -82,11 +85,21 @@ pub fn render_html(input: &ReportInput) -> String {
             .unwrap_or_default()
     );
     if let Some(a) = &input.box_vs_display {
-        bars(&mut h, a, "fig4", &format!("Fig. 4 — {} vs {}", a.test, a.reference));
+        bars(
+            &mut h,
+            a,
+            "fig4",
+            &format!("Fig. 4 — {} vs {}", a.test, a.reference),
+        );
         planes(&mut h, a, "fig5");
     }
     if let Some(a) = &input.box_vs_simulation {
-        bars(&mut h, a, "fig6", &format!("Fig. 6 — {} vs {}", a.test, a.reference));
+        bars(
+            &mut h,
+            a,
+            "fig6",
+            &format!("Fig. 6 — {} vs {}", a.test, a.reference),
+        );
     }
     if let Some(a) = &input.display_vs_simulation {
         bars(&mut h, a, "fig7", &format!("{} vs {}", a.test, a.reference));
@@ -161,7 +174,10 @@ fn planes(h: &mut String, a: &Assessment, id: &str) {
         .map(|(plane, v)| {
             format!(
                 "{} in the {plane} plane",
-                v.iter().map(|p| p.to_string()).collect::<Vec<_>>().join(", ")
+                v.iter()
+                    .map(|p| p.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )
         })
         .collect();

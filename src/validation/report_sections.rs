@@ -342,7 +342,8 @@ mod tests {
         );
         // 1100 wide with 9.677-unit text: 10 px text needs 1100 · 10 / 9.677 = 1136.7 px.
         let small = "<svg width=\"1100\" height=\"480\"><text font-size=\"14.5\">t</text><text font-size=\"9.677\">u</text></svg>";
-        assert!(inline_svg(small).starts_with("<svg class=\"figure\" style=\"min-width:1137px\" width="));
+        assert!(inline_svg(small)
+            .starts_with("<svg class=\"figure\" style=\"min-width:1137px\" width="));
         // From the viewBox and a style property when there is no width attribute.
         let styled = "<svg viewBox=\"0 0 400 100\"><text style=\"font-size:8px\">t</text></svg>";
         assert!(inline_svg(styled).contains("min-width:500px"));

@@ -350,7 +350,10 @@ mod tests {
             v.contains("Of the 3 not shown to be below the JND: 1 outside the display's gamut (2 light skin); 1 dark, where the meter's noise dominates (24 black 2); 1 in gamut and clear of noise: the display model's error (1 dark skin)."),
             "{v}"
         );
-        assert!(v.contains("2 6.01 [5.99, 6.04] (uncertainty unknown"), "{v}");
+        assert!(
+            v.contains("2 6.01 [5.99, 6.04] (uncertainty unknown"),
+            "{v}"
+        );
         assert!(
             v.contains("24 1.11 [0.08, 4.89] (L* 20, interval 4.8 wide against a median 0.0; straddles the JND;"),
             "{v}"

@@ -104,7 +104,9 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
     let mut placed: Vec<Option<Placed>> = vec![None; labels.len()];
     // 32 directions, upper right first, then those nearest it.
     let angles: Vec<f64> = {
-        let mut a: Vec<f64> = (0..32).map(|k| k as f64 * std::f64::consts::TAU / 32.0).collect();
+        let mut a: Vec<f64> = (0..32)
+            .map(|k| k as f64 * std::f64::consts::TAU / 32.0)
+            .collect();
         let pref = -std::f64::consts::FRAC_PI_4;
         let dist = |x: f64| {
             let d = (x - pref).rem_euclid(std::f64::consts::TAU);
@@ -183,7 +185,10 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
         }
         placed[i] = Some(p);
     }
-    placed.into_iter().map(|p| p.expect("every label placed")).collect()
+    placed
+        .into_iter()
+        .map(|p| p.expect("every label placed"))
+        .collect()
 }
 
 /// The point of `r` nearest to `p`.
@@ -253,6 +258,9 @@ mod tests {
         // The first, alone on its ring, sits just off its marker without a leader.
         let lone = place(&labels[..1], 13.0, &markers[..3], frame);
         assert!(lone[0].leader.is_none());
-        assert!(lone[0].rect.x0 > 100.0 && lone[0].rect.y1 < 100.0, "{lone:?}");
+        assert!(
+            lone[0].rect.x0 > 100.0 && lone[0].rect.y1 < 100.0,
+            "{lone:?}"
+        );
     }
 }

@@ -97,16 +97,16 @@ pub fn lab_planes(a: &Assessment, id: &str) -> Planes {
         pairs
             .iter()
             .flat_map(|(r, t)| {
-                (1..3).flat_map(move |k| [r[k], t[k], r[k] + m * (t[k] - r[k])].map(|v| finite(v).abs()))
+                (1..3).flat_map(move |k| {
+                    [r[k], t[k], r[k] + m * (t[k] - r[k])].map(|v| finite(v).abs())
+                })
             })
             .fold(10.0, f64::max)
     };
     let scale0 = P / (2.0 * extent(1.0) * 1.06);
     let longest = pairs
         .iter()
-        .flat_map(|(r, t)| {
-            [AB, LA].map(|ax| finite((t[ax.x] - r[ax.x]).hypot(t[ax.y] - r[ax.y])))
-        })
+        .flat_map(|(r, t)| [AB, LA].map(|ax| finite((t[ax.x] - r[ax.x]).hypot(t[ax.y] - r[ax.y]))))
         .fold(0.0, f64::max);
     let magnification = if longest > 0.0 {
         nice_floor(LONGEST_SHARE * P / (scale0 * longest))
@@ -124,7 +124,16 @@ pub fn lab_planes(a: &Assessment, id: &str) -> Planes {
     let mut html = format!("<div class=\"planes\" id=\"{id}\">");
     let mut unresolved = Vec::new();
     for (ax, range) in [(AB, (-half, half)), (LA, l_range)] {
-        let (svg, short) = plane(a, id, &ax, &pairs, scale, (-half, half), range, magnification);
+        let (svg, short) = plane(
+            a,
+            id,
+            &ax,
+            &pairs,
+            scale,
+            (-half, half),
+            range,
+            magnification,
+        );
         html.push_str(&svg);
         unresolved.push((ax.name, short));
     }
