@@ -480,11 +480,12 @@ fn fig5_shows_each_displacement_in_a_screenshot() {
             } else {
                 "L*a*"
             };
+            let patch = m["patch"].to_string();
             let listed = named.split("; ").any(|part| {
                 part.ends_with(&format!(" in the {plane} plane"))
                     && part
                         .split(|c: char| !c.is_ascii_digit())
-                        .any(|n| n == m["patch"].to_string())
+                        .any(|n| n == patch)
             });
             // Within a tenth of a pixel the page's rounding may put it either side.
             assert!(

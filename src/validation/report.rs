@@ -148,10 +148,10 @@ fn bars(h: &mut String, a: &Assessment, id: &str, head: &str) {
     let lead = head.split(" — ").next().unwrap_or(head);
     let _ = writeln!(
         h,
-        "<figure id=\"{id}-figure\">{}{}<figcaption>{}{}</figcaption></figure>",
+        "<figure id=\"{id}-figure\">{}{}<figcaption><b>{}.</b> {}</figcaption></figure>",
         delta_e_bars(a, id, head),
         delta_e_rows(a, &format!("{id}-rows"), head),
-        format!("<b>{}.</b> ", esc(lead)),
+        esc(lead),
         esc(&summary_line(a))
     );
 }
