@@ -150,7 +150,9 @@ const PROBE: &str = r#"<script>addEventListener('load', () => {
     for (const c of svg.querySelectorAll('circle.box')) {
       const d = svg.querySelector('circle.display[data-patch="' + c.dataset.patch + '"]');
       out.marks.push({ plane: svg.id, patch: +c.dataset.patch, from: centre(c), to: centre(d),
-                       ring: 3.4 * scale, disc: 5 * scale, frame: box(svg.getBoundingClientRect()) });
+                       ring: 3.4 * scale, disc: 5 * scale, frame: box(svg.getBoundingClientRect()),
+                       magnification: +d.dataset.magnification,
+                       figure_magnification: +svg.querySelector('text').textContent.split('×')[1] });
     }
   }
   for (const f of document.querySelectorAll('figure[id$="-figure"]')) {
@@ -423,7 +425,9 @@ fn drawn(c: [u8; 3]) -> bool {
 
 /// Fig. 5 in a 1280 px screenshot: for every patch whose displacement is drawn longer than
 /// its ring's radius, the pixels from its disc to its ring are drawn, and its ring is drawn
-/// at its far side; a patch drawn shorter is named in the caption as such.
+/// at its far side; a patch drawn at a magnification other than the figure's is named in
+/// the caption with it; a patch drawn shorter is named in the caption as such. In the
+/// test data every displacement shows, in both planes.
 #[test]
 fn fig5_shows_each_displacement_in_a_screenshot() {
     let Some(browser) = browser() else {
@@ -463,11 +467,45 @@ fn fig5_shows_each_displacement_in_a_screenshot() {
         .unwrap()
         .to_string();
     let mut checked = 0;
+    let mut own_count = 0;
     for m in marks {
         let xy = |k: &str| (m[k][0].as_f64().unwrap(), m[k][1].as_f64().unwrap());
         let (from, to) = (xy("from"), xy("to"));
         let ring = m["ring"].as_f64().unwrap();
         let len = (to.0 - from.0).hypot(to.1 - from.1);
+        let plane = if m["plane"] == "fig5-ab" {
+            "a*b*"
+        } else {
+            "L*a*"
+        };
+        let (own, figure) = (
+            m["magnification"].as_f64().unwrap(),
+            m["figure_magnification"].as_f64().unwrap(),
+        );
+        assert!(figure >= 1.0, "no magnification in Fig. 5's title");
+        if own != figure {
+            // "…: a*b* plane 9 ×500, 22 ×200; L*a* plane 7 ×100, …."
+            let stated = format!("{} ×{own}", m["patch"]);
+            let listed = caption
+                .split("that shows it): ")
+                .nth(1)
+                .and_then(|rest| rest.split(". ").next())
+                .map(|list| list.trim_end_matches('.'))
+                .is_some_and(|list| {
+                    list.split("; ").any(|part| {
+                        part.starts_with(&format!("{plane} plane "))
+                            && part
+                                .split(", ")
+                                .any(|e| e.trim_start_matches(&format!("{plane} plane ")) == stated)
+                    })
+                });
+            assert!(
+                listed,
+                "patch {} is drawn ×{own} in {plane}, not ×{figure}, and the caption does not say so: {caption}",
+                m["patch"]
+            );
+            own_count += 1;
+        }
         if len < ring {
             // "…, so the ring sits on its disc: 9, 22 in the a*b* plane; 7, 9, 22 in …; their"
             let named = caption
@@ -475,11 +513,6 @@ fn fig5_shows_each_displacement_in_a_screenshot() {
                 .and_then(|(_, rest)| rest.split_once("; their"))
                 .map(|(list, _)| list.to_string())
                 .unwrap_or_default();
-            let plane = if m["plane"] == "fig5-ab" {
-                "a*b*"
-            } else {
-                "L*a*"
-            };
             let patch = m["patch"].to_string();
             let listed = named.split("; ").any(|part| {
                 part.ends_with(&format!(" in the {plane} plane"))
@@ -509,27 +542,45 @@ fn fig5_shows_each_displacement_in_a_screenshot() {
             );
         }
         // The ring, on the far side from the disc: black (the darkest pixel where it is
-        // drawn, as its edge is smoothed), never under another mark.
+        // drawn, as its edge is smoothed), or where it has a magnification of its own, blue
+        // (the bluest pixel there), never under another mark.
         let (fx, fy) = (to.0 + ring * ux, to.1 + ring * uy);
-        let far = [-1.0, 0.0, 1.0]
+        let around = [-1.0, 0.0, 1.0]
             .iter()
-            .flat_map(|dx| [-1.0, 0.0, 1.0].map(|dy| img.at(fx + dx, fy + dy)))
-            .min_by_key(|c| c.iter().map(|&v| u32::from(v)).sum::<u32>())
-            .unwrap();
+            .flat_map(|dx| [-1.0, 0.0, 1.0].map(|dy| img.at(fx + dx, fy + dy)));
+        let blueness = |c: &[u8; 3]| i32::from(c[2]) - i32::from(c[0]);
+        let far = if own == figure {
+            around
+                .min_by_key(|c| c.iter().map(|&v| u32::from(v)).sum::<u32>())
+                .unwrap()
+        } else {
+            around.max_by_key(blueness).unwrap()
+        };
         assert!(
-            far.iter().all(|&v| v < 100),
+            if own == figure {
+                // Black, or where a short mark of its own magnification is drawn over it, blue.
+                far.iter().all(|&v| v < 100) || blueness(&far) > 80
+            } else {
+                blueness(&far) > 80
+            },
             "patch {} in {}: its ring is not drawn (pixel {far:?})",
             m["patch"],
             m["plane"]
         );
         checked += 1;
     }
-    eprintln!("Fig. 5: {checked} of 48 displacements checked pixel by pixel");
-    // The data's displacements run from 0.08 to 9.3 ΔE*ab: at the ×5 its largest allows,
-    // over half are drawn long enough to see.
+    eprintln!(
+        "Fig. 5: {checked} of 48 displacements checked pixel by pixel, {own_count} at a magnification of their own"
+    );
+    // The data's displacements run from 0.08 to 9.3 ΔE*ab: the small ones get their own
+    // magnification, so every one is drawn long enough to see.
+    assert_eq!(
+        checked, 48,
+        "not every displacement is drawn long enough to see"
+    );
     assert!(
-        checked >= 24,
-        "only {checked} displacements long enough to check"
+        own_count > 0,
+        "the test data's small displacements need their own magnification"
     );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -11,7 +11,7 @@ mod labels;
 mod planes;
 
 pub use bars::{delta_e_bars, delta_e_rows};
-pub use planes::{lab_planes, Planes, MIN_DRAWN};
+pub use planes::{lab_planes, Planes, MAX_OWN, MIN_DRAWN, OWN_COLOUR};
 
 use crate::color::{Lab, Xyz};
 

@@ -8,7 +8,8 @@ use std::fmt::Write;
 
 use super::assess::{Assessment, JND_DE76};
 use super::figures::{
-    decisive, delta_e_bars, delta_e_rows, esc, interval_text, lab_planes, srgb_swatch,
+    decisive, delta_e_bars, delta_e_rows, esc, interval_text, lab_planes, srgb_swatch, MAX_OWN,
+    OWN_COLOUR,
 };
 use super::readings::UncertaintySource;
 use super::report_sections::{
@@ -167,6 +168,29 @@ fn planes(h: &mut String, a: &Assessment, id: &str) {
         test = esc(&a.test),
         reference = esc(&a.reference),
     );
+    let own: Vec<String> = f
+        .own
+        .iter()
+        .filter(|(_, v)| !v.is_empty())
+        .map(|(plane, v)| {
+            format!(
+                "{plane} plane {}",
+                v.iter()
+                    .map(|(p, k)| format!("{p} ×{}", super::figures::trim(*k)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+        .collect();
+    if !own.is_empty() {
+        let blue = format!("<svg class=\"key\" width=\"12\" height=\"12\" viewBox=\"0 0 12 12\" aria-hidden=\"true\"><circle cx=\"6\" cy=\"6\" r=\"3.4\" fill=\"none\" stroke=\"{OWN_COLOUR}\" stroke-width=\"1.4\"/></svg>");
+        let _ = write!(
+            caption,
+            " {blue} In blue, a displacement under {:.2} in the plane, too short to see at ×{m}, drawn at a magnification of its own (the least of 1, 2, 5, 10, … that shows it): {}.",
+            f.floor,
+            own.join("; ")
+        );
+    }
     let short: Vec<String> = f
         .unresolved
         .iter()
@@ -195,8 +219,7 @@ fn planes(h: &mut String, a: &Assessment, id: &str) {
             .collect();
         let _ = write!(
             caption,
-            " At ×{m} a displacement under {:.2} is drawn shorter than the ring's radius, so the ring sits on its disc: {}; their ΔE*ab are {}.",
-            f.floor,
+            " A displacement too short to draw even at ×{MAX_OWN} is drawn shorter than the ring's radius, so the ring sits on its disc: {}; their ΔE*ab are {}.",
             short.join("; "),
             de.join(", ")
         );

@@ -3,7 +3,9 @@
 //! at its place; the test reading is a ring at the end of a line from it, the displacement
 //! magnified by one stated factor, so differences of a few tenths of a ΔE*ab show in a
 //! plane that spans ±90. Both planes share one scale (isotropic), so a line's length in
-//! either is its displacement times the factor. Labels are placed by a collision pass
+//! either is its displacement times the factor. A displacement too short to see at that
+//! factor is drawn in blue at a larger one of its own, which the caption states patch by
+//! patch, so every difference shows. Labels are placed by a collision pass
 //! ([`super::labels`]).
 
 use std::fmt::Write;
@@ -27,6 +29,14 @@ const DISC: f64 = 5.0;
 const RING: f64 = 3.4;
 /// A displacement drawn shorter than the ring's radius leaves the ring on its disc.
 pub const MIN_DRAWN: f64 = RING;
+/// A displacement drawn shorter than this (user units) is drawn at a magnification of its
+/// own: long enough that a line shows between disc and ring.
+const SEEN: f64 = RING + 3.0;
+/// The largest magnification a patch of its own may get; a displacement too short to see
+/// even at this is drawn as short, its ring on its disc, and named as such.
+pub const MAX_OWN: f64 = 1000.0;
+/// The colour of a displacement drawn at a magnification of its own.
+pub const OWN_COLOUR: &str = "#1f5fbf";
 /// The longest displacement, magnified, is drawn at most this share of the plot's side: a
 /// factor that shows small displacements, while the longest line crosses no more than
 /// part of the plane.
@@ -39,9 +49,12 @@ pub struct Planes {
     pub html: String,
     /// Every displacement is drawn this many times its length.
     pub magnification: f64,
-    /// ΔE*ab (in a plane) under which a displacement is drawn shorter than [`MIN_DRAWN`].
+    /// ΔE*ab (in a plane) under which a displacement would be too short to see at
+    /// [`Self::magnification`]: such a one gets a magnification of its own.
     pub floor: f64,
-    /// Per plane ("a*b*", "L*a*"), the patches drawn shorter than [`MIN_DRAWN`].
+    /// Per plane ("a*b*", "L*a*"), the patches drawn at a magnification of their own, and it.
+    pub own: Vec<(&'static str, Vec<(usize, f64)>)>,
+    /// Per plane ("a*b*", "L*a*"), the patches drawn shorter than [`MIN_DRAWN`] even so.
     pub unresolved: Vec<(&'static str, Vec<usize>)>,
 }
 
@@ -57,6 +70,23 @@ fn nice_floor(v: f64) -> f64 {
         }
     }
     best
+}
+
+/// The smallest of 1, 2, 5, 10, 20, … not below `v`, or `None` above [`MAX_OWN`].
+fn nice_ceil(v: f64) -> Option<f64> {
+    (0..4)
+        .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+        .find(|&c| c >= v && c <= MAX_OWN)
+}
+
+/// The magnification a displacement of `d` (in the plane) is drawn at, where `m` makes one
+/// CIELAB unit `scale` user units: `m` itself where that draws it at least [`SEEN`] long,
+/// else the smallest 1-2-5 factor that does, if there is one up to [`MAX_OWN`].
+fn own_magnification(d: f64, m: f64, scale: f64) -> f64 {
+    if d.is_nan() || d <= 0.0 || d * m * scale >= SEEN {
+        return m;
+    }
+    nice_ceil(SEEN / (d * scale)).map_or(m, |own| own.max(m))
 }
 
 /// One plane: its name, axes (horizontal, vertical) as indices into L*, a*, b*.
@@ -123,8 +153,9 @@ pub fn lab_planes(a: &Assessment, id: &str) -> Planes {
     let l_range = ((l_lo / 10.0).floor() * 10.0, (l_hi / 10.0).ceil() * 10.0);
     let mut html = format!("<div class=\"planes\" id=\"{id}\">");
     let mut unresolved = Vec::new();
+    let mut own = Vec::new();
     for (ax, range) in [(AB, (-half, half)), (LA, l_range)] {
-        let (svg, short) = plane(
+        let (svg, short, more) = plane(
             a,
             id,
             &ax,
@@ -136,17 +167,20 @@ pub fn lab_planes(a: &Assessment, id: &str) -> Planes {
         );
         html.push_str(&svg);
         unresolved.push((ax.name, short));
+        own.push((ax.name, more));
     }
     html.push_str("</div>");
     Planes {
         html,
         magnification,
-        floor: MIN_DRAWN / (scale * magnification),
+        floor: SEEN / (scale * magnification),
+        own,
         unresolved,
     }
 }
 
-/// One plane's SVG and the patches whose displacement is drawn shorter than [`MIN_DRAWN`].
+/// One plane's SVG, the patches whose displacement is drawn shorter than [`MIN_DRAWN`], and
+/// those drawn at a magnification of their own (with it).
 #[allow(clippy::too_many_arguments)]
 fn plane(
     a: &Assessment,
@@ -157,7 +191,7 @@ fn plane(
     (xmin, xmax): (f64, f64),
     (ymin, ymax): (f64, f64),
     m: f64,
-) -> (String, Vec<usize>) {
+) -> (String, Vec<usize>, Vec<(usize, f64)>) {
     let ph = (ymax - ymin) * scale;
     let h = TOP + ph + BOTTOM;
     let px = |v: f64| LEFT + (v - xmin) * scale;
@@ -212,17 +246,34 @@ fn plane(
         TOP + ph / 2.0,
         ax.ylabel
     );
+    // Each patch's magnification in this plane: the figure's, or its own where that would
+    // not show its displacement.
+    let factors: Vec<f64> = pairs
+        .iter()
+        .map(|(r, t)| {
+            let d = (t[ax.x] - r[ax.x]).hypot(t[ax.y] - r[ax.y]);
+            own_magnification(d, m, scale)
+        })
+        .collect();
     // Where each patch is drawn: its disc, and its ring at the magnified displacement.
     let marks: Vec<((f64, f64), (f64, f64))> = pairs
         .iter()
-        .map(|(r, t)| {
+        .zip(&factors)
+        .map(|((r, t), &f)| {
             let at = (px(r[ax.x]), py(r[ax.y]));
             let end = (
-                px(r[ax.x] + m * (t[ax.x] - r[ax.x])),
-                py(r[ax.y] + m * (t[ax.y] - r[ax.y])),
+                px(r[ax.x] + f * (t[ax.x] - r[ax.x])),
+                py(r[ax.y] + f * (t[ax.y] - r[ax.y])),
             );
             (at, end)
         })
+        .collect();
+    let more: Vec<(usize, f64)> = a
+        .patches
+        .iter()
+        .zip(&factors)
+        .filter(|(_, &f)| f != m)
+        .map(|(p, &f)| (p.patch, f))
         .collect();
     // The JND at the same magnification, as a scale bar in the plot's lower right.
     let jnd_len = JND_DE76 * m * scale;
@@ -276,16 +327,21 @@ fn plane(
     // White under every line and ring first, then the black marks over them, so a mark
     // shows on a dark disc and where it crosses another.
     let mut short = Vec::new();
-    for pass in 0..2 {
-        for (p, &(at, end)) in a.patches.iter().zip(&marks) {
+    // The marks at a magnification of their own come last: they are short, and would
+    // hide under the long lines of their neighbours.
+    for pass in 0..3 {
+        for ((p, &(at, end)), &f) in a.patches.iter().zip(&marks).zip(&factors) {
+            if (pass == 1 && f != m) || (pass == 2 && f == m) {
+                continue;
+            }
             let len = (end.0 - at.0).hypot(end.1 - at.1);
             if pass == 0 && len < MIN_DRAWN {
                 short.push(p.patch);
             }
-            let (stroke, line_w, ring_w, class) = if pass == 0 {
-                ("#ffffff", 3.4, 3.6, "halo")
-            } else {
-                ("#000000", 1.3, 1.4, "vector")
+            let (stroke, line_w, ring_w, class) = match pass {
+                0 => ("#ffffff", 3.4, 3.6, "halo"),
+                1 => ("#000000", 1.3, 1.4, "vector"),
+                _ => (OWN_COLOUR, 1.3, 1.4, "vector"),
             };
             if len > RING {
                 let k = (len - RING) / len;
@@ -301,9 +357,10 @@ fn plane(
             }
             let _ = write!(
                 s,
-                r#"<circle class="{}" data-patch="{}" cx="{:.2}" cy="{:.2}" r="{RING}" fill="none" stroke="{stroke}" stroke-width="{ring_w}"/>"#,
+                r#"<circle class="{}" data-patch="{}" data-magnification="{}" cx="{:.2}" cy="{:.2}" r="{RING}" fill="none" stroke="{stroke}" stroke-width="{ring_w}"/>"#,
                 if pass == 0 { "halo" } else { "display" },
                 p.patch,
+                trim(f),
                 end.0,
                 end.1
             );
@@ -353,7 +410,7 @@ fn plane(
         );
     }
     s.push_str("</svg>");
-    (s, short)
+    (s, short, more)
 }
 
 #[cfg(test)]
@@ -368,5 +425,21 @@ mod tests {
         assert_eq!(nice_floor(49.9), 20.0);
         assert_eq!(nice_floor(50.0), 50.0);
         assert_eq!(nice_floor(1e9), 1000.0);
+    }
+
+    #[test]
+    fn a_short_displacement_gets_the_least_factor_that_shows_it() {
+        // One CIELAB unit is 2 user units at ×1: 0.02 at ×20 would be 0.8 long.
+        assert_eq!(own_magnification(1.0, 20.0, 2.0), 20.0);
+        // SEEN = 6.4: 0.02 needs ×160, so ×200 (8 units long).
+        assert_eq!(own_magnification(0.02, 20.0, 2.0), 200.0);
+        // Exactly long enough at the figure's factor keeps it.
+        assert_eq!(own_magnification(SEEN / 40.0, 20.0, 2.0), 20.0);
+        // Too short even at ×1000, or none at all: the figure's factor.
+        assert_eq!(own_magnification(0.001, 20.0, 2.0), 20.0);
+        assert_eq!(own_magnification(0.0, 20.0, 2.0), 20.0);
+        assert_eq!(nice_ceil(160.0), Some(200.0));
+        assert_eq!(nice_ceil(1000.0), Some(1000.0));
+        assert_eq!(nice_ceil(1000.1), None);
     }
 }
