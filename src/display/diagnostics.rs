@@ -349,7 +349,7 @@ impl Diagnostics {
         unchecked.dedup();
         let r = &self.residuals;
         let fit = format!(
-            "The fitted {} reproduces the {} patches with mean ΔE00 {:.2}, 95th percentile \
+            "The fitted {} reproduces the {} readings it was fitted to with mean ΔE00 {:.2}, 95th percentile \
              {:.2}, max {:.2}.",
             self.model, r.patches, r.mean_de00, r.p95_de00, r.max_de00
         );

@@ -62,7 +62,7 @@ fn draw(
     let root = SVGBackend::with_string(svg, (900, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| chart_err(&e))?;
     let caption = format!(
-        "{} vs {}: {} of {} below JND",
+        "{} vs {}: ΔE per patch (CIELAB units); {} of {} below JND (point estimates)",
         comparison.test, comparison.reference, comparison.below_jnd, n
     );
     let mut chart = ChartBuilder::on(&root)
@@ -75,7 +75,7 @@ fn draw(
     chart
         .configure_mesh()
         .x_desc("ColorChecker patch")
-        .y_desc("colour difference")
+        .y_desc("ΔE (CIELAB units)")
         .x_labels(n)
         .x_label_formatter(&|x| format!("{}", x.round() as i64))
         .disable_x_mesh()

@@ -1,16 +1,21 @@
 //! The report's figures as inline SVG text: the paper's Fig. 4/6 (ΔE*ab per patch with
-//! error bars and the JND line) and Fig. 5 (a*b* and L*a* planes with an arrow from each
-//! reference reading to its test reading), and the patch swatches in sRGB.
+//! error bars and the JND line, [`bars`]) and Fig. 5 (a*b* and L*a* planes with each
+//! reference reading and its test reading, [`planes`]), and the patch swatches in sRGB.
 //!
 //! Hand-written SVG rather than a plotting library: the figures go inline into one HTML
-//! file, need ids unique within it, and must not depend on fonts or scripts.
+//! file, need ids unique within it, must not depend on fonts or scripts, and need text of
+//! a size chosen for the width they are shown at.
 
-use std::fmt::Write;
+mod bars;
+mod labels;
+mod planes;
+
+pub use bars::{delta_e_bars, delta_e_rows};
+pub use planes::{lab_planes, Planes, MAX_OWN, MIN_DRAWN, OWN_COLOUR};
 
 use crate::color::{Lab, Xyz};
 
-use super::assess::JND_DE76;
-use super::assess::{Assessment, JndVerdict};
+use super::assess::JndVerdict;
 
 /// Escapes text for HTML and SVG.
 pub fn esc(s: &str) -> String {
@@ -107,310 +112,30 @@ fn ticks(start: f64, end: f64, step: f64) -> Vec<f64> {
     out
 }
 
-/// Fig. 4 (and 6): ΔE*ab per patch as bars coloured by the JND verdict, the 95 % interval
-/// as an error bar, ΔE00 as a dot, the JND line, colours outside the display's gamut on a
-/// grey band, and under each bar the two readings' swatches (reference above, test below).
-/// `id` makes the figure's element ids unique in the page.
-pub fn delta_e_bars(a: &Assessment, id: &str, title: &str) -> String {
-    let (w, h) = (960.0, 430.0);
-    let (left, right, top, bottom) = (56.0, 16.0, 40.0, 110.0);
-    let n = a.patches.len().max(1) as f64;
-    let ymax = a
-        .patches
-        .iter()
-        .map(|p| p.de76_interval.hi.max(p.de76).max(p.de00))
-        .fold(JND_DE76 * 1.5, f64::max)
-        * 1.08;
-    let pw = w - left - right;
-    let ph = h - top - bottom;
-    let x_of = |i: usize| left + pw * (i as f64 + 0.5) / n;
-    let y_of = |v: f64| top + ph * (1.0 - v / ymax);
-    let slot = pw / n;
-    let mut s = String::new();
-    let _ = write!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" id="{id}" class="figure" viewBox="0 0 {w} {h}" width="{w}" height="{h}" role="img" aria-label="{t}"><title>{t}</title>"#,
-        t = esc(title)
-    );
-    let _ = write!(
-        s,
-        r##"<rect x="0" y="0" width="{w}" height="{h}" fill="#ffffff"/><text x="{}" y="22" text-anchor="middle" font-size="16" font-family="sans-serif">{}</text>"##,
-        w / 2.0,
-        esc(title)
-    );
-    for (i, p) in a.patches.iter().enumerate() {
-        if p.out_of_gamut {
-            let _ = write!(
-                s,
-                r##"<rect class="oog" x="{:.1}" y="{top}" width="{:.1}" height="{ph}" fill="#d9d9d9"/>"##,
-                x_of(i) - slot / 2.0,
-                slot
-            );
+/// `v` with as many decimals (2 to 4) as it takes to show on which side of `threshold` it
+/// lies: 2.2796 beside the JND 2.3 is "2.28", not "2.3"; 2.2996 is "2.2996".
+pub fn decisive(v: f64, threshold: f64) -> String {
+    for d in 2..=4 {
+        let s = format!("{v:.d$}");
+        let shown: f64 = s.parse().unwrap_or(v);
+        let same_side = (shown - threshold).signum() == (v - threshold).signum();
+        if v == threshold || (same_side && shown != threshold) || !v.is_finite() {
+            return s;
         }
     }
-    let step = tick_step(ymax, 6.0);
-    for v in ticks(0.0, ymax, step) {
-        let y = y_of(v);
-        let _ = write!(
-            s,
-            r##"<line x1="{left}" x2="{}" y1="{y:.1}" y2="{y:.1}" stroke="#e4e4e4"/><text x="{}" y="{:.1}" text-anchor="end" font-size="11" font-family="sans-serif">{}</text>"##,
-            w - right,
-            left - 6.0,
-            y + 4.0,
-            trim(v)
-        );
-    }
-    let bw = slot * 0.55;
-    for (i, p) in a.patches.iter().enumerate() {
-        let x = x_of(i);
-        let _ = write!(
-            s,
-            r#"<rect class="bar" x="{:.1}" y="{:.1}" width="{bw:.1}" height="{:.1}" fill="{}"><title>{} {}: ΔE*ab {:.2} [{:.2}, {:.2}], ΔE00 {:.2}, {}</title></rect>"#,
-            x - bw / 2.0,
-            y_of(p.de76),
-            y_of(0.0) - y_of(p.de76),
-            verdict_colour(p.jnd),
-            p.patch,
-            esc(&p.name),
-            p.de76,
-            p.de76_interval.lo,
-            p.de76_interval.hi,
-            p.de00,
-            p.jnd.name()
-        );
-        let (lo, hi) = (y_of(p.de76_interval.lo), y_of(p.de76_interval.hi));
-        let _ = write!(
-            s,
-            r##"<path class="errorbar" d="M{x:.1},{lo:.1}V{hi:.1}M{:.1},{lo:.1}h{:.1}M{:.1},{hi:.1}h{:.1}" stroke="#222" stroke-width="1.2" fill="none"/>"##,
-            x - 4.0,
-            8.0,
-            x - 4.0,
-            8.0
-        );
-        let _ = write!(
-            s,
-            r##"<circle cx="{x:.1}" cy="{:.1}" r="3" fill="#1f4e9c"/>"##,
-            y_of(p.de00)
-        );
-        let _ = write!(
-            s,
-            r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle" font-size="11" font-family="sans-serif">{}</text>"#,
-            y_of(0.0) + 14.0,
-            p.patch
-        );
-        let sw = slot * 0.8;
-        for (k, side) in [&p.reference, &p.test].into_iter().enumerate() {
-            let c = srgb_swatch(side.lab);
-            let y = y_of(0.0) + 20.0 + k as f64 * sw;
-            let _ = write!(
-                s,
-                r##"<rect class="swatch" x="{:.1}" y="{y:.1}" width="{sw:.1}" height="{sw:.1}" fill="{}" stroke="#888" stroke-width="0.5"/>"##,
-                x - sw / 2.0,
-                c.hex
-            );
-            if c.clipped {
-                let _ = write!(
-                    s,
-                    r##"<path class="clipped" d="M{:.1},{y:.1}l{sw:.1},{sw:.1}" stroke="#000" stroke-width="1"/>"##,
-                    x - sw / 2.0
-                );
-            }
-        }
-    }
-    let jy = y_of(JND_DE76);
-    let _ = write!(
-        s,
-        r##"<line class="jnd" x1="{left}" x2="{}" y1="{jy:.1}" y2="{jy:.1}" stroke="#000" stroke-dasharray="6 4" stroke-width="1.3"/><text x="{}" y="{:.1}" text-anchor="end" font-size="11" font-family="sans-serif">JND {JND_DE76}</text>"##,
-        w - right,
-        w - right - 4.0,
-        jy - 4.0
-    );
-    let _ = write!(
-        s,
-        r##"<line x1="{left}" x2="{left}" y1="{top}" y2="{:.1}" stroke="#000"/><line x1="{left}" x2="{}" y1="{:.1}" y2="{:.1}" stroke="#000"/><text transform="translate(16,{:.1}) rotate(-90)" text-anchor="middle" font-size="12" font-family="sans-serif">ΔE*ab (bar, 95 % interval) · ΔE00 (dot)</text>"##,
-        y_of(0.0),
-        w - right,
-        y_of(0.0),
-        y_of(0.0),
-        top + ph / 2.0
-    );
-    let legend_y = h - 12.0;
-    let mut lx = left;
-    for (label, colour) in [
-        ("below the JND", verdict_colour(JndVerdict::Below)),
-        ("above", verdict_colour(JndVerdict::Above)),
-        ("undecided", verdict_colour(JndVerdict::Undecided)),
-        ("out of the display's gamut", "#d9d9d9"),
-    ] {
-        let _ = write!(
-            s,
-            r#"<rect x="{lx}" y="{}" width="12" height="10" fill="{colour}"/><text x="{}" y="{legend_y}" font-size="11" font-family="sans-serif">{label}</text>"#,
-            legend_y - 9.0,
-            lx + 16.0
-        );
-        lx += 22.0 + 6.5 * label.chars().count() as f64;
-    }
-    let _ = write!(
-        s,
-        r#"<text x="{lx}" y="{legend_y}" font-size="11" font-family="sans-serif">swatches: {} above, {} below; a diagonal marks a clipped colour</text>"#,
-        esc(&a.reference),
-        esc(&a.test)
-    );
-    s.push_str("</svg>");
-    s
+    format!("{v:.4}")
 }
 
-fn trim(v: f64) -> String {
+/// A 95 % interval "[lo, hi]", each end to the decimals [`decisive`] gives it against
+/// `threshold`.
+pub fn interval_text(lo: f64, hi: f64, threshold: f64) -> String {
+    format!("[{}, {}]", decisive(lo, threshold), decisive(hi, threshold))
+}
+
+/// `v` to 2 decimals without trailing zeros ("20", "2.5").
+pub(crate) fn trim(v: f64) -> String {
     let t = format!("{v:.2}");
     t.trim_end_matches('0').trim_end_matches('.').to_string()
-}
-
-/// Fig. 5: the a*b* plane and the L*a* plane side by side, each reference reading a disc in
-/// its colour with an arrow to the test reading.
-pub fn lab_planes(a: &Assessment, id: &str, title: &str) -> String {
-    let (w, h) = (960.0, 500.0);
-    let mut s = String::new();
-    let _ = write!(
-        s,
-        r##"<svg xmlns="http://www.w3.org/2000/svg" id="{id}" class="figure" viewBox="0 0 {w} {h}" width="{w}" height="{h}" role="img" aria-label="{t}"><title>{t}</title><defs><marker id="{id}-arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" markerHeight="7" orient="auto-start-reverse"><path d="M0,0L10,5L0,10z" fill="#222"/></marker></defs><rect x="0" y="0" width="{w}" height="{h}" fill="#ffffff"/><text x="{}" y="22" text-anchor="middle" font-size="16" font-family="sans-serif">{t}</text>"##,
-        w / 2.0,
-        t = esc(title)
-    );
-    let pts = |f: fn([f64; 3]) -> (f64, f64)| -> Vec<Arrow> {
-        a.patches
-            .iter()
-            .map(|p| (f(p.reference.lab), f(p.test.lab)))
-            .collect()
-    };
-    let ab = pts(|l| (l[1], l[2]));
-    let la = pts(|l| (l[1], l[0]));
-    plane(
-        &mut s,
-        a,
-        id,
-        &ab,
-        (40.0, 40.0, 420.0, 420.0),
-        "a*",
-        "b*",
-        None,
-    );
-    plane(
-        &mut s,
-        a,
-        id,
-        &la,
-        (520.0, 40.0, 420.0, 420.0),
-        "a*",
-        "L*",
-        Some((0.0, 100.0)),
-    );
-    s.push_str("</svg>");
-    s
-}
-
-/// From a reference point to a test point in one plane.
-type Arrow = ((f64, f64), (f64, f64));
-
-/// One plane of [`lab_planes`] in the box `(x, y, w, h)`; `y_range` fixes the vertical axis
-/// (L* is 0–100), otherwise both axes share one symmetric range so hues keep their angles.
-#[allow(clippy::too_many_arguments)]
-fn plane(
-    s: &mut String,
-    a: &Assessment,
-    id: &str,
-    pts: &[Arrow],
-    (bx, by, bw, bh): (f64, f64, f64, f64),
-    xlabel: &str,
-    ylabel: &str,
-    y_range: Option<(f64, f64)>,
-) {
-    let extent = pts
-        .iter()
-        .flat_map(|&((x0, y0), (x1, y1))| {
-            let mut v = vec![x0.abs(), x1.abs()];
-            if y_range.is_none() {
-                v.extend([y0.abs(), y1.abs()]);
-            }
-            v
-        })
-        .fold(10.0, f64::max)
-        * 1.1;
-    let (xmin, xmax) = (-extent, extent);
-    let (ymin, ymax) = y_range.unwrap_or((-extent, extent));
-    let (pl, pb) = (36.0, 30.0);
-    let (pw, ph) = (bw - pl, bh - pb);
-    let px = |v: f64| bx + pl + pw * (v - xmin) / (xmax - xmin);
-    let py = |v: f64| by + ph * (1.0 - (v - ymin) / (ymax - ymin));
-    let _ = write!(
-        s,
-        r##"<rect x="{:.1}" y="{by}" width="{pw}" height="{ph}" fill="#fafafa" stroke="#000"/>"##,
-        bx + pl
-    );
-    let step = tick_step(xmax - xmin, 6.0);
-    for v in ticks((xmin / step).ceil() * step, xmax, step) {
-        let _ = write!(
-            s,
-            r##"<line x1="{x:.1}" x2="{x:.1}" y1="{by}" y2="{:.1}" stroke="{}"/><text x="{x:.1}" y="{:.1}" text-anchor="middle" font-size="10" font-family="sans-serif">{}</text>"##,
-            by + ph,
-            if v == 0.0 { "#999" } else { "#e4e4e4" },
-            by + ph + 13.0,
-            trim(v),
-            x = px(v)
-        );
-    }
-    let step = tick_step(ymax - ymin, 6.0);
-    for v in ticks((ymin / step).ceil() * step, ymax, step) {
-        let _ = write!(
-            s,
-            r##"<line x1="{:.1}" x2="{:.1}" y1="{y:.1}" y2="{y:.1}" stroke="{}"/><text x="{:.1}" y="{:.1}" text-anchor="end" font-size="10" font-family="sans-serif">{}</text>"##,
-            bx + pl,
-            bx + pl + pw,
-            if v == 0.0 && y_range.is_none() {
-                "#999"
-            } else {
-                "#e4e4e4"
-            },
-            bx + pl - 4.0,
-            py(v) + 3.0,
-            trim(v),
-            y = py(v)
-        );
-    }
-    let _ = write!(
-        s,
-        r#"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="12" font-family="sans-serif">{xlabel}</text><text transform="translate({:.1},{:.1}) rotate(-90)" text-anchor="middle" font-size="12" font-family="sans-serif">{ylabel}</text>"#,
-        bx + pl + pw / 2.0,
-        by + bh - 2.0,
-        bx + 8.0,
-        by + ph / 2.0
-    );
-    for (p, &((x0, y0), (x1, y1))) in a.patches.iter().zip(pts) {
-        let c = srgb_swatch(p.reference.lab);
-        let _ = write!(
-            s,
-            r##"<g class="patch"><title>{} {}: {} ({:.1}, {:.1}) → {} ({:.1}, {:.1})</title><line class="arrow" x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="#222" stroke-width="1.2" marker-end="url(#{id}-arrow)"/><circle cx="{:.1}" cy="{:.1}" r="6" fill="{}" stroke="{}" stroke-width="{}"/><text x="{:.1}" y="{:.1}" font-size="9" font-family="sans-serif">{}</text></g>"##,
-            p.patch,
-            esc(&p.name),
-            esc(&a.reference),
-            x0,
-            y0,
-            esc(&a.test),
-            x1,
-            y1,
-            px(x0),
-            py(y0),
-            px(x1),
-            py(y1),
-            px(x0),
-            py(y0),
-            c.hex,
-            if c.clipped { "#000" } else { "#666" },
-            if c.clipped { 2 } else { 1 },
-            px(x0) + 7.0,
-            py(y0) - 5.0,
-            p.patch
-        );
-    }
 }
 
 #[cfg(test)]
@@ -425,6 +150,19 @@ mod tests {
         assert!(ticks(f64::NAN, 1.0, 0.1).is_empty());
         // A step lost to rounding beside a huge start never moves v.
         assert_eq!(ticks(1e300, 2e300, 1.0).len(), MAX_TICKS);
+    }
+
+    #[test]
+    fn an_interval_shows_the_digits_that_place_it_against_the_jnd() {
+        assert_eq!(interval_text(2.2796, 2.6104, 2.3), "[2.28, 2.61]");
+        // 2.2996 rounds to 2.30 and 2.300: only four decimals show it below 2.3.
+        assert_eq!(decisive(2.2996, 2.3), "2.2996");
+        assert_eq!(decisive(2.3004, 2.3), "2.3004");
+        assert_eq!(decisive(2.3, 2.3), "2.30");
+        assert_eq!(decisive(0.153, 2.3), "0.15");
+        // Closer than 4 decimals resolve: shown as near as that.
+        assert_eq!(decisive(2.299_999, 2.3), "2.3000");
+        assert_eq!(decisive(f64::NAN, 2.3), "NaN");
     }
 
     #[test]

@@ -13,7 +13,7 @@ use super::report_input::{
 };
 
 fn rows(h: &mut String, rows: &[(String, String)]) {
-    h.push_str("<table>");
+    h.push_str("<div class=\"scroll\"><table>");
     for (k, v) in rows {
         let _ = write!(
             h,
@@ -22,7 +22,7 @@ fn rows(h: &mut String, rows: &[(String, String)]) {
             esc(v)
         );
     }
-    h.push_str("</table>\n");
+    h.push_str("</table></div>\n");
 }
 
 pub fn display_section(h: &mut String, d: &DisplayModelSection) {
@@ -46,7 +46,11 @@ pub fn light_section(h: &mut String, l: &LightFitSection) {
     h.push_str("<h2 id=\"light-fit\">Light distribution fit</h2>\n");
     rows(h, &l.summary);
     if let Some(svg) = &l.chart_svg {
-        let _ = writeln!(h, "<figure id=\"light-chart\">{}</figure>", inline_svg(svg));
+        let _ = writeln!(
+            h,
+            "<figure id=\"light-chart\"><div class=\"scroll\">{}</div></figure>",
+            inline_svg(svg)
+        );
     }
 }
 
@@ -75,8 +79,43 @@ pub fn inline_svg(svg: &str) -> String {
         return "<p>(the chart holds scripts or external references and is not shown)</p>".into();
     }
     let body = &svg[start..];
-    // Fits the page like the report's own figures.
-    format!("<svg class=\"figure\"{}", &body[4..])
+    // Fits the page like the report's own figures, but never so small that its smallest
+    // text is under 10 px: below that width it scrolls in its box.
+    let min_width = readable_width(body)
+        .map(|w| format!(" style=\"min-width:{:.0}px\"", w.ceil()))
+        .unwrap_or_default();
+    format!("<svg class=\"figure\"{min_width}{}", &body[4..])
+}
+
+/// The width at which the SVG `svg` (from its `<svg` on) draws its smallest text at 10 px:
+/// its width times 10 over its smallest font size, when it states both.
+fn readable_width(svg: &str) -> Option<f64> {
+    let tag = &svg[..svg.find('>')?];
+    let width = attribute(tag, "width")
+        .or_else(|| attribute(tag, "viewBox").and_then(|v| v.split_whitespace().nth(2)))
+        .and_then(|w| w.trim_end_matches("px").parse::<f64>().ok())
+        .filter(|w| w.is_finite() && *w > 0.0)?;
+    let smallest = svg
+        .match_indices("font-size")
+        .filter_map(|(i, _)| {
+            let rest = svg[i + "font-size".len()..].trim_start_matches(['=', ':', ' ', '"', '\'']);
+            let end = rest
+                .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+                .unwrap_or(rest.len());
+            rest[..end].parse::<f64>().ok()
+        })
+        .filter(|f| f.is_finite() && *f > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    smallest
+        .is_finite()
+        .then(|| (width * 10.0 / smallest).min(4.0 * width))
+}
+
+/// The value of `name="…"` in a start tag.
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let i = tag.find(&key)? + key.len();
+    tag[i..].split('"').next()
 }
 
 /// An attribute `on…=` (an event handler) anywhere in the markup.
@@ -136,7 +175,7 @@ pub fn render_section(h: &mut String, r: &RenderConfidenceSection) {
         let worst = r.per_patch.iter().map(|p| p.1).fold(0.0, f64::max);
         let _ = write!(
             h,
-            "<p>Per patch, the render's {} (largest {worst:.3}):</p><table>",
+            "<p>Per patch, the render's {} (largest {worst:.3}):</p><div class=\"scroll\"><table>",
             esc(measure)
         );
         // Rows of 12 patches, one ColorChecker row pair each, to fit the page.
@@ -151,12 +190,12 @@ pub fn render_section(h: &mut String, r: &RenderConfidenceSection) {
             }
             h.push_str("</tr>");
         }
-        h.push_str("</table>\n");
+        h.push_str("</table></div>\n");
     }
 }
 
 pub fn instruments_section(h: &mut String, list: &[InstrumentUsed]) {
-    h.push_str("<h2 id=\"instruments\">Instruments and calibrations</h2>\n<table><tr><th>role</th><th>model</th><th>serial</th><th>firmware</th><th>connection</th><th>calibrations</th></tr>");
+    h.push_str("<h2 id=\"instruments\">Instruments and calibrations</h2>\n<div class=\"scroll\"><table><tr><th>role</th><th>model</th><th>serial</th><th>firmware</th><th>connection</th><th>calibrations</th></tr>");
     let or_dash = |v: &Option<String>| esc(v.as_deref().unwrap_or("—"));
     for i in list {
         let cal = if i.calibrations.is_empty() {
@@ -178,11 +217,11 @@ pub fn instruments_section(h: &mut String, list: &[InstrumentUsed]) {
             or_dash(&i.connection),
         );
     }
-    h.push_str("</table>\n");
+    h.push_str("</table></div>\n");
 }
 
 pub fn inputs_section(h: &mut String, files: &[InputFile]) {
-    h.push_str("<h2 id=\"inputs\">Inputs</h2>\n<table><tr><th>role</th><th>file</th><th>format</th><th>patches</th><th>SHA-256</th></tr>");
+    h.push_str("<h2 id=\"inputs\">Inputs</h2>\n<div class=\"scroll\"><table><tr><th>role</th><th>file</th><th>format</th><th>patches</th><th>SHA-256</th></tr>");
     for f in files {
         let _ = write!(
             h,
@@ -198,7 +237,7 @@ pub fn inputs_section(h: &mut String, files: &[InputFile]) {
             esc(f.sha256.as_deref().unwrap_or("—"))
         );
     }
-    h.push_str("</table>\n");
+    h.push_str("</table></div>\n");
 }
 
 /// What a side's interval holds when the input does not say: from its readings' sources.
@@ -301,6 +340,13 @@ mod tests {
             out,
             "<svg class=\"figure\" width=\"10\" height=\"5\"><line x1=\"0\"/><text>on = off</text></svg>"
         );
+        // 1100 wide with 9.677-unit text: 10 px text needs 1100 · 10 / 9.677 = 1136.7 px.
+        let small = "<svg width=\"1100\" height=\"480\"><text font-size=\"14.5\">t</text><text font-size=\"9.677\">u</text></svg>";
+        assert!(inline_svg(small)
+            .starts_with("<svg class=\"figure\" style=\"min-width:1137px\" width="));
+        // From the viewBox and a style property when there is no width attribute.
+        let styled = "<svg viewBox=\"0 0 400 100\"><text style=\"font-size:8px\">t</text></svg>";
+        assert!(inline_svg(styled).contains("min-width:500px"));
         for bad in [
             "<svg><script>x()</script></svg>",
             "<svg><rect onload=\"x()\"/></svg>",

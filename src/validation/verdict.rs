@@ -7,7 +7,7 @@
 use std::fmt::Write;
 
 use super::assess::{Assessment, JndVerdict, PatchAssessment, JND_DE76};
-use super::figures::esc;
+use super::figures::{decisive, esc, interval_text};
 use super::readings::UncertaintySource;
 use super::report_input::ReportInput;
 
@@ -269,11 +269,10 @@ fn verdict_with(
         .map(|(p, why)| {
             let d = why.details();
             format!(
-                "{} {:.1} [{:.1}, {:.1}]{}",
+                "{} {} {}{}",
                 p.patch,
-                p.de76,
-                p.de76_interval.lo,
-                p.de76_interval.hi,
+                decisive(p.de76, JND_DE76),
+                interval_text(p.de76_interval.lo, p.de76_interval.hi, JND_DE76),
                 if d.is_empty() {
                     String::new()
                 } else {
@@ -351,9 +350,12 @@ mod tests {
             v.contains("Of the 3 not shown to be below the JND: 1 outside the display's gamut (2 light skin); 1 dark, where the meter's noise dominates (24 black 2); 1 in gamut and clear of noise: the display model's error (1 dark skin)."),
             "{v}"
         );
-        assert!(v.contains("2 6.0 [6.0, 6.0] (uncertainty unknown"), "{v}");
         assert!(
-            v.contains("24 1.1 [0.1, 4.9] (L* 20, interval 4.8 wide against a median 0.0; straddles the JND;"),
+            v.contains("2 6.01 [5.99, 6.04] (uncertainty unknown"),
+            "{v}"
+        );
+        assert!(
+            v.contains("24 1.11 [0.08, 4.89] (L* 20, interval 4.8 wide against a median 0.0; straddles the JND;"),
             "{v}"
         );
     }

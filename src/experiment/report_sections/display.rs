@@ -37,8 +37,31 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
     if let Some(i) = v["instrument"].as_str() {
         row("measured with", i.to_string());
     }
-    if let (Some(r), Some(f)) = (v["readings"].as_u64(), v["fit_patches"].as_u64()) {
-        row("readings", format!("{r} ({f} patches fitted)"));
+    let fit = &v["fit_residuals"];
+    let ver = &v["verification"];
+    // The session's readings are the fit's (its colours, some read more than once) and the
+    // held-out verification patches'; the fit residuals are over the fit's readings.
+    let fit_readings = fit["patches"].as_u64();
+    if let Some(r) = v["readings"].as_u64() {
+        let held_out = ver["patches"].as_array().map(|p| p.len() as u64);
+        let s = match (fit_readings, v["fit_patches"].as_u64(), held_out) {
+            (Some(fr), Some(fc), Some(vc)) if fr >= fc && fr + vc <= r => {
+                let mut s = format!("{r}: {fr} for the fit");
+                if fr > fc {
+                    s += &format!(" ({fc} colours, {} of them read again)", fr - fc);
+                } else {
+                    s += &format!(" ({fc} colours)");
+                }
+                s += &format!(" and {vc} held out for verification");
+                if r > fr + vc {
+                    s += &format!("; {} not used", r - fr - vc);
+                }
+                s
+            }
+            (_, Some(fc), _) => format!("{r} ({fc} colours fitted)"),
+            _ => r.to_string(),
+        };
+        row("readings", s);
     }
     if let Some(w) = triple(&v["white_xyz"]) {
         row("white X, Y, Z (cd/m²)", w);
@@ -46,15 +69,14 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
     if let Some(b) = triple(&v["black_xyz"]) {
         row("black X, Y, Z (cd/m²)", b);
     }
-    let fit = &v["fit_residuals"];
     if let (Some(mean), Some(p95), Some(max)) = (
         num(&fit["mean_de00"]),
         num(&fit["p95_de00"]),
         num(&fit["max_de00"]),
     ) {
         let mut s = format!("ΔE00 mean {mean:.3}, p95 {p95:.3}, max {max:.3}");
-        if let Some(n) = fit["patches"].as_u64() {
-            s += &format!(" over {n} patches");
+        if let Some(n) = fit_readings {
+            s += &format!(" over the {n} fit readings");
         }
         if let Some(w) = triple(&fit["worst_rgb"]) {
             s += &format!(" (worst at drive {w})");
@@ -69,7 +91,6 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
             row("PLCC assumption contradicted", f.to_string());
         }
     }
-    let ver = &v["verification"];
     let verification_de00 = match (num(&ver["mean"]), num(&ver["p95"]), num(&ver["max"])) {
         (Some(a), Some(b), Some(c)) => Some([a, b, c]),
         _ => None,
@@ -148,10 +169,14 @@ mod tests {
                 .find(|(n, _)| n == k)
                 .map(|(_, v)| v.as_str())
         };
-        assert_eq!(get("readings"), Some("782 (729 patches fitted)"));
+        // 782 readings: 734 fit readings of 729 colours and 2 verification patches leave 46 not used.
+        assert_eq!(
+            get("readings"),
+            Some("782: 734 for the fit (729 colours, 5 of them read again) and 2 held out for verification; 46 not used")
+        );
         assert_eq!(
             get("fit residuals"),
-            Some("ΔE00 mean 0.001, p95 0.000, max 0.249 over 734 patches (worst at drive 1.0000, 1.0000, 1.0000); XYZ RMS 0.0066 cd/m²")
+            Some("ΔE00 mean 0.001, p95 0.000, max 0.249 over the 734 fit readings (worst at drive 1.0000, 1.0000, 1.0000); XYZ RMS 0.0066 cd/m²")
         );
         assert_eq!(
             get("PLCC assumption contradicted"),
