@@ -146,7 +146,8 @@ fn complexity(kind: ModelKind) -> usize {
         ModelKind::Plcc => 3,
         ModelKind::MatrixLsq => 4,
         ModelKind::ShaperMatrix => 5,
-        ModelKind::Lut => 6,
+        ModelKind::Plvc => 6,
+        ModelKind::Lut => 7,
     }
 }
 

@@ -14,6 +14,7 @@ mod lut_scattered;
 mod matrix_lsq;
 mod matrix_trc;
 mod plcc;
+mod plvc;
 pub mod samples;
 mod shaper_matrix;
 mod trc;
@@ -28,6 +29,7 @@ pub use lut_scattered::{default_grid, fit_lut_scattered, ScatteredLut, LAMBDAS};
 pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma};
+pub use plvc::fit_plvc;
 pub use samples::{fold_of, Sample};
 pub use shaper_matrix::{default_knots, fit_shaper_matrix};
 pub use trc::{fit_power_gamma, FastInverse, Trc};
@@ -41,7 +43,7 @@ use serde::{Deserialize, Serialize};
 pub enum ModelParams {
     /// XYZ = XYZ₀ + M·TRC(rgb) (plcc, plcc-gamma, gog, gogo, matrix-lsq).
     MatrixTrc(MatrixTrc),
-    /// A 3D LUT with per-channel shapers (lut).
+    /// A 3D LUT with per-channel shapers (lut, and plvc as the grid of its additive sums).
     Lut(Lut3d),
 }
 
