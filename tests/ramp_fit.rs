@@ -195,7 +195,12 @@ fn print_ramp_table() {
                 }
             }
             let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
-            line += &format!(" auto→{}", sel.model);
+            line += &format!(" auto→{} | cv", sel.model);
+            for c in &sel.candidates {
+                if let Ok(e) = &c.cv_mean_de00 {
+                    line += &format!(" {} {e:.3}", c.model);
+                }
+            }
             println!("{line}");
         }
     }
@@ -286,7 +291,12 @@ fn scratch_real() {
             ("sum-minus-max", Box::new(|l: [f64; 3]| (l[0] + l[1] + l[2] - l[0].max(l[1]).max(l[2])) / 2.0)),
             ("min", Box::new(|l: [f64; 3]| l[0].min(l[1]).min(l[2]))),
         ];
-        let mut line = format!("{}: fit {} held {} white-add ΔY {:+.2}%", &f.file_name().unwrap().to_string_lossy()[..12], fit.len(), held.len(), 100.0 * dw[1] / profile.white_xyz[1]);
+        let set = metamer::display::model::samples::SortedSamples::new(&fit);
+        let prim: Vec<[f64;3]> = (0..3).map(|c| set.primaries[c].unwrap()).collect();
+        let kk = set.black.unwrap();
+        let addw: [f64;3] = std::array::from_fn(|i| prim[0][i]+prim[1][i]+prim[2][i]-2.0*kk[i]);
+        let ade = delta_e2000(Xyz::from_array(addw).to_lab(w), Xyz::from_array(profile.white_xyz).to_lab(w));
+        let mut line = format!("{}: fit {} held {} white-add ΔY {:+.2}% ΔE00 {ade:.2}", &f.file_name().unwrap().to_string_lossy()[..12], fit.len(), held.len(), 100.0 * dw[1] / profile.white_xyz[1]);
         for (name, wf) in &variants {
             let e: f64 = held.iter().map(|p| {
                 let a = model.forward(p.rgb);
@@ -320,5 +330,23 @@ fn scratch_greys() {
         // secondaries at full
         let sec: Vec<String> = [[1.0, 1.0, 0.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]].iter().filter_map(|t| m.patches.iter().find(|p| p.rgb == *t).map(|p| format!("{:+.1}", 100.0 * (p.xyz[1] - model.forward(p.rgb)[1]) / model.forward(p.rgb)[1]))).collect();
         println!("{}: whites Y {} | grey ΔY% {} | secondaries ΔY% {}", &f.file_name().unwrap().to_string_lossy()[..12], whites.join(","), pick.join(" "), sec.join(" "));
+    }
+}
+
+#[test]
+#[ignore]
+fn scratch_crt() {
+    use metamer::display::model::{fit_shaper_matrix, samples::SortedSamples, ModelParams};
+    for seed in [1u64, 2, 3, 4, 5, 6] {
+        let (panel, patches) = ramp_set(Preset::IdealCrt, Some(seed));
+        let set = SortedSamples::new(&patches);
+        let mut line = format!("seed {seed}:");
+        for knots in [1usize, 6] {
+            let m = fit_shaper_matrix(&set, &patches, knots).unwrap();
+            let p = ModelParams::MatrixTrc(m);
+            line += &format!(" knots{knots} {:.4}", inverse_error(&panel, &|t| p.model().inverse(t).rgb));
+        }
+        if let Some(e) = colprof_error(&panel, &patches, &std::path::Path::new("target/ramp-fit/crt-scratch").join(seed.to_string())) { line += &format!(" colprof {e:.4}"); }
+        println!("{line}");
     }
 }

@@ -169,6 +169,21 @@ fn xy(v: [f64; 3]) -> (f64, f64) {
     (v[0] / s, v[1] / s)
 }
 
+impl Additivity {
+    /// The measured white against the additive sum R + G + B − 2K (black plus the three
+    /// primaries' contributions, each the mean of its readings), in CIELAB relative to
+    /// `white`; None unless all five were measured.
+    pub fn check(set: &SortedSamples, white: Xyz) -> Option<Additivity> {
+        let (k, measured) = (set.black?, set.white?);
+        let [r, g, b] = [set.primaries[0]?, set.primaries[1]?, set.primaries[2]?];
+        let sum: [f64; 3] = std::array::from_fn(|i| r[i] + g[i] + b[i] - 2.0 * k[i]);
+        Some(Additivity {
+            de00: de(measured, sum, white),
+            luminance_error_percent: 100.0 * (measured[1] - sum[1]) / measured[1],
+        })
+    }
+}
+
 impl Diagnostics {
     /// Checks the patch set; `white` is the Lab reference (the display white).
     /// `noise`: the measurement noise, when known (see [`repeat_noise`]).
@@ -189,15 +204,7 @@ impl Diagnostics {
             let col = |c: usize| -> [f64; 3] { std::array::from_fn(|k| prims[c][k] - black[k]) };
             let m: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| col(c)[r]));
             condition = Some(condition_number(&m));
-            if let Some(white_measured) = set.white {
-                let predicted: [f64; 3] =
-                    std::array::from_fn(|k| black[k] + (0..3).map(|c| col(c)[k]).sum::<f64>());
-                additivity = Some(Additivity {
-                    de00: de(white_measured, predicted, w),
-                    luminance_error_percent: 100.0 * (white_measured[1] - predicted[1])
-                        / white_measured[1],
-                });
-            }
+            additivity = Additivity::check(set, w);
             for (c, name) in CHANNEL_NAMES.iter().enumerate() {
                 let p = col(c);
                 let norm2: f64 = p.iter().map(|v| v * v).sum();

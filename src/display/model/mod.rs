@@ -24,7 +24,7 @@ pub use error::FitError;
 pub use gog::{fit_gog, fit_gog_curve, gog_curve, gog_problem, GogProblem};
 pub use kind::ModelKind;
 pub use least_squares::levenberg_marquardt;
-pub use lut::{fit_lut, has_full_grid, Lut3d};
+pub use lut::{fit_lut, has_full_grid, is_measured_grid, Lut3d};
 pub use lut_scattered::{default_grid, fit_lut_scattered, ScatteredLut, LAMBDAS};
 pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
