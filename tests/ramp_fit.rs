@@ -350,3 +350,39 @@ fn scratch_crt() {
         println!("{line}");
     }
 }
+
+/// The mixture study's table (the ramp-only plan plus a grid):
+/// `cargo test --release --test ramp_fit -- --ignored --nocapture print_mixture_study`.
+#[test]
+#[ignore]
+fn print_mixture_study() {
+    use metamer::display::budget::{run_mixture_study, MIXTURE_MODELS};
+    for trials in [1usize, 3] {
+        let points = run_mixture_study(&Preset::ALL, &MIXTURE_MODELS, trials, 1, &|_, _| {}).unwrap();
+        for p in points {
+            println!(
+                "trials {trials} {} {} grid {} patches {}: mean {:.3} p95 {:.3} ({:.0} ms)",
+                p.preset, p.model, p.cube, p.patches, p.mean_de00, p.p95_de00, p.fit_ms
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn scratch_default_plan() {
+    use metamer::display::budget::{budget_patches, Budget};
+    for preset in Preset::ALL {
+        let panel = VirtualPanel::preset(preset);
+        let mut line = format!("{}:", panel.name());
+        for (steps, cube) in [(9, 9), (9, 5), (9, 4), (17, 5), (9, 0)] {
+            let (codes, distinct) = budget_patches(Budget { ramp_steps: steps, cube });
+            let patches = with_meter_noise(&measure(&panel, &codes), 1);
+            let t = std::time::Instant::now();
+            let kind = if cube == 0 { ModelKind::Plvc } else { ModelKind::Lut };
+            let e = model_error(&panel, kind, &patches).unwrap();
+            line += &format!(" {steps}/{cube} ({distinct}) {e:.3} [{} ms]", t.elapsed().as_millis());
+        }
+        println!("{line}");
+    }
+}

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals};
+use super::diagnostics::{mixed_patches, percentile, repeat_noise, Diagnostics, Noise, Residuals};
 use super::model::samples::SortedSamples;
 use super::model::Sample;
 use super::model::{
@@ -66,7 +66,14 @@ pub fn fit_profile_with(
         }),
         None => repeat_noise(patches, white),
     };
-    let diagnostics = Diagnostics::compute(&set, kind, white, residuals.clone(), noise);
+    let diagnostics = Diagnostics::compute(
+        &set,
+        kind,
+        white,
+        residuals.clone(),
+        noise,
+        mixed_patches(patches),
+    );
     let input = match source {
         Some(path) => {
             let bytes = std::fs::read(path).map_err(|e| FitError::Io {

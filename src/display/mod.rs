@@ -10,6 +10,7 @@ pub mod model;
 pub mod profile;
 pub mod scattered;
 pub mod select;
+pub mod select_chart;
 pub mod verify;
 
 // Using a profile.

@@ -23,7 +23,7 @@
 //! its smoothness prior. Cross-validation then ranks the rest (any greys are held out as
 //! usual), and the one-standard-error rule applies among them.
 
-use super::diagnostics::{repeat_noise, Additivity, TOLERANCE_DE00};
+use super::diagnostics::{mixed_patches, repeat_noise, Additivity, TOLERANCE_DE00};
 use super::fit::{check_samples, fit_params, FitOptions};
 use super::model::samples::{SortedSamples, SAME_DRIVE};
 use super::model::{fold_of, FitError, ModelKind, Sample};
@@ -52,7 +52,7 @@ pub struct Candidate {
 /// What the patch set says about mixtures.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MixtureEvidence {
-    /// Mixed patches off the cube's corners (two or more channels on).
+    /// Mixed patches (two or more channels on, the white not counted).
     pub mixed: usize,
     /// Fewer than [`MIN_MIXED`] mixed patches: the white decides which candidates compete.
     pub few: bool,
@@ -162,8 +162,7 @@ pub fn select_model(
         });
     }
     let fold = |i: usize| fold_of(i) % folds;
-    let is_mixed = |i: &usize| patches[*i].rgb.iter().filter(|&&d| d > SAME_DRIVE).count() >= 2;
-    let n_mixed = rotating.iter().filter(|i| is_mixed(i)).count();
+    let n_mixed = mixed_patches(patches);
     let full = SortedSamples::new(patches);
     let white = full.white;
     let sigma = options.noise_de00.or_else(|| {

@@ -74,11 +74,14 @@ pub fn fit_lut_scattered(
             "the grid needs at least 2 points per axis, not {grid}"
         )));
     }
-    let shaper_matrix = fit_shaper_matrix(set, patches, default_knots(patches.len())).map_err(|e| {
-        failed(format!(
-            "its shapers and start come from shaper-matrix, which failed: {e}"
-        ))
-    })?;
+    // Singular primaries are the user's measurement, not the base's fault: said as such.
+    let shaper_matrix =
+        fit_shaper_matrix(set, patches, default_knots(patches.len())).map_err(|e| match e {
+            FitError::SingularPrimaries { .. } => e,
+            e => failed(format!(
+                "its shapers and start come from shaper-matrix, which failed: {e}"
+            )),
+        })?;
     let mut bases = vec![Base {
         kind: ModelKind::ShaperMatrix,
         shaper: shaper_matrix.trc.clone(),
