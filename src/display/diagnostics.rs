@@ -6,9 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::budget::mixture_advice;
+use super::mixture_advice::mixture_advice;
 use super::model::samples::{Sample, SortedSamples, CHANNEL_NAMES, SAME_DRIVE};
-use super::select::MIN_MIXED;
 use super::model::{condition_number, fit_power_gamma, ModelKind};
 use crate::color::{delta_e2000, Xyz};
 
@@ -435,7 +434,7 @@ impl Diagnostics {
         let measured = match mixed {
             0 => "Mixed colours were not measured (no patch but the white has two channels \
                   on)"
-                .to_string(),
+            .to_string(),
             n => format!(
                 "Mixed colours were barely measured ({n} patch{} with two or more channels on \
                  besides the white)",
@@ -462,6 +461,10 @@ impl Diagnostics {
         )
     }
 }
+
+/// Fewer mixed patches than this (two or more channels on, the white not counted) leave
+/// each of five folds one mixture or none: too few to judge mixtures by cross-validation.
+pub const MIN_MIXED: usize = 10;
 
 /// Patches with two or more channels on, the white (all channels full) not counted: the
 /// mixtures a set measured.

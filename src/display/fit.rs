@@ -10,8 +10,8 @@ use super::model::samples::SortedSamples;
 use super::model::Sample;
 use super::model::{
     default_grid, default_knots, fit_gog, fit_lut, fit_lut_scattered, fit_matrix_lsq, fit_plcc,
-    fit_plcc_gamma, fit_plvc, fit_shaper_matrix, is_measured_grid, DisplayModel, FitError, ModelKind,
-    ModelParams,
+    fit_plcc_gamma, fit_plvc, fit_shaper_matrix, is_measured_grid, DisplayModel, FitError,
+    ModelKind, ModelParams,
 };
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
 use crate::color::{delta_e2000, Xyz};
@@ -131,7 +131,9 @@ pub fn fit_params(
         ModelKind::Plvc => ModelParams::Lut(fit_plvc(set)?),
         ModelKind::Gog | ModelKind::Gogo => ModelParams::MatrixTrc(fit_gog(set, kind)?),
         ModelKind::MatrixLsq => ModelParams::MatrixTrc(fit_matrix_lsq(set, patches)?),
-        ModelKind::Lut if is_measured_grid(set, patches) => ModelParams::Lut(fit_lut(set, patches)?),
+        ModelKind::Lut if is_measured_grid(set, patches) => {
+            ModelParams::Lut(fit_lut(set, patches)?)
+        }
         ModelKind::Lut => ModelParams::Lut(
             fit_lut_scattered(set, patches, default_grid(patches.len()), None)?.lut,
         ),

@@ -6,6 +6,7 @@
 pub mod diagnostics;
 pub mod fit;
 pub mod measurements;
+pub mod mixture_advice;
 pub mod model;
 pub mod profile;
 pub mod scattered;

@@ -29,9 +29,7 @@ use super::model::samples::{SortedSamples, SAME_DRIVE};
 use super::model::{fold_of, FitError, ModelKind, Sample};
 use crate::color::{delta_e2000, Xyz};
 
-/// Fewer mixed patches than this (two or more channels on, the white not counted) leave
-/// each of five folds one mixture or none: too few to judge mixtures by cross-validation.
-pub const MIN_MIXED: usize = 10;
+pub use super::diagnostics::MIN_MIXED;
 
 /// One candidate's cross-validated score, or why it could not be fitted.
 #[derive(Clone, Debug, PartialEq)]
@@ -165,13 +163,14 @@ pub fn select_model(
     let n_mixed = mixed_patches(patches);
     let full = SortedSamples::new(patches);
     let white = full.white;
-    let sigma = options.noise_de00.or_else(|| {
-        white.and_then(|w| repeat_noise(patches, w).map(|n| n.de00))
-    });
+    let sigma = options
+        .noise_de00
+        .or_else(|| white.and_then(|w| repeat_noise(patches, w).map(|n| n.de00)));
     let mixtures = MixtureEvidence {
         mixed: n_mixed,
         few: n_mixed < MIN_MIXED,
-        additivity_de00: white.and_then(|w| Additivity::check(&full, Xyz::from_array(w)).map(|a| a.de00)),
+        additivity_de00: white
+            .and_then(|w| Additivity::check(&full, Xyz::from_array(w)).map(|a| a.de00)),
         // Two white readings differ by σ√2; beyond twice that the model, not the meter,
         // is to blame.
         allowance_de00: TOLERANCE_DE00 + sigma.map_or(0.0, |s| 2.0 * s * 2f64.sqrt()),

@@ -59,6 +59,26 @@ pub struct DriveStep {
     pub label: String,
 }
 
+/// What a plan with too few mixed fit patches (two or more channels on, the white not
+/// counted: the grey ramp's steps, a grid) leaves unmeasured, and what a grid would buy (from
+/// the budget study); None when the plan measures enough mixtures for `auto` to judge them.
+pub fn plan_advice(plan: &Plan) -> Option<String> {
+    let mixed = plan
+        .distinct
+        .iter()
+        .filter(|s| s.purpose == Purpose::Fit)
+        .filter(|s| s.rgb.iter().filter(|&&v| v > 0).count() >= 2 && s.rgb != [255; 3])
+        .count();
+    (mixed < crate::display::diagnostics::MIN_MIXED).then(|| {
+        format!(
+            "this plan fits on {mixed} mixed patch{} besides the white, too few to judge \
+             mixtures: the profile's mixed colours will rest on the model's assumptions. {}",
+            if mixed == 1 { "" } else { "es" },
+            crate::display::mixture_advice::mixture_advice()
+        )
+    })
+}
+
 /// Points per axis of the LUT's default grid.
 pub const LUT_GRID_STEPS: usize = 5;
 

@@ -21,8 +21,8 @@
 //! what the grid LUT of [`super::fit_lut`] stores.
 
 use super::error::FitError;
-use super::samples::{fold_of, Sample, SortedSamples};
 use super::plvc::fit_plvc;
+use super::samples::{fold_of, Sample, SortedSamples};
 use super::shaper_matrix::{default_knots, fit_shaper_matrix};
 use super::{DisplayModel, Lut3d, ModelKind, Trc};
 use crate::color::{delta_e2000, Xyz};
@@ -117,7 +117,11 @@ pub fn fit_lut_scattered(
     Ok(ScatteredLut {
         lut,
         lambda: best.lambda,
-        cv: if lambda.is_some() { Vec::new() } else { best.cv },
+        cv: if lambda.is_some() {
+            Vec::new()
+        } else {
+            best.cv
+        },
         base: best.base,
     })
 }

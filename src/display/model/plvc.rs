@@ -192,7 +192,8 @@ mod tests {
                 });
             }
         }
-        let sum: [f64; 3] = std::array::from_fn(|i| black[i] + (0..3).map(|c| primaries[c][i]).sum::<f64>());
+        let sum: [f64; 3] =
+            std::array::from_fn(|i| black[i] + (0..3).map(|c| primaries[c][i]).sum::<f64>());
         let white: [f64; 3] = std::array::from_fn(|i| black[i] + 0.95 * (sum[i] - black[i]));
         patches.push(Sample {
             rgb: [1.0; 3],
