@@ -287,6 +287,10 @@ fn scratch_floor() {
     }
 }
 
+/// How much of the white's departure from additivity a mixture gets, from its channels'
+/// luminance fractions.
+type WhiteShare = Box<dyn Fn([f64; 3]) -> f64>;
+
 #[test]
 #[ignore]
 fn scratch_real() {
@@ -324,7 +328,7 @@ fn scratch_real() {
                 ((model.forward(e)[1] - k[1]) / prim_y[c]).clamp(0.0, 1.0)
             })
         };
-        let variants: Vec<(&str, Box<dyn Fn([f64; 3]) -> f64>)> = vec![
+        let variants: Vec<(&str, WhiteShare)> = vec![
             ("plain", Box::new(|_l| 0.0)),
             (
                 "pairs",
