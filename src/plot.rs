@@ -127,7 +127,7 @@ fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
 
 /// Ten colours that stay apart for the common colour-vision deficiencies (P. Tol's "muted"
 /// scheme, with black first), so a chart needs neither colour names nor good eyes.
-const PALETTE: [RGBColor; 10] = [
+pub const PALETTE: [RGBColor; 10] = [
     RGBColor(0, 0, 0),
     RGBColor(204, 102, 119),
     RGBColor(51, 34, 136),

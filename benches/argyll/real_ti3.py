@@ -19,7 +19,11 @@ the same for both sides). For each file:
      -iA -pX` looks the held-out drive values up (display-absolute XYZ in cd/m²) and ΔE00
      comes from `metamer color delta-e`, relative to the same white as metamer's.
 The held-out ΔE00 of each method is pooled over the folds (every non-corner patch is judged
-once). The script checks that the held-out XYZ it parses equal what `metamer verify` read
+once).
+
+With --ramps-only the split is not random: the fit set is what a ramp-only plan measures
+(black, white and every single-channel patch, all their repeats), and the held-out set is
+every mixed patch of the file (greys, secondaries, the rest), judged once. The script checks that the held-out XYZ it parses equal what `metamer verify` read
 for its worst patches, so both sides are judged against the same numbers. Prints a Markdown
 table; OUT/results.json keeps every fold's figures.
 """
@@ -34,7 +38,8 @@ import sys
 sys.path.insert(0, os.path.dirname(__file__))
 from compare import METAMER, delta_e00, lab, run, stats  # noqa: E402
 
-MODELS = ["plcc", "plcc-gamma", "gog", "gogo", "matrix-lsq", "shaper-matrix", "lut", "auto"]
+MODELS = ["plcc", "plcc-gamma", "plvc", "gog", "gogo", "matrix-lsq", "shaper-matrix", "lut",
+          "auto"]
 
 
 def tokens(line):
@@ -97,7 +102,13 @@ def corner(rgb):
     return all(v <= 1e-6 or v >= 1 - 1e-6 for v in rgb)
 
 
-def one_file(path, out, folds, seed, models):
+def single_channel(rgb):
+    """Black, white or a patch with one channel on: what a ramp-only plan measures."""
+    on = [v > 1e-6 for v in rgb]
+    return sum(on) <= 1 or all(v >= 1 - 1e-6 for v in rgb)
+
+
+def one_file(path, out, folds, seed, models, ramps_only=False):
     name = os.path.splitext(os.path.basename(path))[0]
     d = os.path.join(out, name)
     if os.path.exists(d):
@@ -110,10 +121,16 @@ def one_file(path, out, folds, seed, models):
     fixed = [i for i, c in enumerate(ti3.rgb) if corner(c)]
     rest = [i for i, c in enumerate(ti3.rgb) if not corner(c)]
     random.Random(seed).shuffle(rest)
+    if ramps_only:
+        folds = 1
     records = []
     for k in range(folds):
-        held = sorted(rest[k::folds])
-        fit = sorted(fixed + [i for i in rest if i not in set(held)])
+        if ramps_only:
+            fit = [i for i, c in enumerate(ti3.rgb) if single_channel(c)]
+            held = [i for i, c in enumerate(ti3.rgb) if not single_channel(c)]
+        else:
+            held = sorted(rest[k::folds])
+            fit = sorted(fixed + [i for i in rest if i not in set(held)])
         fd = os.path.join(d, f"fold{k}")
         os.makedirs(fd)
         ti3.write(os.path.join(fd, "fit.ti3"), fit)
@@ -170,6 +187,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--models", nargs="+", default=MODELS)
     ap.add_argument("--sources", help="tab-separated: file name, where it came from")
+    ap.add_argument("--ramps-only", action="store_true",
+                    help="fit on black, white and the single-channel patches; judge on the rest")
     a = ap.parse_args()
     if shutil.which("colprof") is None:
         sys.exit("ArgyllCMS colprof is not installed (apt-get install argyll)")
@@ -185,7 +204,8 @@ def main():
     for f in sorted(os.listdir(a.dir)):
         if not f.endswith(".ti3"):
             continue
-        n, records = one_file(os.path.join(a.dir, f), a.out, a.folds, a.seed, a.models)
+        n, records = one_file(os.path.join(a.dir, f), a.out, a.folds, a.seed, a.models,
+                              a.ramps_only)
         everything += records
         cells = []
         for m in methods:
@@ -197,9 +217,11 @@ def main():
             mean = sum(g["mean"] * g["n"] for g in got) / total
             chose = sorted({g["chose"] for g in got if g["chose"]})
             cells.append(f"{mean:.3f}" + (f" ({', '.join(chose)})" if chose else ""))
-        rows.append(f"| {f} | {n} | " + " | ".join(cells) + " |")
+        sizes = f"{records[0]['fit']} / {records[0]['held_out']}" if a.ramps_only else str(n)
+        rows.append(f"| {f} | {sizes} | " + " | ".join(cells) + " |")
     json.dump(everything, open(os.path.join(a.out, "results.json"), "w"), indent=1)
-    print("| file | patches | " + " | ".join(methods) + " |")
+    head = "fit / held-out" if a.ramps_only else "patches"
+    print(f"| file | {head} | " + " | ".join(methods) + " |")
     print("| --- | --- |" + " --- |" * len(methods))
     print("\n".join(rows))
     if sources:

@@ -7,8 +7,8 @@ use std::time::Duration;
 use clap::ValueEnum;
 use metamer::display::characterize::finish::{files, Summary};
 use metamer::display::characterize::{
-    self, default_grid_steps, log_path, CharacterizeError, Options, Outcome, Plan, PlanError,
-    PlanOptions, DEFAULT_RAMP_STEPS,
+    self, default_grid_steps, log_path, plan_advice, CharacterizeError, Options, Outcome, Plan,
+    PlanError, PlanOptions, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::ModelKind;
 use metamer::output::OutputPolicy;
@@ -45,7 +45,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, value_name = "K")]
     repeats: usize,
     /// Add an N×N×N grid of the drive cube to the fit patches (default: none; for --model lut
-    /// the ramp steps, so the grid holds the ramps' levels: 9³ = 729 patches by default).
+    /// 5, or the ramp steps when fewer: 5³ = 125 grid patches by default).
     #[arg(long, value_name = "N")]
     grid_steps: Option<usize>,
     /// Wait between showing a patch and measuring it (default: 500 for a window, 0 for a
@@ -89,7 +89,10 @@ pub fn run(args: Args) -> CliResult {
         repeats: args.repeats,
         grid_steps,
     };
-    Plan::new(plan).map_err(|e| CliError::Usage(plan_usage(&e)))?;
+    let planned = Plan::new(plan).map_err(|e| CliError::Usage(plan_usage(&e)))?;
+    if let Some(advice) = plan_advice(&planned) {
+        eprintln!("note: {advice}");
+    }
     // Before anything is opened: a real meter with nobody to aim it is refused.
     let attended = attendance(&[&args.instrument], args.unattended)
         .map_err(super::measure_box::nobody_at_the_rig)?;

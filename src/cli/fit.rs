@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use super::{CliError, CliResult};
 use metamer::display::icc::{agreement, encode_icc, inverse_agreement, IccVersion};
+use metamer::display::select_chart::selection_svg;
 use metamer::display::{
     fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
 };
@@ -40,6 +41,9 @@ pub struct Args {
     /// A2B0/B2A0 tables for lut.
     #[arg(long, value_name = "OUT.icc")]
     icc: Option<PathBuf>,
+    /// auto only: also draw each candidate's held-out error, the choice marked, as SVG.
+    #[arg(long, value_name = "OUT.svg")]
+    chart: Option<PathBuf>,
     /// The ICC version of --icc: 4 (default) or 2.4.
     #[arg(long, value_name = "4|2.4")]
     icc_version: Option<IccVersion>,
@@ -90,11 +94,20 @@ pub fn run(args: Args) -> CliResult {
     if args.icc_version.is_some() && args.icc.is_none() {
         return Err(CliError::Usage("--icc-version needs --icc OUT.icc".into()));
     }
-    // The ICC profile follows the output policy: never onto the measurements or the JSON
-    // profile, never over an existing file; checked before the fit so no work is lost.
+    // The ICC profile and the chart follow the output policy: never onto the measurements
+    // or the JSON profile, never over an existing file; checked before the fit so no work
+    // is lost.
     let mut icc_policy = OutputPolicy::new(args.force);
     icc_policy.inputs([args.measurements.as_path(), args.output.as_path()]);
     if let Some(path) = &args.icc {
+        icc_policy.check(path)?;
+    }
+    if let Some(path) = &args.chart {
+        if args.model != ModelChoice::Auto {
+            return Err(CliError::Usage(
+                "--chart draws the model selection: it needs --model auto".into(),
+            ));
+        }
         icc_policy.check(path)?;
     }
     let m = read_measurement_file(&args.measurements)?;
@@ -127,6 +140,13 @@ pub fn run(args: Args) -> CliResult {
         ModelChoice::Auto => {
             let selection = select_model(&m.patches, args.folds, &options)?;
             println!("{selection}");
+            if let Some(path) = &args.chart {
+                let svg = selection_svg(&selection).map_err(|message| {
+                    CliError::Failed(format!("cannot draw {}: {message}", path.display()).into())
+                })?;
+                icc_policy.write(path, svg.as_bytes())?;
+                println!("selection chart written to {}", path.display());
+            }
             selection.model
         }
     };

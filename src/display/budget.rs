@@ -29,6 +29,9 @@ use crate::output::{OutputError, OutputPolicy};
 use crate::plot::{log_log_svg, LogLogChart, Series};
 use crate::rig::virtual_display::{Preset, VirtualPanel};
 
+/// The series name of the ramp-only plan with a grid added.
+pub const RAMPS_PLUS_GRID: &str = "ramps+grid";
+
 /// One patch budget: ramp steps per channel (including 0 and full drive) and the points
 /// per axis of the RGB cube (0 for none).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -50,6 +53,48 @@ pub const SCATTERED_SIZES: [usize; 3] = [50, 200, 1000];
 /// The models that fit scattered sets: the joint shaper + matrix and the LUT fitted by
 /// regularised least squares (a grid-only model needs the grid, a ramp model ramps).
 pub const SCATTERED_MODELS: [ModelKind; 2] = [ModelKind::ShaperMatrix, ModelKind::Lut];
+
+/// The models charted on the ramp-only plan with a grid added ([`ADDED_GRIDS`]): PLVC, the
+/// best a ramp-only set supports, and the LUT, which learns the mixtures the grid measures.
+pub const MIXTURE_MODELS: [ModelKind; 2] = [ModelKind::Plvc, ModelKind::Lut];
+
+/// Points per axis of the grids added to the ramp-only plan (0: none); charted as
+/// `MODEL ramps+grid`.
+pub const ADDED_GRIDS: [usize; 5] = [0, 2, 3, 4, 5];
+
+/// The paper's and PsychoPy's plan: black, white and 16 steps of each primary (1/16 … 16/16
+/// of full drive as 8-bit codes), 50 patches and no mixture but the white.
+pub fn ramp_only_plan() -> Vec<[u8; 3]> {
+    let mut codes = vec![[0, 0, 0], [255, 255, 255]];
+    for c in 0..3 {
+        for k in 1..=16u32 {
+            let mut rgb = [0u8; 3];
+            rgb[c] = (f64::from(255 * k) / 16.0).round() as u8;
+            codes.push(rgb);
+        }
+    }
+    codes
+}
+
+/// [`ramp_only_plan`] plus an evenly spaced `grid`³ grid of the drive cube (the codes
+/// `characterize --grid-steps` measures), without measuring a code twice.
+pub fn ramps_with_grid(grid: usize) -> Vec<[u8; 3]> {
+    let mut codes = ramp_only_plan();
+    if grid >= 2 {
+        let level = |i: usize| (255.0 * i as f64 / (grid - 1) as f64).round() as u8;
+        for r in 0..grid {
+            for g in 0..grid {
+                for b in 0..grid {
+                    let rgb = [level(r), level(g), level(b)];
+                    if !codes.contains(&rgb) {
+                        codes.push(rgb);
+                    }
+                }
+            }
+        }
+    }
+    codes
+}
 
 /// The budget of `model` with `ramp_steps` steps.
 pub fn budget_for(model: ModelKind, ramp_steps: usize) -> Budget {
@@ -122,8 +167,15 @@ pub fn run_budget_study(
         .copied()
         .filter(|k| SCATTERED_MODELS.contains(k))
         .collect();
-    let total =
-        presets.len() * (RAMP_STEPS.len() * models.len() + SCATTERED_SIZES.len() * scattered.len());
+    let mixture: Vec<ModelKind> = models
+        .iter()
+        .copied()
+        .filter(|k| MIXTURE_MODELS.contains(k))
+        .collect();
+    let total = presets.len()
+        * (RAMP_STEPS.len() * models.len()
+            + SCATTERED_SIZES.len() * scattered.len()
+            + ADDED_GRIDS.len() * mixture.len());
     let mut done = 0;
     let mut points = Vec::new();
     for &preset in presets {
@@ -176,6 +228,73 @@ pub fn run_budget_study(
                         format!("{kind} scattered"),
                         n,
                         none,
+                        errors,
+                        fit_ms,
+                    ));
+                }
+            }
+        }
+    }
+    let mut done_before = done;
+    points.extend(run_mixture_study(
+        presets,
+        &mixture,
+        trials,
+        seed,
+        &|d, _| {
+            progress(done_before + d, total);
+        },
+    )?);
+    done_before += presets.len() * ADDED_GRIDS.len() * mixture.len();
+    debug_assert_eq!(done_before, total);
+    Ok(points)
+}
+
+/// The ramp-only plan with each of [`ADDED_GRIDS`] added, fitted with `models` (those of
+/// [`MIXTURE_MODELS`]), each set read `trials` times by a meter seeded with `seed` (its own
+/// meter, so these points do not depend on what else the study measured); `progress` gets
+/// (done, total).
+pub fn run_mixture_study(
+    presets: &[Preset],
+    models: &[ModelKind],
+    trials: usize,
+    seed: u64,
+    progress: &dyn Fn(usize, usize),
+) -> Result<Vec<BudgetPoint>, BudgetError> {
+    let targets_rgb = random_patches(200, seed ^ 0xB0D6E7);
+    let total = presets.len() * ADDED_GRIDS.len() * models.len();
+    let mut done = 0;
+    let mut points = Vec::new();
+    for &preset in presets {
+        let panel = VirtualPanel::preset(preset);
+        let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
+        let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
+        let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
+        let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
+        let mut study = Study {
+            panel: &panel,
+            white: Xyz::from_array(panel.xyz([255; 3])),
+            targets: &targets,
+            stimulus: &stimulus,
+            meter: meter.as_mut(),
+            trials: trials.max(1),
+        };
+        for &kind in models {
+            for grid in ADDED_GRIDS {
+                done += 1;
+                let drive = ramps_with_grid(grid);
+                let outcome = study.measure(kind, &drive)?;
+                progress(done, total);
+                if let Some((errors, fit_ms)) = outcome {
+                    let budget = Budget {
+                        ramp_steps: 17,
+                        cube: grid,
+                    };
+                    points.push(point(
+                        preset,
+                        format!("{kind} {RAMPS_PLUS_GRID}"),
+                        drive.len(),
+                        budget,
                         errors,
                         fit_ms,
                     ));

@@ -6,7 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::model::samples::{Sample, SortedSamples, CHANNEL_NAMES};
+use super::mixture_advice::mixture_advice;
+use super::model::samples::{Sample, SortedSamples, CHANNEL_NAMES, SAME_DRIVE};
 use super::model::{condition_number, fit_power_gamma, ModelKind};
 use crate::color::{delta_e2000, Xyz};
 
@@ -66,6 +67,11 @@ pub struct Diagnostics {
     /// Measurement noise, ΔE00 of one reading (1σ): from repeated patches or given.
     #[serde(default)]
     pub noise: Option<Noise>,
+    /// Mixed patches (two or more channels on, the white not counted), when fewer than
+    /// model selection needs to judge mixtures: the verdict then says what the profile's
+    /// mixtures rest on and how much a measured grid would help.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub few_mixtures: Option<usize>,
     /// Assumptions that fail beyond the tolerance and the measurement noise, each in one
     /// sentence.
     pub failures: Vec<String>,
@@ -169,15 +175,32 @@ fn xy(v: [f64; 3]) -> (f64, f64) {
     (v[0] / s, v[1] / s)
 }
 
+impl Additivity {
+    /// The measured white against the additive sum R + G + B − 2K (black plus the three
+    /// primaries' contributions, each the mean of its readings), in CIELAB relative to
+    /// `white`; None unless all five were measured.
+    pub fn check(set: &SortedSamples, white: Xyz) -> Option<Additivity> {
+        let (k, measured) = (set.black?, set.white?);
+        let [r, g, b] = [set.primaries[0]?, set.primaries[1]?, set.primaries[2]?];
+        let sum: [f64; 3] = std::array::from_fn(|i| r[i] + g[i] + b[i] - 2.0 * k[i]);
+        Some(Additivity {
+            de00: de(measured, sum, white),
+            luminance_error_percent: 100.0 * (measured[1] - sum[1]) / measured[1],
+        })
+    }
+}
+
 impl Diagnostics {
     /// Checks the patch set; `white` is the Lab reference (the display white).
-    /// `noise`: the measurement noise, when known (see [`repeat_noise`]).
+    /// `noise`: the measurement noise, when known (see [`repeat_noise`]); `mixed`: how
+    /// many mixed patches the set holds (see [`mixed_patches`]).
     pub fn compute(
         set: &SortedSamples,
         model: ModelKind,
         white: [f64; 3],
         residuals: Residuals,
         noise: Option<Noise>,
+        mixed: usize,
     ) -> Diagnostics {
         let w = Xyz::from_array(white);
         let mut channels = Vec::new();
@@ -189,15 +212,7 @@ impl Diagnostics {
             let col = |c: usize| -> [f64; 3] { std::array::from_fn(|k| prims[c][k] - black[k]) };
             let m: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| col(c)[r]));
             condition = Some(condition_number(&m));
-            if let Some(white_measured) = set.white {
-                let predicted: [f64; 3] =
-                    std::array::from_fn(|k| black[k] + (0..3).map(|c| col(c)[k]).sum::<f64>());
-                additivity = Some(Additivity {
-                    de00: de(white_measured, predicted, w),
-                    luminance_error_percent: 100.0 * (white_measured[1] - predicted[1])
-                        / white_measured[1],
-                });
-            }
+            additivity = Additivity::check(set, w);
             for (c, name) in CHANNEL_NAMES.iter().enumerate() {
                 let p = col(c);
                 let norm2: f64 = p.iter().map(|v| v * v).sum();
@@ -270,6 +285,7 @@ impl Diagnostics {
             condition_number: condition,
             residuals,
             noise,
+            few_mixtures: (mixed < MIN_MIXED).then_some(mixed),
             failures: Vec::new(),
             verdict: String::new(),
         };
@@ -403,11 +419,63 @@ impl Diagnostics {
                 power_notes.join("; ")
             ));
         }
+        if let Some(mixed) = self.few_mixtures {
+            verdict.push(' ');
+            verdict.push_str(&self.mixture_note(mixed));
+        }
         verdict.push(' ');
         verdict.push_str(&fit);
         self.failures = failures;
         self.verdict = verdict;
     }
+
+    /// What a profile fitted without (enough) mixtures rests on, in a few sentences.
+    fn mixture_note(&self, mixed: usize) -> String {
+        let measured = match mixed {
+            0 => "Mixed colours were not measured (no patch but the white has two channels \
+                  on)"
+            .to_string(),
+            n => format!(
+                "Mixed colours were barely measured ({n} patch{} with two or more channels on \
+                 besides the white)",
+                if n == 1 { "" } else { "es" }
+            ),
+        };
+        let check = match &self.additivity {
+            Some(a) => format!(
+                "the one check there is, the white against black plus the three primaries \
+                 (R + G + B − 2K), differs by ΔE00 {:.2} (luminance {:+.1} %): mixtures near \
+                 white may be off by about that much, and further in the midtones, since \
+                 crosstalk that vanishes at full drive is invisible to it",
+                a.de00, a.luminance_error_percent
+            ),
+            None => "not even the white against the sum of the primaries could be checked \
+                     (black, the three primaries and white are needed)"
+                .to_string(),
+        };
+        format!(
+            "{measured}, so between the ramps the profile's colours rest on {}'s assumptions; \
+             {check}. {}",
+            self.model,
+            mixture_advice()
+        )
+    }
+}
+
+/// Fewer mixed patches than this (two or more channels on, the white not counted) leave
+/// each of five folds one mixture or none: too few to judge mixtures by cross-validation.
+pub const MIN_MIXED: usize = 10;
+
+/// Patches with two or more channels on, the white (all channels full) not counted: the
+/// mixtures a set measured.
+pub fn mixed_patches(patches: &[Sample]) -> usize {
+    patches
+        .iter()
+        .filter(|p| {
+            p.rgb.iter().filter(|&&d| d > SAME_DRIVE).count() >= 2
+                && !p.rgb.iter().all(|&d| d >= 1.0 - SAME_DRIVE)
+        })
+        .count()
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {

@@ -5,13 +5,13 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use super::diagnostics::{percentile, repeat_noise, Diagnostics, Noise, Residuals};
+use super::diagnostics::{mixed_patches, percentile, repeat_noise, Diagnostics, Noise, Residuals};
 use super::model::samples::SortedSamples;
 use super::model::Sample;
 use super::model::{
     default_grid, default_knots, fit_gog, fit_lut, fit_lut_scattered, fit_matrix_lsq, fit_plcc,
-    fit_plcc_gamma, fit_shaper_matrix, has_full_grid, DisplayModel, FitError, ModelKind,
-    ModelParams,
+    fit_plcc_gamma, fit_plvc, fit_shaper_matrix, is_measured_grid, DisplayModel, FitError,
+    ModelKind, ModelParams,
 };
 use super::profile::{InputFile, Profile, PROFILE_FORMAT};
 use crate::color::{delta_e2000, Xyz};
@@ -66,7 +66,14 @@ pub fn fit_profile_with(
         }),
         None => repeat_noise(patches, white),
     };
-    let diagnostics = Diagnostics::compute(&set, kind, white, residuals.clone(), noise);
+    let diagnostics = Diagnostics::compute(
+        &set,
+        kind,
+        white,
+        residuals.clone(),
+        noise,
+        mixed_patches(patches),
+    );
     let input = match source {
         Some(path) => {
             let bytes = std::fs::read(path).map_err(|e| FitError::Io {
@@ -121,9 +128,12 @@ pub fn fit_params(
     Ok(match kind {
         ModelKind::Plcc => ModelParams::MatrixTrc(fit_plcc(set)?),
         ModelKind::PlccGamma => ModelParams::MatrixTrc(fit_plcc_gamma(set, options.gamma)?),
+        ModelKind::Plvc => ModelParams::Lut(fit_plvc(set)?),
         ModelKind::Gog | ModelKind::Gogo => ModelParams::MatrixTrc(fit_gog(set, kind)?),
         ModelKind::MatrixLsq => ModelParams::MatrixTrc(fit_matrix_lsq(set, patches)?),
-        ModelKind::Lut if has_full_grid(patches) => ModelParams::Lut(fit_lut(set, patches)?),
+        ModelKind::Lut if is_measured_grid(set, patches) => {
+            ModelParams::Lut(fit_lut(set, patches)?)
+        }
         ModelKind::Lut => ModelParams::Lut(
             fit_lut_scattered(set, patches, default_grid(patches.len()), None)?.lut,
         ),

@@ -6,10 +6,12 @@
 pub mod diagnostics;
 pub mod fit;
 pub mod measurements;
+pub mod mixture_advice;
 pub mod model;
 pub mod profile;
 pub mod scattered;
 pub mod select;
+pub mod select_chart;
 pub mod verify;
 
 // Using a profile.

@@ -11,11 +11,25 @@
 //! less than that noise allows are not told apart by them: then the simpler model is
 //! chosen (the one-standard-error rule), since the one with more freedom is as likely to
 //! have followed the noise. The standard error is that of the paired per-patch differences.
+//!
+//! A set with fewer than [`MIN_MIXED`] mixed patches (two or more channels on; the white
+//! is a corner) says little about mixtures, which is what a rendering shows: its held-out
+//! patches are ramp readings, which judge each channel's curve and nothing else (the
+//! paper's and PsychoPy's plans, black, white and ramps, hold no mixture at all). There the
+//! measured mixtures decide which candidates may compete: a candidate whose fit misses the
+//! measured white by more than the verdict's tolerance (plus the noise margin, when the
+//! noise is known) is set aside, since its mixtures are not held by the one mixture that
+//! was measured; the LUT is not a candidate, since between the ramps its colours would be
+//! its smoothness prior. Cross-validation then ranks the rest (any greys are held out as
+//! usual), and the one-standard-error rule applies among them.
 
+use super::diagnostics::{mixed_patches, repeat_noise, Additivity, TOLERANCE_DE00};
 use super::fit::{check_samples, fit_params, FitOptions};
 use super::model::samples::{SortedSamples, SAME_DRIVE};
 use super::model::{fold_of, FitError, ModelKind, Sample};
 use crate::color::{delta_e2000, Xyz};
+
+pub use super::diagnostics::MIN_MIXED;
 
 /// One candidate's cross-validated score, or why it could not be fitted.
 #[derive(Clone, Debug, PartialEq)]
@@ -25,6 +39,26 @@ pub struct Candidate {
     pub cv_mean_de00: Result<f64, String>,
     /// Each held-out patch's ΔE00, in the order of the rotating patches (empty if not fitted).
     pub held_out_de00: Vec<f64>,
+    /// On a set with few mixtures: ΔE00 between the measured white and the candidate's
+    /// white, fitted to every patch.
+    pub white_de00: Option<f64>,
+    /// Why the candidate does not compete although it was fitted (on a set with few
+    /// mixtures).
+    pub set_aside: Option<String>,
+}
+
+/// What the patch set says about mixtures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MixtureEvidence {
+    /// Mixed patches (two or more channels on, the white not counted).
+    pub mixed: usize,
+    /// Fewer than [`MIN_MIXED`] mixed patches: the white decides which candidates compete.
+    pub few: bool,
+    /// ΔE00 between the measured white and black + the three primaries' contributions
+    /// (R + G + B − 2K), when all five were measured.
+    pub additivity_de00: Option<f64>,
+    /// The largest miss of the white a candidate may have on a set with few mixtures.
+    pub allowance_de00: f64,
 }
 
 /// The chosen model and every candidate's score, in [`ModelKind::ALL`] order.
@@ -36,6 +70,7 @@ pub struct Selection {
     pub lowest: Option<ModelKind>,
     pub folds: usize,
     pub held_out: usize,
+    pub mixtures: MixtureEvidence,
     pub candidates: Vec<Candidate>,
 }
 
@@ -47,11 +82,39 @@ impl std::fmt::Display for Selection {
              (cube corners always fitted)",
             self.folds, self.held_out
         )?;
+        let m = &self.mixtures;
+        if m.few {
+            writeln!(
+                f,
+                "the set holds {} mixed patch{} (fewer than {MIN_MIXED}): held out, its \
+                 patches judge the channels' curves, not how they mix; candidates whose fit \
+                 misses the measured white by more than ΔE00 {:.2} are set aside{}",
+                m.mixed,
+                if m.mixed == 1 { "" } else { "es" },
+                m.allowance_de00,
+                m.additivity_de00
+                    .map(|a| format!(" (the additive sum R+G+B−2K misses it by {a:.2})"))
+                    .unwrap_or_default()
+            )?;
+        }
         for c in &self.candidates {
             let mark = if c.model == self.model { "*" } else { " " };
-            match &c.cv_mean_de00 {
-                Ok(de) => writeln!(f, "{mark} {:<14} CV mean ΔE00 {de:.3}", c.model.name())?,
-                Err(why) => writeln!(f, "  {:<14} not fitted: {why}", c.model.name())?,
+            let white = c
+                .white_de00
+                .map(|w| format!(", white ΔE00 {w:.2}"))
+                .unwrap_or_default();
+            match (&c.cv_mean_de00, &c.set_aside) {
+                (Ok(de), None) => writeln!(
+                    f,
+                    "{mark} {:<14} CV mean ΔE00 {de:.3}{white}",
+                    c.model.name()
+                )?,
+                (Ok(de), Some(why)) => writeln!(
+                    f,
+                    "  {:<14} CV mean ΔE00 {de:.3}{white}: set aside, {why}",
+                    c.model.name()
+                )?,
+                (Err(why), _) => writeln!(f, "  {:<14} not fitted: {why}", c.model.name())?,
             }
         }
         match self.lowest {
@@ -97,16 +160,75 @@ pub fn select_model(
         });
     }
     let fold = |i: usize| fold_of(i) % folds;
+    let n_mixed = mixed_patches(patches);
+    let full = SortedSamples::new(patches);
+    let white = full.white;
+    let sigma = options
+        .noise_de00
+        .or_else(|| white.and_then(|w| repeat_noise(patches, w).map(|n| n.de00)));
+    let mixtures = MixtureEvidence {
+        mixed: n_mixed,
+        few: n_mixed < MIN_MIXED,
+        additivity_de00: white
+            .and_then(|w| Additivity::check(&full, Xyz::from_array(w)).map(|a| a.de00)),
+        // Two white readings differ by σ√2; beyond twice that the model, not the meter,
+        // is to blame.
+        allowance_de00: TOLERANCE_DE00 + sigma.map_or(0.0, |s| 2.0 * s * 2f64.sqrt()),
+    };
     let mut candidates = Vec::new();
     for kind in ModelKind::ALL {
+        if mixtures.few && kind == ModelKind::Lut {
+            candidates.push(Candidate {
+                model: kind,
+                cv_mean_de00: Err("not a candidate on a set with few mixed patches: its \
+                                   colours between the ramps would be its smoothness prior, \
+                                   not a measurement"
+                    .into()),
+                held_out_de00: Vec::new(),
+                white_de00: None,
+                set_aside: None,
+            });
+            continue;
+        }
         let scores = cross_validate(kind, patches, &rotating, folds, &fold, options);
+        let white_de00 = match (&scores, white, mixtures.few) {
+            (Ok(_), Some(w), true) => fit_params(kind, &full, patches, options)
+                .ok()
+                .map(|p| de(p.model().forward([1.0; 3]), w, w))
+                .filter(|e| e.is_finite()),
+            _ => None,
+        };
+        let set_aside = white_de00
+            .filter(|&e| e > mixtures.allowance_de00)
+            .map(|e| {
+                format!(
+                    "its fit misses the measured white by ΔE00 {e:.2}, more than {:.2}: its \
+                     mixtures are not held by the measurements",
+                    mixtures.allowance_de00
+                )
+            });
         candidates.push(Candidate {
             model: kind,
             cv_mean_de00: scores.as_ref().map(|s| s.0).map_err(Clone::clone),
             held_out_de00: scores.map(|s| s.1).unwrap_or_default(),
+            white_de00,
+            set_aside,
         });
     }
-    let best = candidates
+    // Those the white sets aside compete only if it sets aside every candidate.
+    let competing: Vec<Candidate> = if candidates
+        .iter()
+        .any(|c| c.cv_mean_de00.is_ok() && c.set_aside.is_none())
+    {
+        candidates
+            .iter()
+            .filter(|c| c.set_aside.is_none())
+            .cloned()
+            .collect()
+    } else {
+        candidates.clone()
+    };
+    let best = competing
         .iter()
         .filter_map(|c| c.cv_mean_de00.as_ref().ok().map(|e| (c.model, *e)))
         .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -125,28 +247,37 @@ pub fn select_model(
                     .join("; ")
             ),
         })?;
-    let chosen = simplest_within_one_se(&candidates, best.0);
+    let chosen = simplest_within_one_se(&competing, best.0);
     Ok(Selection {
         model: chosen,
         lowest: (chosen != best.0).then_some(best.0),
         folds,
         held_out: rotating.len(),
+        mixtures,
         candidates,
     })
 }
 
+/// ΔE00 between two XYZ, CIELAB relative to `white`.
+fn de(a: [f64; 3], b: [f64; 3], white: [f64; 3]) -> f64 {
+    let w = Xyz::from_array(white);
+    delta_e2000(Xyz::from_array(a).to_lab(w), Xyz::from_array(b).to_lab(w))
+}
+
 /// Fewest free parameters first: a power law, gain-offset-gamma (two, three per channel),
-/// the ramp-interpolating TRCs with the primaries' or a fitted matrix, the knotted shapers,
-/// and the LUT with thousands of nodes.
+/// the shapers (a power law per channel, knots only where cross-validation keeps them),
+/// the ramp tables (one value per measured level) with the primaries' or a fitted matrix,
+/// PLVC's tables of XYZ per level, and the LUT with hundreds of nodes.
 fn complexity(kind: ModelKind) -> usize {
     match kind {
         ModelKind::PlccGamma => 0,
         ModelKind::Gog => 1,
         ModelKind::Gogo => 2,
-        ModelKind::Plcc => 3,
-        ModelKind::MatrixLsq => 4,
-        ModelKind::ShaperMatrix => 5,
-        ModelKind::Lut => 6,
+        ModelKind::ShaperMatrix => 3,
+        ModelKind::Plcc => 4,
+        ModelKind::MatrixLsq => 5,
+        ModelKind::Plvc => 6,
+        ModelKind::Lut => 7,
     }
 }
 
@@ -231,6 +362,8 @@ mod tests {
             model,
             cv_mean_de00: Ok(de.iter().sum::<f64>() / de.len() as f64),
             held_out_de00: de.to_vec(),
+            white_de00: None,
+            set_aside: None,
         }
     }
 

@@ -9,7 +9,8 @@ pub mod run;
 pub mod verify;
 
 pub use plan::{
-    default_grid_steps, DriveStep, Plan, PlanError, PlanOptions, Purpose, DEFAULT_RAMP_STEPS,
+    default_grid_steps, plan_advice, DriveStep, Plan, PlanError, PlanOptions, Purpose,
+    DEFAULT_RAMP_STEPS,
 };
 pub use report::{write_report, Report, ReportError};
 pub use run::{log_path, run, CharacterizeError, LogDetails, Options, Outcome, LOG_FILE};

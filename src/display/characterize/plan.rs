@@ -59,12 +59,39 @@ pub struct DriveStep {
     pub label: String,
 }
 
-/// The drive-cube grid a model needs by default: none for the matrix models; for the LUT,
-/// whose grid is every combination of the levels measured on each axis (ramps included), a
-/// grid of the ramps' own levels, which is what completes it.
+/// What a plan with too few mixed fit patches (two or more channels on, the white not
+/// counted: the grey ramp's steps, a grid) leaves unmeasured, and what a grid would buy (from
+/// the budget study); None when the plan measures enough mixtures for `auto` to judge them.
+pub fn plan_advice(plan: &Plan) -> Option<String> {
+    let mixed = plan
+        .distinct
+        .iter()
+        .filter(|s| s.purpose == Purpose::Fit)
+        .filter(|s| s.rgb.iter().filter(|&&v| v > 0).count() >= 2 && s.rgb != [255; 3])
+        .count();
+    (mixed < crate::display::diagnostics::MIN_MIXED).then(|| {
+        format!(
+            "this plan fits on {mixed} mixed patch{} besides the white, too few to judge \
+             mixtures: the profile's mixed colours will rest on the model's assumptions. {}",
+            if mixed == 1 { "" } else { "es" },
+            crate::display::mixture_advice::mixture_advice()
+        )
+    })
+}
+
+/// Points per axis of the LUT's default grid.
+pub const LUT_GRID_STEPS: usize = 5;
+
+/// The drive-cube grid a model needs by default: none for the matrix models; for the LUT a
+/// 5³ grid (or the ramps' levels, when the ramps have fewer): the LUT corrects PLVC, which
+/// the ramps give, where the grid's mixtures show it wrong. On the simulated monitors with
+/// the CS-100A's noise, ramps of 9 and a 5³ grid (141 patches) reproduced the verification
+/// colours as well as ramps of 9 and the 9³ grid of their levels (729 patches): ΔE00 0.144
+/// against 0.162 on ips-lcd, 0.260 against 0.247 on wide-gamut-ccfl, 0.006 against 0.030 on
+/// ideal-crt (tests/ramp_fit.rs, 2026-12-02).
 pub fn default_grid_steps(model: ModelKind, ramp_steps: usize) -> usize {
     if model == ModelKind::Lut {
-        ramp_steps
+        ramp_steps.min(LUT_GRID_STEPS)
     } else {
         0
     }

@@ -10,6 +10,9 @@ pub enum ModelKind {
     Plcc,
     /// Paper Eq. 9 with a power-law TRC per channel (fitted, or given as the paper's 2.2).
     PlccGamma,
+    /// Post & Calhoun's PLVC: each channel adds its own measured ramp light (XYZ, not a
+    /// scalar times its primary), so chromaticity may drift along a ramp; additive.
+    Plvc,
     /// Gain-offset-gamma per channel + primaries matrix, least squares.
     Gog,
     /// GOG with an extra additive offset per channel.
@@ -25,9 +28,10 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
-    pub const ALL: [ModelKind; 7] = [
+    pub const ALL: [ModelKind; 8] = [
         ModelKind::Plcc,
         ModelKind::PlccGamma,
+        ModelKind::Plvc,
         ModelKind::Gog,
         ModelKind::Gogo,
         ModelKind::Lut,
@@ -39,6 +43,7 @@ impl ModelKind {
         match self {
             ModelKind::Plcc => "plcc",
             ModelKind::PlccGamma => "plcc-gamma",
+            ModelKind::Plvc => "plvc",
             ModelKind::Gog => "gog",
             ModelKind::Gogo => "gogo",
             ModelKind::Lut => "lut",

@@ -265,6 +265,20 @@ pub fn has_full_grid(patches: &[Sample]) -> bool {
     seen.into_iter().all(|s| s)
 }
 
+/// Whether the set is a measured grid that the grid LUT stores as it is: a full grid
+/// ([`has_full_grid`]) whose levels include every ramp level. Ramps finer than the grid
+/// (say 17 levels beside a 3³ grid) hold detail the grid would drop, so such a set is
+/// fitted by the scattered LUT, which keeps every patch.
+pub fn is_measured_grid(set: &SortedSamples, patches: &[Sample]) -> bool {
+    has_full_grid(patches)
+        && (0..3).all(|c| {
+            let grid = grid_levels(patches, c);
+            set.ramps[c]
+                .iter()
+                .all(|(d, _)| grid.iter().any(|l| (l - d).abs() < SAME_DRIVE))
+        })
+}
+
 pub fn fit_lut(set: &SortedSamples, patches: &[Sample]) -> Result<Lut3d, FitError> {
     let kind = ModelKind::Lut;
     let (black, m) = black_and_primaries(set, kind)?;

@@ -2,8 +2,11 @@
 //! per channel), not read off the data, and its nodes are found by regularised least
 //! squares, so any patch set fits in memory and time linear in patches + N³.
 //!
-//! The table is the shaper + matrix model (whose curves are also the LUT's shapers) plus a
-//! correction c at every node. Each patch constrains the four nodes of its tetrahedron
+//! The table is a base model (whose curves are also the LUT's shapers) plus a correction c
+//! at every node. The base is the shaper + matrix model, or on a set with ramps of every
+//! channel PLVC (the ramps' own light, added), whichever cross-validates better: on ramps
+//! with a few mixed patches PLVC keeps the ramps' chromaticity drift that a matrix cannot,
+//! and the correction learns the mixtures. Each patch constrains the four nodes of its tetrahedron
 //! through the interpolation weights; a discrete Laplacian (second differences along each
 //! axis) keeps the correction smooth where cells hold no patches, so an empty region of
 //! the cube follows the matrix model and its neighbours instead of drifting. Per channel of
@@ -18,9 +21,10 @@
 //! what the grid LUT of [`super::fit_lut`] stores.
 
 use super::error::FitError;
+use super::plvc::fit_plvc;
 use super::samples::{fold_of, Sample, SortedSamples};
 use super::shaper_matrix::{default_knots, fit_shaper_matrix};
-use super::{DisplayModel, Lut3d, ModelKind};
+use super::{DisplayModel, Lut3d, ModelKind, Trc};
 use crate::color::{delta_e2000, Xyz};
 
 /// The regularisation weights cross-validation chooses from.
@@ -39,13 +43,17 @@ pub fn default_grid(patches: usize) -> usize {
     }
 }
 
-/// A fitted scattered LUT and how its λ was chosen.
+/// A fitted scattered LUT and how its base and λ were chosen.
 #[derive(Clone, Debug)]
 pub struct ScatteredLut {
     pub lut: Lut3d,
     pub lambda: f64,
-    /// (λ, cross-validated mean ΔE00) for every λ tried; empty when λ was given.
+    /// (λ, cross-validated mean ΔE00) for every λ tried on the chosen base; empty when λ
+    /// was given.
     pub cv: Vec<(f64, f64)>,
+    /// The model the table corrects: shaper-matrix, or PLVC on a set with ramps where it
+    /// predicts held-out patches better.
+    pub base: ModelKind,
 }
 
 /// Fits an N³ LUT (`grid` points per axis, ≥ 2) to `patches`; `lambda` None chooses it by
@@ -66,24 +74,95 @@ pub fn fit_lut_scattered(
             "the grid needs at least 2 points per axis, not {grid}"
         )));
     }
-    let base = fit_shaper_matrix(set, patches, default_knots(patches.len())).map_err(|e| {
-        failed(format!(
-            "its shapers and start come from shaper-matrix, which failed: {e}"
-        ))
-    })?;
+    // Singular primaries are the user's measurement, not the base's fault: said as such.
+    let shaper_matrix =
+        fit_shaper_matrix(set, patches, default_knots(patches.len())).map_err(|e| match e {
+            FitError::SingularPrimaries { .. } => e,
+            e => failed(format!(
+                "its shapers and start come from shaper-matrix, which failed: {e}"
+            )),
+        })?;
+    let mut bases = vec![Base {
+        kind: ModelKind::ShaperMatrix,
+        shaper: shaper_matrix.trc.clone(),
+        model: Box::new(shaper_matrix),
+    }];
+    // With ramps, PLVC reproduces every ramp reading and adds them in mixtures; the
+    // cross-validation below keeps it only where it predicts held-out patches better.
+    if let Ok(plvc) = fit_plvc(set) {
+        bases.push(Base {
+            kind: ModelKind::Plvc,
+            shaper: plvc.shaper.clone(),
+            model: Box::new(plvc),
+        });
+    }
     let level: Vec<f64> = (0..grid).map(|i| i as f64 / (grid - 1) as f64).collect();
     let levels = [level.clone(), level.clone(), level.clone()];
+    let lambdas: Vec<f64> = lambda.map_or(LAMBDAS.to_vec(), |l| vec![l]);
+    let mut best: Option<Fitted> = None;
+    for base in bases {
+        let fitted = fit_on_base(set, patches, &levels, base, &lambdas).map_err(failed)?;
+        if best.as_ref().is_none_or(|b| fitted.score < b.score) {
+            best = Some(fitted);
+        }
+    }
+    let best = best.expect("shaper-matrix is always a base");
+    let nodes: Vec<[f64; 3]> = best
+        .base_nodes
+        .iter()
+        .zip(&best.correction)
+        .map(|(b, d)| std::array::from_fn(|k| b[k] + d[k]))
+        .collect();
+    let lut = Lut3d::from_parts(levels, best.shaper, nodes).map_err(failed)?;
+    Ok(ScatteredLut {
+        lut,
+        lambda: best.lambda,
+        cv: if lambda.is_some() {
+            Vec::new()
+        } else {
+            best.cv
+        },
+        base: best.base,
+    })
+}
+
+/// A model the table corrects, and whose curves shape its axes.
+struct Base {
+    kind: ModelKind,
+    shaper: [Trc; 3],
+    model: Box<dyn DisplayModel>,
+}
+
+/// The table fitted on one base.
+struct Fitted {
+    base: ModelKind,
+    shaper: [Trc; 3],
+    base_nodes: Vec<[f64; 3]>,
+    correction: Vec<[f64; 3]>,
+    lambda: f64,
+    cv: Vec<(f64, f64)>,
+    /// The lowest cross-validated mean ΔE00 (0 when nothing was cross-validated).
+    score: f64,
+}
+
+fn fit_on_base(
+    set: &SortedSamples,
+    patches: &[Sample],
+    levels: &[Vec<f64>; 3],
+    base: Base,
+    lambdas: &[f64],
+) -> Result<Fitted, String> {
+    let grid = levels[0].len();
     let mut base_nodes = Vec::with_capacity(grid * grid * grid);
-    for &r in &level {
-        for &g in &level {
-            for &b in &level {
-                base_nodes.push(base.forward([r, g, b]));
+    for &r in &levels[0] {
+        for &g in &levels[1] {
+            for &b in &levels[2] {
+                base_nodes.push(base.model.forward([r, g, b]));
             }
         }
     }
-    let lut =
-        Lut3d::from_parts(levels.clone(), base.trc.clone(), base_nodes.clone()).map_err(failed)?;
-    let white = set.white.unwrap_or_else(|| base.forward([1.0; 3]));
+    let lut = Lut3d::from_parts(levels.clone(), base.shaper.clone(), base_nodes.clone())?;
+    let white = set.white.unwrap_or_else(|| base.model.forward([1.0; 3]));
     let yw = white[1];
     let slope = |y: f64| 116.0 / 3.0 / yw * (y / yw).max(0.008856).powf(-2.0 / 3.0);
     let rows: Vec<Row> = patches
@@ -102,52 +181,48 @@ pub fn fit_lut_scattered(
         .collect();
     let scale = slope(0.2 * yw).powi(2);
     let problem = Problem { grid, scale };
-    let (lambda, cv) = match lambda {
-        Some(l) => (l, Vec::new()),
-        None => {
-            let wl = Xyz::from_array(white);
-            let mut cv = Vec::new();
-            for &l in &LAMBDAS {
-                let mut sum = 0.0;
-                let mut count = 0usize;
-                for fold in 0..FOLDS.min(patches.len()) {
-                    let train: Vec<&Row> = rows
-                        .iter()
-                        .enumerate()
-                        .filter(|(i, _)| fold_of(*i) % FOLDS != fold)
-                        .map(|(_, r)| r)
-                        .collect();
-                    let c = problem.solve(&train, l);
-                    for (i, (row, p)) in rows.iter().zip(patches).enumerate() {
-                        if fold_of(i) % FOLDS == fold {
-                            let f = predict(row, &base_nodes, &c);
-                            sum += delta_e2000(
-                                Xyz::from_array(f).to_lab(wl),
-                                Xyz::from_array(p.xyz).to_lab(wl),
-                            );
-                            count += 1;
-                        }
-                    }
-                }
-                cv.push((l, sum / count.max(1) as f64));
-            }
-            let best = cv
+    let wl = Xyz::from_array(white);
+    let mut cv = Vec::new();
+    for &l in lambdas {
+        let mut sum = 0.0;
+        let mut count = 0usize;
+        for fold in 0..FOLDS.min(patches.len()) {
+            let train: Vec<&Row> = rows
                 .iter()
-                .copied()
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .expect("LAMBDAS is not empty");
-            (best.0, cv)
+                .enumerate()
+                .filter(|(i, _)| fold_of(*i) % FOLDS != fold)
+                .map(|(_, r)| r)
+                .collect();
+            let c = problem.solve(&train, l);
+            for (i, (row, p)) in rows.iter().zip(patches).enumerate() {
+                if fold_of(i) % FOLDS == fold {
+                    let f = predict(row, &base_nodes, &c);
+                    sum += delta_e2000(
+                        Xyz::from_array(f).to_lab(wl),
+                        Xyz::from_array(p.xyz).to_lab(wl),
+                    );
+                    count += 1;
+                }
+            }
         }
-    };
-    let all: Vec<&Row> = rows.iter().collect();
-    let c = problem.solve(&all, lambda);
-    let nodes: Vec<[f64; 3]> = base_nodes
+        cv.push((l, sum / count.max(1) as f64));
+    }
+    let (lambda, score) = cv
         .iter()
-        .zip(&c)
-        .map(|(b, d)| std::array::from_fn(|k| b[k] + d[k]))
-        .collect();
-    let lut = Lut3d::from_parts(levels, base.trc, nodes).map_err(failed)?;
-    Ok(ScatteredLut { lut, lambda, cv })
+        .copied()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .ok_or("no regularisation weight to try")?;
+    let all: Vec<&Row> = rows.iter().collect();
+    let correction = problem.solve(&all, lambda);
+    Ok(Fitted {
+        base: base.kind,
+        shaper: base.shaper,
+        base_nodes,
+        correction,
+        lambda,
+        cv,
+        score,
+    })
 }
 
 /// One patch in the normal equations.

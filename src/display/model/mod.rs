@@ -14,6 +14,7 @@ mod lut_scattered;
 mod matrix_lsq;
 mod matrix_trc;
 mod plcc;
+mod plvc;
 pub mod samples;
 mod shaper_matrix;
 mod trc;
@@ -23,11 +24,12 @@ pub use error::FitError;
 pub use gog::{fit_gog, fit_gog_curve, gog_curve, gog_problem, GogProblem};
 pub use kind::ModelKind;
 pub use least_squares::levenberg_marquardt;
-pub use lut::{fit_lut, has_full_grid, Lut3d};
+pub use lut::{fit_lut, has_full_grid, is_measured_grid, Lut3d};
 pub use lut_scattered::{default_grid, fit_lut_scattered, ScatteredLut, LAMBDAS};
 pub use matrix_lsq::fit_matrix_lsq;
 pub use matrix_trc::{condition_number, MatrixTrc, MAX_CONDITION};
 pub use plcc::{fit_plcc, fit_plcc_gamma};
+pub use plvc::fit_plvc;
 pub use samples::{fold_of, Sample};
 pub use shaper_matrix::{default_knots, fit_shaper_matrix};
 pub use trc::{fit_power_gamma, FastInverse, Trc};
@@ -41,7 +43,7 @@ use serde::{Deserialize, Serialize};
 pub enum ModelParams {
     /// XYZ = XYZ₀ + M·TRC(rgb) (plcc, plcc-gamma, gog, gogo, matrix-lsq).
     MatrixTrc(MatrixTrc),
-    /// A 3D LUT with per-channel shapers (lut).
+    /// A 3D LUT with per-channel shapers (lut, and plvc as the grid of its additive sums).
     Lut(Lut3d),
 }
 
