@@ -21,6 +21,7 @@ use metamer_drivers::{MeasureMode, Reading};
 use serde::{Deserialize, Serialize};
 
 use crate::color::Spectrum;
+use crate::validation::covariance::{self, Cov3};
 
 /// Distance from the median, in noise σ, beyond which a reading is an outlier. At 5σ a
 /// normal reading is flagged about once in 1.7 million.
@@ -73,6 +74,11 @@ pub struct GroupStats {
     pub xyz: [f64; 3],
     /// Standard deviation of Y of the readings kept (0 for one reading).
     pub sd_y: f64,
+    /// Sample covariance of X, Y, Z of one reading among those kept (0 for one reading):
+    /// a meter's noise in x, y moves X and Z together, and a yellow's Z by far more than
+    /// its Y.
+    #[serde(default)]
+    pub cov: Cov3,
     /// The noise σ of Y the instrument allows at this level.
     pub noise_y: f64,
     /// Repeat numbers (0-based) left out as outliers.
@@ -132,27 +138,15 @@ pub fn group(readings: &[&Reading], noise: Noise) -> Result<GroupStats, StatsErr
         .map(|(_, r)| *r)
         .collect();
     let k = kept.len() as f64;
-    let mut xyz = [0.0; 3];
-    for r in &kept {
-        for (m, v) in xyz.iter_mut().zip(r.xyz) {
-            *m += v / k;
-        }
-    }
-    let sd_y = if kept.len() > 1 {
-        (kept
-            .iter()
-            .map(|r| (r.xyz[1] - xyz[1]).powi(2))
-            .sum::<f64>()
-            / (k - 1.0))
-            .sqrt()
-    } else {
-        0.0
-    };
+    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz).collect();
+    let (xyz, cov) = covariance::sample(&xs);
+    let sd_y = cov[1][1].sqrt();
     let noise_y = noise.sigma(xyz[1]);
     Ok(GroupStats {
         n: readings.len(),
         xyz,
         sd_y,
+        cov,
         noise_y,
         spread_exceeds_noise: kept.len() > 1
             && (k - 1.0) * sd_y * sd_y > chi2_999(kept.len() - 1) * noise_y * noise_y,

@@ -220,6 +220,7 @@ fn source_name(s: UncertaintySource) -> &'static str {
     match s {
         UncertaintySource::Repeats => "repeats",
         UncertaintySource::Given => "given sd",
+        UncertaintySource::Instrument => "stated repeatability",
         UncertaintySource::Render => "render",
         UncertaintySource::Unknown => "unknown",
     }
