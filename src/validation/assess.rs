@@ -219,14 +219,6 @@ pub fn assess(
             JndVerdict::Undecided => jnd.undecided += 1,
         }
     }
-    let draws: Vec<PatchDraws<'_>> = propagated
-        .iter()
-        .map(|p| PatchDraws {
-            reference_lab: p.reference_lab,
-            test_lab: p.test_lab,
-            noise: p.noise.as_ref(),
-        })
-        .collect();
     let seed = match opts.propagation {
         Propagation::MonteCarlo { seed, .. } => seed,
         Propagation::Linear => 0,
@@ -237,6 +229,18 @@ pub fn assess(
             .map(|p| match metric {
                 Metric::De76 => p.de76,
                 Metric::De00 => p.de00,
+            })
+            .collect();
+        let draws: Vec<PatchDraws<'_>> = propagated
+            .iter()
+            .map(|p| PatchDraws {
+                reference_lab: p.reference_lab,
+                test_lab: p.test_lab,
+                noise: p.noise.as_ref(),
+                interval: Some(match metric {
+                    Metric::De76 => p.de76,
+                    Metric::De00 => p.de00,
+                }),
             })
             .collect();
         Stat {

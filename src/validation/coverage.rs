@@ -273,6 +273,7 @@ fn summary_coverage(patches: &[Truth], summary: Summary, how: Stated, seed: u64)
                     reference_lab: *r,
                     test_lab: *t,
                     noise: Some(n),
+                    interval: Some(patch_interval(*r, *t, n, Metric::De76, key)),
                 })
                 .collect();
             let i = summary_interval(&draws, Metric::De76, summary, key).unwrap();
@@ -296,11 +297,16 @@ fn the_mean_and_max_over_patches_are_covered() {
 }
 
 /// Covariances from 5 and 3 repeats per patch: pooled, their degrees of freedom make the
-/// mean's interval nearly the normal one, and it holds.
+/// mean's interval nearly the normal one; the max holds its patches' t intervals.
 #[test]
-fn the_mean_with_estimated_covariances_is_covered() {
-    let got = summary_coverage(&six_patches(1.0), Summary::Mean, Stated::Estimated, 9);
-    check_summary("the mean ΔE*ab of 6 patches, covariances from repeats", got);
+fn the_mean_and_max_with_estimated_covariances_are_covered() {
+    for (summary, seed) in [(Summary::Mean, 9), (Summary::Max, 12)] {
+        let got = summary_coverage(&six_patches(1.0), summary, Stated::Estimated, seed);
+        check_summary(
+            &format!("the {summary:?} ΔE*ab of 6 patches, covariances from repeats"),
+            got,
+        );
+    }
 }
 
 /// Where noise swamps most patches.

@@ -21,12 +21,14 @@ use super::propagate::Interval;
 /// 1 − the confidence level.
 const ALPHA: f64 = 0.05;
 
-/// How finely the boundary is found, relative to its scale: ΔE to 1e-4 of itself.
-const TOLERANCE: f64 = 1e-4;
+/// How finely a patch's bounds are found, relative to their scale: ΔE to 1e-4 of itself
+/// (a verdict turns on the third decimal near 2.3).
+pub const PATCH_TOLERANCE: f64 = 1e-4;
 
-/// The largest c ≥ 0 for which `holds` (true at 0) stays true, found by doubling from 1
-/// until it fails and then bisecting; at most 2⁶⁰ when it never fails.
-fn boundary(holds: impl Fn(f64) -> bool) -> f64 {
+/// The largest c ≥ 0 for which `holds` (true at 0) stays true, to `tolerance` of itself,
+/// found by doubling from 1 until it fails and then bisecting; at most 2⁶⁰ when it never
+/// fails.
+fn boundary(holds: impl Fn(f64) -> bool, tolerance: f64) -> f64 {
     let (mut a, mut b) = (0.0, 1.0);
     let mut doublings = 0;
     while holds(b) {
@@ -37,7 +39,7 @@ fn boundary(holds: impl Fn(f64) -> bool) -> f64 {
             return b;
         }
     }
-    while b - a > TOLERANCE * b {
+    while b - a > tolerance * b {
         let m = 0.5 * (a + b);
         if holds(m) {
             a = m;
@@ -49,29 +51,48 @@ fn boundary(holds: impl Fn(f64) -> bool) -> f64 {
 }
 
 /// The 95 % interval of a difference observed as `obs`, from `draws` noise draws:
-/// `stat(c, i)` is draw i's statistic when the truth is the observed configuration scaled
-/// by c, `truth(c)` the noiseless statistic there (so `truth(1)` is `obs`).
+/// `stat(c, i)` is draw i's statistic when the truth is the observed configuration's
+/// family member c, `truth(c)` the noiseless statistic there (so `truth(1)` is `obs`);
+/// bounds to `tolerance` of themselves.
 pub fn invert(
     obs: f64,
     draws: usize,
     stat: impl Fn(f64, usize) -> f64,
     truth: impl Fn(f64) -> f64,
+    tolerance: f64,
 ) -> Interval {
     if draws == 0 {
         return Interval { lo: obs, hi: obs };
     }
-    // The share of draws at truth c that come out no larger than what was observed.
-    let below = |c: f64| (0..draws).filter(|&i| stat(c, i) <= obs).count() as f64 / draws as f64;
-    let at_zero = below(0.0);
-    let hi = if at_zero < ALPHA / 2.0 {
-        obs
-    } else {
-        truth(boundary(|c| below(c) >= ALPHA / 2.0))
+    // Whether at least `k` draws at truth c come out no larger than what was observed;
+    // counting stops as soon as the answer is known.
+    let at_least = |c: f64, k: usize| {
+        let mut below = 0;
+        for i in 0..draws {
+            if stat(c, i) <= obs {
+                below += 1;
+                if below >= k {
+                    return true;
+                }
+            } else if below + (draws - i - 1) < k {
+                return false;
+            }
+        }
+        below >= k
     };
-    let lo = if at_zero <= 1.0 - ALPHA / 2.0 {
-        truth(0.0)
+    // A truth stays while at least 2.5 % of its draws fall at or below the observation
+    // (for the upper end) and no more than 97.5 % do (for the lower end).
+    let low_tail = ((ALPHA / 2.0) * draws as f64).ceil() as usize;
+    let high_tail = ((1.0 - ALPHA / 2.0) * draws as f64).floor() as usize + 1;
+    let hi = if at_least(0.0, low_tail) {
+        truth(boundary(|c| at_least(c, low_tail), tolerance))
     } else {
-        truth(boundary(|c| below(c) > 1.0 - ALPHA / 2.0))
+        obs
+    };
+    let lo = if at_least(0.0, high_tail) {
+        truth(boundary(|c| at_least(c, high_tail), tolerance))
+    } else {
+        truth(0.0)
     };
     Interval {
         lo: lo.min(obs),
@@ -102,6 +123,7 @@ mod tests {
             noise.len(),
             |c, i| length([0, 1, 2].map(|k| c * d[k] + noise[i][k])),
             |c| c * obs,
+            PATCH_TOLERANCE,
         )
     }
 
@@ -137,7 +159,7 @@ mod tests {
         let i = interval([0.01, 0.0, 0.0], &noise);
         assert_eq!((i.lo, i.hi), (0.0, 0.01));
         // No noise: the point.
-        let i = invert(2.0, 0, |_, _| 0.0, |c| 2.0 * c);
+        let i = invert(2.0, 0, |_, _| 0.0, |c| 2.0 * c, PATCH_TOLERANCE);
         assert_eq!((i.lo, i.hi), (2.0, 2.0));
     }
 }

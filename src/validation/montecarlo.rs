@@ -7,9 +7,9 @@
 //! freedom ν = V² / Σ(vⱼ²/νⱼ), where vⱼ is each side's variance along the colour difference
 //! and νⱼ = kⱼ − 1 (a stated repeatability or a renderer's error counts as known): each
 //! draw's noise is scaled by √(ν/χ²_ν). A summary over patches pools their degrees of
-//! freedom the same way (for the max, each patch weighted by how often it is the
-//! largest), so 24 patches of 3 repeats each are nearly normal while one patch of 3 is
-//! t₂. Scaling each side on its own instead would give a sum of t's far wider than the
+//! freedom the same way for a mean, so 24 patches of 3 repeats each are nearly normal
+//! while one patch of 3 is t₂; a max, which turns on one patch or two, takes its draws
+//! with the covariances as known and then holds every patch's own bounds. Scaling each side on its own instead would give a sum of t's far wider than the
 //! estimated covariance warrants (97.9 % coverage where 95 % is asked).
 //!
 //! The family of truths inverted over is the profile one: for each true length, the
@@ -28,7 +28,7 @@
 use metamer_drivers::noise::SplitMix64;
 
 use super::covariance::{self, Cov3};
-use super::inversion::invert;
+use super::inversion::{invert, PATCH_TOLERANCE};
 use super::propagate::{Interval, Model, Uncertain};
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz};
 
@@ -75,12 +75,17 @@ impl Summary {
     }
 }
 
-/// One patch's observed CIELAB pair and its noise, as a summary over patches takes it.
+/// One patch's observed CIELAB pair, its noise and its own interval by the summary's
+/// metric, as a summary over patches takes them.
 pub struct PatchDraws<'a> {
     pub reference_lab: Lab,
     pub test_lab: Lab,
     pub noise: Option<&'a LabNoise>,
+    pub interval: Option<Interval>,
 }
+
+/// How finely a summary's bounds are found, relative to their scale.
+const SUMMARY_TOLERANCE: f64 = 1e-3;
 
 /// One draw of `side`'s CIELAB less its observed `lab`.
 fn draw(side: &Uncertain, lab: Lab, white: Xyz, rng: &mut SplitMix64) -> [f64; 3] {
@@ -309,6 +314,7 @@ pub fn patch_interval(r: Lab, t: Lab, noise: &LabNoise, metric: Metric, seed: u6
             )
         },
         |c| metric.of(r, at(c)),
+        PATCH_TOLERANCE,
     )
 }
 
@@ -342,38 +348,20 @@ pub fn summary_interval(
         .iter()
         .map(|p| (p[0].0 + p[1].0).max(f64::MIN_POSITIVE))
         .collect();
-    // Each patch's weight in the summary: equal in a mean; in a max, how often it is the
-    // largest among the draws about the observed readings.
-    let weights: Vec<f64> = match summary {
-        Summary::Mean => vec![1.0; patches.len()],
-        Summary::Max => {
-            let mut wins = vec![0.0; patches.len()];
-            for i in 0..n {
-                let best = (0..patches.len()).max_by(|&a, &b| {
-                    let v = |k: usize| {
-                        let p = &patches[k];
-                        match p.noise {
-                            Some(d) => norm(
-                                sub(add(p.test_lab, d.test[i]), add(p.reference_lab, d.reference[i])),
-                            ),
-                            None => lengths[k],
-                        }
-                    };
-                    v(a).total_cmp(&v(b))
-                });
-                if let Some(k) = best {
-                    wins[k] += 1.0;
-                }
-            }
-            wins
-        }
+    // A mean pools the patches' degrees of freedom (Welch–Satterthwaite over all of them:
+    // nearly normal for many patches). A max turns on one patch or two, whose own
+    // intervals carry their t: its draws take the covariances as known, and its bounds
+    // then hold every patch's own (the max is at least each patch's difference).
+    let nu = match summary {
+        Summary::Mean => effective_dof(
+            &parts
+                .iter()
+                .flat_map(|p| [(1.0, p[0]), (1.0, p[1])])
+                .collect::<Vec<_>>(),
+        ),
+        Summary::Max => None,
     };
-    let weighted: Vec<(f64, Part)> = weights
-        .iter()
-        .zip(&parts)
-        .flat_map(|(w, p)| [(*w, p[0]), (*w, p[1])])
-        .collect();
-    let scale = t_scales(effective_dof(&weighted), n, seed);
+    let scale = t_scales(nu, n, seed);
     let top = lengths.iter().copied().fold(0.0, f64::max);
     // The patches' true lengths at c (c = 1: the observed ones).
     let family = |c: f64| -> Vec<f64> {
@@ -446,7 +434,7 @@ pub fn summary_interval(
         .collect();
     // The truths are found once per c, not per draw.
     let cache = std::cell::RefCell::new((f64::NAN, Vec::new()));
-    Some(invert(
+    let mut interval = invert(
         summary.of(&observed),
         n,
         |c, i| {
@@ -457,7 +445,15 @@ pub fn summary_interval(
             value(&k.1, Some(i))
         },
         |c| value(&truths(c), None),
-    ))
+        SUMMARY_TOLERANCE,
+    );
+    if summary == Summary::Max {
+        for i in patches.iter().filter_map(|p| p.interval) {
+            interval.lo = interval.lo.max(i.lo);
+            interval.hi = interval.hi.max(i.hi);
+        }
+    }
+    Some(interval)
 }
 
 #[cfg(test)]
