@@ -16,7 +16,7 @@ use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome
 use crate::output::OutputPolicy;
 use crate::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use crate::rig::Scenario;
-use crate::validation::covariance::Repeatability;
+use crate::session::repeats::Repeatability;
 use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator};
 
 /// How the box is measured.
@@ -151,7 +151,7 @@ pub fn measure(
     };
     // Each spot's scatter in X, Y and Z together, over the repeats the reduction kept;
     // a spot read once carries the meter's stated repeatability.
-    let stated = Repeatability::of(&m.spot);
+    let stated = Repeatability::emissive_of(&m.spot);
     let stats: Vec<PatchStat> = summary
         .spot_xyz
         .iter()

@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::Reading;
 
 use super::cache::{write_atomic, CacheError};
-use crate::validation::covariance::{self, Cov3, Repeatability};
+use crate::session::repeats::Repeatability;
+use crate::validation::covariance::{self, Cov3};
 
 /// The readings of one ColorChecker patch.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -63,7 +64,7 @@ impl PatchStat {
                 let mut s = PatchStat::of(p, &xs);
                 if let [one] = of_patch.as_slice() {
                     if let Some(c) =
-                        Repeatability::of(&one.instrument).and_then(|r| r.covariance(one.xyz))
+                        Repeatability::emissive_of(&one.instrument).and_then(|r| r.covariance(one.xyz))
                     {
                         s.cov = c;
                     }
@@ -231,7 +232,7 @@ mod tests {
         let g = PatchStat::group(&[(16, &one), (17, &one), (17, &two)]);
         // σY = 0.1 % of 10.
         assert!((g[0].sd()[1] - 0.01).abs() < 1e-12, "{g:?}");
-        let stated = Repeatability::of("cs100a").unwrap().covariance(one.xyz).unwrap();
+        let stated = Repeatability::emissive_of("cs100a").unwrap().covariance(one.xyz).unwrap();
         assert_eq!(g[0].cov, stated);
         assert!((g[1].sd()[1] - 0.1 / 2f64.sqrt()).abs() < 1e-12, "{g:?}");
         let unknown = Reading::from_yxy(10.0, 0.45, 0.5, "mystery");

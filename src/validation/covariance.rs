@@ -1,7 +1,8 @@
 //! The uncertainty of one patch's XYZ as a full 3×3 covariance: estimated from repeated
 //! readings (their X, Y and Z scatter together: a meter's repeats mostly move luminance
 //! and chromaticity, not one axis at a time), or, for a single reading, the instrument's
-//! stated repeatability in Y and in x, y carried to X, Y, Z to first order.
+//! stated repeatability in Y and in x, y carried to X, Y, Z to first order
+//! ([`crate::session::repeats::Repeatability::covariance`]).
 
 use nalgebra::{Matrix3, SymmetricEigen};
 
@@ -136,62 +137,6 @@ pub fn of_factors(factors: &[[f64; 3]]) -> Cov3 {
     c
 }
 
-/// An instrument's stated repeatability of one emissive reading (1σ).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Repeatability {
-    /// Of Y, relative.
-    pub y_rel: f64,
-    /// Of x and of y, absolute (taken as independent).
-    pub xy: f64,
-}
-
-impl Repeatability {
-    /// What the instrument named `model` states, for the instruments this program drives:
-    /// the CS-100A ±0.2 % in Y and ±0.001 in x, y (Konica Minolta's data sheet, taken as
-    /// 2σ); the i1Pro emissive 0.1 % in Y (the unit's declared figure) and, as no x, y
-    /// figure is stated for it here, the CS-100A's. None for any other name.
-    pub fn of(model: &str) -> Option<Repeatability> {
-        let m = model.trim().to_ascii_lowercase();
-        if m.contains("cs100a") || m.contains("cs-100a") || m.contains("i1pro") {
-            Some(Repeatability {
-                y_rel: 0.001,
-                xy: 0.0005,
-            })
-        } else {
-            None
-        }
-    }
-
-    /// The covariance of X, Y, Z of one reading of `xyz`: with X = xY/y and
-    /// Z = (1 − x − y)Y/y, J·diag(σx², σy², σY²)·Jᵀ with J the derivatives of (X, Y, Z) by
-    /// (x, y, Y). None without a chromaticity (X + Y + Z ≤ 0).
-    pub fn covariance(&self, xyz: [f64; 3]) -> Option<Cov3> {
-        let s = xyz[0] + xyz[1] + xyz[2];
-        if !(s > 0.0 && xyz[1] > 0.0) {
-            return None;
-        }
-        let (x, y, big_y) = (xyz[0] / s, xyz[1] / s, xyz[1]);
-        // Columns: ∂/∂x, ∂/∂y, ∂/∂Y.
-        let j = [
-            [big_y / y, -x * big_y / (y * y), x / y],
-            [0.0, 0.0, 1.0],
-            [-big_y / y, -(1.0 - x) * big_y / (y * y), (1.0 - x - y) / y],
-        ];
-        let var = [
-            self.xy * self.xy,
-            self.xy * self.xy,
-            (self.y_rel * big_y).powi(2),
-        ];
-        let mut c = ZERO;
-        for (a, row) in c.iter_mut().enumerate() {
-            for (b, v) in row.iter_mut().enumerate() {
-                *v = (0..3).map(|k| j[a][k] * var[k] * j[b][k]).sum();
-            }
-        }
-        Some(c)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,47 +175,5 @@ mod tests {
         assert!(e.contains("negative variance"), "{e}");
         assert!(check(&[[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]).is_err());
         assert!(check(&[[f64::NAN, 0.0, 0.0], [0.0; 3], [0.0; 3]]).is_err());
-    }
-
-    /// The stated repeatability carried to X, Y, Z matches the scatter of readings drawn
-    /// as the CS-100A's noise is (Y and x, y independent normals), to within the sampling
-    /// error of 200 000 draws.
-    #[test]
-    fn stated_repeatability_carries_to_xyz_as_sampled() {
-        let r = Repeatability::of("cs100a").unwrap();
-        assert_eq!(Repeatability::of("spectralon"), None);
-        // A saturated yellow (ColorChecker 16 under a white display): x 0.45, y 0.50,
-        // where Z = (1 − x − y)Y/y is small and chromaticity noise moves it by a lot.
-        let (x, y, big_y) = (0.45, 0.50, 10.0);
-        let xyz = [x * big_y / y, big_y, (1.0 - x - y) * big_y / y];
-        let c = r.covariance(xyz).unwrap();
-        let mut rng = metamer_drivers::noise::SplitMix64::new(7);
-        let draws: Vec<[f64; 3]> = (0..200_000)
-            .map(|_| {
-                let (xx, yy, ly) = (
-                    x + r.xy * rng.normal(),
-                    y + r.xy * rng.normal(),
-                    big_y * (1.0 + r.y_rel * rng.normal()),
-                );
-                [xx * ly / yy, ly, (1.0 - xx - yy) * ly / yy]
-            })
-            .collect();
-        let (_, s) = sample(&draws);
-        for i in 0..3 {
-            for j in 0..3 {
-                let scale = (c[i][i] * c[j][j]).sqrt();
-                assert!(
-                    (s[i][j] - c[i][j]).abs() < 0.02 * scale,
-                    "{i}{j}: sampled {} vs {}",
-                    s[i][j],
-                    c[i][j]
-                );
-            }
-        }
-        // By hand: σY = 0.01; σZ from x and y: ∂Z/∂x = −Y/y = −20, ∂Z/∂y = −(1−x)Y/y² =
-        // −22, ∂Z/∂Y = 0.1: σZ² = 0.0005²·(400 + 484) + 0.01²·0.01 = 2.22e-4.
-        assert!((c[1][1] - 1e-4).abs() < 1e-15);
-        assert!((c[2][2] - 2.22e-4).abs() < 1e-12, "{}", c[2][2]);
-        assert_eq!(r.covariance([0.0, 0.0, 0.0]), None);
     }
 }

@@ -11,7 +11,8 @@
 use metamer_drivers::noise::SplitMix64;
 use rayon::prelude::*;
 
-use super::covariance::{self, Cov3, Repeatability};
+use super::covariance::{self, Cov3};
+use crate::session::repeats::Repeatability;
 use super::montecarlo::{
     lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Summary,
 };
@@ -161,7 +162,7 @@ fn moved(from: [f64; 3], dir: [f64; 3], de: f64) -> [f64; 3] {
 /// repeatability of one reading of it, scaled by `noise`.
 fn yellow(de: f64, noise: f64, k_reference: usize, k_test: usize) -> Truth {
     let reference = [9.0356, 9.9766, 1.2852];
-    let one = Repeatability::of("cs100a")
+    let one = Repeatability::emissive_of("cs100a")
         .unwrap()
         .covariance(reference)
         .unwrap();

@@ -16,7 +16,7 @@
 //! overstated), no truth passes: the interval is then [0, estimate]. Every interval holds
 //! its estimate.
 
-use super::propagate::Interval;
+use super::uncertain::Interval;
 
 /// 1 − the confidence level.
 const ALPHA: f64 = 0.05;

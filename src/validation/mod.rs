@@ -21,6 +21,7 @@ pub mod readings;
 pub mod report;
 mod report_input;
 mod report_sections;
+pub mod uncertain;
 pub mod verdict;
 
 use serde::{Deserialize, Serialize};

@@ -29,7 +29,7 @@ use metamer_drivers::noise::SplitMix64;
 
 use super::covariance::{self, Cov3};
 use super::inversion::{invert, PATCH_TOLERANCE};
-use super::propagate::{Interval, Model, Uncertain};
+use super::uncertain::{lab_of, Interval, Uncertain};
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz};
 
 /// One patch's Monte Carlo draws: how each draw moves the reference's and the test's
@@ -91,7 +91,7 @@ const SUMMARY_TOLERANCE: f64 = 1e-3;
 fn draw(side: &Uncertain, lab: Lab, white: Xyz, rng: &mut SplitMix64) -> [f64; 3] {
     let z: Vec<f64> = side.factors.iter().map(|_| rng.normal()).collect();
     let zl = [rng.normal(), rng.normal(), rng.normal()];
-    let moved = Model::lab(side, &z, &zl, white);
+    let moved = lab_of(side, &z, &zl, white);
     [moved.l - lab.l, moved.a - lab.a, moved.b - lab.b]
 }
 

@@ -22,6 +22,8 @@ use metamer_drivers::noise::SplitMix64;
 use serde::{Deserialize, Serialize};
 
 use super::montecarlo::{lab_noise, patch_interval, LabNoise, Metric};
+use super::uncertain::lab_of;
+pub use super::uncertain::{render_lab_sigma, Interval, RenderStatement, Uncertain, Z975};
 
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz};
 
@@ -57,33 +59,6 @@ impl Propagation {
     }
 }
 
-/// One side of a comparison with its uncertainty.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Uncertain {
-    pub xyz: [f64; 3],
-    /// Independent standard-normal factors, each moving XYZ along its vector: their
-    /// Σ f fᵀ is the covariance of the mean.
-    pub factors: Vec<[f64; 3]>,
-    /// Degrees of freedom of that covariance where it was estimated from repeats (k − 1);
-    /// None where it is known (an instrument's stated repeatability, a renderer's error).
-    pub dof: Option<usize>,
-    /// Extra standard uncertainty of each CIELAB coordinate.
-    pub u_lab: f64,
-}
-
-/// A 95 % interval.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Interval {
-    pub lo: f64,
-    pub hi: f64,
-}
-
-impl Interval {
-    pub fn contains(self, v: f64) -> bool {
-        self.lo <= v && v <= self.hi
-    }
-}
-
 /// The intervals of both colour differences of one patch, with the two readings' CIELAB
 /// and their noise draws (Monte Carlo only) so a summary over patches can get its own
 /// interval the same way.
@@ -103,32 +78,9 @@ impl std::fmt::Debug for Propagated {
     }
 }
 
-/// The 97.5th percentile of the standard normal.
-pub const Z975: f64 = 1.959_963_985;
-
-/// How a renderer states a patch's ΔE*ab uncertainty.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderStatement {
-    /// A path tracer's 95 % half-width, 1.96·√(tr Σ) of its estimate's CIELAB covariance.
-    HalfWidth95,
-    /// A deterministic solver's bound on the error vector's length.
-    Bound,
-}
-
-/// The per-axis standard uncertainty in CIELAB that a renderer's per-patch ΔE*ab statement
-/// stands for, the error taken as isotropic: a half-width h = 1.96·√(3σ²) gives
-/// σ = h / (1.96·√3); a bound is taken as the 95th percentile of the error's length,
-/// σ = b / √χ²₃(0.95).
-pub fn render_lab_sigma(de: f64, how: RenderStatement) -> f64 {
-    match how {
-        RenderStatement::HalfWidth95 => de / (Z975 * 3f64.sqrt()),
-        RenderStatement::Bound => de / super::readings::CHI3_95,
-    }
-}
-
 /// Both colour differences with the factors set to `z`: the reference's XYZ factors, the
 /// test's, then three CIELAB factors for each side.
-pub(super) struct Model<'a> {
+struct Model<'a> {
     reference: &'a Uncertain,
     test: &'a Uncertain,
     white: Xyz,
@@ -139,28 +91,13 @@ impl Model<'_> {
         self.reference.factors.len() + self.test.factors.len() + 6
     }
 
-    pub(super) fn lab(side: &Uncertain, z: &[f64], zl: &[f64], white: Xyz) -> Lab {
-        let mut xyz = side.xyz;
-        for (f, zi) in side.factors.iter().zip(z) {
-            for (x, v) in xyz.iter_mut().zip(f) {
-                *x += v * zi;
-            }
-        }
-        let l = Xyz::from_array(xyz).to_lab(white);
-        Lab::new(
-            l.l + side.u_lab * zl[0],
-            l.a + side.u_lab * zl[1],
-            l.b + side.u_lab * zl[2],
-        )
-    }
-
     fn eval(&self, z: &[f64]) -> (f64, f64) {
         let nr = self.reference.factors.len();
         let nt = self.test.factors.len();
         let (zr, rest) = z.split_at(nr);
         let (zt, zl) = rest.split_at(nt);
-        let r = Self::lab(self.reference, zr, &zl[..3], self.white);
-        let t = Self::lab(self.test, zt, &zl[3..], self.white);
+        let r = lab_of(self.reference, zr, &zl[..3], self.white);
+        let t = lab_of(self.test, zt, &zl[3..], self.white);
         (delta_e76(r, t), delta_e2000(r, t))
     }
 }

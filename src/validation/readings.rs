@@ -16,17 +16,15 @@ use metamer_color::text::{echo, echo_message, strip_bom};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use super::covariance::{self, Cov3, Repeatability};
-use super::propagate::{render_lab_sigma, RenderStatement};
+use super::covariance::{self, Cov3};
+use crate::session::repeats::Repeatability;
+pub use super::uncertain::CHI3_95;
+use super::uncertain::{render_lab_sigma, RenderStatement};
 use crate::color::COLORCHECKER_NAMES;
 
 /// The number of patches of the chart.
 pub const PATCHES: usize = 24;
 
-/// The 95th percentile of the length of a 3-D isotropic normal vector in units of its
-/// per-axis σ (√χ²₃(0.95) = √7.8147): converts a renderer's 95 % ΔE half-width to a
-/// per-axis standard uncertainty in CIELAB.
-pub const CHI3_95: f64 = 2.795_483;
 
 /// Which file format the readings were in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -459,7 +457,7 @@ fn combine(rows: &[&Row]) -> PatchReading {
     let stated = (rows.len() == 1)
         .then(|| {
             let r = rows[0];
-            let rep = Repeatability::of(r.instrument.as_deref()?)?;
+            let rep = Repeatability::emissive_of(r.instrument.as_deref()?)?;
             rep.covariance(r.xyz)
         })
         .flatten();

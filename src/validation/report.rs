@@ -151,7 +151,7 @@ fn summary_line(a: &Assessment) -> String {
             .unwrap_or_default()
     };
     format!(
-        "{} of {} patches below the JND, {} above, {} undecided; ΔE*ab mean {:.2}{} max {:.2}{}; ΔE00 mean {:.2}{} max {:.2}{}.",
+        "{} of {} patches below the JND at 95 % confidence, {} above, {} undecided; ΔE*ab mean {:.2}{} max {:.2}{}; ΔE00 mean {:.2}{} max {:.2}{}.",
         a.jnd.below,
         a.patches.len(),
         a.jnd.above,
