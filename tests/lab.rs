@@ -181,11 +181,16 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
         let counts = &lab[key]["jnd"];
         assert_eq!(
             [&counts["below"], &counts["above"], &counts["undecided"]],
-            [a.jnd.below, a.jnd.above, a.jnd.undecided].map(serde_json::Value::from).each_ref(),
+            [a.jnd.below, a.jnd.above, a.jnd.undecided]
+                .map(serde_json::Value::from)
+                .each_ref(),
             "{key}"
         );
         assert_eq!(lab[key]["below_jnd_point"], a.below_jnd_point, "{key}");
-        assert_eq!(lab[key]["max_de76"]["value"].as_f64(), Some(a.max_de76.value));
+        assert_eq!(
+            lab[key]["max_de76"]["value"].as_f64(),
+            Some(a.max_de76.value)
+        );
         assert!(said.contains(&a.summary()), "{key}: {said}");
         assert!(
             a.summary().contains(&format!(
@@ -214,7 +219,9 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
             ("mean ΔE00", a.mean_de00),
             ("max ΔE00", a.max_de00),
         ] {
-            let i = s.interval.unwrap_or_else(|| panic!("{key} {what}: no interval"));
+            let i = s
+                .interval
+                .unwrap_or_else(|| panic!("{key} {what}: no interval"));
             assert!(i.lo <= s.value && s.value <= i.hi, "{key} {what} {s:?}");
         }
     }
@@ -266,11 +273,20 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
     assert_eq!(std::fs::read(dir.join("display/log.jsonl")).unwrap(), log);
     let again = json(&dir.join("lab.json"));
     assert!(again["seconds"].as_f64().unwrap() < 5.0);
-    assert_eq!(again["stages"], lab["stages"].as_array().unwrap().iter().map(|s| {
-        let mut s = s.clone();
-        s["reused"] = true.into();
-        s
-    }).collect::<Vec<_>>().into());
+    assert_eq!(
+        again["stages"],
+        lab["stages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| {
+                let mut s = s.clone();
+                s["reused"] = true.into();
+                s
+            })
+            .collect::<Vec<_>>()
+            .into()
+    );
     assert!(again["stages"][0]["seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(again["options"]["box_repeats"], 1);
     assert_eq!(again["display_vs_box"]["jnd"], lab["display_vs_box"]["jnd"]);

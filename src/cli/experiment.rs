@@ -12,9 +12,9 @@ use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
 use metamer::experiment::validate::{ValidationResult, FILE};
 use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
-use metamer::validation::export::HTML_FILE;
 use metamer::render::scene::Scene;
 use metamer::session::{on_ctrl_c, RunOptions};
+use metamer::validation::export::HTML_FILE;
 
 use super::{CliError, CliResult};
 

@@ -63,8 +63,8 @@ impl PatchStat {
                 let xs: Vec<[f64; 3]> = of_patch.iter().map(|r| r.xyz).collect();
                 let mut s = PatchStat::of(p, &xs);
                 if let [one] = of_patch.as_slice() {
-                    if let Some(c) =
-                        Repeatability::emissive_of(&one.instrument).and_then(|r| r.covariance(one.xyz))
+                    if let Some(c) = Repeatability::emissive_of(&one.instrument)
+                        .and_then(|r| r.covariance(one.xyz))
                     {
                         s.cov = c;
                     }
@@ -230,9 +230,13 @@ mod tests {
         let one = Reading::from_yxy(10.0, 0.45, 0.5, "cs100a");
         let two = Reading::from_yxy(10.1, 0.45, 0.5, "cs100a");
         let g = PatchStat::group(&[(16, &one), (17, &one), (17, &two)]);
-        // σY = 0.1 % of 10.
-        assert!((g[0].sd()[1] - 0.01).abs() < 1e-12, "{g:?}");
-        let stated = Repeatability::emissive_of("cs100a").unwrap().covariance(one.xyz).unwrap();
+        // σY: 0.1 % of 10 and the last of four digits of 10.00 (0.01, variance 0.01²/12):
+        // 0.01·√(1 + 1/12) = 0.010408.
+        assert!((g[0].sd()[1] - 0.010_408_33).abs() < 1e-8, "{g:?}");
+        let stated = Repeatability::emissive_of("cs100a")
+            .unwrap()
+            .covariance(one.xyz)
+            .unwrap();
         assert_eq!(g[0].cov, stated);
         assert!((g[1].sd()[1] - 0.1 / 2f64.sqrt()).abs() < 1e-12, "{g:?}");
         let unknown = Reading::from_yxy(10.0, 0.45, 0.5, "mystery");

@@ -26,8 +26,8 @@ use crate::experiment::{self, BoxSource, ExperimentOptions, Progress, Stage, Sta
 use crate::output::OutputPolicy;
 use crate::rig::{Preset, Scenario};
 use crate::session::RunOptions;
-use crate::validation::export::HTML_FILE;
 use crate::validation::assess::{Assessment, JndCount, JndVerdict, Stat};
+use crate::validation::export::HTML_FILE;
 use crate::validation::propagate::Interval;
 
 /// What a lab run is made of.

@@ -138,9 +138,7 @@ impl Repeatability {
     pub fn sigma_xy(&self, y: f64) -> Option<f64> {
         self.xy.map(|xy| match xy {
             XyNoise::Fixed(s) => s,
-            XyNoise::PerRelativeY(k) => {
-                k * self.sigma_y(y) / y.abs().max(f64::MIN_POSITIVE)
-            }
+            XyNoise::PerRelativeY(k) => k * self.sigma_y(y) / y.abs().max(f64::MIN_POSITIVE),
         })
     }
 

@@ -9,8 +9,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::color::{delta_e2000, delta_e76, Xyz, COLORCHECKER_NAMES};
 
-use super::error::ValidationError;
 use super::covariance::{self, Cov3};
+use super::error::ValidationError;
 use super::montecarlo::{summary_interval, Metric, PatchDraws, Summary};
 use super::propagate::{propagate, Interval, Propagated, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
@@ -282,7 +282,6 @@ impl Stat {
         }
     }
 }
-
 
 impl Assessment {
     /// The one-line summary a user reads first: the verdicts at 95 % confidence, the

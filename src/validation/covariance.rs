@@ -169,7 +169,10 @@ mod tests {
             }
         }
         // X and Y perfectly correlated: one direction has no variance; two factors.
-        assert_eq!(factors(&[[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 0.0]]).len(), 1);
+        assert_eq!(
+            factors(&[[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 0.0]]).len(),
+            1
+        );
         // |cov XY| = 3 > sd X · sd Y = 2: no such covariance.
         let e = check(&[[1.0, 3.0, 0.0], [3.0, 4.0, 0.0], [0.0, 0.0, 1.0]]).unwrap_err();
         assert!(e.contains("negative variance"), "{e}");

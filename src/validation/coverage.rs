@@ -12,12 +12,12 @@ use metamer_drivers::noise::SplitMix64;
 use rayon::prelude::*;
 
 use super::covariance::{self, Cov3};
-use crate::session::repeats::Repeatability;
 use super::montecarlo::{
     lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Summary,
 };
 use super::propagate::{Interval, Uncertain};
 use crate::color::{delta_e76, Lab, Xyz};
+use crate::session::repeats::Repeatability;
 
 const TRIALS: u64 = 2000;
 /// Trials of a summary, whose band is wider.
@@ -139,10 +139,7 @@ fn coverage(truth: &Truth, how: Stated, seed: u64) -> (f64, f64) {
             (u64::from(held), u64::from(pct.contains(de)))
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    (
-        hits as f64 / TRIALS as f64,
-        naive as f64 / TRIALS as f64,
-    )
+    (hits as f64 / TRIALS as f64, naive as f64 / TRIALS as f64)
 }
 
 /// A colour `de` ΔE*ab from `from` along the unit CIELAB direction `dir`.
@@ -181,7 +178,10 @@ fn check(name: &str, (got, naive): (f64, f64)) {
     let percentiles = if naive.is_nan() {
         String::new()
     } else {
-        format!(" (percentiles of noisy ΔE about the readings: {:.1} %)", 100.0 * naive)
+        format!(
+            " (percentiles of noisy ΔE about the readings: {:.1} %)",
+            100.0 * naive
+        )
     };
     eprintln!("coverage of {name}: {:.1} %{percentiles}", 100.0 * got);
     assert!((got - 0.95).abs() <= 0.02, "{name}: {got}");
@@ -315,6 +315,9 @@ fn the_mean_and_max_with_estimated_covariances_are_covered() {
 fn the_mean_and_max_of_patches_lost_in_noise_are_covered() {
     for (summary, seed) in [(Summary::Mean, 10), (Summary::Max, 11)] {
         let got = summary_coverage(&six_patches(4.0), summary, Stated::Known, seed);
-        check_summary(&format!("the {summary:?} ΔE*ab of 6 patches lost in noise"), got);
+        check_summary(
+            &format!("the {summary:?} ΔE*ab of 6 patches lost in noise"),
+            got,
+        );
     }
 }

@@ -173,7 +173,10 @@ impl Family {
     fn new(d: [f64; 3], noise: Option<&LabNoise>) -> Family {
         let (values, basis) = match noise {
             Some(n) => covariance::eigen_decomposition(&difference_covariance(n)),
-            None => ([1.0; 3], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+            None => (
+                [1.0; 3],
+                [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            ),
         };
         let top = values.iter().copied().fold(0.0, f64::max);
         // An axis without noise would keep its component at every c; a floor lets every

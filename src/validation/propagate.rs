@@ -281,7 +281,10 @@ mod tests {
         let estimated = propagate(&r, &t(Some(2)), WHITE, how, 2).de76;
         let half = |i: Interval| 0.5 * (i.hi - i.lo);
         assert!((half(known) / sigma - 1.96).abs() < 0.05, "{known:?}");
-        assert!((half(estimated) / sigma - 4.3027).abs() < 0.2, "{estimated:?}");
+        assert!(
+            (half(estimated) / sigma - 4.3027).abs() < 0.2,
+            "{estimated:?}"
+        );
     }
 
     #[test]

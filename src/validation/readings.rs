@@ -17,14 +17,13 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::covariance::{self, Cov3};
-use crate::session::repeats::Repeatability;
 pub use super::uncertain::CHI3_95;
 use super::uncertain::{render_lab_sigma, RenderStatement};
 use crate::color::COLORCHECKER_NAMES;
+use crate::session::repeats::Repeatability;
 
 /// The number of patches of the chart.
 pub const PATCHES: usize = 24;
-
 
 /// Which file format the readings were in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -461,8 +460,10 @@ fn combine(rows: &[&Row]) -> PatchReading {
             rep.covariance(r.xyz)
         })
         .flatten();
-    let (u_factors, dof, source) = if let Some(given) =
-        rows.iter().map(|r| r.covariance()).collect::<Option<Vec<Cov3>>>()
+    let (u_factors, dof, source) = if let Some(given) = rows
+        .iter()
+        .map(|r| r.covariance())
+        .collect::<Option<Vec<Cov3>>>()
     {
         let mut c = covariance::ZERO;
         for (r, g) in rows.iter().zip(&given) {
@@ -491,9 +492,7 @@ fn combine(rows: &[&Row]) -> PatchReading {
     // A ΔE statement stands for what the XYZ standard error does not say (a radiosity
     // solver's discretisation); with a standard error it would count the same noise twice.
     let from_de = match rows[0].de95 {
-        Some((de, how)) if rows[0].stderr.is_none() && rows.len() == 1 => {
-            render_lab_sigma(de, how)
-        }
+        Some((de, how)) if rows[0].stderr.is_none() && rows.len() == 1 => render_lab_sigma(de, how),
         _ => 0.0,
     };
     let given_lab = rows.iter().filter_map(|r| r.u_lab).fold(0.0, f64::max);

@@ -76,4 +76,3 @@ pub fn lab_of(side: &Uncertain, z: &[f64], zl: &[f64], white: Xyz) -> Lab {
         l.b + side.u_lab * zl[2],
     )
 }
-

@@ -506,5 +506,8 @@ fn the_stated_repeatability_holds_at_every_level() {
     // The figure by hand: at 25 cd/m², 0.15 %·√(100/25) = 0.3 % with 0.013/25 = 0.052 % in
     // quadrature: 0.30447 %.
     assert!((repeatability_y(25.0) - 0.003_044_7).abs() < 1e-7);
-    assert_eq!(repeatability_y(200.0), (REPEATABILITY_Y.powi(2) + 0.000_065f64.powi(2)).sqrt());
+    assert_eq!(
+        repeatability_y(200.0),
+        (REPEATABILITY_Y.powi(2) + 0.000_065f64.powi(2)).sqrt()
+    );
 }
