@@ -229,12 +229,14 @@ mod tests {
         let g = group(&refs, i1).unwrap();
         assert!((g.noise_y - 0.068_33).abs() < 1e-4, "{g:?}");
         assert!(!g.spread_exceeds_noise && g.outliers.is_empty(), "{g:?}");
-        // Ten times the scatter (sd 1: 4·1/0.0683² = 857) is flagged.
-        let wide: Vec<Reading> = [19.0, 19.0, 20.0, 21.0, 21.0]
+        // Three times the scatter (sd 0.3: 4·0.09/0.0683² = 77; each reading within 4.4σ
+        // of the median, no outlier) is flagged.
+        let wide: Vec<Reading> = [19.7, 19.7, 20.0, 20.3, 20.3]
             .iter()
             .map(|&y| Reading::from_yxy(y, 0.3, 0.3, "i1pro"))
             .collect();
         let refs: Vec<&Reading> = wide.iter().collect();
-        assert!(group(&refs, i1).unwrap().spread_exceeds_noise);
+        let g = group(&refs, i1).unwrap();
+        assert!(g.spread_exceeds_noise && g.outliers.is_empty(), "{g:?}");
     }
 }
