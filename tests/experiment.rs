@@ -104,8 +104,8 @@ fn stages_run_once_and_rerun_only_downstream_of_a_change() {
     .unwrap();
     // Box and simulation are the same deterministic render here.
     assert!(
-        v.simulation_vs_box.max_de76 < 1e-9,
-        "{}",
+        v.simulation_vs_box.max_de76.value < 1e-9,
+        "{:?}",
         v.simulation_vs_box.max_de76
     );
     // The lut model reproduces every colour it can show to within the JND.

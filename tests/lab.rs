@@ -153,27 +153,96 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
     ] {
         assert!(dir.join(f).exists(), "{f} missing");
     }
-    assert!(said.contains("validation/report.html"), "{said}");
+    // The run ends by saying where the report is.
+    let last = said.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("report: ") && last.contains("validation/report.html"),
+        "{said}"
+    );
     // lab.json is the validation's result in short.
     let lab = json(&dir.join("lab.json"));
     let v: ValidationResult =
         serde_json::from_value(json(&dir.join("validation/comparisons.json"))).unwrap();
     assert_eq!(lab["options"]["scenario"], "display-white");
-    assert_eq!(
-        lab["display_vs_box"]["below_jnd"],
-        v.display_vs_box.below_jnd
-    );
-    assert_eq!(
-        lab["display_vs_box"]["max_de76"].as_f64().unwrap(),
-        v.display_vs_box.max_de76
-    );
+    assert_eq!(lab["options"]["box_repeats"], 1);
     assert_eq!(
         lab["out_of_gamut_patches"],
         serde_json::to_value(&v.out_of_gamut_patches).unwrap()
     );
+    let report = std::fs::read_to_string(dir.join("validation/report.html")).unwrap();
+    for (key, a) in [
+        ("display_vs_box", &v.display_vs_box),
+        ("simulation_vs_box", &v.simulation_vs_box),
+        ("display_vs_simulation", &v.display_vs_simulation),
+    ] {
+        // One verdict everywhere: lab.json, comparisons.json and the terminal count the
+        // same patches below, above and undecided at 95 %, and the point-estimate count
+        // only under its name.
+        let counts = &lab[key]["jnd"];
+        assert_eq!(
+            [&counts["below"], &counts["above"], &counts["undecided"]],
+            [a.jnd.below, a.jnd.above, a.jnd.undecided]
+                .map(serde_json::Value::from)
+                .each_ref(),
+            "{key}"
+        );
+        assert_eq!(lab[key]["below_jnd_point"], a.below_jnd_point, "{key}");
+        assert_eq!(
+            lab[key]["max_de76"]["value"].as_f64(),
+            Some(a.max_de76.value)
+        );
+        assert!(said.contains(&a.summary()), "{key}: {said}");
+        assert!(
+            a.summary().contains(&format!(
+                "{} of 24 patches below the JND (ΔE*ab 2.3) at 95 % confidence, {} above, {} undecided ({} below by point estimate)",
+                a.jnd.below, a.jnd.above, a.jnd.undecided, a.below_jnd_point
+            )),
+            "{}",
+            a.summary()
+        );
+        // No interval excludes its estimate.
+        for p in &a.patches {
+            for (what, value, i) in [
+                ("ΔE*ab", p.de76, p.de76_interval),
+                ("ΔE00", p.de00, p.de00_interval),
+            ] {
+                assert!(
+                    i.lo <= value && value <= i.hi && i.lo >= 0.0,
+                    "{key} patch {} {what} {value} outside {i:?}",
+                    p.patch
+                );
+            }
+        }
+        for (what, s) in [
+            ("mean ΔE*ab", a.mean_de76),
+            ("max ΔE*ab", a.max_de76),
+            ("mean ΔE00", a.mean_de00),
+            ("max ΔE00", a.max_de00),
+        ] {
+            let i = s
+                .interval
+                .unwrap_or_else(|| panic!("{key} {what}: no interval"));
+            assert!(i.lo <= s.value && s.value <= i.hi, "{key} {what} {s:?}");
+        }
+    }
+    // The report's headline counts as the rest do.
+    let b = &v.display_vs_box;
+    assert!(
+        report.contains(&format!(
+            "display vs box: {} of 24 patches are below the JND (ΔE*ab 2.3) with 95 % confidence, {} above and {} undecided ({} below by point estimate)",
+            b.jnd.below, b.jnd.above, b.jnd.undecided, b.below_jnd_point
+        )),
+        "the report's verdict"
+    );
     // The box and the simulation differ by the instruments' noise and the render's
-    // ±0.5 only: all 24 below the JND.
-    assert_eq!(v.simulation_vs_box.below_jnd, 24);
+    // ±0.5 only: all 24 below the JND by point estimate, none above.
+    assert_eq!(v.simulation_vs_box.below_jnd_point, 24);
+    assert_eq!(v.simulation_vs_box.jnd.above, 0);
+    // Single readings carry the meter's stated repeatability, the simulation its
+    // render's uncertainty: no patch's interval is a point.
+    for p in &v.display_vs_box.patches {
+        assert!(p.de76_interval.hi > p.de76_interval.lo, "patch {}", p.patch);
+    }
 
     // Lit by the display's white, no measured colour lies clearly outside the display's
     // primaries: at most 1 % of its largest drive on the wrong side of an edge (the yellow
@@ -194,7 +263,7 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
         }
     }
 
-    // A second call re-uses every stage.
+    // A second call re-uses every stage, and lab.json keeps each stage's recorded time.
     let log = std::fs::read(dir.join("display/log.jsonl")).unwrap();
     let second = quick_lab(&dir, &[]);
     assert_eq!(
@@ -202,7 +271,25 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
         STAGES.map(|s| (s.to_string(), "re-used".to_string()))
     );
     assert_eq!(std::fs::read(dir.join("display/log.jsonl")).unwrap(), log);
-    assert!(json(&dir.join("lab.json"))["seconds"].as_f64().unwrap() < 5.0);
+    let again = json(&dir.join("lab.json"));
+    assert!(again["seconds"].as_f64().unwrap() < 5.0);
+    assert_eq!(
+        again["stages"],
+        lab["stages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| {
+                let mut s = s.clone();
+                s["reused"] = true.into();
+                s
+            })
+            .collect::<Vec<_>>()
+            .into()
+    );
+    assert!(again["stages"][0]["seconds"].as_f64().unwrap() > 0.0);
+    assert_eq!(again["options"]["box_repeats"], 1);
+    assert_eq!(again["display_vs_box"]["jnd"], lab["display_vs_box"]["jnd"]);
 
     // Another light is another box: the box stage runs again (its measurements kept
     // aside), and with it every stage after it.

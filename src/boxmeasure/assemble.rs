@@ -17,7 +17,7 @@ use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
 use super::plan::{BoxPlan, BoxStep, Stage, Target};
 use super::scene::{scene_json, BoxContents};
-use super::stats::{group, mean_spectrum, GroupStats, Noise, StatsError};
+use super::stats::{group, mean_spectrum, GroupStats, Repeatability, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
 use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
@@ -199,7 +199,7 @@ fn reduce(
     for (target, group_entries) in by_target(entries) {
         let w = what(&target);
         let readings: Vec<_> = group_entries.iter().map(|e| &e.reading).collect();
-        let noise = Noise::of(&readings[0].instrument, group_entries[0].mode);
+        let noise = Repeatability::stated(&readings[0].instrument, group_entries[0].mode);
         let err = |source| AssembleError::Stats {
             what: format!("{stage} {w}"),
             source,

@@ -1,12 +1,9 @@
 //! Repeated readings of one target: their mean, their spread against what the instrument's
 //! noise allows, and the readings that lie too far off to be noise (outliers).
 //!
-//! The noise model is each instrument's stated repeatability (1σ of one reading):
-//! - CS-100A: ±0.2 % in Y and ±0.001 in x, y (Konica Minolta data sheet, as 2σ), so 0.1 %
-//!   of Y;
-//! - i1Pro, emissive: 0.1 % of Y; reflective: 0.002 absolute per band, i.e. 0.2 in Y on
-//!   the scale where white is 100 (the simulated unit's declared repeatability, matching
-//!   X-Rite's inter-reading figure for the i1Pro).
+//! The noise model is each instrument's stated repeatability (1σ of one reading), the one
+//! the session flags readings by ([`Repeatability`]): the i1Pro's grows below full signal,
+//! so a dim tile integrated the driver's longest time is allowed its larger scatter.
 //!
 //! An outlier is a reading whose Y lies more than [`OUTLIER_SIGMAS`] noise σ from the median
 //! of its group (the median, not the mean, so the outlier does not hide itself); outliers
@@ -17,10 +14,12 @@
 //! (Wilson–Hilferty: k·(1 − 2/(9k) + z·√(2/(9k)))³ with z = 3.090, within 3 % of the
 //! tabulated quantile for k = 1 and closer beyond).
 
-use metamer_drivers::{MeasureMode, Reading};
+use metamer_drivers::Reading;
 use serde::{Deserialize, Serialize};
 
 use crate::color::Spectrum;
+pub use crate::session::repeats::Repeatability;
+use crate::validation::covariance::{self, Cov3};
 
 /// Distance from the median, in noise σ, beyond which a reading is an outlier. At 5σ a
 /// normal reading is flagged about once in 1.7 million.
@@ -35,35 +34,6 @@ pub fn chi2_999(k: usize) -> f64 {
     k * (1.0 - a + Z_999 * a.sqrt()).powi(3)
 }
 
-/// One reading's noise, 1σ of Y: relative (emissive) or absolute (reflective, Y of white
-/// = 100).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum Noise {
-    Relative { sigma: f64 },
-    Absolute { sigma: f64 },
-}
-
-impl Noise {
-    /// The repeatability of `model` in `mode` (models this program drives; others get the
-    /// CS-100A's, the most conservative of them, for emissive and the i1Pro's for
-    /// reflective).
-    pub fn of(model: &str, mode: MeasureMode) -> Noise {
-        match (model, mode) {
-            (_, MeasureMode::Reflective) => Noise::Absolute { sigma: 0.2 },
-            _ => Noise::Relative { sigma: 0.001 },
-        }
-    }
-
-    /// σ of Y for a reading of `y`.
-    pub fn sigma(self, y: f64) -> f64 {
-        match self {
-            Noise::Relative { sigma } => sigma * y.abs(),
-            Noise::Absolute { sigma } => sigma,
-        }
-    }
-}
-
 /// A group of repeated readings reduced.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GroupStats {
@@ -73,6 +43,11 @@ pub struct GroupStats {
     pub xyz: [f64; 3],
     /// Standard deviation of Y of the readings kept (0 for one reading).
     pub sd_y: f64,
+    /// Sample covariance of X, Y, Z of one reading among those kept (0 for one reading):
+    /// a meter's noise in x, y moves X and Z together, and a yellow's Z by far more than
+    /// its Y.
+    #[serde(default)]
+    pub cov: Cov3,
     /// The noise σ of Y the instrument allows at this level.
     pub noise_y: f64,
     /// Repeat numbers (0-based) left out as outliers.
@@ -105,12 +80,12 @@ fn median(v: &[f64]) -> f64 {
 
 /// Which of the Ys are outliers (needs three readings: with two, neither can be told
 /// from the other).
-fn outliers(ys: &[f64], noise: Noise) -> Vec<usize> {
+fn outliers(ys: &[f64], noise: Repeatability) -> Vec<usize> {
     if ys.len() < 3 {
         return Vec::new();
     }
     let m = median(ys);
-    let sigma = noise.sigma(m).max(f64::MIN_POSITIVE);
+    let sigma = noise.sigma_y(m).max(f64::MIN_POSITIVE);
     ys.iter()
         .enumerate()
         .filter(|(_, y)| ((*y - m) / sigma).abs() > OUTLIER_SIGMAS)
@@ -119,7 +94,7 @@ fn outliers(ys: &[f64], noise: Noise) -> Vec<usize> {
 }
 
 /// Reduces the readings of one target.
-pub fn group(readings: &[&Reading], noise: Noise) -> Result<GroupStats, StatsError> {
+pub fn group(readings: &[&Reading], noise: Repeatability) -> Result<GroupStats, StatsError> {
     if readings.is_empty() {
         return Err(StatsError::Empty);
     }
@@ -132,27 +107,15 @@ pub fn group(readings: &[&Reading], noise: Noise) -> Result<GroupStats, StatsErr
         .map(|(_, r)| *r)
         .collect();
     let k = kept.len() as f64;
-    let mut xyz = [0.0; 3];
-    for r in &kept {
-        for (m, v) in xyz.iter_mut().zip(r.xyz) {
-            *m += v / k;
-        }
-    }
-    let sd_y = if kept.len() > 1 {
-        (kept
-            .iter()
-            .map(|r| (r.xyz[1] - xyz[1]).powi(2))
-            .sum::<f64>()
-            / (k - 1.0))
-            .sqrt()
-    } else {
-        0.0
-    };
-    let noise_y = noise.sigma(xyz[1]);
+    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz).collect();
+    let (xyz, cov) = covariance::sample(&xs);
+    let sd_y = cov[1][1].sqrt();
+    let noise_y = noise.sigma_y(xyz[1]);
     Ok(GroupStats {
         n: readings.len(),
         xyz,
         sd_y,
+        cov,
         noise_y,
         spread_exceeds_noise: kept.len() > 1
             && (k - 1.0) * sd_y * sd_y > chi2_999(kept.len() - 1) * noise_y * noise_y,
@@ -201,6 +164,7 @@ pub fn mean_spectrum(readings: &[&Reading], stats: &GroupStats) -> Result<Spectr
 #[cfg(test)]
 mod tests {
     use super::*;
+    use metamer_drivers::MeasureMode;
 
     fn reading(y: f64) -> Reading {
         Reading {
@@ -211,7 +175,7 @@ mod tests {
 
     #[test]
     fn a_reading_five_sigma_off_the_median_is_an_outlier_and_left_out_of_the_mean() {
-        let noise = Noise::Relative { sigma: 0.001 };
+        let noise = Repeatability::stated("cs100a", MeasureMode::Emissive);
         // σ = 0.1 at Y = 100: 100.3 is 3σ off (kept), 101 is 10σ off (outlier).
         let ys = [100.0, 100.1, 99.9, 100.3, 101.0];
         let rs: Vec<Reading> = ys.iter().map(|&y| reading(y)).collect();
@@ -226,13 +190,12 @@ mod tests {
 
     #[test]
     fn a_spread_beyond_the_noise_is_flagged_and_two_readings_have_no_outlier() {
-        let noise = Noise::Absolute { sigma: 0.2 };
+        let noise = Repeatability::stated("i1pro", MeasureMode::Reflective);
         let rs: Vec<Reading> = [20.0, 21.0].iter().map(|&y| reading(y)).collect();
         let refs: Vec<&Reading> = rs.iter().collect();
         let g = group(&refs, noise).unwrap();
         assert!(g.outliers.is_empty());
         // sd = 0.7071: 1·0.5/0.04 = 12.5 > χ²(1) ≈ 11.
-
         assert!(g.spread_exceeds_noise, "{g:?}");
         let rs: Vec<Reading> = [20.0, 20.6].iter().map(|&y| reading(y)).collect();
         let refs: Vec<&Reading> = rs.iter().collect();
@@ -248,5 +211,32 @@ mod tests {
             let got = chi2_999(k);
             assert!((got / want - 1.0).abs() < 0.035, "{k}: {got} vs {want}");
         }
+    }
+
+    /// A dim tile read by the i1Pro at its longest integration scatters more than a bright
+    /// one, and the figure allows it: at 20 cd/m² σ is 0.3417 % (0.15 %·√5 with 0.013/20 in
+    /// quadrature), 0.0683 cd/m²; five readings with sd 0.1 give 4·0.1²/0.0683² = 8.6 <
+    /// χ²(4) ≈ 18.5, where a flat 0.1 % (σ 0.02) would give 100 and flag it.
+    #[test]
+    fn a_dim_i1pro_tile_is_allowed_the_scatter_of_its_level() {
+        let i1 = Repeatability::stated("i1pro", MeasureMode::Emissive);
+        // Mean 20, deviations −0.1, −0.1, 0, 0.1, 0.1: sd = √(0.04/4) = 0.1.
+        let rs: Vec<Reading> = [19.9, 19.9, 20.0, 20.1, 20.1]
+            .iter()
+            .map(|&y| Reading::from_yxy(y, 0.3, 0.3, "i1pro"))
+            .collect();
+        let refs: Vec<&Reading> = rs.iter().collect();
+        let g = group(&refs, i1).unwrap();
+        assert!((g.noise_y - 0.068_33).abs() < 1e-4, "{g:?}");
+        assert!(!g.spread_exceeds_noise && g.outliers.is_empty(), "{g:?}");
+        // Three times the scatter (sd 0.3: 4·0.09/0.0683² = 77; each reading within 4.4σ
+        // of the median, no outlier) is flagged.
+        let wide: Vec<Reading> = [19.7, 19.7, 20.0, 20.3, 20.3]
+            .iter()
+            .map(|&y| Reading::from_yxy(y, 0.3, 0.3, "i1pro"))
+            .collect();
+        let refs: Vec<&Reading> = wide.iter().collect();
+        let g = group(&refs, i1).unwrap();
+        assert!(g.spread_exceeds_noise && g.outliers.is_empty(), "{g:?}");
     }
 }

@@ -10,9 +10,11 @@ use metamer::experiment::box_stage::BoxMeasure;
 use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
+use metamer::experiment::validate::{ValidationResult, FILE};
 use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
 use metamer::render::scene::Scene;
 use metamer::session::{on_ctrl_c, RunOptions};
+use metamer::validation::export::HTML_FILE;
 
 use super::{CliError, CliResult};
 
@@ -274,20 +276,23 @@ pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>
     }
 }
 
-/// The validation's three comparisons in a line each, when the validation stage has run.
+/// The validation's three comparisons in a line each, in the report's words, and where
+/// the report is, when the validation stage has run.
 pub(super) fn print_comparisons(dir: &Path) {
-    let validation = dir.join("validation").join("comparisons.json");
-    if let Ok(text) = std::fs::read_to_string(&validation) {
-        if let Ok(v) =
-            serde_json::from_str::<metamer::experiment::validate::ValidationResult>(&text)
-        {
+    let validation = dir.join(Stage::Validation.name());
+    if let Ok(text) = std::fs::read_to_string(validation.join(FILE)) {
+        if let Ok(v) = serde_json::from_str::<ValidationResult>(&text) {
             for c in [
                 &v.display_vs_box,
                 &v.simulation_vs_box,
                 &v.display_vs_simulation,
             ] {
-                println!("{} vs {}: {}", c.test, c.reference, c.summary());
+                println!("{}", c.summary());
             }
         }
+    }
+    let report = validation.join(HTML_FILE);
+    if report.exists() {
+        println!("report: {}", report.display());
     }
 }

@@ -150,10 +150,7 @@ fn print_summary(s: &LabSummary) {
         &s.simulation_vs_box,
         &s.display_vs_simulation,
     ] {
-        println!(
-            "{} vs {}: {} of {} below the JND; ΔE*ab mean {:.2} max {:.2}; ΔE00 mean {:.2} max {:.2}",
-            c.test, c.reference, c.below_jnd, c.patches, c.mean_de76, c.max_de76, c.mean_de00, c.max_de00
-        );
+        println!("{}", c.summary);
     }
     println!("total {:.1} s", s.seconds);
 }

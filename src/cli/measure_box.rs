@@ -314,12 +314,12 @@ fn print_summary(s: &Summary) -> CliResult {
     }
     writeln!(
         out,
-        "measured scene rendered vs box spots: ΔE*ab mean {:.2}, max {:.2}; ΔE00 mean {:.2}, max {:.2}; {} of {} below the JND",
+        "measured scene rendered vs box spots: ΔE*ab mean {:.2}, max {:.2}; ΔE00 mean {:.2}, max {:.2}; {} of {} below the JND by point estimate",
         c.mean_de76,
         c.max_de76,
         c.mean_de00,
         c.max_de00,
-        c.below_jnd,
+        c.below_jnd_point,
         c.patches.len()
     )?;
     let f = &s.files;

@@ -20,7 +20,8 @@ use super::{parse_triple, CliError, CliResult};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum PropagationArg {
-    /// Percentiles of seeded Monte Carlo draws (right near ΔE = 0 too).
+    /// Seeded Monte Carlo draws of the readings' noise, the interval by inverting the test
+    /// of each true difference (bias-aware; right near ΔE = 0 too).
     MonteCarlo,
     /// ΔE ± 1.96 σ by first-order propagation.
     Linear,
@@ -34,7 +35,7 @@ const MAX_MODEL_TERM: f64 = 1000.0;
 #[derive(clap::Args)]
 pub struct Args {
     /// The box's readings: a session journal (.jsonl), `metamer spot --json` output, or a
-    /// CSV patch,X,Y,Z[,sd_X,sd_Y,sd_Z][,n][,out_of_gamut].
+    /// CSV patch,X,Y,Z[,sd_X,sd_Y,sd_Z[,cov_XY,cov_XZ,cov_YZ]][,n][,u_lab][,out_of_gamut].
     #[arg(long, value_name = "READINGS")]
     reference: PathBuf,
     /// The display's readings of the rendering (same formats).
@@ -236,15 +237,13 @@ fn bad_white(e: ValidationError) -> CliError {
 }
 
 fn render_confidence(set: &ReadingSet) -> metamer::validation::report::RenderConfidenceSection {
-    use metamer::validation::readings::CHI3_95;
     metamer::validation::report::RenderConfidenceSection {
         method: format!("{} ({})", set.file.display(), set.format.name()),
         target_de: None,
         per_patch: set
             .patches
             .iter()
-            .filter(|(_, p)| p.u_lab > 0.0)
-            .map(|(k, p)| (*k, p.u_lab * CHI3_95))
+            .filter_map(|(k, p)| Some((*k, p.render_de95?)))
             .collect(),
         measure: "95 % ΔE*ab half-width or error bound".into(),
         ..Default::default()

@@ -16,6 +16,7 @@ use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome
 use crate::output::OutputPolicy;
 use crate::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use crate::rig::Scenario;
+use crate::session::repeats::Repeatability;
 use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator};
 
 /// How the box is measured.
@@ -148,22 +149,25 @@ pub fn measure(
             return Err(bad(format!("stage(s) {} not measured", names.join(", "))));
         }
     };
-    // The reduction keeps Y's spread; X and Z are given the same relative spread.
+    // Each spot's scatter in X, Y and Z together, over the repeats the reduction kept;
+    // a spot read once carries the meter's stated repeatability.
+    let stated = Repeatability::emissive_of(&m.spot);
     let stats: Vec<PatchStat> = summary
         .spot_xyz
         .iter()
         .zip(summary.spots.iter())
         .map(|((patch, xyz), r)| {
-            let rel = if xyz[1] > 0.0 {
-                r.stats.sd_y / xyz[1]
-            } else {
-                0.0
+            let n = r.stats.n - r.stats.outliers.len();
+            let cov = match (n, stated.and_then(|s| s.covariance(*xyz))) {
+                (1, Some(c)) => c,
+                _ => r.stats.cov,
             };
             PatchStat {
                 patch: *patch,
                 xyz: *xyz,
-                sd: xyz.map(|v| v * rel),
-                n: r.stats.n - r.stats.outliers.len(),
+                cov,
+                n,
+                u_lab: 0.0,
             }
         })
         .collect();

@@ -21,6 +21,7 @@ use crate::render::radiosity::image::{render_image_from, RadiosityImageOptions};
 use crate::render::radiosity::{self, render_spots_radiosity_solved, RadiosityOptions};
 use crate::render::spot::patch_aim;
 use crate::render::{render_spots_with_progress, Scene, SpotOptions, Strategy};
+use crate::validation::propagate::{render_lab_sigma, RenderStatement};
 
 /// What the simulation stage renders.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -177,13 +178,30 @@ pub fn simulate(
             what: format!("the rendered reading of patch {}", bad.patch),
         });
     }
+    if let Some(bad) = spots
+        .iter()
+        .find(|s| !(s.de_uncertainty.is_finite() && s.de_uncertainty >= 0.0))
+    {
+        return Err(ExperimentError::NotFinite {
+            what: format!("the render's uncertainty of patch {}", bad.patch),
+        });
+    }
     std::fs::create_dir_all(dir).map_err(|source| ExperimentError::Io {
         file: dir.to_path_buf(),
         source,
     })?;
+    // The render's own uncertainty goes with its readings, so `metamer validate` given
+    // this file counts it as the experiment's validation does.
+    let statement = match method {
+        "radiosity" => RenderStatement::Bound,
+        _ => RenderStatement::HalfWidth95,
+    };
     let stats: Vec<PatchStat> = spots
         .iter()
-        .map(|s| PatchStat::of(s.patch, &[s.xyz]))
+        .map(|s| PatchStat {
+            u_lab: render_lab_sigma(s.de_uncertainty, statement),
+            ..PatchStat::of(s.patch, &[s.xyz])
+        })
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
     let mut files = vec![SPOTS_FILE, SUMMARY_FILE];

@@ -24,7 +24,11 @@ pub struct StageOutcome {
     pub stage: Stage,
     /// Its inputs were unchanged and its outputs intact: nothing was run.
     pub reused: bool,
+    /// This call's time on the stage (next to none where re-used).
     pub seconds: f64,
+    /// How long the run that produced the stage's outputs took: this call's where it ran,
+    /// the stage record's where re-used (0 for a box given as files).
+    pub ran_seconds: f64,
     pub dir: PathBuf,
 }
 
@@ -118,12 +122,12 @@ pub fn run(
         let inputs = inputs_of(stage, opts)?;
         let forced = opts.stage == Some(stage);
         let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
-        if !forced
-            && ((stage == Stage::Box && given_box)
-                || sd
-                    .reusable(&inputs, super::products::products(stage))
-                    .is_some())
-        {
+        let record = if forced || (stage == Stage::Box && given_box) {
+            None
+        } else {
+            sd.reusable(&inputs, super::products::products(stage))
+        };
+        if !forced && ((stage == Stage::Box && given_box) || record.is_some()) {
             if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
                 progress(Progress::Note(format!(
                     "box: given, measured earlier or elsewhere ({} and {})",
@@ -139,7 +143,8 @@ pub fn run(
             outcomes.push(StageOutcome {
                 stage,
                 reused: true,
-                seconds: 0.0,
+                seconds: start.elapsed().as_secs_f64(),
+                ran_seconds: record.map_or(0.0, |r| r.seconds),
                 dir: sd.dir.clone(),
             });
             continue;
@@ -159,11 +164,13 @@ pub fn run(
             sd.invalidate()?;
         }
         let files = run_stage(stage, opts, &sd, progress)?;
-        sd.finish(&inputs, &files, start.elapsed().as_secs_f64())?;
+        let seconds = start.elapsed().as_secs_f64();
+        sd.finish(&inputs, &files, seconds)?;
         outcomes.push(StageOutcome {
             stage,
             reused: false,
-            seconds: start.elapsed().as_secs_f64(),
+            seconds,
+            ran_seconds: seconds,
             dir: sd.dir.clone(),
         });
     }
@@ -235,7 +242,8 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
                 &p(Stage::DisplaySpots, display_spots::SPOTS_FILE)?,
             )?
             .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?
-            .file("reproduction", &p(Stage::Reproduction, reproduction::FILE)?)?,
+            .file("reproduction", &p(Stage::Reproduction, reproduction::FILE)?)?
+            .value("result", &validate::RESULT_VERSION),
     })
 }
 

@@ -13,21 +13,32 @@ use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::validation::{
     assess, compare, read_readings, write_delta_e_chart_shaded, write_report_files, AssessOptions,
-    Comparison, ReadingSet, ReportInput,
+    Assessment, ReadingSet, ReportInput,
 };
 
-/// Everything the validation found, as `validation/validation.json`.
+/// What the validation found, as `validation/comparisons.json`: each comparison patch by
+/// patch with both readings' uncertainty (the mean's covariance in X, Y, Z), ΔE*ab and
+/// ΔE00 with their bias-aware 95 % intervals, the verdict on the JND at 95 % confidence
+/// (`jnd`: below, above, undecided) and the count by point estimate named as such
+/// (`below_jnd_point`), and the mean and max with their intervals.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ValidationResult {
+    /// The file's layout ([`RESULT_VERSION`]).
+    pub version: u32,
     /// CIELAB's reference white, cd/m².
     pub white: [f64; 3],
     pub out_of_gamut_patches: Vec<usize>,
-    pub display_vs_box: Comparison,
-    pub simulation_vs_box: Comparison,
-    pub display_vs_simulation: Comparison,
+    pub display_vs_box: Assessment,
+    pub simulation_vs_box: Assessment,
+    pub display_vs_simulation: Assessment,
 }
 
 pub const FILE: &str = "comparisons.json";
+
+/// The layout of [`FILE`]: 2 since it holds intervals and verdicts (1 held point
+/// estimates only). Part of the validation stage's inputs, so a stage written in the
+/// earlier layout runs again.
+pub const RESULT_VERSION: u32 = 2;
 
 /// The readings of `a` and `b` for the patches both have, in patch order; refuses sets
 /// that do not hold the same patches (a stage that lost readings must not pass as valid).
@@ -95,7 +106,11 @@ pub fn report_input(
     );
     let mut uncertainty = Vec::new();
     if let Some(u) = &sections.render_uncertainty {
-        u.apply(&mut s);
+        // The stage's readings carry the render's uncertainty themselves; a simulation
+        // stage written before they did has it in its summary only.
+        if s.patches.values().all(|p| p.u_lab == 0.0) {
+            u.apply(&mut s);
+        }
         uncertainty.push(("simulation".to_string(), u.description.clone()));
     }
     for (side, set) in [("box", &b), ("display", &d)] {
@@ -132,8 +147,8 @@ pub fn report_input(
     })
 }
 
-/// What a meter's readings' intervals contain: the standard error of the mean of each
-/// patch's repeats, or nothing where a patch was read once.
+/// What a meter's readings' intervals contain: the covariance of the mean of each patch's
+/// repeats, or for a patch read once the instrument's stated repeatability, or nothing.
 fn repeatability(set: &ReadingSet) -> String {
     let ns: Vec<usize> = set.patches.values().map(|p| p.n).collect();
     let (lo, hi) = (
@@ -145,31 +160,20 @@ fn repeatability(set: &ReadingSet) -> String {
     } else {
         format!("{lo}–{hi}")
     };
-    if hi <= 1 {
+    let known = set.patches.values().all(|p| !p.u_factors.is_empty());
+    if hi <= 1 && known {
+        "single readings: the meter's stated repeatability (CS-100A: 0.1 % in Y, 0.0005 in x and y, 1σ) carried to X, Y, Z".into()
+    } else if hi <= 1 {
         "single readings: the meter's repeatability is unknown and not in the interval".into()
     } else {
         format!(
-            "the meter's repeatability, the standard error of the mean of {k} repeats per patch (their scatter in X, Y, Z kept together)"
+            "the meter's repeatability: the full covariance in X, Y, Z of the mean of {k} repeats per patch, widened for the few repeats it is estimated from (Student's t with k − 1 degrees of freedom)"
         )
     }
 }
 
-/// The validation report (Figs. 4–6, uncertainty intervals, verdict, every section) of
-/// the readings.
-fn report(
-    dir: &Path,
-    white: [f64; 3],
-    files: &ReadingFiles<'_>,
-    out_of_gamut: &[usize],
-) -> Result<Vec<String>, ExperimentError> {
-    let input = report_input(dir, white, files, out_of_gamut)?;
-    let written = write_report_files(dir, &input, &OutputPolicy::new(true))?;
-    Ok(written
-        .iter()
-        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect())
-}
-
+/// Compares box, display and simulation: the point comparisons' CSV and ΔE chart each,
+/// then the assessments with uncertainty into `comparisons.json` and the report.
 pub fn validate(
     dir: &Path,
     white: [f64; 3],
@@ -186,22 +190,15 @@ pub fn validate(
     let simulation_vs_box = compare("box", &b, "simulation", &s, w)?;
     let (s, d) = paired(("simulation", simulation), ("display", display))?;
     let display_vs_simulation = compare("simulation", &s, "display", &d, w)?;
-    let result = ValidationResult {
-        white,
-        out_of_gamut_patches: out_of_gamut.to_vec(),
-        display_vs_box,
-        simulation_vs_box,
-        display_vs_simulation,
-    };
     std::fs::create_dir_all(dir).map_err(|source| ExperimentError::Io {
         file: dir.to_path_buf(),
         source,
     })?;
     let mut files = Vec::new();
     for (stem, c) in [
-        ("display_vs_box", &result.display_vs_box),
-        ("simulation_vs_box", &result.simulation_vs_box),
-        ("display_vs_simulation", &result.display_vs_simulation),
+        ("display_vs_box", &display_vs_box),
+        ("simulation_vs_box", &simulation_vs_box),
+        ("display_vs_simulation", &display_vs_simulation),
     ] {
         let csv = format!("{stem}.csv");
         write_atomic(&dir.join(&csv), c.to_csv().as_bytes())?;
@@ -221,10 +218,25 @@ pub fn validate(
         )?;
         files.extend([csv, svg]);
     }
+    let input = report_input(dir, white, inputs, out_of_gamut)?;
+    let take = |a: &Option<Assessment>| a.clone().expect("the experiment's report has all three");
+    let result = ValidationResult {
+        version: RESULT_VERSION,
+        white,
+        out_of_gamut_patches: out_of_gamut.to_vec(),
+        display_vs_box: take(&input.box_vs_display),
+        simulation_vs_box: take(&input.box_vs_simulation),
+        display_vs_simulation: take(&input.display_vs_simulation),
+    };
     let text = serde_json::to_string_pretty(&result).map_err(ExperimentError::Json)?;
     write_atomic(&dir.join(FILE), text.as_bytes())?;
     files.push(FILE.to_string());
-    files.extend(report(dir, white, inputs, out_of_gamut)?);
+    let written = write_report_files(dir, &input, &OutputPolicy::new(true))?;
+    files.extend(
+        written
+            .iter()
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())),
+    );
     Ok((result, files))
 }
 
@@ -292,20 +304,56 @@ mod tests {
         let a = assess("box", &b, "simulation", &sim(), white, &linear).unwrap();
         let i = a.patches[0].de76_interval;
         assert!((i.hi - 10.468_21).abs() < 1e-4, "{i:?}");
-        // Monte Carlo agrees (the render's a*, b* terms lengthen ΔE by σ²/ΔE ≈ 0.002; a
-        // 2.5 % quantile of 4000 draws is good to about 0.02).
-        let mc = assess(
+        // Monte Carlo knows the box's covariance comes from 4 repeats (3 degrees of
+        // freedom) and the render's is stated: Welch–Satterthwaite gives
+        // ν = (0.238888² + 0.147286²)² / (0.238888⁴/3) = 5.7143, t(0.975, 5.7143) =
+        // 2.47688 (SciPy), a half-width 2.47688·0.280643 = 0.69512; the render's a*, b*
+        // terms lengthen ΔE by 2·σ²/(2ΔE) ≈ 0.002: [9.3027, 10.6929]. A 2.5 % quantile of
+        // 20 000 draws is good to about 0.01.
+        let many = AssessOptions {
+            propagation: Propagation::MonteCarlo {
+                draws: 20_000,
+                seed: 1,
+            },
+            ..AssessOptions::default()
+        };
+        let mc = assess("box", &b, "simulation", &s, white, &many).unwrap();
+        let m = mc.patches[0].de76_interval;
+        assert!(
+            (m.lo - 9.3027).abs() < 0.025 && (m.hi - 10.6929).abs() < 0.025,
+            "{m:?}"
+        );
+        // The same scatter given as a known covariance (one row, n = 1: a stated
+        // repeatability), all along the grey axis: Monte Carlo agrees with linearisation.
+        let u = [0.950_47, 1.0, 1.088_83].map(|v| 0.2 * v);
+        let known = parse_readings(
+            &format!(
+                "patch,X,Y,Z,sd_X,sd_Y,sd_Z,cov_XY,cov_XZ,cov_YZ,n\n7,{},{},{},{},{},{},{},1\n",
+                grey(y),
+                u[0],
+                u[1],
+                u[2],
+                u[0] * u[1],
+                u[0] * u[2],
+                u[1] * u[2]
+            ),
+            Path::new("box.csv"),
+        )
+        .unwrap();
+        assert_eq!(known.patches[&7].dof, None);
+        let m = assess(
             "box",
-            &b,
+            &known,
             "simulation",
             &s,
             white,
             &AssessOptions::default(),
         )
-        .unwrap();
-        let m = mc.patches[0].de76_interval;
+        .unwrap()
+        .patches[0]
+            .de76_interval;
         assert!(
-            (m.lo - 9.45).abs() < 0.03 && (m.hi - 10.55).abs() < 0.03,
+            (m.lo - 9.448).abs() < 0.03 && (m.hi - 10.548).abs() < 0.03,
             "{m:?}"
         );
     }

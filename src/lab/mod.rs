@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use crate::boxmeasure::BoxPlan;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
 use crate::experiment::box_stage::BoxMeasure;
@@ -25,8 +26,9 @@ use crate::experiment::{self, BoxSource, ExperimentOptions, Progress, Stage, Sta
 use crate::output::OutputPolicy;
 use crate::rig::{Preset, Scenario};
 use crate::session::RunOptions;
+use crate::validation::assess::{Assessment, JndCount, JndVerdict, Stat};
 use crate::validation::export::HTML_FILE;
-use crate::validation::Comparison;
+use crate::validation::propagate::Interval;
 
 /// What a lab run is made of.
 #[derive(Clone, Debug, Serialize)]
@@ -43,7 +45,8 @@ pub struct LabOptions {
     pub target_de: f64,
     /// Spot readings averaged per patch on the display.
     pub repeats: usize,
-    /// Readings of each tile and spot in the box; None: the box plan's.
+    /// Readings of each tile and spot in the box; None: the box plan's (`lab.json` records
+    /// the number used).
     pub box_repeats: Option<usize>,
     pub seed: u64,
     /// The simulated instruments' time scale (1 = their real pace).
@@ -127,30 +130,57 @@ impl LabOptions {
     }
 }
 
-/// One comparison in a line: what the report's full tables say in short.
+/// One comparison in short: what the report's full tables say, in the report's words.
 #[derive(Clone, Debug, Serialize)]
 pub struct ComparisonSummary {
     pub reference: String,
     pub test: String,
     pub patches: usize,
-    pub below_jnd: usize,
-    pub mean_de76: f64,
-    pub max_de76: f64,
-    pub mean_de00: f64,
-    pub max_de00: f64,
+    /// The verdicts at 95 % confidence: below, above, undecided.
+    pub jnd: JndCount,
+    /// Patches whose ΔE*ab point estimate is below the JND (no uncertainty considered).
+    pub below_jnd_point: usize,
+    /// The patches not shown to be below the JND, with their 95 % intervals.
+    pub not_below: Vec<PatchVerdict>,
+    pub mean_de76: Stat,
+    pub max_de76: Stat,
+    pub mean_de00: Stat,
+    pub max_de00: Stat,
+    /// The line the terminal shows.
+    pub summary: String,
 }
 
-impl From<&Comparison> for ComparisonSummary {
-    fn from(c: &Comparison) -> ComparisonSummary {
+/// A patch's ΔE*ab, its 95 % interval and what they say of the JND.
+#[derive(Clone, Debug, Serialize)]
+pub struct PatchVerdict {
+    pub patch: usize,
+    pub de76: f64,
+    pub interval: Interval,
+    pub jnd: JndVerdict,
+}
+
+impl From<&Assessment> for ComparisonSummary {
+    fn from(a: &Assessment) -> ComparisonSummary {
         ComparisonSummary {
-            reference: c.reference.clone(),
-            test: c.test.clone(),
-            patches: c.patches.len(),
-            below_jnd: c.below_jnd,
-            mean_de76: c.mean_de76,
-            max_de76: c.max_de76,
-            mean_de00: c.mean_de00,
-            max_de00: c.max_de00,
+            reference: a.reference.clone(),
+            test: a.test.clone(),
+            patches: a.patches.len(),
+            jnd: a.jnd,
+            below_jnd_point: a.below_jnd_point,
+            not_below: a
+                .failing()
+                .map(|p| PatchVerdict {
+                    patch: p.patch,
+                    de76: p.de76,
+                    interval: p.de76_interval,
+                    jnd: p.jnd,
+                })
+                .collect(),
+            mean_de76: a.mean_de76,
+            max_de76: a.max_de76,
+            mean_de00: a.mean_de00,
+            max_de00: a.max_de00,
+            summary: a.summary(),
         }
     }
 }
@@ -161,6 +191,8 @@ pub struct StageSummary {
     pub stage: &'static str,
     /// Its inputs were unchanged and its outputs intact: nothing was run.
     pub reused: bool,
+    /// How long the run that produced its outputs took (for a re-used stage, the time its
+    /// record keeps).
     pub seconds: f64,
 }
 
@@ -169,7 +201,7 @@ impl From<&StageOutcome> for StageSummary {
         StageSummary {
             stage: o.stage.name(),
             reused: o.reused,
-            seconds: o.seconds,
+            seconds: o.ran_seconds,
         }
     }
 }
@@ -223,8 +255,13 @@ pub fn run_lab(
     };
     let text = std::fs::read_to_string(&file).map_err(|e| bad(e.to_string()))?;
     let v: ValidationResult = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    // The box's readings per target as the box stage took them: given, or the plan's.
+    let options = LabOptions {
+        box_repeats: Some(opts.box_repeats.unwrap_or(BoxPlan::default().repeats)),
+        ..opts.clone()
+    };
     let summary = LabSummary {
-        options: opts.clone(),
+        options,
         stages: stages.iter().map(StageSummary::from).collect(),
         seconds: start.elapsed().as_secs_f64(),
         white: v.white,

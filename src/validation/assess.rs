@@ -4,12 +4,15 @@
 //! "Below the JND" is said of a patch only where its ΔE*ab interval's upper end is below
 //! 2.3, "above" only where the lower end is above it; otherwise it is undecided.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::color::{delta_e2000, delta_e76, Xyz, COLORCHECKER_NAMES};
 
+use super::covariance::{self, Cov3};
 use super::error::ValidationError;
-use super::propagate::{percentiles, propagate, Interval, Propagation, Uncertain};
+use super::montecarlo::{summary_interval, Metric, PatchDraws, Summary};
+use super::propagate::{propagate, Interval, Propagated, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
 
 /// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
@@ -48,7 +51,15 @@ impl JndVerdict {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Side {
     pub xyz: [f64; 3],
+    /// Standard uncertainty of the mean in X, Y and Z (the square roots of `cov_xyz`'s
+    /// diagonal).
     pub u_xyz: [f64; 3],
+    /// The mean's full covariance in X, Y and Z.
+    #[serde(default)]
+    pub cov_xyz: Cov3,
+    /// Its degrees of freedom where estimated from repeats (k − 1); None where known.
+    #[serde(default)]
+    pub dof: Option<usize>,
     pub u_lab: f64,
     pub n: usize,
     pub uncertainty: UncertaintySource,
@@ -79,7 +90,8 @@ pub struct JndCount {
     pub undecided: usize,
 }
 
-/// A statistic over the patches with its interval (Monte Carlo only).
+/// A statistic over the patches with its interval (Monte Carlo only; bias-aware, so it
+/// holds the value).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stat {
     pub value: f64,
@@ -100,9 +112,10 @@ pub struct Assessment {
     pub max_de76: Stat,
     pub mean_de00: Stat,
     pub max_de00: Stat,
-    /// Patches whose ΔE*ab itself is below the JND (no uncertainty considered), as the
-    /// paper counts them.
+    /// Patches whose ΔE*ab point estimate is below the JND (no uncertainty considered), as
+    /// the paper counts them: shown only named as such.
     pub below_jnd_point: usize,
+    /// The verdicts at 95 % confidence: the count every summary leads with.
     pub jnd: JndCount,
 }
 
@@ -130,6 +143,8 @@ fn side(p: &PatchReading, white: Xyz, extra_lab: f64) -> (Side, Uncertain) {
         Side {
             xyz: p.xyz,
             u_xyz: p.u_xyz,
+            cov_xyz: covariance::of_factors(&p.u_factors),
+            dof: p.dof,
             u_lab,
             n: p.n,
             uncertainty: p.source,
@@ -138,6 +153,7 @@ fn side(p: &PatchReading, white: Xyz, extra_lab: f64) -> (Side, Uncertain) {
         Uncertain {
             xyz: p.xyz,
             factors: p.u_factors.clone(),
+            dof: p.dof,
             u_lab,
         },
     )
@@ -172,21 +188,15 @@ pub fn assess(
     }
     // Spread over three axes so the expected squared length of the term is its ΔE².
     let model_lab = opts.model_term_de / 3f64.sqrt();
-    let mut draws76: Vec<Vec<f64>> = Vec::new();
-    let mut draws00: Vec<Vec<f64>> = Vec::new();
-    let patches: Vec<PatchAssessment> = common
-        .iter()
+    // Patches are independent: their intervals are found in parallel.
+    let (patches, propagated): (Vec<PatchAssessment>, Vec<Propagated>) = common
+        .par_iter()
         .map(|&k| {
             let (r, ru) = side(&reference.patches[&k], white, 0.0);
             let (t, tu) = side(&test.patches[&k], white, model_lab);
             let p = propagate(&ru, &tu, white, opts.propagation, k);
-            let (rl, tl) = (
-                Xyz::from_array(r.xyz).to_lab(white),
-                Xyz::from_array(t.xyz).to_lab(white),
-            );
-            draws76.push(p.draws76);
-            draws00.push(p.draws00);
-            PatchAssessment {
+            let (rl, tl) = (p.reference_lab, p.test_lab);
+            let a = PatchAssessment {
                 patch: k,
                 name: COLORCHECKER_NAMES[k - 1].to_string(),
                 de76: delta_e76(rl, tl),
@@ -197,9 +207,10 @@ pub fn assess(
                 out_of_gamut: reference.patches[&k].out_of_gamut || test.patches[&k].out_of_gamut,
                 reference: r,
                 test: t,
-            }
+            };
+            (a, p)
         })
-        .collect();
+        .unzip();
     let mut jnd = JndCount::default();
     for p in &patches {
         match p.jnd {
@@ -208,10 +219,45 @@ pub fn assess(
             JndVerdict::Undecided => jnd.undecided += 1,
         }
     }
-    let mean_de76 = summary(&patches, |p| p.de76, &draws76, mean);
-    let max_de76 = summary(&patches, |p| p.de76, &draws76, max);
-    let mean_de00 = summary(&patches, |p| p.de00, &draws00, mean);
-    let max_de00 = summary(&patches, |p| p.de00, &draws00, max);
+    let seed = match opts.propagation {
+        Propagation::MonteCarlo { seed, .. } => seed,
+        Propagation::Linear => 0,
+    };
+    let stat = |(metric, summary): (Metric, Summary)| {
+        let values: Vec<f64> = patches
+            .iter()
+            .map(|p| match metric {
+                Metric::De76 => p.de76,
+                Metric::De00 => p.de00,
+            })
+            .collect();
+        let draws: Vec<PatchDraws<'_>> = propagated
+            .iter()
+            .map(|p| PatchDraws {
+                reference_lab: p.reference_lab,
+                test_lab: p.test_lab,
+                noise: p.noise.as_ref(),
+                interval: Some(match metric {
+                    Metric::De76 => p.de76,
+                    Metric::De00 => p.de00,
+                }),
+            })
+            .collect();
+        Stat {
+            value: summary.of(&values),
+            interval: summary_interval(&draws, metric, summary, seed),
+        }
+    };
+    let stats: Vec<Stat> = [
+        (Metric::De76, Summary::Mean),
+        (Metric::De76, Summary::Max),
+        (Metric::De00, Summary::Mean),
+        (Metric::De00, Summary::Max),
+    ]
+    .into_par_iter()
+    .map(stat)
+    .collect();
+    let [mean_de76, max_de76, mean_de00, max_de00] = [stats[0], stats[1], stats[2], stats[3]];
     Ok(Assessment {
         reference: reference_name.into(),
         test: test_name.into(),
@@ -227,61 +273,33 @@ pub fn assess(
     })
 }
 
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
-}
-
-fn max(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-}
-
-/// A statistic of the patches' values and, when every patch has Monte Carlo draws, the
-/// percentiles of the same statistic taken draw by draw.
-fn summary(
-    patches: &[PatchAssessment],
-    pick: fn(&PatchAssessment) -> f64,
-    draws: &[Vec<f64>],
-    stat: fn(&[f64]) -> f64,
-) -> Stat {
-    let values: Vec<f64> = patches.iter().map(pick).collect();
-    // A patch without uncertainty has no draws: its value stands in every draw.
-    let n = draws.iter().map(Vec::len).max().unwrap_or(0);
-    let interval = (n > 0)
-        .then(|| {
-            let per_draw: Vec<f64> = (0..n)
-                .map(|i| {
-                    let v: Vec<f64> = draws
-                        .iter()
-                        .zip(&values)
-                        .map(|(d, v)| d.get(i).copied().unwrap_or(*v))
-                        .collect();
-                    stat(&v)
-                })
-                .collect();
-            percentiles(&per_draw)
-        })
-        .flatten();
-    Stat {
-        value: stat(&values),
-        interval,
+impl Stat {
+    /// "0.55 [0.50, 0.62]", or the value alone without an interval.
+    pub fn show(&self) -> String {
+        match self.interval {
+            Some(i) => format!("{:.2} [{:.2}, {:.2}]", self.value, i.lo, i.hi),
+            None => format!("{:.2}", self.value),
+        }
     }
 }
 
 impl Assessment {
-    /// The one-line summary a user reads first.
+    /// The one-line summary a user reads first: the verdicts at 95 % confidence, the
+    /// point-estimate count named as such, the summaries with their intervals.
     pub fn summary(&self) -> String {
         format!(
-            "{} vs {}: {} of {} patches below the JND (ΔE*ab {JND_DE76}) with 95 % confidence, {} above, {} undecided; ΔE*ab mean {:.2} max {:.2}; ΔE00 mean {:.2} max {:.2}",
+            "{} vs {}: {} of {} patches below the JND (ΔE*ab {JND_DE76}) at 95 % confidence, {} above, {} undecided ({} below by point estimate); ΔE*ab mean {} max {}; ΔE00 mean {} max {}",
             self.test,
             self.reference,
             self.jnd.below,
             self.patches.len(),
             self.jnd.above,
             self.jnd.undecided,
-            self.mean_de76.value,
-            self.max_de76.value,
-            self.mean_de00.value,
-            self.max_de00.value
+            self.below_jnd_point,
+            self.mean_de76.show(),
+            self.max_de76.show(),
+            self.mean_de00.show(),
+            self.max_de00.show()
         )
     }
 

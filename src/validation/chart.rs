@@ -62,8 +62,8 @@ fn draw(
     let root = SVGBackend::with_string(svg, (900, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| chart_err(&e))?;
     let caption = format!(
-        "{} vs {}: ΔE per patch (CIELAB units); {} of {} below JND (point estimates)",
-        comparison.test, comparison.reference, comparison.below_jnd, n
+        "{} vs {}: ΔE per patch (CIELAB units); {} of {} below JND by point estimate",
+        comparison.test, comparison.reference, comparison.below_jnd_point, n
     );
     let mut chart = ChartBuilder::on(&root)
         .caption(caption, ("sans-serif", 18))

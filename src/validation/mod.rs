@@ -8,15 +8,21 @@
 
 pub mod assess;
 mod chart;
+pub mod covariance;
+#[cfg(test)]
+mod coverage;
 mod error;
 pub mod export;
 pub mod figures;
+pub mod inversion;
+pub mod montecarlo;
 pub mod plausible;
 pub mod propagate;
 pub mod readings;
 pub mod report;
 mod report_input;
 mod report_sections;
+pub mod uncertain;
 pub mod verdict;
 
 use serde::{Deserialize, Serialize};
@@ -58,8 +64,10 @@ pub struct Comparison {
     pub max_de76: f64,
     pub mean_de00: f64,
     pub max_de00: f64,
-    /// How many patches differ by less than [`JND_DE76`].
-    pub below_jnd: usize,
+    /// How many patches' ΔE*ab point estimates are below [`JND_DE76`] (no uncertainty
+    /// considered: [`assess`] says what holds at 95 % confidence).
+    #[serde(alias = "below_jnd")]
+    pub below_jnd_point: usize,
 }
 
 /// Compares `test` against `reference`, patch by patch, in CIELAB relative to `white`.
@@ -115,7 +123,7 @@ pub fn compare(
         reference: reference_name.into(),
         test: test_name.into(),
         white: white.to_array(),
-        below_jnd: patches.iter().filter(|p| p.de76 < JND_DE76).count(),
+        below_jnd_point: patches.iter().filter(|p| p.de76 < JND_DE76).count(),
         patches,
         mean_de76,
         max_de76,
@@ -148,8 +156,8 @@ impl Comparison {
     /// The one-line summary a user reads first.
     pub fn summary(&self) -> String {
         format!(
-            "{} of {} patches below the JND (ΔE*ab < {JND_DE76}); ΔE*ab mean {:.2} max {:.2}; ΔE00 mean {:.2} max {:.2}",
-            self.below_jnd,
+            "{} of {} patches below the JND (ΔE*ab < {JND_DE76}) by point estimate; ΔE*ab mean {:.2} max {:.2}; ΔE00 mean {:.2} max {:.2}",
+            self.below_jnd_point,
             self.patches.len(),
             self.mean_de76,
             self.max_de76,
@@ -168,15 +176,17 @@ mod tests {
         let white = Xyz::new(95.047, 100.0, 108.883);
         let a = vec![Xyz::new(20.0, 21.0, 22.0), Xyz::new(40.0, 42.0, 44.0)];
         let c = compare("box", &a, "display", &a, white).unwrap();
-        assert_eq!(c.below_jnd, 2);
+        assert_eq!(c.below_jnd_point, 2);
         assert_eq!(c.max_de76, 0.0);
         // A grey at L* = 50 against one at L* = 51.5 (by hand: ((50+16)/116)^3 = 0.18418652,
         // ((51.5+16)/116)^3 = 0.19703227): neutral, so ΔE*ab = ΔL* = 1.5.
         let g = |y: f64| Xyz::new(white.x * y, white.y * y, white.z * y);
         let c = compare("r", &[g(0.18418652)], "t", &[g(0.19703227)], white).unwrap();
         assert!((c.patches[0].de76 - 1.5).abs() < 1e-4, "{:?}", c.patches[0]);
-        assert_eq!(c.below_jnd, 1);
-        assert!(c.summary().starts_with("1 of 1 patches below the JND"));
+        assert_eq!(c.below_jnd_point, 1);
+        assert!(c
+            .summary()
+            .starts_with("1 of 1 patches below the JND (ΔE*ab < 2.3) by point estimate"));
     }
 
     #[test]
@@ -255,6 +265,9 @@ mod chart_tests {
             "{}",
             svg.matches("<rect").count()
         );
-        assert!(svg.contains(&format!("{} of 24 below JND", c.below_jnd)));
+        assert!(svg.contains(&format!(
+            "{} of 24 below JND by point estimate",
+            c.below_jnd_point
+        )));
     }
 }

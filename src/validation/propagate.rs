@@ -1,19 +1,29 @@
-//! Propagating the readings' uncertainty to ΔE*ab and ΔE00: by Monte Carlo (the default)
-//! and by linearisation (first-order, for comparison).
+//! Propagating the readings' uncertainty to ΔE*ab and ΔE00: by Monte Carlo with a
+//! bias-aware interval (the default) and by linearisation (first-order, for comparison).
 //!
-//! Both start from the same model: each reading's X, Y, Z are independent normals about
-//! the mean with the reading's standard uncertainty, and its CIELAB coordinates get an
-//! extra independent normal term per axis (a renderer's ΔE bound, a display model's
-//! verification error). The white is taken as exact: an error in it moves both readings'
-//! CIELAB alike, so ΔE changes only in second order.
+//! Both start from the same model: each reading's mean XYZ moves by a normal with the
+//! mean's full covariance (given as factors), and its CIELAB coordinates get an extra
+//! independent normal term per axis (a renderer's ΔE bound, a display model's
+//! verification error). A covariance estimated from k repeats is uncertain itself: each
+//! Monte Carlo draw scales that side's XYZ noise by √(ν/χ²_ν) with ν = k − 1, so any fixed
+//! linear combination of X, Y, Z follows Student's t with ν degrees of freedom, as it
+//! does for the sample (a stated repeatability or a renderer's error is taken as known).
+//! The white is taken as exact: an error in it moves both readings' CIELAB alike, so ΔE
+//! changes only in second order.
 //!
-//! Monte Carlo draws `draws` samples per patch from the workspace's seeded generator (the
-//! seed is mixed with the patch number, so a patch's interval does not depend on the
-//! others) and takes the 2.5th and 97.5th percentiles: this stays right near ΔE = 0, where
-//! ΔE is not differentiable and the linearised interval (ΔE ± 1.96σ) is wrong.
+//! Monte Carlo draws `draws` noise vectors per patch from the workspace's seeded generator
+//! (the seed is mixed with the patch number, so a patch's interval does not depend on the
+//! others) and inverts the test of each candidate truth ([`super::inversion`]): ΔE is a
+//! length that noise inflates, and the percentiles of noisy ΔE about the observed readings
+//! count that inflation twice. The linearised interval (ΔE ± 1.96σ) is wrong near ΔE = 0,
+//! where ΔE is not differentiable.
 
 use metamer_drivers::noise::SplitMix64;
 use serde::{Deserialize, Serialize};
+
+use super::montecarlo::{lab_noise, patch_interval, LabNoise, Metric};
+use super::uncertain::lab_of;
+pub use super::uncertain::{render_lab_sigma, Interval, RenderStatement, Uncertain, Z975};
 
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz};
 
@@ -40,7 +50,7 @@ impl Propagation {
     pub fn describe(self) -> String {
         match self {
             Propagation::MonteCarlo { draws, seed } => format!(
-                "Monte Carlo: {draws} draws per patch (seed {seed}), 2.5th–97.5th percentiles"
+                "Monte Carlo: {draws} noise draws per patch (seed {seed}), the interval by inverting the test of each true difference (bias-aware: noise lengthens ΔE)"
             ),
             Propagation::Linear => {
                 "linearisation: ΔE ± 1.96 σ, σ by central differences".to_string()
@@ -49,60 +59,22 @@ impl Propagation {
     }
 }
 
-/// One side of a comparison with its uncertainty.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Uncertain {
-    pub xyz: [f64; 3],
-    /// Independent standard-normal factors, each moving XYZ along its vector.
-    pub factors: Vec<[f64; 3]>,
-    /// Extra standard uncertainty of each CIELAB coordinate.
-    pub u_lab: f64,
-}
-
-/// A 95 % interval.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Interval {
-    pub lo: f64,
-    pub hi: f64,
-}
-
-/// The intervals of both colour differences of one patch, and each draw's values (Monte
-/// Carlo only; empty otherwise) so a summary over patches can get its own interval.
+/// The intervals of both colour differences of one patch, with the two readings' CIELAB
+/// and their noise draws (Monte Carlo only) so a summary over patches can get its own
+/// interval the same way.
 #[derive(Clone, PartialEq)]
 pub struct Propagated {
     pub de76: Interval,
     pub de00: Interval,
-    pub draws76: Vec<f64>,
-    pub draws00: Vec<f64>,
+    pub reference_lab: Lab,
+    pub test_lab: Lab,
+    pub noise: Option<LabNoise>,
 }
 
 impl std::fmt::Debug for Propagated {
     // The draws are thousands of numbers; the intervals are what a reader needs.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "ΔE*ab {:?} ΔE00 {:?}", self.de76, self.de00)
-    }
-}
-
-/// The 97.5th percentile of the standard normal.
-pub const Z975: f64 = 1.959_963_985;
-
-/// How a renderer states a patch's ΔE*ab uncertainty.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderStatement {
-    /// A path tracer's 95 % half-width, 1.96·√(tr Σ) of its estimate's CIELAB covariance.
-    HalfWidth95,
-    /// A deterministic solver's bound on the error vector's length.
-    Bound,
-}
-
-/// The per-axis standard uncertainty in CIELAB that a renderer's per-patch ΔE*ab statement
-/// stands for, the error taken as isotropic: a half-width h = 1.96·√(3σ²) gives
-/// σ = h / (1.96·√3); a bound is taken as the 95th percentile of the error's length,
-/// σ = b / √χ²₃(0.95).
-pub fn render_lab_sigma(de: f64, how: RenderStatement) -> f64 {
-    match how {
-        RenderStatement::HalfWidth95 => de / (Z975 * 3f64.sqrt()),
-        RenderStatement::Bound => de / super::readings::CHI3_95,
     }
 }
 
@@ -119,28 +91,13 @@ impl Model<'_> {
         self.reference.factors.len() + self.test.factors.len() + 6
     }
 
-    fn lab(side: &Uncertain, z: &[f64], zl: &[f64], white: Xyz) -> Lab {
-        let mut xyz = side.xyz;
-        for (f, zi) in side.factors.iter().zip(z) {
-            for (x, v) in xyz.iter_mut().zip(f) {
-                *x += v * zi;
-            }
-        }
-        let l = Xyz::from_array(xyz).to_lab(white);
-        Lab::new(
-            l.l + side.u_lab * zl[0],
-            l.a + side.u_lab * zl[1],
-            l.b + side.u_lab * zl[2],
-        )
-    }
-
     fn eval(&self, z: &[f64]) -> (f64, f64) {
         let nr = self.reference.factors.len();
         let nt = self.test.factors.len();
         let (zr, rest) = z.split_at(nr);
         let (zt, zl) = rest.split_at(nt);
-        let r = Self::lab(self.reference, zr, &zl[..3], self.white);
-        let t = Self::lab(self.test, zt, &zl[3..], self.white);
+        let r = lab_of(self.reference, zr, &zl[..3], self.white);
+        let t = lab_of(self.test, zt, &zl[3..], self.white);
         (delta_e76(r, t), delta_e2000(r, t))
     }
 }
@@ -162,6 +119,10 @@ pub fn propagate(
     let n = model.len();
     let zero = vec![0.0; n];
     let (d76, d00) = model.eval(&zero);
+    let (rl, tl) = (
+        Xyz::from_array(reference.xyz).to_lab(white),
+        Xyz::from_array(test.xyz).to_lab(white),
+    );
     let uncertain = !reference.factors.is_empty()
         || !test.factors.is_empty()
         || reference.u_lab > 0.0
@@ -169,31 +130,22 @@ pub fn propagate(
     let point = Propagated {
         de76: Interval { lo: d76, hi: d76 },
         de00: Interval { lo: d00, hi: d00 },
-        draws76: Vec::new(),
-        draws00: Vec::new(),
+        reference_lab: rl,
+        test_lab: tl,
+        noise: None,
     };
     if !uncertain {
         return point;
     }
     match how {
         Propagation::MonteCarlo { draws, seed } => {
-            let mut rng = SplitMix64::new(SplitMix64::mix(seed ^ ((patch as u64) << 32)));
-            let mut draws76 = Vec::with_capacity(draws);
-            let mut draws00 = Vec::with_capacity(draws);
-            let mut z = zero;
-            for _ in 0..draws {
-                for zi in z.iter_mut() {
-                    *zi = rng.normal();
-                }
-                let (a, b) = model.eval(&z);
-                draws76.push(a);
-                draws00.push(b);
-            }
+            let key = SplitMix64::mix(seed ^ ((patch as u64) << 32));
+            let noise = lab_noise(reference, test, white, draws, &mut SplitMix64::new(key));
             Propagated {
-                de76: percentiles(&draws76).unwrap_or(point.de76),
-                de00: percentiles(&draws00).unwrap_or(point.de00),
-                draws76,
-                draws00,
+                de76: patch_interval(rl, tl, &noise, Metric::De76, key),
+                de00: patch_interval(rl, tl, &noise, Metric::De00, key),
+                noise: Some(noise),
+                ..point
             }
         }
         Propagation::Linear => {
@@ -216,29 +168,10 @@ pub fn propagate(
             Propagated {
                 de76: around(d76, v76),
                 de00: around(d00, v00),
-                draws76: Vec::new(),
-                draws00: Vec::new(),
+                ..point
             }
         }
     }
-}
-
-/// The 2.5th and 97.5th percentiles (linear interpolation between order statistics).
-pub fn percentiles(values: &[f64]) -> Option<Interval> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let q = |p: f64| {
-        let x = p * (v.len() - 1) as f64;
-        let (i, f) = (x.floor() as usize, x.fract());
-        v[i] + (v[(i + 1).min(v.len() - 1)] - v[i]) * f
-    };
-    Some(Interval {
-        lo: q(0.025),
-        hi: q(0.975),
-    })
 }
 
 #[cfg(test)]
@@ -251,15 +184,19 @@ mod tests {
         Uncertain {
             xyz,
             factors: Vec::new(),
+            dof: None,
             u_lab: 0.0,
         }
     }
 
     /// Two neutral greys at L* = 50 and 60 (Y/Yn = ((L*+16)/116)³: 0.18418652 and
-    /// 0.28123334), the test one with an isotropic CIELAB error σ = 0.5 per axis. Far from
-    /// 0, ΔE*ab ≈ |ΔL* + e_L| is normal with sd 0.5: the interval is 10 ± 1.96·0.5.
+    /// 0.28123334), the test one with an isotropic CIELAB error σ = 0.5 per axis: ΔE*ab/σ
+    /// is a noncentral χ₃, and the interval of its noncentrality for an observed 10/0.5 =
+    /// 20 is [17.9873, 21.9122]·0.5 (SciPy: ncx2.cdf(20², 3, λ²) = 0.975 and 0.025), i.e.
+    /// [8.9937, 10.9561]: centred 0.025 below the estimate, where the percentiles of noisy
+    /// ΔE about the readings would sit 0.025 above it.
     #[test]
-    fn isotropic_lab_noise_gives_the_analytic_interval() {
+    fn isotropic_lab_noise_gives_the_noncentral_chi_interval() {
         let g = |y: f64| [WHITE.x * y, WHITE.y * y, WHITE.z * y];
         let r = exact(g(0.184_186_52));
         let t = Uncertain {
@@ -276,10 +213,9 @@ mod tests {
             },
             1,
         );
-        // The two perpendicular terms add σ²/D = 0.025 to ΔE; Monte Carlo's own error on a
-        // 2.5 % quantile with 20 000 draws is about 0.01.
-        assert!((mc.de76.lo - (10.025 - 0.98)).abs() < 0.03, "{:?}", mc.de76);
-        assert!((mc.de76.hi - (10.025 + 0.98)).abs() < 0.03, "{:?}", mc.de76);
+        // Monte Carlo's own error on a 2.5 % quantile with 20 000 draws is about 0.01.
+        assert!((mc.de76.lo - 8.9937).abs() < 0.03, "{:?}", mc.de76);
+        assert!((mc.de76.hi - 10.9561).abs() < 0.03, "{:?}", mc.de76);
         let lin = propagate(&r, &t, WHITE, Propagation::Linear, 1);
         assert!((lin.de76.lo - 9.02).abs() < 1e-3, "{:?}", lin.de76);
         assert!((lin.de76.hi - 10.98).abs() < 1e-3, "{:?}", lin.de76);
@@ -292,6 +228,7 @@ mod tests {
         let r = Uncertain {
             xyz: [21.0, 12.0, 5.0],
             factors: vec![[0.04, 0.0, 0.0], [0.0, 0.024, 0.0], [0.0, 0.0, 0.01]],
+            dof: None,
             u_lab: 0.0,
         };
         let t = Uncertain {
@@ -306,50 +243,55 @@ mod tests {
         let lin = propagate(&r, &t, WHITE, Propagation::Linear, 15);
         let width = lin.de76.hi - lin.de76.lo;
         assert!(width > 0.5, "{width}");
-        assert!(
-            (mc.de76.lo - lin.de76.lo).abs() < 0.05 * width,
-            "{:?} {:?} / {:?} {:?}",
-            mc.de76,
-            mc.de00,
-            lin.de76,
-            lin.de00
-        );
-        assert!(
-            (mc.de76.hi - lin.de76.hi).abs() < 0.05 * width,
-            "{:?} {:?} / {:?} {:?}",
-            mc.de76,
-            mc.de00,
-            lin.de76,
-            lin.de00
-        );
-        let w00 = lin.de00.hi - lin.de00.lo;
-        assert!(
-            (mc.de00.lo - lin.de00.lo).abs() < 0.08 * w00,
-            "{:?} {:?} / {:?} {:?}",
-            mc.de76,
-            mc.de00,
-            lin.de76,
-            lin.de00
-        );
-        assert!(
-            (mc.de00.hi - lin.de00.hi).abs() < 0.08 * w00,
-            "{:?} {:?} / {:?} {:?}",
-            mc.de76,
-            mc.de00,
-            lin.de76,
-            lin.de00
-        );
+        for (m, l, w, tol) in [
+            (mc.de76, lin.de76, width, 0.05),
+            (mc.de00, lin.de00, lin.de00.hi - lin.de00.lo, 0.08),
+        ] {
+            assert!(
+                (m.lo - l.lo).abs() < tol * w && (m.hi - l.hi).abs() < tol * w,
+                "{mc:?} / {lin:?}"
+            );
+        }
         // The same seed gives the same interval.
         assert_eq!(mc, propagate(&r, &t, WHITE, how, 15));
     }
 
+    /// A covariance from 3 repeats (2 degrees of freedom) widens the interval of a linear
+    /// quantity by Student's t: far from 0, ΔE*ab of greys apart in L* moves with ΔL*
+    /// alone, so the half-width is t₂(0.975)·σ = 4.3027σ against 1.96σ when σ is known.
     #[test]
-    fn no_uncertainty_gives_a_point_and_percentiles_by_hand() {
+    fn an_estimated_covariance_widens_the_interval_by_students_t() {
+        let g = |y: f64| [WHITE.x * y, WHITE.y * y, WHITE.z * y];
+        // σ of Y 0.05 along the grey axis (a* and b* stay 0).
+        let axis = [0.950_47 * 0.05, 0.05, 1.088_83 * 0.05];
+        let t = |dof| Uncertain {
+            xyz: g(0.281_233_34),
+            factors: vec![axis],
+            dof,
+            u_lab: 0.0,
+        };
+        let r = exact(g(0.184_186_52));
+        let how = Propagation::MonteCarlo {
+            draws: 40_000,
+            seed: 4,
+        };
+        // dL*/dY at Y = 28.123334 (L* 60): (116/3)·(116/76)²/100 = 0.900799 per unit of Y.
+        let sigma = 0.05 * 0.900_799;
+        let known = propagate(&r, &t(None), WHITE, how, 2).de76;
+        let estimated = propagate(&r, &t(Some(2)), WHITE, how, 2).de76;
+        let half = |i: Interval| 0.5 * (i.hi - i.lo);
+        assert!((half(known) / sigma - 1.96).abs() < 0.05, "{known:?}");
+        assert!(
+            (half(estimated) / sigma - 4.3027).abs() < 0.2,
+            "{estimated:?}"
+        );
+    }
+
+    #[test]
+    fn no_uncertainty_gives_a_point() {
         let r = exact([20.0, 21.0, 22.0]);
         let p = propagate(&r, &r, WHITE, Propagation::default(), 2);
         assert_eq!(p.de76, Interval { lo: 0.0, hi: 0.0 });
-        // 0..=100: the 2.5th percentile is 2.5, the 97.5th 97.5.
-        let v: Vec<f64> = (0..=100).map(f64::from).collect();
-        assert_eq!(percentiles(&v), Some(Interval { lo: 2.5, hi: 97.5 }));
+        assert!(p.noise.is_none());
     }
 }

@@ -1,10 +1,13 @@
 //! Readings of the ColorChecker patches as `validate` takes them: a session journal, the
 //! output of `metamer spot --json`, the output of `metamer render spots --json`, or a CSV
-//! `patch,X,Y,Z` with optional `sd_X,sd_Y,sd_Z`, `n` and `out_of_gamut` columns. The format
-//! is sniffed from the content; every error names the file and the line.
+//! `patch,X,Y,Z` with optional columns (see [`csv`]): `sd_X,sd_Y,sd_Z` and
+//! `cov_XY,cov_XZ,cov_YZ` (one reading's covariance), `n`, `u_lab` (a renderer's CIELAB
+//! standard uncertainty) and `out_of_gamut`. The format is sniffed from the content; every
+//! error names the file and the line.
 //!
-//! Each patch ends with one mean XYZ and its standard uncertainty, and with where that
-//! uncertainty came from, so a report can say how far it may be trusted.
+//! Each patch ends with one mean XYZ and the full covariance of that mean, the degrees of
+//! freedom of the covariance where it was estimated from repeats, and where it came from,
+//! so a report can say how far it may be trusted.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -13,15 +16,14 @@ use metamer_color::text::{echo, echo_message, strip_bom};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use super::covariance::{self, Cov3};
+pub use super::uncertain::CHI3_95;
+use super::uncertain::{render_lab_sigma, RenderStatement};
 use crate::color::COLORCHECKER_NAMES;
+use crate::session::repeats::Repeatability;
 
 /// The number of patches of the chart.
 pub const PATCHES: usize = 24;
-
-/// The 95th percentile of the length of a 3-D isotropic normal vector in units of its
-/// per-axis σ (√χ²₃(0.95) = √7.8147): converts a renderer's 95 % ΔE half-width to a
-/// per-axis standard uncertainty in CIELAB.
-pub const CHI3_95: f64 = 2.795_483;
 
 /// Which file format the readings were in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -48,10 +50,12 @@ impl Format {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum UncertaintySource {
-    /// The scatter of repeated readings (standard error of their mean).
+    /// The scatter of repeated readings (the covariance of their mean).
     Repeats,
-    /// Standard deviations given with the readings.
+    /// Standard deviations (and covariances) given with the readings.
     Given,
+    /// One reading, with the instrument's stated repeatability in Y and x, y.
+    Instrument,
     /// The renderer's confidence (standard error of its estimate, or its 95 % ΔE bound).
     Render,
     /// One reading and nothing said about it: its uncertainty is unknown (taken as 0).
@@ -66,13 +70,22 @@ pub struct PatchReading {
     /// Standard uncertainty of the mean in X, Y and Z.
     pub u_xyz: [f64; 3],
     /// The uncertainty of the mean as independent standard-normal factors, each moving XYZ
-    /// along its vector: from repeats, each reading's deviation / √(k(k−1)), which keeps
-    /// the correlation of X, Y and Z (a meter's repeats mostly scale all three); from
-    /// given standard deviations, one factor per axis.
+    /// along its vector (Σ f fᵀ is the mean's covariance): from repeats, each reading's
+    /// deviation / √(k(k−1)), which keeps the correlation of X, Y and Z (a meter's repeats
+    /// mostly move luminance and chromaticity, not one axis); from a given or stated
+    /// covariance, its eigenvectors.
     pub u_factors: Vec<[f64; 3]>,
+    /// Degrees of freedom of that covariance where it was estimated from the readings'
+    /// scatter (k − 1 for k repeats); None where it is known (stated, rendered).
+    #[serde(default)]
+    pub dof: Option<usize>,
     /// An extra per-axis standard uncertainty in CIELAB (from a renderer's ΔE bound), 0 if
     /// none.
     pub u_lab: f64,
+    /// The renderer's own ΔE*ab statement for the patch (its 95 % half-width or error
+    /// bound), as the input gave it.
+    #[serde(default)]
+    pub render_de95: Option<f64>,
     /// Readings averaged.
     pub n: usize,
     pub source: UncertaintySource,
@@ -165,12 +178,42 @@ struct Row {
     xyz: [f64; 3],
     /// Standard deviation of one reading, and how many readings the row averages.
     sd: Option<[f64; 3]>,
+    /// The covariances XY, XZ, YZ of one reading (0 where not given).
+    cov: [f64; 3],
     n: usize,
     /// A renderer's standard error of XYZ.
     stderr: Option<[f64; 3]>,
     /// A renderer's 95 % ΔE*ab half-width or bound.
-    de95: Option<f64>,
+    de95: Option<(f64, RenderStatement)>,
+    /// A renderer's per-axis CIELAB standard uncertainty.
+    u_lab: Option<f64>,
+    /// The instrument that took the reading, when the input names it.
+    instrument: Option<String>,
     out_of_gamut: bool,
+}
+
+impl Row {
+    /// A plain reading: no spread, no render statement.
+    fn reading(line: usize, patch: PatchId, xyz: [f64; 3]) -> Row {
+        Row {
+            line,
+            patch,
+            xyz,
+            sd: None,
+            cov: [0.0; 3],
+            n: 1,
+            stderr: None,
+            de95: None,
+            u_lab: None,
+            instrument: None,
+            out_of_gamut: false,
+        }
+    }
+
+    /// One reading's covariance as the row gives it.
+    fn covariance(&self) -> Option<Cov3> {
+        self.sd.map(|sd| covariance::from_parts(sd, self.cov))
+    }
 }
 
 /// Reads `file`, sniffing its format.
@@ -314,7 +357,18 @@ impl Parsed {
                 }
             }
         }
-        if let Some(de) = r.de95 {
+        if let Some(c) = r.covariance() {
+            covariance::check(&c).map_err(|e| self.bad(r.line, e))?;
+        }
+        if let Some(u) = r.u_lab {
+            if !(0.0..=MAX_DE95).contains(&u) {
+                return Err(self.bad(
+                    r.line,
+                    format!("u_lab {u:?}: must be ≥ 0 and at most {MAX_DE95}"),
+                ));
+            }
+        }
+        if let Some((de, _)) = r.de95 {
             if !(0.0..=MAX_DE95).contains(&de) {
                 return Err(self.bad(
                     r.line,
@@ -405,10 +459,12 @@ fn patch_id(v: &Value) -> Option<PatchId> {
     }
 }
 
-/// Combines the rows of one patch: the equal-weight mean and its standard uncertainty —
-/// from the given standard deviations where every row has them (each row's sd/√n, the
-/// mean's √Σu²/k), else from the scatter of the rows (s/√k) when there are several, else
-/// from a renderer's confidence; unknown (0) for one bare reading.
+/// Combines the rows of one patch: the equal-weight mean and the covariance of that mean —
+/// from the given covariances where every row has them (each row's over its n; the mean's
+/// Σ/k²), else from the scatter of the rows when there are several (their sample
+/// covariance over k, with k − 1 degrees of freedom), else from a renderer's confidence,
+/// else, for one reading of a named instrument, from its stated repeatability; unknown (0)
+/// for one bare reading.
 fn combine(rows: &[&Row]) -> PatchReading {
     let k = rows.len() as f64;
     let mut mean = [0.0; 3];
@@ -428,48 +484,62 @@ fn combine(rows: &[&Row]) -> PatchReading {
             })
             .collect()
     };
-    let (u_factors, source) = if rows.iter().all(|r| r.sd.is_some()) {
-        let mut u = [0.0; 3];
-        for r in rows {
-            let sd = r.sd.expect("checked");
-            for (ui, s) in u.iter_mut().zip(sd) {
-                *ui += (s / (r.n as f64).sqrt()).powi(2);
-            }
+    let stated = (rows.len() == 1)
+        .then(|| {
+            let r = rows[0];
+            let rep = Repeatability::emissive_of(r.instrument.as_deref()?)?;
+            rep.covariance(r.xyz)
+        })
+        .flatten();
+    let (u_factors, dof, source) = if let Some(given) = rows
+        .iter()
+        .map(|r| r.covariance())
+        .collect::<Option<Vec<Cov3>>>()
+    {
+        let mut c = covariance::ZERO;
+        for (r, g) in rows.iter().zip(&given) {
+            c = covariance::sum(&c, &covariance::scaled(g, 1.0 / (r.n as f64 * k * k)));
         }
-        (axes(u.map(|v| v.sqrt() / k)), UncertaintySource::Given)
+        // A standard deviation of one reading is a stated one; of several, their sample's.
+        let dof = rows.iter().filter(|r| r.n > 1).map(|r| r.n - 1).min();
+        (covariance::factors(&c), dof, UncertaintySource::Given)
     } else if rows.len() >= 2 {
         let scale = (k * (k - 1.0)).sqrt();
         let factors = rows
             .iter()
             .map(|r| [0, 1, 2].map(|i| (r.xyz[i] - mean[i]) / scale))
             .collect();
-        (factors, UncertaintySource::Repeats)
+        (factors, Some(rows.len() - 1), UncertaintySource::Repeats)
     } else if let Some(se) = rows[0].stderr {
-        (axes(se), UncertaintySource::Render)
-    } else if rows[0].de95.is_some() {
-        (Vec::new(), UncertaintySource::Render)
+        (axes(se), None, UncertaintySource::Render)
+    } else if rows[0].de95.is_some() || rows[0].u_lab.is_some() {
+        (Vec::new(), None, UncertaintySource::Render)
+    } else if let Some(c) = stated {
+        (covariance::factors(&c), None, UncertaintySource::Instrument)
     } else {
-        (Vec::new(), UncertaintySource::Unknown)
+        (Vec::new(), None, UncertaintySource::Unknown)
     };
-    let mut u_xyz = [0.0; 3];
-    for f in &u_factors {
-        for (u, v) in u_xyz.iter_mut().zip(f) {
-            *u += v * v;
-        }
-    }
-    let u_xyz = u_xyz.map(f64::sqrt);
-    // A ΔE bound stands for what the XYZ standard error does not say (a radiosity solver's
-    // discretisation); with a standard error it would count the same noise twice.
-    let u_lab = if source == UncertaintySource::Render && rows[0].stderr.is_none() {
-        rows[0].de95.unwrap_or(0.0) / CHI3_95
+    let u_xyz = covariance::sd(&covariance::of_factors(&u_factors));
+    // A ΔE statement stands for what the XYZ standard error does not say (a radiosity
+    // solver's discretisation); with a standard error it would count the same noise twice.
+    let from_de = match rows[0].de95 {
+        Some((de, how)) if rows[0].stderr.is_none() && rows.len() == 1 => render_lab_sigma(de, how),
+        _ => 0.0,
+    };
+    let given_lab = rows.iter().filter_map(|r| r.u_lab).fold(0.0, f64::max);
+    let u_lab = from_de.hypot(given_lab);
+    let source = if source == UncertaintySource::Given && u_factors.is_empty() && u_lab > 0.0 {
+        UncertaintySource::Render
     } else {
-        0.0
+        source
     };
     PatchReading {
         xyz: mean,
         u_xyz,
         u_factors,
+        dof,
         u_lab,
+        render_de95: rows[0].de95.map(|d| d.0),
         n,
         source,
         out_of_gamut: rows.iter().any(|r| r.out_of_gamut),

@@ -238,7 +238,7 @@ fn summary_line(a: &Assessment) -> String {
             .unwrap_or_default()
     };
     format!(
-        "{} of {} patches below the JND, {} above, {} undecided; ΔE*ab mean {:.2}{} max {:.2}{}; ΔE00 mean {:.2}{} max {:.2}{}.",
+        "{} of {} patches below the JND at 95 % confidence, {} above, {} undecided; ΔE*ab mean {:.2}{} max {:.2}{}; ΔE00 mean {:.2}{} max {:.2}{}.",
         a.jnd.below,
         a.patches.len(),
         a.jnd.above,
@@ -303,6 +303,7 @@ fn source_name(s: UncertaintySource) -> &'static str {
     match s {
         UncertaintySource::Repeats => "repeats",
         UncertaintySource::Given => "given sd",
+        UncertaintySource::Instrument => "stated repeatability",
         UncertaintySource::Render => "render",
         UncertaintySource::Unknown => "unknown",
     }

@@ -260,6 +260,10 @@ fn described(a: &Assessment, reference: bool) -> String {
             UncertaintySource::Given,
             "the standard deviations given with the readings",
         ),
+        (
+            UncertaintySource::Instrument,
+            "the instrument's stated repeatability (single readings)",
+        ),
         (UncertaintySource::Render, "the renderer's confidence"),
         (
             UncertaintySource::Unknown,

@@ -44,11 +44,34 @@ pub fn lamp(nm: f64) -> f64 {
     1.5e6 * (0.25 + 0.75 * (nm - START_NM) / 350.0)
 }
 /// Repeatability the simulated instrument declares for an emissive reading whose largest
-/// cell reaches the sensor target (any light from about 90 cd/m² up; dimmer ones are
-/// integrated 2 s and are noisier in proportion): relative 1σ of Y. Measured 0.12 % on
-/// 100 cd/m² of LED-RGB1, one reading of 1.8 s with the shot noise of ~37 000 counts at
-/// its peak (`a_noisy_100_cd_white_repeats_within_the_documented_repeatability`).
+/// cell reaches the sensor target: relative 1σ of Y. Measured 0.12 % on 100 cd/m² of
+/// LED-RGB1, one reading of 1.8 s with the shot noise of ~37 000 counts at its peak
+/// (`a_noisy_100_cd_white_repeats_within_the_documented_repeatability`).
 pub const REPEATABILITY_Y: f64 = 0.0015;
+/// Below about this luminance (cd/m²) the driver integrates its longest time (2 s) and the
+/// cells collect fewer photons than the target: the relative noise of Y grows as
+/// √(this / Y) (shot noise). Where the cap starts depends on the light's spectrum (LED-RGB1
+/// about 90 cd/m², the ips-lcd white above 103); this is the upper end.
+pub const FULL_SIGNAL_CD_M2: f64 = 100.0;
+/// The sensor's own noise at 2 s (read noise, the dark current's shot noise and the
+/// subtracted dark's), in cd/m² of Y (1σ): what dominates below about 1 cd/m².
+pub const DARK_NOISE_CD_M2: f64 = 0.013;
+
+/// The relative 1σ of Y of one emissive reading of `cd_m2`: [`REPEATABILITY_Y`] down to
+/// [`FULL_SIGNAL_CD_M2`], then growing as the shot noise does, with the sensor's own
+/// noise in quadrature. Checked against the simulated unit from 0.5 to 400 cd/m²
+/// (`the_stated_repeatability_holds_at_every_level`).
+pub fn repeatability_y(cd_m2: f64) -> f64 {
+    let y = cd_m2.abs().max(f64::MIN_POSITIVE);
+    let shot = REPEATABILITY_Y * REPEATABILITY_Y * (FULL_SIGNAL_CD_M2 / y).max(1.0);
+    (shot + (DARK_NOISE_CD_M2 / y).powi(2)).sqrt()
+}
+
+/// The 1σ of x and of y of one emissive reading, relative to that of Y
+/// ([`repeatability_y`]): the same photons' noise, spread over the bands that make X
+/// and Z. Measured 0.19–0.27 from 1 to 400 cd/m² in the check above (0.33 at 0.5 cd/m²,
+/// where chromaticity means little); stated above the upper end.
+pub const REPEATABILITY_XY_PER_Y: f64 = 0.3;
 /// Repeatability of a reflectance band, absolute 1σ (both the white and the sample shot are
 /// noisy).
 pub const REPEATABILITY_REFLECTANCE: f64 = 0.002;

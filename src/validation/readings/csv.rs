@@ -1,9 +1,21 @@
-//! The CSV form of readings `validate` takes: `patch,X,Y,Z` and optional columns.
+//! The CSV form of readings `validate` takes: `patch,X,Y,Z` and optional columns, in any
+//! order, names matched without regard to case:
+//!
+//! - `sd_X,sd_Y,sd_Z`: standard deviation of one reading. With `n` ≥ 2 it is taken as the
+//!   sample's of those n readings (n − 1 degrees of freedom); with n = 1 as a stated,
+//!   known repeatability.
+//! - `cov_XY,cov_XZ,cov_YZ`: the covariances of one reading that go with the sd columns
+//!   (all three or none; without them the axes are independent).
+//! - `n`: readings the row averages (default 1).
+//! - `u_lab`: a renderer's standard uncertainty per CIELAB axis.
+//! - `out_of_gamut`: 1 where the display cannot show the colour.
+//!
+//! The experiment's stages write `patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,cov_XY,cov_XZ,cov_YZ,u_lab`.
 
 use super::*;
 
 impl Parsed {
-    /// `patch,X,Y,Z[,sd_X,sd_Y,sd_Z][,n][,out_of_gamut]`, columns in any order.
+    /// `patch,X,Y,Z` and the optional columns above.
     pub(super) fn csv(&mut self, text: &str) -> Result<(), ReadingsError> {
         let mut lines = text
             .lines()
@@ -18,7 +30,7 @@ impl Parsed {
                 self.bad(
                     hline,
                     format!(
-                        "the header '{}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, n, out_of_gamut)",
+                        "the header '{}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, cov_XY,cov_XZ,cov_YZ, n, u_lab, out_of_gamut)",
                         echo(header)
                     ),
                 )
@@ -30,7 +42,18 @@ impl Parsed {
             (None, None, None) => None,
             _ => return Err(self.bad(hline, "give all three of sd_X, sd_Y, sd_Z or none")),
         };
-        let (cn, cg) = (col("n"), col("out_of_gamut"));
+        let cov = match (col("cov_XY"), col("cov_XZ"), col("cov_YZ")) {
+            (Some(a), Some(b), Some(c)) if sd.is_some() => Some([a, b, c]),
+            (None, None, None) => None,
+            (Some(_), Some(_), Some(_)) => {
+                return Err(self.bad(
+                    hline,
+                    "cov_XY, cov_XZ, cov_YZ need the sd_X, sd_Y, sd_Z they go with",
+                ))
+            }
+            _ => return Err(self.bad(hline, "give all three of cov_XY, cov_XZ, cov_YZ or none")),
+        };
+        let (cn, cg, cu) = (col("n"), col("out_of_gamut"), col("u_lab"));
         for (line, l) in lines {
             let cells: Vec<&str> = l.split(',').map(str::trim).collect();
             if cells.len() != names.len() {
@@ -100,15 +123,18 @@ impl Parsed {
                 },
                 None => false,
             };
+            let cov = match cov {
+                Some(c) => [num(c[0])?, num(c[1])?, num(c[2])?],
+                None => [0.0; 3],
+            };
+            let u_lab = cu.map(num).transpose()?;
             self.rows.push(Row {
-                line,
-                patch,
-                xyz: [num(cx)?, num(cy)?, num(cz)?],
                 sd,
+                cov,
                 n,
-                stderr: None,
-                de95: None,
+                u_lab,
                 out_of_gamut,
+                ..Row::reading(line, patch, [num(cx)?, num(cy)?, num(cz)?])
             });
         }
         Ok(())

@@ -54,15 +54,14 @@ impl Parsed {
                         continue;
                     };
                     let xyz = self.xyz_of(&v["reading"], "xyz", line)?;
+                    let emissive = v["mode"].as_str().is_none_or(|m| m == "emissive");
                     self.rows.push(Row {
-                        line,
-                        patch,
-                        xyz,
-                        sd: None,
-                        n: 1,
-                        stderr: None,
-                        de95: None,
+                        instrument: v["reading"]["instrument"]
+                            .as_str()
+                            .filter(|_| emissive)
+                            .map(String::from),
                         out_of_gamut: v["data"]["out_of_gamut"].as_bool().unwrap_or(false),
+                        ..Row::reading(line, patch, xyz)
                     });
                 }
                 Some("calibration") => {}
@@ -109,14 +108,14 @@ impl Parsed {
                 })?),
             };
             let row = Row {
-                line,
-                patch: patch.unwrap_or(PatchId::Number(0)),
-                xyz,
-                sd: None,
-                n: 1,
-                stderr: None,
-                de95: None,
+                // A spot line does not say its mode: only a meter that reads emitted
+                // light alone (the CS-100A) is known to have taken an emissive reading.
+                instrument: v["instrument"]
+                    .as_str()
+                    .filter(|m| m.to_ascii_lowercase().contains("cs100a"))
+                    .map(String::from),
                 out_of_gamut: v["out_of_gamut"].as_bool().unwrap_or(false),
+                ..Row::reading(line, patch.unwrap_or(PatchId::Number(0)), xyz)
             };
             if patch.is_none() {
                 unnumbered.push(self.rows.len());
@@ -182,16 +181,15 @@ impl Parsed {
                 Some(_) => Some(self.xyz_of(p, "XYZ_stderr", 1)?),
                 None => None,
             };
-            let de95 = p["de_ci95"].as_f64().or_else(|| p["de_bound"].as_f64());
+            let de95 = match (p["de_ci95"].as_f64(), p["de_bound"].as_f64()) {
+                (Some(h), _) => Some((h, RenderStatement::HalfWidth95)),
+                (None, Some(b)) => Some((b, RenderStatement::Bound)),
+                (None, None) => None,
+            };
             self.rows.push(Row {
-                line: 1,
-                patch,
-                xyz,
-                sd: None,
-                n: 1,
                 stderr,
                 de95,
-                out_of_gamut: false,
+                ..Row::reading(1, patch, xyz)
             });
         }
         Ok(())
