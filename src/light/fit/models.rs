@@ -1,11 +1,23 @@
-//! The fall-off models of one half-plane, f(γ) with f(0) = 1, and their least-squares fits.
+//! The fall-off models, f(γ) with f(0) = 1, and their least-squares fits.
 //!
 //! Every model is 1 along the normal by construction, so the normal reading only sets the
 //! scale (the normal luminance) and the fit uses the off-normal angles alone. Residuals are
 //! in relative luminance (reading / normal luminance − model).
+//!
+//! The parametric families (`lambertian`, `cos-power`, `cos-poly`, `lobes`) fit each
+//! half-plane on its own: each is a function of cos γ, flat at the normal. A real luminaire
+//! whose two sides differ in shape (a diffuser over an off-centre LED array) is not: its
+//! luminance has a slope at the normal, the same seen from either side. The two plane
+//! families fit a whole plane in the signed angle, so they are smooth across γ = 0:
+//! `series` ([`super::series`]) and `spline` ([`super::spline`]). Either is stored as the
+//! two halves' parameters, each half in its own γ ≥ 0, so the table and the chart evaluate
+//! every model the same way.
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+
+use super::series::{self, SERIES_TERMS};
+use super::spline;
 
 /// A family of fall-off curves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -19,15 +31,22 @@ pub enum LdcModel {
     CosPoly,
     /// f = a·cosⁿγ + (1 − a)·cosᵐγ, 0 ≤ a ≤ 1, n ≤ m: a broad and a narrow lobe.
     Lobes,
+    /// Per plane, in the signed angle x: f = cosⁿx·(1 + b₁ sin x + … + b₄ sin⁴x).
+    Series,
+    /// Per plane: the lobes fit of each half plus a natural cubic spline in the signed
+    /// angle through its residuals, so the curve passes through every reading.
+    Spline,
 }
 
 impl LdcModel {
-    /// From the fewest free parameters to the most: the order `auto` prefers on a tie.
-    pub const ALL: [LdcModel; 4] = [
+    /// The parametric families first, then the plane families.
+    pub const ALL: [LdcModel; 6] = [
         LdcModel::Lambertian,
         LdcModel::CosPower,
         LdcModel::CosPoly,
         LdcModel::Lobes,
+        LdcModel::Series,
+        LdcModel::Spline,
     ];
 
     pub fn name(self) -> &'static str {
@@ -36,16 +55,44 @@ impl LdcModel {
             LdcModel::CosPower => "cos-power",
             LdcModel::CosPoly => "cos-poly",
             LdcModel::Lobes => "lobes",
+            LdcModel::Series => "series",
+            LdcModel::Spline => "spline",
         }
     }
 
-    /// Free parameters per half-plane.
-    pub fn parameters(self) -> usize {
+    /// Whether one fit covers a whole plane (both halves, smooth across γ = 0) rather than
+    /// each half-plane on its own.
+    pub fn per_plane(self) -> bool {
+        matches!(self, LdcModel::Series | LdcModel::Spline)
+    }
+
+    /// The fewest angles off the normal a fit needs: in each half-plane, and in each plane
+    /// (both halves together). (Its residuals need one in each half-plane.)
+    pub fn min_angles(self) -> (usize, usize) {
+        match self {
+            LdcModel::Lambertian => (0, 0),
+            LdcModel::CosPower => (1, 2),
+            LdcModel::CosPoly => (2, 4),
+            LdcModel::Lobes => (3, 6),
+            // Five coefficients per plane; a half with one angle would be extrapolated
+            // from the other side.
+            LdcModel::Series => (2, SERIES_TERMS + 1),
+            // The lobes fit of each half is the spline's base.
+            LdcModel::Spline => (3, 6),
+        }
+    }
+
+    /// Free parameters of one plane fitted to `angles` readings off the normal: the
+    /// measure of size by which `auto` prefers the smaller of two models that predict as
+    /// well. An interpolant has one per reading besides its base.
+    pub fn parameters(self, angles: usize) -> usize {
         match self {
             LdcModel::Lambertian => 0,
-            LdcModel::CosPower => 1,
-            LdcModel::CosPoly => 2,
-            LdcModel::Lobes => 3,
+            LdcModel::CosPower => 2,
+            LdcModel::CosPoly => 4,
+            LdcModel::Series => SERIES_TERMS + 1,
+            LdcModel::Lobes => 6,
+            LdcModel::Spline => 6 + angles,
         }
     }
 }
@@ -64,7 +111,7 @@ impl std::str::FromStr for LdcModel {
             .into_iter()
             .find(|m| m.name() == t)
             .ok_or_else(|| {
-                format!("unknown light distribution model '{s}': expected lambertian, cos-power, cos-poly or lobes")
+                format!("unknown light distribution model '{s}': expected lambertian, cos-power, cos-poly, lobes, series or spline")
             })
     }
 }
@@ -86,6 +133,23 @@ pub enum Params {
         n: f64,
         m: f64,
     },
+    /// cosⁿγ·(1 + Σ b_k sinᵏγ) in this half's own γ ≥ 0 (the other half of the plane has
+    /// the same n and the odd coefficients negated: sin(−γ) = −sin γ).
+    Series {
+        n: f64,
+        b: [f64; SERIES_TERMS],
+    },
+    /// The lobes curve (a, n, m) plus a cubic spline through (knot, residual) with the
+    /// given second derivatives (per degree²) at the knots; the first knot is 0°. Past the
+    /// last knot the spline holds its last value.
+    Spline {
+        a: f64,
+        n: f64,
+        m: f64,
+        knots_deg: Vec<f64>,
+        residuals: Vec<f64>,
+        curvature: Vec<f64>,
+    },
 }
 
 impl Params {
@@ -95,6 +159,8 @@ impl Params {
             Params::CosPower { .. } => LdcModel::CosPower,
             Params::CosPoly { .. } => LdcModel::CosPoly,
             Params::Lobes { .. } => LdcModel::Lobes,
+            Params::Series { .. } => LdcModel::Series,
+            Params::Spline { .. } => LdcModel::Spline,
         }
     }
 
@@ -102,13 +168,26 @@ impl Params {
     /// past the data (the table clamps it to 0).
     pub fn eval(&self, gamma_deg: f64) -> f64 {
         let c = gamma_deg.to_radians().cos().max(0.0);
-        match *self {
+        match self {
             Params::Lambertian => 1.0,
-            Params::CosPower { n } => c.powf(n),
+            Params::CosPower { n } => c.powf(*n),
             Params::CosPoly {
                 coeffs: [a0, a1, a2],
             } => a0 + a1 * c + a2 * c * c,
-            Params::Lobes { a, n, m } => a * c.powf(n) + (1.0 - a) * c.powf(m),
+            Params::Lobes { a, n, m } => a * c.powf(*n) + (1.0 - a) * c.powf(*m),
+            Params::Series { n, b } => series::eval(*n, b, gamma_deg),
+            Params::Spline {
+                a,
+                n,
+                m,
+                knots_deg,
+                residuals,
+                curvature,
+            } => {
+                a * c.powf(*n)
+                    + (1.0 - a) * c.powf(*m)
+                    + spline::eval(knots_deg, residuals, curvature, gamma_deg)
+            }
         }
     }
 
@@ -123,19 +202,57 @@ impl Params {
                 format!("a0={a0:.3} a1={a1:.3} a2={a2:.3}")
             }
             Params::Lobes { a, n, m } => format!("a={a:.3} n={n:.3} m={m:.3}"),
+            Params::Series { n, b } => format!(
+                "n={n:.3} b={}",
+                b.iter()
+                    .map(|v| format!("{v:+.3}"))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
+            Params::Spline {
+                a,
+                n,
+                m,
+                ref residuals,
+                ..
+            } => {
+                let worst = residuals.iter().fold(0.0f64, |w, r| w.max(r.abs()));
+                format!(
+                    "lobes a={a:.3} n={n:.3} m={m:.3} + spline through {} residuals (largest {worst:.4})",
+                    residuals.len() - 1
+                )
+            }
         }
     }
 }
 
 /// The largest exponent searched: cos¹⁰⁰ is already below 1 % at 12°, far narrower than
 /// any panel light.
-const MAX_EXPONENT: f64 = 100.0;
+pub(crate) const MAX_EXPONENT: f64 = 100.0;
 
-/// Least-squares fit of `model` to points (γ in degrees, relative luminance). The caller
-/// guarantees at least `model.parameters()` points.
+/// One half-plane's points: γ ≥ 0 in degrees, increasing, and relative luminance.
+pub type HalfPoints<'a> = (&'a [f64], &'a [f64]);
+
+/// Least-squares fit of `model` to one plane: `pos` and `neg` are its two halves (each in
+/// its own γ ≥ 0); returns their parameters in that order. The caller guarantees
+/// [`LdcModel::min_angles`].
+pub fn fit_plane(model: LdcModel, pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
+    match model {
+        LdcModel::Series => series::fit(pos, neg),
+        LdcModel::Spline => spline::fit(pos, neg),
+        _ => [fit_half(model, pos.0, pos.1), fit_half(model, neg.0, neg.1)],
+    }
+}
+
+/// Least-squares fit of a half-plane `model` to points (γ in degrees, relative
+/// luminance). The caller guarantees [`LdcModel::min_angles`]; the plane families are
+/// fitted by [`fit_plane`] (given here, they see this half mirrored onto the other).
 pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
     let c: Vec<f64> = gamma_deg.iter().map(|g| g.to_radians().cos()).collect();
     match model {
+        LdcModel::Series | LdcModel::Spline => {
+            fit_plane(model, (gamma_deg, y), (gamma_deg, y))[0].clone()
+        }
         LdcModel::Lambertian => Params::Lambertian,
         LdcModel::CosPower => {
             let sse = |n: f64| sse(&c, y, |ci| ci.powf(n));
@@ -148,7 +265,7 @@ pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
     }
 }
 
-fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     c.iter().zip(y).map(|(&ci, &yi)| (f(ci) - yi).powi(2)).sum()
 }
 
