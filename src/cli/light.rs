@@ -331,7 +331,7 @@ fn print_photometry(file: &std::path::Path, table: &CGammaTable, p: &Photometry)
         .iter()
         .map(|g| format!(" {:>9}", format!("{g}°")))
         .collect();
-    println!("    {:<6}{head}", "");
+    println!("    {:<6}{head}", "C \\ γ");
     for h in HalfPlane::ALL {
         let cells: String = gammas
             .iter()

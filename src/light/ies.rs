@@ -146,23 +146,28 @@ fn keywords(lines: &[&str]) -> Vec<(String, String)> {
     out
 }
 
-/// A comma inside a value of a line whose values are separated by blanks: LM-63 separates
-/// values by blanks or commas and writes decimals with a point, so "10 5,5 0,0" is either a
-/// decimal comma (5.5, 0.0) or two values each (5, 5, 0, 0); read either way the counts
-/// may still come out right. The first such value and its line, if any.
+/// A comma inside a value on a line that separates values by blanks: LM-63 separates
+/// values by blanks or commas and writes decimals with a point, so "10 5,5 0,0" is either
+/// decimal commas (10, 5.5, 0.0) or two values each (10, 5, 5, 0, 0), and the counts can
+/// come out right either way. A line whose values are all separated by commas (with or
+/// without blanks) is the format's own. The first such value and its line, if any.
 fn ambiguous_comma(text: &str, first_line: usize) -> Option<(usize, String)> {
+    let inner_comma = |w: &str| {
+        let b = w.as_bytes();
+        (1..b.len().saturating_sub(1))
+            .any(|k| b[k] == b',' && b[k - 1].is_ascii_digit() && b[k + 1].is_ascii_digit())
+    };
     text.lines().enumerate().find_map(|(i, l)| {
         let words: Vec<&str> = l.split_whitespace().collect();
-        if words.len() < 2 {
+        let blank_separated = words
+            .windows(2)
+            .any(|w| !w[0].ends_with(',') && !w[1].starts_with(','));
+        if !blank_separated {
             return None;
         }
         words
             .iter()
-            .find(|w| {
-                let b = w.as_bytes();
-                (1..b.len().saturating_sub(1))
-                    .any(|k| b[k] == b',' && b[k - 1].is_ascii_digit() && b[k + 1].is_ascii_digit())
-            })
+            .find(|w| inner_comma(w))
             .map(|w| (first_line + i, w.to_string()))
     })
 }

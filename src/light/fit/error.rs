@@ -67,7 +67,7 @@ pub enum LdcError {
         got: usize,
         need: usize,
     },
-    #[error("the {plane} plane at {angle}°: the reading {value:e} is {ratio:e} times the normal luminance {normal:e}; a distribution relative to the normal takes at most {max} times it (is the 0° reading right?)")]
+    #[error("the {plane} plane at {angle}°: the reading {value:e} is {ratio:.3e} times the normal luminance {normal:e}; a distribution relative to the normal takes at most {max} times it (is the 0° reading right?)")]
     FarAboveNormal {
         plane: Plane,
         angle: f64,

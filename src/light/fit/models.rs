@@ -265,7 +265,7 @@ pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
     }
 }
 
-pub(crate) fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     c.iter().zip(y).map(|(&ci, &yi)| (f(ci) - yi).powi(2)).sum()
 }
 
@@ -288,36 +288,45 @@ fn fit_cos_poly(c: &[f64], y: &[f64]) -> Params {
 /// For fixed exponents the best weight is a linear least-squares problem
 /// (y − cᵐ = a·(cⁿ − cᵐ)), so the search runs over (n, m) only: a grid, then Nelder–Mead.
 fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
-    let best_a = |n: f64, m: f64| -> f64 {
+    // The best weight and the sum of squares for the powers cⁿ and cᵐ at the points.
+    let weight_and_sse = |pn: &[f64], pm: &[f64]| -> (f64, f64) {
         let (mut uu, mut ur) = (0.0, 0.0);
-        for (&ci, &yi) in c.iter().zip(y) {
-            let (pn, pm) = (ci.powf(n), ci.powf(m));
-            uu += (pn - pm).powi(2);
-            ur += (pn - pm) * (yi - pm);
+        for ((&p, &q), &yi) in pn.iter().zip(pm).zip(y) {
+            uu += (p - q).powi(2);
+            ur += (p - q) * (yi - q);
         }
-        if uu < 1e-300 {
+        let a = if uu < 1e-300 {
             1.0
         } else {
             (ur / uu).clamp(0.0, 1.0)
-        }
+        };
+        let sse = pn
+            .iter()
+            .zip(pm)
+            .zip(y)
+            .map(|((&p, &q), &yi)| (a * p + (1.0 - a) * q - yi).powi(2))
+            .sum();
+        (a, sse)
     };
+    let powers = |e: f64| -> Vec<f64> { c.iter().map(|ci| ci.powf(e)).collect() };
     let cost = |p: [f64; 2]| -> f64 {
         let n = p[0].clamp(0.0, MAX_EXPONENT);
         let m = p[1].clamp(0.0, MAX_EXPONENT);
-        let a = best_a(n, m);
-        sse(c, y, |ci| a * ci.powf(n) + (1.0 - a) * ci.powf(m))
+        weight_and_sse(&powers(n), &powers(m)).1
     };
     // Exponents spaced quadratically: fine where panel lights live (0…10), coarse above.
+    // Their powers are computed once for the whole grid.
     const K: usize = 60;
     let grid: Vec<f64> = (0..=K)
         .map(|k| MAX_EXPONENT * (k as f64 / K as f64).powi(2))
         .collect();
+    let table: Vec<Vec<f64>> = grid.iter().map(|&e| powers(e)).collect();
     let mut best = ([0.0, 0.0], f64::INFINITY);
-    for (i, &n) in grid.iter().enumerate() {
-        for &m in &grid[i..] {
-            let v = cost([n, m]);
+    for i in 0..grid.len() {
+        for j in i..grid.len() {
+            let v = weight_and_sse(&table[i], &table[j]).1;
             if v < best.1 {
-                best = ([n, m], v);
+                best = ([grid[i], grid[j]], v);
             }
         }
     }
@@ -329,7 +338,7 @@ fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
     if n > m {
         std::mem::swap(&mut n, &mut m);
     }
-    let a = best_a(n, m);
+    let a = weight_and_sse(&powers(n), &powers(m)).0;
     Params::Lobes { a, n, m }
 }
 
