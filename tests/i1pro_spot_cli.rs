@@ -79,9 +79,11 @@ fn light_on_the_grid(dir: &std::path::Path) -> [f64; 3] {
 fn emissive_json_matches_color_xyz_of_its_spectrum_and_of_the_light() {
     let dir = temp_dir("emissive");
     let want = light_on_the_grid(&dir);
+    // Without noise: the whole-count rounding of the reading and the darks, about one count
+    // in a blue band of 4000 at the sensor target.
     for (spec, tol) in [
-        ("sim:i1pro?time_scale=0&noise=off", 1e-4),
-        ("sim:i1pro?time_scale=0&noise=off&rev=e", 1e-4),
+        ("sim:i1pro?time_scale=0&noise=off", 3e-4),
+        ("sim:i1pro?time_scale=0&noise=off&rev=e", 3e-4),
         ("sim:i1pro?time_scale=0&seed=7", 4.0 * REPEATABILITY_Y),
     ] {
         let csv = dir.join("spectrum.csv");
@@ -219,7 +221,7 @@ fn bad_integration_and_modes_are_usage_or_instrument_errors() {
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.contains("--integration 10: expected auto or a time in seconds from 0.005 to 4.45"),
+        e.contains("--integration 10: expected auto or a time in seconds from 0.004716 to 2"),
         "{e}"
     );
     let o = metamer(&[

@@ -5,15 +5,20 @@
 //! Tolerances: the PCS numbers are 16-bit. A curve entry is a multiple of 1/65535 and a
 //! colorant of 1/65536, so near black one step moves a* or b* by up to
 //! 500·7.787·(1/65535)/0.96 ≈ 0.06 (the slope of CIELAB's linear segment): max ΔE00 0.05
-//! for matrix/TRC over every patch, mean 0.005. The LUT profiles add the 33³ CLUT's
-//! trilinear interpolation of a model that interpolates its own grid tetrahedrally: max
-//! ΔE00 0.1. The D50 adaptation is exact in both (the same Bradford matrix is in `chad`).
+//! for matrix/TRC over every patch, mean 0.005. The LUT profiles' A2B0 puts its nodes on
+//! the model's levels, so tetrahedral interpolation (the readback's, and LittleCMS's)
+//! follows the model to the same 16-bit limits. The D50 adaptation is exact in both (the
+//! same Bradford matrix is in `chad`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use metamer::color::{delta_e2000, Xyz};
-use metamer::display::icc::{agreement, encode_icc, pcs::D50, IccForward, IccVersion, Pcs};
+use metamer::display::icc::layout::{tags, HEADER};
+use metamer::display::icc::{
+    agreement, encode_icc, icc_white, inverse_agreement, pcs::D50, profile_pcs, IccForward,
+    IccVersion,
+};
 use metamer::display::{fit_profile, read_measurement_file, ModelKind, Profile};
 use moxcms::{ColorProfile, DataColorSpace, ProfileClass, ProfileVersion};
 
@@ -44,7 +49,8 @@ const MATRIX_MODELS: [ModelKind; 3] = [
 fn matrix_profiles_carry_the_model_and_the_required_tags() {
     for kind in MATRIX_MODELS {
         let (profile, drives) = fitted(kind);
-        let pcs = Pcs::new(profile.white_xyz).unwrap();
+        let pcs = profile_pcs(&profile).unwrap();
+        let white = icc_white(&profile);
         for version in [IccVersion::V4, IccVersion::V2_4] {
             let icc = encode_icc(&profile, version, "test display").unwrap();
             assert_eq!(icc.summary.clipped_black, [0.0; 3], "{kind}");
@@ -57,12 +63,14 @@ fn matrix_profiles_carry_the_model_and_the_required_tags() {
                 IccVersion::V2_4 => ProfileVersion::V2_4,
             };
             assert_eq!(p.version(), expected);
-            // lumi: the measured white in cd/m² (s15Fixed16: 1/65536 steps).
+            // lumi: the model's white in cd/m² (s15Fixed16: 1/65536 steps), within its
+            // fit of the measured 120.25.
             let lumi = p.luminance.unwrap();
-            assert!((lumi.y - 120.25).abs() < 1e-4, "{}", lumi.y);
-            // chad takes the measured white (Y = 1) to D50.
+            assert!((lumi.y - white[1]).abs() < 1e-4, "{}", lumi.y);
+            assert!((lumi.y - 120.25).abs() < 1.5, "{}", lumi.y);
+            // chad takes the model's white (Y = 1) to D50.
             let chad = p.chromatic_adaptation.unwrap().v;
-            let w = profile.white_xyz.map(|v| v / profile.white_xyz[1]);
+            let w = white.map(|v| v / white[1]);
             for r in 0..3 {
                 let v: f64 = (0..3).map(|c| chad[r][c] * w[c]).sum();
                 assert!((v - D50[r]).abs() < 1e-4, "chad row {r}: {v}");
@@ -91,7 +99,53 @@ fn matrix_profiles_carry_the_model_and_the_required_tags() {
                 worst < 0.05 && mean < 0.005,
                 "{kind} {version}: {mean} {worst}"
             );
+            // RGB 1,1,1 is the PCS white: the colorants sum to D50 (what qcms checks).
+            let sum = [p.red_colorant, p.green_colorant, p.blue_colorant]
+                .iter()
+                .fold([0.0; 3], |a, c| [a[0] + c.x, a[1] + c.y, a[2] + c.z]);
+            for k in 0..3 {
+                assert!((sum[k] - D50[k]).abs() < 2e-4, "{kind} {version}: {sum:?}");
+            }
+            check_layout(&icc.bytes, false);
         }
+    }
+}
+
+/// ICC.1:2010 §7: every tag's data on a 4-byte boundary inside the file, the file a
+/// multiple of 4 bytes long and as long as its header says, the tag count what the table
+/// holds, and the tags a display profile needs.
+fn check_layout(bytes: &[u8], lut: bool) {
+    let be = |at: usize| u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(be(0), bytes.len(), "header size");
+    assert_eq!(bytes.len() % 4, 0, "file size {}", bytes.len());
+    let count = be(HEADER);
+    let t = tags(bytes).unwrap();
+    assert_eq!(t.len(), count);
+    let table_end = HEADER + 4 + 12 * count;
+    let mut spans = Vec::new();
+    for i in 0..count {
+        let (sig, offset, size) = (
+            String::from_utf8_lossy(&bytes[HEADER + 4 + 12 * i..HEADER + 8 + 12 * i]).to_string(),
+            be(HEADER + 8 + 12 * i),
+            be(HEADER + 12 + 12 * i),
+        );
+        assert_eq!(offset % 4, 0, "{sig} at {offset}");
+        assert!(offset >= table_end && offset + size <= bytes.len(), "{sig}");
+        spans.push((offset, offset + size, sig));
+    }
+    spans.sort();
+    for w in spans.windows(2) {
+        assert!(w[0].1 <= w[1].0, "{} overlaps {}", w[0].2, w[1].2);
+    }
+    let sigs: Vec<&str> = spans.iter().map(|s| s.2.as_str()).collect();
+    let mut need = vec![
+        "desc", "cprt", "wtpt", "lumi", "chad", "rXYZ", "gXYZ", "bXYZ", "rTRC", "gTRC", "bTRC",
+    ];
+    if lut {
+        need.extend(["A2B0", "B2A0"]);
+    }
+    for n in need {
+        assert!(sigs.contains(&n), "no {n} in {sigs:?}");
     }
 }
 
@@ -104,6 +158,32 @@ fn lut_profiles_carry_the_model_in_a2b0_and_invert_it_in_b2a0() {
         assert!(p.lut_a_to_b_perceptual.is_some() && p.lut_b_to_a_perceptual.is_some());
         let a = agreement(&icc.bytes, &profile, &drives).unwrap();
         assert!(a.max_de00 < 0.1 && a.mean_de00 < 0.01, "{version}: {a:?}");
+        // B2A0 then the model gives back each patch's colour (all inside the gamut).
+        let b = inverse_agreement(&icc.bytes, &profile, &drives).unwrap();
+        assert!(b.max_de00 < 0.3 && b.mean_de00 < 0.03, "{version}: {b:?}");
+        // The matrix/TRC tags a reader without LUT support uses: the model's shapers and
+        // primaries, RGB 1,1,1 at the PCS white.
+        let m = IccForward::parse_matrix(&icc.bytes).unwrap();
+        let w = m.pcs_xyz([1.0; 3]);
+        for k in 0..3 {
+            assert!((w[k] - D50[k]).abs() < 5e-4, "{w:?}");
+        }
+        let pcs = profile_pcs(&profile).unwrap();
+        let worst = drives
+            .iter()
+            .map(|&d| {
+                delta_e2000(
+                    lab_d50(pcs.to_pcs(profile.forward(d))),
+                    lab_d50(m.pcs_xyz(d)),
+                )
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 3.0,
+            "matrix/TRC tags of the LUT profile: max ΔE00 {worst}"
+        );
+        eprintln!("lut {version}: A2B0 {a:?}, B2A0 {b:?}, matrix/TRC tags max ΔE00 {worst:.3}");
+        check_layout(&icc.bytes, true);
     }
 }
 
@@ -197,7 +277,7 @@ fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
             })
             .collect();
         assert_eq!(rows.len(), devices.len(), "{text}");
-        let pcs = Pcs::new(profile.white_xyz).unwrap();
+        let pcs = profile_pcs(&profile).unwrap();
         let mut worst = 0.0f64;
         for (d, theirs) in devices.iter().zip(rows) {
             let ours = pcs.to_pcs(profile.forward(*d));

@@ -187,3 +187,117 @@ fn spot_spectrum_on_a_colorimeter_is_refused_before_measuring() {
     assert!(!out.contains("#1"), "a reading was taken first: {out}");
     assert!(!csv.exists());
 }
+
+/// A real instrument with nobody at it: every guided command, its stdin not a terminal and
+/// without `--unattended`, refuses before any reading, naming `--unattended`. The meter is a
+/// live CS-100A emulator on a pseudo-terminal that counts what it is asked to measure:
+/// nothing, until `--unattended` says the rig may measure alone.
+#[cfg(unix)]
+#[test]
+fn a_real_instrument_with_nobody_at_it_is_refused_before_any_reading() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+
+    use metamer_drivers::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
+    use metamer_drivers::cs100a::pty::PtyEmulator;
+    use metamer_drivers::{View, World};
+
+    struct Counted(AtomicUsize);
+    impl World for Counted {
+        fn view(&self) -> View {
+            self.0.fetch_add(1, Ordering::SeqCst);
+            View::from([95.047, 100.0, 108.883])
+        }
+    }
+    let seen = Arc::new(Counted(AtomicUsize::new(0)));
+    let config = EmulatorConfig {
+        seed: 1,
+        time_scale: 0.0,
+        noise: false,
+    };
+    let emu = PtyEmulator::start(Cs100aEmulator::new(seen.clone(), config)).unwrap();
+    let meter = format!("cs100a:{}", emu.path());
+    let d = scratch("unattended");
+    let out = d.join("out").display().to_string();
+    let box_plan = d.join("plan.json");
+    std::fs::write(&box_plan, r#"{"patches": [1]}"#).unwrap();
+    let box_plan = box_plan.display().to_string();
+    let sessions: [&[&str]; 5] = [
+        &[
+            "measure-box",
+            "-o",
+            &out,
+            "--plan",
+            &box_plan,
+            "--spectral",
+            "i1pro",
+            "--spot",
+            &meter,
+        ],
+        &[
+            "measure-box",
+            "-o",
+            &out,
+            "--spectral",
+            "replay:x.jsonl",
+            "--spot",
+            &meter,
+            "--stage",
+            "spots",
+        ],
+        &[
+            "characterize",
+            "--display",
+            "virtual",
+            "--instrument",
+            &meter,
+            "-o",
+            &out,
+        ],
+        &["spot", "--instrument", &meter, "--count", "3"],
+        &[
+            "experiment",
+            "-o",
+            &out,
+            "--spectral",
+            "sim:i1pro",
+            "--spot",
+            &meter,
+        ],
+    ];
+    for args in sessions {
+        let (code, _, err) = refused(args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!(
+                "{meter} is a real instrument and stdin is not a terminal"
+            )) || err.contains("i1pro is a real instrument and stdin is not a terminal"),
+            "{args:?}: {err}"
+        );
+        assert!(
+            err.contains("add --unattended") && err.contains("nothing was measured"),
+            "{args:?}: {err}"
+        );
+        assert!(!d.join("out").exists(), "{args:?} wrote {out}");
+    }
+    assert_eq!(
+        seen.0.load(Ordering::SeqCst),
+        0,
+        "the meter was asked to measure"
+    );
+    // Said unattended, the same meter measures: the refusal above was not a dead port.
+    let o = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args([
+            "spot",
+            "--instrument",
+            &meter,
+            "--count",
+            "2",
+            "--unattended",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(seen.0.load(Ordering::SeqCst), 2);
+    std::fs::remove_dir_all(&d).unwrap();
+}

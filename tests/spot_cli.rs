@@ -114,6 +114,8 @@ fn sim_human_output_and_spec_options() {
         "sim:cs100a?time_scale=0&noise=off",
         "--speed",
         "slow",
+        // A real meter's port, and stdin is not a terminal: nobody to ask, by choice.
+        "--unattended",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
@@ -236,7 +238,12 @@ fn bad_specs_and_arguments() {
     );
     let o = metamer(&["spot", "--instrument", "sim:cs100a", "--count", "0"]);
     assert_eq!(o.status.code(), Some(2));
-    let o = metamer(&["spot", "--instrument", "cs100a:/dev/metamer-missing"]);
+    let o = metamer(&[
+        "spot",
+        "--instrument",
+        "cs100a:/dev/metamer-missing",
+        "--unattended",
+    ]);
     assert_eq!(o.status.code(), Some(1));
     assert!(
         stderr(&o).contains("serial port /dev/metamer-missing does not exist"),
@@ -333,6 +340,8 @@ fn a_meter_on_a_serial_port() {
         "2",
         "--speed",
         "slow",
+        // A real meter's port, and stdin is not a terminal: nobody to ask, by choice.
+        "--unattended",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     for v in json_lines(&o) {

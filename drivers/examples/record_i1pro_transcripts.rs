@@ -131,7 +131,7 @@ fn light() -> View {
 
 /// The XYZ of the light on the instrument's 36 bands.
 fn exact(s: &Spectrum) -> [f64; 3] {
-    let grid = Spectrum::from_grid(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
+    let grid = Spectrum::measured(380.0, 10.0, s.on_grid(380.0, 10.0, 36)).unwrap();
     radiance_to_xyz(&grid, ObserverKind::Cie1931).to_array()
 }
 
@@ -155,7 +155,7 @@ fn main() {
     let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
     r.calibrate(emissive);
     r.measure(emissive, light(), Some(led));
-    r.finish(&path, "Rev D (firmware 505): open (GetMisc, reset, clock mode, whole EEPROM), dark calibration on the white tile (darks at 5 ms and 2 s), one emissive reading of 100 cd/m² of LED-RGB1 with the integration time found by a trial reading. Recorded from sim:i1pro with noise off.");
+    r.finish(&path, "Rev D (firmware 505): open (GetMisc, reset, its two clock modes read by selecting each, whole EEPROM), dark calibration on the white tile (212 readings of 4.716 ms in clock mode 2, nine of 2 s in mode 1), one emissive reading of 100 cd/m² of LED-RGB1 with the integration time (1.82 s) found by a trial reading. Recorded from sim:i1pro with noise off.");
 
     let path = p("fixed_integration");
     let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
@@ -209,7 +209,7 @@ fn main() {
         View::radiance(default_light().scaled(10.0)).unwrap(),
         None,
     );
-    r.finish(&path, "Rev D: 100 000 cd/m² saturates the sensor at the trial time and again at the shortest time (too bright); then 1000 cd/m² at a fixed 0.5 s saturates too. Both are errors that say what to do, never a clipped spectrum. Recorded from sim:i1pro with noise off.");
+    r.finish(&path, "Rev D: 100 000 cd/m² saturates the sensor at the trial time and again at the shortest time, 4.716 ms in clock mode 2 (too bright); then 1000 cd/m² at a fixed 0.5 s saturates too. Both are errors that say what to do, never a clipped spectrum. Recorded from sim:i1pro with noise off.");
 
     let path = p("too_dark");
     let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
@@ -219,7 +219,7 @@ fn main() {
         View::radiance(default_light().scaled(1e-6)).unwrap(),
         None,
     );
-    r.finish(&path, "Rev D: 0.0001 cd/m² gives no signal above the dark threshold even at the longest integration time (4.46 s): too dark. Recorded from sim:i1pro with noise off.");
+    r.finish(&path, "Rev D: 0.0001 cd/m² gives no signal distinguishable from the sensor's noise even at the longest integration time (2 s): too dark. Recorded from sim:i1pro with noise off.");
 
     let path = p("eeprom_missing_key");
     let r = Run::open(
@@ -242,7 +242,7 @@ fn main() {
         View::WhiteTile,
     );
     r.calibrate(emissive);
-    r.finish(&path, "Rev D: the first dark's bulk read delivers 1024 of its 2048 bytes; the driver reports the short read and makes no reading of it. Recorded from sim:i1pro with its short-read fault injected.");
+    r.finish(&path, "Rev D: the first dark's bulk read delivers 27136 of its 54272 bytes (212 readings); the driver reports the short read and makes no reading of it. Recorded from sim:i1pro with its short-read fault injected.");
 
     let path = p("disconnect_mid_read");
     let mut r = Run::open(
@@ -257,9 +257,64 @@ fn main() {
     r.measure(emissive, light(), None);
     r.finish(&path, "Rev D: the instrument is unplugged while the driver waits for the trial reading's data: a disconnect error naming the request, no reading. Recorded from sim:i1pro with its disconnect fault injected.");
 
+    let path = p("short_integration_bright");
+    let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
+    r.calibrate(emissive);
+    let bright = default_light().scaled(300.0);
+    r.measure(
+        emissive,
+        View::radiance(bright.clone()).unwrap(),
+        Some(exact(&bright)),
+    );
+    r.measure(emissive, light(), Some(led));
+    r.finish(&path, "Rev D: 30 000 cd/m² (a bare LED, a lamp): the trial at 0.1 s saturates, the trial at 4.716 ms (clock mode 2, 131 clocks of 36 µs) gives the rate, and the reading integrates 6.05 ms in mode 2, below mode 1's 8.84 ms; then 100 cd/m² in mode 1 again. Recorded from sim:i1pro with noise off.");
+
+    let path = p("one_clock_mode_bright");
+    let mut r = Run::open(
+        &path,
+        EmulatorConfig {
+            clock_modes: 1,
+            ..quiet(Revision::AToD)
+        },
+        View::WhiteTile,
+    );
+    r.calibrate(emissive);
+    r.measure(emissive, View::radiance(bright).unwrap(), None);
+    let lamp = default_light().scaled(200.0);
+    r.measure(
+        emissive,
+        View::radiance(lamp.clone()).unwrap(),
+        Some(exact(&lamp)),
+    );
+    r.finish(&path, "Rev D that reports one clock mode (68 µs × 130): the shortest integration is 8.84 ms, never less; 30 000 cd/m² saturates there (too bright, the unit has no shorter mode), 20 000 cd/m² is measured at 9.0 ms. Recorded from sim:i1pro with one clock mode and noise off.");
+
+    let path = p("display_luminances");
+    let mut r = Run::open(&path, quiet(Revision::AToD), View::WhiteTile);
+    r.calibrate(emissive);
+    for cd in [0.22, 10.0, 300.0, 1000.0] {
+        let s = default_light().scaled(cd / 100.0);
+        let x = (cd >= 100.0).then(|| exact(&s));
+        r.measure(emissive, View::radiance(s).unwrap(), x);
+    }
+    r.finish(&path, "Rev D: the integration times real luminances force: a display's black (0.22 cd/m²) and 10 cd/m² at the longest time (2 s), 300 cd/m² at 0.60 s, a 1000 cd/m² light tile at 0.18 s. Recorded from sim:i1pro with noise off.");
+
+    let path = p("ambient_no_table");
+    let mut r = Run::open(
+        &path,
+        EmulatorConfig {
+            no_ambient_table: true,
+            ..quiet(Revision::AToD)
+        },
+        View::WhiteTile,
+    );
+    r.measure(MeasureMode::Ambient, light(), None);
+    r.calibrate(emissive);
+    r.measure(emissive, light(), Some(led));
+    r.finish(&path, "Rev D whose EEPROM's capability bits (0x0BC2 = 0x6000) claim the diffuser while its ambient table (0x044E) is the −1 \"no ambient\" marker: ambient mode is refused with the reason, before any transfer; emissive readings work. Recorded from sim:i1pro with that table.");
+
     let path = p("rev_e_open_reading");
     let mut r = Run::open(&path, quiet(Revision::E), View::WhiteTile);
     r.calibrate(emissive);
     r.measure(emissive, light(), Some(led));
-    r.finish(&path, "Rev E (i1Pro 2, firmware 629): open (GetMisc, reset, measurement characteristics, EEPROM size, 16 KiB EEPROM with both directories), bands from the factory wavelength cubic, dark calibration and one emissive reading with 0xD4. Recorded from sim:i1pro?rev=e with noise off.");
+    r.finish(&path, "Rev E (i1Pro 2, firmware 629): open (GetMisc, reset, measurement characteristics, EEPROM size, 16 KiB EEPROM with both directories), bands from the factory wavelength cubic, dark calibration (204 readings of 4.896 ms, nine of 2 s) and one emissive reading with 0xD4. Recorded from sim:i1pro?rev=e with noise off.");
 }

@@ -32,5 +32,5 @@ pub use instrument::{
 };
 pub use open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
 pub use permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};
-pub use spec::{check_spec, open_instrument, open_instrument_with};
+pub use spec::{check_spec, is_physical, open_instrument, open_instrument_with};
 pub use world::{Light, SharedWorld, View, World, DEFAULT_STIMULUS_XYZ};

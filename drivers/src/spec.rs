@@ -54,6 +54,22 @@ pub fn check_spec(spec: &str) -> Result<(), DriverError> {
     check_in(registry::MODELS, spec)
 }
 
+/// Whether `spec` names a physical instrument (`cs100a:PORT`, `i1pro[:SERIAL]`): not a
+/// simulation and not a replayed transcript, so something real is measured and somebody
+/// has to place, aim or calibrate it. A spec naming no model is not (opening it fails).
+pub fn is_physical(spec: &str) -> bool {
+    is_physical_in(registry::MODELS, spec)
+}
+
+fn is_physical_in(models: &[Model], spec: &str) -> bool {
+    let (kind, _) = spec.split_once(':').unwrap_or((spec, ""));
+    kind != REPLAY_PREFIX
+        && kind != SIM_PREFIX
+        && models
+            .iter()
+            .any(|m| m.spec_prefixes.contains(&kind) && m.real.is_some())
+}
+
 fn check_in(models: &[Model], spec: &str) -> Result<(), DriverError> {
     let unknown = || DriverError::UnknownSpec {
         spec: spec.to_string(),
@@ -240,6 +256,28 @@ mod tests {
             e.to_string().starts_with("the cs100a cannot do reflective"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn only_a_device_spec_is_physical() {
+        for spec in [
+            "cs100a:/dev/ttyUSB0",
+            "cs100a:COM3",
+            "i1pro",
+            "i1pro:1234567",
+        ] {
+            assert!(is_physical(spec), "{spec}");
+        }
+        for spec in [
+            "sim:cs100a",
+            "sim:i1pro?time_scale=0",
+            "replay:session.jsonl",
+            "replay:cs100a:odd-name.jsonl",
+            "i1d3:1",
+            "",
+        ] {
+            assert!(!is_physical(spec), "{spec}");
+        }
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //! `build.rs`). Each header's `expect` lists the steps and what the user must see: the
 //! readings the live driver got when the transcript was recorded (replay must give them
 //! again to the last bit), for noise-free recordings also the exact XYZ of the light (the
-//! colour core on the light's 36 bands, to 1e-4), or an error message (a substring). Time
+//! colour core on the light's 36 bands, to 3e-4: the whole-count rounding of the reading
+//! and of the darks), or an error message (a substring). Time
 //! moves only by `advance_s` steps, so calibrations expire exactly where the transcript did.
 
 use std::path::Path;
@@ -93,7 +94,7 @@ fn replay_transcript(path: &str) {
             if let Some(exact) = step.get("exact_XYZ").and_then(Value::as_array) {
                 for (g, w) in r.xyz.iter().zip(exact) {
                     let w = w.as_f64().unwrap();
-                    assert!((g - w).abs() / w < 1e-4, "{at}: {:?} vs {exact:?}", r.xyz);
+                    assert!((g - w).abs() / w < 3e-4, "{at}: {:?} vs {exact:?}", r.xyz);
                 }
             }
             let flags: Vec<&str> = r.flags.iter().map(|f| f.name()).collect();

@@ -438,13 +438,15 @@ impl BoxPlan {
     /// target again.
     pub fn prompt(&self, target: &Target) -> String {
         match target {
-            Target::Tile { row, col } => {
-                format!("place the i1Pro on tile row {row}, column {col} of the light")
-            }
+            Target::Tile { row, col } => format!(
+                "place the i1Pro on tile row {row}, column {col} of the light on the left wall ({})",
+                self.tile_place(*row, *col)
+            ),
             Target::Falloff { plane, angle_deg } => {
                 let [row, col] = self.falloff_tile();
                 format!(
-                    "aim the spot meter at the centre of tile row {row}, column {col} from {} in the {} plane ({})",
+                    "aim the spot meter at the centre of tile row {row}, column {col} ({}) from {} in the {} plane ({})",
+                    self.tile_place(row, col),
                     signed(*angle_deg),
                     plane.name(),
                     direction(*plane, *angle_deg)
@@ -458,10 +460,47 @@ impl BoxPlan {
                 patch_name(*patch)
             ),
             Target::Spot { patch } => format!(
-                "aim the spot meter from the viewpoint at ColorChecker patch {patch} ({})",
+                "aim the spot meter from the viewpoint at ColorChecker patch {patch} ({}) on the right wall",
                 patch_name(*patch)
             ),
         }
+    }
+
+    /// Where tile (row, col) of the light is, as the operator finds it looking into the box
+    /// through its open front (the light on the left wall; row 0 at the top, column 0
+    /// nearest the open front: `docs/validation-box.md`): `the top corner nearest the open
+    /// front`, `3rd row from the top, 4th column from the open front`.
+    pub fn tile_place(&self, row: usize, col: usize) -> String {
+        let (rows, cols) = (self.geometry.rows, self.geometry.cols);
+        let top = row == 0;
+        let bottom = row + 1 == rows;
+        let front = col == 0;
+        let back = col + 1 == cols;
+        let centre = |i: usize, n: usize| n % 2 == 1 && i == n / 2;
+        if rows == 1 && cols == 1 {
+            return "the whole light".into();
+        }
+        if rows > 1 && cols > 1 && (top || bottom) && (front || back) {
+            let v = if top { "top" } else { "bottom" };
+            let h = if front { "the open front" } else { "the back" };
+            return format!("the {v} corner nearest {h}");
+        }
+        if centre(row, rows) && centre(col, cols) {
+            return "the centre tile".into();
+        }
+        let vertical = match () {
+            _ if rows == 1 => "the only row".to_string(),
+            _ if top => "top row".to_string(),
+            _ if bottom => "bottom row".to_string(),
+            _ => format!("{} row from the top", ordinal(row + 1)),
+        };
+        let horizontal = match () {
+            _ if cols == 1 => "the only column".to_string(),
+            _ if front => "column nearest the open front".to_string(),
+            _ if back => "column nearest the back".to_string(),
+            _ => format!("{} column from the open front", ordinal(col + 1)),
+        };
+        format!("{vertical}, {horizontal}")
     }
 
     /// One stage as a session plan; its options are the stage and the plan's canonical
@@ -482,6 +521,18 @@ impl BoxPlan {
             steps: self.steps(stage),
         }
     }
+}
+
+/// `1st`, `2nd`, `3rd`, `4th`, … `11th`, `21st`.
+fn ordinal(n: usize) -> String {
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
 }
 
 fn signed(angle_deg: f64) -> String {
@@ -535,9 +586,22 @@ mod tests {
         assert_eq!(
             tiles[5 * 13].prepare,
             Prepare::Operator {
-                prompt: "place the i1Pro on tile row 2, column 3 of the light".into()
+                prompt: "place the i1Pro on tile row 2, column 3 of the light on the left wall \
+                         (3rd row from the top, 4th column from the open front)"
+                    .into()
             }
         );
+        let place = |r, c| p.tile_place(r, c);
+        assert_eq!(place(0, 0), "the top corner nearest the open front");
+        assert_eq!(place(4, 4), "the bottom corner nearest the back");
+        assert_eq!(place(2, 2), "the centre tile");
+        assert_eq!(place(0, 2), "top row, 3rd column from the open front");
+        assert_eq!(
+            place(3, 0),
+            "4th row from the top, column nearest the open front"
+        );
+        assert_eq!(ordinal(12), "12th");
+        assert_eq!(ordinal(22), "22nd");
         assert_eq!(p.falloff_tile(), [2, 2]);
         assert_eq!(Plane::Vertical.c_gamma(-40.0), (270.0, 40.0));
         assert_eq!(Plane::Horizontal.c_gamma(20.0), (0.0, 20.0));

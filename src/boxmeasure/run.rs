@@ -12,7 +12,8 @@ use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary
 use super::plan::{BoxPlan, BoxStep, Stage, SPECTRAL, SPOT};
 use crate::output::OutputPolicy;
 use crate::session::{
-    Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session, SessionError,
+    placements, Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session,
+    SessionError, StageOf,
 };
 
 /// What to measure and how.
@@ -152,14 +153,27 @@ pub fn run(
         if session.done() == total {
             continue;
         }
+        let number = Stage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;
+        let of = Stage::ALL.len();
+        progress.stage(&StageOf {
+            number,
+            of,
+            name: stage.name().into(),
+        });
+        let placed = placements(&session.plan().steps)
+            .iter()
+            .enumerate()
+            .filter(|(i, r)| r.as_ref().is_some_and(|r| r.start == *i))
+            .count();
+        let what = format!("stage {number}/{of} {stage}: {total} readings at {placed} placements");
         if session.recovered > 0 || session.torn_bytes > 0 {
             progress.note(&format!(
-                "resuming {stage}: {} of {total} readings in {}",
+                "resuming {what}; {} of them are in {}",
                 session.recovered,
                 path.display()
             ));
         } else {
-            progress.note(&format!("stage {stage}: {total} readings"));
+            progress.note(&what);
         }
         let end = session
             .run(&mut rig, &options.run, progress)

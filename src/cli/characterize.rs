@@ -14,8 +14,8 @@ use metamer::display::ModelKind;
 use metamer::output::OutputPolicy;
 use metamer::rig::ScreenSpec;
 use metamer::session::{
-    on_ctrl_c, refuse_existing, BarProgress, JournalError, RunEnd, RunOptions, SessionError,
-    TerminalOperator,
+    attendance, on_ctrl_c, refuse_existing, Attendance, BarProgress, JournalError, RunEnd,
+    RunOptions, SessionError,
 };
 use metamer_drivers::{open_instrument, DriverError, Speed};
 
@@ -69,6 +69,10 @@ pub struct Args {
     /// replaces its own without it).
     #[arg(long)]
     force: bool,
+    /// Nobody is at the rig: take every reading without asking anyone to aim or calibrate
+    /// the instrument. A real instrument without a terminal on stdin needs it.
+    #[arg(long)]
+    unattended: bool,
     /// Stop after N new readings, as if interrupted (tests; splitting a long session).
     #[arg(long, value_name = "N", hide = true)]
     stop_after: Option<usize>,
@@ -86,6 +90,9 @@ pub fn run(args: Args) -> CliResult {
         grid_steps,
     };
     Plan::new(plan).map_err(|e| CliError::Usage(plan_usage(&e)))?;
+    // Before anything is opened: a real meter with nobody to aim it is refused.
+    let attended = attendance(&[&args.instrument], args.unattended)
+        .map_err(super::measure_box::nobody_at_the_rig)?;
     if !args.resume {
         // Before a full-screen window or an instrument is opened for nothing.
         refuse_existing(&log_path(&args.out))
@@ -139,8 +146,8 @@ pub fn run(args: Args) -> CliResult {
         &options,
         display.as_mut(),
         instrument.as_mut(),
-        &mut TerminalOperator,
-        &mut BarProgress::new("patch"),
+        attended.operator().as_mut(),
+        &mut BarProgress::new("patch").attended(attended == Attendance::Terminal),
     )
     .map_err(translate)?;
     match outcome {
@@ -166,12 +173,18 @@ pub fn run(args: Args) -> CliResult {
                     )
                     .into(),
                 )),
-                RunEnd::Aborted { .. } => Err(CliError::Failed(
-                    format!(
-                        "stopped at the operator's request with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
-                    )
-                    .into(),
-                )),
+                RunEnd::Aborted { .. } if done == 0 => {
+                    println!(
+                        "stopped at your request before any of the {total} readings: continue with --resume (log: {log})"
+                    );
+                    Ok(())
+                }
+                RunEnd::Aborted { .. } => {
+                    println!(
+                        "stopped at your request with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
+                    );
+                    Ok(())
+                }
             }
         }
     }

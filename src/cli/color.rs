@@ -34,6 +34,19 @@ enum QuantityArg {
     Reflectance,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum MethodArg {
+    /// CIE 15:2018's standard method: a spectrum on an even grid coarser than 1 nm (5 nm,
+    /// an i1Pro's 10 nm) is interpolated to 1 nm by Sprague (CIE 167:2005), held at its end
+    /// values beyond its range and summed over 360–830 nm; a spectrum at 1 nm is summed as
+    /// given, over 380–780 nm.
+    Cie15,
+    /// Linear interpolation to 1 nm, a radiance zero and a reflectance held outside its
+    /// table, summed over 380–780 nm (paper Eq. 8; what the renderer and the validation box
+    /// do with their tables).
+    Linear,
+}
+
 #[derive(clap::Args)]
 struct XyzArgs {
     /// Spectral CSV: '#' comments, header 'nm,…', rows of wavelength and values.
@@ -52,6 +65,10 @@ struct XyzArgs {
     /// Only this column (its header name, or the number before ':' in ColorChecker files).
     #[arg(long)]
     column: Option<String>,
+    /// How the samples are integrated (protocols/color/README.md compares the two with
+    /// ArgyllCMS and colour-science).
+    #[arg(long, value_enum, default_value = "cie15")]
+    method: MethodArg,
     /// JSON: one object per column, one per line.
     #[arg(long)]
     json: bool,
@@ -116,13 +133,11 @@ fn xyz(a: XyzArgs) -> CliResult {
     // A chosen column is named in the output, as every column of a file with several is.
     let named = columns.len() > 1 || a.column.is_some();
     for (name, spectrum) in columns {
-        let d = describe(
-            &spectrum.with_outside(outside),
-            quantity,
-            &illuminant,
-            a.observer,
-            white,
-        );
+        let spectrum = match a.method {
+            MethodArg::Cie15 => spectrum.with_outside(outside).as_measured(),
+            MethodArg::Linear => spectrum.with_outside(outside),
+        };
+        let d = describe(&spectrum, quantity, &illuminant, a.observer, white);
         let mut numbers: Vec<f64> = d.xyz.to_array().into();
         numbers.extend(d.xyy.to_array());
         numbers.extend(d.lab.map(|l| l.to_array()).into_iter().flatten());

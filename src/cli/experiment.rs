@@ -87,6 +87,10 @@ pub struct Args {
     /// Do not mirror the reproduced image (the paper views the display in a mirror).
     #[arg(long)]
     no_mirror: bool,
+    /// Nobody is at the rig: take every reading without asking anyone to place, aim or
+    /// calibrate the instruments. Real instruments without a terminal on stdin need it.
+    #[arg(long)]
+    unattended: bool,
 }
 
 pub fn run_cli(args: Args) -> CliResult {
@@ -168,12 +172,19 @@ pub fn run_cli(args: Args) -> CliResult {
         repeats: args.repeats,
         stage,
         resume: args.resume,
-        unattended: false,
+        unattended: args.unattended,
         run: RunOptions {
             stop_after: None,
             interrupt: Some(interrupt),
         },
     };
+    // Before any stage runs: a real rig with nobody to ask is refused.
+    let specs: Vec<&str> = match &opts.box_source {
+        BoxSource::Measure(m) => vec![&m.spectral, &m.spot, &opts.display.spot],
+        BoxSource::Existing { .. } => vec![&opts.display.spot],
+    };
+    metamer::session::attendance(&specs, args.unattended)
+        .map_err(super::measure_box::nobody_at_the_rig)?;
     let shown = StageProgress::default();
     let outcomes = run(&opts, &|p| shown.show(p));
     shown.finish();

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::{CliError, CliResult};
-use metamer::display::icc::{agreement, encode_icc, IccVersion};
+use metamer::display::icc::{agreement, encode_icc, inverse_agreement, IccVersion};
 use metamer::display::{
     fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
 };
@@ -174,6 +174,12 @@ pub fn run(args: Args) -> CliResult {
             check.max_de00,
             check.points
         );
+        if let Ok(inverse) = inverse_agreement(&icc.bytes, &profile, &drives) {
+            println!(
+                "its B2A0 inverts the model to ΔE00 mean {:.4}, max {:.4} over the same patches",
+                inverse.mean_de00, inverse.max_de00
+            );
+        }
         let clipped = icc.summary.clipped_black;
         if clipped.iter().any(|&v| v > 0.0) {
             println!(

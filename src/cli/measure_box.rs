@@ -13,8 +13,8 @@ use metamer::output::OutputPolicy;
 use metamer::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use metamer::rig::Scenario;
 use metamer::session::{
-    on_ctrl_c, BarProgress, JournalError, Operator, RunEnd, RunOptions, SessionError,
-    TerminalOperator,
+    attendance, on_ctrl_c, Attendance, BarProgress, JournalError, NobodyAtTheRig, Operator, RunEnd,
+    RunOptions, SessionError,
 };
 use metamer_drivers::{open_instrument, DriverError, Instrument, SharedWorld, View, World};
 
@@ -56,6 +56,10 @@ pub struct Args {
     /// Replace an existing scene.json, light.json/.svg/.ies/.ldt or summary.json in DIR.
     #[arg(long)]
     force: bool,
+    /// Nobody is at the rig: take every reading without asking anyone to place, aim or
+    /// calibrate the instruments. Real instruments without a terminal on stdin need it.
+    #[arg(long)]
+    unattended: bool,
     /// Stop after N new readings, as if interrupted (tests; splitting a long session).
     #[arg(long, value_name = "N", hide = true)]
     stop_after: Option<usize>,
@@ -115,6 +119,9 @@ pub fn run(args: Args) -> CliResult {
         ));
     }
     let light = box_light(args.scenario.as_deref(), simulated[0])?;
+    // Before anything is opened: a real rig with nobody to ask is refused.
+    let attended =
+        attendance(&[&args.spectral, &args.spot], args.unattended).map_err(nobody_at_the_rig)?;
     let mut rig_options = BTreeMap::new();
     let (mut spectral, mut spot, mut operator): (_, _, Box<dyn Operator>) = if simulated[0] {
         let light = light.unwrap_or_default();
@@ -134,7 +141,7 @@ pub fn run(args: Args) -> CliResult {
         (
             open(&args.spectral, None)?,
             open(&args.spot, None)?,
-            Box::new(TerminalOperator),
+            attended.operator(),
         )
     };
     let mut output = OutputPolicy::new(args.force);
@@ -164,7 +171,8 @@ pub fn run(args: Args) -> CliResult {
             spot: spot.as_mut(),
         },
         operator.as_mut(),
-        &mut BarProgress::new("reading"),
+        &mut BarProgress::new("reading")
+            .attended(!simulated[0] && attended == Attendance::Terminal),
     )
     .map_err(translate)?;
     match outcome {
@@ -186,9 +194,15 @@ pub fn run(args: Args) -> CliResult {
         } => {
             let missing = total - done;
             let log = log.display();
-            let text = format!(
-                "stage {stage}: {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
-            );
+            let text = if done == 0 {
+                format!(
+                    "stage {stage}: none of its {total} readings taken yet: continue with --resume"
+                )
+            } else {
+                format!(
+                    "stage {stage}: {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
+                )
+            };
             match end {
                 RunEnd::Stopped { .. } | RunEnd::Complete => {
                     println!("stopped: {text}");
@@ -197,9 +211,10 @@ pub fn run(args: Args) -> CliResult {
                 RunEnd::Interrupted { .. } => {
                     Err(CliError::Failed(format!("interrupted: {text}").into()))
                 }
-                RunEnd::Aborted { .. } => Err(CliError::Failed(
-                    format!("stopped at the operator's request: {text}").into(),
-                )),
+                RunEnd::Aborted { .. } => {
+                    println!("stopped at your request: {text}");
+                    Ok(())
+                }
             }
         }
     }
@@ -230,8 +245,21 @@ fn translate(e: MeasureBoxError) -> CliError {
         )),
         MeasureBoxError::Session {
             stage,
-            source: SessionError::Step { .. },
-        } => Some(format!("stage {stage}: {}; then run the same command with --resume", e_source(&e))),
+            source:
+                SessionError::Step {
+                    index,
+                    total,
+                    label,
+                    prepare,
+                    done,
+                    journal,
+                    source,
+                },
+        } => Some(format!(
+            "stage {stage}, reading {} of {total} ({label}: {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+            index + 1,
+            journal.display()
+        )),
         _ => None,
     };
     match text {
@@ -240,11 +268,11 @@ fn translate(e: MeasureBoxError) -> CliError {
     }
 }
 
-fn e_source(e: &MeasureBoxError) -> String {
-    match e {
-        MeasureBoxError::Session { source, .. } => source.to_string(),
-        e => e.to_string(),
-    }
+/// A real rig with nobody to ask, refused in the words of the command line.
+pub(super) fn nobody_at_the_rig(e: NobodyAtTheRig) -> CliError {
+    usage(format!(
+        "{e}. Run the command at a terminal, or add --unattended if the rig may measure without anyone at it; nothing was measured"
+    ))
 }
 
 fn print_summary(s: &Summary) -> CliResult {

@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use clap::ValueEnum;
 use metamer::color::{colorchecker, ColorCheckerSet};
-use metamer::session::TerminalOperator;
-use metamer::spot::{read, spectra_csv, SimulatedHands};
+use metamer::session::attendance;
+use metamer::spot::{read, spectra_csv, SimulatedHands, SpotError};
 use metamer_drivers::i1pro::emulator::default_light;
 use metamer_drivers::{
     open_instrument_with, DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Speed, View,
@@ -69,6 +69,10 @@ pub struct Args {
     /// Record the exchange with the instrument to this new transcript (never overwritten).
     #[arg(long, value_name = "FILE.jsonl")]
     record: Option<PathBuf>,
+    /// Nobody is at the instrument: calibrate and read without asking. A real instrument
+    /// without a terminal on stdin needs it (an i1Pro would calibrate wherever it points).
+    #[arg(long)]
+    unattended: bool,
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -94,6 +98,9 @@ pub fn run(args: Args) -> CliResult {
         // Before measuring: a refused output is found while nothing is lost.
         spectrum_out.check(path)?;
     }
+    // Before the instrument is opened: a real one with nobody to place it is refused.
+    let attended = attendance(&[&args.instrument], args.unattended)
+        .map_err(super::measure_box::nobody_at_the_rig)?;
     let mode = match args.mode {
         ModeArg::Emissive => MeasureMode::Emissive,
         ModeArg::Reflective => MeasureMode::Reflective,
@@ -146,10 +153,21 @@ pub fn run(args: Args) -> CliResult {
     if !args.json {
         writeln!(out, "{} on {}", info.model, info.connection)?;
     }
-    let mut operator = TerminalOperator;
+    let mut operator = attended.operator();
     let mut readings = Vec::new();
     for i in 1..=args.count {
-        let reading = read(instrument.as_mut(), mode, &mut operator, hands.as_ref())?;
+        let reading = match read(instrument.as_mut(), mode, operator.as_mut(), hands.as_ref()) {
+            Ok(r) => r,
+            Err(SpotError::Declined(_)) => {
+                eprintln!(
+                    "stopped at your request after {} of {} readings",
+                    readings.len(),
+                    args.count
+                );
+                break;
+            }
+            Err(e) => return Err(e.into()),
+        };
         if args.json {
             writeln!(out, "{}", json_line(&reading))?;
         } else {
@@ -159,7 +177,7 @@ pub fn run(args: Args) -> CliResult {
         out.flush()?;
         readings.push(reading);
     }
-    if let Some(path) = &args.spectrum {
+    if let Some(path) = args.spectrum.as_ref().filter(|_| !readings.is_empty()) {
         let csv = spectra_csv(&readings).ok_or_else(|| {
             CliError::Usage(format!(
                 "--spectrum: the {} returned readings without a spectrum",

@@ -2,7 +2,8 @@
 //! validation box): a plan of steps ([`plan`]), a durable resumable journal ([`journal`]) of
 //! what was measured ([`record`]), and a runner that takes each step the journal lacks
 //! ([`runner`]; calibrate, prepare, settle, measure: [`step`]),
-//! with the operator ([`operator`]), the screen ([`screen`]), progress ([`progress`]) and
+//! with the operator ([`operator`]), the readings a placement should repeat ([`repeats`]),
+//! the screen ([`screen`]), progress ([`progress`]) and
 //! Ctrl-C ([`interrupt`]) as small parts a caller supplies or picks.
 
 pub mod interrupt;
@@ -11,15 +12,19 @@ pub mod operator;
 pub mod plan;
 pub mod progress;
 pub mod record;
+pub mod repeats;
 pub mod runner;
 pub mod screen;
 pub mod step;
 
 pub use interrupt::on_ctrl_c;
 pub use journal::{refuse_existing, torn_path, CalibrationRecord, Header, Journal, JournalError};
-pub use operator::{Answer, Operator, OperatorError, ScriptedOperator, TerminalOperator};
-pub use plan::{Prepare, SessionPlan, Step};
-pub use progress::{BarProgress, NoProgress, ProgressSink, StepProgress};
+pub use operator::{
+    attendance, Answer, Attendance, NobodyAtTheRig, Operator, OperatorError, Readings, Recheck,
+    ScriptedOperator, TerminalOperator, Unattended,
+};
+pub use plan::{placements, Prepare, SessionPlan, Step};
+pub use progress::{BarProgress, NoProgress, ProgressSink, StageOf, StepProgress};
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
 pub use screen::{DisplayScreen, Screen};

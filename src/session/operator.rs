@@ -1,5 +1,6 @@
 //! The person at the rig: asked to act (cap the sensor, place the instrument on a tile,
-//! aim the meter) and to confirm when done, or to abort the session.
+//! aim the meter) and to confirm when done, or to abort the session; and whether anybody
+//! is there to ask at all.
 
 use std::io::{BufRead, IsTerminal, Write};
 
@@ -12,6 +13,44 @@ pub enum Answer {
     Abort,
 }
 
+/// What to do with a reading that differs from its placement's earlier readings by more
+/// than the instrument repeats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Recheck {
+    /// The instrument was re-aimed or re-placed: set this reading aside and read again.
+    Again,
+    /// Keep it (the target did change, or the operator trusts it).
+    Keep,
+    /// Stop the session here; the reading is not kept.
+    Stop,
+}
+
+/// The readings one placement is for, so a request can say how many are coming.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Readings {
+    /// The first reading this request is for, 1-based (above 1 when a placement is asked
+    /// again: after a calibration, or when a resumed session continues mid-placement).
+    pub first: usize,
+    /// Readings of the placement in all.
+    pub of: usize,
+}
+
+impl std::fmt::Display for Readings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (self.first, self.of) {
+            (_, 1) => f.write_str("1 reading"),
+            (1, n) => write!(f, "{n} readings"),
+            (k, n) if k == n => write!(f, "reading {n} of {n}"),
+            (k, n) => write!(f, "readings {k}–{n} of {n}"),
+        }
+    }
+}
+
+/// A placement request as the terminal shows it: `{what} — 5 readings`.
+pub fn placement_prompt(what: &str, readings: Readings) -> String {
+    format!("{what} — {readings}")
+}
+
 /// The operator could not be asked.
 #[derive(Debug, thiserror::Error)]
 #[error("asking the operator: {0}")]
@@ -21,35 +60,146 @@ pub struct OperatorError(#[from] pub std::io::Error);
 pub trait Operator {
     /// Shows `prompt` and waits until the operator has done it or declines.
     fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError>;
+
+    /// Asks for the placement `what` (the plan's words, the same for each of its readings)
+    /// before `readings` of it are taken. By default [`Operator::ask`] with `what` alone:
+    /// a simulated rig acts on the plan's words.
+    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+        let _ = readings;
+        self.ask(what)
+    }
+
+    /// A reading differs from its placement's earlier ones (`why` says how): read it again,
+    /// keep it, or stop. By default kept: a script or a simulated rig has nothing to re-aim.
+    fn recheck(&mut self, why: &str) -> Result<Recheck, OperatorError> {
+        let _ = why;
+        Ok(Recheck::Keep)
+    }
 }
 
 /// The operator at the terminal: the prompt on stderr, Enter confirms, `q` (or `abort`)
-/// then Enter, or end of input, aborts. Without a terminal on stdin (scripts, CI) nobody can
-/// act on a prompt, so every request counts as done.
+/// then Enter, or end of input, aborts. Without a terminal on stdin nobody can act on a
+/// prompt, so every request counts as done: a command lets that happen only where nothing
+/// physical is measured or the user said the rig runs unattended ([`attendance`]).
 #[derive(Debug, Default)]
 pub struct TerminalOperator;
 
+/// One line from the terminal after `prompt`; None without a terminal.
+fn read_answer(prompt: &str) -> Result<Option<String>, OperatorError> {
+    let stdin = std::io::stdin();
+    if !stdin.is_terminal() {
+        return Ok(None);
+    }
+    eprint!("{prompt} ");
+    std::io::stderr().flush()?;
+    let mut line = String::new();
+    if stdin.lock().read_line(&mut line)? == 0 {
+        // End of input (Ctrl-D) stops, as `q` does; end the prompt's line.
+        eprintln!();
+        return Ok(Some("q".into()));
+    }
+    Ok(Some(line.trim().to_lowercase()))
+}
+
+fn is_stop(answer: &str) -> bool {
+    matches!(answer, "q" | "quit" | "abort" | "stop")
+}
+
 impl Operator for TerminalOperator {
     fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
-        let stdin = std::io::stdin();
-        if !stdin.is_terminal() {
-            return Ok(Answer::Confirmed);
-        }
-        eprint!("{prompt}; press Enter when done (q to stop) ");
-        std::io::stderr().flush()?;
-        let mut line = String::new();
-        if stdin.lock().read_line(&mut line)? == 0 {
-            return Ok(Answer::Abort);
-        }
-        Ok(match line.trim() {
-            "q" | "quit" | "abort" => Answer::Abort,
-            _ => Answer::Confirmed,
+        Ok(
+            match read_answer(&format!("{prompt}; press Enter when done (q to stop)"))? {
+                Some(a) if is_stop(&a) => Answer::Abort,
+                _ => Answer::Confirmed,
+            },
+        )
+    }
+
+    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+        self.ask(&placement_prompt(what, readings))
+    }
+
+    fn recheck(&mut self, why: &str) -> Result<Recheck, OperatorError> {
+        let prompt = format!(
+            "{why}: re-aim and press Enter to read it again, k then Enter to keep it (q to stop)"
+        );
+        Ok(match read_answer(&prompt)? {
+            None => Recheck::Keep,
+            Some(a) if is_stop(&a) => Recheck::Stop,
+            Some(a) if matches!(a.as_str(), "k" | "keep") => Recheck::Keep,
+            Some(_) => Recheck::Again,
         })
     }
 }
 
+/// Nobody at the rig, by the user's choice: every request counts as done without a word.
+#[derive(Debug, Default)]
+pub struct Unattended;
+
+impl Operator for Unattended {
+    fn ask(&mut self, _: &str) -> Result<Answer, OperatorError> {
+        Ok(Answer::Confirmed)
+    }
+}
+
+/// Who answers a session's requests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Attendance {
+    /// Somebody at the terminal: ask them ([`TerminalOperator`]).
+    Terminal,
+    /// Nobody: the user said so, or no terminal and nothing physical measured (simulated
+    /// or replayed instruments), so every request counts as done.
+    Unattended,
+}
+
+impl Attendance {
+    /// The operator that answers for this attendance.
+    pub fn operator(self) -> Box<dyn Operator> {
+        match self {
+            Attendance::Terminal => Box::new(TerminalOperator),
+            Attendance::Unattended => Box::new(Unattended),
+        }
+    }
+}
+
+/// A physical instrument would be driven with nobody to place, aim or calibrate it.
+#[derive(Debug, thiserror::Error)]
+#[error("{spec} is a real instrument and stdin is not a terminal: nobody can be asked to place, aim or calibrate it, and it would measure wherever it points")]
+pub struct NobodyAtTheRig {
+    /// The first physical instrument's spec.
+    pub spec: String,
+}
+
+/// Who answers the requests of a session with the instruments `specs` (as the user named
+/// them): refused when one is physical, stdin is no terminal and the user did not say
+/// `unattended`; nothing is opened, so the refusal comes before any reading.
+pub fn attendance(specs: &[&str], unattended: bool) -> Result<Attendance, NobodyAtTheRig> {
+    attendance_with(specs, unattended, std::io::stdin().is_terminal())
+}
+
+/// [`attendance`] with the terminal's presence given (for tests).
+pub fn attendance_with(
+    specs: &[&str],
+    unattended: bool,
+    terminal: bool,
+) -> Result<Attendance, NobodyAtTheRig> {
+    if unattended {
+        return Ok(Attendance::Unattended);
+    }
+    if terminal {
+        return Ok(Attendance::Terminal);
+    }
+    match specs.iter().find(|s| metamer_drivers::is_physical(s)) {
+        Some(spec) => Err(NobodyAtTheRig {
+            spec: spec.to_string(),
+        }),
+        None => Ok(Attendance::Unattended),
+    }
+}
+
 /// An operator that follows a script and remembers every prompt it was shown: for tests
-/// and simulated rigs, where nothing has to be done by hand.
+/// and simulated rigs, where nothing has to be done by hand. Placement requests are
+/// remembered as the terminal shows them (with their reading count).
 #[derive(Debug, Default)]
 pub struct ScriptedOperator {
     /// Answers in order; when they run out, every further request is confirmed.
@@ -77,5 +227,53 @@ impl Operator for ScriptedOperator {
     fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
         self.prompts.push(prompt.to_string());
         Ok(self.answers.pop_front().unwrap_or(Answer::Confirmed))
+    }
+
+    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+        self.ask(&placement_prompt(what, readings))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_placement_says_how_many_readings_it_is_for() {
+        let p = |first, of| placement_prompt("aim at patch 1", Readings { first, of });
+        assert_eq!(p(1, 1), "aim at patch 1 — 1 reading");
+        assert_eq!(p(1, 5), "aim at patch 1 — 5 readings");
+        assert_eq!(p(3, 5), "aim at patch 1 — readings 3–5 of 5");
+        assert_eq!(p(5, 5), "aim at patch 1 — reading 5 of 5");
+    }
+
+    #[test]
+    fn a_real_instrument_needs_a_terminal_or_unattended() {
+        let real = ["sim:i1pro", "cs100a:/dev/ttyUSB0"];
+        let e = attendance_with(&real, false, false).unwrap_err();
+        assert_eq!(e.spec, "cs100a:/dev/ttyUSB0");
+        assert_eq!(
+            attendance_with(&real, true, false).unwrap(),
+            Attendance::Unattended
+        );
+        assert_eq!(
+            attendance_with(&real, false, true).unwrap(),
+            Attendance::Terminal
+        );
+        // Said unattended at a terminal: nobody is asked.
+        assert_eq!(
+            attendance_with(&real, true, true).unwrap(),
+            Attendance::Unattended
+        );
+        // Simulated and replayed instruments measure nothing real.
+        let played = ["sim:cs100a", "replay:a.jsonl"];
+        assert_eq!(
+            attendance_with(&played, false, false).unwrap(),
+            Attendance::Unattended
+        );
+        assert_eq!(
+            attendance_with(&played, false, true).unwrap(),
+            Attendance::Terminal
+        );
     }
 }

@@ -5,10 +5,12 @@ use std::time::Duration;
 
 use metamer_drivers::{MeasureMode, Reading};
 
+use super::repeats::Deviation;
+
 /// One step as it is done.
 #[derive(Clone, Copy, Debug)]
 pub struct StepProgress<'a> {
-    /// Entries in the journal now, this one included.
+    /// Entries in the journal once this reading is kept, this one included.
     pub done: usize,
     pub total: usize,
     /// The step's plan index.
@@ -20,6 +22,20 @@ pub struct StepProgress<'a> {
     pub elapsed: Duration,
     /// The steps still to take at the mean pace of this run's steps so far.
     pub remaining: Duration,
+    /// (k, n): reading k (1-based) of the n its placement is for; None for a step the
+    /// operator does not set up (a colour shown on a screen).
+    pub placement: Option<(usize, usize)>,
+    /// How the reading differs from its placement's earlier ones, when by more than the
+    /// instrument repeats.
+    pub deviation: Option<&'a Deviation>,
+}
+
+/// Which part of a longer measurement a session is: stage `number` of `of`, `name`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StageOf {
+    pub number: usize,
+    pub of: usize,
+    pub name: String,
 }
 
 /// Receives a session's progress.
@@ -28,6 +44,12 @@ pub trait ProgressSink {
     fn start(&mut self, done: usize, total: usize) {
         let _ = (done, total);
     }
+    /// The session about to run is this stage of a longer measurement.
+    fn stage(&mut self, stage: &StageOf) {
+        let _ = stage;
+    }
+    /// A reading was taken: reported before it is journalled, so a reading the instrument
+    /// did not repeat can be shown before the operator is asked about it.
     fn step(&mut self, progress: &StepProgress<'_>);
     /// Something the operator should read (resuming, a calibration done).
     fn note(&mut self, text: &str) {
@@ -55,11 +77,56 @@ impl<F: FnMut(&StepProgress<'_>)> ProgressSink for F {
     }
 }
 
-/// A progress bar on stderr, for the command line; notes are printed above it.
+/// A reading's luminance (four significant digits, as the meters send) with its unit, and
+/// its chromaticity: `Y 101.2 cd/m² · xy 0.3127 0.3290`.
+pub fn reading_summary(mode: MeasureMode, r: &Reading) -> String {
+    let [x, y, lum] = r.xyy;
+    let lum = if lum.is_finite() { lum } else { r.xyz[1] };
+    let digits = if lum == 0.0 || !lum.is_finite() {
+        0
+    } else {
+        (3 - lum.abs().log10().floor() as i32).clamp(0, 6) as usize
+    };
+    let unit = match mode {
+        MeasureMode::Emissive => " cd/m²",
+        MeasureMode::Ambient => " lx",
+        MeasureMode::Reflective => " (white 100)",
+    };
+    let xy = if x.is_finite() && y.is_finite() {
+        format!("{x:.4} {y:.4}")
+    } else {
+        "—".into()
+    };
+    format!("Y {lum:.digits$}{unit} · xy {xy}")
+}
+
+/// The line shown after a reading: `reading 3/5 · stage 1/4 · Y 101.2 cd/m² · xy 0.3127
+/// 0.3290`, with what makes it doubtful appended; a step outside a placement is counted
+/// among all the session's (`patch 12/44`, with `noun`).
+pub fn reading_line(p: &StepProgress<'_>, stage: Option<&StageOf>, noun: &str) -> String {
+    let mut line = match p.placement {
+        Some((k, n)) => format!("reading {k}/{n}"),
+        None => format!("{noun} {}/{}", p.done, p.total),
+    };
+    if let Some(s) = stage {
+        line.push_str(&format!(" · stage {}/{} {}", s.number, s.of, s.name));
+    }
+    line.push_str(&format!(" · {}", reading_summary(p.mode, p.reading)));
+    if let Some(d) = p.deviation {
+        line.push_str(&format!(" · differs: {d}"));
+    }
+    line
+}
+
+/// A progress bar on stderr, for the command line; notes are printed above it. Attended,
+/// every reading of a placement also gets a line of its own above the bar, so the
+/// operator sees each value (the bar is cleared whenever a request waits for them).
 pub struct BarProgress {
     bar: indicatif::ProgressBar,
-    /// What a step is called in the bar (`patch`, `step`).
+    /// What a step is called in the bar (`patch`, `reading`).
     noun: &'static str,
+    stage: Option<StageOf>,
+    lines: bool,
 }
 
 impl BarProgress {
@@ -67,7 +134,15 @@ impl BarProgress {
         BarProgress {
             bar: indicatif::ProgressBar::hidden(),
             noun,
+            stage: None,
+            lines: false,
         }
+    }
+
+    /// A line per reading of a placement: somebody is at the rig, watching.
+    pub fn attended(mut self, attended: bool) -> BarProgress {
+        self.lines = attended;
+        self
     }
 }
 
@@ -85,9 +160,20 @@ impl ProgressSink for BarProgress {
         self.bar.reset_eta();
     }
 
+    fn stage(&mut self, stage: &StageOf) {
+        self.stage = Some(stage.clone());
+    }
+
     fn step(&mut self, p: &StepProgress<'_>) {
-        self.bar
-            .set_message(format!("{} → Y {:.3}", p.label, p.reading.xyz[1]));
+        let line = reading_line(p, self.stage.as_ref(), self.noun);
+        if (self.lines && p.placement.is_some()) || p.deviation.is_some() {
+            self.note(&format!("  {line}"));
+        }
+        self.bar.set_message(format!(
+            "{} → {}",
+            p.label,
+            reading_summary(p.mode, p.reading)
+        ));
         self.bar.set_position(p.done as u64);
     }
 
@@ -105,5 +191,47 @@ impl ProgressSink for BarProgress {
 
     fn finish(&mut self) {
         self.bar.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reading_line_says_where_the_session_is_and_what_was_read() {
+        let r = Reading::from_yxy(101.234, 0.31271, 0.32902, "cs100a");
+        let mut p = StepProgress {
+            done: 13,
+            total: 125,
+            index: 12,
+            label: "tile 0,2 #3",
+            mode: MeasureMode::Emissive,
+            reading: &r,
+            elapsed: Duration::ZERO,
+            remaining: Duration::ZERO,
+            placement: Some((3, 5)),
+            deviation: None,
+        };
+        let stage = StageOf {
+            number: 1,
+            of: 4,
+            name: "tiles".into(),
+        };
+        assert_eq!(
+            reading_line(&p, Some(&stage), "reading"),
+            "reading 3/5 · stage 1/4 tiles · Y 101.2 cd/m² · xy 0.3127 0.3290"
+        );
+        p.placement = None;
+        p.mode = MeasureMode::Reflective;
+        assert_eq!(
+            reading_line(&p, None, "patch"),
+            "patch 13/125 · Y 101.2 (white 100) · xy 0.3127 0.3290"
+        );
+        let dark = Reading::from_yxy(0.0123, f64::NAN, f64::NAN, "cs100a");
+        assert_eq!(
+            reading_summary(MeasureMode::Emissive, &dark),
+            "Y 0.01230 cd/m² · xy —"
+        );
     }
 }

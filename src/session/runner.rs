@@ -1,6 +1,8 @@
 //! Taking a plan's steps: for each step the journal lacks, in plan order, take it (calibrate
-//! if due, prepare, settle, measure: [`super::step`]), append the entry, report progress;
-//! stop before the next step on an interrupt.
+//! if due, prepare — the operator asked once per placement —, settle, measure:
+//! [`super::step`]), report it, put a reading its instrument cannot have repeated to the
+//! operator ([`super::repeats`]: read again, keep, stop), append the entry; stop before the
+//! next step on an interrupt.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -8,15 +10,18 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
+use metamer_drivers::Reading;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use super::journal::{
     CalibrationRecord, Header, Journal, JournalError, JOURNAL_FORMAT, JOURNAL_VERSION,
 };
-use super::plan::{Prepare, SessionPlan};
-use super::progress::{ProgressSink, StepProgress};
+use super::operator::Recheck;
+use super::plan::{placements, Prepare, SessionPlan};
+use super::progress::{reading_summary, ProgressSink, StepProgress};
 use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
+use super::repeats::{deviation, Repeatability};
 use super::step::{Rig, StepFailure, StepTaker};
 
 /// The session could not start or go on.
@@ -327,11 +332,13 @@ where
         progress: &mut dyn ProgressSink,
     ) -> Result<RunEnd, SessionError> {
         let total = self.plan.steps.len();
+        let placements = placements(&self.plan.steps);
+        let mut placed = None;
         let mut done = self.done();
         let mut new = 0usize;
         let start = Instant::now();
         let journal_path = self.journal.path().to_path_buf();
-        for index in 0..total {
+        for (index, placement) in placements.into_iter().enumerate() {
             if self.entries[index].is_some() {
                 continue;
             }
@@ -347,10 +354,6 @@ where
                 return Ok(RunEnd::Stopped { missing });
             }
             let step = &self.plan.steps[index];
-            // Step k's noise is the same whichever run takes it (see Instrument::seek_noise).
-            if let Some(instrument) = rig.instrument(&step.role) {
-                instrument.seek_noise(index as u64);
-            }
             let fail = |source: StepFailure| SessionError::Step {
                 index,
                 total,
@@ -360,18 +363,80 @@ where
                 journal: journal_path.clone(),
                 source: Box::new(source),
             };
-            let mut taker = StepTaker {
-                index,
-                step,
-                rig,
-                journal: &mut self.journal,
-                calibrations: &mut self.calibrations,
-                earlier_calibrations: self.earlier_calibrations,
-                progress,
-            };
-            let reading = match taker.take().map_err(fail)? {
-                Some(r) => r,
-                None => return Ok(RunEnd::Aborted { missing }),
+            // Step k's noise is the same whichever run takes it (see Instrument::seek_noise).
+            if let Some(instrument) = rig.instrument(&step.role) {
+                instrument.seek_noise(index as u64);
+            }
+            let reading = loop {
+                let mut taker = StepTaker {
+                    index,
+                    step,
+                    rig,
+                    journal: &mut self.journal,
+                    calibrations: &mut self.calibrations,
+                    earlier_calibrations: self.earlier_calibrations,
+                    progress,
+                    placement: placement.clone(),
+                    placed: &mut placed,
+                };
+                let reading = match taker.take().map_err(fail)? {
+                    Some(r) => r,
+                    None => return Ok(RunEnd::Aborted { missing }),
+                };
+                // The placement's readings before this one, earlier runs' included.
+                let earlier: Vec<&Reading> = placement
+                    .clone()
+                    .map(|r| r.start..index)
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|i| self.entries[i].as_ref().map(|e| &e.reading))
+                    .collect();
+                let model = rig
+                    .instrument(&step.role)
+                    .map(|i| i.info().model)
+                    .unwrap_or_default();
+                let deviation =
+                    deviation(&earlier, &reading, Repeatability::stated(&model, step.mode));
+                let elapsed = start.elapsed();
+                progress.step(&StepProgress {
+                    done: done + 1,
+                    total,
+                    index,
+                    label: &step.label,
+                    mode: step.mode,
+                    reading: &reading,
+                    elapsed,
+                    remaining: elapsed.mul_f64((total - done - 1) as f64 / (new + 1) as f64),
+                    placement: placement.as_ref().map(|r| (index - r.start + 1, r.len())),
+                    deviation: deviation.as_ref(),
+                });
+                if deviation.is_none() {
+                    break reading;
+                }
+                let why = match &placement {
+                    Some(r) => format!(
+                        "reading {}/{} ({}) differs",
+                        index - r.start + 1,
+                        r.len(),
+                        step.label
+                    ),
+                    None => format!("{} differs", step.label),
+                };
+                let operator = &mut *rig.operator;
+                let mut answer = Ok(Recheck::Keep);
+                progress.suspend(&mut || answer = operator.recheck(&why));
+                match answer.map_err(|e| fail(StepFailure::Operator(e)))? {
+                    Recheck::Keep => break reading,
+                    Recheck::Stop => return Ok(RunEnd::Aborted { missing }),
+                    Recheck::Again => {
+                        progress.note(&format!(
+                            "  set aside: {}; reading it again",
+                            reading_summary(step.mode, &reading)
+                        ));
+                        // The operator re-aimed and confirmed: the placement stands.
+                        placed = placement.as_ref().map(|r| r.start);
+                    }
+                }
             };
             let entry = Entry {
                 index,
@@ -386,17 +451,6 @@ where
                 .map_err(|e| fail(StepFailure::Journal(e)))?;
             done += 1;
             new += 1;
-            let elapsed = start.elapsed();
-            progress.step(&StepProgress {
-                done,
-                total,
-                index,
-                label: &step.label,
-                mode: step.mode,
-                reading: &entry.reading,
-                elapsed,
-                remaining: elapsed.mul_f64((total - done) as f64 / new as f64),
-            });
             self.entries[index] = Some(entry);
         }
         Ok(RunEnd::Complete)

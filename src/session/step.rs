@@ -12,7 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use super::journal::{CalibrationRecord, JournalError};
-use super::operator::{Answer, Operator, OperatorError};
+use super::operator::{Answer, Operator, OperatorError, Readings};
 use super::plan::{Prepare, Step};
 use super::progress::ProgressSink;
 use super::record::SessionJournal;
@@ -86,6 +86,12 @@ pub(super) struct StepTaker<'s, 'r, 'a, H, D> {
     /// How many of `calibrations` were journalled by earlier runs of the session.
     pub(super) earlier_calibrations: usize,
     pub(super) progress: &'s mut dyn ProgressSink,
+    /// The steps of this step's placement (see [`super::plan::placements`]).
+    pub(super) placement: Option<std::ops::Range<usize>>,
+    /// The first step of the placement the operator set up in this run, while it stands:
+    /// its later readings are taken without asking again. A calibration (the instrument
+    /// moved to its tile or capped) clears it.
+    pub(super) placed: &'s mut Option<usize>,
 }
 
 impl<'a, H, D> StepTaker<'_, '_, 'a, H, D>
@@ -192,7 +198,7 @@ where
             let outcome = self.instrument()?.calibrate(mode, &condition)?;
             let record = CalibrationRecord {
                 role: role.clone(),
-                instrument: model,
+                instrument: model.clone(),
                 mode,
                 condition: condition.clone(),
                 before_step: self.index,
@@ -200,14 +206,23 @@ where
                 time_s: metamer_drivers::instrument::now_s(),
             };
             self.journal.append_calibration(&record)?;
-            self.progress.note(&format!(
-                "calibrated the {role} instrument for {mode}: {}",
-                condition.prompt()
-            ));
             self.calibrations.push(record);
+            // Whatever the operator had set up, the instrument was moved for this.
+            *self.placed = None;
+            let how = calibrated(&condition);
             match outcome {
-                CalibrationOutcome::Done => return Ok(true),
-                CalibrationOutcome::Needs(next) => condition = next,
+                CalibrationOutcome::Done => {
+                    self.progress.note(&format!(
+                        "calibrated the {role} instrument ({model}) for {mode} readings {how}"
+                    ));
+                    return Ok(true);
+                }
+                CalibrationOutcome::Needs(next) => {
+                    self.progress.note(&format!(
+                        "the {role} instrument ({model}) took its {mode} calibration reading {how}; it needs one more"
+                    ));
+                    condition = next;
+                }
             }
         }
         Err(StepFailure::Calibration {
@@ -234,8 +249,38 @@ where
                 screen.show(*rgb).map_err(StepFailure::Screen)?;
                 Ok(true)
             }
-            Prepare::Operator { prompt } => Ok(self.ask(prompt)? == Answer::Confirmed),
+            Prepare::Operator { prompt } => {
+                let Some(range) = self.placement.clone() else {
+                    return Ok(self.ask(prompt)? == Answer::Confirmed);
+                };
+                if *self.placed == Some(range.start) {
+                    return Ok(true);
+                }
+                let readings = Readings {
+                    first: self.index - range.start + 1,
+                    of: range.len(),
+                };
+                let operator = &mut *self.rig.operator;
+                let mut answer = Ok(Answer::Abort);
+                self.progress
+                    .suspend(&mut || answer = operator.ask_placement(prompt, readings));
+                let confirmed = answer? == Answer::Confirmed;
+                if confirmed {
+                    *self.placed = Some(range.start);
+                }
+                Ok(confirmed)
+            }
             Prepare::None => Ok(true),
         }
+    }
+}
+
+/// How a calibration was taken, said after it: `on its white calibration tile`.
+fn calibrated(condition: &CalibrationCondition) -> String {
+    match condition {
+        CalibrationCondition::OnWhiteTile => "on its white calibration tile".into(),
+        CalibrationCondition::SensorCapped => "with its sensor capped".into(),
+        CalibrationCondition::OnTarget => "aimed at the target".into(),
+        CalibrationCondition::Other(s) => format!("({s})"),
     }
 }

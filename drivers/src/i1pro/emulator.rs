@@ -6,9 +6,13 @@
 //! sees (a light's radiance; under its lamp a surface's or the white tile's reflectance
 //! times the lamp) → the resampled values the calibration factors turn into it → the cell
 //! values the filter maps to them → plus the dark current → raw counts. Then the sensor's
-//! noise (photon noise, √counts, and a read noise of [`READ_NOISE`] counts) and its
-//! full well ([`FULL_WELL`], above the EEPROM's saturation threshold so the driver sees the
-//! saturation) apply.
+//! noise (shot noise of the light and of the dark current, √counts, and a read noise of
+//! [`READ_NOISE`] counts) and its full well ([`FULL_WELL`], above the EEPROM's saturation
+//! threshold so the driver sees the saturation) apply.
+//!
+//! It refuses (stalls) what a real unit cannot do rather than doing it anyway: an
+//! integration shorter than one sub-clock of the clock mode in force, a clock mode it does
+//! not have, and clock-mode requests on firmware before 301, which has none.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -39,10 +43,12 @@ pub const FULL_WELL: f64 = 60_000.0;
 pub fn lamp(nm: f64) -> f64 {
     1.5e6 * (0.25 + 0.75 * (nm - START_NM) / 350.0)
 }
-/// Repeatability the simulated instrument declares for an emissive reading near the sensor
-/// target: relative 1σ of Y (photon noise of ~37 000 counts averaged over the cells and
-/// readings, with margin).
-pub const REPEATABILITY_Y: f64 = 0.001;
+/// Repeatability the simulated instrument declares for an emissive reading whose largest
+/// cell reaches the sensor target (any light from about 90 cd/m² up; dimmer ones are
+/// integrated 2 s and are noisier in proportion): relative 1σ of Y. Measured 0.12 % on
+/// 100 cd/m² of LED-RGB1, one reading of 1.8 s with the shot noise of ~37 000 counts at
+/// its peak (`a_noisy_100_cd_white_repeats_within_the_documented_repeatability`).
+pub const REPEATABILITY_Y: f64 = 0.0015;
 /// Repeatability of a reflectance band, absolute 1σ (both the white and the sample shot are
 /// noisy).
 pub const REPEATABILITY_REFLECTANCE: f64 = 0.002;
@@ -77,6 +83,15 @@ pub struct EmulatorConfig {
     /// The unit starts in low power and still answers this many GetMisc in low power after
     /// the power-up reset.
     pub low_power_polls: u32,
+    /// Rev A–D: how many of the clock modes in [`synthetic::CLOCK_MODES`] the unit has (1:
+    /// only the 8.84 ms one).
+    pub clock_modes: u8,
+    /// The firmware revision GetMisc reports, if not the revision's usual one (Rev A–D
+    /// below 301 has no clock modes).
+    pub firmware: Option<u16>,
+    /// The capability bits claim the diffuser, but the ambient table is the "no ambient"
+    /// marker (−1 in every band).
+    pub no_ambient_table: bool,
 }
 
 impl Default for EmulatorConfig {
@@ -90,7 +105,21 @@ impl Default for EmulatorConfig {
             missing_keys: Vec::new(),
             fault: None,
             low_power_polls: 0,
+            clock_modes: 2,
+            firmware: None,
+            no_ambient_table: false,
         }
+    }
+}
+
+impl EmulatorConfig {
+    fn firmware(&self) -> u16 {
+        self.firmware
+            .unwrap_or_else(|| synthetic::firmware(self.revision))
+    }
+
+    fn has_clock_modes(&self) -> bool {
+        self.revision == Revision::AToD && self.firmware() >= 301
     }
 }
 
@@ -100,7 +129,10 @@ pub struct I1ProEmulator {
     world: Arc<dyn World>,
     cal: Calibration,
     image: Vec<u8>,
-    params: (u64, u64, u64, bool),
+    /// Integration time, readings and lamp of the last SetMeasParams.
+    params: (f64, u64, bool),
+    /// The clock mode in force (Rev A–D), from 1.
+    mode: u8,
     pending: Option<(Duration, Vec<u8>)>,
     measurements: u32,
     rng: u64,
@@ -168,10 +200,19 @@ pub fn default_light() -> Spectrum {
 
 impl I1ProEmulator {
     pub fn new(world: Arc<dyn World>, config: EmulatorConfig) -> Result<I1ProEmulator, String> {
-        let image = synthetic::eeprom_image(config.revision, &config.missing_keys)
-            .map_err(|e| e.to_string())?;
+        if !(1..=synthetic::CLOCK_MODES.len() as u8).contains(&config.clock_modes) {
+            return Err(format!(
+                "clock_modes={}: the simulated unit has 1 or 2",
+                config.clock_modes
+            ));
+        }
+        let mut unit = synthetic::calibration(config.revision);
+        if config.no_ambient_table {
+            unit.ambient = None;
+        }
+        let image = synthetic::image_of(&unit, &config.missing_keys).map_err(|e| e.to_string())?;
         // The emulator computes with what the driver will read: the full image, parsed.
-        let full = synthetic::eeprom_image(config.revision, &[]).map_err(|e| e.to_string())?;
+        let full = synthetic::image_of(&unit, &[]).map_err(|e| e.to_string())?;
         let cal = super::unit_calibration(&full, config.revision).map_err(|e| e.to_string())?;
         Ok(I1ProEmulator {
             low_power: (config.low_power_polls > 0).then_some((false, config.low_power_polls)),
@@ -181,7 +222,8 @@ impl I1ProEmulator {
             world,
             cal,
             image,
-            params: (0, 0, 0, false),
+            params: (0.0, 0, false),
+            mode: 1,
             pending: None,
             measurements: 0,
         })
@@ -193,11 +235,33 @@ impl I1ProEmulator {
         self.noise.clone()
     }
 
-    fn clock_s(&self) -> f64 {
+    /// The clock mode in force as GetClockMode reports it.
+    fn clock_mode(&self) -> metamer_protocols::i1pro::replies::ClockMode {
+        let mut c = synthetic::CLOCK_MODES[usize::from(self.mode) - 1];
+        c.max = self.config.clock_modes;
+        c.current = self.mode;
+        c
+    }
+
+    /// The integration clock and sub-clock divider in force.
+    fn clock(&self) -> (f64, u64) {
         match self.config.revision {
-            Revision::AToD => f64::from(synthetic::CLOCK_MODE.clock_us) * 1e-6,
-            Revision::E => MeasChar::KNOWN.clock_s(),
+            Revision::AToD => {
+                let c = self.clock_mode();
+                (c.clock_s(), u64::from(c.sub_clock_divider))
+            }
+            Revision::E => (
+                MeasChar::KNOWN.clock_s(),
+                u64::from(MeasChar::KNOWN.divider),
+            ),
         }
+    }
+
+    /// The integration time of `int_clocks` clocks, or None where the unit refuses it:
+    /// less than one sub-clock of the mode in force.
+    fn integration(&self, int_clocks: u64) -> Option<f64> {
+        let (clock_s, divider) = self.clock();
+        (int_clocks >= divider).then_some(int_clocks as f64 * clock_s)
     }
 
     /// Dark counts of cell `j` after `t` seconds: the converter's bias, a whole number of
@@ -250,8 +314,7 @@ impl I1ProEmulator {
         })
     }
 
-    fn readings(&mut self, int_clocks: u64, n: u64, lamp_on: bool) -> Result<Vec<u8>, String> {
-        let t = int_clocks as f64 * self.clock_s();
+    fn readings(&mut self, t: f64, n: u64, lamp_on: bool) -> Result<Vec<u8>, String> {
         let e = Exposure {
             integration_s: t,
             gain: Gain::Normal,
@@ -281,8 +344,10 @@ impl I1ProEmulator {
             for (j, c) in r.cells.iter_mut().enumerate() {
                 let mut v = f64::from(*c);
                 if self.config.noise {
-                    let photons = (v - dark_counts[j]).max(0.0);
-                    v += (photons + READ_NOISE * READ_NOISE).sqrt() * self.gauss();
+                    // Shot noise of everything the cell collected (the light and the dark
+                    // current, not the converter's bias), and the read noise.
+                    let collected = (v - Self::dark_count(j, 0.0)).max(0.0);
+                    v += (collected + READ_NOISE * READ_NOISE).sqrt() * self.gauss();
                 }
                 *c = v.round().clamp(0.0, FULL_WELL) as i32;
             }
@@ -291,10 +356,10 @@ impl I1ProEmulator {
         readings::encode(&out, revision, synthetic::MAX_POSITIVE).map_err(|e| e.to_string())
     }
 
-    fn start(&mut self, int_clocks: u64, n: u64, lamp_on: bool) -> Answer<()> {
-        match self.readings(int_clocks, n, lamp_on) {
+    fn start(&mut self, t: f64, n: u64, lamp_on: bool) -> Answer<()> {
+        match self.readings(t, n, lamp_on) {
             Ok(bytes) => {
-                let t = int_clocks as f64 * self.clock_s() * n as f64
+                let t = t * n as f64
                     + if lamp_on {
                         super::wire::LAMP_WARMUP_S
                     } else {
@@ -328,6 +393,7 @@ impl UsbDevice for I1ProEmulator {
         match Request::decode(&transfer_in(setup, len), revision) {
             Ok(Request::GetMisc) => {
                 let mut misc = synthetic::misc(revision);
+                misc.firmware = self.config.firmware();
                 if let Some((reset, left)) = self.low_power {
                     misc.power = metamer_protocols::i1pro::replies::POWER_LOW;
                     if reset {
@@ -336,8 +402,8 @@ impl UsbDevice for I1ProEmulator {
                 }
                 Answer::Done(misc.encode().to_vec())
             }
-            Ok(Request::GetClockMode) if revision == Revision::AToD => {
-                Answer::Done(synthetic::CLOCK_MODE.encode().to_vec())
+            Ok(Request::GetClockMode) if self.config.has_clock_modes() => {
+                Answer::Done(self.clock_mode().encode().to_vec())
             }
             Ok(Request::GetMeasChar) => Answer::Done(MeasChar::KNOWN.encode().to_vec()),
             Ok(Request::GetEepromSize) => {
@@ -376,28 +442,41 @@ impl UsbDevice for I1ProEmulator {
                     None => Answer::Stall,
                 }
             }
-            Ok(Request::SetMeasParams(p)) => {
-                self.params = (
-                    u64::from(p.int_clocks),
-                    u64::from(p.lamp_clocks),
-                    u64::from(p.readings),
-                    p.flags & metamer_protocols::i1pro::commands::flags::LAMP_OFF == 0,
-                );
+            Ok(Request::SetClockMode(m))
+                if self.config.has_clock_modes() && (1..=self.config.clock_modes).contains(&m) =>
+            {
+                self.mode = m;
                 Answer::Done(())
             }
+            Ok(Request::SetClockMode(_)) => Answer::Stall,
+            Ok(Request::SetMeasParams(p)) => match self.integration(u64::from(p.int_clocks)) {
+                Some(t) => {
+                    self.params = (
+                        t,
+                        u64::from(p.readings),
+                        p.flags & metamer_protocols::i1pro::commands::flags::LAMP_OFF == 0,
+                    );
+                    Answer::Done(())
+                }
+                None => Answer::Stall,
+            },
             Ok(Request::Trigger)
                 if self.config.fault == Some(Fault::StallTrigger(self.measurements + 1)) =>
             {
                 Answer::Stall
             }
+            Ok(Request::Trigger) if self.params.1 == 0 => Answer::Stall,
             Ok(Request::Trigger) => {
-                let (t, _, n, lamp_on) = self.params;
+                let (t, n, lamp_on) = self.params;
                 self.start(t, n, lamp_on)
             }
-            Ok(Request::MeasureE(p)) => {
-                let lamp_on = p.flags & metamer_protocols::i1pro::commands::flags_e::LAMP != 0;
-                self.start(u64::from(p.int_clocks), u64::from(p.readings), lamp_on)
-            }
+            Ok(Request::MeasureE(p)) => match self.integration(u64::from(p.int_clocks)) {
+                Some(t) => {
+                    let lamp_on = p.flags & metamer_protocols::i1pro::commands::flags_e::LAMP != 0;
+                    self.start(t, u64::from(p.readings), lamp_on)
+                }
+                None => Answer::Stall,
+            },
             Ok(_) => Answer::Done(()),
             Err(_) => Answer::Stall,
         }

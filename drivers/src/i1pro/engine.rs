@@ -3,18 +3,24 @@
 //! the order the instrument needs them).
 
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Averaged, Exposure};
-use metamer_protocols::i1pro::{Calibration, Gain, RawReading, Spectrum};
+use metamer_protocols::i1pro::{Calibration, Gain, RawReading, Revision, Spectrum, CELLS};
 
 use super::error::I1ProError;
 use super::wire::{Shot, Wire};
 use crate::link::usb::UsbLink;
 use crate::DriverError;
 
-/// The long dark of an emissive calibration, seconds: with the one at the shortest
-/// integration time it gives the dark at any time by the codec's linear interpolation.
+/// The long dark of an emissive calibration and the longest integration the driver uses,
+/// seconds (ArgyllCMS's adaptive emissive mode aims at no more than 2 s, and its display
+/// mode integrates 2 s): every emissive time lies between the two darks, so its dark is
+/// interpolated, never extrapolated.
 pub const DARK_LONG_S: f64 = 2.0;
-/// Readings averaged in a dark at the shortest integration time.
-pub const DARK_READINGS: usize = 8;
+/// Readings in the long dark. With one reading of 2 s in a dim light's measurement, nine
+/// in the dark keep its noise at a third of the measurement's (see [`DarkPair::noise`]).
+pub const DARK_LONG_READINGS: usize = 9;
+/// The short dark integrates this long in all, over readings at the shortest time, seconds
+/// (ArgyllCMS: one second of dark at each time it interpolates from).
+pub const DARK_SHORT_TOTAL_S: f64 = 1.0;
 /// Reflective readings integrate this long with the lamp lit, seconds [I: the lamp and the
 /// white tile give counts near the sensor target in about this time].
 pub const REFLECTIVE_S: f64 = 0.02;
@@ -27,24 +33,65 @@ pub const TRIAL_S: f64 = 0.1;
 pub const EMISSIVE_TOTAL_S: f64 = 0.8;
 /// At most this many readings in one emissive shot.
 pub const MAX_READINGS: usize = 16;
+/// A light is too dark when its counts summed over the cells stay within this many
+/// standard deviations of the sensor's noise at the longest time.
+pub const TOO_DARK_SIGMAS: f64 = 5.0;
+/// No reading is more precise than its rounding to whole counts: 1/√12 count.
+const QUANTISATION_COUNTS: f64 = 0.288_675_134_594_812_9;
+
+/// A dark reference: its mean, its integration time, how many readings it averages, and
+/// the spread of one reading (counts, root mean square over the cells).
+#[derive(Clone, Debug)]
+pub struct Dark {
+    pub mean: AbsRaw,
+    pub integration_s: f64,
+    pub readings: usize,
+    pub sigma_counts: f64,
+}
 
 /// The two darks an emissive calibration takes, from which any integration time's dark is
 /// interpolated.
 #[derive(Clone, Debug)]
 pub struct DarkPair {
-    pub short: (AbsRaw, f64),
-    pub long: (AbsRaw, f64),
+    pub short: Dark,
+    pub long: Dark,
+}
+
+/// The noise of one cell of an emissive measurement in the dark, counts (1σ).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CellNoise {
+    /// Of the measurement's mean of readings: what the light has to rise above.
+    pub floor: f64,
+    /// Of the interpolated dark subtracted from it: the same offset in every measurement
+    /// until the next calibration.
+    pub dark: f64,
 }
 
 impl DarkPair {
     pub fn at(&self, t: f64) -> Result<AbsRaw, I1ProError> {
         Ok(pipeline::interpolate_dark(
-            &self.short.0,
-            self.short.1,
-            &self.long.0,
-            self.long.1,
+            &self.short.mean,
+            self.short.integration_s,
+            &self.long.mean,
+            self.long.integration_s,
             t,
         )?)
+    }
+
+    /// The noise budget at integration time `t` with `readings` readings: the noise of one
+    /// reading grows linearly in variance from the short dark's to the long one's (read
+    /// noise plus the dark current's shot noise), and the interpolated dark
+    /// `(1 − w)·d₁ + w·d₂`, `w = (t − t₁)/(t₂ − t₁)`, carries `(1 − w)²σ₁²/n₁ + w²σ₂²/n₂`.
+    pub fn noise(&self, t: f64, readings: usize) -> CellNoise {
+        let (s, l) = (&self.short, &self.long);
+        let w = ((t - s.integration_s) / (l.integration_s - s.integration_s)).clamp(0.0, 1.0);
+        let (v1, v2) = (s.sigma_counts.powi(2), l.sigma_counts.powi(2));
+        let one = (v1 + (v2 - v1) * w).max(QUANTISATION_COUNTS.powi(2));
+        let dark = (1.0 - w).powi(2) * v1 / s.readings as f64 + w.powi(2) * v2 / l.readings as f64;
+        CellNoise {
+            floor: (one / readings.max(1) as f64).sqrt(),
+            dark: dark.sqrt(),
+        }
     }
 }
 
@@ -53,8 +100,12 @@ pub struct Processed {
     pub spectrum: Spectrum,
     pub averaged: Averaged,
     pub integration_s: f64,
+    pub readings: usize,
     /// The largest dark-subtracted count of any cell.
     pub peak_counts: f64,
+    /// The dark-subtracted counts of the mean reading summed over the cells that carry
+    /// light (1–126 on Rev A–D, all 128 on Rev E).
+    pub signal_counts: f64,
 }
 
 fn exposure(t: f64) -> Exposure {
@@ -64,20 +115,29 @@ fn exposure(t: f64) -> Exposure {
     }
 }
 
-/// The integration time the instrument really uses for `t`: a whole number of clocks.
-pub fn quantize<L: UsbLink>(wire: &Wire<L>, t: f64) -> f64 {
-    (t / wire.clock_s).round().max(1.0) * wire.clock_s
+fn used_cells(revision: Revision) -> std::ops::Range<usize> {
+    match revision {
+        Revision::AToD => 1..CELLS - 1,
+        Revision::E => 0..CELLS,
+    }
 }
 
-/// The longest integration time: the EEPROM's, or less where the request cannot carry it
-/// (65535 clocks on Rev A–D).
-pub fn longest<L: UsbLink>(wire: &Wire<L>, cal: &Calibration) -> f64 {
-    let clocks = (cal.max_integration_s / wire.clock_s).floor();
-    let limit = match wire.revision {
-        metamer_protocols::i1pro::Revision::AToD => f64::from(u16::MAX),
-        metamer_protocols::i1pro::Revision::E => f64::from(u32::MAX),
-    };
-    clocks.min(limit) * wire.clock_s
+/// The integration time the instrument really uses for `t`: a whole number of clocks of
+/// the clock mode that runs it.
+pub fn quantize<L: UsbLink>(wire: &Wire<L>, t: f64) -> Result<f64, I1ProError> {
+    Ok(wire.plan(t)?.integration_s)
+}
+
+/// The shortest integration time: one sub-clock of the unit's finest clock mode. As
+/// ArgyllCMS, the driver goes by the clock, not by the EEPROM's minimum (key 0x04C5).
+pub fn shortest<L: UsbLink>(wire: &Wire<L>) -> Result<f64, I1ProError> {
+    quantize(wire, wire.shortest_s())
+}
+
+/// The longest integration time: [`DARK_LONG_S`], or the EEPROM's maximum if that is
+/// shorter.
+pub fn longest<L: UsbLink>(wire: &Wire<L>, cal: &Calibration) -> Result<f64, I1ProError> {
+    quantize(wire, DARK_LONG_S.min(cal.max_integration_s))
 }
 
 /// Takes a dark of `readings` at `t` and checks it saw no light.
@@ -86,8 +146,8 @@ pub fn dark<L: UsbLink>(
     cal: &Calibration,
     t: f64,
     readings: usize,
-) -> Result<AbsRaw, DriverError> {
-    let t = quantize(wire, t);
+) -> Result<Dark, DriverError> {
+    let t = quantize(wire, t)?;
     let raw = wire.shot(Shot {
         integration_s: t,
         readings,
@@ -104,22 +164,49 @@ pub fn dark<L: UsbLink>(
         }
         .into());
     }
-    Ok(avg.mean)
+    let sigma_counts = spread_counts(cal, &raw, &e, &avg.mean)?;
+    Ok(Dark {
+        mean: avg.mean,
+        integration_s: t,
+        readings,
+        sigma_counts,
+    })
 }
 
-/// The emissive (and ambient) dark calibration.
+/// The spread of one reading about the mean, counts: the root of the cells' mean sample
+/// variance (0 for a single reading, which shows none).
+fn spread_counts(
+    cal: &Calibration,
+    raw: &[RawReading],
+    e: &Exposure,
+    mean: &AbsRaw,
+) -> Result<f64, I1ProError> {
+    if raw.len() < 2 {
+        return Ok(0.0);
+    }
+    let cells = used_cells(cal.revision());
+    let mut sum = 0.0;
+    for r in raw {
+        let a = pipeline::to_absraw(cal, r, e)?;
+        for j in cells.clone() {
+            sum += ((a.cells[j] - mean.cells[j]) * e.integration_s).powi(2);
+        }
+    }
+    Ok((sum / ((raw.len() - 1) * cells.len()) as f64).sqrt())
+}
+
+/// The emissive (and ambient) dark calibration: [`DARK_SHORT_TOTAL_S`] of readings at the
+/// shortest time and [`DARK_LONG_READINGS`] at the longest.
 pub fn dark_pair<L: UsbLink>(
     wire: &mut Wire<L>,
     cal: &Calibration,
 ) -> Result<DarkPair, DriverError> {
-    let t1 = quantize(wire, cal.min_integration_s);
-    let t2 = quantize(wire, DARK_LONG_S.min(longest(wire, cal)));
-    let short = dark(wire, cal, t1, DARK_READINGS)?;
-    let long = dark(wire, cal, t2, 1)?;
-    Ok(DarkPair {
-        short: (short, t1),
-        long: (long, t2),
-    })
+    let t1 = shortest(wire)?;
+    let t2 = longest(wire, cal)?;
+    let n1 = ((DARK_SHORT_TOTAL_S / t1).round() as usize).clamp(1, usize::from(u16::MAX));
+    let short = dark(wire, cal, t1, n1)?;
+    let long = dark(wire, cal, t2, DARK_LONG_READINGS)?;
+    Ok(DarkPair { short, long })
 }
 
 /// One shot through steps 1–5 of the pipeline.
@@ -138,11 +225,17 @@ pub fn process<L: UsbLink>(
     })?;
     let e = exposure(t);
     let (spectrum, averaged) = pipeline::measure(cal, &raw, dark, &e).map_err(I1ProError::from)?;
+    let signal_counts = averaged.mean.cells[used_cells(cal.revision())]
+        .iter()
+        .sum::<f64>()
+        * t;
     Ok(Processed {
         spectrum,
         peak_counts: averaged.highest * t,
+        signal_counts,
         averaged,
         integration_s: t,
+        readings,
     })
 }
 
@@ -155,34 +248,41 @@ pub fn readings_for(t: f64) -> usize {
 ///
 /// The search: a trial reading at [`TRIAL_S`] (at the shortest time if that saturates)
 /// gives the peak count per second, and the time that puts the peak at the EEPROM's sensor
-/// target follows by proportion. The light may be too bright (saturating at the shortest
-/// time) or too dark (the peak at the longest time below the dark threshold, the sensor's
-/// noise floor): both are errors that say what to do, never a wrong spectrum.
+/// target follows by proportion, within the shortest and the longest time. The light may
+/// be too bright (saturating at the shortest time) or too dark (at the longest time, its
+/// counts summed over the cells within [`TOO_DARK_SIGMAS`] of the sensor's noise, as
+/// the dark calibration measured it): both are errors that say what to do, never a wrong
+/// spectrum. A dim light above that floor is measured, noisy as it is: a display's black
+/// is a reading, not an error.
 pub fn emissive_shot<L: UsbLink>(
     wire: &mut Wire<L>,
     cal: &Calibration,
     darks: &DarkPair,
     fixed: Option<f64>,
 ) -> Result<Processed, DriverError> {
-    let min = quantize(wire, cal.min_integration_s);
-    let max = longest(wire, cal);
-    let floor = |t: f64| f64::from(cal.dark_threshold) + 900.0 * t;
+    let min = shortest(wire)?;
+    let max = longest(wire, cal)?;
+    let one_mode = wire.modes.len() == 1;
+    let too_bright = || I1ProError::TooBright {
+        min_s: min,
+        one_mode,
+    };
     if let Some(t) = fixed {
-        let t = quantize(wire, t);
+        let t = quantize(wire, t.clamp(min, max))?;
         let p = process(wire, cal, t, readings_for(t), false, &darks.at(t)?)?;
         if p.averaged.saturated {
             return Err(I1ProError::SaturatedAtFixedTime { integration_s: t }.into());
         }
         return check(p);
     }
-    let mut t = quantize(wire, TRIAL_S.clamp(min, max));
+    let mut t = quantize(wire, TRIAL_S.clamp(min, max))?;
     let mut trial = process(wire, cal, t, 1, false, &darks.at(t)?)?;
     if trial.averaged.saturated && t > min {
         t = min;
         trial = process(wire, cal, t, 1, false, &darks.at(t)?)?;
     }
     if trial.averaged.saturated {
-        return Err(I1ProError::TooBright { min_s: min }.into());
+        return Err(too_bright().into());
     }
     let rate = trial.peak_counts.max(0.0) / t;
     let want = if rate > 0.0 {
@@ -190,19 +290,25 @@ pub fn emissive_shot<L: UsbLink>(
     } else {
         max
     };
-    let t = quantize(wire, want.clamp(min, max)).min(max);
+    let t = quantize(wire, want.clamp(min, max))?;
     let p = process(wire, cal, t, readings_for(t), false, &darks.at(t)?)?;
     if p.averaged.saturated {
         // The light grew between the trial and the measurement.
-        return Err(I1ProError::TooBright { min_s: min }.into());
+        return Err(too_bright().into());
     }
-    if p.peak_counts < floor(t) && t >= max * 0.999 {
-        return Err(I1ProError::TooDark {
-            max_s: max,
-            signal: p.peak_counts,
-            floor: floor(t),
+    if t >= max * 0.999 {
+        let noise = darks.noise(t, p.readings);
+        let cells = used_cells(cal.revision()).len() as f64;
+        let floor =
+            TOO_DARK_SIGMAS * (noise.floor.powi(2) + noise.dark.powi(2)).sqrt() * cells.sqrt();
+        if p.signal_counts < floor {
+            return Err(I1ProError::TooDark {
+                max_s: max,
+                signal: p.signal_counts,
+                floor,
+            }
+            .into());
         }
-        .into());
     }
     check(p)
 }
@@ -220,7 +326,7 @@ pub fn white<L: UsbLink>(
     cal: &Calibration,
     dark: &AbsRaw,
 ) -> Result<Spectrum, DriverError> {
-    let t = quantize(wire, REFLECTIVE_S);
+    let t = quantize(wire, REFLECTIVE_S)?;
     let p = process(wire, cal, t, REFLECTIVE_READINGS, true, dark)?;
     if p.averaged.saturated {
         return Err(I1ProError::BadWhite {
@@ -246,7 +352,7 @@ pub fn reflective<L: UsbLink>(
     dark: &AbsRaw,
     factors: &Spectrum,
 ) -> Result<(Spectrum, Processed), DriverError> {
-    let t = quantize(wire, REFLECTIVE_S);
+    let t = quantize(wire, REFLECTIVE_S)?;
     let p = check(process(wire, cal, t, REFLECTIVE_READINGS, true, dark)?)?;
     Ok((pipeline::reflective(&p.spectrum, factors), p))
 }

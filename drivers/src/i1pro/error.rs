@@ -42,13 +42,24 @@ pub enum I1ProError {
     #[error("i1Pro timing: {0}")]
     Timing(#[from] TimingError),
     /// The light saturates the sensor even at the shortest integration time.
-    #[error("the light is too bright for the i1Pro: the sensor saturates even at its shortest integration time of {min_s} s; measure a dimmer target or further away")]
-    TooBright { min_s: f64 },
+    #[error("the light is too bright for the i1Pro: the sensor saturates even at its shortest integration time of {:.3} ms{}; measure a dimmer target or further away", ms(.min_s), one_mode_note(.one_mode))]
+    TooBright {
+        min_s: f64,
+        /// The unit has one clock mode, so its shortest time is one sub-clock of it.
+        one_mode: bool,
+    },
+    /// An integration time no clock mode of the unit can run (a driver bug: the driver
+    /// keeps its times within the unit's range).
+    #[error("an integration time of {seconds} s is outside what the i1Pro's clock modes can run (the shortest is {:.3} ms)", ms(.shortest_s))]
+    IntegrationTime { seconds: f64, shortest_s: f64 },
+    /// The clock modes the unit reports cannot be used.
+    #[error("the i1Pro's clock modes cannot be used: {problem}; unplug and replug it, and if it stays, the unit needs service")]
+    ClockModes { problem: String },
     /// A fixed integration time lets the sensor saturate.
     #[error("the i1Pro's sensor saturated at the fixed integration time of {integration_s} s; set a shorter integration time or let the instrument choose it (auto)")]
     SaturatedAtFixedTime { integration_s: f64 },
-    /// Not enough light to measure even at the longest integration time.
-    #[error("too dark for the i1Pro: even at its longest integration time of {max_s} s the signal ({signal:.0} counts) stays below the sensor's noise floor ({floor:.0} counts); check that the instrument faces the light source and nothing covers it")]
+    /// No light distinguishable from the sensor's noise even at the longest integration time.
+    #[error("too dark for the i1Pro: even at its longest integration time of {max_s:.3} s the light gives {:.0} counts over all cells, within the sensor's noise ({floor:.0} counts, 5σ); check that the instrument faces the light source and nothing covers it", whole(.signal))]
     TooDark { max_s: f64, signal: f64, floor: f64 },
     /// A dark calibration saw light.
     #[error("the dark calibration saw light (mean {mean:.0} counts/s, limit {limit:.0}): place the instrument on its white tile, which covers the sensor, and calibrate again")]
@@ -68,6 +79,23 @@ pub enum I1ProError {
     /// The white-tile reading saturated or was too dim.
     #[error("the white-tile reading was {problem}: make sure the instrument sits flat on its own white tile and calibrate again")]
     BadWhite { problem: &'static str },
+}
+
+/// Rounded counts as they print, without a "-0" for a sum that is a hair below zero.
+fn whole(c: &f64) -> f64 {
+    c.round() + 0.0
+}
+
+fn ms(s: &f64) -> f64 {
+    s * 1e3
+}
+
+fn one_mode_note(one: &bool) -> &'static str {
+    if *one {
+        " (this unit has no shorter clock mode)"
+    } else {
+        ""
+    }
 }
 
 /// A USB transfer that failed, with the request it belonged to.

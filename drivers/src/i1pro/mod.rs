@@ -21,8 +21,10 @@ use std::sync::Arc;
 use metamer_color::{
     radiance_to_xyz, reflectance_to_xyz, Illuminant, ObserverKind, Outside, Quantity, Spectrum, Xyz,
 };
+use metamer_protocols::i1pro::calibration::AmbientTable;
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw};
-use metamer_protocols::i1pro::replies::{ClockMode, MeasChar, Misc};
+use metamer_protocols::i1pro::replies::{MeasChar, Misc};
+use metamer_protocols::i1pro::timing::ClockUnit;
 use metamer_protocols::i1pro::{
     commands, eeprom, replies, wavelength, Calibration, Eeprom, Model, Request, Revision,
     Spectrum as Bands, BANDS, START_NM, STEP_NM,
@@ -60,6 +62,9 @@ pub struct I1Pro<L: UsbLink> {
     integration_s: Option<f64>,
     darks: Option<(DarkPair, f64)>,
     reflective_dark: Option<(AbsRaw, f64)>,
+    /// What the EEPROM's ambient table holds, to say why a unit that claims the diffuser
+    /// has no ambient mode.
+    ambient_table: AmbientTable,
     /// Reflective calibration factors per band, and when they were made.
     white: Option<(Bands, f64)>,
 }
@@ -108,18 +113,19 @@ impl<L: UsbLink> I1Pro<L> {
             Revision::E => {
                 let m = MeasChar::parse(&wire.request(Request::GetMeasChar)?)
                     .map_err(|e| reply("get measurement characteristics", e))?;
-                wire.clock_s = m.clock_s();
-                wire.sub_clock_s = m.clock_s() * f64::from(m.divider);
+                wire.fixed_clock(ClockUnit {
+                    clock_s: m.clock_s(),
+                    divider: m.divider,
+                });
                 let size = replies::parse_eeprom_size(&wire.request(Request::GetEepromSize)?)
                     .map_err(|e| reply("get EEPROM size", e))?;
                 size as usize
             }
             Revision::AToD => {
                 if misc.has_clock_modes() {
-                    let c = ClockMode::parse(&wire.request(Request::GetClockMode)?)
-                        .map_err(|e| reply("get clock mode", e))?;
-                    wire.clock_s = c.clock_s();
-                    wire.sub_clock_s = c.clock_s() * f64::from(c.sub_clock_divider);
+                    wire.read_clock_modes()?;
+                } else {
+                    wire.fixed_clock(wire::CLOCK_BEFORE_301);
                 }
                 eeprom::SIZE_A_TO_D
             }
@@ -131,6 +137,8 @@ impl<L: UsbLink> I1Pro<L> {
         })?;
         let image = wire.read_eeprom(0, length)?;
         let cal = unit_calibration(&image, revision)?;
+        let ambient_table =
+            AmbientTable::in_eeprom(&Eeprom::parse(&image, revision).map_err(I1ProError::from)?);
         let info = InstrumentInfo {
             model: MODEL.into(),
             serial: Some(cal.serial.to_string()),
@@ -145,6 +153,7 @@ impl<L: UsbLink> I1Pro<L> {
             integration_s: None,
             darks: None,
             reflective_dark: None,
+            ambient_table,
             white: None,
         })
     }
@@ -183,6 +192,18 @@ impl<L: UsbLink> I1Pro<L> {
         DriverError::Unsupported {
             instrument: MODEL.into(),
             what: match mode {
+                MeasureMode::Ambient if self.cal.claims_ambient() => {
+                    let table = match self.ambient_table {
+                        AmbientTable::Unusable { band, value } => format!(
+                            "holds {value} at {} nm, not a positive factor",
+                            START_NM + STEP_NM * band as f64
+                        ),
+                        _ => "is the \"no ambient\" marker (−1 in every band) that units without the diffuser store".into(),
+                    };
+                    format!(
+                        "ambient measurements: its EEPROM's capability bits claim the diffuser, but its ambient calibration (key 0x044E) {table}, so an ambient reading would be meaningless; emissive and reflective measurements are unaffected"
+                    )
+                }
                 MeasureMode::Ambient => "ambient measurements: this unit has no diffuser".into(),
                 MeasureMode::Reflective => {
                     "reflective measurements: this unit has no white reference".into()
@@ -214,7 +235,7 @@ impl<L: UsbLink> I1Pro<L> {
     }
 
     fn reading(&self, values: Vec<f64>, quantity: Quantity, integration_s: f64) -> Reading {
-        let spectrum = Spectrum::from_grid(START_NM, STEP_NM, values)
+        let spectrum = Spectrum::measured(START_NM, STEP_NM, values)
             .expect("36 bands on an even grid")
             .with_quantity(quantity);
         let xyz: Xyz = match quantity {
@@ -323,8 +344,8 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
                 description: "emissive and ambient integration time; auto finds it per reading"
                     .into(),
                 values: OptionValues::Number {
-                    min: self.cal.min_integration_s,
-                    max: engine::longest(&self.wire, &self.cal),
+                    min: engine::shortest(&self.wire).unwrap_or(self.cal.min_integration_s),
+                    max: engine::longest(&self.wire, &self.cal).unwrap_or(engine::DARK_LONG_S),
                     unit: "s".into(),
                     auto: true,
                 },
@@ -367,7 +388,8 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
                     &self.cal,
                     engine::REFLECTIVE_S,
                     engine::REFLECTIVE_READINGS,
-                )?;
+                )?
+                .mean;
                 let factors = engine::white(&mut self.wire, &self.cal, &dark)?;
                 let now = self.clock.now_s();
                 self.reflective_dark = Some((dark, now));
@@ -427,12 +449,13 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
             self.integration_s = None;
             return Ok(());
         }
-        // The EEPROM's float32 limits, shown as the round numbers they stand for.
-        let round = |v: f64| (v * 1e6).round() / 1e6;
-        let min = round(self.cal.min_integration_s);
-        let max = round(engine::longest(&self.wire, &self.cal));
+        // The clock's limits, shown as the round numbers they stand for (the longest is
+        // 2 s on a whole number of clocks, a little over).
+        let min = engine::shortest(&self.wire)?;
+        let max = engine::longest(&self.wire, &self.cal)?;
+        let (low, high) = ((min * 1e6).round() / 1e6, (max * 1e3).round() / 1e3);
         match value.trim().parse::<f64>() {
-            Ok(t) if t.is_finite() && (min..=max).contains(&t) => {
+            Ok(t) if t.is_finite() && (low..=max.max(high)).contains(&t) => {
                 self.integration_s = Some(t);
                 Ok(())
             }
@@ -440,7 +463,7 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
                 instrument: MODEL.into(),
                 option: name.into(),
                 value: value.into(),
-                message: format!("expected auto or a time in seconds from {min} to {max}"),
+                message: format!("expected auto or a time in seconds from {low} to {high}"),
             }),
         }
     }
@@ -455,5 +478,7 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
     }
 }
 
+#[cfg(test)]
+mod real_unit_tests;
 #[cfg(test)]
 mod tests;

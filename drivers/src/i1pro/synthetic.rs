@@ -42,6 +42,10 @@ pub fn sensitivity(nm: f64) -> f64 {
     0.3 + 0.7 * (-((nm - 560.0) / 150.0).powi(2)).exp()
 }
 
+/// The emissive calibration factor at the sensor's most sensitive wavelength,
+/// mW·m⁻²·sr⁻¹·nm⁻¹ per count per second.
+pub const EMISSIVE_SCALE: f64 = 2.5e-4;
+
 /// The calibration of the simulated unit of `revision`.
 pub fn calibration(revision: Revision) -> Calibration {
     let filter = wavelength::filter_from_poly(&CELL_NM).expect("the cells span 380–730 nm");
@@ -89,9 +93,12 @@ pub fn calibration(revision: Revision) -> Calibration {
         filter,
         // A white ceramic tile: 0.9 in the red, a little lower in the violet.
         white_reference: Some(bands(|nm| 0.9 - 0.05 * (-(nm - 380.0) / 30.0).exp())),
-        // mW·m⁻²·sr⁻¹·nm⁻¹ per count per second: the peaks of 100 cd/m² of LED white light
-        // (about 5 mW·m⁻²·sr⁻¹·nm⁻¹) reach the sensor target in about a quarter of a second.
-        emissive: bands(|nm| 4e-5 / sensitivity(nm)),
+        // mW·m⁻²·sr⁻¹·nm⁻¹ per count per second, set so that the unit is as sensitive as
+        // ArgyllCMS describes a real one: a 2 s reading saturates on about 110 cd/m² of a
+        // display's white (here 110 cd/m² of LED-RGB1 puts its largest cell at the 45 000
+        // counts of saturation in 2.0 s; 100 cd/m² reaches the 37 000 of the sensor target
+        // in about 1.8 s).
+        emissive: bands(|nm| EMISSIVE_SCALE / sensitivity(nm)),
         // The diffuser passes about 1/40 of the light into the optics.
         ambient: Some(bands(|_| 40.0)),
         sensor_target: 37_000,
@@ -105,7 +112,13 @@ pub fn calibration(revision: Revision) -> Calibration {
 /// The simulated unit's EEPROM image, without the items whose keys are in `missing` (to
 /// show what a damaged EEPROM does).
 pub fn eeprom_image(revision: Revision, missing: &[u16]) -> Result<Vec<u8>, I1ProError> {
-    let mut items: Eeprom = calibration(revision).to_eeprom()?;
+    image_of(&calibration(revision), missing)
+}
+
+/// The EEPROM image of a calibration, without the items whose keys are in `missing`.
+pub fn image_of(cal: &Calibration, missing: &[u16]) -> Result<Vec<u8>, I1ProError> {
+    let revision = cal.revision();
+    let mut items: Eeprom = cal.to_eeprom()?;
     for key in missing {
         items.remove(*key);
     }
@@ -119,10 +132,7 @@ pub fn eeprom_image(revision: Revision, missing: &[u16]) -> Result<Vec<u8>, I1Pr
 /// GetMisc's reply of the simulated unit.
 pub fn misc(revision: Revision) -> Misc {
     Misc {
-        firmware: match revision {
-            Revision::AToD => FIRMWARE_D,
-            Revision::E => FIRMWARE_E,
-        },
+        firmware: firmware(revision),
         unknown1: 0,
         max_positive: MAX_POSITIVE,
         unknown3: 1,
@@ -130,12 +140,35 @@ pub fn misc(revision: Revision) -> Misc {
     }
 }
 
-/// The Rev D unit's clock mode: 68 µs integration clock, lamp clock 130 times slower.
-pub const CLOCK_MODE: ClockMode = ClockMode {
-    max: 1,
-    current: 1,
-    unknown: 0,
-    sub_clock_divider: 130,
-    clock_us: 68,
-    flags: 0,
-};
+/// The firmware revision the simulated unit of `revision` reports.
+pub fn firmware(revision: Revision) -> u16 {
+    match revision {
+        Revision::AToD => FIRMWARE_D,
+        Revision::E => FIRMWARE_E,
+    }
+}
+
+/// The Rev D unit's clock modes as GetClockMode reports each when it is in force (`max`
+/// and `current` are filled in by the emulator). Mode 1 is the clock of firmware before
+/// 301: 68 µs, 130 to the sub-clock, 8.84 ms shortest. Mode 2 is 36 µs × 131 = 4.716 ms
+/// [I]: ArgyllCMS's shortest integration on firmware ≥ 301 is 4.716 ms, reached by
+/// stepping the modes until one sub-clock fits, and 4716 µs is 36 µs (Rev E's clock)
+/// × 131; the real mode table is not published.
+pub const CLOCK_MODES: [ClockMode; 2] = [
+    ClockMode {
+        max: 2,
+        current: 1,
+        unknown: 0,
+        sub_clock_divider: 130,
+        clock_us: 68,
+        flags: 0,
+    },
+    ClockMode {
+        max: 2,
+        current: 2,
+        unknown: 0,
+        sub_clock_divider: 131,
+        clock_us: 36,
+        flags: 0,
+    },
+];

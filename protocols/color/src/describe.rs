@@ -2,8 +2,8 @@
 //! `metamer color xyz` prints.
 
 use crate::{
-    illuminant_white, radiance_to_xyz, reflectance_to_xyz, Lab, ObserverKind, Quantity, Spectrum,
-    XyY, Xyz,
+    illuminant_white_over, radiance_to_xyz, reflectance_to_xyz, summation_range, Lab, ObserverKind,
+    Quantity, Spectrum, XyY, Xyz,
 };
 
 /// The colorimetry of one spectrum.
@@ -18,7 +18,8 @@ pub struct Description {
 }
 
 /// XYZ, xyY and CIELAB of a spectrum. For a reflectance the white defaults to the
-/// illuminant's (the perfect diffuser under it); for a radiance only `white` gives Lab.
+/// illuminant's (the perfect diffuser under it, summed as the reflectance is); for a
+/// radiance only `white` gives Lab.
 pub fn describe(
     spectrum: &Spectrum,
     quantity: Quantity,
@@ -31,7 +32,11 @@ pub fn describe(
         Quantity::Radiance | Quantity::Irradiance => (radiance_to_xyz(spectrum, observer), None),
         Quantity::Reflectance => (
             reflectance_to_xyz(spectrum, illuminant, observer),
-            Some(illuminant_white(illuminant, observer)),
+            Some(illuminant_white_over(
+                illuminant,
+                observer,
+                summation_range(spectrum),
+            )),
         ),
     };
     let white = white.or(default_white);

@@ -1,8 +1,10 @@
 //! Sampled spectra: a function of wavelength given at increasing sample points, linearly
-//! interpolated between them (the convention of the validation-box contract and CIE 15:2018
-//! §7.2.2 for tables at 1 nm), zero outside unless the caller asks to hold the end values.
-//! A spectrum may say what it measures ([`Quantity`]), so a reading's spectrum carries its
-//! unit with it.
+//! interpolated between them (the convention of the validation-box contract, and how the CIE
+//! defines its illuminants between their 5 nm samples), zero outside unless the caller asks to
+//! hold the end values. A spectrometer's reading at 5 or 10 nm is instead interpolated as
+//! CIE 167:2005 recommends for evenly spaced data (Sprague, see [`Interpolation`]) and held
+//! at its end values beyond its range ([`Spectrum::measured`]). A spectrum may say what it
+//! measures ([`Quantity`]), so a reading's spectrum carries its unit with it.
 
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +45,23 @@ pub enum Outside {
     HoldEnds,
 }
 
+/// What a spectrum is worth between its samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Interpolation {
+    /// Straight lines between samples (tables at 1 nm, the CIE illuminants, the renderer's
+    /// spectra).
+    #[default]
+    Linear,
+    /// Sprague's (1880) fifth-order interpolation, which CIE 167:2005 recommends for
+    /// evenly spaced spectral data and CIE 15 for data coarser than the 1 nm of its
+    /// colour-matching functions. It needs an even grid of at least 6 samples; a spectrum
+    /// without one is interpolated linearly whatever this says. Colorimetry sums such a
+    /// spectrum over 360–830 nm, the range of the CIE's standard method (see
+    /// [`radiance_to_xyz`](crate::radiance_to_xyz)).
+    Sprague,
+}
+
 /// A sampled spectrum with strictly increasing wavelengths in nm.
 ///
 /// In JSON a spectrum on an even grid is `{"start_nm":380,"step_nm":10,"values":[…]}`, any
@@ -54,6 +73,7 @@ pub struct Spectrum {
     wavelengths_nm: Vec<f64>,
     values: Vec<f64>,
     outside: Outside,
+    interpolation: Interpolation,
     quantity: Option<Quantity>,
 }
 
@@ -89,8 +109,14 @@ impl Spectrum {
             wavelengths_nm,
             values,
             outside: Outside::Zero,
+            interpolation: Interpolation::Linear,
             quantity: None,
         })
+    }
+
+    /// A spectrometer's reading on an even grid: see [`Spectrum::as_measured`].
+    pub fn measured(start_nm: f64, step_nm: f64, values: Vec<f64>) -> Result<Self, ColorError> {
+        Ok(Spectrum::from_grid(start_nm, step_nm, values)?.as_measured())
     }
 
     /// A spectrum on an even grid `start, start+step, …`.
@@ -115,6 +141,53 @@ impl Spectrum {
 
     pub fn outside(&self) -> Outside {
         self.outside
+    }
+
+    /// These samples read as the CIE treats measured data coarser than its 1 nm tables:
+    /// Sprague interpolation between samples (CIE 167:2005 §9.2.4) and the nearest measured
+    /// value beyond the measured range (the CIE's rule for data measured over a shorter range
+    /// than its tables, CIE 15 and CIE 167:2005; ArgyllCMS and colour-science do the same).
+    /// A spectrum at 1 nm or finer, on an uneven grid or with fewer than 6 samples is
+    /// returned unchanged: it is summed as given.
+    pub fn as_measured(self) -> Spectrum {
+        let coarse = self.grid().is_some_and(|(_, step)| step > 1.0)
+            && self.values.len() >= crate::sprague::MIN_SAMPLES;
+        if coarse {
+            self.with_interpolation(Interpolation::Sprague)
+                .with_outside(Outside::HoldEnds)
+        } else {
+            self
+        }
+    }
+
+    /// The same samples with another rule between them.
+    pub fn with_interpolation(mut self, interpolation: Interpolation) -> Self {
+        self.interpolation = interpolation;
+        self
+    }
+
+    /// The rule between samples as set (see [`Spectrum::sprague`] for the one in force).
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
+    }
+
+    /// Whether values between samples follow Sprague's interpolation: asked for, on an even
+    /// grid of at least 6 samples.
+    pub fn sprague(&self) -> bool {
+        self.interpolation == Interpolation::Sprague
+            && self.values.len() >= crate::sprague::MIN_SAMPLES
+            && self.grid().is_some()
+    }
+
+    /// Other values on the same wavelengths, keeping every rule (outside, interpolation,
+    /// quantity): for averages and clamps of readings.
+    pub fn with_values(&self, values: Vec<f64>) -> Result<Spectrum, ColorError> {
+        Ok(Spectrum {
+            interpolation: self.interpolation,
+            outside: self.outside,
+            quantity: self.quantity,
+            ..Spectrum::new(self.wavelengths_nm.clone(), values)?
+        })
     }
 
     /// The same samples marked as measuring `quantity`.
@@ -159,7 +232,7 @@ impl Spectrum {
         )
     }
 
-    /// The value at `nm`, linearly interpolated between samples.
+    /// The value at `nm`, interpolated between samples by the spectrum's [`Interpolation`].
     pub fn value_at(&self, nm: f64) -> f64 {
         let w = &self.wavelengths_nm;
         let (first, last) = self.range_nm();
@@ -169,6 +242,10 @@ impl Spectrum {
                 Outside::HoldEnds if nm < first => self.values[0],
                 Outside::HoldEnds => *self.values.last().expect("never empty"),
             };
+        }
+        if self.sprague() {
+            let (start, step) = (w[0], w[1] - w[0]);
+            return crate::sprague::value_at(&self.values, (nm - start) / step);
         }
         // Index of the first sample strictly above nm; nm lies in [w[i-1], w[i]].
         let i = w.partition_point(|&s| s <= nm);
@@ -200,6 +277,7 @@ impl Spectrum {
             wavelengths_nm: nm,
             values,
             outside: self.outside,
+            interpolation: self.interpolation,
             quantity: self.quantity,
         }
     }
@@ -210,13 +288,16 @@ impl Spectrum {
             wavelengths_nm: self.wavelengths_nm.clone(),
             values: self.values.iter().map(|v| v * k).collect(),
             outside: self.outside,
+            interpolation: self.interpolation,
             quantity: self.quantity,
         }
     }
 
     /// The product of two spectra, sampled on the union of both grids so no sample of
-    /// either is lost. Outside both tables the product follows each factor's own rule. A
-    /// reflectance times anything is what the other factor is (light reflected is light).
+    /// either is lost, and at every whole nanometre between where a factor is interpolated
+    /// by Sprague (the product itself is linear between its samples). Outside both tables
+    /// the product follows each factor's own rule. A reflectance times anything is what the
+    /// other factor is (light reflected is light).
     pub fn product(&self, other: &Spectrum) -> Spectrum {
         let mut nm: Vec<f64> = self
             .wavelengths_nm
@@ -224,6 +305,10 @@ impl Spectrum {
             .chain(other.wavelengths_nm.iter())
             .copied()
             .collect();
+        for s in [self, other].into_iter().filter(|s| s.sprague()) {
+            let (first, last) = s.range_nm();
+            nm.extend((first.ceil() as i64..=last.floor() as i64).map(|l| l as f64));
+        }
         nm.sort_by(f64::total_cmp);
         nm.dedup();
         let values = nm
@@ -243,6 +328,7 @@ impl Spectrum {
             wavelengths_nm: nm,
             values,
             outside,
+            interpolation: Interpolation::Linear,
             quantity,
         }
     }

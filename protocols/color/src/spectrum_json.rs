@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize, Serializer};
 
-use crate::{ColorError, Outside, Quantity, Spectrum};
+use crate::{ColorError, Interpolation, Outside, Quantity, Spectrum};
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -28,6 +28,12 @@ pub(crate) struct SpectrumJson {
     quantity: Option<Quantity>,
     #[serde(default, skip_serializing_if = "is_zero")]
     outside: Outside,
+    #[serde(default, skip_serializing_if = "is_linear")]
+    interpolation: Interpolation,
+}
+
+fn is_linear(i: &Interpolation) -> bool {
+    *i == Interpolation::Linear
 }
 
 fn is_zero(o: &Outside) -> bool {
@@ -55,6 +61,7 @@ impl From<Spectrum> for SpectrumJson {
             wavelengths_nm,
             quantity: s.quantity(),
             outside: s.outside(),
+            interpolation: s.interpolation(),
             values: s.values().to_vec(),
         }
     }
@@ -79,7 +86,9 @@ impl TryFrom<SpectrumJson> for Spectrum {
                 ))
             }
         };
-        let spectrum = spectrum.with_outside(j.outside);
+        let spectrum = spectrum
+            .with_outside(j.outside)
+            .with_interpolation(j.interpolation);
         Ok(match j.quantity {
             Some(q) => spectrum.with_quantity(q),
             None => spectrum,
@@ -115,6 +124,14 @@ mod tests {
             r#"{"wavelengths_nm":[400.0,410.5,700.0],"values":[1.0,2.0,3.0],"quantity":"radiance","outside":"hold_ends"}"#
         );
         assert_eq!(serde_json::from_str::<Spectrum>(&text).unwrap(), s);
+        // A measured spectrum keeps its interpolation.
+        let m = Spectrum::measured(380.0, 10.0, vec![1.0; 6]).unwrap();
+        let text = serde_json::to_string(&m).unwrap();
+        assert_eq!(
+            text,
+            r#"{"start_nm":380,"step_nm":10,"values":[1.0,1.0,1.0,1.0,1.0,1.0],"outside":"hold_ends","interpolation":"sprague"}"#
+        );
+        assert_eq!(serde_json::from_str::<Spectrum>(&text).unwrap(), m);
         // A fractional grid keeps its fractions.
         let f = Spectrum::from_grid(380.5, 3.3, vec![0.0; 4]).unwrap();
         let back: Spectrum = serde_json::from_str(&serde_json::to_string(&f).unwrap()).unwrap();

@@ -5,34 +5,7 @@
 use super::eeprom::{key_name, Eeprom, EepromError, Value};
 use super::{Model, Revision, Spectrum, BANDS, CELLS};
 
-/// EEPROM keys the calibration uses.
-pub mod key {
-    pub const LIN_NORMAL: u16 = 0x03E8;
-    pub const LIN_HIGH: u16 = 0x03E9;
-    pub const FILTER_START: u16 = 0x03EA;
-    pub const FILTER_COUNT: u16 = 0x03EB;
-    pub const FILTER_COEF: u16 = 0x03EC;
-    pub const WHITE_REF: u16 = 0x044C;
-    pub const EMISSIVE: u16 = 0x044D;
-    pub const AMBIENT: u16 = 0x044E;
-    pub const SENSOR_TARGET: u16 = 0x04B4;
-    pub const DARK_THRESHOLD: u16 = 0x04B5;
-    pub const SATURATION_NORMAL: u16 = 0x04B7;
-    pub const SATURATION_HIGH: u16 = 0x04B8;
-    pub const SERIAL: u16 = 0x04BB;
-    pub const MANUFACTURE_DATE: u16 = 0x04BC;
-    pub const HIGH_GAIN_FACTOR: u16 = 0x04BD;
-    pub const MIN_INTEGRATION: u16 = 0x04C5;
-    pub const MAX_INTEGRATION: u16 = 0x04C6;
-    pub const CPLD_REVISION: u16 = 0x0BC0;
-    pub const CAPABILITIES: u16 = 0x0BC2;
-    pub const PHYSICAL_FILTER: u16 = 0x0BC4;
-    pub const CAPABILITIES_E: u16 = 0x2EE2;
-    pub const STRAY_LIGHT: u16 = 0x2F58;
-    pub const STRAY_LIGHT_SCALE: u16 = 0x2F59;
-    pub const WAVELENGTH_POLY_REFLECTIVE: u16 = 0x2F62;
-    pub const WAVELENGTH_POLY_EMISSIVE: u16 = 0x2F63;
-}
+pub mod key;
 
 /// Capability bits of key 0x0BC2 that mean "has the ambient diffuser".
 pub const CAPS_AMBIENT: i32 = 0x6000;
@@ -48,6 +21,9 @@ pub mod caps_e {
     pub const INDICATOR_LEDS: i32 = 0x10;
     pub const UV_FILTER: i32 = 0x20;
 }
+
+mod ambient;
+pub use ambient::AmbientTable;
 
 /// A calibration item that is missing or malformed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -244,14 +220,19 @@ impl Calibration {
         }
     }
 
-    /// Whether the unit has the ambient diffuser (and its calibration).
-    pub fn has_ambient(&self) -> bool {
-        let caps = self.capabilities & CAPS_AMBIENT != 0
+    /// Whether the EEPROM's capability bits say the unit has the ambient diffuser (0x0BC2 &
+    /// 0x6000, or Rev E 0x2EE2 & 0x01), whatever its ambient table holds.
+    pub fn claims_ambient(&self) -> bool {
+        self.capabilities & CAPS_AMBIENT != 0
             || self
                 .rev_e
                 .as_ref()
-                .is_some_and(|e| e.capabilities & caps_e::AMBIENT != 0);
-        caps && self.ambient.is_some()
+                .is_some_and(|e| e.capabilities & caps_e::AMBIENT != 0)
+    }
+
+    /// Whether the unit has the ambient diffuser and a usable calibration for it.
+    pub fn has_ambient(&self) -> bool {
+        self.claims_ambient() && self.ambient.is_some()
     }
 
     /// Whether a UV-cut filter is fitted.
@@ -295,13 +276,16 @@ impl Calibration {
         };
         let caps_e_ambient =
             model.revision() == Revision::E && r.int(key::CAPABILITIES_E)? & caps_e::AMBIENT != 0;
-        let ambient = if capabilities & CAPS_AMBIENT != 0 || caps_e_ambient {
+        // A unit that claims the diffuser must carry the table (ArgyllCMS refuses one that
+        // does not); whether it claims it or not, a table that is the "no ambient" marker
+        // (−1 in every band) or holds a factor that is not a positive number calibrates
+        // nothing: the unit has no ambient mode (see `ambient_table`).
+        let table = if capabilities & CAPS_AMBIENT != 0 || caps_e_ambient {
             Some(r.spectrum(key::AMBIENT)?)
         } else {
-            // Units without the diffuser store −1 in every band, or nothing.
             r.optional_spectrum(key::AMBIENT)?
-                .filter(|a| a.iter().any(|&v| v != -1.0))
         };
+        let ambient = table.filter(|a| AmbientTable::of(Some(a)) == AmbientTable::Usable);
         let rev_e = match model.revision() {
             Revision::AToD => None,
             Revision::E => {

@@ -8,6 +8,50 @@ pub const SUB_CLOCK_DIVIDER_BEFORE_301: u8 = 130;
 /// Rev E's fixed clock: 36 µs × 136 = 4.896 ms shortest integration.
 pub const CLOCK_US_E: u32 = 36;
 pub const SUB_CLOCK_DIVIDER_E: u32 = 136;
+/// One clock mode of a unit: the integration clock's period and the sub-clock divider, as
+/// GetClockMode (0xD1) reports them for the mode in force (Rev A–D firmware ≥ 301), as
+/// firmware before 301 has them fixed, or as Rev E's GetMeasChar (0xD5) reports them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClockUnit {
+    /// Integration clock period, seconds.
+    pub clock_s: f64,
+    /// Integration clocks per sub-clock.
+    pub divider: u32,
+}
+
+impl ClockUnit {
+    /// The shortest integration in this mode: one sub-clock, `clock × divider`. ArgyllCMS
+    /// takes firmware before 301 to stop at 8.84 ms, "one sub clock" (68 µs × 130), and on
+    /// later firmware steps the modes from 1 until the time is at least 0.99 of a
+    /// sub-clock.
+    pub fn shortest_s(&self) -> f64 {
+        self.clock_s * f64::from(self.divider)
+    }
+
+    /// The sub-clock period (the unit of lamp times), seconds.
+    pub fn sub_clock_s(&self) -> f64 {
+        self.shortest_s()
+    }
+}
+
+/// The clock mode and clock count for an integration time `t`: the first mode, in the
+/// unit's order (mode 1 first, as ArgyllCMS steps them), in which `t` rounds to at least
+/// one sub-clock and to at most `max_clocks` clocks. None when no mode can integrate `t`.
+pub fn pick_mode(modes: &[ClockUnit], t: f64, max_clocks: u64) -> Option<(usize, u64)> {
+    if !(t.is_finite() && t > 0.0) {
+        return None;
+    }
+    modes.iter().enumerate().find_map(|(i, m)| {
+        let n = (t / m.clock_s).round();
+        (n >= f64::from(m.divider) && n <= max_clocks as f64).then_some((i, n as u64))
+    })
+}
+
+/// The shortest integration any of `modes` allows.
+pub fn shortest_s(modes: &[ClockUnit]) -> Option<f64> {
+    modes.iter().map(ClockUnit::shortest_s).reduce(f64::min)
+}
+
 /// The lamp must have been off this long before a lamp-off (dark or emissive) reading.
 pub const LAMP_REST_S: f64 = 1.5;
 /// A scan is read in chunks of at most this many readings…

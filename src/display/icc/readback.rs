@@ -1,9 +1,10 @@
 //! An ICC display profile read back by moxcms and evaluated from its tags: matrix/TRC
-//! through moxcms's own curve evaluators, lut16 A2B0 by the lut16Type definition
-//! (ICC.1:2010 10.9: input tables, CLUT, output tables) with trilinear interpolation. It
-//! tells whether a written profile says what the model says.
+//! through moxcms's own curve evaluators, lut16 A2B0 and B2A0 by the lut16Type definition
+//! (ICC.1:2010 10.9: matrix for XYZ input, input tables, CLUT, output tables) with
+//! tetrahedral interpolation in the CLUT, as LittleCMS interpolates three inputs. It tells
+//! whether a written profile says what the model says.
 
-use moxcms::{ColorProfile, LutStore, LutWarehouse, ToneCurveEvaluator};
+use moxcms::{ColorProfile, LutDataType, LutStore, LutWarehouse, ToneCurveEvaluator};
 
 /// Why a profile could not be read back.
 #[derive(Debug, thiserror::Error)]
@@ -12,23 +13,10 @@ pub enum IccReadError {
     Parse(String),
     #[error("the profile has neither rXYZ/gXYZ/bXYZ with rTRC/gTRC/bTRC nor a lut16 A2B0 tag")]
     NoForward,
+    #[error("the profile has no lut16 B2A0 tag")]
+    NoInverse,
     #[error("the profile's {0} is malformed")]
     Malformed(&'static str),
-}
-
-/// Device RGB → PCS XYZ of a parsed profile.
-pub enum IccForward {
-    Matrix {
-        /// Columns: rXYZ, gXYZ, bXYZ.
-        colorants: [[f64; 3]; 3],
-        curves: [Box<dyn ToneCurveEvaluator + Send + Sync>; 3],
-    },
-    Lut16 {
-        input: [Vec<f64>; 3],
-        points: usize,
-        clut: Vec<[f64; 3]>,
-        output: [Vec<f64>; 3],
-    },
 }
 
 fn table(
@@ -55,47 +43,118 @@ fn interpolate(t: &[f64], x: f64) -> f64 {
     t[i] * (1.0 - f) + t[i + 1] * f
 }
 
-impl IccForward {
-    pub fn parse(bytes: &[u8]) -> Result<IccForward, IccReadError> {
-        let p =
-            ColorProfile::new_from_slice(bytes).map_err(|e| IccReadError::Parse(e.to_string()))?;
-        if let (Some(r), Some(g), Some(b)) = (&p.red_trc, &p.green_trc, &p.blue_trc) {
-            let eval = |t: &moxcms::ToneReprCurve| {
-                t.make_linear_evaluator()
-                    .map_err(|_| IccReadError::Malformed("TRC curve"))
-            };
-            let col = |x: moxcms::Xyzd| [x.x, x.y, x.z];
-            let c = [
-                col(p.red_colorant),
-                col(p.green_colorant),
-                col(p.blue_colorant),
-            ];
-            return Ok(IccForward::Matrix {
-                colorants: std::array::from_fn(|r| std::array::from_fn(|k| c[k][r])),
-                curves: [eval(r)?, eval(g)?, eval(b)?],
-            });
-        }
-        let Some(LutWarehouse::Lut(lut)) = &p.lut_a_to_b_perceptual else {
-            return Err(IccReadError::NoForward);
-        };
+/// One lut16Type tag: matrix (XYZ input only), input tables, CLUT, output tables, all as
+/// normalised 0–1 values.
+pub struct Lut16 {
+    matrix: [[f64; 3]; 3],
+    input: [Vec<f64>; 3],
+    points: usize,
+    clut: Vec<[f64; 3]>,
+    output: [Vec<f64>; 3],
+}
+
+impl Lut16 {
+    fn read(lut: &LutDataType, what: &'static str) -> Result<Lut16, IccReadError> {
         let points = lut.num_clut_grid_points as usize;
         if lut.num_input_channels != 3 || lut.num_output_channels != 3 || points < 2 {
-            return Err(IccReadError::Malformed("A2B0 lut16 shape"));
+            return Err(IccReadError::Malformed(what));
         }
-        let input = table(&lut.input_table, 3, "A2B0 input tables")?;
-        let output = table(&lut.output_table, 3, "A2B0 output tables")?;
-        let flat = table(&lut.clut_table, 1, "A2B0 CLUT")?.remove(0);
+        let input = table(&lut.input_table, 3, what)?;
+        let output = table(&lut.output_table, 3, what)?;
+        let flat = table(&lut.clut_table, 1, what)?.remove(0);
         if flat.len() != 3 * points.pow(3) || input.iter().chain(&output).any(|t| t.len() < 2) {
-            return Err(IccReadError::Malformed("A2B0 CLUT size"));
+            return Err(IccReadError::Malformed(what));
         }
         let clut = flat.chunks(3).map(|n| [n[0], n[1], n[2]]).collect();
         let [i0, i1, i2]: [Vec<f64>; 3] = input.try_into().expect("three tables");
         let [o0, o1, o2]: [Vec<f64>; 3] = output.try_into().expect("three tables");
-        Ok(IccForward::Lut16 {
+        Ok(Lut16 {
+            matrix: lut.matrix.v,
             input: [i0, i1, i2],
             points,
             clut,
             output: [o0, o1, o2],
+        })
+    }
+
+    /// Normalised input 0–1 → normalised output 0–1; `matrix` applies it first (only a
+    /// tag with XYZ input may use it).
+    fn eval(&self, v: [f64; 3], matrix: bool) -> [f64; 3] {
+        let v = if matrix {
+            std::array::from_fn(|r| (0..3).map(|c| self.matrix[r][c] * v[c]).sum())
+        } else {
+            v
+        };
+        let n = self.points;
+        let s: [f64; 3] =
+            std::array::from_fn(|c| interpolate(&self.input[c], v[c]) * (n - 1) as f64);
+        let base: [usize; 3] = std::array::from_fn(|c| (s[c].floor() as usize).min(n - 2));
+        let f: [f64; 3] = std::array::from_fn(|c| s[c] - base[c] as f64);
+        let index = |i: [usize; 3]| (i[0] * n + i[1]) * n + i[2];
+        // Tetrahedral: walk from the cell's low corner along the axes in decreasing
+        // order of their fractions (Kasson et al. 1995; LittleCMS's 3-input kernel).
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| f[b].total_cmp(&f[a]));
+        let mut corner = base;
+        let mut prev = self.clut[index(corner)];
+        let mut out = prev;
+        for &axis in &order {
+            corner[axis] += 1;
+            let next = self.clut[index(corner)];
+            for q in 0..3 {
+                out[q] += f[axis] * (next[q] - prev[q]);
+            }
+            prev = next;
+        }
+        std::array::from_fn(|c| interpolate(&self.output[c], out[c]))
+    }
+}
+
+/// Device RGB → PCS XYZ of a parsed profile: its A2B0 when it has one (as ICC readers
+/// choose), else its matrix/TRC.
+pub enum IccForward {
+    Matrix {
+        /// Columns: rXYZ, gXYZ, bXYZ.
+        colorants: [[f64; 3]; 3],
+        curves: [Box<dyn ToneCurveEvaluator + Send + Sync>; 3],
+    },
+    Lut16(Lut16),
+}
+
+impl IccForward {
+    pub fn parse(bytes: &[u8]) -> Result<IccForward, IccReadError> {
+        let p =
+            ColorProfile::new_from_slice(bytes).map_err(|e| IccReadError::Parse(e.to_string()))?;
+        if let Some(LutWarehouse::Lut(lut)) = &p.lut_a_to_b_perceptual {
+            return Ok(IccForward::Lut16(Lut16::read(lut, "A2B0 lut16")?));
+        }
+        Self::matrix(&p)
+    }
+
+    /// The matrix/TRC tags alone, as a reader that knows nothing else uses them.
+    pub fn parse_matrix(bytes: &[u8]) -> Result<IccForward, IccReadError> {
+        let p =
+            ColorProfile::new_from_slice(bytes).map_err(|e| IccReadError::Parse(e.to_string()))?;
+        Self::matrix(&p)
+    }
+
+    fn matrix(p: &ColorProfile) -> Result<IccForward, IccReadError> {
+        let (Some(r), Some(g), Some(b)) = (&p.red_trc, &p.green_trc, &p.blue_trc) else {
+            return Err(IccReadError::NoForward);
+        };
+        let eval = |t: &moxcms::ToneReprCurve| {
+            t.make_linear_evaluator()
+                .map_err(|_| IccReadError::Malformed("TRC curve"))
+        };
+        let col = |x: moxcms::Xyzd| [x.x, x.y, x.z];
+        let c = [
+            col(p.red_colorant),
+            col(p.green_colorant),
+            col(p.blue_colorant),
+        ];
+        Ok(IccForward::Matrix {
+            colorants: std::array::from_fn(|r| std::array::from_fn(|k| c[k][r])),
+            curves: [eval(r)?, eval(g)?, eval(b)?],
         })
     }
 
@@ -107,33 +166,27 @@ impl IccForward {
                     std::array::from_fn(|c| curves[c].evaluate_value(rgb[c] as f32) as f64);
                 std::array::from_fn(|r| (0..3).map(|c| colorants[r][c] * lin[c]).sum())
             }
-            IccForward::Lut16 {
-                input,
-                points,
-                clut,
-                output,
-            } => {
-                let n = *points;
-                let s: [f64; 3] =
-                    std::array::from_fn(|c| interpolate(&input[c], rgb[c]) * (n - 1) as f64);
-                let base: [usize; 3] = std::array::from_fn(|c| (s[c].floor() as usize).min(n - 2));
-                let f: [f64; 3] = std::array::from_fn(|c| s[c] - base[c] as f64);
-                let mut v = [0.0; 3];
-                for corner in 0..8 {
-                    let mut w = 1.0;
-                    let mut idx = 0;
-                    for c in 0..3 {
-                        let up = (corner >> (2 - c)) & 1;
-                        w *= if up == 1 { f[c] } else { 1.0 - f[c] };
-                        idx = idx * n + base[c] + up;
-                    }
-                    for (o, x) in v.iter_mut().zip(clut[idx]) {
-                        *o += w * x;
-                    }
-                }
-                std::array::from_fn(|c| interpolate(&output[c], v[c]) * 65535.0 / 32768.0)
-            }
+            IccForward::Lut16(lut) => lut.eval(rgb, false).map(|v| v * 65535.0 / 32768.0),
         }
+    }
+}
+
+/// PCS XYZ → device RGB through a profile's lut16 B2A0.
+pub struct IccInverse(Lut16);
+
+impl IccInverse {
+    pub fn parse(bytes: &[u8]) -> Result<IccInverse, IccReadError> {
+        let p =
+            ColorProfile::new_from_slice(bytes).map_err(|e| IccReadError::Parse(e.to_string()))?;
+        match &p.lut_b_to_a_perceptual {
+            Some(LutWarehouse::Lut(lut)) => Ok(IccInverse(Lut16::read(lut, "B2A0 lut16")?)),
+            _ => Err(IccReadError::NoInverse),
+        }
+    }
+
+    /// Drive values 0–1 for a PCS XYZ (D50, white Y = 1).
+    pub fn rgb(&self, pcs_xyz: [f64; 3]) -> [f64; 3] {
+        self.0.eval(pcs_xyz.map(|v| v * 32768.0 / 65535.0), true)
     }
 }
 
@@ -154,13 +207,44 @@ pub fn agreement(
 ) -> Result<Agreement, IccReadError> {
     use crate::color::{delta_e2000, Xyz};
     let forward = IccForward::parse(bytes)?;
-    let pcs = super::Pcs::new(profile.white_xyz).ok_or(IccReadError::Malformed("white"))?;
+    let pcs = super::profile_pcs(profile).map_err(|_| IccReadError::Malformed("white"))?;
     let d50 = Xyz::from_array(super::pcs::D50);
     let (mut sum, mut max) = (0.0, 0.0f64);
     for &rgb in drives {
         let ours = Xyz::from_array(pcs.to_pcs(profile.forward(rgb))).to_lab(d50);
         let theirs = Xyz::from_array(forward.pcs_xyz(rgb)).to_lab(d50);
         let de = delta_e2000(ours, theirs);
+        sum += de;
+        max = max.max(de);
+    }
+    Ok(Agreement {
+        points: drives.len(),
+        mean_de00: sum / drives.len().max(1) as f64,
+        max_de00: max,
+    })
+}
+
+/// How closely a written profile's B2A0 inverts the model: for each drive triple, the
+/// model's colour there goes through B2A0 and the drive it gives back through the model;
+/// ΔE00 between the two colours (CIELAB relative to D50 in the PCS). Drive triples are
+/// inside the gamut by construction.
+pub fn inverse_agreement(
+    bytes: &[u8],
+    profile: &crate::display::Profile,
+    drives: &[[f64; 3]],
+) -> Result<Agreement, IccReadError> {
+    use crate::color::{delta_e2000, Xyz};
+    let inverse = IccInverse::parse(bytes)?;
+    let pcs = super::profile_pcs(profile).map_err(|_| IccReadError::Malformed("white"))?;
+    let d50 = Xyz::from_array(super::pcs::D50);
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for &rgb in drives {
+        let want = pcs.to_pcs(profile.forward(rgb));
+        let back = pcs.to_pcs(profile.forward(inverse.rgb(want)));
+        let de = delta_e2000(
+            Xyz::from_array(want).to_lab(d50),
+            Xyz::from_array(back).to_lab(d50),
+        );
         sum += de;
         max = max.max(de);
     }

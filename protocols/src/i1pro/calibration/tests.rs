@@ -111,6 +111,59 @@ fn optional_keys_may_be_missing() {
 }
 
 #[test]
+fn a_diffuser_claimed_over_a_no_ambient_table_gives_no_ambient_mode() {
+    // The capability bits claim the diffuser, but the table is the −1 marker that units
+    // without one store: read as it is, it would turn every reading into negative lux.
+    let mut claimed = calibration_a_to_d();
+    assert_ne!(claimed.capabilities & CAPS_AMBIENT, 0);
+    claimed.ambient = None;
+    let items = claimed.to_eeprom().unwrap();
+    assert_eq!(
+        AmbientTable::in_eeprom(&items),
+        AmbientTable::NoAmbientMarker
+    );
+    let back = Calibration::from_eeprom(&items, Model::I1Pro).unwrap();
+    assert_eq!(back.ambient, None);
+    assert!(back.claims_ambient());
+    assert!(!back.has_ambient());
+
+    // A table with one factor that is not positive calibrates nothing either; which band
+    // is named.
+    let mut bad = calibration_a_to_d().ambient.unwrap();
+    bad[7] = 0.0;
+    let mut items = calibration_a_to_d().to_eeprom().unwrap();
+    items
+        .insert(
+            key::AMBIENT,
+            Value::Floats(bad.iter().map(|&v| v as f32).collect()),
+        )
+        .unwrap();
+    assert_eq!(
+        AmbientTable::in_eeprom(&items),
+        AmbientTable::Unusable {
+            band: 7,
+            value: 0.0
+        }
+    );
+    assert!(!Calibration::from_eeprom(&items, Model::I1Pro)
+        .unwrap()
+        .has_ambient());
+
+    // Rev E claims it with its own capability word.
+    let mut e = calibration_e();
+    e.capabilities = 0;
+    e.ambient = None;
+    let back = Calibration::from_image(&e.to_image().unwrap(), Model::I1Pro2).unwrap();
+    assert!(back.claims_ambient() && !back.has_ambient());
+
+    assert_eq!(AmbientTable::of(None), AmbientTable::Missing);
+    assert_eq!(
+        AmbientTable::of(calibration_a_to_d().ambient.as_ref()),
+        AmbientTable::Usable
+    );
+}
+
+#[test]
 fn malformed_items_are_errors() {
     let full = calibration_a_to_d().to_eeprom().unwrap();
 

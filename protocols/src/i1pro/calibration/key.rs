@@ -1,0 +1,27 @@
+//! EEPROM keys the calibration uses.
+
+pub const LIN_NORMAL: u16 = 0x03E8;
+pub const LIN_HIGH: u16 = 0x03E9;
+pub const FILTER_START: u16 = 0x03EA;
+pub const FILTER_COUNT: u16 = 0x03EB;
+pub const FILTER_COEF: u16 = 0x03EC;
+pub const WHITE_REF: u16 = 0x044C;
+pub const EMISSIVE: u16 = 0x044D;
+pub const AMBIENT: u16 = 0x044E;
+pub const SENSOR_TARGET: u16 = 0x04B4;
+pub const DARK_THRESHOLD: u16 = 0x04B5;
+pub const SATURATION_NORMAL: u16 = 0x04B7;
+pub const SATURATION_HIGH: u16 = 0x04B8;
+pub const SERIAL: u16 = 0x04BB;
+pub const MANUFACTURE_DATE: u16 = 0x04BC;
+pub const HIGH_GAIN_FACTOR: u16 = 0x04BD;
+pub const MIN_INTEGRATION: u16 = 0x04C5;
+pub const MAX_INTEGRATION: u16 = 0x04C6;
+pub const CPLD_REVISION: u16 = 0x0BC0;
+pub const CAPABILITIES: u16 = 0x0BC2;
+pub const PHYSICAL_FILTER: u16 = 0x0BC4;
+pub const CAPABILITIES_E: u16 = 0x2EE2;
+pub const STRAY_LIGHT: u16 = 0x2F58;
+pub const STRAY_LIGHT_SCALE: u16 = 0x2F59;
+pub const WAVELENGTH_POLY_REFLECTIVE: u16 = 0x2F62;
+pub const WAVELENGTH_POLY_EMISSIVE: u16 = 0x2F63;

@@ -1,0 +1,260 @@
+//! A reading that differs from the readings taken before it at the same placement by more
+//! than the instrument repeats: a moved instrument, a bumped tripod, a hand in the light.
+//! Found while the operator is still there to re-aim, not later in the statistics.
+//!
+//! The repeatability is each instrument's stated one (1σ of one reading):
+//! - CS-100A: ±0.2 % in Y and ±0.001 in x, y (as 2σ), plus one unit of the last digit it
+//!   sends (four significant digits of Y, four decimals of x, y); see
+//!   `protocols/cs100a/README.md` (general knowledge, not yet confirmed by Konica Minolta's
+//!   sheet);
+//! - i1Pro: emissive 0.1 % of Y, reflective 0.002 absolute per band, i.e. 0.2 in Y on the
+//!   scale where white is 100 (`protocols/i1pro/README.md`); no chromaticity figure is
+//!   stated, so x, y are not tested;
+//! - other models: the CS-100A's for light and the i1Pro's for surfaces.
+//!
+//! A reading is flagged when its Y (or x, y) lies more than [`FLAG_SIGMAS`] σ from the
+//! mean of the earlier readings, σ being the noise of that difference: σ·√(1 + 1/m) for m
+//! earlier readings. At 5σ honest noise trips it about once in 1.7 million tests, so a
+//! flag is worth the operator's attention; a misaimed spot meter (a few per cent) always
+//! trips it.
+
+use metamer_drivers::{MeasureMode, Reading};
+
+/// How far from the earlier readings' mean, in σ of the difference, a reading is flagged.
+/// The same distance as the box assembly's outlier test, so what is flagged here is what
+/// would be left out there.
+pub const FLAG_SIGMAS: f64 = 5.0;
+
+/// Below this luminance (cd/m²) an emissive reading's relative noise is taken at this
+/// level: near black a relative figure means nothing.
+const DARK_CD_M2: f64 = 1.0;
+
+/// One instrument's stated repeatability in one mode, 1σ of one reading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Repeatability {
+    /// σ of Y relative to Y (emissive, ambient).
+    pub y_relative: f64,
+    /// σ of Y, absolute (reflective, white = 100); 0 where relative.
+    pub y_absolute: f64,
+    /// Significant digits of Y the instrument sends (its last digit is one more unit of
+    /// noise); None: not rounded.
+    pub y_digits: Option<i32>,
+    /// σ of x and of y; None: not stated, not tested.
+    pub xy: Option<f64>,
+    /// Decimals of x, y the instrument sends.
+    pub xy_decimals: Option<i32>,
+}
+
+impl Repeatability {
+    /// The stated repeatability of `model` in `mode`.
+    pub fn stated(model: &str, mode: MeasureMode) -> Repeatability {
+        match (model, mode) {
+            (_, MeasureMode::Reflective) => Repeatability {
+                y_relative: 0.0,
+                y_absolute: 0.2,
+                y_digits: None,
+                xy: None,
+                xy_decimals: None,
+            },
+            ("i1pro", _) => Repeatability {
+                y_relative: 0.001,
+                y_absolute: 0.0,
+                y_digits: None,
+                xy: None,
+                xy_decimals: None,
+            },
+            _ => Repeatability {
+                y_relative: 0.001,
+                y_absolute: 0.0,
+                y_digits: Some(4),
+                xy: Some(0.0005),
+                xy_decimals: Some(4),
+            },
+        }
+    }
+
+    /// σ of one reading's Y at the level `y`.
+    fn sigma_y(&self, y: f64) -> f64 {
+        self.y_absolute + self.y_relative * y.abs().max(DARK_CD_M2)
+    }
+
+    /// One unit of the last digit sent at the level `y`.
+    fn digit_y(&self, y: f64) -> f64 {
+        match self.y_digits {
+            Some(d) if y != 0.0 && y.is_finite() => {
+                10f64.powi(y.abs().log10().floor() as i32 - d + 1)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The figure as a data sheet states it (2σ): `±0.2 %`, `±0.4`.
+    fn stated_y(&self) -> String {
+        if self.y_relative > 0.0 {
+            format!("±{} %", 200.0 * self.y_relative)
+        } else {
+            format!("±{}", 2.0 * self.y_absolute)
+        }
+    }
+}
+
+/// How a reading differs from the earlier readings of its placement, when by more than
+/// the instrument repeats.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Deviation {
+    /// Earlier readings compared with.
+    pub earlier: usize,
+    /// This reading's Y minus their mean, relative to their mean.
+    pub y_relative: f64,
+    /// This reading's Y minus their mean.
+    pub y: f64,
+    /// The larger of |Δx| and |Δy| from their mean x, y.
+    pub xy: f64,
+    /// Which of the two is beyond the instrument's repeatability.
+    pub y_beyond: bool,
+    pub xy_beyond: bool,
+    /// The repeatability as stated (`±0.2 %` in Y, and `±0.001` in x, y when tested).
+    pub stated: String,
+}
+
+impl std::fmt::Display for Deviation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let before = match self.earlier {
+            1 => "the reading before it".to_string(),
+            n => format!("the mean of the {n} readings before it"),
+        };
+        let mut parts = Vec::new();
+        if self.y_beyond {
+            let side = if self.y >= 0.0 { "above" } else { "below" };
+            parts.push(format!(
+                "Y {:.2} % {side} {before}",
+                100.0 * self.y_relative.abs()
+            ));
+        }
+        if self.xy_beyond {
+            let of = if self.y_beyond { "it" } else { before.as_str() };
+            parts.push(format!("x, y {:.4} off {of}", self.xy));
+        }
+        write!(
+            f,
+            "{}; the instrument repeats within {}",
+            parts.join(", "),
+            self.stated
+        )
+    }
+}
+
+/// How `this` differs from the `earlier` readings of the same placement, if by more than
+/// `r` allows; None with no earlier reading or within the noise.
+pub fn deviation(earlier: &[&Reading], this: &Reading, r: Repeatability) -> Option<Deviation> {
+    let m = earlier.len();
+    if m == 0 {
+        return None;
+    }
+    let spread = (1.0 + 1.0 / m as f64).sqrt();
+    let mean_y = earlier.iter().map(|e| e.xyz[1]).sum::<f64>() / m as f64;
+    let dy = this.xyz[1] - mean_y;
+    let y_limit = FLAG_SIGMAS * r.sigma_y(mean_y) * spread + r.digit_y(mean_y);
+    let y_beyond = dy.abs() > y_limit;
+    // Chromaticity means nothing near black, and is not tested where not stated.
+    let xys: Vec<[f64; 2]> = earlier
+        .iter()
+        .map(|e| [e.xyy[0], e.xyy[1]])
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .collect();
+    let mut xy = 0.0;
+    let mut xy_beyond = false;
+    if let Some(sigma) = r.xy.filter(|_| {
+        mean_y.abs() >= DARK_CD_M2 && xys.len() == m && this.xyy[..2].iter().all(|v| v.is_finite())
+    }) {
+        let mean = |k: usize| xys.iter().map(|p| p[k]).sum::<f64>() / m as f64;
+        xy = (this.xyy[0] - mean(0))
+            .abs()
+            .max((this.xyy[1] - mean(1)).abs());
+        let digit = r.xy_decimals.map_or(0.0, |d| 10f64.powi(-d));
+        xy_beyond = xy > FLAG_SIGMAS * sigma * spread + digit;
+    }
+    if !(y_beyond || xy_beyond) {
+        return None;
+    }
+    let mut stated = format!("{} in Y", r.stated_y());
+    if let Some(sigma) = r.xy {
+        stated.push_str(&format!(" and ±{} in x, y", 2.0 * sigma));
+    }
+    Some(Deviation {
+        earlier: m,
+        y_relative: dy / mean_y.abs().max(f64::MIN_POSITIVE),
+        y: dy,
+        xy,
+        y_beyond,
+        xy_beyond,
+        stated,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reading(x: f64, y: f64, lum: f64) -> Reading {
+        Reading::from_yxy(lum, x, y, "test")
+    }
+
+    #[test]
+    fn honest_noise_is_not_flagged_and_a_moved_meter_is() {
+        let cs = Repeatability::stated("cs100a", MeasureMode::Emissive);
+        let earlier = [
+            reading(0.3127, 0.3290, 100.0),
+            reading(0.3128, 0.3289, 100.2),
+        ];
+        let refs: Vec<&Reading> = earlier.iter().collect();
+        // Mean 100.1; σ of the difference 0.1 % · 100.1 · √1.5 = 0.1226; 5σ = 0.613, plus
+        // the last digit 0.1 (four significant digits of 100): flagged beyond 0.713.
+        assert_eq!(deviation(&refs, &reading(0.3127, 0.3290, 100.8), cs), None);
+        let d = deviation(&refs, &reading(0.3127, 0.3290, 100.9), cs).unwrap();
+        assert!(d.y_beyond && !d.xy_beyond);
+        assert!((d.y_relative - 0.8 / 100.1).abs() < 1e-12);
+        assert_eq!(
+            d.to_string(),
+            "Y 0.80 % above the mean of the 2 readings before it; the instrument repeats \
+             within ±0.2 % in Y and ±0.001 in x, y"
+        );
+        // x, y: σ 0.0005 · √1.5 · 5 = 0.00306, plus 0.0001: flagged beyond 0.00316 off
+        // the mean (0.31275, 0.32895).
+        assert_eq!(deviation(&refs, &reading(0.3158, 0.3290, 100.1), cs), None);
+        let d = deviation(&refs, &reading(0.3160, 0.3290, 100.1), cs).unwrap();
+        assert!(!d.y_beyond && d.xy_beyond);
+        assert!((d.xy - 0.00325).abs() < 1e-12);
+        assert!(d.to_string().starts_with("x, y 0.0033 off the mean"), "{d}");
+    }
+
+    #[test]
+    fn one_earlier_reading_and_the_dark_and_surfaces() {
+        let cs = Repeatability::stated("cs100a", MeasureMode::Emissive);
+        let first = reading(0.3127, 0.3290, 10.0);
+        // One earlier reading: σ·√2. At 10 cd/m², 5 · 0.01 · √2 = 0.0707, plus the last
+        // digit 0.01.
+        assert_eq!(
+            deviation(&[&first], &reading(0.3127, 0.3290, 10.08), cs),
+            None
+        );
+        let d = deviation(&[&first], &reading(0.3127, 0.3290, 9.91), cs).unwrap();
+        assert_eq!(
+            d.to_string(),
+            "Y 0.90 % below the reading before it; the instrument repeats within ±0.2 % in Y \
+             and ±0.001 in x, y"
+        );
+        // Near black Y's noise is that of 1 cd/m² and x, y are not tested.
+        let dark = reading(0.30, 0.30, 0.05);
+        assert_eq!(deviation(&[&dark], &reading(0.40, 0.20, 0.055), cs), None);
+        assert!(deviation(&[&dark], &reading(0.30, 0.30, 0.065), cs).is_some());
+        // A surface on the i1Pro: 0.2 absolute in Y (white = 100), x, y untested.
+        let i1 = Repeatability::stated("i1pro", MeasureMode::Reflective);
+        let grey = reading(0.31, 0.33, 20.0);
+        assert_eq!(deviation(&[&grey], &reading(0.35, 0.33, 21.4), i1), None);
+        let d = deviation(&[&grey], &reading(0.31, 0.33, 21.5), i1).unwrap();
+        assert!(d.to_string().ends_with("repeats within ±0.4 in Y"), "{d}");
+        // Nothing to compare with.
+        assert_eq!(deviation(&[], &grey, i1), None);
+    }
+}
