@@ -315,3 +315,60 @@ fn light_fit_never_writes_a_number_that_is_not_finite() {
     assert!(out.contains("normal luminance 1.000e-300"), "{out}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_light_table_past_a_million_times_the_normal_is_refused_in_a_scene_with_its_file() {
+    let dir = scratch("bigtable");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data");
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    for csv in [
+        "colorchecker_babelcolor_average.csv",
+        "display_white_ips_lcd.csv",
+        "paper_white_reflectance.csv",
+    ] {
+        std::fs::copy(data.join(csv), dir.join(csv)).unwrap();
+    }
+    // 10 cd along the normal, 1e300 cd at 45°: f = 1e300/(10·cos 45°) = 1.414e299. This
+    // went into the radiosity solver, overflowed, and was reported as reflectances that
+    // return more light than reaches them, naming no file.
+    std::fs::write(
+        dir.join("big.ies"),
+        "IES:LM-63-2019\r\n[TEST] big\r\nTILT=NONE\r\n1 -1 1 3 1 1 2 0.3 0.3 0\r\n\
+         1 1 0\r\n0 45 90\r\n0\r\n10 1e300 0\r\n",
+    )
+    .unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(data.join("scenes/validation-box.json")).unwrap(),
+    )
+    .unwrap();
+    scene["emitters"][0]["distribution"] = serde_json::json!({"kind": "ies", "file": "../big.ies"});
+    std::fs::write(dir.join("scenes/ies.json"), scene.to_string()).unwrap();
+    let table =
+        serde_json::json!({"c_deg": [0], "gamma_deg": [0, 45, 90], "values": [[1, 1e300, 0]]});
+    scene["emitters"][0]["distribution"] = serde_json::json!({"kind": "c_gamma", "table": table});
+    std::fs::write(dir.join("scenes/inline.json"), scene.to_string()).unwrap();
+    for (file, words) in [
+        (
+            "scenes/ies.json",
+            "scenes/ies.json: emitters[0].distribution.file: scenes/../big.ies: values[0][1] (C 0°, γ 45°)",
+        ),
+        ("scenes/inline.json", "emitters[0].distribution.table: "),
+    ] {
+        let (code, out, err) = run(&dir, &["render", "spots", file, "--max-seconds", "20"]);
+        assert_eq!(code, Some(1), "{out}{err}");
+        assert!(err.contains(words), "{err}");
+        assert!(!err.contains("reflectance"), "{err}");
+    }
+    let (_, _, err) = run(&dir, &["render", "spots", "scenes/inline.json"]);
+    assert!(err.contains("the normal's; got 1.000e300"), "{err}");
+    let (_, _, err) = run(&dir, &["render", "spots", "scenes/ies.json"]);
+    assert!(err.contains("the normal's; got 1.414e299"), "{err}");
+    // `light show` refuses the file too, with its name.
+    let (code, _, err) = run(&dir, &["light", "show", "big.ies"]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("big.ies: values[0][1] (C 0°, γ 45°): relative luminance must be finite, ≥ 0 and at most 1e6 times the normal's; got 1.414e299"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

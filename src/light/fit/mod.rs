@@ -18,6 +18,7 @@ pub mod error;
 pub mod half;
 pub mod models;
 pub mod planes;
+pub mod search;
 pub mod series;
 pub mod spline;
 

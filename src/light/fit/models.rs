@@ -16,6 +16,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use super::search::{minimise_1d, nelder_mead, MAX_EXPONENT};
 use super::series::{self, SERIES_TERMS};
 use super::spline;
 
@@ -226,10 +227,6 @@ impl Params {
     }
 }
 
-/// The largest exponent searched: cos¹⁰⁰ is already below 1 % at 12°, far narrower than
-/// any panel light.
-pub(crate) const MAX_EXPONENT: f64 = 100.0;
-
 /// One half-plane's points: γ ≥ 0 in degrees, increasing, and relative luminance.
 pub type HalfPoints<'a> = (&'a [f64], &'a [f64]);
 
@@ -238,8 +235,12 @@ pub type HalfPoints<'a> = (&'a [f64], &'a [f64]);
 /// [`LdcModel::min_angles`].
 pub fn fit_plane(model: LdcModel, pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
     match model {
-        LdcModel::Series => series::fit(pos, neg),
-        LdcModel::Spline => spline::fit(pos, neg),
+        LdcModel::Series => {
+            let (n, b) = series::fit(pos, neg);
+            let mirrored = series::mirrored(&b);
+            [Params::Series { n, b }, Params::Series { n, b: mirrored }]
+        }
+        LdcModel::Spline => fit_spline(pos, neg),
         _ => [fit_half(model, pos.0, pos.1), fit_half(model, neg.0, neg.1)],
     }
 }
@@ -263,6 +264,52 @@ pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
         LdcModel::CosPoly => fit_cos_poly(&c, y),
         LdcModel::Lobes => fit_lobes(&c, y),
     }
+}
+
+/// The `spline` fit (see [`super::spline`]) to one plane's halves `pos` (signed angle γ)
+/// and `neg` (−γ); each half's parameters, `pos` first.
+fn fit_spline(pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
+    let base = [
+        fit_half(LdcModel::Lobes, pos.0, pos.1),
+        fit_half(LdcModel::Lobes, neg.0, neg.1),
+    ];
+    let residual = |p: &Params, g: &[f64], y: &[f64]| -> Vec<f64> {
+        g.iter().zip(y).map(|(&g, &y)| y - p.eval(g)).collect()
+    };
+    let rp = residual(&base[0], pos.0, pos.1);
+    let rn = residual(&base[1], neg.0, neg.1);
+    // Knots across the plane: the negative half mirrored, the normal, the positive half.
+    let mut x: Vec<f64> = neg.0.iter().rev().map(|g| -g).collect();
+    let mut y: Vec<f64> = rn.iter().rev().copied().collect();
+    x.push(0.0);
+    y.push(0.0);
+    x.extend_from_slice(pos.0);
+    y.extend_from_slice(&rp);
+    let m = spline::natural_curvature(&x, &y);
+    let zero = neg.0.len();
+    let half = |base: &Params, g: &[f64], r: &[f64], curv: Vec<f64>| -> Params {
+        let Params::Lobes { a, n, m } = *base else {
+            unreachable!("the base is a lobes fit")
+        };
+        let mut knots_deg = vec![0.0];
+        knots_deg.extend_from_slice(g);
+        let mut residuals = vec![0.0];
+        residuals.extend_from_slice(r);
+        Params::Spline {
+            a,
+            n,
+            m,
+            knots_deg,
+            residuals,
+            curvature: curv,
+        }
+    };
+    let curv_pos: Vec<f64> = m[zero..].to_vec();
+    let curv_neg: Vec<f64> = m[..=zero].iter().rev().copied().collect();
+    [
+        half(&base[0], pos.0, &rp, curv_pos),
+        half(&base[1], neg.0, &rn, curv_neg),
+    ]
 }
 
 fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
@@ -340,100 +387,6 @@ fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
     }
     let a = weight_and_sse(&powers(n), &powers(m)).0;
     Params::Lobes { a, n, m }
-}
-
-/// Minimum of `f` on [lo, hi]: the best of `steps` + 1 grid points, then golden-section
-/// search in the two grid cells around it (the sums of squares here are smooth but not
-/// always unimodal over the whole range).
-pub(crate) fn minimise_1d(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize) -> f64 {
-    let h = (hi - lo) / steps as f64;
-    let (mut best_x, mut best_v) = (lo, f64::INFINITY);
-    for k in 0..=steps {
-        let x = lo + h * k as f64;
-        let v = f(x);
-        if v < best_v {
-            (best_x, best_v) = (x, v);
-        }
-    }
-    let (mut a, mut b) = ((best_x - h).max(lo), (best_x + h).min(hi));
-    let r = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..100 {
-        if f1 < f2 {
-            b = x2;
-            (x2, f2) = (x1, f1);
-            x1 = b - r * (b - a);
-            f1 = f(x1);
-        } else {
-            a = x1;
-            (x1, f1) = (x2, f2);
-            x2 = a + r * (b - a);
-            f2 = f(x2);
-        }
-    }
-    let x = (a + b) / 2.0;
-    if f(x) <= best_v {
-        x
-    } else {
-        best_x
-    }
-}
-
-/// Nelder–Mead on two variables with the standard coefficients (reflection 1, expansion 2,
-/// contraction ½, shrink ½), from `start` with an initial simplex of edge `step`.
-fn nelder_mead(
-    f: impl Fn([f64; 2]) -> f64,
-    start: [f64; 2],
-    step: f64,
-    iterations: usize,
-) -> [f64; 2] {
-    let mut s = [
-        start,
-        [start[0] + step, start[1]],
-        [start[0], start[1] + step],
-    ];
-    let mut v = s.map(&f);
-    let lerp =
-        |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
-    for _ in 0..iterations {
-        let mut idx = [0, 1, 2];
-        idx.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
-        s = idx.map(|i| s[i]);
-        v = idx.map(|i| v[i]);
-        let spread = (v[2] - v[0]).abs();
-        let size = (s[2][0] - s[0][0]).abs().max((s[2][1] - s[0][1]).abs());
-        if spread <= 1e-30 + 1e-15 * v[0].abs() && size < 1e-12 {
-            break;
-        }
-        let centroid = lerp(s[0], s[1], 0.5);
-        let reflected = lerp(s[2], centroid, 2.0);
-        let fr = f(reflected);
-        if fr < v[0] {
-            let expanded = lerp(s[2], centroid, 3.0);
-            let fe = f(expanded);
-            (s[2], v[2]) = if fe < fr {
-                (expanded, fe)
-            } else {
-                (reflected, fr)
-            };
-        } else if fr < v[1] {
-            (s[2], v[2]) = (reflected, fr);
-        } else {
-            let contracted = lerp(s[2], centroid, 0.5);
-            let fc = f(contracted);
-            if fc < v[2] {
-                (s[2], v[2]) = (contracted, fc);
-            } else {
-                for k in 1..3 {
-                    s[k] = lerp(s[0], s[k], 0.5);
-                    v[k] = f(s[k]);
-                }
-            }
-        }
-    }
-    let best = (0..3).min_by(|&i, &j| v[i].total_cmp(&v[j])).unwrap_or(0);
-    s[best]
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::models::{minimise_1d, HalfPoints, Params, MAX_EXPONENT};
+use super::search::{minimise_1d, MAX_EXPONENT};
 
 /// Coefficients b₁ … b₄ of the polynomial in sin x.
 pub const SERIES_TERMS: usize = 4;
@@ -32,9 +32,10 @@ pub fn eval(n: f64, b: &[f64; SERIES_TERMS], gamma_deg: f64) -> f64 {
     c.powf(n) * poly
 }
 
-/// The least-squares fit to one plane's halves `pos` (x = γ) and `neg` (x = −γ); returns
-/// each half's parameters, `pos` first.
-pub fn fit(pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
+/// The least-squares fit to one plane's halves `pos` (x = γ) and `neg` (x = −γ), each
+/// given as (angles in degrees, relative luminance): n and the coefficients in `pos`'s γ
+/// (`neg`'s are [`mirrored`]).
+pub fn fit(pos: (&[f64], &[f64]), neg: (&[f64], &[f64])) -> (f64, [f64; SERIES_TERMS]) {
     let x: Vec<f64> = pos
         .0
         .iter()
@@ -65,14 +66,17 @@ pub fn fit(pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
         (if sse.is_finite() { sse } else { f64::INFINITY }, b)
     };
     let n = minimise_1d(|n| solve(n).0, 0.0, MAX_EXPONENT, 400);
-    let b = solve(n).1;
-    let mut mirrored = b;
-    for (k, v) in mirrored.iter_mut().enumerate() {
-        if k % 2 == 0 {
-            *v = -*v;
-        }
+    (n, solve(n).1)
+}
+
+/// The coefficients of the plane's other half in its own γ: sin(−γ) = −sin γ, so the odd
+/// terms change sign.
+pub fn mirrored(b: &[f64; SERIES_TERMS]) -> [f64; SERIES_TERMS] {
+    let mut m = *b;
+    for v in m.iter_mut().step_by(2) {
+        *v = -*v;
     }
-    [Params::Series { n, b }, Params::Series { n, b: mirrored }]
+    m
 }
 
 #[cfg(test)]
@@ -94,15 +98,16 @@ mod tests {
         };
         let (gp, yp) = half(truth, 1.0);
         let (gn, yn) = half(truth, -1.0);
-        let [p, q] = fit((&gp, &yp), (&gn, &yn));
+        let (n, b) = fit((&gp, &yp), (&gn, &yn));
+        let (p, q) = (|g| eval(n, &b, g), |g| eval(n, &mirrored(&b), g));
         for x in [-70.0, -35.0, -5.0, 5.0, 25.0, 65.0] {
-            let got = if x >= 0.0 { p.eval(x) } else { q.eval(-x) };
+            let got = if x >= 0.0 { p(x) } else { q(-x) };
             assert!((got - truth(x)).abs() < 1e-6, "{x}: {got} vs {}", truth(x));
         }
         // The slope at the normal, 0.1 per radian, is the same from both sides.
         let h = 1e-4;
-        let right = (p.eval(h) - 1.0) / h.to_radians();
-        let left = (1.0 - q.eval(h)) / h.to_radians();
+        let right = (p(h) - 1.0) / h.to_radians();
+        let left = (1.0 - q(h)) / h.to_radians();
         assert!((right - 0.1).abs() < 1e-3 && (left - 0.1).abs() < 1e-3);
     }
 }

@@ -12,8 +12,6 @@
 //! integrated squared curvature through the points; with the lobes fit taking the bulk of
 //! the shape, what it bends is small.
 
-use super::models::{fit_half, HalfPoints, LdcModel, Params};
-
 /// The spline's value at γ (degrees, ≥ 0) of one half: knots increasing from 0, values
 /// and second derivatives at them; the last value past the last knot.
 pub fn eval(knots: &[f64], values: &[f64], curvature: &[f64], gamma_deg: f64) -> f64 {
@@ -73,52 +71,6 @@ pub fn natural_curvature(x: &[f64], y: &[f64]) -> Vec<f64> {
     m
 }
 
-/// The fit to one plane's halves `pos` (signed angle γ) and `neg` (−γ); each half's
-/// parameters, `pos` first.
-pub fn fit(pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
-    let base = [
-        fit_half(LdcModel::Lobes, pos.0, pos.1),
-        fit_half(LdcModel::Lobes, neg.0, neg.1),
-    ];
-    let residual = |p: &Params, g: &[f64], y: &[f64]| -> Vec<f64> {
-        g.iter().zip(y).map(|(&g, &y)| y - p.eval(g)).collect()
-    };
-    let rp = residual(&base[0], pos.0, pos.1);
-    let rn = residual(&base[1], neg.0, neg.1);
-    // Knots across the plane: the negative half mirrored, the normal, the positive half.
-    let mut x: Vec<f64> = neg.0.iter().rev().map(|g| -g).collect();
-    let mut y: Vec<f64> = rn.iter().rev().copied().collect();
-    x.push(0.0);
-    y.push(0.0);
-    x.extend_from_slice(pos.0);
-    y.extend_from_slice(&rp);
-    let m = natural_curvature(&x, &y);
-    let zero = neg.0.len();
-    let half = |base: &Params, g: &[f64], r: &[f64], curv: Vec<f64>| -> Params {
-        let Params::Lobes { a, n, m } = *base else {
-            unreachable!("the base is a lobes fit")
-        };
-        let mut knots_deg = vec![0.0];
-        knots_deg.extend_from_slice(g);
-        let mut residuals = vec![0.0];
-        residuals.extend_from_slice(r);
-        Params::Spline {
-            a,
-            n,
-            m,
-            knots_deg,
-            residuals,
-            curvature: curv,
-        }
-    };
-    let curv_pos: Vec<f64> = m[zero..].to_vec();
-    let curv_neg: Vec<f64> = m[..=zero].iter().rev().copied().collect();
-    [
-        half(&base[0], pos.0, &rp, curv_pos),
-        half(&base[1], neg.0, &rn, curv_neg),
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -142,6 +94,7 @@ mod tests {
 
     #[test]
     fn the_curve_passes_through_every_reading_and_is_smooth_at_the_normal() {
+        use crate::light::fit::models::{fit_plane, LdcModel};
         let truth = |x: f64| {
             let r = x.to_radians();
             (-(r / 0.9).powi(2)).exp() * (1.0 - 0.05 * r.sin())
@@ -149,7 +102,7 @@ mod tests {
         let g: Vec<f64> = (1..=4).map(|k| 20.0 * k as f64).collect();
         let yp: Vec<f64> = g.iter().map(|&g| truth(g)).collect();
         let yn: Vec<f64> = g.iter().map(|&g| truth(-g)).collect();
-        let [p, q] = fit((&g, &yp), (&g, &yn));
+        let [p, q] = fit_plane(LdcModel::Spline, (&g, &yp), (&g, &yn));
         for (k, &gk) in g.iter().enumerate() {
             assert!((p.eval(gk) - yp[k]).abs() < 1e-12);
             assert!((q.eval(gk) - yn[k]).abs() < 1e-12);
