@@ -222,7 +222,10 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         .collect::<Result<_, _>>()?;
     // A plane listed twice (or out of order) would be dropped or mirrored over another
     // one's data without a word.
-    if let Some(w) = c_at.windows(2).find(|w| !(w[1].1 > w[0].1)) {
+    if let Some(w) = c_at
+        .windows(2)
+        .find(|w| w[1].1.partial_cmp(&w[0].1) != Some(std::cmp::Ordering::Greater))
+    {
         return Err(fmt_err(
             w[1].0,
             format!(

@@ -142,7 +142,7 @@ impl Falloff {
             let data = self.plane(plane);
             for (&angle, &value) in data.angles_deg.iter().zip(&data.luminance) {
                 let ratio = value / l0;
-                if !(ratio <= MAX_RELATIVE) {
+                if ratio.is_nan() || ratio > MAX_RELATIVE {
                     return Err(LdcError::FarAboveNormal {
                         plane,
                         angle,
