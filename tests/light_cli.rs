@@ -45,20 +45,45 @@ fn fit_exports_and_show_reads_back() {
     ];
     let (code, out, err) = run(&fit_args);
     assert_eq!(code, Some(0), "{out}{err}");
-    for m in ["lambertian", "cos-power", "cos-poly", "lobes", "chose "] {
+    for m in [
+        "lambertian",
+        "cos-power",
+        "cos-poly",
+        "lobes",
+        "series",
+        "spline",
+        "chose ",
+    ] {
         assert!(out.contains(m), "{m} missing from\n{out}");
     }
-    let svg = std::fs::read_to_string(dir.join("LIGHT.svg")).unwrap();
-    assert!(svg.contains("(chosen)"));
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("LIGHT.json")).unwrap()).unwrap();
     assert_eq!(json["normal_luminance"], 1.0);
+    // The chart shows every candidate's held-out error as the fit scored it, the tie
+    // limit, and the unit (relative readings) in its title.
+    let svg = std::fs::read_to_string(dir.join("LIGHT.svg")).unwrap();
+    assert!(svg.contains("(chosen)"));
+    assert!(
+        svg.contains("readings relative to the normal (1 at 0°)"),
+        "title"
+    );
+    assert!(svg.contains("held-out error: leave-one-out RMS"));
+    assert!(svg.contains("tie limit"));
+    for c in json["candidates"].as_array().unwrap() {
+        let v = c["cv_rms"].as_f64().unwrap();
+        let shown = format!("{:.*}", (2 - v.log10().floor() as i32).max(0) as usize, v);
+        assert!(
+            svg.contains(&format!("\n{shown}\n")),
+            "{} {shown}",
+            c["model"]
+        );
+    }
     // The panel: I₀ = 1000 cd/m² · 0.09 m² = 90 cd, read back from both files.
     for f in ["p.ies", "p.ldt"] {
         let (code, out, err) = run(&["light", "show", f]);
         assert_eq!(code, Some(0), "{out}{err}");
-        assert!(out.contains("normal 90.0000 cd"), "{out}");
-        assert!(out.contains("normal luminance 1000.0000 cd/m²"), "{out}");
+        assert!(out.contains("normal 90.000 cd"), "{out}");
+        assert!(out.contains("normal luminance 1000.0 cd/m²"), "{out}");
     }
     // Existing outputs need --force; relative readings need --luminance for candela.
     let (code, _, err) = run(&fit_args);

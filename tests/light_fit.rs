@@ -49,6 +49,50 @@ fn family(model: LdcModel) -> [Params; 4] {
             (0.8, 2.0, 20.0),
         ]
         .map(|(a, n, m)| Params::Lobes { a, n, m }),
+        // One series per plane: each half's odd coefficients are the other's negated.
+        LdcModel::Series => [
+            Params::Series {
+                n: 0.8,
+                b: [0.1, 0.05, 0.0, 0.0],
+            },
+            Params::Series {
+                n: 1.5,
+                b: [-0.05, -0.3, 0.02, 0.1],
+            },
+            Params::Series {
+                n: 0.8,
+                b: [-0.1, 0.05, 0.0, 0.0],
+            },
+            Params::Series {
+                n: 1.5,
+                b: [0.05, -0.3, -0.02, 0.1],
+            },
+        ],
+        // The spline follows any smooth curve; its truth here is a lobes mix with a slope
+        // at the normal that no half-plane model has (fitted by the spline itself).
+        LdcModel::Spline => {
+            let f = fit(&skewed_lobes(), ModelChoice::Named(LdcModel::Spline)).unwrap();
+            std::array::from_fn(|k| f.halves[k].params.clone())
+        }
+    }
+}
+
+/// Readings every 10° of lobes mixes tilted by (1 + 0.1 sin γ).
+fn skewed_lobes() -> Falloff {
+    let f = |x: f64, a: f64, n: f64, m: f64| {
+        let c = cos(x);
+        (a * c.powf(n) + (1.0 - a) * c.powf(m)) * (1.0 + 0.1 * x.to_radians().sin())
+    };
+    let plane = |a, n, m| {
+        let angles: Vec<f64> = (-7..=7).map(|k| 10.0 * k as f64).collect();
+        PlaneData {
+            luminance: angles.iter().map(|&x| f(x, a, n, m)).collect(),
+            angles_deg: angles,
+        }
+    };
+    Falloff {
+        horizontal: plane(0.6, 1.0, 8.0),
+        vertical: plane(0.8, 0.5, 3.0),
     }
 }
 
@@ -86,7 +130,9 @@ fn each_model_recovers_its_own_asymmetric_distribution() {
 
 #[test]
 fn auto_picks_the_generating_family_or_one_as_good() {
-    for model in LdcModel::ALL {
+    // The spline's own curves are not a family to recover: past the last reading it holds
+    // its correction by convention. What it is for is tested with the skewed distributions.
+    for model in LdcModel::ALL.into_iter().filter(|&m| m != LdcModel::Spline) {
         let truth = family(model);
         let f = fit(&falloff(1.0, &truth), ModelChoice::Auto).unwrap();
         let e = held_out_error(&f, &truth);
@@ -298,4 +344,185 @@ fn a_csv_column_without_readings_is_an_empty_plane() {
         ),
         "{e}"
     );
+}
+
+/// A distribution given as the relative luminance of each plane at its signed angle.
+struct Skewed {
+    name: &'static str,
+    horizontal: fn(f64) -> f64,
+    vertical: fn(f64) -> f64,
+}
+
+fn rad(x: f64) -> f64 {
+    x.to_radians()
+}
+
+/// Smooth distributions whose two halves differ in shape as well as width, the kind a
+/// diffuser over an off-centre LED array gives: the first is the one that was reported
+/// (3 % off at held-out angles with the half-plane models alone), the others are ours.
+const SKEWED: [Skewed; 5] = [
+    Skewed {
+        name: "cos^0.8·(1 + 0.1 sin γ) ; exp(−(γ/0.9)²)·(1 − 0.05 sin γ)",
+        horizontal: |x| cos(x).powf(0.8) * (1.0 + 0.1 * rad(x).sin()),
+        vertical: |x| (-(rad(x) / 0.9).powi(2)).exp() * (1.0 - 0.05 * rad(x).sin()),
+    },
+    Skewed {
+        name: "cos^1.5·(1 + 0.15 sin γ) ; (0.7 cos + 0.3 cos⁶)·(1 + 0.08 sin γ)",
+        horizontal: |x| cos(x).powf(1.5) * (1.0 + 0.15 * rad(x).sin()),
+        vertical: |x| (0.7 * cos(x) + 0.3 * cos(x).powi(6)) * (1.0 + 0.08 * rad(x).sin()),
+    },
+    Skewed {
+        name: "batwing cos^0.5·(1 + 0.3 sin²γ) ; exp(−(γ/1.1)⁴)·(1 − 0.1 sin γ)",
+        horizontal: |x| cos(x).powf(0.5) * (1.0 + 0.3 * rad(x).sin().powi(2)),
+        vertical: |x| (-(rad(x) / 1.1).powi(4)).exp() * (1.0 - 0.1 * rad(x).sin()),
+    },
+    Skewed {
+        name: "cos^1.2 tilted by 10° ; exp(−(γ/0.7)²)·(1 + 0.05 sin 2γ)",
+        horizontal: |x| cos(x - 10.0).powf(1.2) / cos(10.0).powf(1.2),
+        vertical: |x| (-(rad(x) / 0.7).powi(2)).exp() * (1.0 + 0.05 * (2.0 * rad(x)).sin()),
+    },
+    Skewed {
+        name: "Gaussian off the normal ; cos²·(1 + 0.12 sin γ − 0.05 sin²γ)",
+        horizontal: |x| (-((rad(x) - 0.1) / 0.8).powi(2)).exp() / (-(0.1f64 / 0.8).powi(2)).exp(),
+        vertical: |x| cos(x).powi(2) * (1.0 + 0.12 * rad(x).sin() - 0.05 * rad(x).sin().powi(2)),
+    },
+];
+
+/// Nine readings per plane, −80° … 80° in 20° steps.
+fn nine_angles(d: &Skewed) -> Falloff {
+    let plane = |f: fn(f64) -> f64| {
+        let angles: Vec<f64> = (-4..=4).map(|k| 20.0 * k as f64).collect();
+        PlaneData {
+            luminance: angles.iter().map(|&x| f(x)).collect(),
+            angles_deg: angles,
+        }
+    };
+    Falloff {
+        horizontal: plane(d.horizontal),
+        vertical: plane(d.vertical),
+    }
+}
+
+/// The largest error of the IES file's candela at the angles between the readings (±10°,
+/// 30°, 50°, 70° in both planes), relative to the normal intensity: the file written, read
+/// back by the reader.
+fn ies_held_out_error(f: &metamer::light::LdcFit, d: &Skewed) -> f64 {
+    use metamer::light::ies::{self, IesInfo};
+    let panel = metamer::light::Panel::new(0.5, 0.5, 1000.0).unwrap();
+    let info = IesInfo {
+        test: "held-out angles".into(),
+        issue_date: "2026-12-02".into(),
+        luminaire: d.name.into(),
+        generation: "test".into(),
+    };
+    let text = ies::to_string(&f.table, &panel, &info);
+    let (table, p) = ies::parse(&text, Path::new("skewed.ies")).unwrap();
+    let i0 = panel.normal_intensity_cd();
+    assert!((p.normal_intensity_cd - i0).abs() < 1e-9 * i0);
+    let mut worst = 0.0f64;
+    for (c, truth, sign) in [
+        (0.0, d.horizontal, 1.0),
+        (180.0, d.horizontal, -1.0),
+        (90.0, d.vertical, 1.0),
+        (270.0, d.vertical, -1.0),
+    ] {
+        for g in [10.0, 30.0, 50.0, 70.0] {
+            let want = i0 * truth(sign * g) * cos(g);
+            let got = p.normal_intensity_cd * table.at(c, g) * cos(g);
+            worst = worst.max((got - want).abs() / i0);
+        }
+    }
+    worst
+}
+
+/// Prints (with `--nocapture`) the table the light README gives: each model's held-out
+/// score, auto's pick and its IES error at the angles between the readings, and what the
+/// half-plane models alone would have given.
+#[test]
+fn skewed_distributions_are_reproduced_at_held_out_angles_in_the_ies_table() {
+    use metamer::light::fit::cv::{choose, Score};
+    println!(
+        "| distribution | {} | auto | IES error | half-plane models alone | IES error |",
+        LdcModel::ALL.map(|m| m.name()).join(" | ")
+    );
+    for d in &SKEWED {
+        let f = fit(&nine_angles(d), ModelChoice::Auto).unwrap();
+        let e = ies_held_out_error(&f, d);
+        // The rule applied to the parametric candidates alone: the choice before the
+        // plane families existed.
+        let scores: Vec<Score> = f
+            .candidates
+            .iter()
+            .filter(|c| !c.model.per_plane())
+            .map(|c| Score {
+                model: c.model,
+                parameters: c.parameters,
+                cv_rms: c.cv_rms,
+            })
+            .collect();
+        let old = scores[choose(&scores).unwrap().0].model;
+        let old_e = ies_held_out_error(&fit(&nine_angles(d), ModelChoice::Named(old)).unwrap(), d);
+        let loo: Vec<String> = f
+            .candidates
+            .iter()
+            .map(|c| c.cv_rms.map_or("-".into(), |v| format!("{v:.4}")))
+            .collect();
+        println!(
+            "| {} | {} | {} | {:.2} % | {old} | {:.2} % |",
+            d.name,
+            loo.join(" | "),
+            f.model,
+            e * 100.0,
+            old_e * 100.0
+        );
+        assert!(
+            e < 0.01,
+            "{}: {} chosen ({}), {:.2} % of the normal intensity off",
+            d.name,
+            f.model,
+            f.why,
+            e * 100.0
+        );
+        // The half-plane models alone cannot: that is why the plane families exist.
+        assert!(old_e > 0.01, "{}: {old} {old_e}", d.name);
+        // The tilted lobe is the one no closed form here follows: only the curve through
+        // the readings predicts its held-out angles.
+        if d.name.contains("tilted") {
+            assert_eq!(f.model, LdcModel::Spline, "{}", f.why);
+        }
+    }
+}
+
+#[test]
+fn a_cos_power_truth_is_still_fitted_by_cos_power() {
+    let truth = family(LdcModel::CosPower);
+    let nine = |noise: f64| {
+        // Nine readings per plane, −80° … 80° in 20° steps.
+        let plane = |pos: &Params, neg: &Params| {
+            let angles: Vec<f64> = (-4..=4).map(|k| 20.0 * k as f64).collect();
+            PlaneData {
+                luminance: angles
+                    .iter()
+                    .map(|&a| if a >= 0.0 { pos } else { neg }.eval(a.abs()))
+                    .collect(),
+                angles_deg: angles,
+            }
+        };
+        let mut d = Falloff {
+            horizontal: plane(&truth[0], &truth[2]),
+            vertical: plane(&truth[1], &truth[3]),
+        };
+        // Readings to 3 decimals, as a meter shows them: noise the richer models could
+        // follow, but must not be chosen for.
+        for p in [&mut d.horizontal, &mut d.vertical] {
+            for (k, v) in p.luminance.iter_mut().enumerate() {
+                *v = ((*v + noise * if k % 2 == 0 { 1.0 } else { -1.0 }) * 1000.0).round() / 1000.0;
+            }
+        }
+        d
+    };
+    for noise in [0.0, 0.002] {
+        let f = fit(&nine(noise), ModelChoice::Auto).unwrap();
+        assert_eq!(f.model, LdcModel::CosPower, "noise {noise}: {}", f.why);
+    }
 }

@@ -32,7 +32,9 @@ struct FitArgs {
     /// Readings: CSV `angle_deg,horizontal,vertical` (signed angles; either plane alone).
     #[arg(long, value_name = "FILE.csv")]
     falloff: PathBuf,
-    /// lambertian, cos-power, cos-poly, lobes, or auto (leave-one-out cross-validation).
+    /// lambertian, cos-power, cos-poly, lobes, series, spline, or auto (leave-one-out
+    /// cross-validation picks the simplest model that predicts held-out angles as well as
+    /// the best).
     #[arg(long, default_value = "auto")]
     model: ModelChoice,
     /// The fit, its scores and its C-γ table (JSON).
@@ -208,29 +210,30 @@ fn same_path(a: &std::path::Path, b: &std::path::Path) -> bool {
 
 fn print_fit(source: &std::path::Path, fit: &LdcFit) {
     println!(
-        "{}: normal luminance {:.6} (horizontal {}, vertical {} at 0°)",
+        "{}: normal luminance {} (horizontal {}, vertical {} at 0°)",
         source.display(),
-        fit.normal_luminance,
-        fit.normal_readings[0],
-        fit.normal_readings[1]
+        num(fit.normal_luminance),
+        num(fit.normal_readings[0]),
+        num(fit.normal_readings[1])
     );
     println!(
-        "  {:<11} {:>8} {:>8} {:>8}  parameters per half-plane",
-        "model", "rms", "LOO rms", "LOO max"
+        "  {:<11} {:>5} {:>9} {:>9} {:>9}  parameters per half-plane",
+        "model", "par.", "rms", "LOO rms", "LOO max"
     );
-    let num = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
+    let score = |v: Option<f64>| v.map_or("-".to_string(), num);
     for c in &fit.candidates {
         let mark = if c.model == fit.model { "*" } else { " " };
         println!(
-            "{mark} {:<11} {:>8} {:>8} {:>8}  {}",
+            "{mark} {:<11} {:>5} {:>9} {:>9} {:>9}  {}",
             c.model.name(),
-            num(c.rms),
-            num(c.cv_rms),
-            num(c.cv_max),
+            c.parameters,
+            score(c.rms),
+            score(c.cv_rms),
+            score(c.cv_max),
             c.note.as_deref().unwrap_or("")
         );
-        for h in &c.halves {
-            if c.model.parameters() > 0 {
+        if c.parameters > 0 {
+            for h in &c.halves {
                 println!("      {:<20} {}", h.half.to_string(), h.params.describe());
             }
         }
@@ -245,6 +248,22 @@ fn print_fit(source: &std::path::Path, fit: &LdcFit) {
             .map(|r| format!("{:+}°:{:+.4}", r.angle_deg, r.residual))
             .collect();
         println!("  {plane:<10} {}", cells.join(" "));
+    }
+}
+
+/// A number for a table: 5 significant digits in at most 9 characters, in exponent form
+/// outside 0.001 … 99999 so that a tiny or a huge value keeps its column.
+fn num(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".into()
+    } else if !v.is_finite() {
+        format!("{v}")
+    } else if (1e-3..1e5).contains(&a) {
+        let decimals = (4 - a.log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.3e}")
     }
 }
 
@@ -270,6 +289,12 @@ fn run_show(a: ShowArgs) -> CliResult {
 
 fn print_photometry(file: &std::path::Path, table: &CGammaTable, p: &Photometry) {
     println!("{}: {}", file.display(), p.format);
+    if let Some(enc) = &p.text_encoding {
+        println!("  text lines read as {enc} (not UTF-8)");
+    }
+    for (key, text) in &p.labels {
+        println!("  {key:<11} {text}");
+    }
     println!(
         "  C-planes: {} stored, symmetry {}; {} after expansion; γ 0…90° in {} steps",
         p.stored_planes,
@@ -278,33 +303,41 @@ fn print_photometry(file: &std::path::Path, table: &CGammaTable, p: &Photometry)
         table.gamma_deg().len() - 1
     );
     println!(
-        "  candela: {:.4} … {:.4} cd (normal {:.4} cd)",
-        p.min_intensity_cd, p.max_intensity_cd, p.normal_intensity_cd
+        "  candela: {} … {} cd (normal {} cd)",
+        num(p.min_intensity_cd),
+        num(p.max_intensity_cd),
+        num(p.normal_intensity_cd)
     );
     match p.normal_luminance_cd_m2() {
         Some(l) => println!(
-            "  luminous opening {} m × {} m ({:.6} m²): normal luminance {:.4} cd/m²",
-            p.width_m, p.height_m, p.area_m2, l
+            "  luminous opening {} m × {} m ({} m²): normal luminance {} cd/m²",
+            num(p.width_m),
+            num(p.height_m),
+            num(p.area_m2),
+            num(l)
         ),
         None => println!("  no luminous opening given: luminance unknown"),
     }
-    println!("  flux {:.4} lm (front hemisphere)", p.flux_lm);
+    println!("  flux {} lm (front hemisphere)", num(p.flux_lm));
     if p.max_backward_cd > 0.0 {
         println!(
-            "  up to {:.4} cd behind the panel (γ > 90°), left out of the distribution",
-            p.max_backward_cd
+            "  up to {} cd behind the panel (γ > 90°), left out of the distribution",
+            num(p.max_backward_cd)
         );
     }
     println!("  relative luminance f(C, γ):");
     let gammas = [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0];
-    let head: Vec<String> = gammas.iter().map(|g| format!("{g:>6}°")).collect();
-    println!("    {:<6} {}", "", head.join(""));
+    let head: String = gammas
+        .iter()
+        .map(|g| format!(" {:>9}", format!("{g}°")))
+        .collect();
+    println!("    {:<6}{head}", "C \\ γ");
     for h in HalfPlane::ALL {
-        let cells: Vec<String> = gammas
+        let cells: String = gammas
             .iter()
-            .map(|&g| format!("{:>7.4}", table.at(h.c_deg(), g)))
+            .map(|&g| format!(" {:>9}", num(table.at(h.c_deg(), g))))
             .collect();
-        println!("    {:<6} {}", format!("C{}", h.c_deg()), cells.join(""));
+        println!("    {:<6}{cells}", format!("C{}", h.c_deg()));
     }
 }
 

@@ -33,15 +33,26 @@ pub enum CGammaError {
         got: usize,
         expected: usize,
     },
-    #[error("values[{plane}][{index}] = {value}: relative luminance must be finite and ≥ 0")]
+    #[error(
+        "values[{plane}][{index}] (C {c_deg}°, γ {gamma_deg}°): relative luminance must be \
+         finite, ≥ 0 and at most 1e6 times the normal's; got {value:.3e}"
+    )]
     BadValue {
         plane: usize,
         index: usize,
+        c_deg: f64,
+        gamma_deg: f64,
         value: f64,
     },
     #[error("values[{plane}][0] = {value}: the luminance along the normal must be 1 (the table is relative to it)")]
     NotNormalised { plane: usize, value: f64 },
 }
+
+/// The largest relative luminance a table may hold. A panel's luminance at grazing angles
+/// can exceed its normal luminance many times over (I/(I₀ cos γ) grows as cos γ → 0), but
+/// not by a million: a value past that is a wrong unit or a broken file, and multiplied by
+/// a luminance and an area it overflows what a renderer sums.
+pub const MAX_RELATIVE: f64 = 1e6;
 
 /// Relative luminance f(C, γ) on a grid of C-planes and γ angles.
 ///
@@ -113,7 +124,8 @@ fn increasing(
 
 impl CGammaTable {
     /// A validated table: C-planes strictly increasing in [0°, 360°), γ strictly increasing
-    /// from 0° to 90°, one row per plane, values finite and ≥ 0 and 1 along the normal.
+    /// from 0° to 90°, one row per plane, values finite, in [0, [`MAX_RELATIVE`]] and 1
+    /// along the normal.
     pub fn new(
         c_deg: Vec<f64>,
         gamma_deg: Vec<f64>,
@@ -142,11 +154,13 @@ impl CGammaTable {
             if let Some((index, &value)) = row
                 .iter()
                 .enumerate()
-                .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+                .find(|(_, v)| !(v.is_finite() && (0.0..=MAX_RELATIVE).contains(*v)))
             {
                 return Err(CGammaError::BadValue {
                     plane,
                     index,
+                    c_deg: c_deg[plane],
+                    gamma_deg: gamma_deg[index],
                     value,
                 });
             }

@@ -25,8 +25,8 @@ use metamer_color::text::{echo, strip_bom};
 
 use super::cgamma::CGammaTable;
 use super::photometry::{
-    candela_grid, finish, format_sig, mirror_planes, tokens, Opening, Panel, Photometry,
-    PhotometryError,
+    candela_grid, decode_text, finish, format_sig, mirror_planes, tokens, Opening, Panel,
+    Photometry, PhotometryError,
 };
 
 /// Text for the keyword lines of a written file.
@@ -111,12 +111,65 @@ fn one_line(s: &str) -> String {
 }
 
 /// Reads an IES file: the distribution as a C-γ table (front hemisphere) and its photometry.
+/// Text that is not UTF-8 is read as Windows-1252 (see [`decode_text`]).
 pub fn read(path: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
-    let text = metamer_color::text::read_text(path).map_err(|source| PhotometryError::Io {
+    let bytes = metamer_color::text::read_bytes(path).map_err(|source| PhotometryError::Io {
         file: path.to_path_buf(),
         source,
     })?;
-    parse(&text, path)
+    let (text, encoding) = decode_text(&bytes);
+    let (table, mut photometry) = parse(&text, path)?;
+    photometry.text_encoding = encoding.map(String::from);
+    Ok((table, photometry))
+}
+
+/// The keyword lines before `TILT=` as (keyword, text); `[MORE]` continues the line before.
+fn keywords(lines: &[&str]) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for l in lines {
+        let l = l.trim();
+        let Some(rest) = l.strip_prefix('[') else {
+            continue;
+        };
+        let Some((key, text)) = rest.split_once(']') else {
+            continue;
+        };
+        let (key, text) = (key.trim().to_ascii_uppercase(), echo(text.trim()));
+        match out.last_mut() {
+            Some(last) if key == "MORE" => {
+                last.1.push(' ');
+                last.1.push_str(&text);
+            }
+            _ => out.push((key, text)),
+        }
+    }
+    out
+}
+
+/// A comma inside a value on a line that separates values by blanks: LM-63 separates
+/// values by blanks or commas and writes decimals with a point, so "10 5,5 0,0" is either
+/// decimal commas (10, 5.5, 0.0) or two values each (10, 5, 5, 0, 0), and the counts can
+/// come out right either way. A line whose values are all separated by commas (with or
+/// without blanks) is the format's own. The first such value and its line, if any.
+fn ambiguous_comma(text: &str, first_line: usize) -> Option<(usize, String)> {
+    let inner_comma = |w: &str| {
+        let b = w.as_bytes();
+        (1..b.len().saturating_sub(1))
+            .any(|k| b[k] == b',' && b[k - 1].is_ascii_digit() && b[k + 1].is_ascii_digit())
+    };
+    text.lines().enumerate().find_map(|(i, l)| {
+        let words: Vec<&str> = l.split_whitespace().collect();
+        let blank_separated = words
+            .windows(2)
+            .any(|w| !w[0].ends_with(',') && !w[1].starts_with(','));
+        if !blank_separated {
+            return None;
+        }
+        words
+            .iter()
+            .find(|w| inner_comma(w))
+            .map(|w| (first_line + i, w.to_string()))
+    })
 }
 
 /// [`read`] on text; `source` names the file in errors.
@@ -145,14 +198,25 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     };
     let tilt_value = lines[tilt].trim_start()[5..].trim().to_ascii_uppercase();
     let rest = lines[tilt + 1..].join("\n");
+    if let Some((line, word)) = ambiguous_comma(&rest, tilt + 2) {
+        return Err(fmt_err(
+            line,
+            format!(
+                "'{}': a comma inside a value on a line of blank-separated values — a \
+                 decimal comma, or two values? LM-63 writes decimals with a point and \
+                 separates values by blanks or commas",
+                echo(&word)
+            ),
+        ));
+    }
     let toks = tokens(&rest, tilt + 2);
-    let mut pos = 0usize;
+    let pos = std::cell::Cell::new(0usize);
     let last_line = lines.len();
-    let mut next = |what: &str| -> Result<(usize, f64), PhotometryError> {
-        let Some((line, t)) = toks.get(pos) else {
+    let next = |what: &str| -> Result<(usize, f64), PhotometryError> {
+        let Some((line, t)) = toks.get(pos.get()) else {
             return Err(fmt_err(last_line, format!("the file ends before {what}")));
         };
-        pos += 1;
+        pos.set(pos.get() + 1);
         t.parse::<f64>()
             .map(|v| (*line, v))
             .map_err(|_| fmt_err(*line, format!("{what}: '{}' is not a number", echo(t))))
@@ -161,15 +225,41 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         // Lamp-to-luminaire geometry, the number of tilt angles, the angles, the factors:
         // they scale the lamp's output with its tilt, which a fixed panel does not have.
         next("the tilt geometry")?;
-        let (line, n) = next("the number of tilt angles")?;
+        let (count_line, n) = next("the number of tilt angles")?;
         if n.is_nan() || n < 0.0 || n.fract() != 0.0 {
             return Err(fmt_err(
-                line,
+                count_line,
                 format!("the number of tilt angles {n} is not a count"),
             ));
         }
-        for _ in 0..(n as usize).saturating_mul(2) {
-            next("the tilt table")?;
+        let mut last = (count_line, f64::NEG_INFINITY);
+        for k in 0..(n as usize).saturating_mul(2) {
+            let (line, v) = next("the TILT=INCLUDE table")?;
+            if (k as f64) < n && v <= last.1 {
+                return Err(fmt_err(
+                    line,
+                    format!(
+                        "the TILT=INCLUDE table's angles must increase: {}° then {v}° (its \
+                         count on line {count_line} says {n} angles, then {n} factors)",
+                        last.1
+                    ),
+                ));
+            }
+            last = (line, v);
+        }
+        // The line of lamps, lumens, multiplier, … starts a line of its own: a table that
+        // ends in the middle of a line has more or fewer values than its count says, and
+        // every number after it would be read as the wrong field.
+        if let Some((line, t)) = toks.get(pos.get()).filter(|(l, _)| *l == last.0) {
+            return Err(fmt_err(
+                *line,
+                format!(
+                    "the TILT=INCLUDE table ends in the middle of line {line}, before '{}': its \
+                     count on line {count_line} says {n} angles and {n} factors, but the \
+                     values do not end with a line (one too few or too many?)",
+                    echo(t)
+                ),
+            ));
         }
     }
     let count = |(line, v): (usize, f64), what: &str| -> Result<usize, PhotometryError> {
@@ -216,7 +306,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     next("the input watts")?;
     // The counts are the file's word: the lists grow with the numbers actually there, so a
     // count of 4294967296 ends at the end of the file, not in a 34 GB allocation.
-    let mut read_n = |n: usize, what: &str| -> Result<(usize, Vec<f64>), PhotometryError> {
+    let read_n = |n: usize, what: &str| -> Result<(usize, Vec<f64>), PhotometryError> {
         let mut v = Vec::new();
         let mut first_line = 0;
         for k in 0..n {
@@ -238,6 +328,24 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
                 .map(|v| v * multiplier)
                 .collect::<Vec<f64>>(),
         );
+    }
+    // Every value the counts call for is read; more numbers mean a count or a value is
+    // wrong, and the table read would be shifted (a DOS end-of-file mark is not a value).
+    let extra: Vec<&(usize, String)> = toks[pos.get()..]
+        .iter()
+        .filter(|(_, t)| !t.chars().all(char::is_control))
+        .collect();
+    if let Some((line, t)) = extra.first() {
+        return Err(fmt_err(
+            *line,
+            format!(
+                "{} value(s) after the last candela value, from '{}' on: the counts \
+                 ({n_vertical} vertical × {n_horizontal} horizontal angles) do not match the \
+                 numbers in the file",
+                extra.len(),
+                echo(t)
+            ),
+        ));
     }
     let first_c = horizontal[0];
     let last_c = horizontal[n_horizontal - 1];
@@ -295,7 +403,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         area_m2: area,
     };
     let stored_planes = n_horizontal;
-    finish(
+    let (table, mut photometry) = finish(
         version,
         symmetry.into(),
         stored_planes,
@@ -306,7 +414,9 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     .map_err(|message| PhotometryError::Content {
         file: source.to_path_buf(),
         message,
-    })
+    })?;
+    photometry.labels = keywords(&lines[..tilt]);
+    Ok((table, photometry))
 }
 
 #[cfg(test)]

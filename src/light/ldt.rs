@@ -26,8 +26,8 @@ use metamer_color::text::{echo, strip_bom};
 
 use super::cgamma::CGammaTable;
 use super::photometry::{
-    candela_grid, finish, flux_lm, format_sig, mirror_planes, tokens, Opening, Panel, Photometry,
-    PhotometryError,
+    candela_grid, decode_text, finish, flux_lm, format_sig, mirror_planes, tokens, Opening, Panel,
+    Photometry, PhotometryError,
 };
 
 /// Text for the descriptive lines of a written file.
@@ -114,9 +114,11 @@ pub fn read(path: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
         file: path.to_path_buf(),
         source,
     })?;
-    // Files from Windows tools are often Latin-1; the text fields are not used.
-    let text = String::from_utf8_lossy(&bytes);
-    parse(&text, path)
+    // Files from Windows tools are often in its code page: see `decode_text`.
+    let (text, encoding) = decode_text(&bytes);
+    let (table, mut photometry) = parse(&text, path)?;
+    photometry.text_encoding = encoding.map(String::from);
+    Ok((table, photometry))
 }
 
 /// [`read`] on text; `source` names the file in errors.
@@ -198,24 +200,42 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     let data_start = 27 + 6 * sets;
     let rest = lines.get(data_start - 1..).unwrap_or(&[]).join("\n");
     let toks = tokens_decimal_comma(&rest, data_start);
-    let mut pos = 0usize;
-    let mut next = |what: &str| -> Result<f64, PhotometryError> {
-        let Some((line, t)) = toks.get(pos) else {
+    let pos = std::cell::Cell::new(0usize);
+    let next_at = |what: &str| -> Result<(usize, f64), PhotometryError> {
+        let Some((line, t)) = toks.get(pos.get()) else {
             return Err(fmt_err(
                 lines.len().max(1),
                 format!("the file ends before {what}"),
             ));
         };
-        pos += 1;
+        pos.set(pos.get() + 1);
         t.parse::<f64>()
+            .map(|v| (*line, v))
             .map_err(|_| fmt_err(*line, format!("{what}: '{}' is not a number", echo(t))))
     };
+    let next = |what: &str| next_at(what).map(|(_, v)| v);
     for _ in 0..10 {
         next("the direct ratios")?;
     }
-    let c_angles: Vec<f64> = (0..mc)
-        .map(|_| next("the C angles"))
+    let c_at: Vec<(usize, f64)> = (0..mc)
+        .map(|_| next_at("the C angles"))
         .collect::<Result<_, _>>()?;
+    // A plane listed twice (or out of order) would be dropped or mirrored over another
+    // one's data without a word.
+    if let Some(w) = c_at
+        .windows(2)
+        .find(|w| w[1].1.partial_cmp(&w[0].1) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(fmt_err(
+            w[1].0,
+            format!(
+                "the C angles must increase: C{}° then C{}° (a plane listed twice, or out of \
+                 order)",
+                w[0].1, w[1].1
+            ),
+        ));
+    }
+    let c_angles: Vec<f64> = c_at.iter().map(|c| c.1).collect();
     let gammas: Vec<f64> = (0..ng)
         .map(|_| next("the γ angles"))
         .collect::<Result<_, _>>()?;
@@ -283,7 +303,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         height_m: l,
         area_m2: area.abs(),
     };
-    finish(
+    let (table, mut photometry) = finish(
         "EULUMDAT".into(),
         symmetry.into(),
         stored,
@@ -294,7 +314,22 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     .map_err(|message| PhotometryError::Content {
         file: source.to_path_buf(),
         message,
+    })?;
+    photometry.labels = [
+        (1, "company"),
+        (8, "report"),
+        (9, "luminaire"),
+        (10, "number"),
+        (11, "file name"),
+        (12, "date/user"),
+    ]
+    .iter()
+    .filter_map(|&(k, name)| {
+        let t = lines.get(k - 1)?.trim();
+        (!t.is_empty()).then(|| (name.to_string(), echo(t)))
     })
+    .collect();
+    Ok((table, photometry))
 }
 
 /// Tokens of the numeric block with decimal commas read as points (EULUMDAT separates

@@ -169,6 +169,13 @@ pub struct Photometry {
     /// Intensity the file has behind the panel (γ > 90°), cd; a flat emitter has none and
     /// it is left out of the distribution.
     pub max_backward_cd: f64,
+    /// The file's descriptive lines (IES keywords such as `MANUFAC`, EULUMDAT's company,
+    /// luminaire name, …), in the file's order.
+    #[serde(default)]
+    pub labels: Vec<(String, String)>,
+    /// The encoding the text was read in when it was not UTF-8 ("Windows-1252").
+    #[serde(default)]
+    pub text_encoding: Option<String>,
 }
 
 impl Photometry {
@@ -176,6 +183,35 @@ impl Photometry {
     pub fn normal_luminance_cd_m2(&self) -> Option<f64> {
         (self.area_m2 > 0.0).then(|| self.normal_intensity_cd / self.area_m2)
     }
+}
+
+/// A photometric file's bytes as text, and the name of the encoding when it was not UTF-8.
+///
+/// LM-63 asks for ASCII and EULUMDAT names none, but files from lighting tools carry
+/// manufacturer and luminaire names in the Windows code page ("Müller", a no-break space
+/// 0xA0). Numbers are ASCII in every one of these encodings, so only the labels depend on
+/// the choice. Bytes that are not UTF-8 are read as Windows-1252: Latin-1 (each byte its
+/// own code point) except 0x80–0x9F, which hold the printable characters of the mapping
+/// table `cp1252.txt` published by Unicode (and WHATWG's `index-windows-1252`); its five
+/// unassigned bytes keep their Latin-1 code points, as WHATWG's decoder does.
+pub fn decode_text(bytes: &[u8]) -> (String, Option<&'static str>) {
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        return (text.to_string(), None);
+    }
+    const HIGH: [u16; 32] = [
+        0x20AC, 0x0081, 0x201A, 0x0192, 0x201E, 0x2026, 0x2020, 0x2021, 0x02C6, 0x2030, 0x0160,
+        0x2039, 0x0152, 0x008D, 0x017D, 0x008F, 0x0090, 0x2018, 0x2019, 0x201C, 0x201D, 0x2022,
+        0x2013, 0x2014, 0x02DC, 0x2122, 0x0161, 0x203A, 0x0153, 0x009D, 0x017E, 0x0178,
+    ];
+    let text = bytes
+        .iter()
+        .map(|&b| match b {
+            0x80..=0x9F => char::from_u32(u32::from(HIGH[usize::from(b - 0x80)]))
+                .unwrap_or(char::REPLACEMENT_CHARACTER),
+            _ => char::from(b),
+        })
+        .collect();
+    (text, Some("Windows-1252"))
 }
 
 /// Candela on a grid (C-planes × γ from 0 to 90°, full circle of C) to a relative table:
@@ -391,6 +427,8 @@ pub(crate) fn finish(
         stored_planes,
         symmetry,
         max_backward_cd: back,
+        labels: Vec::new(),
+        text_encoding: None,
     };
     Ok((table, photometry))
 }

@@ -58,6 +58,32 @@ pub enum LdcError {
         got: usize,
         need: usize,
     },
+    #[error(
+        "the {plane} plane: {got} angle(s) off the normal, the {model} model needs at least {need}"
+    )]
+    TooFewPlaneAngles {
+        plane: Plane,
+        model: LdcModel,
+        got: usize,
+        need: usize,
+    },
+    #[error("the {plane} plane at {angle}°: the reading {value:e} is {ratio:.3e} times the normal luminance {normal:e}; a distribution relative to the normal takes at most {max} times it (is the 0° reading right?)")]
+    FarAboveNormal {
+        plane: Plane,
+        angle: f64,
+        value: f64,
+        normal: f64,
+        ratio: f64,
+        max: f64,
+    },
+    #[error("the two planes' readings along the normal, {horizontal:e} (horizontal) and {vertical:e} (vertical), differ by a factor of {ratio:.3}: both look along the same direction, so one of them is wrong")]
+    NormalsDisagree {
+        horizontal: f64,
+        vertical: f64,
+        ratio: f64,
+    },
+    #[error("{what} is {value}: the fit has no finite value there")]
+    NotFinite { what: String, value: f64 },
     #[error("no model could be cross-validated: every half-plane needs at least 2 angles off the normal")]
     NothingToChoose,
     #[error("cannot draw the chart: {message}")]

@@ -18,6 +18,9 @@ pub mod error;
 pub mod half;
 pub mod models;
 pub mod planes;
+pub mod search;
+pub mod series;
+pub mod spline;
 
 use serde::{Deserialize, Serialize};
 
@@ -61,6 +64,9 @@ pub struct HalfFit {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Candidate {
     pub model: LdcModel,
+    /// Free parameters over both planes (what `auto` counts to prefer the smaller model).
+    #[serde(default)]
+    pub parameters: usize,
     /// Per half-plane in C0, C90, C180, C270 order; empty when the model could not be
     /// fitted (see `note`).
     pub halves: Vec<HalfFit>,
@@ -111,6 +117,7 @@ pub const TABLE_GAMMA_STEP: f64 = 1.0;
 pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
     let normal_readings = falloff.validate()?;
     let l0 = (normal_readings[0] + normal_readings[1]) / 2.0;
+    falloff.check_relative(l0)?;
     let halves: Vec<(Vec<f64>, Vec<f64>)> = HalfPlane::ALL
         .iter()
         .map(|&h| {
@@ -118,29 +125,29 @@ pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
             (g, l.into_iter().map(|v| v / l0).collect())
         })
         .collect();
+    if let ModelChoice::Named(m) = choice {
+        if let Some(e) = unmet(m, &halves) {
+            return Err(e);
+        }
+    }
     let candidates: Vec<Candidate> = LdcModel::ALL
         .iter()
         .map(|&m| candidate(m, &halves))
         .collect();
     let (chosen, why) = match choice {
         ModelChoice::Named(m) => {
-            let need = m.parameters().max(1);
-            for (&h, (g, _)) in HalfPlane::ALL.iter().zip(&halves) {
-                if g.len() < need {
-                    return Err(LdcError::TooFewAngles {
-                        half: h,
-                        model: m,
-                        got: g.len(),
-                        need,
-                    });
-                }
-            }
             let i = LdcModel::ALL.iter().position(|&x| x == m).unwrap_or(0);
             (i, format!("{m}: named"))
         }
         ModelChoice::Auto => {
-            let scores: Vec<(LdcModel, Option<f64>)> =
-                candidates.iter().map(|c| (c.model, c.cv_rms)).collect();
+            let scores: Vec<cv::Score> = candidates
+                .iter()
+                .map(|c| cv::Score {
+                    model: c.model,
+                    parameters: c.parameters,
+                    cv_rms: c.cv_rms,
+                })
+                .collect();
             cv::choose(&scores).ok_or(LdcError::NothingToChoose)?
         }
     };
@@ -162,7 +169,7 @@ pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
         }
     }
     let table = build_table(&chosen_halves)?;
-    Ok(LdcFit {
+    let fit = LdcFit {
         model,
         halves: chosen_halves,
         residuals,
@@ -171,7 +178,9 @@ pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
         normal_luminance: l0,
         normal_readings,
         table,
-    })
+    };
+    fit.check_finite()?;
+    Ok(fit)
 }
 
 impl LdcFit {
@@ -184,6 +193,99 @@ impl LdcFit {
     pub fn chosen(&self) -> Option<&Candidate> {
         self.candidates.iter().find(|c| c.model == self.model)
     }
+
+    /// Every number of the fit is finite: JSON has no infinity (serde writes `null`), and
+    /// a table or a score of inf is of no use to anyone. The readings' checks make this
+    /// hold; this says which number if they ever do not.
+    fn check_finite(&self) -> Result<(), LdcError> {
+        let params = |p: &Params| -> Vec<f64> {
+            match p {
+                Params::Lambertian => vec![],
+                Params::CosPower { n } => vec![*n],
+                Params::CosPoly { coeffs } => coeffs.to_vec(),
+                Params::Lobes { a, n, m } => vec![*a, *n, *m],
+                Params::Series { n, b } => std::iter::once(*n).chain(b.iter().copied()).collect(),
+                Params::Spline {
+                    a,
+                    n,
+                    m,
+                    knots_deg,
+                    residuals,
+                    curvature,
+                } => [*a, *n, *m]
+                    .into_iter()
+                    .chain(knots_deg.iter().chain(residuals).chain(curvature).copied())
+                    .collect(),
+            }
+        };
+        let bad = |what: String, v: f64| LdcError::NotFinite { what, value: v };
+        for c in &self.candidates {
+            for (what, v) in [
+                ("RMS", c.rms),
+                ("leave-one-out RMS", c.cv_rms),
+                ("leave-one-out max", c.cv_max),
+            ] {
+                if let Some(v) = v.filter(|v| !v.is_finite()) {
+                    return Err(bad(format!("the {} model's {what}", c.model), v));
+                }
+            }
+            for h in &c.halves {
+                for v in params(&h.params).into_iter().chain([h.rms]) {
+                    if !v.is_finite() {
+                        return Err(bad(
+                            format!("the {} model's fit of half-plane {}", c.model, h.half),
+                            v,
+                        ));
+                    }
+                }
+            }
+        }
+        for r in &self.residuals {
+            for v in [r.measured, r.fitted, r.residual] {
+                if !v.is_finite() {
+                    return Err(bad(
+                        format!("the residual at {}° in the {} plane", r.angle_deg, r.plane),
+                        v,
+                    ));
+                }
+            }
+        }
+        if !self.normal_luminance.is_finite() {
+            return Err(bad("the normal luminance".into(), self.normal_luminance));
+        }
+        Ok(())
+    }
+}
+
+/// Why `model` cannot be fitted to `halves` (C0, C90, C180, C270), if it cannot.
+fn unmet(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Option<LdcError> {
+    let (half, plane) = model.min_angles();
+    let need = half.max(1);
+    for (&h, (g, _)) in HalfPlane::ALL.iter().zip(halves) {
+        if g.len() < need {
+            return Some(LdcError::TooFewAngles {
+                half: h,
+                model,
+                got: g.len(),
+                need,
+            });
+        }
+    }
+    for (p, (pos, neg)) in [Plane::Horizontal, Plane::Vertical]
+        .into_iter()
+        .zip([(0, 2), (1, 3)])
+    {
+        let got = halves[pos].0.len() + halves[neg].0.len();
+        if got < plane {
+            return Some(LdcError::TooFewPlaneAngles {
+                plane: p,
+                model,
+                got,
+                need: plane,
+            });
+        }
+    }
+    None
 }
 
 /// The C of a signed angle in a measured plane.
@@ -197,44 +299,46 @@ pub fn plane_c(plane: Plane, angle_deg: f64) -> f64 {
 }
 
 fn candidate(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Candidate {
-    let need = model.parameters().max(1);
+    let per_plane = |h: usize, v: usize| halves[h].0.len() + halves[v].0.len();
     let mut out = Candidate {
         model,
+        parameters: model.parameters(per_plane(0, 2)) + model.parameters(per_plane(1, 3)),
         halves: Vec::new(),
         rms: None,
         cv_rms: None,
         cv_max: None,
         note: None,
     };
-    if let Some((h, (g, _))) = HalfPlane::ALL
-        .iter()
-        .zip(halves)
-        .find(|(_, (g, _))| g.len() < need)
-    {
-        out.note = Some(format!(
-            "not fitted: half-plane {h} has {} angle(s) off the normal, needs {need}",
-            g.len()
-        ));
+    if let Some(e) = unmet(model, halves) {
+        out.note = Some(match e {
+            LdcError::TooFewAngles {
+                half, got, need, ..
+            } => {
+                format!(
+                    "not fitted: half-plane {half} has {got} angle(s) off the normal, needs {need}"
+                )
+            }
+            LdcError::TooFewPlaneAngles {
+                plane, got, need, ..
+            } => {
+                format!(
+                    "not fitted: the {plane} plane has {got} angle(s) off the normal, needs {need}"
+                )
+            }
+            other => format!("not fitted: {other}"),
+        });
         return out;
     }
-    let (mut sq, mut n) = (0.0, 0usize);
+    // Planes as (positive half, negative half) indices into C0, C90, C180, C270.
+    let mut params: Vec<Option<Params>> = vec![None; 4];
     let mut held_out = Some(Vec::new());
-    for (&h, (g, y)) in HalfPlane::ALL.iter().zip(halves) {
-        let params = models::fit_half(model, g, y);
-        let r: Vec<f64> = g
-            .iter()
-            .zip(y)
-            .map(|(&gi, &yi)| yi - params.eval(gi))
-            .collect();
-        let half_sq: f64 = r.iter().map(|e| e * e).sum();
-        sq += half_sq;
-        n += r.len();
-        out.halves.push(HalfFit {
-            half: h,
-            params,
-            rms: (half_sq / r.len() as f64).sqrt(),
-        });
-        held_out = match (held_out, cv::leave_one_out(model, g, y)) {
+    for (pos, neg) in [(0, 2), (1, 3)] {
+        let p = (halves[pos].0.as_slice(), halves[pos].1.as_slice());
+        let n = (halves[neg].0.as_slice(), halves[neg].1.as_slice());
+        let [fp, fn_] = models::fit_plane(model, p, n);
+        params[pos] = Some(fp);
+        params[neg] = Some(fn_);
+        held_out = match (held_out, cv::leave_one_out_plane(model, p, n)) {
             (Some(mut all), Some(e)) => {
                 all.extend(e);
                 Some(all)
@@ -242,17 +346,42 @@ fn candidate(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Candidate {
             _ => None,
         };
     }
-    out.rms = Some((sq / n as f64).sqrt());
+    let (mut sq, mut count) = (0.0, 0usize);
+    for ((&h, (g, y)), p) in HalfPlane::ALL.iter().zip(halves).zip(params) {
+        let params = p.unwrap_or(Params::Lambertian);
+        let half_sq: f64 = g
+            .iter()
+            .zip(y)
+            .map(|(&gi, &yi)| (yi - params.eval(gi)).powi(2))
+            .sum();
+        sq += half_sq;
+        count += g.len();
+        out.halves.push(HalfFit {
+            half: h,
+            params,
+            rms: (half_sq / g.len() as f64).sqrt(),
+        });
+    }
+    out.rms = Some((sq / count as f64).sqrt());
     match held_out {
         Some(e) => {
             out.cv_rms = Some((e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt());
             out.cv_max = Some(e.iter().fold(0.0f64, |m, x| m.max(x.abs())));
         }
         None => {
-            out.note = Some(format!(
-                "not cross-validated: every half-plane needs {} angles off the normal",
-                model.parameters() + 1
-            ))
+            let (half, plane) = model.min_angles();
+            out.note = Some(if model.per_plane() {
+                format!(
+                    "not cross-validated: every half-plane needs {} angles off the normal and every plane {}",
+                    half + 1,
+                    plane + 1
+                )
+            } else {
+                format!(
+                    "not cross-validated: every half-plane needs {} angles off the normal",
+                    half + 1
+                )
+            })
         }
     }
     out

@@ -1,11 +1,24 @@
-//! The fall-off models of one half-plane, f(γ) with f(0) = 1, and their least-squares fits.
+//! The fall-off models, f(γ) with f(0) = 1, and their least-squares fits.
 //!
 //! Every model is 1 along the normal by construction, so the normal reading only sets the
 //! scale (the normal luminance) and the fit uses the off-normal angles alone. Residuals are
 //! in relative luminance (reading / normal luminance − model).
+//!
+//! The parametric families (`lambertian`, `cos-power`, `cos-poly`, `lobes`) fit each
+//! half-plane on its own: each is a function of cos γ, flat at the normal. A real luminaire
+//! whose two sides differ in shape (a diffuser over an off-centre LED array) is not: its
+//! luminance has a slope at the normal, the same seen from either side. The two plane
+//! families fit a whole plane in the signed angle, so they are smooth across γ = 0:
+//! `series` ([`super::series`]) and `spline` ([`super::spline`]). Either is stored as the
+//! two halves' parameters, each half in its own γ ≥ 0, so the table and the chart evaluate
+//! every model the same way.
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+
+use super::search::{minimise_1d, nelder_mead, MAX_EXPONENT};
+use super::series::{self, SERIES_TERMS};
+use super::spline;
 
 /// A family of fall-off curves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -19,15 +32,22 @@ pub enum LdcModel {
     CosPoly,
     /// f = a·cosⁿγ + (1 − a)·cosᵐγ, 0 ≤ a ≤ 1, n ≤ m: a broad and a narrow lobe.
     Lobes,
+    /// Per plane, in the signed angle x: f = cosⁿx·(1 + b₁ sin x + … + b₄ sin⁴x).
+    Series,
+    /// Per plane: the lobes fit of each half plus a natural cubic spline in the signed
+    /// angle through its residuals, so the curve passes through every reading.
+    Spline,
 }
 
 impl LdcModel {
-    /// From the fewest free parameters to the most: the order `auto` prefers on a tie.
-    pub const ALL: [LdcModel; 4] = [
+    /// The parametric families first, then the plane families.
+    pub const ALL: [LdcModel; 6] = [
         LdcModel::Lambertian,
         LdcModel::CosPower,
         LdcModel::CosPoly,
         LdcModel::Lobes,
+        LdcModel::Series,
+        LdcModel::Spline,
     ];
 
     pub fn name(self) -> &'static str {
@@ -36,16 +56,44 @@ impl LdcModel {
             LdcModel::CosPower => "cos-power",
             LdcModel::CosPoly => "cos-poly",
             LdcModel::Lobes => "lobes",
+            LdcModel::Series => "series",
+            LdcModel::Spline => "spline",
         }
     }
 
-    /// Free parameters per half-plane.
-    pub fn parameters(self) -> usize {
+    /// Whether one fit covers a whole plane (both halves, smooth across γ = 0) rather than
+    /// each half-plane on its own.
+    pub fn per_plane(self) -> bool {
+        matches!(self, LdcModel::Series | LdcModel::Spline)
+    }
+
+    /// The fewest angles off the normal a fit needs: in each half-plane, and in each plane
+    /// (both halves together). (Its residuals need one in each half-plane.)
+    pub fn min_angles(self) -> (usize, usize) {
+        match self {
+            LdcModel::Lambertian => (0, 0),
+            LdcModel::CosPower => (1, 2),
+            LdcModel::CosPoly => (2, 4),
+            LdcModel::Lobes => (3, 6),
+            // Five coefficients per plane; a half with one angle would be extrapolated
+            // from the other side.
+            LdcModel::Series => (2, SERIES_TERMS + 1),
+            // The lobes fit of each half is the spline's base.
+            LdcModel::Spline => (3, 6),
+        }
+    }
+
+    /// Free parameters of one plane fitted to `angles` readings off the normal: the
+    /// measure of size by which `auto` prefers the smaller of two models that predict as
+    /// well. An interpolant has one per reading besides its base.
+    pub fn parameters(self, angles: usize) -> usize {
         match self {
             LdcModel::Lambertian => 0,
-            LdcModel::CosPower => 1,
-            LdcModel::CosPoly => 2,
-            LdcModel::Lobes => 3,
+            LdcModel::CosPower => 2,
+            LdcModel::CosPoly => 4,
+            LdcModel::Series => SERIES_TERMS + 1,
+            LdcModel::Lobes => 6,
+            LdcModel::Spline => 6 + angles,
         }
     }
 }
@@ -64,7 +112,7 @@ impl std::str::FromStr for LdcModel {
             .into_iter()
             .find(|m| m.name() == t)
             .ok_or_else(|| {
-                format!("unknown light distribution model '{s}': expected lambertian, cos-power, cos-poly or lobes")
+                format!("unknown light distribution model '{s}': expected lambertian, cos-power, cos-poly, lobes, series or spline")
             })
     }
 }
@@ -86,6 +134,23 @@ pub enum Params {
         n: f64,
         m: f64,
     },
+    /// cosⁿγ·(1 + Σ b_k sinᵏγ) in this half's own γ ≥ 0 (the other half of the plane has
+    /// the same n and the odd coefficients negated: sin(−γ) = −sin γ).
+    Series {
+        n: f64,
+        b: [f64; SERIES_TERMS],
+    },
+    /// The lobes curve (a, n, m) plus a cubic spline through (knot, residual) with the
+    /// given second derivatives (per degree²) at the knots; the first knot is 0°. Past the
+    /// last knot the spline holds its last value.
+    Spline {
+        a: f64,
+        n: f64,
+        m: f64,
+        knots_deg: Vec<f64>,
+        residuals: Vec<f64>,
+        curvature: Vec<f64>,
+    },
 }
 
 impl Params {
@@ -95,6 +160,8 @@ impl Params {
             Params::CosPower { .. } => LdcModel::CosPower,
             Params::CosPoly { .. } => LdcModel::CosPoly,
             Params::Lobes { .. } => LdcModel::Lobes,
+            Params::Series { .. } => LdcModel::Series,
+            Params::Spline { .. } => LdcModel::Spline,
         }
     }
 
@@ -102,13 +169,26 @@ impl Params {
     /// past the data (the table clamps it to 0).
     pub fn eval(&self, gamma_deg: f64) -> f64 {
         let c = gamma_deg.to_radians().cos().max(0.0);
-        match *self {
+        match self {
             Params::Lambertian => 1.0,
-            Params::CosPower { n } => c.powf(n),
+            Params::CosPower { n } => c.powf(*n),
             Params::CosPoly {
                 coeffs: [a0, a1, a2],
             } => a0 + a1 * c + a2 * c * c,
-            Params::Lobes { a, n, m } => a * c.powf(n) + (1.0 - a) * c.powf(m),
+            Params::Lobes { a, n, m } => a * c.powf(*n) + (1.0 - a) * c.powf(*m),
+            Params::Series { n, b } => series::eval(*n, b, gamma_deg),
+            Params::Spline {
+                a,
+                n,
+                m,
+                knots_deg,
+                residuals,
+                curvature,
+            } => {
+                a * c.powf(*n)
+                    + (1.0 - a) * c.powf(*m)
+                    + spline::eval(knots_deg, residuals, curvature, gamma_deg)
+            }
         }
     }
 
@@ -123,19 +203,57 @@ impl Params {
                 format!("a0={a0:.3} a1={a1:.3} a2={a2:.3}")
             }
             Params::Lobes { a, n, m } => format!("a={a:.3} n={n:.3} m={m:.3}"),
+            Params::Series { n, b } => format!(
+                "n={n:.3} b={}",
+                b.iter()
+                    .map(|v| format!("{v:+.3}"))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
+            Params::Spline {
+                a,
+                n,
+                m,
+                ref residuals,
+                ..
+            } => {
+                let worst = residuals.iter().fold(0.0f64, |w, r| w.max(r.abs()));
+                format!(
+                    "lobes a={a:.3} n={n:.3} m={m:.3} + spline through {} residuals (largest {worst:.4})",
+                    residuals.len() - 1
+                )
+            }
         }
     }
 }
 
-/// The largest exponent searched: cos¹⁰⁰ is already below 1 % at 12°, far narrower than
-/// any panel light.
-const MAX_EXPONENT: f64 = 100.0;
+/// One half-plane's points: γ ≥ 0 in degrees, increasing, and relative luminance.
+pub type HalfPoints<'a> = (&'a [f64], &'a [f64]);
 
-/// Least-squares fit of `model` to points (γ in degrees, relative luminance). The caller
-/// guarantees at least `model.parameters()` points.
+/// Least-squares fit of `model` to one plane: `pos` and `neg` are its two halves (each in
+/// its own γ ≥ 0); returns their parameters in that order. The caller guarantees
+/// [`LdcModel::min_angles`].
+pub fn fit_plane(model: LdcModel, pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
+    match model {
+        LdcModel::Series => {
+            let (n, b) = series::fit(pos, neg);
+            let mirrored = series::mirrored(&b);
+            [Params::Series { n, b }, Params::Series { n, b: mirrored }]
+        }
+        LdcModel::Spline => fit_spline(pos, neg),
+        _ => [fit_half(model, pos.0, pos.1), fit_half(model, neg.0, neg.1)],
+    }
+}
+
+/// Least-squares fit of a half-plane `model` to points (γ in degrees, relative
+/// luminance). The caller guarantees [`LdcModel::min_angles`]; the plane families are
+/// fitted by [`fit_plane`] (given here, they see this half mirrored onto the other).
 pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
     let c: Vec<f64> = gamma_deg.iter().map(|g| g.to_radians().cos()).collect();
     match model {
+        LdcModel::Series | LdcModel::Spline => {
+            fit_plane(model, (gamma_deg, y), (gamma_deg, y))[0].clone()
+        }
         LdcModel::Lambertian => Params::Lambertian,
         LdcModel::CosPower => {
             let sse = |n: f64| sse(&c, y, |ci| ci.powf(n));
@@ -146,6 +264,52 @@ pub fn fit_half(model: LdcModel, gamma_deg: &[f64], y: &[f64]) -> Params {
         LdcModel::CosPoly => fit_cos_poly(&c, y),
         LdcModel::Lobes => fit_lobes(&c, y),
     }
+}
+
+/// The `spline` fit (see [`super::spline`]) to one plane's halves `pos` (signed angle γ)
+/// and `neg` (−γ); each half's parameters, `pos` first.
+fn fit_spline(pos: HalfPoints, neg: HalfPoints) -> [Params; 2] {
+    let base = [
+        fit_half(LdcModel::Lobes, pos.0, pos.1),
+        fit_half(LdcModel::Lobes, neg.0, neg.1),
+    ];
+    let residual = |p: &Params, g: &[f64], y: &[f64]| -> Vec<f64> {
+        g.iter().zip(y).map(|(&g, &y)| y - p.eval(g)).collect()
+    };
+    let rp = residual(&base[0], pos.0, pos.1);
+    let rn = residual(&base[1], neg.0, neg.1);
+    // Knots across the plane: the negative half mirrored, the normal, the positive half.
+    let mut x: Vec<f64> = neg.0.iter().rev().map(|g| -g).collect();
+    let mut y: Vec<f64> = rn.iter().rev().copied().collect();
+    x.push(0.0);
+    y.push(0.0);
+    x.extend_from_slice(pos.0);
+    y.extend_from_slice(&rp);
+    let m = spline::natural_curvature(&x, &y);
+    let zero = neg.0.len();
+    let half = |base: &Params, g: &[f64], r: &[f64], curv: Vec<f64>| -> Params {
+        let Params::Lobes { a, n, m } = *base else {
+            unreachable!("the base is a lobes fit")
+        };
+        let mut knots_deg = vec![0.0];
+        knots_deg.extend_from_slice(g);
+        let mut residuals = vec![0.0];
+        residuals.extend_from_slice(r);
+        Params::Spline {
+            a,
+            n,
+            m,
+            knots_deg,
+            residuals,
+            curvature: curv,
+        }
+    };
+    let curv_pos: Vec<f64> = m[zero..].to_vec();
+    let curv_neg: Vec<f64> = m[..=zero].iter().rev().copied().collect();
+    [
+        half(&base[0], pos.0, &rp, curv_pos),
+        half(&base[1], neg.0, &rn, curv_neg),
+    ]
 }
 
 fn sse(c: &[f64], y: &[f64], f: impl Fn(f64) -> f64) -> f64 {
@@ -171,36 +335,45 @@ fn fit_cos_poly(c: &[f64], y: &[f64]) -> Params {
 /// For fixed exponents the best weight is a linear least-squares problem
 /// (y − cᵐ = a·(cⁿ − cᵐ)), so the search runs over (n, m) only: a grid, then Nelder–Mead.
 fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
-    let best_a = |n: f64, m: f64| -> f64 {
+    // The best weight and the sum of squares for the powers cⁿ and cᵐ at the points.
+    let weight_and_sse = |pn: &[f64], pm: &[f64]| -> (f64, f64) {
         let (mut uu, mut ur) = (0.0, 0.0);
-        for (&ci, &yi) in c.iter().zip(y) {
-            let (pn, pm) = (ci.powf(n), ci.powf(m));
-            uu += (pn - pm).powi(2);
-            ur += (pn - pm) * (yi - pm);
+        for ((&p, &q), &yi) in pn.iter().zip(pm).zip(y) {
+            uu += (p - q).powi(2);
+            ur += (p - q) * (yi - q);
         }
-        if uu < 1e-300 {
+        let a = if uu < 1e-300 {
             1.0
         } else {
             (ur / uu).clamp(0.0, 1.0)
-        }
+        };
+        let sse = pn
+            .iter()
+            .zip(pm)
+            .zip(y)
+            .map(|((&p, &q), &yi)| (a * p + (1.0 - a) * q - yi).powi(2))
+            .sum();
+        (a, sse)
     };
+    let powers = |e: f64| -> Vec<f64> { c.iter().map(|ci| ci.powf(e)).collect() };
     let cost = |p: [f64; 2]| -> f64 {
         let n = p[0].clamp(0.0, MAX_EXPONENT);
         let m = p[1].clamp(0.0, MAX_EXPONENT);
-        let a = best_a(n, m);
-        sse(c, y, |ci| a * ci.powf(n) + (1.0 - a) * ci.powf(m))
+        weight_and_sse(&powers(n), &powers(m)).1
     };
     // Exponents spaced quadratically: fine where panel lights live (0…10), coarse above.
+    // Their powers are computed once for the whole grid.
     const K: usize = 60;
     let grid: Vec<f64> = (0..=K)
         .map(|k| MAX_EXPONENT * (k as f64 / K as f64).powi(2))
         .collect();
+    let table: Vec<Vec<f64>> = grid.iter().map(|&e| powers(e)).collect();
     let mut best = ([0.0, 0.0], f64::INFINITY);
-    for (i, &n) in grid.iter().enumerate() {
-        for &m in &grid[i..] {
-            let v = cost([n, m]);
+    for i in 0..grid.len() {
+        for j in i..grid.len() {
+            let v = weight_and_sse(&table[i], &table[j]).1;
             if v < best.1 {
-                best = ([n, m], v);
+                best = ([grid[i], grid[j]], v);
             }
         }
     }
@@ -212,102 +385,8 @@ fn fit_lobes(c: &[f64], y: &[f64]) -> Params {
     if n > m {
         std::mem::swap(&mut n, &mut m);
     }
-    let a = best_a(n, m);
+    let a = weight_and_sse(&powers(n), &powers(m)).0;
     Params::Lobes { a, n, m }
-}
-
-/// Minimum of `f` on [lo, hi]: the best of `steps` + 1 grid points, then golden-section
-/// search in the two grid cells around it (the sums of squares here are smooth but not
-/// always unimodal over the whole range).
-pub(crate) fn minimise_1d(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize) -> f64 {
-    let h = (hi - lo) / steps as f64;
-    let (mut best_x, mut best_v) = (lo, f64::INFINITY);
-    for k in 0..=steps {
-        let x = lo + h * k as f64;
-        let v = f(x);
-        if v < best_v {
-            (best_x, best_v) = (x, v);
-        }
-    }
-    let (mut a, mut b) = ((best_x - h).max(lo), (best_x + h).min(hi));
-    let r = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..100 {
-        if f1 < f2 {
-            b = x2;
-            (x2, f2) = (x1, f1);
-            x1 = b - r * (b - a);
-            f1 = f(x1);
-        } else {
-            a = x1;
-            (x1, f1) = (x2, f2);
-            x2 = a + r * (b - a);
-            f2 = f(x2);
-        }
-    }
-    let x = (a + b) / 2.0;
-    if f(x) <= best_v {
-        x
-    } else {
-        best_x
-    }
-}
-
-/// Nelder–Mead on two variables with the standard coefficients (reflection 1, expansion 2,
-/// contraction ½, shrink ½), from `start` with an initial simplex of edge `step`.
-fn nelder_mead(
-    f: impl Fn([f64; 2]) -> f64,
-    start: [f64; 2],
-    step: f64,
-    iterations: usize,
-) -> [f64; 2] {
-    let mut s = [
-        start,
-        [start[0] + step, start[1]],
-        [start[0], start[1] + step],
-    ];
-    let mut v = s.map(&f);
-    let lerp =
-        |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
-    for _ in 0..iterations {
-        let mut idx = [0, 1, 2];
-        idx.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
-        s = idx.map(|i| s[i]);
-        v = idx.map(|i| v[i]);
-        let spread = (v[2] - v[0]).abs();
-        let size = (s[2][0] - s[0][0]).abs().max((s[2][1] - s[0][1]).abs());
-        if spread <= 1e-30 + 1e-15 * v[0].abs() && size < 1e-12 {
-            break;
-        }
-        let centroid = lerp(s[0], s[1], 0.5);
-        let reflected = lerp(s[2], centroid, 2.0);
-        let fr = f(reflected);
-        if fr < v[0] {
-            let expanded = lerp(s[2], centroid, 3.0);
-            let fe = f(expanded);
-            (s[2], v[2]) = if fe < fr {
-                (expanded, fe)
-            } else {
-                (reflected, fr)
-            };
-        } else if fr < v[1] {
-            (s[2], v[2]) = (reflected, fr);
-        } else {
-            let contracted = lerp(s[2], centroid, 0.5);
-            let fc = f(contracted);
-            if fc < v[2] {
-                (s[2], v[2]) = (contracted, fc);
-            } else {
-                for k in 1..3 {
-                    s[k] = lerp(s[0], s[k], 0.5);
-                    v[k] = f(s[k]);
-                }
-            }
-        }
-    }
-    let best = (0..3).min_by(|&i, &j| v[i].total_cmp(&v[j])).unwrap_or(0);
-    s[best]
 }
 
 #[cfg(test)]

@@ -119,6 +119,44 @@ impl Falloff {
         Ok(normal)
     }
 
+    /// Checks the readings against the normal luminance `l0` (the mean of the planes' 0°
+    /// readings): the two 0° readings look along one direction and must agree within a
+    /// factor of [`MAX_NORMAL_RATIO`], and no reading may exceed [`MAX_RELATIVE`] times
+    /// `l0` (a 0° reading of 1e-300 made every ratio overflow into an infinite fit).
+    pub fn check_relative(&self, l0: f64) -> Result<(), LdcError> {
+        let [h, v] = [
+            self.horizontal.luminance_at(0.0),
+            self.vertical.luminance_at(0.0),
+        ];
+        if let (Some(h), Some(v)) = (h, v) {
+            let ratio = h.max(v) / h.min(v);
+            if ratio.is_nan() || ratio > MAX_NORMAL_RATIO {
+                return Err(LdcError::NormalsDisagree {
+                    horizontal: h,
+                    vertical: v,
+                    ratio,
+                });
+            }
+        }
+        for plane in [Plane::Horizontal, Plane::Vertical] {
+            let data = self.plane(plane);
+            for (&angle, &value) in data.angles_deg.iter().zip(&data.luminance) {
+                let ratio = value / l0;
+                if ratio.is_nan() || ratio > MAX_RELATIVE {
+                    return Err(LdcError::FarAboveNormal {
+                        plane,
+                        angle,
+                        value,
+                        normal: l0,
+                        ratio,
+                        max: MAX_RELATIVE,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The off-normal points of one half-plane: (γ, reading), γ increasing.
     pub fn half(&self, half: HalfPlane) -> (Vec<f64>, Vec<f64>) {
         let (plane, sign) = half.plane();
@@ -132,6 +170,22 @@ impl Falloff {
             .collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         pts.into_iter().unzip()
+    }
+}
+
+/// The largest factor between the two planes' 0° readings.
+pub const MAX_NORMAL_RATIO: f64 = 2.0;
+/// The largest reading, relative to the normal luminance: a panel brighter off its normal
+/// than this is not described by a distribution relative to it.
+pub const MAX_RELATIVE: f64 = 100.0;
+
+impl PlaneData {
+    /// The reading at `angle_deg`, if there is one.
+    pub fn luminance_at(&self, angle_deg: f64) -> Option<f64> {
+        self.angles_deg
+            .iter()
+            .position(|&a| a == angle_deg)
+            .and_then(|i| self.luminance.get(i).copied())
     }
 }
 
