@@ -275,17 +275,18 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
     assert!(again["seconds"].as_f64().unwrap() < 5.0);
     assert_eq!(
         again["stages"],
-        lab["stages"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|s| {
-                let mut s = s.clone();
-                s["reused"] = true.into();
-                s
-            })
-            .collect::<Vec<_>>()
-            .into()
+        serde_json::Value::from(
+            lab["stages"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|s| {
+                    let mut s = s.clone();
+                    s["reused"] = true.into();
+                    s
+                })
+                .collect::<Vec<_>>()
+        )
     );
     assert!(again["stages"][0]["seconds"].as_f64().unwrap() > 0.0);
     assert_eq!(again["options"]["box_repeats"], 1);

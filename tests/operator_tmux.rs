@@ -137,7 +137,7 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     let plan = dir.join("plan.json");
     std::fs::write(
         &plan,
-        r#"{"repeats": 3, "patches": [1, 2], "falloff_angles_deg": [0, 20],
+        r#"{"repeats": 3, "patches": [1, 2], "falloff_angles_deg": [-20, 0, 20],
             "geometry": {"rows": 1, "cols": 2}}"#,
     )
     .unwrap();
@@ -202,7 +202,7 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     tmux.wait_for("EXIT2=0", 1);
 
     // The fall-off: the operator stops at the first request.
-    tmux.wait_for("from 0° in the horizontal plane (on the normal) — 1 reading; press Enter when done (q to stop)", 1);
+    tmux.wait_for("from -20° in the horizontal plane (towards the open front) — 1 reading; press Enter when done (q to stop)", 1);
     tmux.keys(&["q", "Enter"]);
     let screen = tmux.wait_for("EXIT3=", 1);
 
@@ -259,7 +259,7 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     // `q`: stopped, how to go on, exit 0; nothing measured.
     assert!(
         screen.contains(
-            "stopped at your request: stage falloff: none of its 4 readings taken yet: continue with --resume\nEXIT3=0"
+            "stopped at your request: stage falloff: none of its 6 readings taken yet: continue with --resume\nEXIT3=0"
         ),
         "{screen}"
     );

@@ -11,6 +11,7 @@ use super::file::{
     CameraFile, DistributionFile, EmitterFile, MeterFile, SceneFile, SpectrumRef, SurfaceFile,
     TileFile,
 };
+use crate::light::CGammaTable;
 
 /// A field of the scene file that is not what the format allows. Shown with the path and
 /// message cut to a readable length: both may quote the file (a key, a file name, a value).
@@ -41,6 +42,15 @@ fn kind(v: &Value) -> &'static str {
 }
 
 /// A leaf value through serde, its error prefixed with the path.
+/// A C-γ table as written, before its own checks.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTable {
+    c_deg: Vec<f64>,
+    gamma_deg: Vec<f64>,
+    values: Vec<Vec<f64>>,
+}
+
 fn leaf<T: DeserializeOwned>(path: &str, v: &Value, shape: &str) -> Result<T, PathError> {
     T::deserialize(v).map_err(|e| PathError {
         path: path.to_string(),
@@ -226,15 +236,21 @@ fn distribution(p: &str, v: &Value) -> Result<DistributionFile, PathError> {
         }
         "c_gamma" => {
             let o = Obj::new(p, v, &["kind", "table"])?;
-            Ok(DistributionFile::CGamma {
-                table: o.req("table", |p, v| {
-                    leaf(
-                        p,
-                        v,
-                        "a C-γ table {\"c_deg\": […], \"gamma_deg\": [0 … 90], \"values\": [[1, …], …]}",
-                    )
-                })?,
-            })
+            // The shape first, then the table's own checks, so that a bad value is named
+            // by its place in the table rather than lost inside a "wrong shape" message.
+            let raw: RawTable = o.req("table", |p, v| {
+                leaf(
+                    p,
+                    v,
+                    "a C-γ table {\"c_deg\": […], \"gamma_deg\": [0 … 90], \"values\": [[1, …], …]}",
+                )
+            })?;
+            let table =
+                CGammaTable::new(raw.c_deg, raw.gamma_deg, raw.values).map_err(|e| PathError {
+                    path: format!("{p}.table"),
+                    message: e.to_string(),
+                })?;
+            Ok(DistributionFile::CGamma { table })
         }
         "ies" | "ldt" => {
             let o = Obj::new(p, v, &["kind", "file"])?;
