@@ -242,10 +242,10 @@ fn verdict_with(
             .iter()
             .filter_map(|(_, w)| w.origin.map(|o| o.1))
             .fold(0.0, f64::max);
-        let which = if failing.len() == 1 {
-            "it".to_string()
-        } else {
-            format!("all {}", failing.len())
+        let which = match failing.len() {
+            1 => "it".to_string(),
+            2 => "both".to_string(),
+            n => format!("all {n}"),
         };
         let _ = write!(
             s,

@@ -46,7 +46,7 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
     let (how, measure, method) = if s.method == "radiosity" {
         (
             RenderStatement::Bound,
-            "ΔE*ab error bound (finest level against the level before)",
+            "ΔE*ab error bound (the mesh levels' extrapolation against its alternatives)",
             "deterministic radiosity solver",
         )
     } else {
