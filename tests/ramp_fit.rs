@@ -206,96 +206,23 @@ fn print_ramp_table() {
     }
 }
 
-#[test]
-#[ignore]
-fn scratch_explore() {
-    for preset in [Preset::IpsLcd, Preset::WideGamutCcfl] {
-        let (panel, patches) = ramp_set(preset, None);
-        let white = Xyz::from_array(panel.xyz([255; 3]));
-        let targets = mixed_targets();
-        for kind in ModelKind::ALL {
-            let Ok(profile) = fit_profile(kind, &patches, None) else {
-                continue;
-            };
-            let m = profile.model();
-            let fwd: f64 = targets
-                .iter()
-                .map(|&c| {
-                    let t = panel.xyz(c);
-                    delta_e2000(
-                        Xyz::from_array(m.forward(c.map(|v| f64::from(v) / 255.0))).to_lab(white),
-                        Xyz::from_array(t).to_lab(white),
-                    )
-                })
-                .sum::<f64>()
-                / targets.len() as f64;
-            let greys: Vec<String> = [32u8, 64, 128, 192, 255]
-                .iter()
-                .map(|&g| {
-                    let t = panel.xyz([g; 3]);
-                    let f = m.forward([f64::from(g) / 255.0; 3]);
-                    format!("{g}:{:+.2}%", 100.0 * (f[1] - t[1]) / t[1])
-                })
-                .collect();
-            let inv = inverse_error(&panel, &|t| profile.inverse(t).rgb);
-            println!(
-                "{} {kind}: fwd {fwd:.3} inv {inv:.3} grey Y err {}",
-                panel.name(),
-                greys.join(" ")
-            );
-        }
-    }
-}
-
-#[test]
-#[ignore]
-fn scratch_floor() {
-    for preset in [Preset::IpsLcd, Preset::WideGamutCcfl] {
-        let panel = VirtualPanel::preset(preset);
-        let mut p = preset.params();
-        p.crosstalk = [[0.0; 3]; 3];
-        let additive = VirtualPanel::new("additive", p);
-        let white = Xyz::from_array(panel.xyz([255; 3]));
-        let targets = mixed_targets();
-        // PLVC built from the true single-channel responses (with crosstalk, as measured).
-        let plvc = |c: [u8; 3]| -> [f64; 3] {
-            let k = panel.xyz([0; 3]);
-            let mut out = k;
-            for ch in 0..3 {
-                let mut rgb = [0u8; 3];
-                rgb[ch] = c[ch];
-                let x = panel.xyz(rgb);
-                for i in 0..3 {
-                    out[i] += x[i] - k[i];
-                }
-            }
-            out
-        };
-        let (mut e1, mut e2) = (0.0, 0.0);
-        for &c in &targets {
-            let t = Xyz::from_array(panel.xyz(c)).to_lab(white);
-            e1 += delta_e2000(Xyz::from_array(additive.xyz(c)).to_lab(white), t);
-            e2 += delta_e2000(Xyz::from_array(plvc(c)).to_lab(white), t);
-        }
-        let n = targets.len() as f64;
-        println!(
-            "{}: additive-truth fwd {:.3}, plvc-from-true-ramps fwd {:.3}",
-            panel.name(),
-            e1 / n,
-            e2 / n
-        );
-    }
-}
-
 /// How much of the white's departure from additivity a mixture gets, from its channels'
 /// luminance fractions.
 type WhiteShare = Box<dyn Fn([f64; 3]) -> f64>;
 
+/// The study behind PLVC's spread of the white's departure over mixtures: each real
+/// monitor's `.ti3` file in `METAMER_REAL_TI3` (default `/tmp/real-ti3`; other people's
+/// data, not in the repository) fitted with PLVC on its single-channel patches and judged on
+/// its mixed ones, with each way of sharing the departure:
+/// `cargo test --release --test ramp_fit -- --ignored --nocapture print_white_share_study`.
 #[test]
 #[ignore]
-fn scratch_real() {
+fn print_white_share_study() {
     use metamer::display::read_measurement_file;
-    let dir = std::path::Path::new("/tmp/real-ti3");
+    let dir = std::path::PathBuf::from(
+        std::env::var_os("METAMER_REAL_TI3").unwrap_or_else(|| "/tmp/real-ti3".into()),
+    );
+    let dir = dir.as_path();
     let mut files: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -377,102 +304,6 @@ fn scratch_real() {
     }
 }
 
-#[test]
-#[ignore]
-fn scratch_greys() {
-    use metamer::display::read_measurement_file;
-    let dir = std::path::Path::new("/tmp/real-ti3");
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ti3"))
-        .collect();
-    files.sort();
-    for f in files {
-        let m = read_measurement_file(&f).unwrap();
-        let single = |p: &Sample| {
-            p.rgb.iter().filter(|&&v| v > 1e-6).count() <= 1
-                || p.rgb.iter().all(|&v| v >= 1.0 - 1e-6)
-        };
-        let fit: Vec<Sample> = m.patches.iter().copied().filter(|p| single(p)).collect();
-        let profile = fit_profile(ModelKind::Plvc, &fit, None).unwrap();
-        let model = profile.model();
-        let whites: Vec<String> = m
-            .patches
-            .iter()
-            .filter(|p| p.rgb.iter().all(|&v| v >= 1.0 - 1e-6))
-            .map(|p| format!("{:.2}", p.xyz[1]))
-            .collect();
-        let mut greys: Vec<(f64, f64)> = m
-            .patches
-            .iter()
-            .filter(|p| {
-                p.rgb[0] > 0.05
-                    && (p.rgb[0] - p.rgb[1]).abs() < 1e-6
-                    && (p.rgb[1] - p.rgb[2]).abs() < 1e-6
-            })
-            .map(|p| {
-                (
-                    p.rgb[0],
-                    100.0 * (p.xyz[1] - model.forward(p.rgb)[1]) / model.forward(p.rgb)[1],
-                )
-            })
-            .collect();
-        greys.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let pick: Vec<String> = greys
-            .iter()
-            .step_by((greys.len() / 10).max(1))
-            .map(|(d, e)| format!("{d:.2}:{e:+.1}"))
-            .collect();
-        // secondaries at full
-        let sec: Vec<String> = [[1.0, 1.0, 0.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]]
-            .iter()
-            .filter_map(|t| {
-                m.patches.iter().find(|p| p.rgb == *t).map(|p| {
-                    format!(
-                        "{:+.1}",
-                        100.0 * (p.xyz[1] - model.forward(p.rgb)[1]) / model.forward(p.rgb)[1]
-                    )
-                })
-            })
-            .collect();
-        println!(
-            "{}: whites Y {} | grey ΔY% {} | secondaries ΔY% {}",
-            &f.file_name().unwrap().to_string_lossy()[..12],
-            whites.join(","),
-            pick.join(" "),
-            sec.join(" ")
-        );
-    }
-}
-
-#[test]
-#[ignore]
-fn scratch_crt() {
-    use metamer::display::model::{fit_shaper_matrix, samples::SortedSamples, ModelParams};
-    for seed in [1u64, 2, 3, 4, 5, 6] {
-        let (panel, patches) = ramp_set(Preset::IdealCrt, Some(seed));
-        let set = SortedSamples::new(&patches);
-        let mut line = format!("seed {seed}:");
-        for knots in [1usize, 6] {
-            let m = fit_shaper_matrix(&set, &patches, knots).unwrap();
-            let p = ModelParams::MatrixTrc(m);
-            line += &format!(
-                " knots{knots} {:.4}",
-                inverse_error(&panel, &|t| p.model().inverse(t).rgb)
-            );
-        }
-        if let Some(e) = colprof_error(
-            &panel,
-            &patches,
-            &std::path::Path::new("target/ramp-fit/crt-scratch").join(seed.to_string()),
-        ) {
-            line += &format!(" colprof {e:.4}");
-        }
-        println!("{line}");
-    }
-}
-
 /// The mixture study's table (the ramp-only plan plus a grid):
 /// `cargo test --release --test ramp_fit -- --ignored --nocapture print_mixture_study`.
 #[test]
@@ -488,35 +319,6 @@ fn print_mixture_study() {
                 p.preset, p.model, p.cube, p.patches, p.mean_de00, p.p95_de00, p.fit_ms
             );
         }
-    }
-}
-
-#[test]
-#[ignore]
-fn scratch_default_plan() {
-    use metamer::display::budget::{budget_patches, Budget};
-    for preset in Preset::ALL {
-        let panel = VirtualPanel::preset(preset);
-        let mut line = format!("{}:", panel.name());
-        for (steps, cube) in [(9, 9), (9, 5), (9, 4), (17, 5), (9, 0)] {
-            let (codes, distinct) = budget_patches(Budget {
-                ramp_steps: steps,
-                cube,
-            });
-            let patches = with_meter_noise(&measure(&panel, &codes), 1);
-            let t = std::time::Instant::now();
-            let kind = if cube == 0 {
-                ModelKind::Plvc
-            } else {
-                ModelKind::Lut
-            };
-            let e = model_error(&panel, kind, &patches).unwrap();
-            line += &format!(
-                " {steps}/{cube} ({distinct}) {e:.3} [{} ms]",
-                t.elapsed().as_millis()
-            );
-        }
-        println!("{line}");
     }
 }
 

@@ -3,14 +3,22 @@
 //!
 //! Where `matrix-lsq` takes its curves from single-channel ramps, this model lets every
 //! patch shape them, so scattered patch sets (no ramps at all) fit as well as ramp sets.
-//! The fit runs in two Levenberg–Marquardt stages whose error is the CIELAB difference
-//! relative to the display white, so dark and bright patches count by what is seen:
+//! The fit runs in two Levenberg–Marquardt stages:
 //! 1. a power law per channel with the matrix and black offset (15 parameters), started
-//!    from γ 2.2 and a weighted linear least-squares matrix;
+//!    from γ 2.2 and a weighted linear least-squares matrix. Its error is each reading's
+//!    miss in units of a meter's noise (relative luminance, x and y): when this stage is
+//!    kept the display follows the form and only noise is left, and then the most likely
+//!    parameters average every reading's noise by its size. In CIELAB the dark patches'
+//!    chromaticity would count for less than their noise warrants, and on an additive
+//!    power-law display read with a CS-100A's noise its matrix was worse: on the ramp-only
+//!    set of `ideal-crt` (six meter seeds) the inverse round trip's mean ΔE00 fell from
+//!    0.0083 to 0.0030 (`tests/ramp_fit.rs`, `print_ramp_table` and `benches/argyll`);
 //! 2. each curve becomes a ramp table on `K` evenly spaced drive knots, interpolated in
 //!    the domain of its stage-1 power law (so the start is exactly stage 1), whose knot
 //!    values are free but monotone by construction: the root-domain value at knot k is the
-//!    normalised cumulative sum of positive increments e^tⱼ.
+//!    normalised cumulative sum of positive increments e^tⱼ. Its error is the CIELAB
+//!    difference relative to the display white, so where the curves are not power laws
+//!    dark and bright patches count by what is seen.
 //!
 //! Stage 1 is stage 2 with all increments equal. Which of the two is returned is decided by
 //! cross-validation: on a display whose curves are power laws the knots would only follow
@@ -102,6 +110,15 @@ fn fit_stages(
         }
         r
     };
+    let floor = NOISE_FLOOR * yw;
+    let noise_residual = |predict: &dyn Fn([f64; 3]) -> [f64; 3]| -> Vec<f64> {
+        let mut r = Vec::with_capacity(3 * patches.len());
+        for p in patches {
+            let q = predict(p.rgb);
+            r.extend(reading_residual(q, p.xyz, floor));
+        }
+        r
+    };
     // Parameters shared by both stages: matrix (row-major) and black, in units of white Y.
     let mut shared: Vec<f64> = m0.iter().flatten().map(|v| v / yw).collect();
     shared.extend(black0.iter().map(|v| v / yw));
@@ -129,7 +146,7 @@ fn fit_stages(
     hi1.extend(&upper);
     let stage1 = |p: &[f64]| -> Vec<f64> {
         let (m, b) = unpack(&p[3..]);
-        lab_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
+        noise_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
     };
     let p1 = levenberg_marquardt(&stage1, &start, &lo1, &hi1);
     let gamma = [p1[0], p1[1], p1[2]];
@@ -176,6 +193,39 @@ fn fit_stages(
         MatrixTrc::new(kind, b, m, tables(p)).map_err(singular)
     };
     Ok((model(&start2)?, model(&p2)?))
+}
+
+/// Below this fraction of the white's luminance a reading's noise is taken as constant,
+/// as near black a meter's noise stops shrinking with the light (the same floor as
+/// `matrix-lsq`'s weights).
+const NOISE_FLOOR: f64 = 0.01;
+
+/// Relative luminance and chromaticity repeatability of one reading (1σ): those of the
+/// CS-100A (0.1 % of Y, 0.0005 in x and y). Only their ratio shapes the fit.
+const SIGMA_Y_REL: f64 = 0.001;
+const SIGMA_XY: f64 = 0.0005;
+
+/// A prediction's miss of a reading in units of the reading's noise: relative luminance,
+/// x and y. Below `floor` (cd/m²) luminance counts as `floor`, as a meter's noise stops
+/// shrinking with the light near black.
+fn reading_residual(predicted: [f64; 3], measured: [f64; 3], floor: f64) -> [f64; 3] {
+    let chroma = |v: [f64; 3]| {
+        let s = v[0] + v[1] + v[2];
+        if s.abs() < 1e-300 {
+            [0.0, 0.0]
+        } else {
+            [v[0] / s, v[1] / s]
+        }
+    };
+    let (cp, cm) = (chroma(predicted), chroma(measured));
+    let y = measured[1].max(floor);
+    // Near black a reading's chromaticity is as uncertain as its luminance allows.
+    let w = (measured[1] / floor).min(1.0);
+    [
+        (predicted[1] - measured[1]) / y / SIGMA_Y_REL,
+        w * (cp[0] - cm[0]) / SIGMA_XY,
+        w * (cp[1] - cm[1]) / SIGMA_XY,
+    ]
 }
 
 /// Folds of the cross-validation that decides between stage 1 and stage 2.
