@@ -5,14 +5,7 @@
 //! patch shape them, so scattered patch sets (no ramps at all) fit as well as ramp sets.
 //! The fit runs in two Levenberg–Marquardt stages:
 //! 1. a power law per channel with the matrix and black offset (15 parameters), started
-//!    from γ 2.2 and a weighted linear least-squares matrix. Its error is each reading's
-//!    miss in units of a meter's noise (relative luminance, x and y): when this stage is
-//!    kept the display follows the form and only noise is left, and then the most likely
-//!    parameters average every reading's noise by its size. In CIELAB the dark patches'
-//!    chromaticity would count for less than their noise warrants, and on an additive
-//!    power-law display read with a CS-100A's noise its matrix was worse: on the ramp-only
-//!    set of `ideal-crt` (six meter seeds) the inverse round trip's mean ΔE00 fell from
-//!    0.0083 to 0.0030 (`tests/ramp_fit.rs`, `print_ramp_table` and `benches/argyll`);
+//!    from γ 2.2 and a weighted linear least-squares matrix;
 //! 2. each curve becomes a ramp table on `K` evenly spaced drive knots, interpolated in
 //!    the domain of its stage-1 power law (so the start is exactly stage 1), whose knot
 //!    values are free but monotone by construction: the root-domain value at knot k is the
@@ -20,9 +13,17 @@
 //!    difference relative to the display white, so where the curves are not power laws
 //!    dark and bright patches count by what is seen.
 //!
-//! Stage 1 is stage 2 with all increments equal. Which of the two is returned is decided by
-//! cross-validation: on a display whose curves are power laws the knots would only follow
-//! the meter's noise, while on most LCDs they are what makes the fit.
+//! Stage 1 is stage 2 with all increments equal. Which of the two forms is returned is
+//! decided by cross-validation: on a display whose curves are power laws the knots would
+//! only follow the meter's noise, while on most LCDs they are what makes the fit.
+//!
+//! When the power laws are kept, the display follows the form and what is left is the
+//! meter's noise; then they are refitted with each reading's miss counted in units of a
+//! reading's noise (relative luminance, x and y), the most likely parameters, which
+//! average every reading's noise by its size. CIELAB counts the dim patches' chromaticity
+//! for less than their noise warrants: on the ramp-only set of `ideal-crt` read with the
+//! CS-100A's noise (six meter seeds) the inverse round trip's mean ΔE00 fell from 0.0083
+//! to 0.0030, below `colprof -as`'s 0.0069 (`tests/ramp_fit.rs`).
 
 use nalgebra::{DMatrix, DVector};
 
@@ -51,19 +52,22 @@ pub fn fit_shaper_matrix(
     patches: &[Sample],
     knots: usize,
 ) -> Result<MatrixTrc, FitError> {
-    let stages = fit_stages(set, patches, knots)?;
-    if knots <= 1 {
-        return Ok(stages.1);
+    let (lab, knotted, noise) = fit_stages(set, patches, knots, true)?;
+    let power = noise.unwrap_or(lab.clone());
+    if knots <= 1 || choose_stage(set, patches, knots, (lab, knotted.clone())) {
+        return Ok(power);
     }
-    Ok(choose_stage(set, patches, knots, stages))
+    Ok(knotted)
 }
 
-/// Stage 1's model (power laws, as stage-2 tables with equal increments) and stage 2's.
+/// Stage 1's model fitted in CIELAB (power laws, as stage-2 tables with equal increments),
+/// stage 2's, and with `noise_units` stage 1 refitted in units of a reading's noise.
 fn fit_stages(
     set: &SortedSamples,
     patches: &[Sample],
     knots: usize,
-) -> Result<(MatrixTrc, MatrixTrc), FitError> {
+    noise_units: bool,
+) -> Result<(MatrixTrc, MatrixTrc, Option<MatrixTrc>), FitError> {
     let kind = ModelKind::ShaperMatrix;
     let knots = knots.max(1);
     if patches.len() < 8 {
@@ -146,9 +150,14 @@ fn fit_stages(
     hi1.extend(&upper);
     let stage1 = |p: &[f64]| -> Vec<f64> {
         let (m, b) = unpack(&p[3..]);
-        noise_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
+        lab_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
     };
     let p1 = levenberg_marquardt(&stage1, &start, &lo1, &hi1);
+    let stage1_noise = |p: &[f64]| -> Vec<f64> {
+        let (m, b) = unpack(&p[3..]);
+        noise_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
+    };
+    let p1_noise = noise_units.then(|| levenberg_marquardt(&stage1_noise, &p1, &lo1, &hi1));
     let gamma = [p1[0], p1[1], p1[2]];
 
     // Stage 2: monotone knot tables in each power law's root domain.
@@ -192,7 +201,19 @@ fn fit_stages(
         let (m, b) = unpack(&p[3 * free..]);
         MatrixTrc::new(kind, b, m, tables(p)).map_err(singular)
     };
-    Ok((model(&start2)?, model(&p2)?))
+    let noise = match p1_noise {
+        Some(p) => {
+            let (m, b) = unpack(&p[3..]);
+            let trc = std::array::from_fn(|c| Trc::Table {
+                drive: drive.clone(),
+                value: drive.iter().map(|d| d.powf(p[c])).collect(),
+                exponent: p[c],
+            });
+            Some(MatrixTrc::new(kind, b, m, trc).map_err(singular)?)
+        }
+        None => None,
+    };
+    Ok((model(&start2)?, model(&p2)?, noise))
 }
 
 /// Below this fraction of the white's luminance a reading's noise is taken as constant,
@@ -235,14 +256,15 @@ const FOLDS: usize = 3;
 /// so its cost is bounded whatever the file holds.
 const CV_PATCHES: usize = 1000;
 
-/// Stage 1 when it predicts held-out patches at least as well as stage 2 (mean ΔE00 over
-/// [`FOLDS`] folds, the cube's corners always fitted), otherwise stage 2.
+/// Whether the power laws (stage 1) predict held-out patches at least as well as the knots
+/// (stage 2), both fitted in CIELAB (mean ΔE00 over [`FOLDS`] folds, the cube's corners
+/// always fitted): the form is chosen by what is seen, like against like.
 fn choose_stage(
     set: &SortedSamples,
     patches: &[Sample],
     knots: usize,
     stages: (MatrixTrc, MatrixTrc),
-) -> MatrixTrc {
+) -> bool {
     let corner = |p: &Sample| {
         p.rgb
             .iter()
@@ -260,8 +282,9 @@ fn choose_stage(
             .filter(|&&i| !held(i))
             .map(|&i| patches[i])
             .collect();
-        let Ok((one, two)) = fit_stages(&SortedSamples::new(&train), &train, knots) else {
-            return stages.1;
+        let Ok((one, two, _)) = fit_stages(&SortedSamples::new(&train), &train, knots, false)
+        else {
+            return false;
         };
         for &i in chosen.iter().filter(|&&i| held(i)) {
             let measured = Xyz::from_array(patches[i].xyz).to_lab(white);
@@ -273,11 +296,7 @@ fn choose_stage(
             }
         }
     }
-    if error[0] <= error[1] {
-        stages.0
-    } else {
-        stages.1
-    }
+    error[0] <= error[1]
 }
 
 /// Black offset and matrix by linear least squares for fixed power-law curves, each patch
@@ -413,6 +432,31 @@ mod tests {
         let s_curve = noisy_display(|d| d * d * (3.0 - 2.0 * d));
         let fit = fit_shaper_matrix(&SortedSamples::new(&s_curve), &s_curve, 8).unwrap();
         assert!(!is_power_law(&fit), "{:?}", fit.trc);
+    }
+
+    /// By hand: a reading of XYZ (40, 50, 10) has x 0.4, y 0.5. A prediction 1 % brighter
+    /// at the same chromaticity misses by 0.01 / 0.001 = 10 luminance σ and no chromatic
+    /// σ; (41, 50, 9) has the same sum and Y, x 0.41: 0.01 / 0.0005 = 20 σ in x, 0 in y.
+    /// A reading of Y 0.5 below a floor of 1 counts its luminance miss against the floor
+    /// and its chromaticity at half weight.
+    #[test]
+    fn a_readings_miss_is_counted_in_units_of_its_noise() {
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-9);
+        let m = [40.0, 50.0, 10.0];
+        let r = reading_residual([40.4, 50.5, 10.1], m, 1.0);
+        assert!(close(r, [10.0, 0.0, 0.0]), "{r:?}");
+        let r = reading_residual([41.0, 50.0, 9.0], m, 1.0);
+        assert!(close(r, [0.0, 20.0, 0.0]), "{r:?}");
+        let dim = [0.4, 0.5, 0.1];
+        let r = reading_residual([0.41, 0.5, 0.09], dim, 1.0);
+        assert!(close(r, [0.0, 10.0, 0.0]), "{r:?}");
+        let r = reading_residual([0.4, 0.51, 0.1], dim, 1.0);
+        let x = 0.4 / 1.01 - 0.4;
+        let y = 0.51 / 1.01 - 0.5;
+        assert!(
+            close(r, [0.01 / 0.001, 0.5 * x / 0.0005, 0.5 * y / 0.0005]),
+            "{r:?}"
+        );
     }
 
     #[test]
