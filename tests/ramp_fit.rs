@@ -173,8 +173,12 @@ fn print_ramp_table() {
     let out = std::path::PathBuf::from(
         std::env::var_os("METAMER_RAMP_OUT").unwrap_or_else(|| "target/ramp-fit".into()),
     );
+    // METAMER_RAMP_SEEDS (e.g. "1,2,3,4,5,6") picks the meter seeds; 1, 2, 3 by default.
+    let seeds: Vec<u64> = std::env::var("METAMER_RAMP_SEEDS")
+        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
+        .unwrap_or_else(|_| vec![1, 2, 3]);
     for preset in Preset::ALL {
-        for noise in [None, Some(1u64), Some(2), Some(3)] {
+        for noise in std::iter::once(None).chain(seeds.iter().map(|&s| Some(s))) {
             let (panel, patches) = ramp_set(preset, noise);
             let mut line = format!(
                 "{} {}:",

@@ -22,8 +22,8 @@
 //! reading's noise (relative luminance, x and y), the most likely parameters, which
 //! average every reading's noise by its size. CIELAB counts the dim patches' chromaticity
 //! for less than their noise warrants: on the ramp-only set of `ideal-crt` read with the
-//! CS-100A's noise (six meter seeds) the inverse round trip's mean ΔE00 fell from 0.0083
-//! to 0.0030, below `colprof -as`'s 0.0069 (`tests/ramp_fit.rs`).
+//! CS-100A's noise (six meter seeds) the inverse round trip's mean ΔE00 fell from 0.008
+//! to 0.003, below `colprof -as`'s 0.007 (benches/argyll/README.md, `tests/ramp_fit.rs`).
 
 use nalgebra::{DMatrix, DVector};
 
