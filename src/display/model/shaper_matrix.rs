@@ -17,10 +17,12 @@
 //! decided by cross-validation: on a display whose curves are power laws the knots would
 //! only follow the meter's noise, while on most LCDs they are what makes the fit.
 //!
-//! When the power laws are kept, the display follows the form and what is left is the
-//! meter's noise; then they are refitted with each reading's miss counted in units of a
-//! reading's noise (relative luminance, x and y), the most likely parameters, which
-//! average every reading's noise by its size. CIELAB counts the dim patches' chromaticity
+//! When the power laws are kept and they hold within a meter's noise (their misses, in
+//! units of the CS-100A's noise, no more than twice that noise on average), what is left
+//! is the meter's noise; then they are refitted with each reading's miss counted in units
+//! of a reading's noise (relative luminance, x and y), the most likely parameters, which
+//! average every reading's noise by its size. Where the misses are larger, the form is
+//! what misses, and the CIELAB fit stays. CIELAB counts the dim patches' chromaticity
 //! for less than their noise warrants: on the ramp-only set of `ideal-crt` read with the
 //! CS-100A's noise (six meter seeds) the inverse round trip's mean ΔE00 fell from 0.008
 //! to 0.003, below `colprof -as`'s 0.007 (benches/argyll/README.md, `tests/ramp_fit.rs`).
@@ -157,7 +159,16 @@ fn fit_stages(
         let (m, b) = unpack(&p[3..]);
         noise_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
     };
-    let p1_noise = noise_units.then(|| levenberg_marquardt(&stage1_noise, &p1, &lo1, &hi1));
+    // Kept only where the power laws hold within the noise: a reduced χ² (in units of the
+    // assumed noise) beyond MAX_REDUCED_CHI2 says the misses are the form's, not the
+    // meter's, and then CIELAB's weighting by what is seen is the better one.
+    let p1_noise = noise_units
+        .then(|| levenberg_marquardt(&stage1_noise, &p1, &lo1, &hi1))
+        .filter(|p| {
+            let dof = (3 * patches.len()).saturating_sub(p.len()).max(1);
+            let chi2: f64 = stage1_noise(p).iter().map(|r| r * r).sum();
+            chi2 / dof as f64 <= MAX_REDUCED_CHI2
+        });
     let gamma = [p1[0], p1[1], p1[2]];
 
     // Stage 2: monotone knot tables in each power law's root domain.
@@ -220,6 +231,13 @@ fn fit_stages(
 /// as near black a meter's noise stops shrinking with the light (the same floor as
 /// `matrix-lsq`'s weights).
 const NOISE_FLOOR: f64 = 0.01;
+
+/// The most a power-law fit's mean squared miss may be, in units of the assumed noise's
+/// variance, for it to be taken as noise: 4, misses up to twice the CS-100A's 1σ (a meter
+/// twice as noisy still qualifies). On the ramp-only sets of `ips-lcd` and
+/// `wide-gamut-ccfl`, whose curves are not power laws, it was 700–2400 with or without the
+/// meter's noise; on the noisy `ideal-crt` 0.7–0.9.
+const MAX_REDUCED_CHI2: f64 = 4.0;
 
 /// Relative luminance and chromaticity repeatability of one reading (1σ): those of the
 /// CS-100A (0.1 % of Y, 0.0005 in x and y). Only their ratio shapes the fit.
