@@ -261,7 +261,7 @@ fn littlecms_reads_lut_and_shaper_matrix_profiles_of_simulated_displays_as_metam
 }
 
 /// The table of real monitors: `METAMER_REAL_TI3=DIR cargo test --release --test icc_readers
-/// -- --ignored --nocapture`.
+/// -- --ignored --nocapture`; `METAMER_REAL_MODELS=lut,plcc` limits the models.
 #[test]
 #[ignore]
 fn print_real_monitor_table() {
@@ -277,6 +277,9 @@ fn print_real_monitor_table() {
         .filter(|p| p.extension().is_some_and(|e| e == "ti3"))
         .collect();
     files.sort();
+    let only: Option<Vec<String>> = std::env::var("METAMER_REAL_MODELS")
+        .ok()
+        .map(|v| v.split(',').map(|m| m.trim().to_string()).collect());
     println!(
         "| file | model | ICC | held out | verify | LittleCMS forward | max gap | in gamut | \
          reproduce | LittleCMS inverse | inverse max |"
@@ -288,6 +291,12 @@ fn print_real_monitor_table() {
         let name = f.file_name().unwrap().to_string_lossy().to_string();
         let short: String = name.chars().take(24).collect();
         for kind in ModelKind::ALL {
+            if only
+                .as_ref()
+                .is_some_and(|o| !o.contains(&kind.to_string()))
+            {
+                continue;
+            }
             let Ok(profile) = fit_profile(kind, &fit, Some(&f)) else {
                 println!("| {short} | {kind} | — | refused | | | | | | | |");
                 continue;
