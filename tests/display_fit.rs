@@ -533,3 +533,62 @@ fn a_white_repeat_read_30_percent_low_is_warned_about_not_taken_as_noise() {
     let n = metamer::display::diagnostics::repeat_noise(&patches, white).unwrap();
     assert!(n.disagreeing.is_empty(), "{:?}", n.disagreeing);
 }
+
+/// The cube's eight corners and half-drive ramps of a linear display, with the white
+/// measured at R + G − B: a table through them must fold (the exact count on a 2×2×2 table
+/// is derived by hand in `Lut3d::folded_tetrahedra`'s test). The fit (a 9-level scattered
+/// table: 8³ cells × 6 = 3072 tetrahedra) records the count and the report says so before
+/// its residuals; with an additive white nothing folds and the report says nothing.
+#[test]
+fn a_folded_table_is_reported() {
+    let black = [0.5, 0.5, 0.6];
+    let (r, g, b) = ([40.0, 20.0, 2.0], [35.0, 70.0, 10.0], [18.0, 8.0, 95.0]);
+    let corners = |white: [f64; 3]| -> Vec<Sample> {
+        let mut out = Vec::new();
+        for i in 0..2 {
+            for j in 0..2 {
+                for k in 0..2 {
+                    let xyz = if (i, j, k) == (1, 1, 1) {
+                        white
+                    } else {
+                        std::array::from_fn(|c| {
+                            black[c] + i as f64 * r[c] + j as f64 * g[c] + k as f64 * b[c]
+                        })
+                    };
+                    out.push(Sample {
+                        rgb: [i, j, k].map(f64::from),
+                        xyz,
+                    });
+                }
+            }
+        }
+        // Half-drive ramps (a linear display) for the table's shapers.
+        for (c, p) in [r, g, b].iter().enumerate() {
+            let mut rgb = [0.0; 3];
+            rgb[c] = 0.5;
+            out.push(Sample {
+                rgb,
+                xyz: std::array::from_fn(|k| black[k] + 0.5 * p[k]),
+            });
+        }
+        out
+    };
+    let folded = corners(std::array::from_fn(|c| black[c] + r[c] + g[c] - b[c]));
+    let p = fit_profile(ModelKind::Lut, &folded, None).unwrap();
+    let Some([folded, 3072]) = p.diagnostics.folded_tetrahedra else {
+        panic!("{:?}", p.diagnostics.folded_tetrahedra);
+    };
+    assert!(folded > 0);
+    let v = &p.diagnostics.verdict;
+    let warning = v
+        .find(&format!("folds in {folded} of its 3072 tetrahedra"))
+        .expect(v);
+    assert!(
+        warning < v.find("The fitted lut reproduces").unwrap(),
+        "{v}"
+    );
+    let additive = corners(std::array::from_fn(|c| black[c] + r[c] + g[c] + b[c]));
+    let p = fit_profile(ModelKind::Lut, &additive, None).unwrap();
+    assert_eq!(p.diagnostics.folded_tetrahedra, None);
+    assert!(!p.diagnostics.verdict.contains("folds"));
+}

@@ -72,6 +72,10 @@ pub struct Diagnostics {
     /// mixtures rest on and how much a measured grid would help.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub few_mixtures: Option<usize>,
+    /// Of a table model (lut), the tetrahedra that fold and all of them (see
+    /// `Lut3d::folded_tetrahedra`), when any fold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub folded_tetrahedra: Option<[usize; 2]>,
     /// Assumptions that fail beyond the tolerance and the measurement noise, each in one
     /// sentence.
     pub failures: Vec<String>,
@@ -286,6 +290,7 @@ impl Diagnostics {
             residuals,
             noise,
             few_mixtures: (mixed < MIN_MIXED).then_some(mixed),
+            folded_tetrahedra: None,
             failures: Vec::new(),
             verdict: String::new(),
         };
@@ -427,6 +432,28 @@ impl Diagnostics {
         verdict.push_str(&fit);
         self.failures = failures;
         self.verdict = verdict;
+    }
+
+    /// Records that `folded` of a table's `total` tetrahedra fold and says so in the
+    /// verdict, before its last sentence (the fit's residuals).
+    pub fn note_folds(&mut self, folded: usize, total: usize) {
+        if folded == 0 {
+            return;
+        }
+        self.folded_tetrahedra = Some([folded, total]);
+        let warning = format!(
+            "Warning: the fitted table folds in {folded} of its {total} tetrahedra ({:.1} %): \
+             colours there have more than one drive value (or none), so the model's inverse \
+             (reproduce, the ICC profile's B2A0 table) is unreliable there; a display adds \
+             light with every channel, so the fold is the fit's (often noise in dark \
+             readings): measure more patches, or use shaper-matrix.",
+            100.0 * folded as f64 / total as f64
+        );
+        let at = self
+            .verdict
+            .rfind(" The fitted ")
+            .unwrap_or(self.verdict.len());
+        self.verdict.insert_str(at, &format!(" {warning}"));
     }
 
     /// What a profile fitted without (enough) mixtures rests on, in a few sentences.

@@ -66,7 +66,7 @@ pub fn fit_profile_with(
         }),
         None => repeat_noise(patches, white),
     };
-    let diagnostics = Diagnostics::compute(
+    let mut diagnostics = Diagnostics::compute(
         &set,
         kind,
         white,
@@ -74,6 +74,10 @@ pub fn fit_profile_with(
         noise,
         mixed_patches(patches),
     );
+    if let ModelParams::Lut(table) = &params {
+        let (folded, total) = table.folded_tetrahedra();
+        diagnostics.note_folds(folded, total);
+    }
     let input = match source {
         Some(path) => {
             let bytes = std::fs::read(path).map_err(|e| FitError::Io {

@@ -140,6 +140,53 @@ impl Lut3d {
         out
     }
 
+    /// How many of the table's tetrahedra are folded, and how many it has. A folded one maps
+    /// shaped drive to XYZ with the orientation opposite to the primaries' (or flat), so
+    /// colours near it have more than one drive, or none, and no single-valued inverse
+    /// (Newton's here, an ICC B2A0 table) can follow the model there. A display adds light
+    /// with every channel, so its own map is one-to-one: a fold is the fit's.
+    pub fn folded_tetrahedra(&self) -> (usize, usize) {
+        let last = self.levels.clone().map(|l| l.len() - 1);
+        let origin = self.node([0, 0, 0]);
+        let reference = Matrix3::from_columns(&[
+            self.node([last[0], 0, 0]) - origin,
+            self.node([0, last[1], 0]) - origin,
+            self.node([0, 0, last[2]]) - origin,
+        ])
+        .determinant()
+        .signum();
+        let orders = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
+        let mut folded = 0;
+        for i in 0..last[0] {
+            for j in 0..last[1] {
+                for k in 0..last[2] {
+                    for order in orders {
+                        let mut corner = [i, j, k];
+                        let mut prev = self.node(corner);
+                        let mut edges = Matrix3::zeros();
+                        for axis in order {
+                            corner[axis] += 1;
+                            let next = self.node(corner);
+                            edges.set_column(axis, &(next - prev));
+                            prev = next;
+                        }
+                        if edges.determinant() * reference <= 0.0 {
+                            folded += 1;
+                        }
+                    }
+                }
+            }
+        }
+        (folded, 6 * last.iter().product::<usize>())
+    }
+
     /// Cell and fractions of a shaped point (fractions outside 0–1 beyond the cube).
     fn locate(&self, s: [f64; 3]) -> ([usize; 3], [f64; 3], [f64; 3]) {
         let mut cell = [0; 3];
@@ -367,4 +414,46 @@ pub fn fit_lut(set: &SortedSamples, patches: &[Sample]) -> Result<Lut3d, FitErro
         message,
     })?;
     Ok(lut)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2×2×2 table of an additive display (node = i·R + j·G + k·B) folds nowhere. With the
+    /// white moved to R + G − B, by hand: the tetrahedra reaching the white last along blue
+    /// (orders r-g-b and g-r-b) end with the edge W − R − G = −B, so their edge matrix is
+    /// (R, G, −B) and flips; along green the last edge is G − 2B and along red R − 2B,
+    /// which keep det(R, G, B). So 2 of the 6 fold.
+    #[test]
+    fn a_white_pulled_behind_the_primaries_folds_two_tetrahedra_of_six() {
+        let (r, g, b) = ([40.0, 20.0, 2.0], [35.0, 70.0, 10.0], [18.0, 8.0, 95.0]);
+        let table = |white: [f64; 3]| {
+            let mut nodes = Vec::new();
+            for i in 0..2 {
+                for j in 0..2 {
+                    for k in 0..2 {
+                        nodes.push(if (i, j, k) == (1, 1, 1) {
+                            white
+                        } else {
+                            std::array::from_fn(|c| {
+                                i as f64 * r[c] + j as f64 * g[c] + k as f64 * b[c]
+                            })
+                        });
+                    }
+                }
+            }
+            let axis = vec![0.0, 1.0];
+            Lut3d::from_parts(
+                [axis.clone(), axis.clone(), axis],
+                std::array::from_fn(|_| Trc::Power { gamma: 1.0 }),
+                nodes,
+            )
+            .unwrap()
+        };
+        let additive = table(std::array::from_fn(|c| r[c] + g[c] + b[c]));
+        assert_eq!(additive.folded_tetrahedra(), (0, 6));
+        let pulled = table(std::array::from_fn(|c| r[c] + g[c] - b[c]));
+        assert_eq!(pulled.folded_tetrahedra(), (2, 6));
+    }
 }
