@@ -444,9 +444,10 @@ impl Diagnostics {
         let warning = format!(
             "Warning: the fitted table folds in {folded} of its {total} tetrahedra ({:.1} %): \
              colours there have more than one drive value (or none), so the model's inverse \
-             (reproduce, the ICC profile's B2A0 table) is unreliable there; a display adds \
-             light with every channel, so the fold is the fit's (often noise in dark \
-             readings): measure more patches, or use shaper-matrix.",
+             (reproduce, the ICC profile's B2A0 table) is unreliable there. A display's light \
+             rises with every channel, so a fold usually comes from the fit (noise in dark \
+             readings, few patches next to a face of the cube): measure more patches there, \
+             or use shaper-matrix, which cannot fold.",
             100.0 * folded as f64 / total as f64
         );
         let at = self
