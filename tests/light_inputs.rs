@@ -27,6 +27,32 @@ fn run(dir: &Path, args: &[&str]) -> (Option<i32>, String, String) {
     )
 }
 
+/// Fits the project's nine-angle falloff and writes it as `p.ldt` in `dir`.
+fn write_ldt(dir: &Path) {
+    let csv = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/light_falloff_9_angles.csv"
+    );
+    let args = [
+        "light",
+        "fit",
+        "--falloff",
+        csv,
+        "-o",
+        "l.json",
+        "--ldt",
+        "p.ldt",
+        "--width-m",
+        "0.3",
+        "--height-m",
+        "0.3",
+        "--luminance",
+        "1000",
+    ];
+    let (code, out, err) = run(dir, &args);
+    assert_eq!(code, Some(0), "{out}{err}");
+}
+
 /// A rotationally symmetric Lambertian panel of 0.6 m × 0.6 m at 1000 cd/m² (I₀ = 360
 /// cd, I = 360·cos γ), its keyword lines in Windows-1252 as a European manufacturer's
 /// tool writes them: ü (0xFC), a no-break space (0xA0) in the catalogue number, the
@@ -86,28 +112,7 @@ fn an_ies_with_windows_1252_labels_reads_as_the_other_readers_read_it() {
 #[test]
 fn an_ldt_with_windows_1252_labels_reads() {
     let dir = scratch("ldt1252");
-    let csv = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/light_falloff_9_angles.csv"
-    );
-    let args = [
-        "light",
-        "fit",
-        "--falloff",
-        csv,
-        "-o",
-        "l.json",
-        "--ldt",
-        "p.ldt",
-        "--width-m",
-        "0.3",
-        "--height-m",
-        "0.3",
-        "--luminance",
-        "1000",
-    ];
-    let (code, out, err) = run(&dir, &args);
-    assert_eq!(code, Some(0), "{out}{err}");
+    write_ldt(&dir);
     let written = std::fs::read(dir.join("p.ldt")).unwrap();
     let first_break = written.iter().position(|&b| b == b'\r').unwrap();
     let mut latin = b"Leuchten M\xfcller".to_vec();
@@ -220,28 +225,7 @@ fn a_tilt_table_of_the_wrong_length_is_named_as_such() {
 #[test]
 fn an_ldt_listing_a_c_plane_twice_is_refused_with_its_line() {
     let dir = scratch("ldtdup");
-    let csv = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/light_falloff_9_angles.csv"
-    );
-    let args = [
-        "light",
-        "fit",
-        "--falloff",
-        csv,
-        "-o",
-        "l.json",
-        "--ldt",
-        "p.ldt",
-        "--width-m",
-        "0.3",
-        "--height-m",
-        "0.3",
-        "--luminance",
-        "1000",
-    ];
-    let (code, out, err) = run(&dir, &args);
-    assert_eq!(code, Some(0), "{out}{err}");
+    write_ldt(&dir);
     let text = std::fs::read_to_string(dir.join("p.ldt")).unwrap();
     let mut lines: Vec<&str> = text.split("\r\n").collect();
     // 26 header lines, one lamp set of six, ten direct ratios: the C angles from line 43,

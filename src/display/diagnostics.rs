@@ -197,7 +197,8 @@ impl Additivity {
 impl Diagnostics {
     /// Checks the patch set; `white` is the Lab reference (the display white).
     /// `noise`: the measurement noise, when known (see [`repeat_noise`]); `mixed`: how
-    /// many mixed patches the set holds (see [`mixed_patches`]).
+    /// many mixed patches the set holds (see [`mixed_patches`]); `folded`: of a table model,
+    /// its folded tetrahedra and all of them (see `Lut3d::folded_tetrahedra`).
     pub fn compute(
         set: &SortedSamples,
         model: ModelKind,
@@ -205,6 +206,7 @@ impl Diagnostics {
         residuals: Residuals,
         noise: Option<Noise>,
         mixed: usize,
+        folded: Option<(usize, usize)>,
     ) -> Diagnostics {
         let w = Xyz::from_array(white);
         let mut channels = Vec::new();
@@ -290,7 +292,7 @@ impl Diagnostics {
             residuals,
             noise,
             few_mixtures: (mixed < MIN_MIXED).then_some(mixed),
-            folded_tetrahedra: None,
+            folded_tetrahedra: folded.filter(|f| f.0 > 0).map(|(f, t)| [f, t]),
             failures: Vec::new(),
             verdict: String::new(),
         };
@@ -428,33 +430,14 @@ impl Diagnostics {
             verdict.push(' ');
             verdict.push_str(&self.mixture_note(mixed));
         }
+        if let Some([folded, total]) = self.folded_tetrahedra {
+            verdict.push(' ');
+            verdict.push_str(&fold_note(folded, total));
+        }
         verdict.push(' ');
         verdict.push_str(&fit);
         self.failures = failures;
         self.verdict = verdict;
-    }
-
-    /// Records that `folded` of a table's `total` tetrahedra fold and says so in the
-    /// verdict, before its last sentence (the fit's residuals).
-    pub fn note_folds(&mut self, folded: usize, total: usize) {
-        if folded == 0 {
-            return;
-        }
-        self.folded_tetrahedra = Some([folded, total]);
-        let warning = format!(
-            "Warning: the fitted table folds in {folded} of its {total} tetrahedra ({:.1} %): \
-             colours there have more than one drive value (or none), so the model's inverse \
-             (reproduce, the ICC profile's B2A0 table) is unreliable there. A display's light \
-             rises with every channel, so a fold usually comes from the fit (noise in dark \
-             readings, few patches next to a face of the cube): measure more patches there, \
-             or use shaper-matrix, which cannot fold.",
-            100.0 * folded as f64 / total as f64
-        );
-        let at = self
-            .verdict
-            .rfind(" The fitted ")
-            .unwrap_or(self.verdict.len());
-        self.verdict.insert_str(at, &format!(" {warning}"));
     }
 
     /// What a profile fitted without (enough) mixtures rests on, in a few sentences.
@@ -504,6 +487,19 @@ pub fn mixed_patches(patches: &[Sample]) -> usize {
                 && !p.rgb.iter().all(|&d| d >= 1.0 - SAME_DRIVE)
         })
         .count()
+}
+
+/// The verdict's warning for a table that folds in `folded` of its `total` tetrahedra.
+fn fold_note(folded: usize, total: usize) -> String {
+    format!(
+        "Warning: the fitted table folds in {folded} of its {total} tetrahedra ({:.1} %): \
+         colours there have more than one drive value (or none), so the model's inverse \
+         (reproduce, the ICC profile's B2A0 table) is unreliable there. A display's light \
+         rises with every channel, so a fold usually comes from the fit (noise in dark \
+         readings, few patches next to a face of the cube): measure more patches there, or \
+         use shaper-matrix, which cannot fold.",
+        100.0 * folded as f64 / total as f64
+    )
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {

@@ -66,18 +66,19 @@ pub fn fit_profile_with(
         }),
         None => repeat_noise(patches, white),
     };
-    let mut diagnostics = Diagnostics::compute(
+    let folded = match &params {
+        ModelParams::Lut(table) => Some(table.folded_tetrahedra()),
+        _ => None,
+    };
+    let diagnostics = Diagnostics::compute(
         &set,
         kind,
         white,
         residuals.clone(),
         noise,
         mixed_patches(patches),
+        folded,
     );
-    if let ModelParams::Lut(table) = &params {
-        let (folded, total) = table.folded_tetrahedra();
-        diagnostics.note_folds(folded, total);
-    }
     let input = match source {
         Some(path) => {
             let bytes = std::fs::read(path).map_err(|e| FitError::Io {

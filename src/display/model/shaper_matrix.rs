@@ -55,9 +55,8 @@ pub fn fit_shaper_matrix(
     knots: usize,
 ) -> Result<MatrixTrc, FitError> {
     let (lab, knotted, noise) = fit_stages(set, patches, knots, true)?;
-    let power = noise.unwrap_or(lab.clone());
-    if knots <= 1 || choose_stage(set, patches, knots, (lab, knotted.clone())) {
-        return Ok(power);
+    if knots <= 1 || choose_stage(set, patches, knots, &knotted) {
+        return Ok(noise.unwrap_or(lab));
     }
     Ok(knotted)
 }
@@ -276,12 +275,13 @@ const CV_PATCHES: usize = 1000;
 
 /// Whether the power laws (stage 1) predict held-out patches at least as well as the knots
 /// (stage 2), both fitted in CIELAB (mean ΔE00 over [`FOLDS`] folds, the cube's corners
-/// always fitted): the form is chosen by what is seen, like against like.
+/// always fitted): the form is chosen by what is seen, like against like. `knotted` (the whole
+/// set's stage 2) gives the white where the set has none.
 fn choose_stage(
     set: &SortedSamples,
     patches: &[Sample],
     knots: usize,
-    stages: (MatrixTrc, MatrixTrc),
+    knotted: &MatrixTrc,
 ) -> bool {
     let corner = |p: &Sample| {
         p.rgb
@@ -291,7 +291,7 @@ fn choose_stage(
     let mut order: Vec<usize> = (0..patches.len()).collect();
     order.sort_by_key(|&i| fold_of(i));
     let chosen: Vec<usize> = order.into_iter().take(CV_PATCHES).collect();
-    let white = Xyz::from_array(set.white.unwrap_or_else(|| stages.1.forward([1.0; 3])));
+    let white = Xyz::from_array(set.white.unwrap_or_else(|| knotted.forward([1.0; 3])));
     let mut error = [0.0f64; 2];
     for fold in 0..FOLDS {
         let held = |i: usize| !corner(&patches[i]) && fold_of(i) % FOLDS == fold;
