@@ -534,35 +534,30 @@ fn a_white_repeat_read_30_percent_low_is_warned_about_not_taken_as_noise() {
     assert!(n.disagreeing.is_empty(), "{:?}", n.disagreeing);
 }
 
-/// The cube's eight corners and half-drive ramps of a linear display, with the white
-/// measured at R + G − B: a table through them must fold (the exact count on a 2×2×2 table
-/// is derived by hand in `Lut3d::folded_tetrahedra`'s test). The fit (a 9-level scattered
-/// table: 8³ cells × 6 = 3072 tetrahedra) records the count and the report says so before
-/// its residuals; with an additive white nothing folds and the report says nothing.
-#[test]
-fn a_folded_table_is_reported() {
-    let black = [0.5, 0.5, 0.6];
-    let (r, g, b) = ([40.0, 20.0, 2.0], [35.0, 70.0, 10.0], [18.0, 8.0, 95.0]);
-    let corners = |white: [f64; 3]| -> Vec<Sample> {
-        let mut out = Vec::new();
-        for i in 0..2 {
-            for j in 0..2 {
-                for k in 0..2 {
-                    let xyz = if (i, j, k) == (1, 1, 1) {
-                        white
-                    } else {
-                        std::array::from_fn(|c| {
-                            black[c] + i as f64 * r[c] + j as f64 * g[c] + k as f64 * b[c]
-                        })
-                    };
-                    out.push(Sample {
-                        rgb: [i, j, k].map(f64::from),
-                        xyz,
-                    });
-                }
+const FOLD_BLACK: [f64; 3] = [0.5, 0.5, 0.6];
+const FOLD_PRIMARIES: [[f64; 3]; 3] = [[40.0, 20.0, 2.0], [35.0, 70.0, 10.0], [18.0, 8.0, 95.0]];
+
+/// Patches of a linear display at the drive levels `levels` (every combination), except that
+/// full white reads `white`, plus half-drive ramps for the table's shapers.
+fn grid_with_white(levels: &[f64], white: [f64; 3]) -> Vec<Sample> {
+    let (black, [r, g, b]) = (FOLD_BLACK, FOLD_PRIMARIES);
+    let mut out = Vec::new();
+    for &i in levels {
+        for &j in levels {
+            for &k in levels {
+                let xyz = if (i, j, k) == (1.0, 1.0, 1.0) {
+                    white
+                } else {
+                    std::array::from_fn(|c| black[c] + i * r[c] + j * g[c] + k * b[c])
+                };
+                out.push(Sample {
+                    rgb: [i, j, k],
+                    xyz,
+                });
             }
         }
-        // Half-drive ramps (a linear display) for the table's shapers.
+    }
+    if !levels.contains(&0.5) {
         for (c, p) in [r, g, b].iter().enumerate() {
             let mut rgb = [0.0; 3];
             rgb[c] = 0.5;
@@ -571,24 +566,66 @@ fn a_folded_table_is_reported() {
                 xyz: std::array::from_fn(|k| black[k] + 0.5 * p[k]),
             });
         }
-        out
-    };
-    let folded = corners(std::array::from_fn(|c| black[c] + r[c] + g[c] - b[c]));
-    let p = fit_profile(ModelKind::Lut, &folded, None).unwrap();
-    let Some([folded, 3072]) = p.diagnostics.folded_tetrahedra else {
-        panic!("{:?}", p.diagnostics.folded_tetrahedra);
-    };
-    assert!(folded > 0);
+    }
+    out
+}
+
+fn white_at(sign_of_blue: f64) -> [f64; 3] {
+    let (black, [r, g, b]) = (FOLD_BLACK, FOLD_PRIMARIES);
+    std::array::from_fn(|c| black[c] + r[c] + g[c] + sign_of_blue * b[c])
+}
+
+/// A measured 3×3×3 grid of a linear display whose white reads R + G − B: the grid LUT
+/// stores every reading, so its top cell folds. By hand (as in `Lut3d::folded_tetrahedra`'s
+/// test): the paths reaching white last along blue end with the edge W − (R + G + B/2) =
+/// −1.5·B and flip; the others keep the primaries' orientation, so 2 of the 2³·6 = 48
+/// tetrahedra fold. The report says so before its residuals; with an additive white it
+/// says nothing.
+#[test]
+fn a_folded_table_is_reported() {
+    let levels = [0.0, 0.5, 1.0];
+    let p = fit_profile(
+        ModelKind::Lut,
+        &grid_with_white(&levels, white_at(-1.0)),
+        None,
+    )
+    .unwrap();
+    assert_eq!(p.diagnostics.folded_tetrahedra, Some([2, 48]));
     let v = &p.diagnostics.verdict;
-    let warning = v
-        .find(&format!("folds in {folded} of its 3072 tetrahedra"))
-        .expect(v);
+    let warning = v.find("folds in 2 of its 48 tetrahedra").expect(v);
     assert!(
         warning < v.find("The fitted lut reproduces").unwrap(),
         "{v}"
     );
-    let additive = corners(std::array::from_fn(|c| black[c] + r[c] + g[c] + b[c]));
-    let p = fit_profile(ModelKind::Lut, &additive, None).unwrap();
+    let p = fit_profile(
+        ModelKind::Lut,
+        &grid_with_white(&levels, white_at(1.0)),
+        None,
+    )
+    .unwrap();
     assert_eq!(p.diagnostics.folded_tetrahedra, None);
     assert!(!p.diagnostics.verdict.contains("folds"));
+}
+
+/// The same impossible white among the cube's corners and half ramps goes to the scattered
+/// fit (a 9-level table: 8³·6 = 3072 tetrahedra), which without a constraint folds there.
+/// The fit holds the edges of its folded tetrahedra along their channels and refits until
+/// the determinant test (a different criterion from the one it enforces) finds no fold; an
+/// additive white needs no edge held.
+#[test]
+fn the_scattered_fit_does_not_fold_where_the_readings_would() {
+    use metamer::display::model::{fit_lut_scattered, samples::SortedSamples};
+    let fit = |patches: &[Sample], lambda| {
+        fit_lut_scattered(&SortedSamples::new(patches), patches, 9, lambda).unwrap()
+    };
+    let corners = [0.0, 1.0];
+    let folded = grid_with_white(&corners, white_at(-1.0));
+    let constrained = fit(&folded, None);
+    assert_eq!(constrained.lut.folded_tetrahedra(), (0, 3072));
+    assert!(constrained.held_edges > 0);
+    let p = fit_profile(ModelKind::Lut, &folded, None).unwrap();
+    assert_eq!(p.diagnostics.folded_tetrahedra, None);
+    let additive = fit(&grid_with_white(&corners, white_at(1.0)), None);
+    assert_eq!(additive.held_edges, 0);
+    assert_eq!(additive.lut.folded_tetrahedra(), (0, 3072));
 }

@@ -146,45 +146,9 @@ impl Lut3d {
     /// (Newton's here, an ICC B2A0 table) can follow the model there. A display adds light
     /// with every channel, so its own map is one-to-one: a fold is the fit's.
     pub fn folded_tetrahedra(&self) -> (usize, usize) {
-        let last = self.levels.clone().map(|l| l.len() - 1);
-        let origin = self.node([0, 0, 0]);
-        let reference = Matrix3::from_columns(&[
-            self.node([last[0], 0, 0]) - origin,
-            self.node([0, last[1], 0]) - origin,
-            self.node([0, 0, last[2]]) - origin,
-        ])
-        .determinant()
-        .signum();
-        let orders = [
-            [0, 1, 2],
-            [0, 2, 1],
-            [1, 0, 2],
-            [1, 2, 0],
-            [2, 0, 1],
-            [2, 1, 0],
-        ];
-        let mut folded = 0;
-        for i in 0..last[0] {
-            for j in 0..last[1] {
-                for k in 0..last[2] {
-                    for order in orders {
-                        let mut corner = [i, j, k];
-                        let mut prev = self.node(corner);
-                        let mut edges = Matrix3::zeros();
-                        for axis in order {
-                            corner[axis] += 1;
-                            let next = self.node(corner);
-                            edges.set_column(axis, &(next - prev));
-                            prev = next;
-                        }
-                        if edges.determinant() * reference <= 0.0 {
-                            folded += 1;
-                        }
-                    }
-                }
-            }
-        }
-        (folded, 6 * last.iter().product::<usize>())
+        let dims = self.levels.clone().map(|l| l.len());
+        let folded = folded_paths(dims, |i| self.node(i)).len();
+        (folded, 6 * dims.iter().map(|n| n - 1).product::<usize>())
     }
 
     /// Cell and fractions of a shaped point (fractions outside 0–1 beyond the cube).
@@ -414,6 +378,53 @@ pub fn fit_lut(set: &SortedSamples, patches: &[Sample]) -> Result<Lut3d, FitErro
         message,
     })?;
     Ok(lut)
+}
+
+/// The folded tetrahedra of an n₀×n₁×n₂ table whose node at grid index i is `node(i)`, each as
+/// the four grid indices its path visits (from the cell's low corner one axis at a time, as
+/// the interpolation's decomposition does). Folded means oriented against the full-on
+/// primaries minus black, or flat; the three steps of the path are the edge matrix's columns.
+pub(crate) fn folded_paths(
+    dims: [usize; 3],
+    node: impl Fn([usize; 3]) -> Vector3<f64>,
+) -> Vec<[[usize; 3]; 4]> {
+    let last = dims.map(|n| n - 1);
+    let origin = node([0, 0, 0]);
+    let reference = Matrix3::from_columns(&[
+        node([last[0], 0, 0]) - origin,
+        node([0, last[1], 0]) - origin,
+        node([0, 0, last[2]]) - origin,
+    ])
+    .determinant()
+    .signum();
+    let orders = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut folded = Vec::new();
+    for i in 0..last[0] {
+        for j in 0..last[1] {
+            for k in 0..last[2] {
+                for order in orders {
+                    let mut path = [[i, j, k]; 4];
+                    let mut edges = Matrix3::zeros();
+                    for (step, &axis) in order.iter().enumerate() {
+                        path[step + 1] = path[step];
+                        path[step + 1][axis] += 1;
+                        edges.set_column(axis, &(node(path[step + 1]) - node(path[step])));
+                    }
+                    if edges.determinant() * reference <= 0.0 {
+                        folded.push(path);
+                    }
+                }
+            }
+        }
+    }
+    folded
 }
 
 #[cfg(test)]

@@ -15,12 +15,15 @@
 //! are solved by Jacobi-preconditioned conjugate gradients without forming a matrix. Ω
 //! weights each patch by dL*/dY at its luminance (the error is judged in CIELAB, where dark
 //! colours are more sensitive), s is that weight at mid grey so λ has no unit, and λ is
-//! chosen by k-fold cross-validation on held-out ΔE00.
+//! chosen by k-fold cross-validation on held-out ΔE00. If the final table folds (noise in
+//! dark readings can ask for it; a display cannot), `lut_unfold` refits it with the folded
+//! tetrahedra's edges held along their channels.
 //!
 //! On a full grid of measured nodes with λ → 0 every node equals its measurement, which is
 //! what the grid LUT of [`super::fit_lut`] stores.
 
 use super::error::FitError;
+use super::lut_unfold::{unfold, Held, Unfolded};
 use super::plvc::fit_plvc;
 use super::samples::{fold_of, Sample, SortedSamples};
 use super::shaper_matrix::{default_knots, fit_shaper_matrix};
@@ -54,6 +57,9 @@ pub struct ScatteredLut {
     /// The model the table corrects: shaper-matrix, or PLVC on a set with ramps where it
     /// predicts held-out patches better.
     pub base: ModelKind,
+    /// Lattice edges held along their channel so the table does not fold (0 when the
+    /// unconstrained fit folds nowhere; see `lut_unfold`).
+    pub held_edges: usize,
 }
 
 /// Fits an N³ LUT (`grid` points per axis, ≥ 2) to `patches`; `lambda` None chooses it by
@@ -123,6 +129,7 @@ pub fn fit_lut_scattered(
             best.cv
         },
         base: best.base,
+        held_edges: best.held_edges,
     })
 }
 
@@ -143,6 +150,7 @@ struct Fitted {
     cv: Vec<(f64, f64)>,
     /// The lowest cross-validated mean ΔE00 (0 when nothing was cross-validated).
     score: f64,
+    held_edges: usize,
 }
 
 fn fit_on_base(
@@ -213,7 +221,29 @@ fn fit_on_base(
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .ok_or("no regularisation weight to try")?;
     let all: Vec<&Row> = rows.iter().collect();
-    let correction = problem.solve(&all, lambda);
+    let fitted = problem.solve(&all, lambda);
+    // A held edge off by a fraction δ of the primaries' light costs about as much as a
+    // reading off by δ·Y_white at mid grey.
+    let stiffness = scale * yw * yw;
+    let steps: [Vec<f64>; 3] = std::array::from_fn(|c| {
+        let at = |d: f64| base.shaper[c].eval(d);
+        let span = at(1.0) - at(0.0);
+        levels[c]
+            .windows(2)
+            .map(|w| (at(w[1]) - at(w[0])) / span)
+            .collect()
+    });
+    let Unfolded {
+        correction,
+        held_edges,
+    } = unfold(
+        grid,
+        &steps,
+        &base_nodes,
+        fitted,
+        stiffness,
+        |held, rho, start| problem.solve_held(&all, lambda, held, rho, start),
+    );
     Ok(Fitted {
         base: base.kind,
         shaper: base.shaper,
@@ -222,6 +252,7 @@ fn fit_on_base(
         lambda,
         cv,
         score,
+        held_edges,
     })
 }
 
@@ -292,7 +323,68 @@ impl Problem {
     /// The corrections at every node for the rows given.
     fn solve(&self, rows: &[&Row], lambda: f64) -> Vec<[f64; 3]> {
         let v = self.nodes();
-        let mut diag = vec![RIDGE * self.scale; v];
+        let diag = self.diagonal(rows, lambda);
+        let mut out = vec![[0.0; 3]; v];
+        for k in 0..3 {
+            let mut rhs = vec![0.0; v];
+            self.add_rhs(rows, k, &mut rhs);
+            let x = conjugate_gradients(|x, y| self.apply(rows, lambda, x, y), &rhs, &diag, None);
+            for (o, xi) in out.iter_mut().zip(x) {
+                o[k] = xi;
+            }
+        }
+        out
+    }
+
+    /// As [`Self::solve`], with every held edge pulled to its target by the penalty
+    /// ρ·(u·(c_to − c_from) − target)². u mixes X, Y and Z, so the three are solved as one
+    /// system (laid out X block, Y block, Z block), started from `start`.
+    fn solve_held(
+        &self,
+        rows: &[&Row],
+        lambda: f64,
+        held: &[Held],
+        rho: f64,
+        start: &[[f64; 3]],
+    ) -> Vec<[f64; 3]> {
+        let v = self.nodes();
+        let one = self.diagonal(rows, lambda);
+        let mut diag: Vec<f64> = (0..3).flat_map(|_| one.iter().copied()).collect();
+        let mut rhs = vec![0.0; 3 * v];
+        for k in 0..3 {
+            self.add_rhs(rows, k, &mut rhs[k * v..(k + 1) * v]);
+        }
+        for h in held {
+            for k in 0..3 {
+                diag[k * v + h.from] += rho * h.u[k] * h.u[k];
+                diag[k * v + h.to] += rho * h.u[k] * h.u[k];
+                rhs[k * v + h.to] += rho * h.target * h.u[k];
+                rhs[k * v + h.from] -= rho * h.target * h.u[k];
+            }
+        }
+        let apply = |x: &[f64], out: &mut [f64]| {
+            for k in 0..3 {
+                let block = k * v..(k + 1) * v;
+                self.apply(rows, lambda, &x[block.clone()], &mut out[block]);
+            }
+            for h in held {
+                let g: f64 = (0..3)
+                    .map(|k| h.u[k] * (x[k * v + h.to] - x[k * v + h.from]))
+                    .sum();
+                for k in 0..3 {
+                    out[k * v + h.to] += rho * h.u[k] * g;
+                    out[k * v + h.from] -= rho * h.u[k] * g;
+                }
+            }
+        };
+        let x0: Vec<f64> = (0..3 * v).map(|i| start[i % v][i / v]).collect();
+        let x = conjugate_gradients(apply, &rhs, &diag, Some(x0));
+        (0..v).map(|i| [x[i], x[v + i], x[2 * v + i]]).collect()
+    }
+
+    /// The Jacobi preconditioner: the diagonal of one channel's normal matrix.
+    fn diagonal(&self, rows: &[&Row], lambda: f64) -> Vec<f64> {
+        let mut diag = vec![RIDGE * self.scale; self.nodes()];
         for r in rows {
             for &(i, f) in &r.w {
                 diag[i] += r.omega2 * f * f;
@@ -302,20 +394,16 @@ impl Problem {
         for (d, l) in diag.iter_mut().zip(&lap_diag) {
             *d += lambda * self.scale * l;
         }
-        let mut out = vec![[0.0; 3]; v];
-        for k in 0..3 {
-            let mut rhs = vec![0.0; v];
-            for r in rows {
-                for &(i, f) in &r.w {
-                    rhs[i] += r.omega2 * f * r.target[k];
-                }
-            }
-            let x = conjugate_gradients(|x, y| self.apply(rows, lambda, x, y), &rhs, &diag);
-            for (o, xi) in out.iter_mut().zip(x) {
-                o[k] = xi;
+        diag
+    }
+
+    /// Adds Wᵀ Ω (target) of XYZ channel k to `rhs`.
+    fn add_rhs(&self, rows: &[&Row], k: usize, rhs: &mut [f64]) {
+        for r in rows {
+            for &(i, f) in &r.w {
+                rhs[i] += r.omega2 * f * r.target[k];
             }
         }
-        out
     }
 }
 
@@ -346,17 +434,29 @@ fn laplacian_diagonal(n: usize) -> Vec<f64> {
     out
 }
 
-/// Jacobi-preconditioned conjugate gradients for a symmetric positive definite operator.
-fn conjugate_gradients(apply: impl Fn(&[f64], &mut [f64]), b: &[f64], diag: &[f64]) -> Vec<f64> {
+/// Jacobi-preconditioned conjugate gradients for a symmetric positive definite operator,
+/// from `start` or from zero.
+fn conjugate_gradients(
+    apply: impl Fn(&[f64], &mut [f64]),
+    b: &[f64],
+    diag: &[f64],
+    start: Option<Vec<f64>>,
+) -> Vec<f64> {
     let n = b.len();
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-    let mut x = vec![0.0; n];
-    let mut r = b.to_vec();
+    let mut ap = vec![0.0; n];
+    let (mut x, mut r) = match start {
+        Some(x) => {
+            apply(&x, &mut ap);
+            let r = b.iter().zip(&ap).map(|(b, a)| b - a).collect();
+            (x, r)
+        }
+        None => (vec![0.0; n], b.to_vec()),
+    };
     let mut z: Vec<f64> = r.iter().zip(diag).map(|(r, d)| r / d).collect();
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
     let stop = 1e-20 * dot(b, b).max(1e-300);
-    let mut ap = vec![0.0; n];
     for _ in 0..(4 * n).max(100) {
         if dot(&r, &r) <= stop {
             break;

@@ -11,6 +11,7 @@ mod kind;
 mod least_squares;
 mod lut;
 mod lut_scattered;
+mod lut_unfold;
 mod matrix_lsq;
 mod matrix_trc;
 mod plcc;

@@ -1,0 +1,159 @@
+//! Keeping a fitted table one-to-one. A display adds light with every channel, so the map
+//! from drive to XYZ never folds; a table fitted to noisy readings can (the dark first cell
+//! along an axis holds a step of well under 1 % of the primary, which noise in a few dark
+//! readings outweighs), and where it folds no inverse follows it.
+//!
+//! The constraint is per lattice edge. Write each step of a tetrahedron's path in the
+//! primaries' coordinates (P⁻¹·ΔXYZ, P the full-on primaries minus black): the step along
+//! channel j is column j of the tetrahedron's edge matrix in that basis. When every column's
+//! own component exceeds the sum of the others' magnitudes the matrix is column diagonally
+//! dominant with a positive diagonal, so its determinant is positive (Gershgorin: every
+//! eigenvalue has a positive real part) and the tetrahedron keeps the primaries'
+//! orientation. With the signs of the off-diagonal components fixed at the current fit,
+//! "own component − Σ ± others ≥ margin" is linear in the node values: the fit holds the
+//! edges of every folded tetrahedron to it by a quadratic penalty, refits, and repeats
+//! until nothing folds. Edges of tetrahedra that never fold are left free, so a table that
+//! does not fold is not changed at all.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::lut::folded_paths;
+
+/// The margin an edge is held to, as a fraction of the step an additive display would take
+/// there (the shaped coordinate's step): enough that the penalty's small remaining violation
+/// stays positive, and never zero, which would let pinned constraints shrink an edge to
+/// nothing.
+const MARGIN: f64 = 0.05;
+
+/// Refits before giving up (each either holds new edges or stiffens the penalty tenfold).
+const ROUNDS: usize = 12;
+
+/// One lattice edge held along its channel: the penalty is ρ·(u·(c_to − c_from) − target)²
+/// on the corrections c.
+pub(super) struct Held {
+    pub from: usize,
+    pub to: usize,
+    pub u: [f64; 3],
+    pub target: f64,
+}
+
+/// The outcome: the corrections, and how many edges had to be held.
+pub(super) struct Unfolded {
+    pub correction: Vec<[f64; 3]>,
+    pub held_edges: usize,
+}
+
+/// Refits `correction` (on an n³ grid over `base`) until the table `base + correction`
+/// folds nowhere, calling `solve(held, ρ, start)` for each refit. `steps[c][i]` is the
+/// share of channel c's full light between its grid levels i and i + 1 (the normalised
+/// shaper's step). `stiffness` is the penalty weight, per squared fraction of a primary,
+/// that makes a held edge about as costly as the readings; ρ starts at 100 times that.
+/// Returns the least-folded fit found if folds remain after every round.
+pub(super) fn unfold(
+    grid: usize,
+    steps: &[Vec<f64>; 3],
+    base: &[[f64; 3]],
+    correction: Vec<[f64; 3]>,
+    stiffness: f64,
+    mut solve: impl FnMut(&[Held], f64, &[[f64; 3]]) -> Vec<[f64; 3]>,
+) -> Unfolded {
+    let n = grid;
+    let index = |v: [usize; 3]| (v[0] * n + v[1]) * n + v[2];
+    let at = |nodes: &[[f64; 3]], i: usize| Vector3::from(nodes[i]);
+    let black = at(base, 0);
+    let primaries = Matrix3::from_columns(&[
+        at(base, index([n - 1, 0, 0])) - black,
+        at(base, index([0, n - 1, 0])) - black,
+        at(base, index([0, 0, n - 1])) - black,
+    ]);
+    let table = |c: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        base.iter()
+            .zip(c)
+            .map(|(b, d)| std::array::from_fn(|k| b[k] + d[k]))
+            .collect()
+    };
+    let folds = |c: &[[f64; 3]]| {
+        let nodes = table(c);
+        folded_paths([n; 3], |i| at(&nodes, index(i)))
+    };
+    let mut current = correction;
+    let mut folded = folds(&current);
+    let Some(to_primaries) = primaries.try_inverse().filter(|_| !folded.is_empty()) else {
+        return Unfolded {
+            correction: current,
+            held_edges: 0,
+        };
+    };
+    let mut best = (folded.len(), current.clone());
+    // Edges (from, to) of tetrahedra that folded, with their channel.
+    let mut held: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    // The constraints (edge, signs) that were ever short of their margin. They stay pinned
+    // to it: releasing the ones a refit satisfies lets the readings pull them back, and the
+    // set oscillates instead of converging; growing only, it converges in finitely many
+    // rounds.
+    let mut binding: BTreeSet<(usize, usize, usize)> = BTreeSet::new();
+    let signs = [[1.0, 1.0], [1.0, -1.0], [-1.0, 1.0], [-1.0, -1.0]];
+    // "own ≥ Σ|others| + margin" is the four linear constraints own ± a ± b ≥ margin.
+    let constraint = |from: usize, to: usize, axis: usize, combo: usize| {
+        let base_step = at(base, to) - at(base, from);
+        let level = [from / (n * n), from / n % n, from % n][axis];
+        let margin = MARGIN * steps[axis][level];
+        let mut u = to_primaries.row(axis).transpose();
+        let others = (0..3).filter(|&o| o != axis);
+        for (o, sign) in others.zip(signs[combo]) {
+            u += sign * to_primaries.row(o).transpose();
+        }
+        (u, margin, base_step)
+    };
+    let mut rho = 100.0 * stiffness;
+    for _ in 0..ROUNDS {
+        for path in &folded {
+            for step in 0..3 {
+                let axis = (0..3)
+                    .find(|&a| path[step + 1][a] != path[step][a])
+                    .expect("each step of a path moves along one axis");
+                held.insert((index(path[step]), index(path[step + 1])), axis);
+            }
+        }
+        let nodes = table(&current);
+        let before = binding.len();
+        for (&(from, to), &axis) in &held {
+            let step = at(&nodes, to) - at(&nodes, from);
+            for combo in 0..signs.len() {
+                let (u, margin, _) = constraint(from, to, axis, combo);
+                if u.dot(&step) < margin {
+                    binding.insert((from, to, combo));
+                }
+            }
+        }
+        if binding.len() == before {
+            rho *= 10.0;
+        }
+        let rows: Vec<Held> = binding
+            .iter()
+            .map(|&(from, to, combo)| {
+                let (u, margin, base_step) = constraint(from, to, held[&(from, to)], combo);
+                Held {
+                    from,
+                    to,
+                    u: u.into(),
+                    target: margin - u.dot(&base_step),
+                }
+            })
+            .collect();
+        current = solve(&rows, rho, &current);
+        folded = folds(&current);
+        if folded.len() < best.0 {
+            best = (folded.len(), current.clone());
+        }
+        if folded.is_empty() {
+            break;
+        }
+    }
+    Unfolded {
+        correction: best.1,
+        held_edges: held.len(),
+    }
+}
