@@ -495,9 +495,10 @@ fn fold_note(folded: usize, total: usize) -> String {
         "Warning: the fitted table folds in {folded} of its {total} tetrahedra ({:.1} %): \
          colours there have more than one drive value (or none), so the model's inverse \
          (reproduce, the ICC profile's B2A0 table) is unreliable there. A display's light \
-         rises with every channel, so a fold usually comes from the fit (noise in dark \
-         readings, few patches next to a face of the cube): measure more patches there, or \
-         use shaper-matrix, which cannot fold.",
+         rises with every channel, so a fold comes from noise in the readings the table \
+         stores (a measured grid keeps every reading as a node; a table fitted to scattered \
+         patches is held from folding): measure those patches again, or use shaper-matrix, \
+         which cannot fold.",
         100.0 * folded as f64 / total as f64
     )
 }
