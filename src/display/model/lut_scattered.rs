@@ -113,10 +113,14 @@ pub fn fit_lut_scattered(
         }
     }
     let best = best.expect("shaper-matrix is always a base");
+    let Unfolded {
+        correction,
+        held_edges,
+    } = best.unfold();
     let nodes: Vec<[f64; 3]> = best
         .base_nodes
         .iter()
-        .zip(&best.correction)
+        .zip(&correction)
         .map(|(b, d)| std::array::from_fn(|k| b[k] + d[k]))
         .collect();
     let lut = Lut3d::from_parts(levels, best.shaper, nodes).map_err(failed)?;
@@ -129,7 +133,7 @@ pub fn fit_lut_scattered(
             best.cv
         },
         base: best.base,
-        held_edges: best.held_edges,
+        held_edges,
     })
 }
 
@@ -150,7 +154,11 @@ struct Fitted {
     cv: Vec<(f64, f64)>,
     /// The lowest cross-validated mean ΔE00 (0 when nothing was cross-validated).
     score: f64,
-    held_edges: usize,
+    rows: Vec<Row>,
+    problem: Problem,
+    stiffness: f64,
+    /// Per channel, the share of its light between consecutive grid levels.
+    steps: [Vec<f64>; 3],
 }
 
 fn fit_on_base(
@@ -221,10 +229,7 @@ fn fit_on_base(
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .ok_or("no regularisation weight to try")?;
     let all: Vec<&Row> = rows.iter().collect();
-    let fitted = problem.solve(&all, lambda);
-    // A held edge off by a fraction δ of the primaries' light costs about as much as a
-    // reading off by δ·Y_white at mid grey.
-    let stiffness = scale * yw * yw;
+    let correction = problem.solve(&all, lambda);
     let steps: [Vec<f64>; 3] = std::array::from_fn(|c| {
         let at = |d: f64| base.shaper[c].eval(d);
         let span = at(1.0) - at(0.0);
@@ -233,17 +238,6 @@ fn fit_on_base(
             .map(|w| (at(w[1]) - at(w[0])) / span)
             .collect()
     });
-    let Unfolded {
-        correction,
-        held_edges,
-    } = unfold(
-        grid,
-        &steps,
-        &base_nodes,
-        fitted,
-        stiffness,
-        |held, rho, start| problem.solve_held(&all, lambda, held, rho, start),
-    );
     Ok(Fitted {
         base: base.kind,
         shaper: base.shaper,
@@ -252,8 +246,30 @@ fn fit_on_base(
         lambda,
         cv,
         score,
-        held_edges,
+        rows,
+        problem,
+        // A held edge off by a fraction δ of the primaries' light costs about as much as a
+        // reading off by δ·Y_white at mid grey.
+        stiffness: scale * yw * yw,
+        steps,
     })
+}
+
+impl Fitted {
+    /// The correction refitted so the table does not fold (see `lut_unfold`), and how many
+    /// edges that held; done for the chosen base only, since the choice rests on the
+    /// cross-validated score.
+    fn unfold(&self) -> Unfolded {
+        let all: Vec<&Row> = self.rows.iter().collect();
+        unfold(
+            self.problem.grid,
+            &self.steps,
+            &self.base_nodes,
+            self.correction.clone(),
+            self.stiffness,
+            |held, rho, start| self.problem.solve_held(&all, self.lambda, held, rho, start),
+        )
+    }
 }
 
 /// One patch in the normal equations.
@@ -328,7 +344,13 @@ impl Problem {
         for k in 0..3 {
             let mut rhs = vec![0.0; v];
             self.add_rhs(rows, k, &mut rhs);
-            let x = conjugate_gradients(|x, y| self.apply(rows, lambda, x, y), &rhs, &diag, None);
+            let x = conjugate_gradients(
+                |x, y| self.apply(rows, lambda, x, y),
+                &rhs,
+                &diag,
+                None,
+                1e-10,
+            );
             for (o, xi) in out.iter_mut().zip(x) {
                 o[k] = xi;
             }
@@ -378,7 +400,10 @@ impl Problem {
             }
         };
         let x0: Vec<f64> = (0..3 * v).map(|i| start[i % v][i / v]).collect();
-        let x = conjugate_gradients(apply, &rhs, &diag, Some(x0));
+        // Started warm, each refit stops at a relative residual of 10⁻⁸: half the
+        // iterations of 10⁻¹⁰ for the same table on the Surface Pro's halves, where 10⁻⁶
+        // already led the rounds to a different (and 0.06 ΔE00 worse) table.
+        let x = conjugate_gradients(apply, &rhs, &diag, Some(x0), 1e-8);
         (0..v).map(|i| [x[i], x[v + i], x[2 * v + i]]).collect()
     }
 
@@ -435,12 +460,13 @@ fn laplacian_diagonal(n: usize) -> Vec<f64> {
 }
 
 /// Jacobi-preconditioned conjugate gradients for a symmetric positive definite operator,
-/// from `start` or from zero.
+/// from `start` or from zero, until the residual is `tolerance` of |b|.
 fn conjugate_gradients(
     apply: impl Fn(&[f64], &mut [f64]),
     b: &[f64],
     diag: &[f64],
     start: Option<Vec<f64>>,
+    tolerance: f64,
 ) -> Vec<f64> {
     let n = b.len();
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
@@ -456,7 +482,7 @@ fn conjugate_gradients(
     let mut z: Vec<f64> = r.iter().zip(diag).map(|(r, d)| r / d).collect();
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
-    let stop = 1e-20 * dot(b, b).max(1e-300);
+    let stop = tolerance * tolerance * dot(b, b).max(1e-300);
     for _ in 0..(4 * n).max(100) {
         if dot(&r, &r) <= stop {
             break;
