@@ -9,11 +9,10 @@
 //! own component exceeds the sum of the others' magnitudes the matrix is column diagonally
 //! dominant with a positive diagonal, so its determinant is positive (Gershgorin: every
 //! eigenvalue has a positive real part) and the tetrahedron keeps the primaries'
-//! orientation. With the signs of the off-diagonal components fixed at the current fit,
-//! "own component ± each other ≥ margin" (four sign choices) is linear in the node values:
-//! the fit holds the edges of every folded tetrahedron to it by a quadratic penalty (a
-//! hinge: only constraints short of their margin pull), refits, and repeats until nothing
-//! folds. Edges of tetrahedra that never fold are left free, so a table that does not fold
+//! orientation. "Own component ≥ Σ |others| + margin" is the four constraints "own ± one
+//! other ± the third ≥ margin", each linear in the node values: the fit holds the edges of
+//! every folded tetrahedron to them by a quadratic penalty (a hinge: only constraints short
+//! of their margin pull), refits, and repeats until nothing folds. Edges of tetrahedra that never fold are left free, so a table that does not fold
 //! is not changed at all. On the Surface Pro 2017's DisplayCAL set (the folding table this
 //! was built for) the one-to-one table predicts held-out patches about 0.03 ΔE00 worse
 //! than the folded one (4 %), and a smaller margin costs less: 0.2 of an additive step cost
