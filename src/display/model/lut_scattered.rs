@@ -157,8 +157,6 @@ struct Fitted {
     rows: Vec<Row>,
     problem: Problem,
     stiffness: f64,
-    /// Per channel, the share of its light between consecutive grid levels.
-    steps: [Vec<f64>; 3],
 }
 
 fn fit_on_base(
@@ -230,14 +228,6 @@ fn fit_on_base(
         .ok_or("no regularisation weight to try")?;
     let all: Vec<&Row> = rows.iter().collect();
     let correction = problem.solve(&all, lambda);
-    let steps: [Vec<f64>; 3] = std::array::from_fn(|c| {
-        let at = |d: f64| base.shaper[c].eval(d);
-        let span = at(1.0) - at(0.0);
-        levels[c]
-            .windows(2)
-            .map(|w| (at(w[1]) - at(w[0])) / span)
-            .collect()
-    });
     Ok(Fitted {
         base: base.kind,
         shaper: base.shaper,
@@ -251,7 +241,6 @@ fn fit_on_base(
         // A held edge off by a fraction δ of the primaries' light costs about as much as a
         // reading off by δ·Y_white at mid grey.
         stiffness: scale * yw * yw,
-        steps,
     })
 }
 
@@ -261,9 +250,17 @@ impl Fitted {
     /// cross-validated score.
     fn unfold(&self) -> Unfolded {
         let all: Vec<&Row> = self.rows.iter().collect();
+        // Per channel, the share of its light between consecutive (evenly spaced) levels.
+        let n = self.problem.grid;
+        let steps: [Vec<f64>; 3] = std::array::from_fn(|c| {
+            let at = |i: usize| self.shaper[c].eval(i as f64 / (n - 1) as f64);
+            (0..n - 1)
+                .map(|i| (at(i + 1) - at(i)) / (at(n - 1) - at(0)))
+                .collect()
+        });
         unfold(
-            self.problem.grid,
-            &self.steps,
+            n,
+            &steps,
             &self.base_nodes,
             self.correction.clone(),
             self.stiffness,
