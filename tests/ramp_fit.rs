@@ -327,13 +327,16 @@ fn print_mixture_study() {
 }
 
 /// On the 50-patch ramp-only sets of the three simulated displays, read with the meter's
-/// noise, `auto`'s pick reproduces mixed colours (through the true display) within 5 % of
-/// the best model's error: the held-out patches are all single-channel, so this checks
-/// that the choice does not rest on them alone.
+/// noise (seeds 1 and 5), `auto`'s pick reproduces mixed colours (through the true display)
+/// within 5 % of the best model's error: the held-out patches are all single-channel, so
+/// this checks that the choice does not rest on them alone. On the ideal CRT with seed 5 the
+/// one white reading misses the additive sum by ΔE00 1.17 from noise alone; judged against
+/// the tolerance without that noise, it set aside every model but PLVC (0.246 against
+/// `shaper-matrix`'s 0.002).
 #[test]
 fn auto_on_ramps_picks_within_5_percent_of_the_best_model() {
-    for preset in Preset::ALL {
-        let (panel, patches) = ramp_set(preset, Some(1));
+    for (preset, seed) in Preset::ALL.into_iter().flat_map(|p| [(p, 1), (p, 5)]) {
+        let (panel, patches) = ramp_set(preset, Some(seed));
         let errors: Vec<(ModelKind, f64)> = ModelKind::ALL
             .iter()
             .filter_map(|&k| model_error(&panel, k, &patches).map(|e| (k, e)))
@@ -343,11 +346,44 @@ fn auto_on_ramps_picks_within_5_percent_of_the_best_model() {
         let picked = errors.iter().find(|e| e.0 == sel.model).unwrap().1;
         assert!(
             picked <= 1.05 * best,
-            "{}: auto took {} ({picked:.3}), the best is {best:.3}: {errors:?}\n{sel}",
+            "{} seed {seed}: auto took {} ({picked:.3}), the best is {best:.3}: {errors:?}\n{sel}",
             panel.name(),
             sel.model
         );
     }
+}
+
+/// The white sets a model aside for missing it only beyond what the meter's noise allows:
+/// on the ideal CRT (additive by construction) read with the meter's noise, no seed of six
+/// sets any candidate aside, although the white misses the additive sum by up to ΔE00 1.4
+/// there; with that white read 15 % darker than the sum (a real panel's white fell 7.6 %
+/// short in one of the DisplayCAL files the benches use), every candidate whose matrix is
+/// the primaries' is set aside and PLVC, which passes through the white, is chosen.
+#[test]
+fn the_white_sets_models_aside_only_beyond_the_noise() {
+    for seed in 1..=6 {
+        let (_, patches) = ramp_set(Preset::IdealCrt, Some(seed));
+        let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
+        assert!(
+            sel.candidates.iter().all(|c| c.set_aside.is_none()),
+            "seed {seed}:\n{sel}"
+        );
+        let noise = sel.mixtures.additivity_noise_de00.unwrap().0;
+        assert!(noise > 0.3 && noise < 1.5, "seed {seed}: {noise}\n{sel}");
+    }
+    let (_, mut patches) = ramp_set(Preset::IdealCrt, Some(1));
+    let black = patches.iter().find(|p| p.rgb == [0.0; 3]).unwrap().xyz;
+    for p in patches.iter_mut().filter(|p| p.rgb == [1.0; 3]) {
+        p.xyz = std::array::from_fn(|k| black[k] + 0.85 * (p.xyz[k] - black[k]));
+    }
+    let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
+    for kind in [ModelKind::Plcc, ModelKind::PlccGamma, ModelKind::Gog] {
+        let c = sel.candidates.iter().find(|c| c.model == kind).unwrap();
+        assert!(c.set_aside.is_some(), "{kind}:\n{sel}");
+    }
+    assert_eq!(sel.model, ModelKind::Plvc, "{sel}");
+    let m = &sel.mixtures;
+    assert!(m.additivity_de00.unwrap() > m.allowance_de00, "{sel}");
 }
 
 /// The fit report on a ramp-only set says that mixtures were not measured, quotes the

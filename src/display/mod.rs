@@ -3,6 +3,7 @@
 //! patch-budget study. The screens that show the colours are devices, in `rig`.
 
 // Measurements, models and fitting.
+pub mod additivity_noise;
 pub mod diagnostics;
 pub mod fit;
 pub mod measurements;

@@ -17,12 +17,18 @@
 //! patches are ramp readings, which judge each channel's curve and nothing else (the
 //! paper's and PsychoPy's plans, black, white and ramps, hold no mixture at all). There the
 //! measured mixtures decide which candidates may compete: a candidate whose fit misses the
-//! measured white by more than the verdict's tolerance (plus the noise margin, when the
-//! noise is known) is set aside, since its mixtures are not held by the one mixture that
-//! was measured; the LUT is not a candidate, since between the ramps its colours would be
+//! measured white by more than the verdict's tolerance plus twice what noise alone makes
+//! of that miss is set aside, since its mixtures are not held by the one mixture that was
+//! measured. The noise is that of the white against the sum of four readings, propagated
+//! from the readings' noise (repeats, or the ramps' smoothness; see
+//! [`super::additivity_noise`]), and it is large: one reading per patch with a CS-100A's
+//! noise moves a perfectly additive display's check by ΔE00 0.8 rms. The LUT is not a candidate, since between the ramps its colours would be
 //! its smoothness prior. Cross-validation then ranks the rest (any greys are held out as
 //! usual), and the one-standard-error rule applies among them.
 
+use super::additivity_noise::{
+    check_noise_de00, ramp_noise, repeat_noise as reading_noise, NoiseSource,
+};
 use super::diagnostics::{mixed_patches, repeat_noise, Additivity, TOLERANCE_DE00};
 use super::fit::{check_samples, fit_params, FitOptions};
 use super::model::samples::{SortedSamples, SAME_DRIVE};
@@ -57,6 +63,9 @@ pub struct MixtureEvidence {
     /// ΔE00 between the measured white and black + the three primaries' contributions
     /// (R + G + B − 2K), when all five were measured.
     pub additivity_de00: Option<f64>,
+    /// How far noise alone moves the white against that sum (root mean square ΔE00), with
+    /// what the reading noise was estimated from (see [`super::additivity_noise`]).
+    pub additivity_noise_de00: Option<(f64, NoiseSource)>,
     /// The largest miss of the white a candidate may have on a set with few mixtures.
     pub allowance_de00: f64,
 }
@@ -92,9 +101,16 @@ impl std::fmt::Display for Selection {
                 m.mixed,
                 if m.mixed == 1 { "" } else { "es" },
                 m.allowance_de00,
-                m.additivity_de00
-                    .map(|a| format!(" (the additive sum R+G+B−2K misses it by {a:.2})"))
-                    .unwrap_or_default()
+                match (m.additivity_de00, m.additivity_noise_de00) {
+                    (Some(a), Some((n, source))) => format!(
+                        " (the additive sum R+G+B−2K misses it by {a:.2}; the meter's noise, \
+                         {source}, moves that by {n:.2} rms)"
+                    ),
+                    (Some(a), None) => {
+                        format!(" (the additive sum R+G+B−2K misses it by {a:.2})")
+                    }
+                    _ => String::new(),
+                }
             )?;
         }
         for c in &self.candidates {
@@ -166,14 +182,25 @@ pub fn select_model(
     let sigma = options
         .noise_de00
         .or_else(|| white.and_then(|w| repeat_noise(patches, w).map(|n| n.de00)));
+    let reading_noise = reading_noise(patches).or_else(|| ramp_noise(&full));
+    let additivity_noise_de00 = white
+        .zip(reading_noise)
+        .and_then(|(w, n)| check_noise_de00(&full, n, Xyz::from_array(w)).map(|e| (e, n.source)));
+    // Two white readings differ by σ√2, and the white and the sum of four readings by what
+    // the ramps' noise propagates to; beyond twice the larger the model, not the meter, is
+    // to blame.
+    let spread = sigma
+        .map(|s| s * 2f64.sqrt())
+        .into_iter()
+        .chain(additivity_noise_de00.map(|n| n.0))
+        .fold(0.0, f64::max);
     let mixtures = MixtureEvidence {
         mixed: n_mixed,
         few: n_mixed < MIN_MIXED,
         additivity_de00: white
             .and_then(|w| Additivity::check(&full, Xyz::from_array(w)).map(|a| a.de00)),
-        // Two white readings differ by σ√2; beyond twice that the model, not the meter,
-        // is to blame.
-        allowance_de00: TOLERANCE_DE00 + sigma.map_or(0.0, |s| 2.0 * s * 2f64.sqrt()),
+        additivity_noise_de00,
+        allowance_de00: TOLERANCE_DE00 + 2.0 * spread,
     };
     let mut candidates = Vec::new();
     for kind in ModelKind::ALL {

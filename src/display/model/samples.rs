@@ -27,6 +27,8 @@ pub struct SortedSamples {
     pub ramp_readings: [Vec<usize>; 3],
     /// Readings averaged into the white.
     pub white_readings: usize,
+    /// Readings averaged into the black.
+    pub black_readings: usize,
 }
 
 fn is(v: f64, target: f64) -> bool {
@@ -48,7 +50,8 @@ impl SortedSamples {
         let pick = |f: &dyn Fn(&Sample) -> bool| -> Vec<[f64; 3]> {
             patches.iter().filter(|p| f(p)).map(|p| p.xyz).collect()
         };
-        let black = mean(&pick(&|p| p.rgb.iter().all(|&d| is(d, 0.0))));
+        let blacks = pick(&|p| p.rgb.iter().all(|&d| is(d, 0.0)));
+        let black = mean(&blacks);
         let whites = pick(&|p| p.rgb.iter().all(|&d| is(d, 1.0)));
         let white = mean(&whites);
         let mut ramps: [Vec<(f64, [f64; 3])>; 3] = Default::default();
@@ -87,6 +90,7 @@ impl SortedSamples {
             ramps,
             ramp_readings,
             white_readings: whites.len(),
+            black_readings: blacks.len(),
         }
     }
 
