@@ -386,6 +386,33 @@ fn the_white_sets_models_aside_only_beyond_the_noise() {
     assert!(m.additivity_de00.unwrap() > m.allowance_de00, "{sel}");
 }
 
+/// On the noise-free ideal CRT every model reproduces the held-out ramps exactly, so the
+/// ramps cannot tell them apart and the simplest (`plcc-gamma`) is chosen. With the white
+/// read 1 % darker than the sum (ΔE00 0.22 from it, far beyond the 0.03 rms that the
+/// ramps' own curvature passes for noise), only PLVC passes through the white, and the
+/// white breaks the tie for it; the report says so.
+#[test]
+fn the_white_breaks_a_tie_on_the_ramps() {
+    let (_, patches) = ramp_set(Preset::IdealCrt, None);
+    let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
+    assert_eq!(sel.model, ModelKind::PlccGamma, "{sel}");
+    let mut darker = patches.clone();
+    let black = darker.iter().find(|p| p.rgb == [0.0; 3]).unwrap().xyz;
+    for p in darker.iter_mut().filter(|p| p.rgb == [1.0; 3]) {
+        p.xyz = std::array::from_fn(|k| black[k] + 0.99 * (p.xyz[k] - black[k]));
+    }
+    let sel = select_model(&darker, 5, &FitOptions::default()).unwrap();
+    assert_eq!(sel.model, ModelKind::Plvc, "{sel}");
+    assert!(sel.white_decided, "{sel}");
+    let miss = sel.mixtures.additivity_de00.unwrap();
+    assert!(miss > 0.15 && miss < 0.3, "{sel}");
+    let report = sel.to_string();
+    assert!(
+        report.contains("misses the measured white least"),
+        "{report}"
+    );
+}
+
 /// The fit report on a ramp-only set says that mixtures were not measured, quotes the
 /// white's departure from the additive sum R + G + B − 2K (computed here from the true
 /// display) and recommends a grid.

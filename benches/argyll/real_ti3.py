@@ -179,6 +179,34 @@ def run_soft(cmd):
     return p.stdout if p.returncode == 0 else None
 
 
+def tally(records, models):
+    """One line: on how many files the best metamer model is at or below colprof -as, and
+    auto's pick is at or below it and within 5 % of the best model (means pooled over folds)."""
+    by_file = {}
+    for r in records:
+        by_file.setdefault(r["file"], []).append(r)
+    counts = {"best <= colprof": 0, "auto <= colprof": 0, "auto within 5 %": 0}
+    n = 0
+    for recs in by_file.values():
+        def pooled(m):
+            got = [r["methods"].get(m) for r in recs]
+            if any(g is None for g in got):
+                return None
+            return sum(g["mean"] * g["n"] for g in got) / sum(g["n"] for g in got)
+        fitted = [v for v in (pooled(m) for m in models) if v is not None]
+        auto, colprof = pooled("auto"), pooled("colprof -as")
+        if not fitted or auto is None or colprof is None:
+            continue
+        n += 1
+        best = min(fitted)
+        counts["best <= colprof"] += best <= colprof
+        counts["auto <= colprof"] += auto <= colprof
+        counts["auto within 5 %"] += auto <= 1.05 * best
+    if n == 0:
+        return ""
+    return f"Of {n} files: " + "; ".join(f"{k} on {v}" for k, v in counts.items()) + "."
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dir")
@@ -224,6 +252,10 @@ def main():
     print(f"| file | {head} | " + " | ".join(methods) + " |")
     print("| --- | --- |" + " --- |" * len(methods))
     print("\n".join(rows))
+    summary = tally(everything, [m for m in a.models if m != "auto"])
+    if summary:
+        print()
+        print(summary)
     if sources:
         print()
         for f in sorted(sources):
