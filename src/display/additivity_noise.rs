@@ -12,13 +12,12 @@
 //! and Y. A set without repeats does not say it directly, but its ramps do. In the
 //! brighter part of a ramp a reading's chromaticity changes smoothly with its luminance
 //! (the channel's own drift and a fading share of black's light) and its luminance follows
-//! a smooth curve of the drive in log–log coordinates, so what a level departs from the line
-//! through its two neighbours is, to a good approximation, noise (a cubic through two
-//! neighbours on either side follows a smooth curve's bend closely). On real monitors
-//! measured through a video card's calibration the ramps are rougher than the meter, since
-//! an 8-bit calibration curve steps each level's luminance by up to a per cent, so repeats
-//! are preferred where a set has them. Either estimate is propagated through the check by drawing each of
-//! the five readings' noise, scaled by how many readings were averaged into it, from a
+//! a smooth curve of the drive in log–log coordinates, so what a level departs from the cubic
+//! through two neighbours on either side is, to a good approximation, noise. On real
+//! monitors measured through a video card's calibration the ramps are rougher than the
+//! meter, since an 8-bit calibration curve steps each level's luminance by up to a per cent,
+//! so repeats are preferred where a set has them. Either estimate is propagated through the
+//! check by drawing each of the five readings' noise, scaled by how many readings were averaged into it, from a
 //! seeded generator so that a fit is repeatable.
 
 use super::model::samples::SortedSamples;
@@ -63,7 +62,7 @@ impl std::fmt::Display for NoiseSource {
 
 /// The spread of repeated readings about their patch's mean, pooled over every bright patch
 /// read more than once; None without such repeats.
-pub fn repeat_noise(patches: &[Sample]) -> Option<ReadingNoise> {
+pub fn repeat_reading_noise(patches: &[Sample]) -> Option<ReadingNoise> {
     let key = |p: &Sample| p.rgb.map(|d| (d * 1e6).round() as i64);
     let mut groups: std::collections::BTreeMap<[i64; 3], Vec<[f64; 3]>> = Default::default();
     for p in patches {
@@ -273,11 +272,11 @@ mod tests {
             p([0.0; 3], [0.02, 0.1, 0.3]),
             p([1.0, 0.0, 0.0], [40.0, 20.0, 2.0]),
         ];
-        let n = repeat_noise(&patches).unwrap();
+        let n = repeat_reading_noise(&patches).unwrap();
         assert_eq!(n.source, NoiseSource::Repeats(2));
         assert!((n.y_rel - 1.0 / 101.0).abs() < 1e-12, "{n:?}");
         assert!(n.xy < 1e-12, "{n:?}");
-        assert!(repeat_noise(&patches[..1]).is_none());
+        assert!(repeat_reading_noise(&patches[..1]).is_none());
     }
 
     /// Without noise the white does not move; for small noise the move scales with it.

@@ -31,9 +31,7 @@
 //! applies. On the single-channel patches of 34 DisplayCAL files of real monitors this
 //! changed two picks, both for the better (benches/argyll/README.md).
 
-use super::additivity_noise::{
-    check_noise_de00, ramp_noise, repeat_noise as reading_noise, NoiseSource,
-};
+use super::additivity_noise::{check_noise_de00, ramp_noise, repeat_reading_noise, NoiseSource};
 use super::diagnostics::{mixed_patches, repeat_noise, Additivity, TOLERANCE_DE00};
 use super::fit::{check_samples, fit_params, FitOptions};
 use super::model::samples::{SortedSamples, SAME_DRIVE};
@@ -197,7 +195,7 @@ pub fn select_model(
     let sigma = options
         .noise_de00
         .or_else(|| white.and_then(|w| repeat_noise(patches, w).map(|n| n.de00)));
-    let reading_noise = reading_noise(patches).or_else(|| ramp_noise(&full));
+    let reading_noise = repeat_reading_noise(patches).or_else(|| ramp_noise(&full));
     let additivity_noise_de00 = white
         .zip(reading_noise)
         .and_then(|(w, n)| check_noise_de00(&full, n, Xyz::from_array(w)).map(|e| (e, n.source)));
