@@ -197,3 +197,49 @@ fn killed_in_every_stage_and_resumed_it_ends_as_an_uninterrupted_run() {
     }
     std::fs::remove_dir_all(&root).unwrap();
 }
+
+/// Ctrl-C in the display stage stops it before its next reading, as in the box and
+/// display-spots stages: the display's profile is not written, the readings taken are in
+/// its journal, and the message says which stage stopped and how to go on. (Were the
+/// stage deaf to the first Ctrl-C, it would finish and the next measuring stage would be
+/// the one that stops.)
+#[test]
+fn ctrl_c_in_the_display_stage_stops_that_stage() {
+    let dir = temp_dir("sigint-display");
+    let (mut child, lines) = spawn(&dir, false);
+    let start = Instant::now();
+    loop {
+        match lines.recv_timeout(Duration::from_millis(50)) {
+            Ok(l) if l.trim() == "display: running" => break,
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                panic!("the lab ended before the display stage ran")
+            }
+            _ => {}
+        }
+        assert!(start.elapsed() < Duration::from_secs(240));
+    }
+    let stage_dir = dir.join("display");
+    while line_count(&stage_dir) < 4 {
+        assert!(
+            start.elapsed() < Duration::from_secs(240),
+            "the display stage journals nothing"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // SAFETY: sending a signal to our own child process.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+        0
+    );
+    let said: Vec<String> = lines.iter().collect();
+    let status = child.wait().unwrap();
+    let said = said.join("\n");
+    assert!(!status.success(), "{said}");
+    assert!(
+        said.contains("the display stage stopped with") && said.contains("resume"),
+        "{said}"
+    );
+    assert!(!stage_dir.join("profile.json").exists());
+    assert!(line_count(&stage_dir) >= 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -282,3 +282,87 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
     drop(meter);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `experiment --unattended` at a terminal, on instruments that are not simulated (a
+/// replayed i1Pro, a CS-100A on a pseudo-terminal): the box stage asks nobody to place,
+/// aim or calibrate anything, as `measure-box --unattended` does, instead of waiting for
+/// an Enter that nobody will press. The transcript holds only emissive readings, so the
+/// session runs the tiles and the fall-off and stops at the materials, where the driver
+/// asks the replay for a reflective calibration it does not hold.
+#[test]
+fn the_experiment_unattended_at_a_terminal_asks_nobody() {
+    let dir = std::env::temp_dir().join(format!("metamer-tmux-un-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let transcript = dir.join("i1pro.jsonl");
+    let recorded = Command::new(METAMER)
+        .args([
+            "spot",
+            "--instrument",
+            "sim:i1pro?time_scale=0",
+            "--count",
+            "2",
+        ])
+        .arg("--record")
+        .arg(&transcript)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    assert!(recorded.status.success(), "{recorded:?}");
+    let light = Arc::new(Light {
+        views: AtomicUsize::new(0),
+        bumped: 0,
+    });
+    let config = EmulatorConfig {
+        seed: 1,
+        time_scale: 0.01,
+        noise: false,
+    };
+    let meter = PtyEmulator::start(Cs100aEmulator::new(light, config)).unwrap();
+    let plan = dir.join("plan.json");
+    std::fs::write(
+        &plan,
+        r#"{"repeats": 1, "falloff_angles_deg": [-20, 0, 20], "geometry": {"rows": 1, "cols": 2}}"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let script = format!(
+        "{} experiment -o {} --plan {} --spectral replay:{} --spot cs100a:{} --stage box --unattended; echo EXIT=$?; sleep 600",
+        quoted(Path::new(METAMER)),
+        quoted(&out),
+        quoted(&plan),
+        quoted(&transcript),
+        meter.path()
+    );
+    let tmux = Tmux {
+        socket: dir.join("tmux.sock"),
+    };
+    let started = tmux.run(&[
+        "new-session",
+        "-d",
+        "-s",
+        "op",
+        "-x",
+        "200",
+        "-y",
+        "60",
+        &script,
+    ]);
+    assert!(started.status.success(), "{started:?}");
+    let screen = tmux.wait_for("EXIT=", 1);
+    assert_eq!(screen.matches("press Enter").count(), 0, "{screen}");
+    assert!(
+        screen.contains("stage materials") && screen.contains("EXIT=1"),
+        "{screen}"
+    );
+    let entries = |stage: &str| {
+        std::fs::read_to_string(out.join("box").join(format!("{stage}.jsonl")))
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with(r#"{"type":"entry""#))
+            .count()
+    };
+    assert_eq!((entries("tiles"), entries("falloff")), (2, 6), "{screen}");
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

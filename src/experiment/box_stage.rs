@@ -17,7 +17,7 @@ use crate::output::OutputPolicy;
 use crate::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
 use crate::rig::Scenario;
 use crate::session::repeats::Repeatability;
-use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator};
+use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator, Unattended};
 
 /// How the box is measured.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -49,6 +49,7 @@ pub fn measure(
     dir: &Path,
     m: &BoxMeasure,
     resume: bool,
+    unattended: bool,
     run: &RunOptions,
     progress: &dyn Fn(Progress),
 ) -> Result<Vec<String>, ExperimentError> {
@@ -96,7 +97,12 @@ pub fn measure(
         (
             open_instrument(&m.spectral, None)?,
             open_instrument(&m.spot, None)?,
-            Box::new(TerminalOperator),
+            // `--unattended` at a terminal: nobody is there to press Enter.
+            if unattended {
+                Box::new(Unattended)
+            } else {
+                Box::new(TerminalOperator)
+            },
         )
     };
     let mut output = OutputPolicy::new(true);

@@ -159,6 +159,7 @@ pub fn characterize_display(
     targets: &[[f64; 3]],
     resume: bool,
     unattended: bool,
+    run: &RunOptions,
     progress: &dyn Fn(Progress),
 ) -> Result<(DisplaySetting, Vec<&'static str>), ExperimentError> {
     let spec = ScreenSpec::parse(&opts.screen)?;
@@ -181,7 +182,9 @@ pub fn characterize_display(
         resume,
         // The stage directory is the experiment's own: a re-run replaces its profile.
         force: true,
-        run: RunOptions::default(),
+        // The experiment's Ctrl-C: the first one stops before the next reading, as in the
+        // box and display-spots stages, instead of leaving only the second, which kills.
+        run: run.clone(),
     };
     let mut scripted = ScriptedOperator::confirming();
     let mut terminal = TerminalOperator;

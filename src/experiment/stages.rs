@@ -263,9 +263,14 @@ fn run_stage(
     };
     match stage {
         Stage::Box => match &opts.box_source {
-            BoxSource::Measure(m) => {
-                box_stage::measure(&sd.dir, m, opts.resume, &opts.run, progress)
-            }
+            BoxSource::Measure(m) => box_stage::measure(
+                &sd.dir,
+                m,
+                opts.resume,
+                opts.unattended,
+                &opts.run,
+                progress,
+            ),
             BoxSource::Existing { .. } => Ok(Vec::new()),
         },
         Stage::Simulation => {
@@ -281,6 +286,7 @@ fn run_stage(
                 &targets,
                 opts.resume,
                 opts.unattended,
+                &opts.run,
                 progress,
             )?;
             Ok(owned(files))
