@@ -56,6 +56,29 @@ fn budget_with_no_trials_is_refused() {
     assert!(!d.join("b").exists(), "nothing is created");
 }
 
+/// The reproduction stage's gamut mapping is checked before the box is measured, not
+/// after the box, the simulation and the display have run.
+#[test]
+fn experiment_with_an_unknown_gamut_mapping_is_refused_before_any_stage() {
+    let d = scratch("gamut");
+    let out = d.join("ex").display().to_string();
+    let (code, _, err) = refused(&[
+        "experiment",
+        "-o",
+        &out,
+        "--spectral",
+        "sim:i1pro?time_scale=0",
+        "--gamut",
+        "nearest",
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("gamut mapping: unknown gamut mapping 'nearest' (known: nearest-lab, clip)"),
+        "{err}"
+    );
+    assert!(!d.join("ex").exists(), "nothing is created");
+}
+
 #[test]
 fn render_spots_with_no_time_is_refused() {
     let (code, _, err) = refused(&["render", "spots", "--max-seconds", "0"]);

@@ -174,6 +174,42 @@ fn prints_and_writes_the_published_colour_differences() {
         stdout.contains("simulation vs box: 24 of 24 patches below the JND"),
         "{stdout}"
     );
+    // --out-of-gamut marks the patches the display cannot show, in the comparisons that
+    // have the display on one side; box vs simulation never went through the display.
+    let marked = validate(&[
+        "--reference",
+        b.to_str().unwrap(),
+        "--test",
+        d.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+        "--force",
+        "--simulation",
+        b.to_str().unwrap(),
+        "--out-of-gamut",
+        "3",
+    ]);
+    assert!(
+        marked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&marked.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("validation.csv")).unwrap();
+    let mut marks: Vec<(String, String)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|c| c[1] == "3")
+        .map(|c| (c[0].to_string(), c[c.len() - 1].to_string()))
+        .collect();
+    marks.sort();
+    let want = [
+        ("box_vs_display", "1"),
+        ("box_vs_simulation", "0"),
+        ("display_vs_simulation", "1"),
+    ]
+    .map(|(a, b)| (a.to_string(), b.to_string()));
+    assert_eq!(marks, want);
     std::fs::remove_dir_all(&dir).ok();
 }
 

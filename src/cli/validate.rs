@@ -72,7 +72,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0, value_name = "DE")]
     model_term: f64,
     /// Patches the display cannot show (comma-separated numbers), besides those the
-    /// readings mark.
+    /// readings mark; marked in the comparisons with the display on one side.
     #[arg(long, value_delimiter = ',', value_name = "LIST")]
     out_of_gamut: Vec<usize>,
     /// The report's title.
@@ -138,14 +138,16 @@ pub fn run(args: Args) -> CliResult {
         },
         model_term_de: args.model_term,
     };
-    let run = |r: &ReadingSet, rn: &str, t: &ReadingSet, tn: &str, model: bool| {
+    // The display model's term and the display's gamut belong to the comparisons that
+    // have the display on one side; box vs simulation never went through the display.
+    let run = |r: &ReadingSet, rn: &str, t: &ReadingSet, tn: &str, display: bool| {
         let o = AssessOptions {
-            model_term_de: if model { opts.model_term_de } else { 0.0 },
+            model_term_de: if display { opts.model_term_de } else { 0.0 },
             ..opts
         };
         assess(rn, r, tn, t, white, &o).map(|mut a| {
             for p in &mut a.patches {
-                p.out_of_gamut |= args.out_of_gamut.contains(&p.patch);
+                p.out_of_gamut |= display && args.out_of_gamut.contains(&p.patch);
             }
             a
         })
