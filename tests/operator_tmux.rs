@@ -94,45 +94,78 @@ fn quoted(p: &Path) -> String {
     format!("'{}'", p.display())
 }
 
-#[test]
-fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
+/// The test's own directory, empty, after checking that tmux is there to drive a terminal.
+fn scratch(tag: &str) -> PathBuf {
     let version = Command::new("tmux").arg("-V").output();
     assert!(
         version.is_ok_and(|o| o.status.success()),
         "this test drives a terminal with tmux: install it (Debian: apt-get install tmux)"
     );
-    let dir = std::env::temp_dir().join(format!("metamer-tmux-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("metamer-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
 
-    // The i1Pro: six emissive readings of the simulated one, recorded, then replayed
-    // through the real driver (a transcript is not a live instrument: no --unattended).
+/// `count` emissive readings of the simulated i1Pro, recorded to `dir/i1pro.jsonl` for
+/// replaying through the real driver.
+fn record_i1pro(dir: &Path, count: usize) -> PathBuf {
     let transcript = dir.join("i1pro.jsonl");
     let recorded = Command::new(METAMER)
-        .args([
-            "spot",
-            "--instrument",
-            "sim:i1pro?time_scale=0",
-            "--count",
-            "6",
-        ])
+        .args(["spot", "--instrument", "sim:i1pro?time_scale=0", "--count"])
+        .arg(count.to_string())
         .arg("--record")
         .arg(&transcript)
         .stdin(Stdio::null())
         .output()
         .unwrap();
     assert!(recorded.status.success(), "{recorded:?}");
-    // The CS-100A: the emulator on a pseudo-terminal, its 5th reading of a bumped meter.
-    let light = Arc::new(Light {
-        views: AtomicUsize::new(0),
-        bumped: 5,
-    });
+    transcript
+}
+
+/// The CS-100A emulator on a pseudo-terminal, seeing `light`, at a hundredth of its pace.
+fn pty_meter(light: Arc<Light>) -> PtyEmulator {
     let config = EmulatorConfig {
         seed: 1,
         time_scale: 0.01,
         noise: false,
     };
-    let meter = PtyEmulator::start(Cs100aEmulator::new(light.clone(), config)).unwrap();
+    PtyEmulator::start(Cs100aEmulator::new(light, config)).unwrap()
+}
+
+/// A 200×60 tmux session `op` running `script`, on a server of the test's own in `dir`.
+fn tmux_running(dir: &Path, script: &str) -> Tmux {
+    let tmux = Tmux {
+        socket: dir.join("tmux.sock"),
+    };
+    let started = tmux.run(&[
+        "new-session",
+        "-d",
+        "-s",
+        "op",
+        "-x",
+        "200",
+        "-y",
+        "60",
+        script,
+    ]);
+    assert!(started.status.success(), "{started:?}");
+    tmux
+}
+
+#[test]
+fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
+    let dir = scratch("tmux");
+
+    // The i1Pro: six emissive readings of the simulated one, recorded, then replayed
+    // through the real driver (a transcript is not a live instrument: no --unattended).
+    let transcript = record_i1pro(&dir, 6);
+    // The CS-100A: the emulator on a pseudo-terminal, its 5th reading of a bumped meter.
+    let light = Arc::new(Light {
+        views: AtomicUsize::new(0),
+        bumped: 5,
+    });
+    let meter = pty_meter(light.clone());
 
     let plan = dir.join("plan.json");
     std::fs::write(
@@ -158,21 +191,7 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
         command("spots"),
         command("falloff")
     );
-    let tmux = Tmux {
-        socket: dir.join("tmux.sock"),
-    };
-    let started = tmux.run(&[
-        "new-session",
-        "-d",
-        "-s",
-        "op",
-        "-x",
-        "200",
-        "-y",
-        "60",
-        &script,
-    ]);
-    assert!(started.status.success(), "{started:?}");
+    let tmux = tmux_running(&dir, &script);
 
     // The tiles: the calibration, then each tile once with its count.
     tmux.wait_for(
@@ -291,34 +310,12 @@ fn an_operator_is_asked_once_per_placement_and_sees_every_reading() {
 /// asks the replay for a reflective calibration it does not hold.
 #[test]
 fn the_experiment_unattended_at_a_terminal_asks_nobody() {
-    let dir = std::env::temp_dir().join(format!("metamer-tmux-un-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let transcript = dir.join("i1pro.jsonl");
-    let recorded = Command::new(METAMER)
-        .args([
-            "spot",
-            "--instrument",
-            "sim:i1pro?time_scale=0",
-            "--count",
-            "2",
-        ])
-        .arg("--record")
-        .arg(&transcript)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    assert!(recorded.status.success(), "{recorded:?}");
-    let light = Arc::new(Light {
+    let dir = scratch("tmux-unattended");
+    let transcript = record_i1pro(&dir, 2);
+    let meter = pty_meter(Arc::new(Light {
         views: AtomicUsize::new(0),
         bumped: 0,
-    });
-    let config = EmulatorConfig {
-        seed: 1,
-        time_scale: 0.01,
-        noise: false,
-    };
-    let meter = PtyEmulator::start(Cs100aEmulator::new(light, config)).unwrap();
+    }));
     let plan = dir.join("plan.json");
     std::fs::write(
         &plan,
@@ -334,21 +331,7 @@ fn the_experiment_unattended_at_a_terminal_asks_nobody() {
         quoted(&transcript),
         meter.path()
     );
-    let tmux = Tmux {
-        socket: dir.join("tmux.sock"),
-    };
-    let started = tmux.run(&[
-        "new-session",
-        "-d",
-        "-s",
-        "op",
-        "-x",
-        "200",
-        "-y",
-        "60",
-        &script,
-    ]);
-    assert!(started.status.success(), "{started:?}");
+    let tmux = tmux_running(&dir, &script);
     let screen = tmux.wait_for("EXIT=", 1);
     assert_eq!(screen.matches("press Enter").count(), 0, "{screen}");
     assert!(

@@ -148,24 +148,34 @@ fn prints_and_writes_the_published_colour_differences() {
     ]);
     assert_eq!(again.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
-    let forced = validate(&[
-        "--reference",
-        b.to_str().unwrap(),
-        "--test",
-        d.to_str().unwrap(),
-        "-o",
-        dir.to_str().unwrap(),
-        "--force",
-        "--simulation",
-        b.to_str().unwrap(),
-        "--propagation",
-        "linear",
-    ]);
-    assert!(
-        forced.status.success(),
-        "{}",
-        String::from_utf8_lossy(&forced.stderr)
-    );
+    // The box's readings again as the simulation, replacing the report each time.
+    let with_simulation = |extra: &[&str]| {
+        let (b, d, o) = (
+            b.to_str().unwrap(),
+            d.to_str().unwrap(),
+            dir.to_str().unwrap(),
+        );
+        let mut args = vec![
+            "--reference",
+            b,
+            "--test",
+            d,
+            "-o",
+            o,
+            "--force",
+            "--simulation",
+            b,
+        ];
+        args.extend_from_slice(extra);
+        let out = validate(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    };
+    let forced = with_simulation(&["--propagation", "linear"]);
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.contains("id=\"fig6\"") && html.contains("id=\"fig7\""));
     // The simulation is the box itself: box vs simulation differs by exactly 0.
@@ -176,24 +186,7 @@ fn prints_and_writes_the_published_colour_differences() {
     );
     // --out-of-gamut marks the patches the display cannot show, in the comparisons that
     // have the display on one side; box vs simulation never went through the display.
-    let marked = validate(&[
-        "--reference",
-        b.to_str().unwrap(),
-        "--test",
-        d.to_str().unwrap(),
-        "-o",
-        dir.to_str().unwrap(),
-        "--force",
-        "--simulation",
-        b.to_str().unwrap(),
-        "--out-of-gamut",
-        "3",
-    ]);
-    assert!(
-        marked.status.success(),
-        "{}",
-        String::from_utf8_lossy(&marked.stderr)
-    );
+    with_simulation(&["--out-of-gamut", "3"]);
     let csv = std::fs::read_to_string(dir.join("validation.csv")).unwrap();
     let mut marks: Vec<(String, String)> = csv
         .lines()
