@@ -105,6 +105,7 @@ pub fn measure(
             },
         )
     };
+    let spot_model = spot.info().model;
     let mut output = OutputPolicy::new(true);
     if let Some(p) = &m.plan {
         output.input(p);
@@ -156,8 +157,9 @@ pub fn measure(
         }
     };
     // Each spot's scatter in X, Y and Z together, over the repeats the reduction kept;
-    // a spot read once carries the meter's stated repeatability.
-    let stated = Repeatability::emissive_of(&m.spot);
+    // a spot read once carries the meter's stated repeatability. The meter's model is the
+    // one it reports, not a guess from its spec: `replay:box-spots.jsonl` names none.
+    let stated = Repeatability::emissive_of(&spot_model);
     let stats: Vec<PatchStat> = summary
         .spot_xyz
         .iter()
@@ -182,4 +184,30 @@ pub fn measure(
         .into_iter()
         .map(String::from)
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A replayed CS-100A whose file name says nothing of the model: the spec names no
+    /// meter, the opened instrument does, and its stated repeatability is the CS-100A's.
+    #[test]
+    fn a_replayed_meter_is_known_by_the_model_it_reports() {
+        let dir = std::env::temp_dir().join(format!("metamer-box-stage-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("spot.jsonl");
+        let transcript = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/protocols/cs100a/transcripts/normal_session.jsonl"
+        );
+        std::fs::copy(transcript, &file).unwrap();
+        let spec = format!("replay:{}", file.display());
+        assert!(Repeatability::emissive_of(&spec).is_none());
+        let meter = open_instrument(&spec, None).unwrap();
+        let stated = Repeatability::emissive_of(&meter.info().model).unwrap();
+        let cs100a = Repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
+        assert_eq!(stated, cs100a);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
