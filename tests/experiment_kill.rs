@@ -77,9 +77,9 @@ fn line_count(stage_dir: &Path) -> usize {
     journal_lines(stage_dir).iter().map(|(_, l)| l.len()).sum()
 }
 
-/// Waits until the child says it runs `stage` (and, for a measuring stage, has journalled a
-/// few more readings), then kills it. Returns whether the stage was still unfinished.
-fn kill_in(child: &mut Child, lines: &mpsc::Receiver<String>, dir: &Path, stage: &str) -> bool {
+/// Waits until the child says it runs `stage` and, for a measuring stage, has journalled a
+/// few more readings.
+fn wait_inside(lines: &mpsc::Receiver<String>, dir: &Path, stage: &str) {
     let start = Instant::now();
     let limit = Duration::from_secs(240);
     let wanted = format!("{stage}: running");
@@ -105,9 +105,15 @@ fn kill_in(child: &mut Child, lines: &mpsc::Receiver<String>, dir: &Path, stage:
             std::thread::sleep(Duration::from_millis(2));
         }
     }
+}
+
+/// Kills the child inside `stage` ([`wait_inside`]). Returns whether the stage was still
+/// unfinished.
+fn kill_in(child: &mut Child, lines: &mpsc::Receiver<String>, dir: &Path, stage: &str) -> bool {
+    wait_inside(lines, dir, stage);
     child.kill().unwrap();
     child.wait().unwrap();
-    !stage_dir.join("stage.json").exists()
+    !dir.join(stage).join("stage.json").exists()
 }
 
 fn spawn(dir: &Path, resume: bool) -> (Child, mpsc::Receiver<String>) {
@@ -207,25 +213,8 @@ fn killed_in_every_stage_and_resumed_it_ends_as_an_uninterrupted_run() {
 fn ctrl_c_in_the_display_stage_stops_that_stage() {
     let dir = temp_dir("sigint-display");
     let (mut child, lines) = spawn(&dir, false);
-    let start = Instant::now();
-    loop {
-        match lines.recv_timeout(Duration::from_millis(50)) {
-            Ok(l) if l.trim() == "display: running" => break,
-            Err(mpsc::RecvTimeoutError::Disconnected) => {
-                panic!("the lab ended before the display stage ran")
-            }
-            _ => {}
-        }
-        assert!(start.elapsed() < Duration::from_secs(240));
-    }
+    wait_inside(&lines, &dir, "display");
     let stage_dir = dir.join("display");
-    while line_count(&stage_dir) < 4 {
-        assert!(
-            start.elapsed() < Duration::from_secs(240),
-            "the display stage journals nothing"
-        );
-        std::thread::sleep(Duration::from_millis(2));
-    }
     // SAFETY: sending a signal to our own child process.
     assert_eq!(
         unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },

@@ -17,8 +17,8 @@
 //! monitors measured through a video card's calibration the ramps are rougher than the
 //! meter, since an 8-bit calibration curve steps each level's luminance by up to a per cent,
 //! so repeats are preferred where a set has them. Either estimate is propagated through the
-//! check by drawing each of the five readings' noise, scaled by how many readings were averaged into it, from a
-//! seeded generator so that a fit is repeatable.
+//! check by drawing each of the five readings' noise, scaled by how many readings were
+//! averaged into it, from a seeded generator so that a fit is repeatable.
 
 use super::model::samples::SortedSamples;
 use super::model::Sample;

@@ -23,13 +23,14 @@
 //! from the readings' noise (repeats, or the ramps' smoothness; see
 //! [`super::additivity_noise`]), and it is large: one reading per patch with a CS-100A's
 //! noise moves a perfectly additive display's check by ΔE00 0.8 rms. The LUT is not a
-//! candidate, since between the ramps its colours would be its smoothness prior. Cross-validation then ranks the rest (any greys are held out as
-//! usual). Among the candidates within one standard error of the best, the ramps cannot
-//! tell which mixes right, and the white can: when its check is known to better than the
-//! verdict's tolerance, those whose miss of it is within that noise of the smallest miss
-//! remain, and the simplest of them is chosen; otherwise the plain one-standard-error rule
-//! applies. On the single-channel patches of 34 DisplayCAL files of real monitors this
-//! changed two picks, both for the better (benches/argyll/README.md).
+//! candidate, since between the ramps its colours would be its smoothness prior.
+//! Cross-validation then ranks the rest (any greys are held out as usual). Among the
+//! candidates within one standard error of the best, the ramps cannot tell which mixes
+//! right, and the white can: when its check is known to better than the verdict's
+//! tolerance, those whose miss of it is within that noise of the smallest miss remain, and
+//! the simplest of them is chosen; otherwise the plain one-standard-error rule applies. On
+//! the single-channel patches of 34 DisplayCAL files of real monitors this changed two
+//! picks, both for the better (benches/argyll/README.md).
 
 use super::additivity_noise::{check_noise_de00, ramp_noise, repeat_reading_noise, NoiseSource};
 use super::diagnostics::{mixed_patches, repeat_noise, Additivity, TOLERANCE_DE00};
@@ -334,14 +335,22 @@ fn complexity(kind: ModelKind) -> usize {
 /// The simplest candidate whose held-out errors exceed the best's by less than one
 /// standard error of their paired differences; `best` if none is simpler.
 fn simplest_within_one_se(candidates: &[Candidate], best: ModelKind) -> ModelKind {
+    tied_with(candidates, best)
+        .into_iter()
+        .min_by_key(|c| complexity(c.model))
+        .map_or(best, |c| c.model)
+}
+
+/// The scored candidates within one standard error of `best` (it among them); none when
+/// `best` is not a candidate.
+fn tied_with(candidates: &[Candidate], best: ModelKind) -> Vec<&Candidate> {
     let Some(top) = candidates.iter().find(|c| c.model == best) else {
-        return best;
+        return Vec::new();
     };
     candidates
         .iter()
         .filter(|c| c.cv_mean_de00.is_ok() && within_one_se(c, top))
-        .min_by_key(|c| complexity(c.model))
-        .map_or(best, |c| c.model)
+        .collect()
 }
 
 /// Whether `c`'s held-out errors exceed `top`'s by less than one standard error of their
@@ -369,13 +378,7 @@ fn within_one_se(c: &Candidate, top: &Candidate) -> bool {
 /// best (within one standard error), those whose miss of the measured white is within
 /// `noise` of the smallest miss, and of those the simplest.
 fn holding_white_within_one_se(candidates: &[Candidate], best: ModelKind, noise: f64) -> ModelKind {
-    let Some(top) = candidates.iter().find(|c| c.model == best) else {
-        return best;
-    };
-    let tied: Vec<&Candidate> = candidates
-        .iter()
-        .filter(|c| c.cv_mean_de00.is_ok() && within_one_se(c, top))
-        .collect();
+    let tied = tied_with(candidates, best);
     let miss = |c: &Candidate| c.white_de00.unwrap_or(f64::INFINITY);
     let least = tied.iter().map(|c| miss(c)).fold(f64::INFINITY, f64::min);
     tied.iter()

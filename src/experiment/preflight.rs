@@ -10,20 +10,13 @@ use super::options::{BoxSource, ExperimentOptions};
 use super::readings::read_readings;
 use super::stage::Stage;
 use crate::boxmeasure::BoxPlan;
-use crate::display::gamut::GamutMapping;
 use crate::render::Scene;
 
 /// Every check, in the order a user would fix them.
 pub fn check(opts: &ExperimentOptions) -> Result<(), ExperimentError> {
     // An option the reproduction stage reads, which would otherwise fail only after the
     // box, the simulation and the display have been measured.
-    opts.reproduction
-        .gamut
-        .parse::<GamutMapping>()
-        .map_err(|e: String| ExperimentError::Option {
-            what: "gamut mapping",
-            message: e,
-        })?;
+    opts.reproduction.mapping()?;
     given_files_outside_stages(opts)?;
     match &opts.box_source {
         BoxSource::Measure(m) => measured_box(m),

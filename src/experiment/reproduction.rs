@@ -27,6 +27,18 @@ pub struct ReproductionOptions {
     pub mirror: bool,
 }
 
+impl ReproductionOptions {
+    /// The gamut mapping `gamut` names.
+    pub fn mapping(&self) -> Result<GamutMapping, ExperimentError> {
+        self.gamut
+            .parse()
+            .map_err(|e: String| ExperimentError::Option {
+                what: "gamut mapping",
+                message: e,
+            })
+    }
+}
+
 /// One patch's drive values.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PatchDrive {
@@ -80,13 +92,7 @@ pub fn reproduce(
     image: Option<(&Path, &[ImagePatch])>,
     opts: &ReproductionOptions,
 ) -> Result<(Reproduction, Vec<&'static str>), ExperimentError> {
-    let mapping: GamutMapping =
-        opts.gamut
-            .parse()
-            .map_err(|e: String| ExperimentError::Option {
-                what: "gamut mapping",
-                message: e,
-            })?;
+    let mapping = opts.mapping()?;
     let targets: Vec<[f64; 3]> = spots.iter().map(|s| s.xyz).collect();
     let drives = reproduce_targets(profile, &targets, mapping);
     let patches: Vec<PatchDrive> = spots
