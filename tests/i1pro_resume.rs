@@ -10,9 +10,9 @@ use std::sync::Arc;
 use metamer::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome, Stage};
 use metamer::output::OutputPolicy;
 use metamer::rig::scenario::Scenario;
-use metamer::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
+use metamer::rig::sim_scene_box::{BoxOperator, TruthBox};
 use metamer::session::{NoProgress, RunEnd, RunOptions};
-use metamer_drivers::{open_instrument, SharedWorld, View};
+use metamer_drivers::{SharedWorld, Spec, View};
 
 const SEED: u64 = 3;
 const SPECTRAL: &str = "sim:i1pro?time_scale=0";
@@ -36,8 +36,14 @@ fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
     let plan = plan();
     let truth = TruthBox::new(&plan, SEED, Scenario::default()).unwrap();
     let world = Arc::new(SharedWorld::new(View::Capped));
-    let mut spectral = open_instrument(&seeded(SPECTRAL, SEED), Some(world.clone())).unwrap();
-    let mut spot = open_instrument(&seeded(SPOT, SEED + 1), Some(world.clone())).unwrap();
+    let mut spectral = Spec::new(SPECTRAL)
+        .with_seed_unless_set(SEED)
+        .open(Some(world.clone()))
+        .unwrap();
+    let mut spot = Spec::new(SPOT)
+        .with_seed_unless_set(SEED + 1)
+        .open(Some(world.clone()))
+        .unwrap();
     let mut operator = BoxOperator::new(truth, world);
     let options = Options {
         dir: dir.to_path_buf(),

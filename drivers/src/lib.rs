@@ -3,7 +3,7 @@
 //! A driver is generic over its link (serial, USB, HID), and every link has a real backend,
 //! a replay backend that feeds recorded transcripts through the same driver code byte for
 //! byte, a record backend, and in-process pairs for emulated devices. Above the drivers sits
-//! one [`Instrument`] trait. Devices are chosen by one string (see [`open_instrument`]);
+//! one [`Instrument`] trait. Devices are chosen by one string, read by [`Spec`];
 //! the models and how each is opened are rows of the [`registry`].
 
 pub mod cs100a;
@@ -19,7 +19,7 @@ mod open;
 mod permissions;
 pub mod registry;
 pub mod simulated;
-mod spec;
+pub mod spec;
 pub mod world;
 
 pub use cs100a::Cs100aError;
@@ -32,5 +32,7 @@ pub use instrument::{
 };
 pub use open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
 pub use permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};
-pub use spec::{check_spec, is_physical, open_instrument, open_instrument_with, MAX_TIME_SCALE};
+pub use spec::{
+    check_spec, is_physical, open_instrument, open_instrument_with, Spec, MAX_TIME_SCALE,
+};
 pub use world::{Light, SharedWorld, View, World, DEFAULT_STIMULUS_XYZ};

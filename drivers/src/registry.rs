@@ -154,8 +154,7 @@ pub const MODELS: &[Model] = &[
 ];
 
 /// Spec words that are not model prefixes.
-pub const REPLAY_PREFIX: &str = "replay";
-pub const SIM_PREFIX: &str = "sim";
+pub use crate::spec::words::{REPLAY_PREFIX, SIM_PREFIX};
 
 /// The model with this stable name.
 pub fn by_name(name: &str) -> Option<&'static Model> {
@@ -186,7 +185,7 @@ pub fn simulated_specs() -> Vec<String> {
     MODELS
         .iter()
         .filter(|m| m.sim.is_some())
-        .map(|m| format!("{SIM_PREFIX}:{}", m.name))
+        .map(|m| crate::spec::words::sim_connection(m.name))
         .collect()
 }
 
@@ -221,7 +220,7 @@ pub fn real_specs() -> Vec<String> {
 pub fn spec_forms() -> String {
     let mut forms = real_specs();
     if !replayable().is_empty() {
-        forms.push(format!("{REPLAY_PREFIX}:FILE.jsonl"));
+        forms.push(crate::spec::words::replay_connection("FILE.jsonl"));
     }
     forms.extend(simulated_specs());
     match forms.split_last() {

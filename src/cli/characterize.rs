@@ -17,7 +17,7 @@ use metamer::session::{
     attendance, on_ctrl_c, refuse_existing, Attendance, BarProgress, JournalError, RunEnd,
     RunOptions, SessionError,
 };
-use metamer_drivers::{open_instrument, DriverError, Speed};
+use metamer_drivers::{DriverError, Spec, Speed};
 
 use super::{CliError, CliResult};
 
@@ -113,14 +113,14 @@ pub fn run(args: Args) -> CliResult {
     for warning in display.warnings() {
         eprintln!("warning: {warning}");
     }
-    let mut instrument =
-        open_instrument(&args.instrument, display.stimulus()).map_err(|e| match e {
-            DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {
-                CliError::Usage(e.to_string())
-            }
-            e => CliError::from(e),
-        })?;
-    if display.stimulus().is_none() && args.instrument.starts_with("sim:") {
+    let meter = Spec::new(args.instrument.as_str());
+    let mut instrument = meter.open(display.stimulus()).map_err(|e| match e {
+        DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {
+            CliError::Usage(e.to_string())
+        }
+        e => CliError::from(e),
+    })?;
+    if display.stimulus().is_none() && meter.is_simulated() {
         eprintln!(
             "warning: a simulated instrument cannot see a real screen; it measures its own fixed light"
         );

@@ -15,6 +15,7 @@ use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, St
 use metamer::render::scene::Scene;
 use metamer::session::{on_ctrl_c, RunOptions};
 use metamer::validation::export::HTML_FILE;
+use metamer_drivers::Spec;
 
 use super::{CliError, CliResult};
 
@@ -132,11 +133,12 @@ pub fn run_cli(args: Args) -> CliResult {
         box_source: match (args.box_scene, args.box_spots, args.spectral) {
             (Some(scene), Some(spots), _) => BoxSource::Existing { scene, spots },
             (_, _, Some(spectral)) => {
-                let simulated = spectral.starts_with("sim:") && args.spot.starts_with("sim:");
+                let (spectral, spot) = (Spec::new(spectral), Spec::new(args.spot.as_str()));
+                let simulated = spectral.is_simulated() && spot.is_simulated();
                 let light = super::measure_box::box_light(args.scenario.as_deref(), simulated)?;
                 BoxSource::Measure(BoxMeasure {
                     spectral,
-                    spot: args.spot.clone(),
+                    spot,
                     plan: args.plan,
                     repeats: args.box_repeats,
                     seed: args.seed,
@@ -164,7 +166,7 @@ pub fn run_cli(args: Args) -> CliResult {
         },
         display: DisplayOptions {
             screen: args.display,
-            spot: args.spot.clone(),
+            spot: Spec::new(args.spot.as_str()),
             model,
         },
         reproduction: ReproductionOptions {
@@ -182,8 +184,12 @@ pub fn run_cli(args: Args) -> CliResult {
     };
     // Before any stage runs: a real rig with nobody to ask is refused.
     let specs: Vec<&str> = match &opts.box_source {
-        BoxSource::Measure(m) => vec![&m.spectral, &m.spot, &opts.display.spot],
-        BoxSource::Existing { .. } => vec![&opts.display.spot],
+        BoxSource::Measure(m) => vec![
+            m.spectral.as_str(),
+            m.spot.as_str(),
+            opts.display.spot.as_str(),
+        ],
+        BoxSource::Existing { .. } => vec![opts.display.spot.as_str()],
     };
     metamer::session::attendance(&specs, args.unattended)
         .map_err(super::measure_box::nobody_at_the_rig)?;

@@ -10,13 +10,13 @@ use metamer::boxmeasure::{
     Summary,
 };
 use metamer::output::OutputPolicy;
-use metamer::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
+use metamer::rig::sim_scene_box::{BoxOperator, TruthBox};
 use metamer::rig::Scenario;
 use metamer::session::{
     attendance, on_ctrl_c, Attendance, BarProgress, JournalError, NobodyAtTheRig, Operator, RunEnd,
     RunOptions, SessionError,
 };
-use metamer_drivers::{open_instrument, DriverError, Instrument, SharedWorld, View, World};
+use metamer_drivers::{DriverError, Instrument, SharedWorld, Spec, View, World};
 
 use super::{CliError, CliResult};
 
@@ -70,8 +70,8 @@ fn usage(e: impl std::fmt::Display) -> CliError {
 }
 
 /// A simulated instrument's spec with the session's seed unless it names its own.
-fn open(spec: &str, world: Option<Arc<dyn World>>) -> Result<Box<dyn Instrument>, CliError> {
-    open_instrument(spec, world).map_err(|e| match e {
+fn open(spec: &Spec, world: Option<Arc<dyn World>>) -> Result<Box<dyn Instrument>, CliError> {
+    spec.open(world).map_err(|e| match e {
         DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => usage(e),
         e => CliError::from(e),
     })
@@ -112,7 +112,8 @@ pub fn run(args: Args) -> CliResult {
         .map(str::parse)
         .transpose()
         .map_err(usage)?;
-    let simulated = [&args.spectral, &args.spot].map(|s| s.starts_with("sim:"));
+    let specs = [&args.spectral, &args.spot].map(Spec::new);
+    let simulated = specs.each_ref().map(Spec::is_simulated);
     if simulated[0] != simulated[1] {
         return Err(usage(
             "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
@@ -130,17 +131,20 @@ pub fn run(args: Args) -> CliResult {
         eprintln!("simulating the box (seed {}, lit by {light})…", args.seed);
         let truth = TruthBox::new(&plan, args.seed, light)?;
         let world = Arc::new(SharedWorld::new(View::Capped));
-        let spectral = open(&seeded(&args.spectral, args.seed), Some(world.clone()))?;
+        let spectral = open(
+            &specs[0].with_seed_unless_set(args.seed),
+            Some(world.clone()),
+        )?;
         let spot = open(
-            &seeded(&args.spot, args.seed.wrapping_add(1)),
+            &specs[1].with_seed_unless_set(args.seed.wrapping_add(1)),
             Some(world.clone()),
         )?;
         let operator = BoxOperator::new(truth, world);
         (spectral, spot, Box::new(operator))
     } else {
         (
-            open(&args.spectral, None)?,
-            open(&args.spot, None)?,
+            open(&specs[0], None)?,
+            open(&specs[1], None)?,
             attended.operator(),
         )
     };

@@ -2,7 +2,7 @@
 //! instrument's calibrations negotiated at the terminal.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use metamer::output::OutputPolicy;
 use std::sync::Arc;
@@ -13,8 +13,7 @@ use metamer::session::attendance;
 use metamer::spot::{read, spectra_csv, SimulatedHands, SpotError};
 use metamer_drivers::i1pro::emulator::default_light;
 use metamer_drivers::{
-    open_instrument_with, DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Speed, View,
-    World,
+    DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Spec, Speed, View, World,
 };
 
 use super::{CliError, CliResult};
@@ -87,9 +86,10 @@ pub fn run(args: Args) -> CliResult {
             )));
         }
     }
+    let spec = Spec::new(args.instrument.as_str());
     let mut spectrum_out = OutputPolicy::new(args.force);
-    if let Some(replayed) = args.instrument.strip_prefix("replay:") {
-        spectrum_out.input(Path::new(replayed));
+    if let Some(replayed) = spec.replay_file() {
+        spectrum_out.input(replayed);
     }
     if let Some(record) = &args.record {
         spectrum_out.input(record);
@@ -106,16 +106,15 @@ pub fn run(args: Args) -> CliResult {
         ModeArg::Reflective => MeasureMode::Reflective,
         ModeArg::Ambient => MeasureMode::Ambient,
     };
-    let hands = args
-        .instrument
-        .starts_with("sim:")
+    let hands = spec
+        .is_simulated()
         .then(|| simulated_target(mode))
         .transpose()?;
     let options = OpenOptions {
         stimulus: hands.as_ref().map(|h| h.world.clone() as Arc<dyn World>),
         record: args.record.clone(),
     };
-    let mut instrument = open_instrument_with(&args.instrument, &options).map_err(|e| match e {
+    let mut instrument = spec.open_with(&options).map_err(|e| match e {
         DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {
             CliError::Usage(e.to_string())
         }

@@ -15,7 +15,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use metamer_drivers::{open_instrument, Request, SharedWorld};
+use metamer_drivers::{Request, SharedWorld, Spec};
 use serde::Serialize;
 
 use super::characterize::plan::random_patches;
@@ -183,8 +183,7 @@ pub fn run_budget_study(
         let white = Xyz::from_array(panel.xyz([255; 3]));
         let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
         let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
-        let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
-        let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
+        let mut meter = cs100a_at_once(seed).open(Some(stimulus.clone()))?;
         let mut study = Study {
             panel: &panel,
             white,
@@ -269,8 +268,7 @@ pub fn run_mixture_study(
         let panel = VirtualPanel::preset(preset);
         let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
         let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
-        let spec = format!("sim:cs100a?time_scale=0&seed={seed}");
-        let mut meter = open_instrument(&spec, Some(stimulus.clone()))?;
+        let mut meter = cs100a_at_once(seed).open(Some(stimulus.clone()))?;
         let mut study = Study {
             panel: &panel,
             white: Xyz::from_array(panel.xyz([255; 3])),
@@ -451,6 +449,13 @@ pub fn write_budget(
         out.write(&file, svg.as_bytes())?;
     }
     Ok(())
+}
+
+/// The simulated CS-100A at no delay, its noise drawn from `seed`.
+fn cs100a_at_once(seed: u64) -> Spec {
+    Spec::simulated("cs100a")
+        .with_option("time_scale", 0)
+        .with_option("seed", seed)
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use metamer_drivers::{open_instrument, Instrument, SharedWorld, View};
+use metamer_drivers::{Instrument, SharedWorld, Spec, View};
 use serde::Serialize;
 
 use super::error::ExperimentError;
@@ -14,7 +14,7 @@ use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
 use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome};
 use crate::output::OutputPolicy;
-use crate::rig::sim_scene_box::{seeded, BoxOperator, TruthBox};
+use crate::rig::sim_scene_box::{BoxOperator, TruthBox};
 use crate::rig::Scenario;
 use crate::session::repeats::Repeatability;
 use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator, Unattended};
@@ -23,8 +23,8 @@ use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator, Unatt
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BoxMeasure {
     /// The spectral instrument (tiles, materials) and the spot meter (fall-off, spots).
-    pub spectral: String,
-    pub spot: String,
+    pub spectral: Spec,
+    pub spot: Spec,
     /// A plan file; None: the paper's plan.
     pub plan: Option<PathBuf>,
     pub repeats: Option<usize>,
@@ -61,7 +61,7 @@ pub fn measure(
         plan.repeats = n;
     }
     plan.validate().map_err(bad)?;
-    let simulated = [&m.spectral, &m.spot].map(|s| s.starts_with("sim:"));
+    let simulated = [&m.spectral, &m.spot].map(Spec::is_simulated);
     if simulated[0] != simulated[1] {
         return Err(bad(
             "the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
@@ -82,11 +82,14 @@ pub fn measure(
         )));
         let truth = TruthBox::new(&plan, m.seed, light).map_err(bad)?;
         let world = Arc::new(SharedWorld::new(View::Capped));
-        let spectral = open_instrument(&seeded(&m.spectral, m.seed), Some(world.clone()))?;
-        let spot = open_instrument(
-            &seeded(&m.spot, m.seed.wrapping_add(1)),
-            Some(world.clone()),
-        )?;
+        let spectral = m
+            .spectral
+            .with_seed_unless_set(m.seed)
+            .open(Some(world.clone()))?;
+        let spot = m
+            .spot
+            .with_seed_unless_set(m.seed.wrapping_add(1))
+            .open(Some(world.clone()))?;
         (spectral, spot, Box::new(BoxOperator::new(truth, world)))
     } else {
         if let Some(light) = m.light {
@@ -95,8 +98,8 @@ pub fn measure(
             )));
         }
         (
-            open_instrument(&m.spectral, None)?,
-            open_instrument(&m.spot, None)?,
+            m.spectral.open(None)?,
+            m.spot.open(None)?,
             // `--unattended` at a terminal: nobody is there to press Enter.
             if unattended {
                 Box::new(Unattended)
@@ -118,8 +121,8 @@ pub fn measure(
         resume,
         rig_options,
         details: BoxDetails {
-            spectral: m.spectral.clone(),
-            spot: m.spot.clone(),
+            spectral: m.spectral.to_string(),
+            spot: m.spot.to_string(),
         },
         run: run.clone(),
     };
@@ -202,9 +205,9 @@ mod tests {
             "/protocols/cs100a/transcripts/normal_session.jsonl"
         );
         std::fs::copy(transcript, &file).unwrap();
-        let spec = format!("replay:{}", file.display());
-        assert!(Repeatability::emissive_of(&spec).is_none());
-        let meter = open_instrument(&spec, None).unwrap();
+        let spec = Spec::replay(&file);
+        assert!(Repeatability::emissive_of(spec.as_str()).is_none());
+        let meter = spec.open(None).unwrap();
         let stated = Repeatability::emissive_of(&meter.info().model).unwrap();
         let cs100a = Repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
         assert_eq!(stated, cs100a);

@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use metamer_drivers::{open_instrument, Instrument};
+use metamer_drivers::{Instrument, Spec};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -24,7 +24,7 @@ pub struct DisplayOptions {
     /// `window:N` or `virtual:PRESET`.
     pub screen: String,
     /// The spot meter, as named on the command line.
-    pub spot: String,
+    pub spot: Spec,
     pub model: ModelKind,
 }
 
@@ -95,14 +95,17 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
 }
 
 /// The spot meter aimed at `screen` (a simulated meter sees a simulated screen).
-pub fn open_meter(spec: &str, screen: &dyn Screen) -> Result<Box<dyn Instrument>, ExperimentError> {
-    if spec.starts_with("sim:") && screen.stimulus().is_none() {
+pub fn open_meter(
+    spec: &Spec,
+    screen: &dyn Screen,
+) -> Result<Box<dyn Instrument>, ExperimentError> {
+    if spec.is_simulated() && screen.stimulus().is_none() {
         return Err(ExperimentError::SimulatedMeterOnRealScreen {
             meter: spec.to_string(),
             screen: screen.spec(),
         });
     }
-    Ok(open_instrument(spec, screen.stimulus())?)
+    Ok(spec.open(screen.stimulus())?)
 }
 
 /// The factor by which the display's white must at least be raised so that `target` fits:
@@ -177,7 +180,7 @@ pub fn characterize_display(
             ..defaults
         },
         model: opts.model,
-        instrument: opts.spot.clone(),
+        instrument: opts.spot.to_string(),
         settle: virtual_white_cd_m2.map(|_| Duration::ZERO),
         resume,
         // The stage directory is the experiment's own: a re-run replaces its profile.

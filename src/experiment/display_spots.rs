@@ -13,7 +13,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use metamer_drivers::MeasureMode;
+use metamer_drivers::{MeasureMode, Spec};
 use serde::{Deserialize, Serialize};
 
 use super::display::{open_meter, open_screen, DisplaySetting};
@@ -185,7 +185,7 @@ pub struct ShownImage<'a> {
 pub struct SpotSession<'a> {
     pub setting: &'a DisplaySetting,
     /// The spot meter as named by the user.
-    pub spot_spec: &'a str,
+    pub spot_spec: &'a Spec,
     pub drives: &'a [PatchDrive],
     /// None: each patch's colour full-screen.
     pub image: Option<ShownImage<'a>>,

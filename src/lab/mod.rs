@@ -12,6 +12,7 @@ pub use error::LabError;
 
 use std::path::{Path, PathBuf};
 
+use metamer_drivers::Spec;
 use serde::Serialize;
 
 use crate::boxmeasure::BoxPlan;
@@ -79,10 +80,10 @@ const MAX_RENDER_SECONDS: f64 = 600.0;
 
 impl LabOptions {
     /// The simulated instrument `model` at this run's pace, with `seed` when given.
-    fn instrument(&self, model: &str, seed: Option<u64>) -> String {
-        let spec = format!("sim:{model}?time_scale={}", self.time_scale);
+    fn instrument(&self, model: &str, seed: Option<u64>) -> Spec {
+        let spec = Spec::simulated(model).with_option("time_scale", self.time_scale);
         match seed {
-            Some(s) => format!("{spec}&seed={s}"),
+            Some(s) => spec.with_option("seed", s),
             None => spec,
         }
     }

@@ -282,15 +282,3 @@ impl Operator for BoxOperator {
         Ok(Answer::Confirmed)
     }
 }
-
-/// `spec` with `seed=` added unless it names one: the simulated box and its instruments
-/// draw their noise from seeds derived from the session's.
-pub fn seeded(spec: &str, seed: u64) -> String {
-    if spec.contains("seed=") {
-        spec.to_string()
-    } else if spec.contains('?') {
-        format!("{spec}&seed={seed}")
-    } else {
-        format!("{spec}?seed={seed}")
-    }
-}

@@ -13,6 +13,7 @@ use crate::link::serial::PortLink;
 use crate::link::{LineSettings, SerialLink};
 use crate::open::{OpenOptions, SimSettings};
 use crate::simulated::Simulated;
+use crate::spec::words::sim_connection;
 use crate::world::{SharedWorld, DEFAULT_STIMULUS_XYZ};
 use crate::DriverError;
 
@@ -43,7 +44,7 @@ pub fn sim(
         time_scale: settings.time_scale,
         noise: settings.noise,
     };
-    let (host, device) = pair(LineSettings::CS100A, "sim:cs100a");
+    let (host, device) = pair(LineSettings::CS100A, &sim_connection(MODEL));
     let emulator = Cs100aEmulator::new(world, config);
     let noise = emulator.noise_cursor();
     emulator.spawn(device);

@@ -17,6 +17,7 @@ use crate::link::usb_real::RusbLink;
 use crate::noise::NoiseCursor;
 use crate::open::{OpenOptions, SimSettings};
 use crate::simulated::Simulated;
+use crate::spec::words::sim_connection;
 use crate::world::{SharedWorld, View, World};
 use crate::DriverError;
 
@@ -57,7 +58,7 @@ pub fn sim(
         ..EmulatorConfig::default()
     };
     for (key, value) in &settings.extra {
-        let bad = |m: String| DriverError::Simulation(format!("sim:{MODEL}: {m}"));
+        let bad = |m: String| DriverError::Simulation(format!("{}: {m}", sim_connection(MODEL)));
         match (key.as_str(), value.as_str()) {
             ("rev", "d") => config.revision = Revision::AToD,
             ("rev", "e") => config.revision = Revision::E,
@@ -99,7 +100,7 @@ fn sim_parts(
 ) -> Result<(Box<dyn Instrument>, NoiseCursor), DriverError> {
     let device = I1ProEmulator::new(world, config).map_err(DriverError::Simulation)?;
     let noise = device.noise_cursor();
-    let (host, _thread) = usb_pair(device, &format!("sim:{MODEL}"));
+    let (host, _thread) = usb_pair(device, &sim_connection(MODEL));
     Ok((connect(host, options, clock, false)?, noise))
 }
 

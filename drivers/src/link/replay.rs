@@ -283,7 +283,7 @@ impl SerialLink for ReplaySerial {
     }
 
     fn describe(&self) -> String {
-        format!("replay:{}", self.t.file)
+        crate::spec::words::replay_connection(&self.t.file)
     }
 }
 

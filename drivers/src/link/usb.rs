@@ -204,7 +204,7 @@ impl UsbLink for ReplayUsb {
     }
 
     fn describe(&self) -> String {
-        format!("replay:{}", self.t.file)
+        crate::spec::words::replay_connection(&self.t.file)
     }
 }
 
@@ -235,7 +235,7 @@ impl HidLink for ReplayUsb {
     }
 
     fn describe(&self) -> String {
-        format!("replay:{}", self.t.file)
+        crate::spec::words::replay_connection(&self.t.file)
     }
 }
 
