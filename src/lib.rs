@@ -12,7 +12,6 @@ pub mod color;
 pub mod digest;
 pub mod display;
 pub mod experiment;
-pub mod lab;
 pub mod light;
 pub mod numeric_csv;
 pub mod output;

@@ -6,7 +6,7 @@
 //! takes the stages, [`stats`] reduces repeats and flags outliers, [`falloff`] makes the
 //! light's distribution, [`scene`] writes the box as a scene file, [`assemble`] puts the
 //! measured scene and its provenance together, and [`compare`] renders it against the box's
-//! spot readings.
+//! spot readings. [`setup`] opens the rig a session measures with.
 
 pub mod assemble;
 pub mod compare;
@@ -14,6 +14,7 @@ pub mod falloff;
 pub mod plan;
 pub mod run;
 pub mod scene;
+pub mod setup;
 pub mod stats;
 
 pub use assemble::{BoxDetails, Summary};

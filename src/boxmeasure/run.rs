@@ -12,8 +12,8 @@ use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary
 use super::plan::{BoxPlan, BoxStep, Stage, SPECTRAL, SPOT};
 use crate::output::OutputPolicy;
 use crate::session::{
-    placements, Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd, RunOptions, Session,
-    SessionError, StageOf,
+    placements, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig, RunEnd,
+    RunOptions, Session, SessionError, StageOf,
 };
 
 /// What to measure and how.
@@ -76,6 +76,79 @@ pub enum MeasureBoxError {
     },
     #[error(transparent)]
     Assemble(#[from] AssembleError),
+}
+
+impl MeasureBoxError {
+    /// What to do next, said with `measure-box`'s flags, where the session engine's own
+    /// message cannot say it: a journal of an earlier session, one written with other
+    /// options, or a reading that failed midway (the others are safe in the journal).
+    pub fn advice(&self) -> Option<String> {
+        let MeasureBoxError::Session { stage, source } = self else {
+            return None;
+        };
+        match source {
+            SessionError::Journal(JournalError::Exists { path, entries }) => Some(format!(
+                "stage {stage}: {} exists with {entries} reading(s) of an earlier session: continue it with --resume, measure the stage again with --stage {stage}, or choose another output directory",
+                path.display()
+            )),
+            SessionError::Journal(JournalError::OptionDiffers {
+                path,
+                option,
+                logged,
+                now,
+            }) => Some(format!(
+                "stage {stage}: {} was written by another session: its {option} is {logged}, this one's is {now}; run with the same --plan/--repeats/--seed and --resume, or choose another output directory",
+                path.display()
+            )),
+            SessionError::Step {
+                index,
+                total,
+                label,
+                prepare,
+                done,
+                journal,
+                source,
+            } => Some(format!(
+                "stage {stage}, reading {} of {total} ({label}: {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+                index + 1,
+                journal.display()
+            )),
+            _ => None,
+        }
+    }
+}
+
+impl Outcome {
+    /// What is still to measure, said with `measure-box`'s flags; None when finished.
+    pub fn left_to_do(&self) -> Option<String> {
+        match self {
+            Outcome::Finished(_) => None,
+            Outcome::StagesMissing(stages) => {
+                let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
+                Some(format!(
+                    "stage(s) {} still to measure before the scene can be assembled (--stage NAME, or the whole session with --resume)",
+                    names.join(", ")
+                ))
+            }
+            Outcome::Incomplete {
+                stage,
+                done,
+                total,
+                log,
+                ..
+            } => Some(if *done == 0 {
+                format!(
+                    "stage {stage}: none of its {total} readings taken yet: continue with --resume"
+                )
+            } else {
+                format!(
+                    "stage {stage}: {} of {total} readings still to take; the others are safe in {}: continue with --resume",
+                    total - done,
+                    log.display()
+                )
+            }),
+        }
+    }
 }
 
 /// Moves an earlier journal of a stage to be measured again out of the way, to

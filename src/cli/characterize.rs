@@ -94,8 +94,8 @@ pub fn run(args: Args) -> CliResult {
         eprintln!("note: {advice}");
     }
     // Before anything is opened: a real meter with nobody to aim it is refused.
-    let attended = attendance(&[&args.instrument], args.unattended)
-        .map_err(super::measure_box::nobody_at_the_rig)?;
+    let attended =
+        attendance(&[&args.instrument], args.unattended).map_err(super::rig::nobody_at_the_rig)?;
     if !args.resume {
         // Before a full-screen window or an instrument is opened for nothing.
         refuse_existing(&log_path(&args.out))

@@ -135,7 +135,7 @@ pub fn run_cli(args: Args) -> CliResult {
             (_, _, Some(spectral)) => {
                 let (spectral, spot) = (Spec::new(spectral), Spec::new(args.spot.as_str()));
                 let simulated = spectral.is_simulated() && spot.is_simulated();
-                let light = super::measure_box::box_light(args.scenario.as_deref(), simulated)?;
+                let light = super::rig::box_light(args.scenario.as_deref(), simulated)?;
                 BoxSource::Measure(BoxMeasure {
                     spectral,
                     spot,
@@ -191,8 +191,7 @@ pub fn run_cli(args: Args) -> CliResult {
         ],
         BoxSource::Existing { .. } => vec![opts.display.spot.as_str()],
     };
-    metamer::session::attendance(&specs, args.unattended)
-        .map_err(super::measure_box::nobody_at_the_rig)?;
+    metamer::session::attendance(&specs, args.unattended).map_err(super::rig::nobody_at_the_rig)?;
     let shown = StageProgress::default();
     let outcomes = run(&opts, &|p| shown.show(p));
     shown.finish();

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
-use metamer::lab::{run_lab, LabOptions, LabSummary, LAB_FILE};
+use metamer::experiment::lab::{run_lab, LabOptions, LabSummary, LAB_FILE};
 use metamer::rig::{Preset, Scenario};
 use metamer::session::{on_ctrl_c, RunOptions};
 

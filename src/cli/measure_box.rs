@@ -1,23 +1,17 @@
 //! `metamer measure-box`: the guided, resumable measurement of the validation box.
 
-use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
-use std::sync::Arc;
 
+use metamer::boxmeasure::setup::{self, BoxRig, RigRequest};
 use metamer::boxmeasure::{
-    self, BoxDetails, BoxPlan, Instruments, MeasureBoxError, Options, Outcome, PlanError, Stage,
-    Summary,
+    self, BoxDetails, BoxPlan, Instruments, Options, Outcome, PlanError, Stage, Summary,
 };
 use metamer::output::OutputPolicy;
-use metamer::rig::sim_scene_box::{BoxOperator, TruthBox};
-use metamer::rig::Scenario;
-use metamer::session::{
-    attendance, on_ctrl_c, Attendance, BarProgress, JournalError, NobodyAtTheRig, Operator, RunEnd,
-    RunOptions, SessionError,
-};
-use metamer_drivers::{DriverError, Instrument, SharedWorld, Spec, View, World};
+use metamer::session::{attendance, on_ctrl_c, Attendance, BarProgress, RunEnd, RunOptions};
+use metamer_drivers::Spec;
 
+use super::rig::{box_light, nobody_at_the_rig};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -69,38 +63,9 @@ fn usage(e: impl std::fmt::Display) -> CliError {
     CliError::Usage(e.to_string())
 }
 
-/// A simulated instrument's spec with the session's seed unless it names its own.
-fn open(spec: &Spec, world: Option<Arc<dyn World>>) -> Result<Box<dyn Instrument>, CliError> {
-    spec.open(world).map_err(|e| match e {
-        DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => usage(e),
-        e => CliError::from(e),
-    })
-}
-
-/// The simulated box's light named by `--scenario`; refused with real instruments, whose
-/// box is lit by whatever light it has.
-pub(super) fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, CliError> {
-    match (name, simulated) {
-        (None, _) => Ok(None),
-        (Some(n), true) => n.parse().map(Some).map_err(usage),
-        (Some(_), false) => Err(usage(
-            "--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light",
-        )),
-    }
-}
-
 pub fn run(args: Args) -> CliResult {
-    let mut plan = match &args.plan {
-        Some(p) => BoxPlan::load(p).map_err(|e| match e {
-            PlanError::Io { .. } => CliError::from(e),
-            e => usage(e),
-        })?,
-        None => BoxPlan::default(),
-    };
-    if let Some(n) = args.repeats {
-        plan.repeats = n;
-    }
-    plan.validate().map_err(|e| match e {
+    let plan = setup::load_plan(args.plan.as_deref(), args.repeats).map_err(|e| match e {
+        PlanError::Io { .. } => CliError::from(e),
         PlanError::Invalid { field, message } if field == "repeats" => {
             usage(format!("--repeats {message}"))
         }
@@ -112,42 +77,8 @@ pub fn run(args: Args) -> CliResult {
         .map(str::parse)
         .transpose()
         .map_err(usage)?;
-    let specs = [&args.spectral, &args.spot].map(Spec::new);
-    let simulated = specs.each_ref().map(Spec::is_simulated);
-    if simulated[0] != simulated[1] {
-        return Err(usage(
-            "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
-        ));
-    }
-    let light = box_light(args.scenario.as_deref(), simulated[0])?;
-    // Before anything is opened: a real rig with nobody to ask is refused.
-    let attended =
-        attendance(&[&args.spectral, &args.spot], args.unattended).map_err(nobody_at_the_rig)?;
-    let mut rig_options = BTreeMap::new();
-    let (mut spectral, mut spot, mut operator): (_, _, Box<dyn Operator>) = if simulated[0] {
-        let light = light.unwrap_or_default();
-        rig_options.insert("seed".to_string(), args.seed.to_string());
-        rig_options.insert("light".to_string(), light.name().to_string());
-        eprintln!("simulating the box (seed {}, lit by {light})…", args.seed);
-        let truth = TruthBox::new(&plan, args.seed, light)?;
-        let world = Arc::new(SharedWorld::new(View::Capped));
-        let spectral = open(
-            &specs[0].with_seed_unless_set(args.seed),
-            Some(world.clone()),
-        )?;
-        let spot = open(
-            &specs[1].with_seed_unless_set(args.seed.wrapping_add(1)),
-            Some(world.clone()),
-        )?;
-        let operator = BoxOperator::new(truth, world);
-        (spectral, spot, Box::new(operator))
-    } else {
-        (
-            open(&specs[0], None)?,
-            open(&specs[1], None)?,
-            attended.operator(),
-        )
-    };
+    let (mut rig, attended) = open_rig(&args, &plan)?;
+    let shown_at_terminal = !rig.simulated && attended == Attendance::Terminal;
     let mut output = OutputPolicy::new(args.force);
     if let Some(p) = &args.plan {
         output.input(p);
@@ -158,7 +89,7 @@ pub fn run(args: Args) -> CliResult {
         plan,
         stage,
         resume: args.resume,
-        rig_options,
+        rig_options: std::mem::take(&mut rig.rig_options),
         details: BoxDetails {
             spectral: args.spectral.clone(),
             spot: args.spot.clone(),
@@ -171,112 +102,76 @@ pub fn run(args: Args) -> CliResult {
     let outcome = boxmeasure::run(
         &options,
         Instruments {
-            spectral: spectral.as_mut(),
-            spot: spot.as_mut(),
+            spectral: rig.spectral.as_mut(),
+            spot: rig.spot.as_mut(),
         },
-        operator.as_mut(),
-        &mut BarProgress::new("reading")
-            .attended(!simulated[0] && attended == Attendance::Terminal),
+        rig.operator.as_mut(),
+        &mut BarProgress::new("reading").attended(shown_at_terminal),
     )
-    .map_err(translate)?;
-    match outcome {
-        Outcome::Finished(summary) => print_summary(&summary),
-        Outcome::StagesMissing(stages) => {
-            let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
-            println!(
-                "stage(s) {} still to measure before the scene can be assembled (--stage NAME, or the whole session with --resume)",
-                names.join(", ")
-            );
-            Ok(())
-        }
-        Outcome::Incomplete {
-            stage,
-            end,
-            done,
-            total,
-            log,
-        } => {
-            let missing = total - done;
-            let log = log.display();
-            let text = if done == 0 {
-                format!(
-                    "stage {stage}: none of its {total} readings taken yet: continue with --resume"
-                )
-            } else {
-                format!(
-                    "stage {stage}: {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
-                )
-            };
-            match end {
-                RunEnd::Stopped { .. } | RunEnd::Complete => {
-                    println!("stopped: {text}");
-                    Ok(())
-                }
-                RunEnd::Interrupted { .. } => {
-                    Err(CliError::Failed(format!("interrupted: {text}").into()))
-                }
-                RunEnd::Aborted { .. } => {
-                    println!("stopped at your request: {text}");
-                    Ok(())
-                }
-            }
-        }
-    }
-}
-
-/// The library's session errors said with this command's flags.
-fn translate(e: MeasureBoxError) -> CliError {
-    let text = match &e {
-        MeasureBoxError::Session {
-            stage,
-            source: SessionError::Journal(JournalError::Exists { path, entries }),
-        } => Some(format!(
-            "stage {stage}: {} exists with {entries} reading(s) of an earlier session: continue it with --resume, measure the stage again with --stage {stage}, or choose another output directory",
-            path.display()
-        )),
-        MeasureBoxError::Session {
-            stage,
-            source:
-                SessionError::Journal(JournalError::OptionDiffers {
-                    path,
-                    option,
-                    logged,
-                    now,
-                }),
-        } => Some(format!(
-            "stage {stage}: {} was written by another session: its {option} is {logged}, this one's is {now}; run with the same --plan/--repeats/--seed and --resume, or choose another output directory",
-            path.display()
-        )),
-        MeasureBoxError::Session {
-            stage,
-            source:
-                SessionError::Step {
-                    index,
-                    total,
-                    label,
-                    prepare,
-                    done,
-                    journal,
-                    source,
-                },
-        } => Some(format!(
-            "stage {stage}, reading {} of {total} ({label}: {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
-            index + 1,
-            journal.display()
-        )),
-        _ => None,
-    };
-    match text {
+    .map_err(|e| match e.advice() {
         Some(t) => CliError::Failed(t.into()),
         None => CliError::from(e),
-    }
+    })?;
+    report(outcome)
 }
 
-/// A real rig with nobody to ask, refused in the words of the command line.
-pub(super) fn nobody_at_the_rig(e: NobodyAtTheRig) -> CliError {
-    usage(format!(
-        "{e}. Run the command at a terminal, or add --unattended if the rig may measure without anyone at it; nothing was measured"
-    ))
+/// The rig `--spectral` and `--spot` name, opened once the requests that need no
+/// instrument are checked: the two agree, `--scenario` suits them, somebody is there.
+fn open_rig(args: &Args, plan: &BoxPlan) -> Result<(BoxRig, Attendance), CliError> {
+    let (spectral, spot) = (
+        Spec::new(args.spectral.as_str()),
+        Spec::new(args.spot.as_str()),
+    );
+    let simulated = setup::is_simulated(&spectral, &spot).map_err(|_| {
+        usage("--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box")
+    })?;
+    let light = box_light(args.scenario.as_deref(), simulated)?;
+    // Before anything is opened: a real rig with nobody to ask is refused.
+    let attended =
+        attendance(&[&args.spectral, &args.spot], args.unattended).map_err(nobody_at_the_rig)?;
+    let request = RigRequest {
+        plan,
+        spectral: &spectral,
+        spot: &spot,
+        seed: args.seed,
+        light,
+    };
+    let rig =
+        setup::open(&request, || attended.operator(), &|n| eprintln!("{n}…")).map_err(|e| {
+            if e.is_request() {
+                usage(e)
+            } else {
+                CliError::from(e)
+            }
+        })?;
+    Ok((rig, attended))
+}
+
+/// Where the session ended, and what is left to do.
+fn report(outcome: Outcome) -> CliResult {
+    let left = outcome.left_to_do().unwrap_or_default();
+    match outcome {
+        Outcome::Finished(summary) => print_summary(&summary),
+        Outcome::Incomplete {
+            end: RunEnd::Interrupted { .. },
+            ..
+        } => Err(CliError::Failed(format!("interrupted: {left}").into())),
+        Outcome::Incomplete {
+            end: RunEnd::Aborted { .. },
+            ..
+        } => {
+            println!("stopped at your request: {left}");
+            Ok(())
+        }
+        Outcome::Incomplete { .. } => {
+            println!("stopped: {left}");
+            Ok(())
+        }
+        Outcome::StagesMissing(_) => {
+            println!("{left}");
+            Ok(())
+        }
+    }
 }
 
 fn print_summary(s: &Summary) -> CliResult {

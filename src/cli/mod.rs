@@ -16,6 +16,7 @@ mod light;
 mod measure_box;
 mod render;
 mod reproduce;
+mod rig;
 mod simulate;
 mod spot;
 mod validate;

@@ -99,8 +99,8 @@ pub fn run(args: Args) -> CliResult {
         spectrum_out.check(path)?;
     }
     // Before the instrument is opened: a real one with nobody to place it is refused.
-    let attended = attendance(&[&args.instrument], args.unattended)
-        .map_err(super::measure_box::nobody_at_the_rig)?;
+    let attended =
+        attendance(&[&args.instrument], args.unattended).map_err(super::rig::nobody_at_the_rig)?;
     let mode = match args.mode {
         ModeArg::Emissive => MeasureMode::Emissive,
         ModeArg::Reflective => MeasureMode::Reflective,

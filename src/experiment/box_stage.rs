@@ -2,19 +2,17 @@
 //! simulated truth box when both instruments are simulated, on the real box otherwise; its
 //! measured scene and spot readings are what the later stages read.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
-use metamer_drivers::{Instrument, SharedWorld, Spec, View};
+use metamer_drivers::Spec;
 use serde::Serialize;
 
 use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
-use crate::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome};
+use crate::boxmeasure::setup::{self, BoxRig, RigError, RigRequest};
+use crate::boxmeasure::{self, BoxDetails, Instruments, Options, Outcome};
 use crate::output::OutputPolicy;
-use crate::rig::sim_scene_box::{BoxOperator, TruthBox};
 use crate::rig::Scenario;
 use crate::session::repeats::Repeatability;
 use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator, Unattended};
@@ -53,61 +51,32 @@ pub fn measure(
     run: &RunOptions,
     progress: &dyn Fn(Progress),
 ) -> Result<Vec<String>, ExperimentError> {
-    let mut plan = match &m.plan {
-        Some(p) => BoxPlan::load(p).map_err(bad)?,
-        None => BoxPlan::default(),
+    let plan = setup::load_plan(m.plan.as_deref(), m.repeats).map_err(bad)?;
+    let request = RigRequest {
+        plan: &plan,
+        spectral: &m.spectral,
+        spot: &m.spot,
+        seed: m.seed,
+        light: m.light,
     };
-    if let Some(n) = m.repeats {
-        plan.repeats = n;
-    }
-    plan.validate().map_err(bad)?;
-    let simulated = [&m.spectral, &m.spot].map(Spec::is_simulated);
-    if simulated[0] != simulated[1] {
-        return Err(bad(
-            "the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
-        ));
-    }
-    let mut rig_options = BTreeMap::new();
-    let (mut spectral, mut spot, mut operator): (
-        Box<dyn Instrument>,
-        Box<dyn Instrument>,
-        Box<dyn Operator>,
-    ) = if simulated[0] {
-        let light = m.light.unwrap_or_default();
-        rig_options.insert("seed".to_string(), m.seed.to_string());
-        rig_options.insert("light".to_string(), light.name().to_string());
-        progress(Progress::Note(format!(
-            "simulating the box (seed {}, lit by {light})",
-            m.seed
-        )));
-        let truth = TruthBox::new(&plan, m.seed, light).map_err(bad)?;
-        let world = Arc::new(SharedWorld::new(View::Capped));
-        let spectral = m
-            .spectral
-            .with_seed_unless_set(m.seed)
-            .open(Some(world.clone()))?;
-        let spot = m
-            .spot
-            .with_seed_unless_set(m.seed.wrapping_add(1))
-            .open(Some(world.clone()))?;
-        (spectral, spot, Box::new(BoxOperator::new(truth, world)))
-    } else {
-        if let Some(light) = m.light {
-            return Err(bad(format!(
-                "the light '{light}' is the simulated box's; real instruments measure the real box, lit by its own light"
-            )));
+    // `--unattended` at a terminal: nobody is there to press Enter.
+    let operator = || -> Box<dyn Operator> {
+        if unattended {
+            Box::new(Unattended)
+        } else {
+            Box::new(TerminalOperator)
         }
-        (
-            m.spectral.open(None)?,
-            m.spot.open(None)?,
-            // `--unattended` at a terminal: nobody is there to press Enter.
-            if unattended {
-                Box::new(Unattended)
-            } else {
-                Box::new(TerminalOperator)
-            },
-        )
     };
+    let BoxRig {
+        mut spectral,
+        mut spot,
+        mut operator,
+        rig_options,
+        ..
+    } = setup::open(&request, operator, &|n| progress(Progress::Note(n))).map_err(|e| match e {
+        RigError::Open(e) => ExperimentError::from(e),
+        e => bad(e),
+    })?;
     let spot_model = spot.info().model;
     let mut output = OutputPolicy::new(true);
     if let Some(p) = &m.plan {

@@ -6,13 +6,14 @@
 //! Each stage writes into its own directory and records the hashes of what it read and
 //! wrote ([`cache`]); a second run re-uses every stage whose inputs are unchanged and runs
 //! exactly those downstream of a change. Measuring stages are journalled sessions and
-//! resume after any interruption.
+//! resume after any interruption. [`lab`] is the experiment preset for the simulated rig.
 
 pub mod box_stage;
 pub mod cache;
 pub mod display;
 pub mod display_spots;
 mod error;
+pub mod lab;
 mod options;
 mod preflight;
 mod products;
