@@ -119,35 +119,52 @@ impl MeasureBoxError {
 }
 
 impl Outcome {
-    /// What is still to measure, said with `measure-box`'s flags; None when finished.
+    /// Whether the session was interrupted (Ctrl-C, a signal): a failure to the caller,
+    /// though every reading taken is safe.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(
+            self,
+            Outcome::Incomplete {
+                end: RunEnd::Interrupted { .. },
+                ..
+            }
+        )
+    }
+
+    /// What is still to measure and how to continue, said with `measure-box`'s flags;
+    /// None when finished.
     pub fn left_to_do(&self) -> Option<String> {
-        match self {
-            Outcome::Finished(_) => None,
+        let (stage, end, done, total, log) = match self {
+            Outcome::Finished(_) => return None,
             Outcome::StagesMissing(stages) => {
                 let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
-                Some(format!(
+                return Some(format!(
                     "stage(s) {} still to measure before the scene can be assembled (--stage NAME, or the whole session with --resume)",
                     names.join(", ")
-                ))
+                ));
             }
             Outcome::Incomplete {
                 stage,
+                end,
                 done,
                 total,
                 log,
-                ..
-            } => Some(if *done == 0 {
-                format!(
-                    "stage {stage}: none of its {total} readings taken yet: continue with --resume"
-                )
-            } else {
-                format!(
-                    "stage {stage}: {} of {total} readings still to take; the others are safe in {}: continue with --resume",
-                    total - done,
-                    log.display()
-                )
-            }),
-        }
+            } => (stage, end, *done, *total, log),
+        };
+        let text = if done == 0 {
+            format!("stage {stage}: none of its {total} readings taken yet: continue with --resume")
+        } else {
+            format!(
+                "stage {stage}: {} of {total} readings still to take; the others are safe in {}: continue with --resume",
+                total - done,
+                log.display()
+            )
+        };
+        Some(match end {
+            RunEnd::Interrupted { .. } => format!("interrupted: {text}"),
+            RunEnd::Aborted { .. } => format!("stopped at your request: {text}"),
+            RunEnd::Stopped { .. } | RunEnd::Complete => format!("stopped: {text}"),
+        })
     }
 }
 

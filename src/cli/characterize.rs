@@ -14,8 +14,7 @@ use metamer::display::ModelKind;
 use metamer::output::OutputPolicy;
 use metamer::rig::ScreenSpec;
 use metamer::session::{
-    attendance, on_ctrl_c, refuse_existing, Attendance, BarProgress, JournalError, RunEnd,
-    RunOptions, SessionError,
+    attendance, on_ctrl_c, refuse_existing, Attendance, BarProgress, RunOptions, SessionError,
 };
 use metamer_drivers::{DriverError, Spec, Speed};
 
@@ -99,7 +98,7 @@ pub fn run(args: Args) -> CliResult {
     if !args.resume {
         // Before a full-screen window or an instrument is opened for nothing.
         refuse_existing(&log_path(&args.out))
-            .map_err(|e| translate(CharacterizeError::Session(SessionError::Journal(e))))?;
+            .map_err(|e| advised(CharacterizeError::Session(SessionError::Journal(e))))?;
         // Files another session left in the directory (a new directory has none).
         if args.out.is_dir() {
             let out = OutputPolicy::new(args.force);
@@ -152,44 +151,22 @@ pub fn run(args: Args) -> CliResult {
         attended.operator().as_mut(),
         &mut BarProgress::new("patch").attended(attended == Attendance::Terminal),
     )
-    .map_err(translate)?;
-    match outcome {
-        Outcome::Finished(summary) => print_summary(&summary),
-        Outcome::Incomplete {
-            end,
-            done,
-            total,
-            log,
-        } => {
-            let missing = total - done;
-            let log = log.display();
-            match end {
-                RunEnd::Stopped { .. } | RunEnd::Complete => {
-                    println!(
-                        "stopped with {missing} of {total} readings still to take; continue with --resume (log: {log})"
-                    );
-                    Ok(())
-                }
-                RunEnd::Interrupted { .. } => Err(CliError::Failed(
-                    format!(
-                        "interrupted with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
-                    )
-                    .into(),
-                )),
-                RunEnd::Aborted { .. } if done == 0 => {
-                    println!(
-                        "stopped at your request before any of the {total} readings: continue with --resume (log: {log})"
-                    );
-                    Ok(())
-                }
-                RunEnd::Aborted { .. } => {
-                    println!(
-                        "stopped at your request with {missing} of {total} readings still to take; the others are safe in {log}: continue with --resume"
-                    );
-                    Ok(())
-                }
-            }
+    .map_err(advised)?;
+    match (&outcome, outcome.left_to_do()) {
+        (Outcome::Finished(summary), _) => print_summary(summary),
+        (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
+        (_, text) => {
+            println!("{}", text.unwrap_or_default());
+            Ok(())
         }
+    }
+}
+
+/// The library's error with its advice in this command's flags, where it has one.
+fn advised(e: CharacterizeError) -> CliError {
+    match e.advice() {
+        Some(t) => CliError::Failed(t.into()),
+        None => CliError::from(e),
     }
 }
 
@@ -203,82 +180,6 @@ fn plan_usage(e: &PlanError) -> String {
         PlanError::GridSteps(n) => {
             format!("--grid-steps must be 0 (no grid) or between 2 and 64, got {n}")
         }
-    }
-}
-
-/// The library's "resume the session" and option names said as this command's flags.
-fn translate(e: CharacterizeError) -> CliError {
-    let text = match &e {
-        CharacterizeError::Session(SessionError::Journal(j)) => journal_text(j),
-        CharacterizeError::Session(SessionError::InstrumentDiffers {
-            path, logged, now, ..
-        }) => Some(format!(
-            "{} was measured with the instrument {logged}, this session has {now}: resume with the instrument it was started with (--instrument), or choose another output directory",
-            path.display()
-        )),
-        CharacterizeError::Session(SessionError::InstrumentSettingDiffers(d)) => Some(format!(
-            "{} was measured with the {} whose {} was {}, this session's is {}: resume with the settings it was started with, or choose another output directory",
-            d.path.display(),
-            d.model,
-            setting_flag(&d.setting),
-            d.logged,
-            d.now
-        )),
-        CharacterizeError::Session(SessionError::Step {
-            index,
-            total,
-            label,
-            prepare,
-            done,
-            journal,
-            source,
-        }) => Some(format!(
-            "patch {} of {total} ({label}, {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
-            index + 1,
-            journal.display()
-        )),
-        _ => None,
-    };
-    match text {
-        Some(t) => CliError::Failed(t.into()),
-        None => CliError::from(e),
-    }
-}
-
-fn journal_text(e: &JournalError) -> Option<String> {
-    Some(match e {
-        JournalError::Exists { path, entries } => format!(
-            "{} exists with {entries} reading(s) of an earlier session: continue it with --resume, or choose another output directory",
-            path.display()
-        ),
-        JournalError::Broken { path, what } => format!(
-            "{} holds no session to continue: {what}; run with --resume to set it aside (as {}.broken-N, kept) and start afresh",
-            path.display(),
-            path.display()
-        ),
-        JournalError::OptionDiffers {
-            path,
-            option,
-            logged,
-            now,
-        } => format!(
-            "{} was written by another session: its --{} is {logged}, this one's is {now}; run with the options it was started with and --resume, or choose another output directory",
-            path.display(),
-            option.replace('_', "-")
-        ),
-        _ => return None,
-    })
-}
-
-/// An instrument setting as the user gave it: a flag, or an option of the `--instrument`
-/// spec of a simulation.
-fn setting_flag(setting: &str) -> String {
-    match setting {
-        "speed" => "--speed".into(),
-        s => match s.strip_prefix(metamer_drivers::simulated::SIM_OPTION_PREFIX) {
-            Some(sim) => format!("simulation's {sim} (--instrument sim:…?{sim}=)"),
-            None => s.to_string(),
-        },
     }
 }
 

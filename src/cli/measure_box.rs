@@ -8,7 +8,7 @@ use metamer::boxmeasure::{
     self, BoxDetails, BoxPlan, Instruments, Options, Outcome, PlanError, Stage, Summary,
 };
 use metamer::output::OutputPolicy;
-use metamer::session::{attendance, on_ctrl_c, Attendance, BarProgress, RunEnd, RunOptions};
+use metamer::session::{attendance, on_ctrl_c, Attendance, BarProgress, RunOptions};
 use metamer_drivers::Spec;
 
 use super::rig::{box_light, nobody_at_the_rig};
@@ -149,26 +149,11 @@ fn open_rig(args: &Args, plan: &BoxPlan) -> Result<(BoxRig, Attendance), CliErro
 
 /// Where the session ended, and what is left to do.
 fn report(outcome: Outcome) -> CliResult {
-    let left = outcome.left_to_do().unwrap_or_default();
-    match outcome {
-        Outcome::Finished(summary) => print_summary(&summary),
-        Outcome::Incomplete {
-            end: RunEnd::Interrupted { .. },
-            ..
-        } => Err(CliError::Failed(format!("interrupted: {left}").into())),
-        Outcome::Incomplete {
-            end: RunEnd::Aborted { .. },
-            ..
-        } => {
-            println!("stopped at your request: {left}");
-            Ok(())
-        }
-        Outcome::Incomplete { .. } => {
-            println!("stopped: {left}");
-            Ok(())
-        }
-        Outcome::StagesMissing(_) => {
-            println!("{left}");
+    match (&outcome, outcome.left_to_do()) {
+        (Outcome::Finished(summary), _) => print_summary(summary),
+        (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
+        (_, text) => {
+            println!("{}", text.unwrap_or_default());
             Ok(())
         }
     }

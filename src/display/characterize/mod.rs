@@ -2,6 +2,7 @@
 //! the session engine with every reading journalled ([`run`]), average repeats and verify a
 //! fitted display model on held-out colours ([`verify`], [`finish`]).
 
+mod advice;
 pub mod finish;
 pub mod plan;
 pub mod report;
