@@ -43,196 +43,141 @@ impl From<Method> for method::Method {
 #[derive(Subcommand)]
 enum Cmd {
     /// The 24 simulated 1° meter readings, refined to a ΔE*ab confidence target.
-    Spots {
-        /// The scene file (default: the validation box built into the program).
-        scene: Option<PathBuf>,
-        /// Stop when every patch's 95 % half-width of ΔE*ab is below this.
-        #[arg(long, default_value_t = 0.1)]
-        target_de: f64,
-        /// Reference white X,Y,Z (default: a perfect white diffuser in place of patch 19).
-        #[arg(long, value_parser = parse_triple)]
-        white: Option<[f64; 3]>,
-        /// Wall-clock limit (s): the readings so far are reported, marked not converged.
-        #[arg(long, default_value_t = 600.0)]
-        max_seconds: f64,
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
-        /// path: the path tracer; auto: radiosity when the scene qualifies.
-        #[arg(long, value_enum, default_value_t = Method::Auto)]
-        method: Method,
-        #[arg(long)]
-        json: bool,
-    },
+    Spots(SpotsArgs),
     /// The camera's XYZ image (absolute cd/m², float) as .exr or .pfm.
-    Image {
-        /// The scene file (default: the built-in validation box).
-        scene: Option<PathBuf>,
-        /// Samples per pixel (radiosity: a √spp × √spp grid of rays, spp rounded down to a
-        /// square).
-        #[arg(long)]
-        spp: u64,
-        /// path: the path tracer; radiosity: the deterministic solver's reflected radiance
-        /// at every ray's first hit (convex scenes of Lambertian rectangles).
-        #[arg(long, value_enum, default_value_t = Method::Path)]
-        method: Method,
-        /// Radiosity: the finest mesh level (the indirect light is extrapolated from it and
-        /// the level before, as the spot readings are).
-        #[arg(long, default_value_t = 3)]
-        level: usize,
-        /// Output size (default: the scene's, 1014×1014); the field of view is kept.
-        #[arg(long)]
-        width: Option<usize>,
-        #[arg(long)]
-        height: Option<usize>,
-        #[arg(short, long)]
-        output: PathBuf,
-        /// sRGB PNG preview, exposed so the perfect white diffuser is at 1.
-        #[arg(long)]
-        preview: Option<PathBuf>,
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Replace the image and preview if they exist.
-        #[arg(long)]
-        force: bool,
-    },
+    Image(ImageArgs),
     /// Illuminance (lux: direct, indirect, total) at points given as CSV rows
     /// x,y,z,nx,ny,nz (header line), the normal being the measuring surface's.
-    Probes {
-        scene: PathBuf,
-        #[arg(long)]
-        points: PathBuf,
-        #[arg(long, value_enum, default_value_t = Method::Auto)]
-        method: Method,
-        /// Radiosity: refine until every bound is below this fraction of the total.
-        #[arg(long, default_value_t = 0.001)]
-        rel_tolerance: f64,
-        /// Path tracing: paths per point.
-        #[arg(long, default_value_t = 65536)]
-        samples: u64,
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Wall-clock limit (s): what finished by then is reported, marked not converged.
-        #[arg(long, default_value_t = 600.0)]
-        max_seconds: f64,
-        #[arg(long)]
-        json: bool,
-    },
+    Probes(ProbesArgs),
     /// CSV and SVG of ΔE*ab error against seconds for each sampling strategy.
-    Convergence {
-        /// The scene file (default: the built-in validation box).
-        scene: Option<PathBuf>,
-        #[arg(short, long)]
-        output: PathBuf,
-        /// Confidence target of the reference run.
-        #[arg(long, default_value_t = 0.05)]
-        reference_de: f64,
-        /// Time budget per strategy.
-        #[arg(long, default_value_t = 20.0)]
-        seconds: f64,
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Replace convergence.csv and convergence.svg if they exist.
-        #[arg(long)]
-        force: bool,
-    },
+    Convergence(ConvergenceArgs),
+}
+
+#[derive(clap::Args)]
+struct SpotsArgs {
+    /// The scene file (default: the validation box built into the program).
+    scene: Option<PathBuf>,
+    /// Stop when every patch's 95 % half-width of ΔE*ab is below this.
+    #[arg(long, default_value_t = 0.1)]
+    target_de: f64,
+    /// Reference white X,Y,Z (default: a perfect white diffuser in place of patch 19).
+    #[arg(long, value_parser = parse_triple)]
+    white: Option<[f64; 3]>,
+    /// Wall-clock limit (s): the readings so far are reported, marked not converged.
+    #[arg(long, default_value_t = 600.0)]
+    max_seconds: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
+    /// path: the path tracer; auto: radiosity when the scene qualifies.
+    #[arg(long, value_enum, default_value_t = Method::Auto)]
+    method: Method,
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct ImageArgs {
+    /// The scene file (default: the built-in validation box).
+    scene: Option<PathBuf>,
+    /// Samples per pixel (radiosity: a √spp × √spp grid of rays, spp rounded down to a
+    /// square).
+    #[arg(long)]
+    spp: u64,
+    /// path: the path tracer; radiosity: the deterministic solver's reflected radiance
+    /// at every ray's first hit (convex scenes of Lambertian rectangles).
+    #[arg(long, value_enum, default_value_t = Method::Path)]
+    method: Method,
+    /// Radiosity: the finest mesh level (the indirect light is extrapolated from it and
+    /// the level before, as the spot readings are).
+    #[arg(long, default_value_t = 3)]
+    level: usize,
+    /// Output size (default: the scene's, 1014×1014); the field of view is kept.
+    #[arg(long)]
+    width: Option<usize>,
+    #[arg(long)]
+    height: Option<usize>,
+    #[arg(short, long)]
+    output: PathBuf,
+    /// sRGB PNG preview, exposed so the perfect white diffuser is at 1.
+    #[arg(long)]
+    preview: Option<PathBuf>,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Replace the image and preview if they exist.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(clap::Args)]
+struct ProbesArgs {
+    scene: PathBuf,
+    #[arg(long)]
+    points: PathBuf,
+    #[arg(long, value_enum, default_value_t = Method::Auto)]
+    method: Method,
+    /// Radiosity: refine until every bound is below this fraction of the total.
+    #[arg(long, default_value_t = 0.001)]
+    rel_tolerance: f64,
+    /// Path tracing: paths per point.
+    #[arg(long, default_value_t = 65536)]
+    samples: u64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Wall-clock limit (s): what finished by then is reported, marked not converged.
+    #[arg(long, default_value_t = 600.0)]
+    max_seconds: f64,
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct ConvergenceArgs {
+    /// The scene file (default: the built-in validation box).
+    scene: Option<PathBuf>,
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Confidence target of the reference run.
+    #[arg(long, default_value_t = 0.05)]
+    reference_de: f64,
+    /// Time budget per strategy.
+    #[arg(long, default_value_t = 20.0)]
+    seconds: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Replace convergence.csv and convergence.svg if they exist.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: Args) -> CliResult {
     match args.command {
-        Cmd::Spots {
-            scene,
-            target_de,
-            white,
-            max_seconds,
-            seed,
-            method,
-            json,
-        } => spots(
-            &SpotsRequest {
-                scene,
-                method: method.into(),
-                target_de,
-                white,
-                max_seconds,
-                seed,
-            },
-            json,
-        ),
-        Cmd::Image {
-            scene,
-            spp,
-            method,
-            level,
-            width,
-            height,
-            output,
-            preview,
-            seed,
-            force,
-        } => image(&ImageRequest {
-            scene,
-            spp,
-            method: method.into(),
-            level,
-            width,
-            height,
-            output,
-            preview,
-            seed,
-            force,
-        }),
-        Cmd::Probes {
-            scene,
-            points,
-            method,
-            rel_tolerance,
-            samples,
-            seed,
-            max_seconds,
-            json,
-        } => probes(
-            &ProbesRequest {
-                scene,
-                points,
-                options: ProbeOptions {
-                    method: method.into(),
-                    rel_tolerance,
-                    samples,
-                    seed,
-                    max_seconds,
-                },
-            },
-            json,
-        ),
-        Cmd::Convergence {
-            scene,
-            output,
-            reference_de,
-            seconds,
-            seed,
-            force,
-        } => {
-            let request = ConvergenceRequest {
-                scene,
-                output,
-                reference_de,
-                seconds,
-                seed,
-                force,
-            };
-            job::convergence::run(&request, &|e| match e {
-                RenderEvent::Log(m) => eprintln!("{m}"),
-                other => print_event(other),
-            })
-            .map_err(cli_error)?;
-            eprintln!(
-                "wrote {}/convergence.csv and convergence.svg",
-                request.output.display()
-            );
-            Ok(())
-        }
+        Cmd::Spots(a) => spots(a),
+        Cmd::Image(a) => image(a),
+        Cmd::Probes(a) => probes(a),
+        Cmd::Convergence(a) => convergence(a),
     }
+}
+
+fn convergence(a: ConvergenceArgs) -> CliResult {
+    let request = ConvergenceRequest {
+        scene: a.scene,
+        output: a.output,
+        reference_de: a.reference_de,
+        seconds: a.seconds,
+        seed: a.seed,
+        force: a.force,
+    };
+    job::convergence::run(&request, &|e| match e {
+        RenderEvent::Log(m) => eprintln!("{m}"),
+        other => print_event(other),
+    })
+    .map_err(cli_error)?;
+    eprintln!(
+        "wrote {}/convergence.csv and convergence.svg",
+        request.output.display()
+    );
+    Ok(())
 }
 
 /// A usage error for a bad request (exit 2), else a failure (exit 1).
@@ -261,12 +206,20 @@ fn progress_bar(len: u64, template: &str) -> Result<indicatif::ProgressBar, CliE
     Ok(bar)
 }
 
-fn spots(request: &SpotsRequest, json: bool) -> CliResult {
+fn spots(a: SpotsArgs) -> CliResult {
+    let request = SpotsRequest {
+        scene: a.scene,
+        method: a.method.into(),
+        target_de: a.target_de,
+        white: a.white,
+        max_seconds: a.max_seconds,
+        seed: a.seed,
+    };
     let bar = progress_bar(
         24,
         "{bar:30} {pos}/{len} patches at target, {elapsed} elapsed {msg}",
     )?;
-    let report = job::spots::run(request, &|e| match e {
+    let report = job::spots::run(&request, &|e| match e {
         RenderEvent::Method(m) => {
             if let Some(why) = m.fallback() {
                 eprintln!("using the path tracer: {why}");
@@ -287,7 +240,7 @@ fn spots(request: &SpotsRequest, json: bool) -> CliResult {
     })
     .map_err(cli_error)?;
     bar.finish_and_clear();
-    if json {
+    if a.json {
         println!("{}", report.to_json()?);
         return Ok(());
     }
@@ -365,10 +318,22 @@ fn print_radiosity_spots(r: &RadiosityResult) {
     }
 }
 
-fn image(request: &ImageRequest) -> CliResult {
+fn image(a: ImageArgs) -> CliResult {
+    let request = ImageRequest {
+        scene: a.scene,
+        spp: a.spp,
+        method: a.method.into(),
+        level: a.level,
+        width: a.width,
+        height: a.height,
+        output: a.output,
+        preview: a.preview,
+        seed: a.seed,
+        force: a.force,
+    };
     // Sized when the job knows the image's height (the scene's camera may set it).
     let bar = progress_bar(0, "{bar:40} {pos}/{len} rows, {elapsed} elapsed, ETA {eta}")?;
-    job::image::run(request, &|e| match e {
+    job::image::run(&request, &|e| match e {
         RenderEvent::ImageSize { height, .. } => bar.set_length(height as u64),
         RenderEvent::Rows(n) => bar.inc(n as u64),
         RenderEvent::ImageWritten(r) => {
@@ -394,9 +359,20 @@ fn image(request: &ImageRequest) -> CliResult {
     Ok(())
 }
 
-fn probes(request: &ProbesRequest, json: bool) -> CliResult {
+fn probes(a: ProbesArgs) -> CliResult {
+    let request = ProbesRequest {
+        scene: a.scene,
+        points: a.points,
+        options: ProbeOptions {
+            method: a.method.into(),
+            rel_tolerance: a.rel_tolerance,
+            samples: a.samples,
+            seed: a.seed,
+            max_seconds: a.max_seconds,
+        },
+    };
     let bar = progress_bar(0, "{msg} {bar:30} {pos}/{len} points, {elapsed}")?;
-    let report = job::probes::run(request, &|e| match e {
+    let report = job::probes::run(&request, &|e| match e {
         RenderEvent::Probe(ProbeProgress::Solved { level, elements }) => {
             bar.set_message(format!("level {level} ({elements} elements)"));
             bar.set_position(0);
@@ -425,7 +401,7 @@ fn probes(request: &ProbesRequest, json: bool) -> CliResult {
             }
         );
     }
-    if json {
+    if a.json {
         println!("{}", report.to_json()?);
     } else {
         print_probes(&report);
