@@ -100,3 +100,45 @@ impl Method {
         Ok(Resolved { method, reason })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::geometry::{Rect, Vec3};
+
+    /// The validation box with a baffle inside: not convex, so no radiosity.
+    fn baffled() -> Scene {
+        let mut scene = Scene::builtin("validation-box").unwrap();
+        let mut baffle = scene.surfaces[0].clone();
+        baffle.name = "baffle".into();
+        baffle.patch = None;
+        baffle.rect = Rect::new(
+            Vec3::new(0.2, 0.05, 0.2),
+            Vec3::new(0.1, 0.0, 0.0),
+            Vec3::new(0.0, 0.1, 0.0),
+        );
+        scene.surfaces.push(baffle);
+        scene
+    }
+
+    #[test]
+    fn auto_takes_radiosity_where_the_scene_qualifies() {
+        let scene = Scene::builtin("validation-box").unwrap();
+        let r = Method::Auto.resolve(&scene).unwrap();
+        assert_eq!((r.method, r.reason), (Solver::Radiosity, Reason::Qualifies));
+        let r = Method::PathTracer.resolve(&scene).unwrap();
+        assert_eq!((r.method, r.reason), (Solver::PathTracer, Reason::Asked));
+    }
+
+    #[test]
+    fn auto_falls_back_with_the_reason_radiosity_refuses() {
+        let scene = baffled();
+        let refusal = Method::Radiosity.resolve(&scene).unwrap_err().to_string();
+        assert!(refusal.contains("not a convex enclosure"), "{refusal}");
+        let r = Method::Auto.resolve(&scene).unwrap();
+        assert_eq!(r.method, Solver::PathTracer);
+        // The reason is the refusal's text, as `render spots` prints it.
+        assert_eq!(r.fallback(), Some(refusal.as_str()));
+        assert_eq!(r.reason.to_string(), refusal);
+    }
+}

@@ -232,3 +232,33 @@ fn output_policy(r: &ImageRequest) -> Result<OutputPolicy, RenderError> {
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_preview_on_the_image_is_a_bad_request_before_anything_renders() {
+        let dir = std::env::temp_dir().join(format!("metamer-job-image-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let output = dir.join("x.exr");
+        let request = ImageRequest {
+            preview: Some(output.clone()),
+            scene: Some(dir.join("no such scene.json")),
+            ..ImageRequest::new(4, output.clone())
+        };
+        let e = run(&request, &|_| panic!("no event")).unwrap_err();
+        assert!(e.is_bad_request());
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "--preview {} is the same file as --output {}",
+                output.display(),
+                output.display()
+            )
+        );
+        let e = run(&ImageRequest::new(0, output), &|_| panic!("no event")).unwrap_err();
+        assert_eq!(e.to_string(), "--spp must be ≥ 1");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

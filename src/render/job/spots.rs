@@ -171,3 +171,49 @@ pub fn run(
         readings,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refusal(request: SpotsRequest) -> RenderError {
+        match run(&request, &|_| {
+            panic!("no event before the request is checked")
+        }) {
+            Err(e) => e,
+            Ok(_) => panic!("accepted"),
+        }
+    }
+
+    #[test]
+    fn the_first_bad_option_is_the_one_reported_before_the_scene_is_read() {
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            target_de: 0.0,
+            max_seconds: 0.0,
+            white: Some([1.0, 0.0, 1.0]),
+            ..SpotsRequest::default()
+        });
+        assert!(e.is_bad_request());
+        assert_eq!(e.to_string(), "--target-de must be > 0");
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            max_seconds: f64::NAN,
+            white: Some([1.0, 0.0, 1.0]),
+            ..SpotsRequest::default()
+        });
+        assert_eq!(e.to_string(), "--max-seconds must be > 0");
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            white: Some([1.0, 0.0, 1.0]),
+            ..SpotsRequest::default()
+        });
+        assert_eq!(e.to_string(), "--white must be finite with Y > 0");
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            ..SpotsRequest::default()
+        });
+        assert!(!e.is_bad_request());
+        assert!(matches!(e, RenderError::Scene(_)), "{e}");
+    }
+}
