@@ -15,12 +15,14 @@ use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
 use crate::color::{delta_e76, Xyz};
 use crate::output::OutputPolicy;
-use crate::render::image::{render_image, spot_mean, Frame, ImageOptions};
+use crate::render::image::{spot_mean, Frame};
 use crate::render::image_io::{write_xyz_image, XyzImage};
-use crate::render::radiosity::image::{render_image_from, RadiosityImageOptions};
-use crate::render::radiosity::{self, render_spots_radiosity_solved, RadiosityOptions};
+use crate::render::job::image::{self, Film, RadiosityLight};
+use crate::render::job::spots::{self, Readings, SpotsReport, SpotsRequest};
+use crate::render::job::{RenderError, RenderEvent};
+use crate::render::method::Method;
 use crate::render::spot::patch_aim;
-use crate::render::{render_spots_with_progress, Scene, SpotOptions, Strategy};
+use crate::render::Scene;
 use crate::validation::propagate::{render_lab_sigma, RenderStatement};
 
 /// What the simulation stage renders.
@@ -105,73 +107,46 @@ pub fn simulate(
     progress: &dyn Fn(Progress),
 ) -> Result<(SimulationSummary, Vec<&'static str>), ExperimentError> {
     let start = Instant::now();
-    let scene = Scene::load(scene_file)?;
-    let scene = &scene;
-    let (method, white, converged, spots, render) = if radiosity::qualifies(scene).is_ok() {
-        let ropts = RadiosityOptions {
-            target_de: opts.target_de,
-            max_seconds: opts.max_seconds,
-            ..RadiosityOptions::default()
-        };
-        let (r, solved) = render_spots_radiosity_solved(scene, &ropts, &|l| {
-            progress(Progress::Note(format!(
-                "radiosity level {}: {} elements, {:.2} s",
-                l.level, l.elements, l.seconds
-            )))
-        })?;
-        let spots = r
-            .patches
-            .iter()
-            .map(|p| SimSpot {
+    // The same entry as `metamer render spots`, with the stage's options; `auto` picks the
+    // solver, and its reason is not a stage note.
+    let request = SpotsRequest {
+        scene: Some(scene_file.to_path_buf()),
+        method: Method::Auto,
+        target_de: opts.target_de,
+        white: None,
+        max_seconds: opts.max_seconds,
+        seed: opts.seed,
+    };
+    let report = spots::run(&request, &|e| match e {
+        RenderEvent::Level(l) => progress(Progress::Note(format!(
+            "radiosity level {}: {} elements, {:.2} s",
+            l.level, l.elements, l.seconds
+        ))),
+        RenderEvent::Spots(p) => progress(Progress::Note(format!(
+            "path tracing: worst 95 % half-width {:.3} ΔE*ab",
+            p.worst_de
+        ))),
+        _ => {}
+    })
+    .map_err(from_render)?;
+    let scene = &report.scene;
+    let (method, white, converged, spots) = match &report.readings {
+        Readings::Radiosity { result: r, .. } => {
+            let spots = r.patches.iter().map(|p| SimSpot {
                 patch: p.patch,
                 xyz: p.xyz,
                 de_uncertainty: p.de_bound,
-            })
-            .collect::<Vec<_>>();
-        let image = Box::new(move |spec: ImageSpec| {
-            let io = RadiosityImageOptions {
-                width: spec.size,
-                height: spec.size,
-                ..RadiosityImageOptions::default()
-            };
-            render_image_from(scene, &solved, &ropts, &io).map_err(ExperimentError::from)
-        }) as Box<dyn Fn(ImageSpec) -> Result<XyzImage, ExperimentError> + '_>;
-        ("radiosity", r.white, r.converged, spots, image)
-    } else {
-        let sopts = SpotOptions {
-            target_de: opts.target_de,
-            max_seconds: opts.max_seconds,
-            seed: opts.seed,
-            ..SpotOptions::default()
-        };
-        let r = render_spots_with_progress(scene, &sopts, &|p| {
-            progress(Progress::Note(format!(
-                "path tracing: worst 95 % half-width {:.3} ΔE*ab",
-                p.worst_de
-            )))
-        })?;
-        let spots = r
-            .patches
-            .iter()
-            .map(|p| SimSpot {
+            });
+            ("radiosity", r.white, r.converged, spots.collect::<Vec<_>>())
+        }
+        Readings::PathTracer(r) => {
+            let spots = r.patches.iter().map(|p| SimSpot {
                 patch: p.patch,
                 xyz: p.xyz,
                 de_uncertainty: p.de_ci95,
-            })
-            .collect::<Vec<_>>();
-        let seed = opts.seed;
-        let image = Box::new(move |spec: ImageSpec| {
-            let io = ImageOptions {
-                width: spec.size,
-                height: spec.size,
-                spp: spec.spp,
-                seed,
-                strategy: Strategy::default(),
-                window: None,
-            };
-            render_image(scene, &io, &|_| {}).map_err(ExperimentError::from)
-        }) as Box<dyn Fn(ImageSpec) -> Result<XyzImage, ExperimentError> + '_>;
-        ("path tracer", r.white, r.converged, spots, image)
+            });
+            ("path tracer", r.white, r.converged, spots.collect())
+        }
     };
     if let Some(bad) = spots.iter().find(|s| !s.xyz.iter().all(|v| v.is_finite())) {
         return Err(ExperimentError::NotFinite {
@@ -218,7 +193,7 @@ pub fn simulate(
                     spec.size, spec.spp
                 ),
             }));
-            let img = render(spec)?;
+            let img = render_image(&report, spec, opts.seed)?;
             image_patches = patches_in_image(scene, &img, &spots, white)?;
             // The stage directory is the stage's own: a re-run replaces its files.
             write_xyz_image(&dir.join(IMAGE_FILE), &img, &OutputPolicy::new(true))?;
@@ -244,6 +219,51 @@ pub fn simulate(
     let text = serde_json::to_string_pretty(&summary).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SUMMARY_FILE), text.as_bytes())?;
     Ok((summary, files))
+}
+
+/// The camera's image: from the radiosity solution the readings came from, one ray per
+/// pixel (it has no noise to average), or by the path tracer at the spec's samples per
+/// pixel. Unlike `metamer render image`, which solves afresh at ⌊√spp⌋² rays per pixel.
+fn render_image(
+    report: &SpotsReport,
+    spec: ImageSpec,
+    seed: u64,
+) -> Result<XyzImage, ExperimentError> {
+    let light = match &report.readings {
+        Readings::Radiosity {
+            solution, options, ..
+        } => RadiosityLight::Solved {
+            levels: solution,
+            options,
+        },
+        // Not used by the path tracer.
+        Readings::PathTracer(_) => RadiosityLight::Solve { level: 3 },
+    };
+    let film = Film {
+        width: spec.size,
+        height: spec.size,
+        spp: spec.spp,
+        seed,
+        light,
+        subpixels: 1,
+    };
+    image::render(&report.scene, report.resolved.method, &film, &|_| {}).map_err(from_render)
+}
+
+/// The stage's error for a render job's: the same error the stage reported when it called
+/// the renderers itself.
+fn from_render(e: RenderError) -> ExperimentError {
+    match e {
+        RenderError::Scene(e) => e.into(),
+        RenderError::Spot(e) => e.into(),
+        RenderError::Radiosity(e) => e.into(),
+        RenderError::Image(e) => e.into(),
+        RenderError::ImageIo(e) => e.into(),
+        other => ExperimentError::Option {
+            what: "simulation",
+            message: other.to_string(),
+        },
+    }
 }
 
 /// Each patch's spot in `img`: where the meter aims, and the image's mean there against the

@@ -10,6 +10,7 @@ use crate::output::{OutputError, OutputPolicy};
 use crate::plot::{log_log_svg, LogLogChart, Series};
 
 use super::integrator::{Strategy, Tracer, Wavelengths};
+use super::method::Method;
 use super::radiosity::{combine, run_level, Prepared, RadiosityError, RadiosityOptions};
 use super::scene::Scene;
 use super::spot::{patch_aim, render_spots, sample_cone, Aim, SpotError, SpotOptions};
@@ -149,7 +150,8 @@ pub fn run(
             n *= 2;
         }
     }
-    if super::radiosity::qualifies(scene).is_ok() {
+    // The radiosity curves where the solver applies: what `auto` would render it with.
+    if Method::Auto.resolve(scene)?.is_radiosity() {
         points.extend(radiosity_points(scene, RADIOSITY_LEVELS, log)?);
     }
     Ok((points, reference.white))
@@ -218,12 +220,16 @@ pub fn radiosity_points(
     Ok(points)
 }
 
+/// The chart's files in its directory.
+pub const CSV_FILE: &str = "convergence.csv";
+pub const SVG_FILE: &str = "convergence.svg";
+
 /// Writes `convergence.csv` and `convergence.svg` into `dir` under the output policy `out`
 /// (both checked before either is written).
 pub fn write(dir: &Path, points: &[Point], out: &OutputPolicy) -> Result<(), ConvergenceError> {
     out.dir(dir)?;
-    let csv = dir.join("convergence.csv");
-    let svg = dir.join("convergence.svg");
+    let csv = dir.join(CSV_FILE);
+    let svg = dir.join(SVG_FILE);
     out.check(&csv)?;
     out.check(&svg)?;
     // Strategy names contain commas: quoted (RFC 4180).

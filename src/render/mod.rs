@@ -26,5 +26,7 @@ pub mod deadline;
 mod exr_layout;
 pub mod image;
 pub mod image_io;
+pub mod job;
+pub mod method;
 pub mod probes;
 pub mod radiosity;

@@ -11,26 +11,18 @@ use rayon::prelude::*;
 use super::deadline::Deadline;
 use super::geometry::VecOps;
 use super::integrator::{Strategy, Tracer};
+use super::method::Method;
 use super::radiosity::probes::{
     probe_illuminance, Illuminance, Probe, ProbeLevel, ProbeProgress, ProbeRun,
 };
-use super::radiosity::{self, RadiosityError, RadiosityOptions};
+use super::radiosity::{RadiosityError, RadiosityOptions};
 use super::scene::Scene;
 use super::spectral::Rng;
-
-/// Which method computes the probes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ProbeMethod {
-    /// The radiosity solver when the room qualifies, else the path tracer.
-    Auto,
-    Radiosity,
-    Path,
-}
 
 /// What a probe run is asked for.
 #[derive(Clone, Copy, Debug)]
 pub struct ProbeOptions {
-    pub method: ProbeMethod,
+    pub method: Method,
     /// Radiosity: refine until every bound is within this fraction of its total.
     pub rel_tolerance: f64,
     /// Path tracing: paths per probe (the run may end sooner at the time limit).
@@ -43,7 +35,7 @@ pub struct ProbeOptions {
 impl Default for ProbeOptions {
     fn default() -> Self {
         ProbeOptions {
-            method: ProbeMethod::Auto,
+            method: Method::Auto,
             rel_tolerance: 1e-3,
             samples: 65_536,
             seed: 1,
@@ -131,18 +123,9 @@ pub fn illuminance(
         });
     }
     let start = std::time::Instant::now();
-    let (radiosity, method_reason) = match opts.method {
-        ProbeMethod::Path => (false, None),
-        ProbeMethod::Radiosity => {
-            radiosity::qualifies(scene)?;
-            (true, None)
-        }
-        ProbeMethod::Auto => match radiosity::qualifies(scene) {
-            Ok(()) => (true, None),
-            Err(why) => (false, Some(why.to_string())),
-        },
-    };
-    let mut result = if radiosity {
+    let resolved = opts.method.resolve(scene)?;
+    let method_reason = resolved.fallback().map(str::to_string);
+    let mut result = if resolved.is_radiosity() {
         let ropts = RadiosityOptions {
             max_seconds: opts.max_seconds,
             ..RadiosityOptions::default()

@@ -192,6 +192,19 @@ fn face_grid(
     Grid { na, nb, xyz }
 }
 
+/// Whether `level` can be an image's finest mesh level; callers that decide on the solver
+/// first check it sooner, so a bad level is reported before whether the scene qualifies.
+pub fn check_level(level: usize) -> Result<(), RadiosityError> {
+    if level == 0 {
+        return Err(RadiosityError::BadOption {
+            what: "the image's mesh level",
+            need: "at least 1",
+            got: 0.0,
+        });
+    }
+    Ok(())
+}
+
 /// Renders the camera's image from the radiosity solution (see the module doc), solving
 /// the levels `opts.level − 1` and `opts.level` first.
 pub fn render_image_radiosity(
@@ -199,13 +212,7 @@ pub fn render_image_radiosity(
     ropts: &RadiosityOptions,
     opts: &RadiosityImageOptions,
 ) -> Result<XyzImage, RadiosityError> {
-    if opts.level == 0 {
-        return Err(RadiosityError::BadOption {
-            what: "the image's mesh level",
-            need: "at least 1",
-            got: 0.0,
-        });
-    }
+    check_level(opts.level)?;
     let deadline = Deadline::after(ropts.max_seconds);
     let p = Prepared::for_probes(scene)?;
     let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();

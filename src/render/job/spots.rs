@@ -1,0 +1,219 @@
+//! The 24 simulated 1° meter readings of a scene to a ΔE*ab target: `metamer render spots`
+//! and the experiment's simulation stage, one entry for both.
+//!
+//! ```no_run
+//! use metamer::render::job::spots::{run, SpotsRequest};
+//! use metamer::render::job::RenderEvent;
+//!
+//! let request = SpotsRequest { target_de: 0.2, ..SpotsRequest::default() };
+//! let report = run(&request, &|event| {
+//!     if let RenderEvent::Method(m) = event {
+//!         if let Some(why) = m.fallback() {
+//!             eprintln!("using the path tracer: {why}");
+//!         }
+//!     }
+//! })?;
+//! println!("{}", report.to_json()?);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::PathBuf;
+
+use super::{load_scene, RenderError, RenderEvent};
+use crate::render::method::{Method, Resolved, Solver};
+use crate::render::radiosity::RadiosityResult;
+use crate::render::radiosity::{render_spots_radiosity_solved, LastLevels, RadiosityOptions};
+use crate::render::scene::Scene;
+use crate::render::spot::{render_spots_with_progress, SpotOptions, SpotResult};
+
+/// What to render.
+#[derive(Clone, Debug)]
+pub struct SpotsRequest {
+    /// The scene file; None is the validation box built into the program.
+    pub scene: Option<PathBuf>,
+    pub method: Method,
+    /// Every patch's ΔE*ab uncertainty (radiosity: its bound; path tracer: its 95 %
+    /// half-width) is driven below this.
+    pub target_de: f64,
+    /// Reference white X,Y,Z (None: a perfect white diffuser in place of patch 19).
+    pub white: Option<[f64; 3]>,
+    /// Wall-clock limit (s): the readings so far are reported, marked not converged.
+    pub max_seconds: f64,
+    /// The path tracer's seed.
+    pub seed: u64,
+}
+
+impl Default for SpotsRequest {
+    fn default() -> Self {
+        SpotsRequest {
+            scene: None,
+            method: Method::Auto,
+            target_de: 0.1,
+            white: None,
+            max_seconds: 600.0,
+            seed: 1,
+        }
+    }
+}
+
+/// The readings as the solver that made them gives them.
+pub enum Readings {
+    PathTracer(SpotResult),
+    Radiosity {
+        result: RadiosityResult,
+        /// The solutions the readings came from, for an image of the same light.
+        solution: LastLevels,
+        /// The options they were solved with.
+        options: RadiosityOptions,
+    },
+}
+
+/// The finished readings with the scene and method they came from.
+pub struct SpotsReport {
+    pub scene: Scene,
+    pub resolved: Resolved,
+    pub readings: Readings,
+}
+
+/// A result with the method that produced it, as `--json` prints it.
+#[derive(serde::Serialize)]
+struct Tagged<'a, T: serde::Serialize> {
+    method: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    provenance: Option<&'a serde_json::Map<String, serde_json::Value>>,
+    #[serde(flatten)]
+    result: &'a T,
+}
+
+impl SpotsReport {
+    /// "path" or "radiosity", as the JSON names the method.
+    pub fn method_name(&self) -> &'static str {
+        match self.readings {
+            Readings::PathTracer(_) => "path",
+            Readings::Radiosity { .. } => "radiosity",
+        }
+    }
+
+    /// One JSON object: the method, the scene's provenance and the readings.
+    pub fn to_json(&self) -> Result<String, serde_json::Error> {
+        let method = self.method_name();
+        let provenance = self.scene.provenance.as_ref();
+        match &self.readings {
+            Readings::PathTracer(result) => serde_json::to_string(&Tagged {
+                method,
+                provenance,
+                result,
+            }),
+            Readings::Radiosity { result, .. } => serde_json::to_string(&Tagged {
+                method,
+                provenance,
+                result,
+            }),
+        }
+    }
+}
+
+/// Checks the request, loads the scene, resolves the method (reported before the work
+/// starts) and renders the readings. The checks run in a fixed order and the first
+/// failure is the one reported.
+pub fn run(
+    request: &SpotsRequest,
+    events: &dyn Fn(RenderEvent),
+) -> Result<SpotsReport, RenderError> {
+    let bad = |m: &str| Err(RenderError::BadRequest(m.into()));
+    if request.target_de.is_nan() || request.target_de <= 0.0 {
+        return bad("--target-de must be > 0");
+    }
+    if request.max_seconds.is_nan() || request.max_seconds <= 0.0 {
+        return bad("--max-seconds must be > 0");
+    }
+    if let Some(w) = request.white {
+        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
+            return bad("--white must be finite with Y > 0");
+        }
+    }
+    let scene = load_scene(request.scene.as_deref(), events)?;
+    let resolved = request.method.resolve(&scene)?;
+    events(RenderEvent::Method(&resolved));
+    let readings = match resolved.method {
+        Solver::Radiosity => {
+            let options = RadiosityOptions {
+                target_de: request.target_de,
+                white: request.white,
+                max_seconds: request.max_seconds,
+                ..RadiosityOptions::default()
+            };
+            let (result, solution) = render_spots_radiosity_solved(&scene, &options, &|l| {
+                events(RenderEvent::Level(l))
+            })?;
+            Readings::Radiosity {
+                result,
+                solution,
+                options,
+            }
+        }
+        Solver::PathTracer => {
+            let options = SpotOptions {
+                target_de: request.target_de,
+                white: request.white,
+                max_seconds: request.max_seconds,
+                seed: request.seed,
+                ..SpotOptions::default()
+            };
+            Readings::PathTracer(render_spots_with_progress(&scene, &options, &|p| {
+                events(RenderEvent::Spots(&p))
+            })?)
+        }
+    };
+    Ok(SpotsReport {
+        scene,
+        resolved,
+        readings,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refusal(request: SpotsRequest) -> RenderError {
+        match run(&request, &|_| {
+            panic!("no event before the request is checked")
+        }) {
+            Err(e) => e,
+            Ok(_) => panic!("accepted"),
+        }
+    }
+
+    #[test]
+    fn the_first_bad_option_is_the_one_reported_before_the_scene_is_read() {
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            target_de: 0.0,
+            max_seconds: 0.0,
+            white: Some([1.0, 0.0, 1.0]),
+            ..SpotsRequest::default()
+        });
+        assert!(e.is_bad_request());
+        assert_eq!(e.to_string(), "--target-de must be > 0");
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            max_seconds: f64::NAN,
+            white: Some([1.0, 0.0, 1.0]),
+            ..SpotsRequest::default()
+        });
+        assert_eq!(e.to_string(), "--max-seconds must be > 0");
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            white: Some([1.0, 0.0, 1.0]),
+            ..SpotsRequest::default()
+        });
+        assert_eq!(e.to_string(), "--white must be finite with Y > 0");
+        let e = refusal(SpotsRequest {
+            scene: Some("no such scene.json".into()),
+            ..SpotsRequest::default()
+        });
+        assert!(!e.is_bad_request());
+        assert!(matches!(e, RenderError::Scene(_)), "{e}");
+    }
+}
