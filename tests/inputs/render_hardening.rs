@@ -100,7 +100,7 @@ fn a_zero_or_negative_time_limit_is_refused() {
         };
         assert!(render_spots_radiosity(&scene, &r, &|_| {}).is_err());
     }
-    let o = metamer(["render", "spots", "--max-seconds", "0"]);
+    let o = metamer(&["render", "spots", "--max-seconds", "0"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--max-seconds"));
 }

@@ -48,11 +48,7 @@ pub fn metamer_command() -> Command {
 }
 
 /// Runs `metamer args` in the test's own working directory and environment.
-pub fn metamer<I, S>(args: I) -> Output
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<OsStr>,
-{
+pub fn metamer<S: AsRef<OsStr>>(args: &[S]) -> Output {
     metamer_command()
         .args(args)
         .output()
@@ -60,11 +56,7 @@ where
 }
 
 /// Runs `metamer args` in the repository's root, so paths such as `data/…` are found.
-pub fn metamer_in_root<I, S>(args: I) -> Output
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<OsStr>,
-{
+pub fn metamer_in_root<S: AsRef<OsStr>>(args: &[S]) -> Output {
     metamer_command()
         .args(args)
         .current_dir(root())
@@ -74,11 +66,7 @@ where
 
 /// Runs `metamer args` without `METAMER_SIM_TIME_SCALE`, so the simulated instruments take
 /// the time their options say and not what the environment running the tests sets.
-pub fn metamer_unscaled<I, S>(args: I) -> Output
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<OsStr>,
-{
+pub fn metamer_unscaled<S: AsRef<OsStr>>(args: &[S]) -> Output {
     metamer_command()
         .args(args)
         .env_remove("METAMER_SIM_TIME_SCALE")
@@ -87,11 +75,7 @@ where
 }
 
 /// [`metamer_unscaled`] in the repository's root.
-pub fn metamer_unscaled_in_root<I, S>(args: I) -> Output
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<OsStr>,
-{
+pub fn metamer_unscaled_in_root<S: AsRef<OsStr>>(args: &[S]) -> Output {
     metamer_command()
         .args(args)
         .current_dir(root())
