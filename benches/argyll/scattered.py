@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """metamer's models against ArgyllCMS `colprof -as` at equal patches, on scattered sets.
 
-The sets come from `tests/scattered_fit.rs` (seeded scrambled-Halton drive values plus the
+The sets come from `tests/display/scattered_fit.rs` (seeded scrambled-Halton drive values plus the
 cube's corners, 50/200/1000 patches, read noise-free from each simulated display; the
 held-out set is 500 seeded random drive values with the white first; each set's
 `fit-noisy.ti3` is the same patches read with the simulated CS-100A's repeatability, seeded):
-  METAMER_SCATTERED_OUT=target/scattered cargo test --release --test scattered_fit \
-      -- --ignored print_held_out_table
+  METAMER_SCATTERED_OUT=target/scattered cargo test --release --test display \
+      -- --ignored scattered_fit::print_held_out_table
 then, from the repository root, after `apt-get install argyll`:
   python3 benches/argyll/scattered.py [--dir target/scattered] [--models shaper-matrix lut auto]
       [--noisy]

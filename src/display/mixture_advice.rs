@@ -19,7 +19,7 @@ pub struct MixtureGain {
 pub const MIXTURE_GAINS_MEASURED: &str =
     "metamer budget (--trials 3 --seed 1), measured 2026-12-02";
 
-/// [`super::budget::run_mixture_study`] on the two LCD presets with 3 trials and seed 1 (`print_mixture_study` in tests/ramp_fit.rs prints
+/// [`super::budget::run_mixture_study`] on the two LCD presets with 3 trials and seed 1 (`print_mixture_study` in tests/display/ramp_fit.rs prints
 /// them); what `fit` tells a user whose set has no
 /// mixtures.
 pub const MEASURED_MIXTURE_GAINS: [MixtureGain; 2] = [

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent reference for tests/color_cli.rs: XYZ and CIELAB of the 24 ColorChecker
+"""Independent reference for tests/cli/color_cli.rs: XYZ and CIELAB of the 24 ColorChecker
 (BabelColor average) patches under CIE D65, CIE 1931 2 deg observer.
 
 Written separately from the Rust code, in plain Python (no shared code, no numpy), from the

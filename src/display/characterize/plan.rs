@@ -88,7 +88,7 @@ pub const LUT_GRID_STEPS: usize = 5;
 /// the CS-100A's noise, ramps of 9 and a 5³ grid (141 patches) reproduced the verification
 /// colours as well as ramps of 9 and the 9³ grid of their levels (729 patches): ΔE00 0.144
 /// against 0.162 on ips-lcd, 0.260 against 0.247 on wide-gamut-ccfl, 0.006 against 0.030 on
-/// ideal-crt (tests/ramp_fit.rs, 2026-12-02).
+/// ideal-crt (tests/display/ramp_fit.rs, 2026-12-02).
 pub fn default_grid_steps(model: ModelKind, ramp_steps: usize) -> usize {
     if model == ModelKind::Lut {
         ramp_steps.min(LUT_GRID_STEPS)

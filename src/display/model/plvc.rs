@@ -17,7 +17,7 @@
 //! monitors and judged on their mixed patches, this spread lowered the mean error on six (by
 //! 5–19 %) against plain PLVC and raised it on one (by 15 %, a white 0.9 % darker than the
 //! sum whose greys are additive within their noise); a product of the shares (l_r l_g l_b) or
-//! the smallest share did less well (`tests/ramp_fit.rs`, `print_white_share_study`).
+//! the smallest share did less well (`tests/display/ramp_fit.rs`, `print_white_share_study`).
 //!
 //! The model is stored as the grid LUT of [`super::Lut3d`] over the ramps' own levels, each
 //! node the additive sum above: tetrahedral interpolation of a sum of per-axis terms is the

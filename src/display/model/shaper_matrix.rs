@@ -25,7 +25,7 @@
 //! what misses, and the CIELAB fit stays. CIELAB counts the dim patches' chromaticity
 //! for less than their noise warrants: on the ramp-only set of `ideal-crt` read with the
 //! CS-100A's noise (six meter seeds) the inverse round trip's mean ΔE00 fell from 0.008
-//! to 0.003, below `colprof -as`'s 0.007 (benches/argyll/README.md, `tests/ramp_fit.rs`).
+//! to 0.003, below `colprof -as`'s 0.007 (benches/argyll/README.md, `tests/display/ramp_fit.rs`).
 
 use nalgebra::{DMatrix, DVector};
 
