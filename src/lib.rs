@@ -6,13 +6,13 @@
 //! spectral path tracer, reproduction on the display and validation in CIELAB.
 //! The `metamer` binary is a thin command line over this library.
 
-pub mod boxmeasure;
 pub mod calendar;
 pub mod color;
 pub mod digest;
 pub mod display;
 pub mod experiment;
 pub mod light;
+pub mod measure_box;
 pub mod numeric_csv;
 pub mod output;
 pub mod plot;

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use metamer::display::ModelKind;
-use metamer::experiment::box_stage::BoxMeasure;
 use metamer::experiment::display::DisplayOptions;
+use metamer::experiment::measure_box::MeasureBox;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
 use metamer::experiment::validate::{ValidationResult, FILE};
@@ -107,7 +107,7 @@ pub fn run_cli(args: Args) -> CliResult {
     }
     // As many as a box plan allows a reading of one thing; a billion was accepted and
     // measured for days.
-    let most = metamer::boxmeasure::plan::MAX_REPEATS;
+    let most = metamer::measure_box::plan::MAX_REPEATS;
     if !(1..=most).contains(&args.repeats) {
         return Err(CliError::Usage(format!(
             "--repeats must be from 1 to {most}, got {}",
@@ -136,7 +136,7 @@ pub fn run_cli(args: Args) -> CliResult {
                 let (spectral, spot) = (Spec::new(spectral), Spec::new(args.spot.as_str()));
                 let simulated = spectral.is_simulated() && spot.is_simulated();
                 let light = super::rig::box_light(args.scenario.as_deref(), simulated)?;
-                BoxSource::Measure(BoxMeasure {
+                BoxSource::Measure(MeasureBox {
                     spectral,
                     spot,
                     plan: args.plan,

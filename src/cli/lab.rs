@@ -70,7 +70,7 @@ pub fn run(args: Args) -> CliResult {
     }
     // As many as a box plan allows a reading of one thing; a billion was accepted and
     // measured for days.
-    let most = metamer::boxmeasure::plan::MAX_REPEATS;
+    let most = metamer::measure_box::plan::MAX_REPEATS;
     if !(1..=most).contains(&args.repeats) {
         return Err(CliError::Usage(format!(
             "--repeats must be from 1 to {most}, got {}",

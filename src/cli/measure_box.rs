@@ -3,8 +3,8 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use metamer::boxmeasure::setup::{self, BoxRig, RigRequest};
-use metamer::boxmeasure::{
+use metamer::measure_box::setup::{self, BoxRig, RigRequest};
+use metamer::measure_box::{
     self, BoxDetails, BoxPlan, Instruments, Options, Outcome, PlanError, Stage, Summary,
 };
 use metamer::output::OutputPolicy;
@@ -99,7 +99,7 @@ pub fn run(args: Args) -> CliResult {
             interrupt: Some(on_ctrl_c()),
         },
     };
-    let outcome = boxmeasure::run(
+    let outcome = measure_box::run(
         &options,
         Instruments {
             spectral: rig.spectral.as_mut(),

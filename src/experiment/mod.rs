@@ -8,12 +8,12 @@
 //! exactly those downstream of a change. Measuring stages are journalled sessions and
 //! resume after any interruption. [`lab`] is the experiment preset for the simulated rig.
 
-pub mod box_stage;
 pub mod cache;
 pub mod display;
 pub mod display_spots;
 mod error;
 pub mod lab;
+pub mod measure_box;
 mod options;
 mod preflight;
 mod products;
@@ -21,13 +21,13 @@ mod progress;
 pub mod readings;
 pub mod report_sections;
 pub mod reproduction;
+mod run;
 pub mod simulation;
 mod stage;
-mod stages;
 pub mod validate;
 
 pub use error::ExperimentError;
 pub use options::{BoxSource, ExperimentOptions};
 pub use progress::Progress;
+pub use run::{run, StageOutcome};
 pub use stage::Stage;
-pub use stages::{run, StageOutcome};

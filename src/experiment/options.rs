@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::box_stage::BoxMeasure;
 use super::display::DisplayOptions;
+use super::measure_box::MeasureBox;
 use super::reproduction::ReproductionOptions;
 use super::simulation::SimulationOptions;
 use super::stage::Stage;
@@ -16,7 +16,7 @@ use crate::session::RunOptions;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum BoxSource {
     /// Measured here, by the `measure-box` session into `box/`.
-    Measure(BoxMeasure),
+    Measure(MeasureBox),
     /// Measurements taken earlier or elsewhere: the measured scene and the spot readings.
     Existing { scene: PathBuf, spots: PathBuf },
 }

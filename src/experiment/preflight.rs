@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use super::box_stage::BoxMeasure;
 use super::error::ExperimentError;
+use super::measure_box::MeasureBox;
 use super::options::{BoxSource, ExperimentOptions};
 use super::readings::read_readings;
 use super::stage::Stage;
-use crate::boxmeasure::BoxPlan;
+use crate::measure_box::BoxPlan;
 use crate::render::Scene;
 
 /// Every check, in the order a user would fix them.
@@ -56,7 +56,7 @@ fn given_files_outside_stages(opts: &ExperimentOptions) -> Result<(), Experiment
 /// The plan's own rules (the fall-off angles the fit needs among them), and the patches:
 /// the measured scene holds the whole chart, so the simulation renders all 24 patches,
 /// the display shows them, and the validation compares the box's spots with each.
-fn measured_box(m: &BoxMeasure) -> Result<(), ExperimentError> {
+fn measured_box(m: &MeasureBox) -> Result<(), ExperimentError> {
     let bad = |e: &dyn std::fmt::Display| ExperimentError::Box(e.to_string());
     let mut plan = match &m.plan {
         Some(p) => BoxPlan::load(p).map_err(|e| bad(&e))?,

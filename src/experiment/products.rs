@@ -3,7 +3,7 @@
 
 use super::cache::Product;
 use super::stage::Stage;
-use super::{box_stage, display, display_spots, reproduction, simulation, validate};
+use super::{display, display_spots, measure_box, reproduction, simulation, validate};
 
 const fn always(file: &'static str) -> Product {
     Product { file, always: true }
@@ -20,8 +20,8 @@ const fn sometimes(file: &'static str) -> Product {
 /// record that does not vouch for each of them is not trusted.
 pub fn products(stage: Stage) -> &'static [Product] {
     const BOX: &[Product] = &[
-        always(box_stage::SCENE_FILE),
-        always(box_stage::SPOTS_FILE),
+        always(measure_box::SCENE_FILE),
+        always(measure_box::SPOTS_FILE),
         sometimes("light.json"),
     ];
     const SIMULATION: &[Product] = &[

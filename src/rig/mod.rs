@@ -6,7 +6,7 @@ pub mod image;
 pub mod scenario;
 pub mod screen;
 pub mod sim_meter;
-pub mod sim_scene_box;
+pub mod simulated_box;
 pub mod spec;
 pub mod virtual_display;
 pub mod window;

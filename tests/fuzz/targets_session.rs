@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use metamer::boxmeasure::{BoxPlan, Stage};
 use metamer::experiment::cache::{Inputs, Product, StageDir};
 use metamer::light::{fit, Falloff, ModelChoice};
+use metamer::measure_box::{BoxPlan, Stage};
 use metamer::session::{reading_problem, Entry, Header, Journal, JournalEntry};
 use metamer::validation::readings::parse_readings;
 use serde::de::DeserializeOwned;

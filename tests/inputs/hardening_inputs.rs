@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
-use metamer::boxmeasure::BoxPlan;
 use metamer::light::{ies, ldt, Falloff};
+use metamer::measure_box::BoxPlan;
 use metamer::validation::readings::parse_readings;
 
 use crate::support::{fresh_dir, root, root_text};

@@ -7,10 +7,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use metamer::boxmeasure::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome, Stage};
+use metamer::measure_box::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome, Stage};
 use metamer::output::OutputPolicy;
 use metamer::rig::scenario::Scenario;
-use metamer::rig::sim_scene_box::{BoxOperator, TruthBox};
+use metamer::rig::simulated_box::{BoxOperator, SimulatedBox};
 use metamer::session::{NoProgress, RunEnd, RunOptions};
 use metamer_drivers::{SharedWorld, Spec, View};
 
@@ -30,7 +30,7 @@ fn plan() -> BoxPlan {
 /// Runs the tiles stage in `dir` with instruments opened afresh, as a new process would.
 fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
     let plan = plan();
-    let truth = TruthBox::new(&plan, SEED, Scenario::default()).unwrap();
+    let truth = SimulatedBox::new(&plan, SEED, Scenario::default()).unwrap();
     let world = Arc::new(SharedWorld::new(View::Capped));
     let mut spectral = Spec::new(SPECTRAL)
         .with_seed_unless_set(SEED)
@@ -57,7 +57,7 @@ fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
         },
         output: OutputPolicy::new(false),
     };
-    boxmeasure::run(
+    measure_box::run(
         &options,
         Instruments {
             spectral: spectral.as_mut(),

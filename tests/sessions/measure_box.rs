@@ -8,13 +8,13 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use metamer::boxmeasure::compare::{compare_readings, render_scene};
-use metamer::boxmeasure::scene::{scene_json, BoxContents};
-use metamer::boxmeasure::BoxPlan;
 use metamer::color::{luminance, Outside, Spectrum, Xyz};
 use metamer::light::CGammaTable;
+use metamer::measure_box::compare::{compare_readings, render_scene};
+use metamer::measure_box::scene::{scene_json, BoxContents};
+use metamer::measure_box::BoxPlan;
 use metamer::render::scene::DistributionFile;
-use metamer::rig::sim_scene_box::TruthBox;
+use metamer::rig::simulated_box::SimulatedBox;
 use metamer::rig::Scenario;
 use serde_json::Value;
 
@@ -68,7 +68,7 @@ fn spectrum(v: &Value) -> Spectrum {
 
 /// The truth as a noiseless i1Pro reports it: every spectrum at the instrument's 36 bands
 /// (380–730 nm, 10 nm), what the measured scene can at best be.
-fn band_limited(truth: &TruthBox, plan: &BoxPlan) -> Value {
+fn band_limited(truth: &SimulatedBox, plan: &BoxPlan) -> Value {
     let bands = |s: &Spectrum, outside| {
         let nm: Vec<f64> = (0..36).map(|i| 380.0 + 10.0 * f64::from(i)).collect();
         let v = nm.iter().map(|&l| s.value_at(l)).collect();
@@ -110,7 +110,7 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     let summary = json(&out.join("summary.json"));
     let scene = json(&out.join("scene.json"));
     let plan: BoxPlan = serde_json::from_str(PLAN).unwrap();
-    let truth = TruthBox::new(&plan, 7, Scenario::DisplayWhite).unwrap();
+    let truth = SimulatedBox::new(&plan, 7, Scenario::DisplayWhite).unwrap();
 
     // Tiles: the mean of n = 2 readings with 0.1 % (1σ) noise each, within 4σ/√2, plus the
     // i1Pro's 1e-4 conversion error (its emulator's noiseless accuracy).

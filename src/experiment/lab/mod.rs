@@ -15,15 +15,15 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::Spec;
 use serde::Serialize;
 
-use crate::boxmeasure::BoxPlan;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
-use crate::experiment::box_stage::BoxMeasure;
 use crate::experiment::display::DisplayOptions;
+use crate::experiment::measure_box::MeasureBox;
 use crate::experiment::reproduction::ReproductionOptions;
 use crate::experiment::simulation::{ImageSpec, SimulationOptions};
 use crate::experiment::validate::{ValidationResult, FILE as COMPARISONS_FILE};
 use crate::experiment::{self, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
+use crate::measure_box::BoxPlan;
 use crate::output::OutputPolicy;
 use crate::rig::{Preset, Scenario};
 use crate::session::RunOptions;
@@ -96,7 +96,7 @@ impl LabOptions {
         let spot = self.instrument("cs100a", None);
         ExperimentOptions {
             dir: dir.to_path_buf(),
-            box_source: BoxSource::Measure(BoxMeasure {
+            box_source: BoxSource::Measure(MeasureBox {
                 spectral: self.instrument("i1pro", None),
                 spot,
                 plan: None,

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::boxmeasure::assemble::iso_date;
+use crate::measure_box::assemble::iso_date;
 use crate::validation::report::InstrumentUsed;
 
 /// The session journals (`*.jsonl`) in `dir`, by name.

@@ -39,7 +39,7 @@ fn the_plan_accepts_exactly_the_angles_the_fit_can_use() {
                     .map(move |&g| (p, g, 80.0 * g.to_radians().cos().powf(1.3)))
             })
             .collect();
-        let fits = crate::boxmeasure::falloff::fit_light(&readings).is_ok();
+        let fits = crate::measure_box::falloff::fit_light(&readings).is_ok();
         assert_eq!(plan.validate().is_ok(), fits, "angles {a:?}");
         if fits {
             accepted += 1

@@ -36,11 +36,11 @@ use std::sync::{Arc, OnceLock};
 
 use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 
-use crate::boxmeasure::compare::{render_scene, CompareError};
-use crate::boxmeasure::plan::{BoxPlan, Stage, Target};
-use crate::boxmeasure::scene::{scene_json, BoxContents};
 use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum};
 use crate::light::{CGammaError, CGammaTable};
+use crate::measure_box::compare::{render_scene, CompareError};
+use crate::measure_box::plan::{BoxPlan, Stage, Target};
+use crate::measure_box::scene::{scene_json, BoxContents};
 use crate::render::scene::DistributionFile;
 use crate::rig::Scenario;
 use crate::session::{Answer, Operator, OperatorError};
@@ -48,7 +48,7 @@ use metamer_drivers::noise::SplitMix64;
 
 /// The truth box could not be made.
 #[derive(Debug, thiserror::Error)]
-pub enum SimSceneBoxError {
+pub enum SimulatedBoxError {
     #[error("the simulated box's distribution: {0}")]
     Table(#[from] CGammaError),
     #[error("rendering the simulated box: {0}")]
@@ -65,7 +65,7 @@ pub const TILE_CD_M2: f64 = 100.0;
 
 /// The box as it really is (in the simulation).
 #[derive(Clone, Debug)]
-pub struct TruthBox {
+pub struct SimulatedBox {
     /// Spectral radiance of each tile along the normal, row-major.
     pub tiles: Vec<Spectrum>,
     pub table: CGammaTable,
@@ -73,7 +73,7 @@ pub struct TruthBox {
     /// Patches 1–24.
     pub patches: Vec<Spectrum>,
     /// The light at each patch seen from the viewpoint, cd/m², patches 1–24: rendered when
-    /// first needed ([`TruthBox::spots`]), since only the spots stage needs it.
+    /// first needed ([`SimulatedBox::spots`]), since only the spots stage needs it.
     spots: OnceLock<Vec<[f64; 3]>>,
     plan: BoxPlan,
     falloff_tile: usize,
@@ -86,16 +86,16 @@ fn grid_nm() -> Vec<f64> {
     (0..n).map(|i| GRID.0 + GRID.2 * i as f64).collect()
 }
 
-fn on_grid(f: impl Fn(f64) -> f64, outside: Outside) -> Result<Spectrum, SimSceneBoxError> {
+fn on_grid(f: impl Fn(f64) -> f64, outside: Outside) -> Result<Spectrum, SimulatedBoxError> {
     let nm = grid_nm();
     let v = nm.iter().map(|&l| f(l)).collect();
     Spectrum::new(nm, v)
         .map(|s| s.with_outside(outside))
-        .map_err(|e| SimSceneBoxError::Spectrum(e.to_string()))
+        .map_err(|e| SimulatedBoxError::Spectrum(e.to_string()))
 }
 
 /// `base` times a smooth seeded perturbation, clamped to [0, 1].
-fn perturbed(base: &Spectrum, rng: &mut SplitMix64) -> Result<Spectrum, SimSceneBoxError> {
+fn perturbed(base: &Spectrum, rng: &mut SplitMix64) -> Result<Spectrum, SimulatedBoxError> {
     let terms: Vec<(f64, f64)> = (1..=3)
         .map(|_| (0.02 * rng.normal(), std::f64::consts::TAU * rng.uniform()))
         .collect();
@@ -113,10 +113,14 @@ fn perturbed(base: &Spectrum, rng: &mut SplitMix64) -> Result<Spectrum, SimScene
     )
 }
 
-impl TruthBox {
+impl SimulatedBox {
     /// The truth box of `plan`'s geometry lit by `light`, perturbed by `seed` (the same
     /// seed perturbs every light alike).
-    pub fn new(plan: &BoxPlan, seed: u64, light: Scenario) -> Result<TruthBox, SimSceneBoxError> {
+    pub fn new(
+        plan: &BoxPlan,
+        seed: u64,
+        light: Scenario,
+    ) -> Result<SimulatedBox, SimulatedBoxError> {
         let g = &plan.geometry;
         let mut rng = SplitMix64::new(seed ^ 0x6d62_6f78);
         let source = light.spectrum();
@@ -155,7 +159,7 @@ impl TruthBox {
             .collect::<Result<Vec<_>, _>>()?;
         let [fr, fc] = plan.falloff_tile();
         let falloff_tile = fr * g.cols + fc;
-        Ok(TruthBox {
+        Ok(SimulatedBox {
             tiles,
             table,
             wall,
@@ -168,7 +172,7 @@ impl TruthBox {
 
     /// The light at each patch 1–24 seen from the viewpoint, cd/m² (rendered on the first
     /// call).
-    pub fn spots(&self) -> Result<&[[f64; 3]], SimSceneBoxError> {
+    pub fn spots(&self) -> Result<&[[f64; 3]], SimulatedBoxError> {
         if let Some(s) = self.spots.get() {
             return Ok(s);
         }
@@ -198,9 +202,9 @@ impl TruthBox {
     }
 
     /// What an instrument placed on or aimed at `target` sees.
-    pub fn view(&self, target: &Target) -> Result<View, SimSceneBoxError> {
+    pub fn view(&self, target: &Target) -> Result<View, SimulatedBoxError> {
         let plan = &self.plan;
-        let drv = |e: metamer_drivers::DriverError| SimSceneBoxError::Spectrum(e.to_string());
+        let drv = |e: metamer_drivers::DriverError| SimulatedBoxError::Spectrum(e.to_string());
         let cols = plan.geometry.cols;
         Ok(match target {
             Target::Tile { row, col } => {
@@ -214,13 +218,13 @@ impl TruthBox {
             Target::Wall => View::surface(self.wall.clone()).map_err(drv)?,
             Target::Patch { patch } => {
                 View::surface(self.patches.get(patch - 1).cloned().ok_or_else(|| {
-                    SimSceneBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
+                    SimulatedBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
                 })?)
                 .map_err(drv)?
             }
             Target::Spot { patch } => {
                 View::xyz(*self.spots()?.get(patch - 1).ok_or_else(|| {
-                    SimSceneBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
+                    SimulatedBoxError::Spectrum(format!("no ColorChecker patch {patch}"))
                 })?)
             }
         })
@@ -231,7 +235,7 @@ impl TruthBox {
 /// says (the world then shows that target), a calibration prompt puts it on its white tile
 /// or caps it. Every prompt is kept.
 pub struct BoxOperator {
-    truth: TruthBox,
+    truth: SimulatedBox,
     world: Arc<SharedWorld>,
     targets: HashMap<String, Target>,
     pub prompts: Vec<String>,
@@ -239,7 +243,7 @@ pub struct BoxOperator {
 
 impl BoxOperator {
     /// The operator of the truth box's plan, moving what `world` shows.
-    pub fn new(truth: TruthBox, world: Arc<SharedWorld>) -> BoxOperator {
+    pub fn new(truth: SimulatedBox, world: Arc<SharedWorld>) -> BoxOperator {
         let mut targets = HashMap::new();
         for stage in Stage::ALL {
             for step in truth.plan.steps(stage) {
@@ -256,7 +260,7 @@ impl BoxOperator {
         }
     }
 
-    pub fn truth(&self) -> &TruthBox {
+    pub fn truth(&self) -> &SimulatedBox {
         &self.truth
     }
 }

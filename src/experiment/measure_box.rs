@@ -10,8 +10,8 @@ use serde::Serialize;
 use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::{write_readings, PatchStat};
-use crate::boxmeasure::setup::{self, BoxRig, RigError, RigRequest};
-use crate::boxmeasure::{self, BoxDetails, Instruments, Options, Outcome};
+use crate::measure_box::setup::{self, BoxRig, RigError, RigRequest};
+use crate::measure_box::{self, BoxDetails, Instruments, Options, Outcome};
 use crate::output::OutputPolicy;
 use crate::rig::Scenario;
 use crate::session::repeats::Repeatability;
@@ -19,7 +19,7 @@ use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator, Unatt
 
 /// How the box is measured.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct BoxMeasure {
+pub struct MeasureBox {
     /// The spectral instrument (tiles, materials) and the spot meter (fall-off, spots).
     pub spectral: Spec,
     pub spot: Spec,
@@ -45,7 +45,7 @@ fn bad(message: impl std::fmt::Display) -> ExperimentError {
 /// Measures the box into `dir`; returns the files the later stages read.
 pub fn measure(
     dir: &Path,
-    m: &BoxMeasure,
+    m: &MeasureBox,
     resume: bool,
     unattended: bool,
     run: &RunOptions,
@@ -101,7 +101,7 @@ pub fn measure(
             total: p.total,
         })
     };
-    let outcome = boxmeasure::run(
+    let outcome = measure_box::run(
         &options,
         Instruments {
             spectral: spectral.as_mut(),

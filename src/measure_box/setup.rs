@@ -10,7 +10,7 @@ use std::sync::Arc;
 use metamer_drivers::{DriverError, Instrument, SharedWorld, Spec, View};
 
 use super::plan::{BoxPlan, PlanError};
-use crate::rig::sim_scene_box::{BoxOperator, SimSceneBoxError, TruthBox};
+use crate::rig::simulated_box::{BoxOperator, SimulatedBox, SimulatedBoxError};
 use crate::rig::Scenario;
 use crate::session::Operator;
 
@@ -25,7 +25,7 @@ pub enum RigError {
     LightOnRealBox(Scenario),
     /// The simulated box could not be made.
     #[error(transparent)]
-    Truth(#[from] SimSceneBoxError),
+    Truth(#[from] SimulatedBoxError),
     /// An instrument could not be opened.
     #[error(transparent)]
     Open(#[from] DriverError),
@@ -119,7 +119,7 @@ pub fn open(
     rig_options.insert("seed".to_string(), seed.to_string());
     rig_options.insert("light".to_string(), light.name().to_string());
     note(format!("simulating the box (seed {seed}, lit by {light})"));
-    let truth = TruthBox::new(request.plan, seed, light)?;
+    let truth = SimulatedBox::new(request.plan, seed, light)?;
     let world = Arc::new(SharedWorld::new(View::Capped));
     let spectral = request
         .spectral

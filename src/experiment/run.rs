@@ -5,10 +5,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::box_stage::{self, BoxMeasure};
 use super::cache::{Inputs, StageDir, RECORD_FILE};
 use super::display::{characterize_display, DisplaySetting};
 use super::error::ExperimentError;
+use super::measure_box::{self, MeasureBox};
 use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
 use super::readings::read_readings;
@@ -60,7 +60,10 @@ fn box_files(opts: &ExperimentOptions) -> (PathBuf, PathBuf) {
         BoxSource::Existing { scene, spots } => (scene.clone(), spots.clone()),
         BoxSource::Measure(_) => {
             let d = opts.dir.join(Stage::Box.name());
-            (d.join(box_stage::SCENE_FILE), d.join(box_stage::SPOTS_FILE))
+            (
+                d.join(measure_box::SCENE_FILE),
+                d.join(measure_box::SPOTS_FILE),
+            )
         }
     }
 }
@@ -189,7 +192,7 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
         Stage::Box => {
             let i = Inputs::new().value("source", &opts.box_source);
             match &opts.box_source {
-                BoxSource::Measure(BoxMeasure {
+                BoxSource::Measure(MeasureBox {
                     plan: Some(plan), ..
                 }) => i.file("plan", plan)?,
                 _ => i,
@@ -263,7 +266,7 @@ fn run_stage(
     };
     match stage {
         Stage::Box => match &opts.box_source {
-            BoxSource::Measure(m) => box_stage::measure(
+            BoxSource::Measure(m) => measure_box::measure(
                 &sd.dir,
                 m,
                 opts.resume,
