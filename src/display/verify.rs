@@ -72,6 +72,30 @@ pub enum VerifyError {
     },
 }
 
+/// Whether a model's prediction `predicted` of patch `index` (from 1, drive `rgb`) is a
+/// colour a display shows. A model may predict a little below zero near black: that is an
+/// error it makes, which the ΔE shows. Only what is no number, or brighter than any
+/// display, is not: its ΔE would be NaN or infinite, and a mean over it NaN while the
+/// maximum hides it.
+pub fn check_prediction(
+    index: usize,
+    rgb: [f64; 3],
+    predicted: [f64; 3],
+) -> Result<(), VerifyError> {
+    match metamer_color::check_xyz(predicted) {
+        Err(
+            e @ (metamer_color::Implausible::NotFinite(_)
+            | metamer_color::Implausible::TooBright { .. }),
+        ) => Err(VerifyError::BadPrediction {
+            index,
+            rgb,
+            predicted,
+            why: e.to_string(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Predicts every patch with `profile` and compares with what was measured.
 pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verification, VerifyError> {
     if patches.is_empty() {
@@ -89,28 +113,19 @@ pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verificat
             });
         }
         let predicted = profile.forward(p.rgb);
-        let bad = |why: String| VerifyError::BadPrediction {
-            index: i + 1,
-            rgb: p.rgb,
-            predicted,
-            why,
-        };
-        // A model may predict a little below zero near black: that is an error it makes,
-        // which the ΔE shows. Only what is no number, or brighter than any display, is not.
-        if let Err(
-            e @ (metamer_color::Implausible::NotFinite(_)
-            | metamer_color::Implausible::TooBright { .. }),
-        ) = metamer_color::check_xyz(predicted)
-        {
-            return Err(bad(e.to_string()));
-        }
+        check_prediction(i + 1, p.rgb, predicted)?;
         let (a, b) = (
             Xyz::from_array(predicted).to_lab(white),
             Xyz::from_array(p.xyz).to_lab(white),
         );
         let (de00, de76) = (delta_e2000(a, b), delta_e76(a, b));
         if !(de00.is_finite() && de76.is_finite()) {
-            return Err(bad(format!("its ΔE00 is {de00}, its ΔE*ab {de76}")));
+            return Err(VerifyError::BadPrediction {
+                index: i + 1,
+                rgb: p.rgb,
+                predicted,
+                why: format!("its ΔE00 is {de00}, its ΔE*ab {de76}"),
+            });
         }
         errors.push(PatchError {
             index: i + 1,

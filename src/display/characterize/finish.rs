@@ -31,6 +31,9 @@ pub enum FinishError {
     Fit { model: ModelKind, source: FitError },
     #[error("the plan has no verification patches")]
     NoVerification,
+    /// The fitted model predicts a verification patch as no colour.
+    #[error(transparent)]
+    Verify(#[from] crate::display::verify::VerifyError),
     #[error(transparent)]
     Profile(#[from] ProfileError),
     #[error("writing {}: {source}", path.display())]
@@ -140,7 +143,7 @@ pub fn finish(
     let profile = fit_profile(model, &training, Some(log))
         .map_err(|source| FinishError::Fit { model, source })?;
     let forward = |rgb: [f64; 3]| profile.forward(rgb);
-    let verification = verify(&averaged, white, &forward).ok_or(FinishError::NoVerification)?;
+    let verification = verify(&averaged, white, &forward)?.ok_or(FinishError::NoVerification)?;
 
     profile.save(&files.profile, out)?;
     let raw: Vec<Sample> = readings

@@ -309,7 +309,9 @@ mod tests {
             .collect();
         // The panel predicting itself: every ΔE00 is 0.
         let forward = |rgb: [f64; 3]| panel.xyz_of_drive(rgb);
-        let v = verify(&patches, panel.xyz([255; 3]), &forward).unwrap();
+        let v = verify(&patches, panel.xyz([255; 3]), &forward)
+            .unwrap()
+            .unwrap();
         assert_eq!((v.patches.len(), v.max), (48, 0.0));
         let file = std::env::temp_dir().join(format!("metamer-report-{}.svg", std::process::id()));
         write_report(

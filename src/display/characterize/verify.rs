@@ -10,6 +10,7 @@ use super::plan::{DriveStep, Purpose};
 use crate::color::{delta_e2000, Xyz};
 use crate::display::diagnostics::percentile;
 use crate::display::model::Sample;
+use crate::display::verify::{check_prediction, VerifyError};
 
 /// A planned patch with its readings averaged.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -110,44 +111,48 @@ pub struct Verification {
 }
 
 /// Compares `predict` (the model's forward direction, drive 0–1 → XYZ) with the measured
-/// verification patches of `patches`. None if there are none.
+/// verification patches of `patches`. None if there are none; an error if the model
+/// predicts a patch as no colour (the same check as `metamer verify`'s), which would
+/// otherwise make the mean NaN and the summary's statistics `null`.
 pub fn verify(
     patches: &[AveragedPatch],
     white_xyz: [f64; 3],
     predict: &dyn Fn([f64; 3]) -> [f64; 3],
-) -> Option<Verification> {
+) -> Result<Option<Verification>, VerifyError> {
     let white = Xyz::from_array(white_xyz);
     let verified: Vec<VerifiedPatch> = patches
         .iter()
         .filter(|p| p.purpose == Purpose::Verify)
         .map(|p| {
-            let predicted = predict(p.to_patch().rgb);
+            let rgb = p.to_patch().rgb;
+            let predicted = predict(rgb);
+            check_prediction(p.patch + 1, rgb, predicted)?;
             let de = delta_e2000(
                 Xyz::from_array(p.xyz).to_lab(white),
                 Xyz::from_array(predicted).to_lab(white),
             );
-            VerifiedPatch {
+            Ok(VerifiedPatch {
                 label: p.label.clone(),
                 rgb8: p.rgb8,
                 measured_xyz: p.xyz,
                 predicted_xyz: predicted,
                 delta_e00: de,
-            }
+            })
         })
-        .collect();
+        .collect::<Result<_, VerifyError>>()?;
     if verified.is_empty() {
-        return None;
+        return Ok(None);
     }
     let mut sorted: Vec<f64> = verified.iter().map(|v| v.delta_e00).collect();
     sorted.sort_by(f64::total_cmp);
     let mean = sorted.iter().sum::<f64>() / sorted.len() as f64;
-    Some(Verification {
+    Ok(Some(Verification {
         white_xyz,
         mean,
         p95: percentile(&sorted, 0.95),
         max: *sorted.last().expect("not empty"),
         patches: verified,
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -213,7 +218,7 @@ mod tests {
             let y = ((l + 16.0) / 116.0).powi(3) * 100.0;
             white.map(|w| w * y / 100.0)
         };
-        let v = verify(&patches, white, &predict).unwrap();
+        let v = verify(&patches, white, &predict).unwrap().unwrap();
         assert_eq!(v.patches.len(), 20);
         for (k, p) in v.patches.iter().enumerate() {
             let dl = (k + 1) as f64 / 10.0;
@@ -233,6 +238,17 @@ mod tests {
         assert!((v.p95 - p95).abs() < 1e-12);
         let mean = v.patches.iter().map(|p| p.delta_e00).sum::<f64>() / 20.0;
         assert!((v.mean - mean).abs() < 1e-12);
-        assert!(verify(&patches[..1], white, &predict).is_none());
+        assert!(verify(&patches[..1], white, &predict).unwrap().is_none());
+        // A model that predicts one patch as no colour is an error naming that patch, not
+        // a NaN mean.
+        let broken = |rgb: [f64; 3]| {
+            if (rgb[0] * 255.0).round() == 7.0 {
+                [f64::NAN; 3]
+            } else {
+                predict(rgb)
+            }
+        };
+        let e = verify(&patches, white, &broken).unwrap_err().to_string();
+        assert!(e.contains("for patch 8 (r,g,b = "), "{e}");
     }
 }
