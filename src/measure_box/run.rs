@@ -105,13 +105,11 @@ impl MeasureBoxError {
                 total,
                 label,
                 prepare,
-                done,
-                journal,
-                source,
+                ..
             } => Some(format!(
-                "stage {stage}, reading {} of {total} ({label}: {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+                "stage {stage}, reading {} of {total} ({label}: {prepare}): {}",
                 index + 1,
-                journal.display()
+                source.safe_so_far()?
             )),
             _ => None,
         }
@@ -122,13 +120,7 @@ impl Outcome {
     /// Whether the session was interrupted (Ctrl-C, a signal): a failure to the caller,
     /// though every reading taken is safe.
     pub fn is_interrupted(&self) -> bool {
-        matches!(
-            self,
-            Outcome::Incomplete {
-                end: RunEnd::Interrupted { .. },
-                ..
-            }
-        )
+        matches!(self, Outcome::Incomplete { end, .. } if end.is_interrupted())
     }
 
     /// What is still to measure and how to continue, said with `measure-box`'s flags;

@@ -70,6 +70,28 @@ pub enum SessionError {
     },
 }
 
+impl SessionError {
+    /// For a reading that failed midway: the failure, then that the readings before it are
+    /// safe in the journal and how to go on. The caller puts which reading it was in front,
+    /// in its own words. None for the other errors.
+    pub fn safe_so_far(&self) -> Option<String> {
+        let SessionError::Step {
+            total,
+            done,
+            journal,
+            source,
+            ..
+        } = self
+        else {
+            return None;
+        };
+        Some(format!(
+            "{source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+            journal.display()
+        ))
+    }
+}
+
 /// Which setting of which instrument differs between a journal and the session resuming it.
 #[derive(Debug)]
 pub struct SettingDiffers {
@@ -102,6 +124,14 @@ pub enum RunEnd {
     Interrupted { missing: usize },
     /// The operator declined a request, with this many steps still missing.
     Aborted { missing: usize },
+}
+
+impl RunEnd {
+    /// Whether the run was interrupted (Ctrl-C, a signal): a failure to the caller, though
+    /// every reading taken is safe.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, RunEnd::Interrupted { .. })
+    }
 }
 
 /// A session bound to its journal.

@@ -74,22 +74,26 @@ impl Spec {
     /// [`check`](Self::check) or when opened, with the forms the registry offers.
     pub fn new(text: impl Into<String>) -> Spec {
         let text = text.into();
-        let (word, rest) = text.split_once(':').unwrap_or((&text, ""));
-        let has_rest = text.contains(':');
-        let kind = match word {
-            SIM_PREFIX if has_rest => {
+        // A word without a colon (`sim`, `replay`, `i1pro`) is a device prefix: only
+        // `sim:` and `replay:` begin a simulation or a transcript.
+        let kind = match text.split_once(':') {
+            Some((SIM_PREFIX, rest)) => {
                 let (model, options) = rest.split_once('?').unwrap_or((rest, ""));
                 Kind::Simulated {
                     model: model.to_string(),
                     options: options.to_string(),
                 }
             }
-            REPLAY_PREFIX if has_rest => Kind::Replay {
+            Some((REPLAY_PREFIX, rest)) => Kind::Replay {
                 file: rest.to_string(),
             },
-            prefix => Kind::Device {
+            Some((prefix, address)) => Kind::Device {
                 prefix: prefix.to_string(),
-                address: rest.to_string(),
+                address: address.to_string(),
+            },
+            None => Kind::Device {
+                prefix: text.clone(),
+                address: String::new(),
             },
         };
         Spec { text, kind }

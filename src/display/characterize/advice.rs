@@ -33,13 +33,11 @@ impl CharacterizeError {
                 total,
                 label,
                 prepare,
-                done,
-                journal,
-                source,
+                ..
             } => Some(format!(
-                "patch {} of {total} ({label}, {prepare}): {source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+                "patch {} of {total} ({label}, {prepare}): {}",
                 index + 1,
-                journal.display()
+                e.safe_so_far()?
             )),
             _ => None,
         }
@@ -50,13 +48,7 @@ impl Outcome {
     /// Whether the session was interrupted (Ctrl-C, a signal): a failure to the caller,
     /// though every reading taken is safe.
     pub fn is_interrupted(&self) -> bool {
-        matches!(
-            self,
-            Outcome::Incomplete {
-                end: RunEnd::Interrupted { .. },
-                ..
-            }
-        )
+        matches!(self, Outcome::Incomplete { end, .. } if end.is_interrupted())
     }
 
     /// What is still to measure and how to continue; None when finished.
@@ -124,5 +116,50 @@ fn setting_flag(setting: &str) -> String {
             Some(sim) => format!("simulation's {sim} (--instrument sim:…?{sim}=)"),
             None => s.to_string(),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::*;
+    use crate::session::{Prepare, StepFailure};
+
+    fn failed_step() -> SessionError {
+        SessionError::Step {
+            index: 6,
+            total: 62,
+            label: "red 3".into(),
+            prepare: Prepare::Show { rgb: [128, 0, 0] },
+            done: 6,
+            journal: PathBuf::from("out/log.jsonl"),
+            source: Box::new(StepFailure::NoScreen),
+        }
+    }
+
+    /// The words a user acts on after a reading failed, written out by hand: which patch,
+    /// what failed, what is safe, and the flag that goes on. The same tail as measure-box's.
+    #[test]
+    fn a_failed_reading_says_which_patch_what_is_safe_and_how_to_go_on() {
+        let e = CharacterizeError::Session(failed_step());
+        assert_eq!(
+            e.advice().unwrap(),
+            "patch 7 of 62 (red 3, RGB [128, 0, 0]): the plan shows drive values but the rig \
+             has no screen\n  6 of 62 readings are safe in out/log.jsonl; fix the cause and \
+             run the same command with --resume"
+        );
+        let box_error = crate::measure_box::MeasureBoxError::Session {
+            stage: crate::measure_box::Stage::Spots,
+            source: failed_step(),
+        };
+        assert_eq!(
+            box_error.advice().unwrap(),
+            "stage spots, reading 7 of 62 (red 3: RGB [128, 0, 0]): the plan shows drive \
+             values but the rig has no screen\n  6 of 62 readings are safe in out/log.jsonl; \
+             fix the cause and run the same command with --resume"
+        );
+        let other = SessionError::Plan(serde_json::from_str::<u8>("x").unwrap_err());
+        assert!(other.safe_so_far().is_none());
     }
 }
