@@ -160,6 +160,17 @@ pub enum ReadingsError {
     Empty { file: PathBuf, message: String },
 }
 
+impl ReadingsError {
+    /// The file the error is about.
+    pub fn file(&self) -> &Path {
+        match self {
+            ReadingsError::Io { file, .. }
+            | ReadingsError::Bad { file, .. }
+            | ReadingsError::Empty { file, .. } => file,
+        }
+    }
+}
+
 /// A patch as a row names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum PatchId {
