@@ -5,16 +5,11 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use metamer::color::Xyz;
-use metamer::output::OutputPolicy;
 use metamer::validation::export::{comparisons, to_json};
-use metamer::validation::plausible;
-use metamer::validation::readings::Format;
-use metamer::validation::report::{InputFile, InstrumentUsed};
-use metamer::validation::{
-    assess, read_readings, write_report_files, AssessOptions, Assessment, Propagation, ReadingSet,
-    ReportInput, ValidationError,
+use metamer::validation::job::{
+    read_sides, validate, Context, Coverage, Outcome, ReadingFiles, Request, White,
 };
+use metamer::validation::{AssessOptions, Assessment, Propagation, ValidationError};
 
 use super::{parse_triple, CliError, CliResult};
 
@@ -81,6 +76,54 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
+    check_numbers(&args)?;
+    let readings = ReadingFiles {
+        box_readings: &args.reference,
+        display: &args.test,
+        simulation: args.simulation.as_deref(),
+    };
+    let white = match args.white.as_str() {
+        "test" => White::Display,
+        "reference" => White::Box,
+        s => match parse_triple(s) {
+            Ok(v) => White::Given(v),
+            // A file that cannot be read is said before a malformed white.
+            Err(e) => {
+                read_sides(&readings, true)?;
+                return Err(CliError::Usage(format!("--white: {e}")));
+            }
+        },
+    };
+    let propagation = match args.propagation {
+        PropagationArg::MonteCarlo => Propagation::MonteCarlo {
+            draws: args.draws,
+            seed: args.seed,
+        },
+        PropagationArg::Linear => Propagation::Linear,
+    };
+    let outcome = validate(&Request {
+        readings,
+        white,
+        options: AssessOptions {
+            propagation,
+            model_term_de: args.model_term,
+        },
+        out_of_gamut: args.out_of_gamut.clone(),
+        coverage: Coverage::Shared,
+        check_readings: true,
+        context: Context::Files,
+        point_files: false,
+        title: args.title.clone(),
+        out: &args.out,
+        force: args.force,
+    })
+    .map_err(refusal)?;
+    print(&outcome, args.json);
+    Ok(())
+}
+
+/// The numbers the library takes as given, checked as this command's options.
+fn check_numbers(args: &Args) -> CliResult {
     if args.draws < 100 {
         return Err(CliError::Usage(
             "--draws must be at least 100 for a 95 % interval".into(),
@@ -104,151 +147,41 @@ pub fn run(args: Args) -> CliResult {
             "--out-of-gamut: patch {bad} is not 1–24"
         )));
     }
-    let reference = read_readings(&args.reference)?;
-    let test = read_readings(&args.test)?;
-    let simulation = args.simulation.as_deref().map(read_readings).transpose()?;
-    let sets: Vec<&ReadingSet> = [&reference, &test].into_iter().chain(&simulation).collect();
-    for set in &sets {
-        plausible::check_luminance(set)?;
-    }
-    let (white, white_source) = match args.white.as_str() {
-        "test" => test.white_or_brightest(),
-        "reference" => reference.white_or_brightest(),
-        s => {
-            let v = parse_triple(s).map_err(|e| CliError::Usage(format!("--white: {e}")))?;
-            metamer_color::check_xyz(v)
-                .map_err(|e| CliError::Usage(format!("--white: not a white: {e}")))?;
-            let white = Xyz::from_array(v);
-            plausible::check_given_white(white)
-                .and_then(|()| plausible::check_white_against(white, &sets))
-                .map_err(|e| CliError::Usage(format!("--white: {e}")))?;
-            (white, "given on the command line".to_string())
-        }
-    };
-    if args.white == "test" || args.white == "reference" {
-        plausible::check_white_against(white, &sets)?;
-    }
-    let opts = AssessOptions {
-        propagation: match args.propagation {
-            PropagationArg::MonteCarlo => Propagation::MonteCarlo {
-                draws: args.draws,
-                seed: args.seed,
-            },
-            PropagationArg::Linear => Propagation::Linear,
-        },
-        model_term_de: args.model_term,
-    };
-    // The display model's term and the display's gamut belong to the comparisons that
-    // have the display on one side; box vs simulation never went through the display.
-    let run = |r: &ReadingSet, rn: &str, t: &ReadingSet, tn: &str, display: bool| {
-        let o = AssessOptions {
-            model_term_de: if display { opts.model_term_de } else { 0.0 },
-            ..opts
-        };
-        assess(rn, r, tn, t, white, &o).map(|mut a| {
-            for p in &mut a.patches {
-                p.out_of_gamut |= display && args.out_of_gamut.contains(&p.patch);
-            }
-            a
-        })
-    };
-    let box_vs_display = run(&reference, "box", &test, "display", true).map_err(bad_white)?;
-    let (box_vs_simulation, display_vs_simulation) = match &simulation {
-        Some(s) => (
-            Some(run(&reference, "box", s, "simulation", false).map_err(bad_white)?),
-            Some(run(s, "simulation", &test, "display", true).map_err(bad_white)?),
-        ),
-        None => (None, None),
-    };
-    let mut input = ReportInput {
-        title: args.title.clone(),
-        white_source,
-        box_vs_display: Some(box_vs_display),
-        box_vs_simulation,
-        display_vs_simulation,
-        out_of_gamut: args.out_of_gamut.clone(),
-        ..ReportInput::default()
-    };
-    input.notes.extend(plausible::scale_note(&reference, &test));
-    for (role, set) in [
-        ("box", Some(&reference)),
-        ("display", Some(&test)),
-        ("simulation", simulation.as_ref()),
-    ] {
-        let Some(set) = set else { continue };
-        input.inputs.push(InputFile {
-            role: role.into(),
-            path: set.file.display().to_string(),
-            format: set.format.name().into(),
-            patches: set.patches.len(),
-            sha256: metamer::digest::sha256_file(&set.file).ok(),
-        });
-        for name in &set.instruments {
-            input.instruments.push(InstrumentUsed {
-                role: role.into(),
-                model: name.clone(),
-                ..InstrumentUsed::default()
-            });
-        }
-        for note in &set.notes {
-            input.notes.push(format!("{}: {note}", set.file.display()));
-        }
-        if set.format == Format::RenderJson {
-            input.render_confidence = Some(render_confidence(set));
-        }
-    }
-    let mut policy = OutputPolicy::new(args.force);
-    policy.inputs(
-        [&args.reference, &args.test]
-            .into_iter()
-            .chain(&args.simulation)
-            .map(PathBuf::as_path),
-    );
-    let files = write_report_files(&args.out, &input, &policy).map_err(|e| match e {
+    Ok(())
+}
+
+/// The library's refusals of what this command's options gave, worded as such.
+fn refusal(e: ValidationError) -> CliError {
+    match e {
+        ValidationError::GivenWhite(m) => CliError::Usage(format!("--white: {m}")),
+        // A white that makes CIELAB meaningless is the user's input, not a data fault.
+        ValidationError::BadWhite { .. } => CliError::Usage(format!("--white: {e}")),
         ValidationError::Output(o) if o.needs_force() => CliError::Usage(format!(
             "{o}: pass --force to replace the report, or choose another -o directory"
         )),
         e => CliError::from(e),
-    })?;
-    if args.json {
-        println!("{}", to_json(&input));
-        return Ok(());
+    }
+}
+
+fn print(outcome: &Outcome, json: bool) {
+    let input = &outcome.report;
+    if json {
+        println!("{}", to_json(input));
+        return;
     }
     for note in &input.notes {
         eprintln!("note: {note}");
     }
+    let white = outcome.white;
     println!(
         "white X Y Z = {:.4} {:.4} {:.4} ({})",
         white.x, white.y, white.z, input.white_source
     );
-    for (_, a) in comparisons(&input) {
+    for (_, a) in comparisons(input) {
         print_table(a);
     }
-    for f in files {
+    for f in &outcome.files {
         println!("wrote {}", f.display());
-    }
-    Ok(())
-}
-
-/// A white that makes CIELAB meaningless is the user's input, not a data fault.
-fn bad_white(e: ValidationError) -> CliError {
-    match e {
-        ValidationError::BadWhite { .. } => CliError::Usage(format!("--white: {e}")),
-        e => CliError::from(e),
-    }
-}
-
-fn render_confidence(set: &ReadingSet) -> metamer::validation::report::RenderConfidenceSection {
-    metamer::validation::report::RenderConfidenceSection {
-        method: format!("{} ({})", set.file.display(), set.format.name()),
-        target_de: None,
-        per_patch: set
-            .patches
-            .iter()
-            .filter_map(|(k, p)| Some((*k, p.render_de95?)))
-            .collect(),
-        measure: "95 % ΔE*ab half-width or error bound".into(),
-        ..Default::default()
     }
 }
 

@@ -28,4 +28,22 @@ pub enum ValidationError {
         file: std::path::PathBuf,
         message: String,
     },
+    #[error(transparent)]
+    Readings(#[from] super::readings::ReadingsError),
+    #[error(transparent)]
+    Implausible(#[from] super::plausible::Implausible),
+    /// The white the caller gave is no white for these readings (the command line words
+    /// it as a refusal of its option).
+    #[error("{0}")]
+    GivenWhite(String),
+    /// Under [`super::job::Coverage::Same`], two sides read different patches.
+    #[error("readings: the {first} readings are of patches {first_patches:?} but the {second} readings of {second_patches:?}")]
+    DifferentPatches {
+        first: &'static str,
+        first_patches: Vec<usize>,
+        second: &'static str,
+        second_patches: Vec<usize>,
+    },
+    #[error("writing JSON: {0}")]
+    Json(#[source] serde_json::Error),
 }

@@ -2,12 +2,14 @@
 //! the display showing the rendering, the simulation) compared in CIELAB with the display's
 //! white as reference white, as in the paper (JND ΔE*ab ≈ 2.3; CIEDE2000 reported too).
 //!
-//! [`compare`] is the plain comparison of two lists of XYZ (the simulated lab's); `validate`
-//! reads measured files ([`readings`]), propagates their uncertainty ([`propagate`],
-//! [`assess`]) and writes the report ([`figures`], [`report`], [`export`]).
+//! [`compare`] is the plain comparison of two lists of XYZ (the simulated lab's);
+//! [`job::validate`], the one entry of `metamer validate` and the experiment's validation
+//! stage, reads measured files ([`readings`]), propagates their uncertainty
+//! ([`propagate`], [`assess`]) and writes the report ([`figures`], [`report`], [`export`]).
 
 pub mod assess;
 mod chart;
+pub mod comparisons;
 pub mod covariance;
 #[cfg(test)]
 mod coverage;
@@ -15,6 +17,7 @@ mod error;
 pub mod export;
 pub mod figures;
 pub mod inversion;
+pub mod job;
 pub mod montecarlo;
 pub mod plausible;
 pub mod propagate;

@@ -160,15 +160,23 @@ pub enum ReadingsError {
     Empty { file: PathBuf, message: String },
 }
 
+impl ReadingsError {
+    /// The file the error is about.
+    pub fn file(&self) -> &Path {
+        match self {
+            ReadingsError::Io { file, .. }
+            | ReadingsError::Bad { file, .. }
+            | ReadingsError::Empty { file, .. } => file,
+        }
+    }
+}
+
 /// A patch as a row names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum PatchId {
     Number(usize),
     White,
 }
-
-/// Largest 95 % ΔE*ab bound a renderer may state: CIELAB's whole gamut spans a few hundred.
-const MAX_DE95: f64 = 1000.0;
 
 /// One reading or row before the repeats of a patch are combined.
 #[derive(Clone, Debug)]
@@ -242,33 +250,39 @@ pub fn parse_readings(text: &str, file: &Path) -> Result<ReadingSet, ReadingsErr
         instruments: Vec::new(),
         notes: Vec::new(),
     };
-    let format = if first.starts_with('{') {
+    let format = p.by_format(first, text)?;
+    let mut set = p.finish(format)?;
+    set.measured_as = not_luminance(text, format);
+    Ok(set)
+}
+
+impl Parsed {
+    /// Parses `text` in the format its first line `first` shows: a journal's header, a
+    /// render's JSON document, `spot --json` lines, else CSV.
+    fn by_format(&mut self, first: &str, text: &str) -> Result<Format, ReadingsError> {
+        if !first.starts_with('{') {
+            self.csv(text)?;
+            return Ok(Format::Csv);
+        }
         let head: Option<Value> = serde_json::from_str(first).ok();
         let is_journal = head
             .as_ref()
             .is_some_and(|v| v["type"] == "header" || v["format"] == "metamer-session-journal");
         if is_journal {
-            p.journal(text)?;
-            Format::Journal
-        } else if let Ok(whole) = serde_json::from_str::<Value>(text) {
-            if whole.get("patches").is_some() {
-                p.render(&whole)?;
-                Format::RenderJson
-            } else {
-                p.spot_lines(text)?;
-                Format::SpotJson
-            }
-        } else {
-            p.spot_lines(text)?;
-            Format::SpotJson
+            self.journal(text)?;
+            return Ok(Format::Journal);
         }
-    } else {
-        p.csv(text)?;
-        Format::Csv
-    };
-    let mut set = p.finish(format)?;
-    set.measured_as = not_luminance(text, format);
-    Ok(set)
+        match serde_json::from_str::<Value>(text) {
+            Ok(whole) if whole.get("patches").is_some() => {
+                self.render(&whole)?;
+                Ok(Format::RenderJson)
+            }
+            _ => {
+                self.spot_lines(text)?;
+                Ok(Format::SpotJson)
+            }
+        }
+    }
 }
 
 /// How readings in `text` (a journal) were taken, when not as light from the scene: the
@@ -337,83 +351,6 @@ impl Parsed {
             self.instruments.push(name.to_string());
         }
     }
-
-    /// A row no instrument or renderer can have produced (X = −1e308, a spread of 1e308)
-    /// is refused where it enters: downstream it becomes an infinite CIELAB and a figure
-    /// whose axis never ends.
-    fn plausible(&self, r: &Row) -> Result<(), ReadingsError> {
-        metamer_color::check_xyz(r.xyz)
-            .map_err(|e| self.bad(r.line, format!("not a measurement: {e}")))?;
-        for (what, spread) in [("standard deviation", r.sd), ("standard error", r.stderr)] {
-            if let Some(v) = spread {
-                if !metamer_color::plausible_spread(v) {
-                    return Err(self.bad(
-                        r.line,
-                        format!(
-                            "a {what} of {v:?}: must be ≥ 0 and at most {:e}",
-                            metamer_color::MAX_CD_M2
-                        ),
-                    ));
-                }
-            }
-        }
-        if let Some(c) = r.covariance() {
-            covariance::check(&c).map_err(|e| self.bad(r.line, e))?;
-        }
-        if let Some(u) = r.u_lab {
-            if !(0.0..=MAX_DE95).contains(&u) {
-                return Err(self.bad(
-                    r.line,
-                    format!("u_lab {u:?}: must be ≥ 0 and at most {MAX_DE95}"),
-                ));
-            }
-        }
-        if let Some((de, _)) = r.de95 {
-            if !(0.0..=MAX_DE95).contains(&de) {
-                return Err(self.bad(
-                    r.line,
-                    format!("a 95 % ΔE*ab bound of {de:?}: must be ≥ 0 and at most {MAX_DE95}"),
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    fn finish(self, format: Format) -> Result<ReadingSet, ReadingsError> {
-        if self.rows.is_empty() {
-            return Err(ReadingsError::Empty {
-                file: self.file,
-                message: format!(
-                    "no readings of ColorChecker patches found ({}); journal entries need a patch number in their step data",
-                    format.name()
-                ),
-            });
-        }
-        for r in &self.rows {
-            self.plausible(r)?;
-        }
-        let mut groups: BTreeMap<usize, Vec<&Row>> = BTreeMap::new();
-        let mut white = Vec::new();
-        for r in &self.rows {
-            match r.patch {
-                PatchId::Number(k) => groups.entry(k).or_default().push(r),
-                PatchId::White => white.push(r),
-            }
-        }
-        let patches = groups
-            .into_iter()
-            .map(|(k, rows)| (k, combine(&rows)))
-            .collect();
-        Ok(ReadingSet {
-            file: self.file,
-            format,
-            patches,
-            white: (!white.is_empty()).then(|| combine(&white)),
-            instruments: self.instruments,
-            notes: self.notes,
-            measured_as: None,
-        })
-    }
 }
 
 /// The ColorChecker patch of a journal entry: the step data's `patch` (1-based ColorChecker
@@ -459,96 +396,9 @@ fn patch_id(v: &Value) -> Option<PatchId> {
     }
 }
 
-/// Combines the rows of one patch: the equal-weight mean and the covariance of that mean —
-/// from the given covariances where every row has them (each row's over its n; the mean's
-/// Σ/k²), else from the scatter of the rows when there are several (their sample
-/// covariance over k, with k − 1 degrees of freedom), else from a renderer's confidence,
-/// else, for one reading of a named instrument, from its stated repeatability; unknown (0)
-/// for one bare reading.
-fn combine(rows: &[&Row]) -> PatchReading {
-    let k = rows.len() as f64;
-    let mut mean = [0.0; 3];
-    for r in rows {
-        for (m, x) in mean.iter_mut().zip(r.xyz) {
-            *m += x / k;
-        }
-    }
-    let n: usize = rows.iter().map(|r| r.n).sum();
-    let axes = |u: [f64; 3]| -> Vec<[f64; 3]> {
-        (0..3)
-            .filter(|&i| u[i] > 0.0)
-            .map(|i| {
-                let mut v = [0.0; 3];
-                v[i] = u[i];
-                v
-            })
-            .collect()
-    };
-    let stated = (rows.len() == 1)
-        .then(|| {
-            let r = rows[0];
-            let rep = Repeatability::emissive_of(r.instrument.as_deref()?)?;
-            rep.covariance(r.xyz)
-        })
-        .flatten();
-    let (u_factors, dof, source) = if let Some(given) = rows
-        .iter()
-        .map(|r| r.covariance())
-        .collect::<Option<Vec<Cov3>>>()
-    {
-        let mut c = covariance::ZERO;
-        for (r, g) in rows.iter().zip(&given) {
-            c = covariance::sum(&c, &covariance::scaled(g, 1.0 / (r.n as f64 * k * k)));
-        }
-        // A standard deviation of one reading is a stated one; of several, their sample's.
-        let dof = rows.iter().filter(|r| r.n > 1).map(|r| r.n - 1).min();
-        (covariance::factors(&c), dof, UncertaintySource::Given)
-    } else if rows.len() >= 2 {
-        let scale = (k * (k - 1.0)).sqrt();
-        let factors = rows
-            .iter()
-            .map(|r| [0, 1, 2].map(|i| (r.xyz[i] - mean[i]) / scale))
-            .collect();
-        (factors, Some(rows.len() - 1), UncertaintySource::Repeats)
-    } else if let Some(se) = rows[0].stderr {
-        (axes(se), None, UncertaintySource::Render)
-    } else if rows[0].de95.is_some() || rows[0].u_lab.is_some() {
-        (Vec::new(), None, UncertaintySource::Render)
-    } else if let Some(c) = stated {
-        (covariance::factors(&c), None, UncertaintySource::Instrument)
-    } else {
-        (Vec::new(), None, UncertaintySource::Unknown)
-    };
-    let u_xyz = covariance::sd(&covariance::of_factors(&u_factors));
-    // A ΔE statement stands for what the XYZ standard error does not say (a radiosity
-    // solver's discretisation); with a standard error it would count the same noise twice.
-    let from_de = match rows[0].de95 {
-        Some((de, how)) if rows[0].stderr.is_none() && rows.len() == 1 => render_lab_sigma(de, how),
-        _ => 0.0,
-    };
-    let given_lab = rows.iter().filter_map(|r| r.u_lab).fold(0.0, f64::max);
-    let u_lab = from_de.hypot(given_lab);
-    let source = if source == UncertaintySource::Given && u_factors.is_empty() && u_lab > 0.0 {
-        UncertaintySource::Render
-    } else {
-        source
-    };
-    PatchReading {
-        xyz: mean,
-        u_xyz,
-        u_factors,
-        dof,
-        u_lab,
-        render_de95: rows[0].de95.map(|d| d.0),
-        n,
-        source,
-        out_of_gamut: rows.iter().any(|r| r.out_of_gamut),
-        line: rows[0].line,
-    }
-}
-
 mod csv;
 mod json;
+mod rows;
 
 #[cfg(test)]
 mod tests;

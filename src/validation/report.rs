@@ -20,7 +20,7 @@ use super::verdict::verdict_paragraph;
 
 pub use super::report_input::{
     DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
-    ReportInput,
+    RenderUncertainty, ReportInput, Sections,
 };
 
 /// The page's style: readable from a 390 px phone to print. Text runs at most 1000 px wide,

@@ -1,9 +1,12 @@
 //! What a validation report shows, as data: the comparisons and the optional sections a
 //! caller fills (the experiment fills them all, `validate` what its files hold).
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 use super::assess::Assessment;
+use super::readings::{ReadingSet, UncertaintySource};
 
 /// Everything a report can show. `box_vs_display` is the paper's result and always there;
 /// the rest is drawn when given.
@@ -99,4 +102,42 @@ pub struct InputFile {
     /// SHA-256 of its bytes (hex), where known.
     #[serde(default)]
     pub sha256: Option<String>,
+}
+
+/// The sections a caller gathers beside the readings (the experiment from its earlier
+/// stages' files), each missing one noted.
+#[derive(Clone, Debug, Default)]
+pub struct Sections {
+    pub display_model: Option<DisplayModelSection>,
+    pub light_fit: Option<LightFitSection>,
+    pub render_confidence: Option<RenderConfidenceSection>,
+    /// The simulation's per-patch uncertainty, to enter the comparisons' intervals.
+    pub render_uncertainty: Option<RenderUncertainty>,
+    pub instruments: Vec<InstrumentUsed>,
+    pub inputs: Vec<InputFile>,
+    pub notes: Vec<String>,
+}
+
+/// The simulation's uncertainty per patch, to enter the comparisons' intervals.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderUncertainty {
+    /// Patch → per-axis CIELAB standard uncertainty.
+    pub sigma_lab: BTreeMap<usize, f64>,
+    /// What it is, for the report.
+    pub description: String,
+}
+
+impl RenderUncertainty {
+    /// Gives each simulated patch of `set` the render's uncertainty (its XYZ carry none
+    /// of their own: the stage writes one rendered value per patch).
+    pub fn apply(&self, set: &mut ReadingSet) {
+        for (k, p) in set.patches.iter_mut() {
+            if let Some(s) = self.sigma_lab.get(k) {
+                p.u_lab = (p.u_lab.powi(2) + s.powi(2)).sqrt();
+                if p.u_factors.is_empty() {
+                    p.source = UncertaintySource::Render;
+                }
+            }
+        }
+    }
 }

@@ -14,11 +14,8 @@ mod render;
 use std::path::{Path, PathBuf};
 
 use crate::digest::sha256_file;
-use crate::validation::report::{
-    DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
-};
-
-pub use render::RenderUncertainty;
+use crate::validation::report::InputFile;
+pub use crate::validation::report::{RenderUncertainty, Sections};
 
 /// Where the stages' files are.
 #[derive(Clone, Debug)]
@@ -50,19 +47,6 @@ impl Layout {
             display_spots_dir: stage(super::Stage::DisplaySpots),
         }
     }
-}
-
-/// Everything gathered for the report.
-#[derive(Clone, Debug, Default)]
-pub struct Sections {
-    pub display_model: Option<DisplayModelSection>,
-    pub light_fit: Option<LightFitSection>,
-    pub render_confidence: Option<RenderConfidenceSection>,
-    /// The simulation's per-patch uncertainty, to enter the comparisons' intervals.
-    pub render_uncertainty: Option<RenderUncertainty>,
-    pub instruments: Vec<InstrumentUsed>,
-    pub inputs: Vec<InputFile>,
-    pub notes: Vec<String>,
 }
 
 /// Gathers every section from the files under `layout`.

@@ -2,40 +2,15 @@
 //! ΔE*ab statement (the path tracer's 95 % half-width, the radiosity solver's bound), the
 //! time, and the same statement as a CIELAB standard uncertainty for the comparisons.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::files::{read_json, unusable};
 use crate::experiment::simulation::{SimulationSummary, SUMMARY_FILE};
 use crate::validation::propagate::{render_lab_sigma, RenderStatement};
-use crate::validation::readings::{ReadingSet, UncertaintySource};
 use crate::validation::report::RenderConfidenceSection;
+pub use crate::validation::report::RenderUncertainty;
 
 const WHAT: &str = "render confidence";
-
-/// The simulation's uncertainty per patch, to enter the comparisons' intervals.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderUncertainty {
-    /// Patch → per-axis CIELAB standard uncertainty.
-    pub sigma_lab: BTreeMap<usize, f64>,
-    /// What it is, for the report.
-    pub description: String,
-}
-
-impl RenderUncertainty {
-    /// Gives each simulated patch of `set` the render's uncertainty (its XYZ carry none
-    /// of their own: the stage writes one rendered value per patch).
-    pub fn apply(&self, set: &mut ReadingSet) {
-        for (k, p) in set.patches.iter_mut() {
-            if let Some(s) = self.sigma_lab.get(k) {
-                p.u_lab = (p.u_lab.powi(2) + s.powi(2)).sqrt();
-                if p.u_factors.is_empty() {
-                    p.source = UncertaintySource::Render;
-                }
-            }
-        }
-    }
-}
 
 /// The section and the uncertainty, or the note saying why there are none.
 pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty), String> {

@@ -14,6 +14,18 @@
 
 use super::*;
 
+/// Where each column of a CSV header is.
+struct Columns {
+    names: Vec<String>,
+    patch: usize,
+    xyz: [usize; 3],
+    sd: Option<[usize; 3]>,
+    cov: Option<[usize; 3]>,
+    n: Option<usize>,
+    out_of_gamut: Option<usize>,
+    u_lab: Option<usize>,
+}
+
 impl Parsed {
     /// `patch,X,Y,Z` and the optional columns above.
     pub(super) fn csv(&mut self, text: &str) -> Result<(), ReadingsError> {
@@ -23,6 +35,16 @@ impl Parsed {
             .map(|(i, l)| (i + 1, l.trim()))
             .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
         let (hline, header) = lines.next().expect("sniffed a first line");
+        let columns = self.csv_header(hline, header)?;
+        for (line, l) in lines {
+            let row = self.csv_row(&columns, line, l)?;
+            self.rows.push(row);
+        }
+        Ok(())
+    }
+
+    /// The header's columns: the four required, each optional group whole or absent.
+    fn csv_header(&self, hline: usize, header: &str) -> Result<Columns, ReadingsError> {
         let names: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
         let col = |name: &str| names.iter().position(|n| n.eq_ignore_ascii_case(name));
         let need = |name: &str| {
@@ -36,7 +58,7 @@ impl Parsed {
                 )
             })
         };
-        let (cp, cx, cy, cz) = (need("patch")?, need("X")?, need("Y")?, need("Z")?);
+        let (patch, x, y, z) = (need("patch")?, need("X")?, need("Y")?, need("Z")?);
         let sd = match (col("sd_X"), col("sd_Y"), col("sd_Z")) {
             (Some(a), Some(b), Some(c)) => Some([a, b, c]),
             (None, None, None) => None,
@@ -53,90 +75,101 @@ impl Parsed {
             }
             _ => return Err(self.bad(hline, "give all three of cov_XY, cov_XZ, cov_YZ or none")),
         };
-        let (cn, cg, cu) = (col("n"), col("out_of_gamut"), col("u_lab"));
-        for (line, l) in lines {
-            let cells: Vec<&str> = l.split(',').map(str::trim).collect();
-            if cells.len() != names.len() {
-                return Err(self.bad(
-                    line,
-                    format!(
-                        "expected {} cells as in the header, found {}",
-                        names.len(),
-                        cells.len()
-                    ),
-                ));
-            }
-            let num = |c: usize| -> Result<f64, ReadingsError> {
-                cells[c]
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| {
-                        self.bad(
-                            line,
-                            format!("{}: '{}' is not a number", names[c], echo(cells[c])),
-                        )
-                    })
-            };
-            let patch = patch_id(&Value::String(cells[cp].to_string())).ok_or_else(|| {
-                self.bad(
-                    line,
-                    format!(
-                        "patch '{}' is not 1–24, a ColorChecker name or 'white'",
-                        echo(cells[cp])
-                    ),
-                )
-            })?;
-            let sd = match sd {
-                Some(c) => {
-                    let v = [num(c[0])?, num(c[1])?, num(c[2])?];
-                    if v.iter().any(|s| *s < 0.0) {
-                        return Err(self.bad(line, "a standard deviation must be ≥ 0"));
-                    }
-                    Some(v)
-                }
-                None => None,
-            };
-            let n = match cn {
-                Some(c) => {
-                    let v = num(c)?;
-                    if v < 1.0 || v.fract() != 0.0 {
-                        return Err(self.bad(
-                            line,
-                            format!("n: '{}' must be a whole number ≥ 1", echo(cells[c])),
-                        ));
-                    }
-                    v as usize
-                }
-                None => 1,
-            };
-            let out_of_gamut = match cg {
-                Some(c) => match cells[c] {
-                    "1" | "true" | "yes" => true,
-                    "0" | "false" | "no" | "" => false,
-                    other => {
-                        return Err(self.bad(
-                            line,
-                            format!("out_of_gamut: '{}' is not 0 or 1", echo(other)),
-                        ))
-                    }
-                },
-                None => false,
-            };
-            let cov = match cov {
-                Some(c) => [num(c[0])?, num(c[1])?, num(c[2])?],
-                None => [0.0; 3],
-            };
-            let u_lab = cu.map(num).transpose()?;
-            self.rows.push(Row {
-                sd,
-                cov,
-                n,
-                u_lab,
-                out_of_gamut,
-                ..Row::reading(line, patch, [num(cx)?, num(cy)?, num(cz)?])
-            });
+        let (n, out_of_gamut, u_lab) = (col("n"), col("out_of_gamut"), col("u_lab"));
+        Ok(Columns {
+            names,
+            patch,
+            xyz: [x, y, z],
+            sd,
+            cov,
+            n,
+            out_of_gamut,
+            u_lab,
+        })
+    }
+
+    /// One data row under `c`; its cells are checked in the order of the columns' rules
+    /// (count, patch, spread, n, gamut flag, covariances, u_lab, X Y Z).
+    fn csv_row(&self, c: &Columns, line: usize, l: &str) -> Result<Row, ReadingsError> {
+        let cells: Vec<&str> = l.split(',').map(str::trim).collect();
+        if cells.len() != c.names.len() {
+            return Err(self.bad(
+                line,
+                format!(
+                    "expected {} cells as in the header, found {}",
+                    c.names.len(),
+                    cells.len()
+                ),
+            ));
         }
-        Ok(())
+        let num = |k: usize| -> Result<f64, ReadingsError> {
+            cells[k]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    self.bad(
+                        line,
+                        format!("{}: '{}' is not a number", c.names[k], echo(cells[k])),
+                    )
+                })
+        };
+        let three = |k: [usize; 3]| -> Result<[f64; 3], ReadingsError> {
+            Ok([num(k[0])?, num(k[1])?, num(k[2])?])
+        };
+        let patch = patch_id(&Value::String(cells[c.patch].to_string())).ok_or_else(|| {
+            self.bad(
+                line,
+                format!(
+                    "patch '{}' is not 1–24, a ColorChecker name or 'white'",
+                    echo(cells[c.patch])
+                ),
+            )
+        })?;
+        let sd = c.sd.map(three).transpose()?;
+        if sd.is_some_and(|v| v.iter().any(|s| *s < 0.0)) {
+            return Err(self.bad(line, "a standard deviation must be ≥ 0"));
+        }
+        let n = match c.n {
+            Some(k) => self.csv_count(line, num(k)?, cells[k])?,
+            None => 1,
+        };
+        let out_of_gamut = match c.out_of_gamut {
+            Some(k) => self.csv_flag(line, cells[k])?,
+            None => false,
+        };
+        let cov = c.cov.map(three).transpose()?.unwrap_or([0.0; 3]);
+        let u_lab = c.u_lab.map(num).transpose()?;
+        Ok(Row {
+            sd,
+            cov,
+            n,
+            u_lab,
+            out_of_gamut,
+            ..Row::reading(line, patch, three(c.xyz)?)
+        })
+    }
+
+    /// The `n` cell: a whole number of readings, at least one.
+    fn csv_count(&self, line: usize, v: f64, cell: &str) -> Result<usize, ReadingsError> {
+        if v < 1.0 || v.fract() != 0.0 {
+            return Err(self.bad(
+                line,
+                format!("n: '{}' must be a whole number ≥ 1", echo(cell)),
+            ));
+        }
+        Ok(v as usize)
+    }
+
+    /// The `out_of_gamut` cell: 1 / true / yes, or 0 / false / no / empty.
+    fn csv_flag(&self, line: usize, cell: &str) -> Result<bool, ReadingsError> {
+        match cell {
+            "1" | "true" | "yes" => Ok(true),
+            "0" | "false" | "no" | "" => Ok(false),
+            other => Err(self.bad(
+                line,
+                format!("out_of_gamut: '{}' is not 0 or 1", echo(other)),
+            )),
+        }
     }
 }
