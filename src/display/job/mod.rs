@@ -2,5 +2,7 @@
 //! events for what is worth saying while it runs, and a report of what it made. The
 //! commands in `src/cli/` only parse their flags into the request and print.
 
+pub mod budget;
 pub mod fit;
 pub mod reproduce;
+pub mod verify;
