@@ -3,12 +3,9 @@
 
 use std::path::PathBuf;
 
-use metamer::display::budget::{run_budget_study, write_budget, RAMP_STEPS};
-use metamer::display::ModelKind;
-use metamer::rig::Preset;
+use metamer::display::job::budget::{self, Error, Request};
 
 use super::{CliError, CliResult};
-use metamer::output::OutputPolicy;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -34,57 +31,36 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    // Options that cannot work are refused before minutes of fitting.
-    if args.trials == 0 {
-        return Err(CliError::Usage(
-            "--trials must be at least 1: each trial is one fresh set of readings".into(),
-        ));
-    }
-    if args.out.exists() && !args.out.is_dir() {
-        return Err(CliError::Usage(format!(
-            "-o {}: is a file, but budget writes budget.csv and one chart per display into a \
-             directory",
-            args.out.display()
-        )));
-    }
-    let presets: Vec<Preset> = if args.displays.is_empty() {
-        Preset::ALL.to_vec()
-    } else {
-        args.displays
-            .iter()
-            .map(|s| s.parse())
-            .collect::<Result<_, String>>()
-            .map_err(CliError::Usage)?
+    let request = Request {
+        out: args.out,
+        displays: args.displays,
+        models: args.models,
+        trials: args.trials,
+        seed: args.seed,
+        force: args.force,
     };
-    let models: Vec<ModelKind> = if args.models.is_empty() {
-        ModelKind::ALL.to_vec()
-    } else {
-        args.models
-            .iter()
-            .map(|s| s.parse())
-            .collect::<Result<_, String>>()
-            .map_err(CliError::Usage)?
-    };
-    let out = OutputPolicy::new(args.force);
-    // Before the study, which takes minutes: a refused output is found now.
-    out.dir(&args.out)?;
-    out.check(&args.out.join("budget.csv"))?;
-    for p in &presets {
-        out.check(&args.out.join(format!("budget-{}.svg", p.name())))?;
-    }
-    let total = presets.len() * models.len() * RAMP_STEPS.len();
-    let bar = indicatif::ProgressBar::new(total as u64);
+    let bar = indicatif::ProgressBar::new(0);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:30} fit {pos}/{len} · about {eta} left")
             .expect("valid template"),
     );
-    let points = run_budget_study(&presets, &models, args.trials, args.seed, &|done, total| {
+    let points = budget::run(&request, &|done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64)
     });
     bar.finish_and_clear();
-    let points = points?;
-    write_budget(&args.out, &points, &out)?;
+    let points = points.map_err(|e| match e {
+        Error::NoTrials => CliError::Usage(
+            "--trials must be at least 1: each trial is one fresh set of readings".into(),
+        ),
+        Error::OutIsFile(path) => CliError::Usage(format!(
+            "-o {}: is a file, but budget writes budget.csv and one chart per display into a \
+             directory",
+            path.display()
+        )),
+        Error::UnknownName(text) => CliError::Usage(text),
+        e => CliError::from(e),
+    })?;
     println!("preset            model                   patches  mean ΔE00  p95 ΔE00  max ΔE00");
     for p in &points {
         println!(
@@ -92,6 +68,6 @@ pub fn run(args: Args) -> CliResult {
             p.preset, p.model, p.patches, p.mean_de00, p.p95_de00, p.max_de00
         );
     }
-    println!("wrote {}", args.out.display());
+    println!("wrote {}", request.out.display());
     Ok(())
 }

@@ -5,17 +5,14 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::ValueEnum;
-use metamer::display::characterize::finish::{files, Summary};
+use metamer::display::characterize::finish::Summary;
 use metamer::display::characterize::{
-    self, default_grid_steps, log_path, plan_advice, CharacterizeError, Options, Outcome, Plan,
-    PlanError, PlanOptions, DEFAULT_RAMP_STEPS,
+    self, default_grid_steps, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions,
+    Request, SimulatedMeter, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::ModelKind;
-use metamer::output::OutputPolicy;
 use metamer::rig::ScreenSpec;
-use metamer::session::{
-    attendance, on_ctrl_c, refuse_existing, Attendance, BarProgress, RunOptions, SessionError,
-};
+use metamer::session::{on_ctrl_c, BarProgress, ProgressSink, RunOptions};
 use metamer_drivers::{DriverError, Spec, Speed};
 
 use super::{CliError, CliResult};
@@ -78,80 +75,36 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let spec = ScreenSpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
+    let screen = ScreenSpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
-    let grid_steps = args
-        .grid_steps
-        .unwrap_or(default_grid_steps(model, args.ramp_steps));
-    let plan = PlanOptions {
-        ramp_steps: args.ramp_steps,
-        repeats: args.repeats,
-        grid_steps,
-    };
-    let planned = Plan::new(plan).map_err(|e| CliError::Usage(plan_usage(&e)))?;
-    if let Some(advice) = plan_advice(&planned) {
-        eprintln!("note: {advice}");
-    }
-    // Before anything is opened: a real meter with nobody to aim it is refused.
-    let attended =
-        attendance(&[&args.instrument], args.unattended).map_err(super::rig::nobody_at_the_rig)?;
-    if !args.resume {
-        // Before a full-screen window or an instrument is opened for nothing.
-        refuse_existing(&log_path(&args.out))
-            .map_err(|e| advised(CharacterizeError::Session(SessionError::Journal(e))))?;
-        // Files another session left in the directory (a new directory has none).
-        if args.out.is_dir() {
-            let out = OutputPolicy::new(args.force);
-            for f in files(&args.out, &log_path(&args.out)).outputs() {
-                out.check(f)?;
-            }
-        }
-    }
-
-    let mut display = spec.open()?;
-    for warning in display.warnings() {
-        eprintln!("warning: {warning}");
-    }
-    let meter = Spec::new(args.instrument.as_str());
-    let mut instrument = meter.open(display.stimulus()).map_err(|e| match e {
-        DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {
-            CliError::Usage(e.to_string())
-        }
-        e => CliError::from(e),
-    })?;
-    if display.stimulus().is_none() && meter.is_simulated() {
-        eprintln!(
-            "warning: a simulated instrument cannot see a real screen; it measures its own fixed light"
-        );
-    }
-    if let Some(speed) = args.speed {
-        let speed = match speed {
+    let request = Request {
+        out: args.out.clone(),
+        screen,
+        virtual_white_cd_m2: None,
+        instrument: Spec::new(args.instrument.as_str()),
+        speed: args.speed.map(|s| match s {
             SpeedArg::Fast => Speed::Fast,
             SpeedArg::Slow => Speed::Slow,
-        };
-        instrument.set_option("speed", speed.name())?;
-    }
-    let options = Options {
-        dir: args.out.clone(),
-        plan,
+        }),
+        plan: PlanOptions {
+            ramp_steps: args.ramp_steps,
+            repeats: args.repeats,
+            grid_steps: (args.grid_steps).unwrap_or(default_grid_steps(model, args.ramp_steps)),
+        },
         model,
-        instrument: args.instrument.clone(),
         settle: args.settle_ms.map(Duration::from_millis),
         resume: args.resume,
         force: args.force,
+        attend: Attend::Terminal {
+            unattended: args.unattended,
+        },
+        simulated_meter: SimulatedMeter::Warn,
         run: RunOptions {
             stop_after: args.stop_after,
             interrupt: Some(on_ctrl_c()),
         },
     };
-    let outcome = characterize::run(
-        &options,
-        display.as_mut(),
-        instrument.as_mut(),
-        attended.operator().as_mut(),
-        &mut BarProgress::new("patch").attended(attended == Attendance::Terminal),
-    )
-    .map_err(advised)?;
+    let outcome = characterize::characterize(&request, &mut Printer(None)).map_err(refusal)?;
     match (&outcome, outcome.left_to_do()) {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
@@ -162,11 +115,33 @@ pub fn run(args: Args) -> CliResult {
     }
 }
 
-/// The library's error with its advice in this command's flags, where it has one.
-fn advised(e: CharacterizeError) -> CliError {
-    match e.advice() {
-        Some(t) => CliError::Failed(t.into()),
-        None => CliError::from(e),
+/// Notes and warnings on stderr, the session's progress as a bar.
+struct Printer(Option<BarProgress>);
+
+impl Listener for Printer {
+    fn note(&mut self, text: &str) {
+        eprintln!("note: {text}");
+    }
+    fn warning(&mut self, text: &str) {
+        eprintln!("warning: {text}");
+    }
+    fn progress(&mut self, attended: bool) -> &mut dyn ProgressSink {
+        self.0.insert(BarProgress::new("patch").attended(attended))
+    }
+}
+
+/// The library's refusal in this command's words: its flags' errors are usage errors.
+fn refusal(e: CharacterizeError) -> CliError {
+    match e {
+        CharacterizeError::Plan(e) => CliError::Usage(plan_usage(&e)),
+        CharacterizeError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
+        CharacterizeError::Instrument(
+            e @ (DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. }),
+        ) => CliError::Usage(e.to_string()),
+        e => match e.advice() {
+            Some(t) => CliError::Failed(t.into()),
+            None => CliError::from(e),
+        },
     }
 }
 

@@ -4,12 +4,9 @@
 use std::path::PathBuf;
 
 use super::{CliError, CliResult};
-use metamer::display::icc::{agreement, encode_icc, inverse_agreement, IccVersion};
-use metamer::display::select_chart::selection_svg;
-use metamer::display::{
-    fit_profile_with, read_measurement_file, select_model, FitOptions, ModelKind,
-};
-use metamer::output::OutputPolicy;
+use metamer::display::icc::IccVersion;
+use metamer::display::job::fit::{self, Error as FitJobError, Event, Request};
+use metamer::display::{FitOptions, ModelKind};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -69,132 +66,36 @@ impl std::str::FromStr for ModelChoice {
 }
 
 pub fn run(args: Args) -> CliResult {
-    if args.output.is_dir() {
-        return Err(CliError::Usage(format!(
-            "-o {}: is a directory; give the profile file to write",
-            args.output.display()
-        )));
-    }
-    let mut out = OutputPolicy::new(args.force);
-    out.input(&args.measurements);
-    // Before the fit, which may take a while: a refused output is found now.
-    out.check(&args.output)?;
-    if let Some(g) = args.gamma {
-        if args.model != ModelChoice::Kind(ModelKind::PlccGamma) {
-            return Err(CliError::Usage(
-                "--gamma applies to --model plcc-gamma only".into(),
-            ));
-        }
-        if !(g.is_finite() && g > 0.0) {
-            return Err(CliError::Usage(format!(
-                "--gamma must be a positive number, got {g}"
-            )));
-        }
-    }
-    if args.icc_version.is_some() && args.icc.is_none() {
-        return Err(CliError::Usage("--icc-version needs --icc OUT.icc".into()));
-    }
-    // The ICC profile and the chart follow the output policy: never onto the measurements
-    // or the JSON profile, never over an existing file; checked before the fit so no work
-    // is lost.
-    let mut icc_policy = OutputPolicy::new(args.force);
-    icc_policy.inputs([args.measurements.as_path(), args.output.as_path()]);
-    if let Some(path) = &args.icc {
-        icc_policy.check(path)?;
-    }
-    if let Some(path) = &args.chart {
-        if args.model != ModelChoice::Auto {
-            return Err(CliError::Usage(
-                "--chart draws the model selection: it needs --model auto".into(),
-            ));
-        }
-        icc_policy.check(path)?;
-    }
-    let m = read_measurement_file(&args.measurements)?;
-    if !m.absolute {
-        eprintln!(
-            "warning: {} holds white-relative XYZ (no LUMINANCE_XYZ_CDM2): taken as if the \
-             white had 100 cd/m²",
-            args.measurements.display()
-        );
-    }
-    if let Some(n) = args.noise {
-        if !(n.is_finite() && n >= 0.0) {
-            return Err(CliError::Usage(format!(
-                "--noise must be a non-negative number, got {n}"
-            )));
-        }
-    }
-    let options = FitOptions {
-        gamma: args.gamma,
-        noise_de00: args.noise,
+    let request = Request {
+        measurements: args.measurements.clone(),
+        model: match args.model {
+            ModelChoice::Auto => None,
+            ModelChoice::Kind(kind) => Some(kind),
+        },
+        folds: args.folds,
+        options: FitOptions {
+            gamma: args.gamma,
+            noise_de00: args.noise,
+        },
+        output: args.output.clone(),
+        force: args.force,
+        icc: args.icc.clone(),
+        icc_version: args.icc_version,
+        chart: args.chart.clone(),
     };
-    if args.folds < 2 {
-        return Err(CliError::Usage(format!(
-            "--folds must be at least 2, got {}",
-            args.folds
-        )));
-    }
-    let kind = match args.model {
-        ModelChoice::Kind(kind) => kind,
-        ModelChoice::Auto => {
-            let selection = select_model(&m.patches, args.folds, &options)?;
-            println!("{selection}");
-            if let Some(path) = &args.chart {
-                let svg = selection_svg(&selection).map_err(|message| {
-                    CliError::Failed(format!("cannot draw {}: {message}", path.display()).into())
-                })?;
-                icc_policy.write(path, svg.as_bytes())?;
-                println!("selection chart written to {}", path.display());
-            }
-            selection.model
-        }
-    };
-    let profile = fit_profile_with(kind, &m.patches, Some(&args.measurements), &options)?;
-    println!(
-        "{} patches from {}; model {}",
-        m.patches.len(),
-        args.measurements.display(),
-        profile.model
-    );
-    println!(
-        "white XYZ {:.3} {:.3} {:.3} cd/m², black XYZ {:.4} {:.4} {:.4} cd/m²",
-        profile.white_xyz[0],
-        profile.white_xyz[1],
-        profile.white_xyz[2],
-        profile.black_xyz[0],
-        profile.black_xyz[1],
-        profile.black_xyz[2]
-    );
-    println!("{}", profile.diagnostics());
-    profile.save(&args.output, &out)?;
-    println!("profile written to {}", args.output.display());
-    if let Some(path) = &args.icc {
-        let version = args.icc_version.unwrap_or(IccVersion::V4);
-        let name = args
-            .measurements
-            .file_name()
-            .unwrap_or_default()
-            .to_string_lossy();
-        let icc = encode_icc(
-            &profile,
-            version,
-            &format!("metamer {} ({name})", profile.model),
-        )?;
-        icc_policy.write(path, &icc.bytes)?;
-        let drives: Vec<[f64; 3]> = m.patches.iter().map(|p| p.rgb).collect();
-        let check = agreement(&icc.bytes, &profile, &drives)?;
+    let report = fit::run(&request, &mut print_event).map_err(|e| refusal(e, &args))?;
+    if let Some(icc) = &report.icc {
         println!(
             "ICC {} profile ({}) written to {}; read back, it follows the model to ΔE00 mean \
              {:.4}, max {:.4} over the {} patches",
             icc.summary.version,
             icc.summary.form,
-            path.display(),
-            check.mean_de00,
-            check.max_de00,
-            check.points
+            icc.path.display(),
+            icc.forward.mean_de00,
+            icc.forward.max_de00,
+            icc.forward.points
         );
-        if let Ok(inverse) = inverse_agreement(&icc.bytes, &profile, &drives) {
+        if let Some(inverse) = &icc.inverse {
             println!(
                 "its B2A0 inverts the model to ΔE00 mean {:.4}, max {:.4} over the same patches",
                 inverse.mean_de00, inverse.max_de00
@@ -210,4 +111,55 @@ pub fn run(args: Args) -> CliResult {
         }
     }
     Ok(())
+}
+
+fn print_event(event: Event<'_>) {
+    match event {
+        Event::Warning(text) => eprintln!("warning: {text}"),
+        Event::Selected(selection) => println!("{selection}"),
+        Event::ChartWritten(path) => println!("selection chart written to {}", path.display()),
+        Event::Fitted {
+            patches,
+            measurements,
+            profile,
+        } => {
+            println!(
+                "{patches} patches from {}; model {}",
+                measurements.display(),
+                profile.model
+            );
+            let (w, k) = (profile.white_xyz, profile.black_xyz);
+            println!(
+                "white XYZ {:.3} {:.3} {:.3} cd/m², black XYZ {:.4} {:.4} {:.4} cd/m²",
+                w[0], w[1], w[2], k[0], k[1], k[2]
+            );
+            println!("{}", profile.diagnostics());
+        }
+        Event::ProfileWritten(path) => println!("profile written to {}", path.display()),
+    }
+}
+
+/// The library's refusals of options in this command's flags.
+fn refusal(e: FitJobError, args: &Args) -> CliError {
+    let usage = |text: String| CliError::Usage(text);
+    match e {
+        FitJobError::OutputIsDirectory(path) => usage(format!(
+            "-o {}: is a directory; give the profile file to write",
+            path.display()
+        )),
+        FitJobError::GammaWithoutPlccGamma => {
+            usage("--gamma applies to --model plcc-gamma only".into())
+        }
+        FitJobError::BadGamma(g) => usage(format!("--gamma must be a positive number, got {g}")),
+        FitJobError::IccVersionWithoutIcc => usage("--icc-version needs --icc OUT.icc".into()),
+        FitJobError::ChartWithoutSelection => {
+            usage("--chart draws the model selection: it needs --model auto".into())
+        }
+        FitJobError::BadNoise(n) => {
+            usage(format!("--noise must be a non-negative number, got {n}"))
+        }
+        FitJobError::Folds(_) => usage(format!("--folds must be at least 2, got {}", args.folds)),
+        FitJobError::Chart { .. } => CliError::Failed(e.to_string().into()),
+        e => CliError::from(e),
+    }
 }

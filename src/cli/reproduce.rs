@@ -2,16 +2,10 @@
 //! through a profile's inverse model, with out-of-gamut values counted.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use super::{CliError, CliResult};
 use metamer::display::gamut::GamutMapping;
-use metamer::display::reproduce::{
-    read_targets, reproduce_image, reproduce_targets, write_drive_csv, write_drive_png,
-};
-use metamer::display::Profile;
-use metamer::output::OutputPolicy;
-use metamer::render::image_io::read_xyz_image;
+use metamer::display::job::reproduce::{self, Error, Report, Request};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -43,73 +37,57 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let bits = args.bits.unwrap_or(8);
-    if bits != 8 && bits != 16 {
-        return Err(CliError::Usage(format!(
-            "--bits must be 8 or 16, got {bits}"
-        )));
-    }
-    if args.bits.is_some() && args.xyz.is_some() {
-        return Err(CliError::Usage(
-            "--bits sets the PNG depth of --image; --xyz writes drive values as CSV numbers".into(),
-        ));
-    }
-    if args.output.is_dir() {
-        return Err(CliError::Usage(format!(
+    let request = Request {
+        profile: args.profile,
+        xyz: args.xyz,
+        image: args.image,
+        output: args.output,
+        force: args.force,
+        bits: args.bits,
+        mirror: args.mirror,
+        gamut: args.gamut,
+    };
+    let usage = |text: &str| CliError::Usage(text.into());
+    let report = reproduce::run(&request).map_err(|e| match e {
+        Error::Bits(bits) => usage(&format!("--bits must be 8 or 16, got {bits}")),
+        Error::BitsForTargets => {
+            usage("--bits sets the PNG depth of --image; --xyz writes drive values as CSV numbers")
+        }
+        Error::OutputIsDirectory(path) => usage(&format!(
             "-o {}: is a directory; give the file to write",
-            args.output.display()
-        )));
-    }
-    let mut out = OutputPolicy::new(args.force);
-    out.input(&args.profile);
-    out.inputs(args.xyz.iter().chain(&args.image).map(PathBuf::as_path));
-    out.check(&args.output)?;
-    let profile = Profile::load(&args.profile)?;
-    match (&args.xyz, &args.image) {
-        (Some(targets), None) => {
-            if args.mirror {
-                return Err(CliError::Usage("--mirror applies to --image only".into()));
-            }
-            let xyz = read_targets(targets)?;
-            let drives = reproduce_targets(&profile, &xyz, args.gamut);
-            write_drive_csv(&args.output, &drives, &out)?;
-            let out = drives.iter().filter(|d| d.out_of_gamut).count();
-            eprintln!(
-                "{} targets, {out} out of gamut ({}); written to {}",
-                drives.len(),
-                if out > 0 && args.gamut == GamutMapping::Clip {
-                    "clipped"
-                } else if out > 0 {
-                    "mapped to the nearest CIELAB colour"
-                } else {
-                    "none to handle"
-                },
-                args.output.display()
-            );
-            Ok(())
-        }
-        (None, Some(image)) => {
-            let img = read_xyz_image(image)?;
-            let start = Instant::now();
-            let drive = reproduce_image(&profile, &img, args.mirror, args.gamut);
-            let elapsed = start.elapsed();
-            write_drive_png(&args.output, &drive, bits, &out)?;
-            let total = img.width * img.height;
-            eprintln!(
-                "{}×{} pixels converted in {:.1} ms; {} out of gamut ({:.3} %); {}-bit PNG \
-                 written to {}",
-                img.width,
-                img.height,
-                elapsed.as_secs_f64() * 1e3,
-                drive.out_of_gamut,
-                100.0 * drive.out_of_gamut as f64 / total.max(1) as f64,
-                bits,
-                args.output.display()
-            );
-            Ok(())
-        }
-        _ => Err(CliError::Usage(
-            "give exactly one of --xyz TARGETS.csv or --image XYZ.exr|XYZ.pfm".into(),
+            path.display()
         )),
+        Error::MirrorForTargets => usage("--mirror applies to --image only"),
+        Error::NoInput => usage("give exactly one of --xyz TARGETS.csv or --image XYZ.exr|XYZ.pfm"),
+        e => CliError::from(e),
+    })?;
+    let output = request.output.display();
+    match report {
+        Report::Targets {
+            count,
+            out_of_gamut: out,
+        } => eprintln!(
+            "{count} targets, {out} out of gamut ({}); written to {output}",
+            if out > 0 && request.gamut == GamutMapping::Clip {
+                "clipped"
+            } else if out > 0 {
+                "mapped to the nearest CIELAB colour"
+            } else {
+                "none to handle"
+            },
+        ),
+        Report::Image {
+            width,
+            height,
+            elapsed,
+            out_of_gamut,
+            bits,
+        } => eprintln!(
+            "{width}×{height} pixels converted in {:.1} ms; {out_of_gamut} out of gamut ({:.3} \
+             %); {bits}-bit PNG written to {output}",
+            elapsed.as_secs_f64() * 1e3,
+            100.0 * out_of_gamut as f64 / (width * height).max(1) as f64,
+        ),
     }
+    Ok(())
 }

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use super::CliResult;
-use metamer::display::{read_measurement_file, verify_profile, Profile};
+use metamer::display::job::verify::{self, Request};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -19,27 +19,23 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let profile = Profile::load(&args.profile)?;
-    let m = read_measurement_file(&args.measurements)?;
-    if !m.absolute {
-        eprintln!(
-            "warning: {} holds white-relative XYZ (no LUMINANCE_XYZ_CDM2): taken as if the \
-             white had 100 cd/m²",
-            args.measurements.display()
-        );
-    }
-    let v = verify_profile(&profile, &m.patches)?;
+    let request = Request {
+        profile: args.profile,
+        measurements: args.measurements,
+    };
+    let report = verify::run(&request, &mut |text| eprintln!("warning: {text}"))?;
+    let v = &report.verification;
     if args.json {
         println!(
             "{}",
-            serde_json::to_string(&v).expect("a verification always serialises")
+            serde_json::to_string(v).expect("a verification always serialises")
         );
     } else {
         println!(
             "{} ({}) against {}",
-            args.profile.display(),
-            profile.model,
-            args.measurements.display()
+            request.profile.display(),
+            report.profile.model,
+            request.measurements.display()
         );
         println!("{v}");
     }

@@ -26,6 +26,9 @@ pub mod characterize;
 // Speed against accuracy.
 pub mod budget;
 
+// Each command's job as one call.
+pub mod job;
+
 pub use diagnostics::{Diagnostics, Noise, Residuals};
 pub use fit::{fit_profile, fit_profile_with, FitOptions};
 pub use icc::{encode_icc, IccError, IccForward, IccProfile, IccVersion};

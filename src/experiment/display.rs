@@ -5,7 +5,6 @@
 //! when it is too dim the user is told what white luminance to set.
 
 use std::path::Path;
-use std::time::Duration;
 
 use metamer_drivers::{Instrument, Spec};
 use nalgebra::{Matrix3, Vector3};
@@ -13,10 +12,10 @@ use serde::{Deserialize, Serialize};
 
 use super::error::ExperimentError;
 use super::progress::Progress;
-use crate::display::characterize::{self, default_grid_steps, PlanOptions};
+use crate::display::characterize::{self, default_grid_steps, CharacterizeError, PlanOptions};
 use crate::display::{ModelKind, Profile};
-use crate::rig::{Screen, ScreenSpec, VirtualDisplay, VirtualPanel};
-use crate::session::{RunOptions, ScriptedOperator, StepProgress, TerminalOperator};
+use crate::rig::{Screen, ScreenSpec, VirtualPanel};
+use crate::session::{ProgressSink, RunOptions, StepProgress};
 
 /// The monitor and how it is characterized.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -52,13 +51,10 @@ pub fn open_screen(
     spec: &str,
     virtual_white_cd_m2: Option<f64>,
 ) -> Result<Box<dyn Screen>, ExperimentError> {
-    let parsed = ScreenSpec::parse(spec)?;
-    Ok(match (&parsed, virtual_white_cd_m2) {
-        (ScreenSpec::Virtual(p), Some(w)) => Box::new(VirtualDisplay::new(
-            VirtualPanel::preset(*p).with_white_luminance(w),
-        )),
-        _ => parsed.open()?,
-    })
+    Ok(characterize::open_screen(
+        &ScreenSpec::parse(spec)?,
+        virtual_white_cd_m2,
+    )?)
 }
 
 /// Headroom above the brightest in-gamut target, so no channel sits at its very end.
@@ -155,6 +151,18 @@ fn check_bright_enough(profile: &Profile, needed: f64, dir: &Path) -> Result<(),
     Ok(())
 }
 
+/// The stage's side of a characterization: no notes or warnings (the stage reports
+/// progress only), its readings as the experiment's progress.
+struct StageListener<F>(F);
+
+impl<F: FnMut(&StepProgress<'_>)> characterize::Listener for StageListener<F> {
+    fn note(&mut self, _: &str) {}
+    fn warning(&mut self, _: &str) {}
+    fn progress(&mut self, _: bool) -> &mut dyn ProgressSink {
+        &mut self.0
+    }
+}
+
 /// Characterizes the display into `dir`; `targets` are the rendered readings it must show.
 pub fn characterize_display(
     dir: &Path,
@@ -165,51 +173,48 @@ pub fn characterize_display(
     run: &RunOptions,
     progress: &dyn Fn(Progress),
 ) -> Result<(DisplaySetting, Vec<&'static str>), ExperimentError> {
-    let spec = ScreenSpec::parse(&opts.screen)?;
-    let virtual_white_cd_m2 = match &spec {
+    let screen = ScreenSpec::parse(&opts.screen)?;
+    let virtual_white_cd_m2 = match &screen {
         ScreenSpec::Virtual(p) => Some(white_luminance_for(&VirtualPanel::preset(*p), targets)),
         ScreenSpec::Window { .. } => None,
     };
-    let mut screen = open_screen(&opts.screen, virtual_white_cd_m2)?;
-    let mut meter = open_meter(&opts.spot, screen.as_ref())?;
     let defaults = PlanOptions::default();
-    let options = characterize::Options {
-        dir: dir.to_path_buf(),
+    let request = characterize::Request {
+        out: dir.to_path_buf(),
+        screen,
+        virtual_white_cd_m2,
+        instrument: opts.spot.clone(),
+        speed: None,
         plan: PlanOptions {
             grid_steps: default_grid_steps(opts.model, defaults.ramp_steps),
             ..defaults
         },
         model: opts.model,
-        instrument: opts.spot.to_string(),
-        settle: virtual_white_cd_m2.map(|_| Duration::ZERO),
+        settle: None,
         resume,
         // The stage directory is the experiment's own: a re-run replaces its profile.
         force: true,
+        attend: characterize::Attend::Stage { unattended },
+        simulated_meter: characterize::SimulatedMeter::Refuse,
         // The experiment's Ctrl-C: the first one stops before the next reading, as in the
         // box and display-spots stages, instead of leaving only the second, which kills.
         run: run.clone(),
     };
-    let mut scripted = ScriptedOperator::confirming();
-    let mut terminal = TerminalOperator;
-    let operator: &mut dyn crate::session::Operator = if unattended || virtual_white_cd_m2.is_some()
-    {
-        &mut scripted
-    } else {
-        &mut terminal
-    };
-    let mut sink = |p: &StepProgress<'_>| {
+    let mut listener = StageListener(|p: &StepProgress<'_>| {
         progress(Progress::Readings {
             done: p.done,
             total: p.total,
         })
-    };
-    let summary = match characterize::run(
-        &options,
-        screen.as_mut(),
-        meter.as_mut(),
-        operator,
-        &mut sink,
-    )? {
+    });
+    let outcome = characterize::characterize(&request, &mut listener).map_err(|e| match e {
+        CharacterizeError::OpenScreen(e) => ExperimentError::OpenScreen(e),
+        CharacterizeError::Instrument(e) => ExperimentError::Instrument(e),
+        CharacterizeError::SimulatedMeterOnRealScreen { meter, screen } => {
+            ExperimentError::SimulatedMeterOnRealScreen { meter, screen }
+        }
+        e => ExperimentError::Characterize(e),
+    })?;
+    let summary = match outcome {
         characterize::Outcome::Finished(summary) => summary,
         characterize::Outcome::Incomplete {
             done, total, log, ..

@@ -80,6 +80,19 @@ pub enum CharacterizeError {
     Aim(#[source] crate::rig::ScreenError),
     #[error("{0}")]
     Output(#[from] OutputError),
+    /// A physical meter with nobody at the rig ([`super::Attend::Terminal`]).
+    #[error(transparent)]
+    NobodyAtTheRig(#[from] crate::session::NobodyAtTheRig),
+    #[error(transparent)]
+    OpenScreen(crate::rig::OpenError),
+    /// The meter could not be opened (its spec, its port, its transcript).
+    #[error(transparent)]
+    Instrument(metamer_drivers::DriverError),
+    /// The meter refused the requested response speed.
+    #[error(transparent)]
+    Speed(metamer_drivers::DriverError),
+    #[error("the simulated meter {meter} cannot see the real screen {screen}; use a real meter, or a virtual display")]
+    SimulatedMeterOnRealScreen { meter: String, screen: String },
 }
 
 /// The journal of a characterization in `dir`.
