@@ -6,6 +6,7 @@ pub mod chart;
 pub mod fit;
 pub mod ies;
 pub mod ldt;
+mod numbers;
 pub mod photometry;
 
 pub use cgamma::{CGammaError, CGammaTable};
