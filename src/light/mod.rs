@@ -5,6 +5,7 @@ pub mod cgamma;
 pub mod chart;
 pub mod fit;
 pub mod ies;
+pub mod job;
 pub mod ldt;
 mod numbers;
 pub mod photometry;
