@@ -416,6 +416,9 @@ fn candela_table(
     Ok(rows)
 }
 
+/// C-planes as (C, candela at each vertical angle).
+type Planes = Vec<(f64, Vec<f64>)>;
+
 /// The symmetry the horizontal angles say, and the stored planes mirrored into the full
 /// circle by it. `h_line` is the line of the first horizontal angle.
 fn unfold(
@@ -423,7 +426,7 @@ fn unfold(
     h_line: usize,
     horizontal: Vec<f64>,
     rows: Vec<Vec<f64>>,
-) -> Result<(&'static str, Vec<(f64, Vec<f64>)>), PhotometryError> {
+) -> Result<(&'static str, Planes), PhotometryError> {
     let n_horizontal = horizontal.len();
     let first_c = horizontal[0];
     let last_c = horizontal[n_horizontal - 1];
