@@ -4,10 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Subcommand, ValueEnum};
 use metamer::color::{
-    delta_e2000, delta_e76, describe, Illuminant, Lab, ObserverKind, Outside, Quantity,
-    SpectralTable, Spectrum, Xyz,
+    pair_differences, spectra_xyz, ColorJobError, Integration, ObserverKind, Quantity, XyzRequest,
 };
-use metamer::numeric_csv::NumericCsv;
 
 use super::{parse_triple, CliError, CliResult};
 
@@ -96,63 +94,35 @@ pub fn run(args: Args) -> CliResult {
     }
 }
 
-fn load_illuminant(name: &str) -> Result<Spectrum, CliError> {
-    if let Ok(known) = name.parse::<Illuminant>() {
-        return Ok(known.spectrum());
+fn color_error(e: ColorJobError) -> CliError {
+    match e {
+        ColorJobError::UnknownIlluminant(_) => CliError::Usage(e.to_string()),
+        ColorJobError::NotFinite { .. } | ColorJobError::PairNotFinite { .. } => {
+            CliError::Failed(e.to_string().into())
+        }
+        ColorJobError::Color(e) => CliError::from(e),
+        ColorJobError::Csv(e) => CliError::from(e),
     }
-    let path = PathBuf::from(name);
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
-        || path.exists()
-    {
-        return Ok(SpectralTable::read(&path)?.first());
-    }
-    Err(CliError::Usage(format!(
-        "unknown illuminant '{name}': use D65, D50, A, FL11, LED-RGB1, LED-B3 or a CSV file"
-    )))
 }
 
 fn xyz(a: XyzArgs) -> CliResult {
-    let table = SpectralTable::read(&a.spectrum)?;
-    let illuminant = load_illuminant(&a.illuminant)?;
-    let (quantity, outside) = match a.quantity {
-        QuantityArg::Radiance => (Quantity::Radiance, Outside::Zero),
-        QuantityArg::Reflectance => (Quantity::Reflectance, Outside::HoldEnds),
+    let request = XyzRequest {
+        spectrum: a.spectrum,
+        quantity: match a.quantity {
+            QuantityArg::Radiance => Quantity::Radiance,
+            QuantityArg::Reflectance => Quantity::Reflectance,
+        },
+        illuminant: a.illuminant,
+        observer: a.observer,
+        white: a.white,
+        column: a.column,
+        method: match a.method {
+            MethodArg::Cie15 => Integration::Cie15,
+            MethodArg::Linear => Integration::Linear,
+        },
     };
-    let columns: Vec<(String, Spectrum)> = match &a.column {
-        Some(name) => vec![(name.clone(), table.column(name)?)],
-        None => table
-            .columns
-            .iter()
-            .cloned()
-            .zip(table.all(Outside::Zero))
-            .collect(),
-    };
-    let white = a.white.map(Xyz::from_array);
-    // A chosen column is named in the output, as every column of a file with several is.
-    let named = columns.len() > 1 || a.column.is_some();
-    for (name, spectrum) in columns {
-        let spectrum = match a.method {
-            MethodArg::Cie15 => spectrum.with_outside(outside).as_measured(),
-            MethodArg::Linear => spectrum.with_outside(outside),
-        };
-        let d = describe(&spectrum, quantity, &illuminant, a.observer, white);
-        let mut numbers: Vec<f64> = d.xyz.to_array().into();
-        numbers.extend(d.xyy.to_array());
-        numbers.extend(d.lab.map(|l| l.to_array()).into_iter().flatten());
-        if numbers.iter().any(|v| !v.is_finite()) {
-            return Err(CliError::Failed(
-                format!(
-                    "{}: column '{}': the result is not a finite number (XYZ {:?}): the \
-                     values are too large to integrate, or the white has no luminance",
-                    a.spectrum.display(),
-                    metamer::color::text::echo(&name),
-                    d.xyz.to_array()
-                )
-                .into(),
-            ));
-        }
+    spectra_xyz(&request, &mut |c| {
+        let d = &c.description;
         if a.json {
             let mut obj = serde_json::json!({
                 "XYZ": d.xyz.to_array(),
@@ -161,8 +131,8 @@ fn xyz(a: XyzArgs) -> CliResult {
             if let Some(lab) = d.lab {
                 obj["Lab"] = serde_json::json!(lab.to_array());
             }
-            if named {
-                obj["column"] = serde_json::json!(name);
+            if c.named {
+                obj["column"] = serde_json::json!(c.name);
             }
             println!("{obj}");
         } else {
@@ -171,34 +141,16 @@ fn xyz(a: XyzArgs) -> CliResult {
                 .map(|l| format!("  L*a*b* {:8.3} {:8.3} {:8.3}", l.l, l.a, l.b))
                 .unwrap_or_default();
             println!(
-                "{name:<24} XYZ {:10.4} {:10.4} {:10.4}  xyY {:.5} {:.5} {:10.4}{lab}",
-                d.xyz.x, d.xyz.y, d.xyz.z, d.xyy.x, d.xyy.y, d.xyy.luminance
+                "{:<24} XYZ {:10.4} {:10.4} {:10.4}  xyY {:.5} {:.5} {:10.4}{lab}",
+                c.name, d.xyz.x, d.xyz.y, d.xyz.z, d.xyy.x, d.xyy.y, d.xyy.luminance
             );
         }
-    }
-    Ok(())
+    })
+    .map_err(color_error)
 }
 
 fn delta_e(a: DeltaEArgs) -> CliResult {
-    let csv = NumericCsv::read(&a.pairs, &["L1", "a1", "b1", "L2", "a2", "b2"])?;
-    let mut results: Vec<(f64, f64)> = Vec::with_capacity(csv.rows.len());
-    for (line, v) in &csv.rows {
-        let p = Lab::new(v[0], v[1], v[2]);
-        let q = Lab::new(v[3], v[4], v[5]);
-        let (d76, d00) = (delta_e76(p, q), delta_e2000(p, q));
-        // Finite Lab values far beyond any colour (1e308) overflow the formulas.
-        if !d76.is_finite() || !d00.is_finite() {
-            return Err(CliError::Failed(
-                format!(
-                    "{}:{line}: the colour difference is not a finite number (ΔE*ab {d76}, \
-                     ΔE00 {d00}): L*a*b* values of real colours lie within a few hundred",
-                    a.pairs.display()
-                )
-                .into(),
-            ));
-        }
-        results.push((d76, d00));
-    }
+    let results = pair_differences(&a.pairs).map_err(color_error)?;
     if a.json {
         let arr: Vec<_> = results
             .iter()

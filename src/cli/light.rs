@@ -6,12 +6,10 @@ use std::path::PathBuf;
 use clap::Subcommand;
 
 use super::{CliError, CliResult};
-use metamer::light::chart::ldc_chart_svg;
 use metamer::light::fit::{HalfPlane, Plane};
-use metamer::light::ies::{self, IesInfo};
-use metamer::light::ldt::{self, LdtInfo};
-use metamer::light::{fit, flux_lm, CGammaTable, Falloff, LdcFit, ModelChoice, Panel, Photometry};
-use metamer::output::{OutputError, OutputPolicy};
+use metamer::light::job::{self, FitEvent, FitRequest, LightError, LightFile};
+use metamer::light::{CGammaTable, LdcFit, ModelChoice, Photometry};
+use metamer::output::OutputError;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -86,126 +84,50 @@ fn output_error(e: OutputError) -> CliError {
     }
 }
 
-fn run_fit(a: FitArgs) -> CliResult {
-    let exports = a.ies.is_some() || a.ldt.is_some();
-    let panel_size = match (a.width_m, a.height_m) {
-        (Some(w), Some(h)) => Some((w, h)),
-        (None, None) if !exports => None,
-        _ => {
-            return Err(CliError::Usage(
-                "--ies and --ldt need the panel's size: give both --width-m and --height-m".into(),
-            ))
-        }
-    };
-    let mut policy = OutputPolicy::new(a.force);
-    policy.input(&a.falloff);
-    let outputs = [
-        Some(&a.output),
-        a.ies.as_ref(),
-        a.ldt.as_ref(),
-        a.chart.as_ref(),
-    ];
-    let outputs: Vec<&PathBuf> = outputs.into_iter().flatten().collect();
-    for (i, out) in outputs.iter().enumerate() {
-        // Two outputs on one path: the second would be refused as existing, after the
-        // first was written over it.
-        if outputs[..i].iter().any(|o| same_path(o, out)) {
-            return Err(CliError::Usage(format!(
-                "{} is given for two outputs; each needs its own file",
-                out.display()
-            )));
-        }
-        policy.check(out).map_err(output_error)?;
+fn light_error(e: LightError) -> CliError {
+    match e {
+        LightError::BadRequest(message) => CliError::Usage(message),
+        LightError::Output(e) => output_error(e),
+        LightError::Fit { .. } => CliError::Failed(e.to_string().into()),
+        e => CliError::from(e),
     }
-    let falloff = Falloff::read_csv(&a.falloff)?;
-    // The panel and its luminance are checked before anything is fitted or written, so a
-    // bad --width-m does not leave the fit written and the light files missing.
-    let panel = match panel_size {
-        None => None,
-        Some((w, h)) => {
-            let l0 = match a.luminance {
-                Some(l) => l,
-                None => {
-                    let normal = falloff.validate().map_err(|e| {
-                        CliError::Failed(format!("{}: {e}", a.falloff.display()).into())
-                    })?;
-                    let l0 = (normal[0] + normal[1]) / 2.0;
-                    if l0 == 1.0 {
-                        return Err(CliError::Usage(
-                            "the readings are relative (1 at the normal): give the panel's \
-                             luminance with --luminance CD_M2"
-                                .into(),
-                        ));
-                    }
-                    l0
-                }
-            };
-            Some(Panel::new(w, h, l0).map_err(|e| CliError::Usage(e.to_string()))?)
-        }
-    };
-    let fit = fit(&falloff, a.model)
-        .map_err(|e| CliError::Failed(format!("{}: {e}", a.falloff.display()).into()))?;
-    print_fit(&a.falloff, &fit);
-    let json = serde_json::to_string_pretty(&fit)?;
-    policy
-        .write(&a.output, json.as_bytes())
-        .map_err(output_error)?;
-    println!("fit written to {}", a.output.display());
-    if let Some(chart) = &a.chart {
-        let svg = ldc_chart_svg(&fit)?;
-        policy.write(chart, svg.as_bytes()).map_err(output_error)?;
-        println!("chart written to {}", chart.display());
-    }
-    if let Some(panel) = panel {
-        let (w, h, l0) = (panel.width_m, panel.height_m, panel.normal_luminance_cd_m2);
-        let flux = flux_lm(&fit.table, &panel);
-        println!(
-            "panel {w} m × {h} m at {l0} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
-            panel.normal_intensity_cd(),
-            flux
-        );
-        let date = today();
-        let luminaire = format!(
-            "flat panel {w} m x {h} m, {} light distribution fitted to {}",
-            fit.model,
-            a.falloff.display()
-        );
-        if let Some(path) = &a.ies {
-            let info = IesInfo {
-                test: format!("metamer light fit {}", a.falloff.display()),
-                issue_date: date.clone(),
-                luminaire: luminaire.clone(),
-                generation: format!("metamer light fit, model {}", fit.model),
-            };
-            let text = ies::to_string(&fit.table, &panel, &info);
-            policy.write(path, text.as_bytes()).map_err(output_error)?;
-            println!("IES written to {}", path.display());
-        }
-        if let Some(path) = &a.ldt {
-            let info = LdtInfo {
-                luminaire,
-                file_name: path
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
-                date_user: format!("{date} metamer"),
-            };
-            let text = ldt::to_string(&fit.table, &panel, &info);
-            policy.write(path, text.as_bytes()).map_err(output_error)?;
-            println!("EULUMDAT written to {}", path.display());
-        }
-    }
-    Ok(())
 }
 
-/// Whether two output paths name one file: spelled alike, or (when it exists) the same
-/// file by another name.
-fn same_path(a: &std::path::Path, b: &std::path::Path) -> bool {
-    a == b
-        || matches!(
-            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
-            (Ok(x), Ok(y)) if x == y
-        )
+fn run_fit(a: FitArgs) -> CliResult {
+    let request = FitRequest {
+        falloff: a.falloff,
+        model: a.model,
+        output: a.output,
+        ies: a.ies,
+        ldt: a.ldt,
+        chart: a.chart,
+        width_m: a.width_m,
+        height_m: a.height_m,
+        luminance: a.luminance,
+        force: a.force,
+    };
+    job::fit(&request, &|event| match event {
+        FitEvent::Fitted(fit) => print_fit(&request.falloff, fit),
+        FitEvent::Written(file, path) => {
+            let what = match file {
+                LightFile::Fit => "fit",
+                LightFile::Chart => "chart",
+                LightFile::Ies => "IES",
+                LightFile::Ldt => "EULUMDAT",
+            };
+            println!("{what} written to {}", path.display());
+        }
+        FitEvent::Panel { panel, flux_lm } => println!(
+            "panel {} m × {} m at {} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
+            panel.width_m,
+            panel.height_m,
+            panel.normal_luminance_cd_m2,
+            panel.normal_intensity_cd(),
+            flux_lm
+        ),
+    })
+    .map_err(light_error)?;
+    Ok(())
 }
 
 fn print_fit(source: &std::path::Path, fit: &LdcFit) {
@@ -268,21 +190,7 @@ fn num(v: f64) -> String {
 }
 
 fn run_show(a: ShowArgs) -> CliResult {
-    let ext = a
-        .file
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    let (table, p) = match ext.as_str() {
-        "ies" => ies::read(&a.file)?,
-        "ldt" => ldt::read(&a.file)?,
-        _ => {
-            return Err(CliError::Usage(format!(
-                "{}: expected a .ies or .ldt file",
-                a.file.display()
-            )))
-        }
-    };
+    let (table, p) = job::show(&a.file).map_err(light_error)?;
     print_photometry(&a.file, &table, &p);
     Ok(())
 }
@@ -338,42 +246,5 @@ fn print_photometry(file: &std::path::Path, table: &CGammaTable, p: &Photometry)
             .map(|&g| format!(" {:>9}", num(table.at(h.c_deg(), g))))
             .collect();
         println!("    {:<6}{cells}", format!("C{}", h.c_deg()));
-    }
-}
-
-/// Today's date (UTC) as YYYY-MM-DD, for the files' issue date.
-fn today() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs())
-        .unwrap_or(0);
-    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
-    format!("{y:04}-{m:02}-{d:02}")
-}
-
-/// The proleptic Gregorian date of a day count since 1970-01-01 (eras of 400 years).
-fn civil_from_days(z: i64) -> (i64, u32, u32) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    (y, m, d)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::civil_from_days;
-
-    #[test]
-    fn dates_from_day_counts() {
-        assert_eq!(civil_from_days(0), (1970, 1, 1));
-        // 2000-03-01 is day 11017; 2024-02-29 is day 19782 (a leap day).
-        assert_eq!(civil_from_days(11_017), (2000, 3, 1));
-        assert_eq!(civil_from_days(19_782), (2024, 2, 29));
     }
 }

@@ -3,15 +3,12 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use metamer::measure_box::setup::{self, BoxRig, RigRequest};
-use metamer::measure_box::{
-    self, BoxDetails, BoxPlan, Instruments, Options, Outcome, PlanError, Stage, Summary,
-};
-use metamer::output::OutputPolicy;
-use metamer::session::{attendance, on_ctrl_c, Attendance, BarProgress, RunOptions};
-use metamer_drivers::Spec;
+use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
+use metamer::measure_box::setup::RigError;
+use metamer::measure_box::{Outcome, PlanError, Summary};
+use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
 
-use super::rig::{box_light, nobody_at_the_rig};
+use super::rig::{box_light_refusal, nobody_at_the_rig};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -64,87 +61,49 @@ fn usage(e: impl std::fmt::Display) -> CliError {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let plan = setup::load_plan(args.plan.as_deref(), args.repeats).map_err(|e| match e {
-        PlanError::Io { .. } => CliError::from(e),
-        PlanError::Invalid { field, message } if field == "repeats" => {
-            usage(format!("--repeats {message}"))
-        }
-        e => usage(e),
-    })?;
-    let stage: Option<Stage> = args
-        .stage
-        .as_deref()
-        .map(str::parse)
-        .transpose()
-        .map_err(usage)?;
-    let (mut rig, attended) = open_rig(&args, &plan)?;
-    let shown_at_terminal = !rig.simulated && attended == Attendance::Terminal;
-    let mut output = OutputPolicy::new(args.force);
-    if let Some(p) = &args.plan {
-        output.input(p);
-    }
-    let options = Options {
-        output,
-        dir: args.out.clone(),
-        plan,
-        stage,
+    let request = MeasureBoxRequest {
+        out: args.out,
+        spectral: args.spectral,
+        spot: args.spot,
+        plan: args.plan,
+        repeats: args.repeats,
         resume: args.resume,
-        rig_options: std::mem::take(&mut rig.rig_options),
-        details: BoxDetails {
-            spectral: args.spectral.clone(),
-            spot: args.spot.clone(),
-        },
+        stage: args.stage,
+        seed: args.seed,
+        scenario: args.scenario,
+        force: args.force,
+        unattended: args.unattended,
         run: RunOptions {
             stop_after: args.stop_after,
             interrupt: Some(on_ctrl_c()),
         },
     };
-    let outcome = measure_box::run(
-        &options,
-        Instruments {
-            spectral: rig.spectral.as_mut(),
-            spot: rig.spot.as_mut(),
-        },
-        rig.operator.as_mut(),
-        &mut BarProgress::new("reading").attended(shown_at_terminal),
-    )
-    .map_err(|e| match e.advice() {
-        Some(t) => CliError::Failed(t.into()),
-        None => CliError::from(e),
-    })?;
+    let outcome = job::measure(&request, &|n| eprintln!("{n}…"), &mut |shown| {
+        Box::new(BarProgress::new("reading").attended(shown))
+    })
+    .map_err(refusal)?;
     report(outcome)
 }
 
-/// The rig `--spectral` and `--spot` name, opened once the requests that need no
-/// instrument are checked: the two agree, `--scenario` suits them, somebody is there.
-fn open_rig(args: &Args, plan: &BoxPlan) -> Result<(BoxRig, Attendance), CliError> {
-    let (spectral, spot) = (
-        Spec::new(args.spectral.as_str()),
-        Spec::new(args.spot.as_str()),
-    );
-    let simulated = setup::is_simulated(&spectral, &spot).map_err(|_| {
-        usage("--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box")
-    })?;
-    let light = box_light(args.scenario.as_deref(), simulated)?;
-    // Before anything is opened: a real rig with nobody to ask is refused.
-    let attended =
-        attendance(&[&args.spectral, &args.spot], args.unattended).map_err(nobody_at_the_rig)?;
-    let request = RigRequest {
-        plan,
-        spectral: &spectral,
-        spot: &spot,
-        seed: args.seed,
-        light,
-    };
-    let rig =
-        setup::open(&request, || attended.operator(), &|n| eprintln!("{n}…")).map_err(|e| {
-            if e.is_request() {
-                usage(e)
-            } else {
-                CliError::from(e)
-            }
-        })?;
-    Ok((rig, attended))
+/// A failure in the command's words: its flags named where the request was wrong.
+fn refusal(e: MeasureBoxJobError) -> CliError {
+    match e {
+        MeasureBoxJobError::Plan(e @ PlanError::Io { .. }) => CliError::from(e),
+        MeasureBoxJobError::Repeats(message) => usage(format!("--repeats {message}")),
+        MeasureBoxJobError::Plan(e) => usage(e),
+        MeasureBoxJobError::UnknownStage(message) => usage(message),
+        MeasureBoxJobError::Rig(RigError::Mixed) => usage(
+            "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
+        ),
+        MeasureBoxJobError::BoxLight(e) => box_light_refusal(e),
+        MeasureBoxJobError::Nobody(e) => nobody_at_the_rig(e),
+        MeasureBoxJobError::Rig(e) if e.is_request() => usage(e),
+        MeasureBoxJobError::Rig(e) => CliError::from(e),
+        MeasureBoxJobError::Measure(e) => match e.advice() {
+            Some(t) => CliError::Failed(t.into()),
+            None => CliError::from(e),
+        },
+    }
 }
 
 /// Where the session ended, and what is left to do.

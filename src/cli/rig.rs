@@ -1,6 +1,7 @@
 //! The refusals shared by the commands that open a rig (`measure-box`, `experiment`,
 //! `spot`, `characterize`), said with their flags.
 
+use metamer::measure_box::setup::{self, BoxLightError};
 use metamer::rig::Scenario;
 use metamer::session::NobodyAtTheRig;
 
@@ -13,12 +14,16 @@ fn usage(e: impl std::fmt::Display) -> CliError {
 /// The simulated box's light named by `--scenario`; refused with real instruments, whose
 /// box is lit by whatever light it has.
 pub(super) fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, CliError> {
-    match (name, simulated) {
-        (None, _) => Ok(None),
-        (Some(n), true) => n.parse().map(Some).map_err(usage),
-        (Some(_), false) => Err(usage(
+    setup::box_light(name, simulated).map_err(box_light_refusal)
+}
+
+/// A `--scenario` the rig cannot have, in the words of the command line.
+pub(super) fn box_light_refusal(e: BoxLightError) -> CliError {
+    match e {
+        BoxLightError::Unknown(message) => usage(message),
+        BoxLightError::RealRig => usage(
             "--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light",
-        )),
+        ),
     }
 }
 

@@ -4,17 +4,9 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use metamer::output::OutputPolicy;
-use std::sync::Arc;
-
 use clap::ValueEnum;
-use metamer::color::{colorchecker, ColorCheckerSet};
-use metamer::session::attendance;
-use metamer::spot::{read, spectra_csv, SimulatedHands, SpotError};
-use metamer_drivers::i1pro::emulator::default_light;
-use metamer_drivers::{
-    DriverError, MeasureMode, OpenOptions, Reading, SharedWorld, Spec, Speed, View, World,
-};
+use metamer::spot::{self, SpotEvent, SpotRequest, SpotRunError};
+use metamer_drivers::{MeasureMode, Reading, Speed};
 
 use super::{CliError, CliResult};
 
@@ -75,132 +67,51 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    if args.count == 0 {
-        return Err(CliError::Usage("--count must be at least 1".into()));
-    }
-    if let Some(path) = &args.record {
-        if path.exists() {
-            return Err(CliError::Usage(format!(
-                "{} exists; a recording is never overwritten, choose another file name",
-                path.display()
-            )));
-        }
-    }
-    let spec = Spec::new(args.instrument.as_str());
-    let mut spectrum_out = OutputPolicy::new(args.force);
-    if let Some(replayed) = spec.replay_file() {
-        spectrum_out.input(replayed);
-    }
-    if let Some(record) = &args.record {
-        spectrum_out.input(record);
-    }
-    if let Some(path) = &args.spectrum {
-        // Before measuring: a refused output is found while nothing is lost.
-        spectrum_out.check(path)?;
-    }
-    // Before the instrument is opened: a real one with nobody to place it is refused.
-    let attended =
-        attendance(&[&args.instrument], args.unattended).map_err(super::rig::nobody_at_the_rig)?;
     let mode = match args.mode {
         ModeArg::Emissive => MeasureMode::Emissive,
         ModeArg::Reflective => MeasureMode::Reflective,
         ModeArg::Ambient => MeasureMode::Ambient,
     };
-    let hands = spec
-        .is_simulated()
-        .then(|| simulated_target(mode))
-        .transpose()?;
-    let options = OpenOptions {
-        stimulus: hands.as_ref().map(|h| h.world.clone() as Arc<dyn World>),
-        record: args.record.clone(),
-    };
-    let mut instrument = spec.open_with(&options).map_err(|e| match e {
-        DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {
-            CliError::Usage(e.to_string())
-        }
-        e => CliError::from(e),
-    })?;
-    // Before measuring: a colorimeter's readings would be taken and then have no spectrum.
-    if args.spectrum.is_some() && !instrument.capabilities().spectral {
-        return Err(CliError::Usage(format!(
-            "--spectrum: the {} measures no spectrum (a colorimeter); leave --spectrum out",
-            instrument.info().model
-        )));
-    }
-    if let Some(speed) = args.speed {
-        let speed = match speed {
+    let request = SpotRequest {
+        instrument: args.instrument,
+        mode,
+        speed: args.speed.map(|s| match s {
             SpeedArg::Fast => Speed::Fast,
             SpeedArg::Slow => Speed::Slow,
-        };
-        instrument.set_option("speed", speed.name())?;
-    }
-    if let Some(t) = &args.integration {
-        instrument
-            .set_option("integration_s", t)
-            .map_err(|e| match e {
-                DriverError::UnknownOption { instrument, .. } => CliError::Usage(format!(
-                    "--integration: the {instrument} has no integration time to set"
-                )),
-                DriverError::BadOption { message, .. } => {
-                    CliError::Usage(format!("--integration {t}: {message}"))
-                }
-                e => CliError::from(e),
-            })?;
-    }
-    let info = instrument.info();
-    let mut out = std::io::stdout().lock();
-    if !args.json {
-        writeln!(out, "{} on {}", info.model, info.connection)?;
-    }
-    let mut operator = attended.operator();
-    let mut readings = Vec::new();
-    for i in 1..=args.count {
-        let reading = match read(instrument.as_mut(), mode, operator.as_mut(), hands.as_ref()) {
-            Ok(r) => r,
-            Err(SpotError::Declined(_)) => {
-                eprintln!(
-                    "stopped at your request after {} of {} readings",
-                    readings.len(),
-                    args.count
-                );
-                break;
-            }
-            Err(e) => return Err(e.into()),
-        };
-        if args.json {
-            writeln!(out, "{}", json_line(&reading))?;
-        } else {
-            writeln!(out, "{}", human_line(i, mode, &reading))?;
-        }
-        // Each reading is shown as it arrives: a later failure must not hide earlier ones.
-        out.flush()?;
-        readings.push(reading);
-    }
-    if let Some(path) = args.spectrum.as_ref().filter(|_| !readings.is_empty()) {
-        let csv = spectra_csv(&readings).ok_or_else(|| {
-            CliError::Usage(format!(
-                "--spectrum: the {} returned readings without a spectrum",
-                info.model
-            ))
-        })?;
-        spectrum_out.write(path, csv.as_bytes())?;
-    }
-    Ok(())
-}
-
-/// What a simulated instrument is aimed at or placed on: 100 cd/m² of CIE LED-RGB1 for
-/// light, the ColorChecker's white 9.5 for a surface.
-fn simulated_target(mode: MeasureMode) -> Result<SimulatedHands, CliError> {
-    let target = match mode {
-        MeasureMode::Reflective => {
-            View::surface(colorchecker(ColorCheckerSet::BabelColorAverage)[18].clone())?
-        }
-        _ => View::radiance(default_light())?,
+        }),
+        integration: args.integration,
+        count: args.count,
+        spectrum: args.spectrum,
+        force: args.force,
+        record: args.record,
+        unattended: args.unattended,
     };
-    Ok(SimulatedHands {
-        world: Arc::new(SharedWorld::new(target.clone())),
-        target,
+    let json = args.json;
+    let mut out = std::io::stdout().lock();
+    spot::run(&request, &mut |event| match event {
+        SpotEvent::Opened(info) if !json => writeln!(out, "{} on {}", info.model, info.connection),
+        SpotEvent::Opened(_) => Ok(()),
+        SpotEvent::Reading { n, reading } => {
+            if json {
+                writeln!(out, "{}", json_line(reading))?;
+            } else {
+                writeln!(out, "{}", human_line(n, mode, reading))?;
+            }
+            // Each reading is shown as it arrives: a later failure must not hide earlier ones.
+            out.flush()
+        }
+        SpotEvent::Stopped { done, of } => {
+            eprintln!("stopped at your request after {done} of {of} readings");
+            Ok(())
+        }
     })
+    .map_err(|e| match e {
+        SpotRunError::BadRequest(message) => CliError::Usage(message),
+        SpotRunError::Nobody(e) => super::rig::nobody_at_the_rig(e),
+        SpotRunError::Output(e) => CliError::from(e),
+        e => CliError::from(e),
+    })?;
+    Ok(())
 }
 
 /// `{"XYZ":[X,Y,Z],"xyY":[x,y,Y],"flags":[…],"instrument":"cs100a"}` and, from spectral

@@ -24,9 +24,10 @@ use std::path::Path;
 use metamer_color::text::{echo, strip_bom};
 
 use super::cgamma::CGammaTable;
+use super::numbers::{tokens, Numbers};
 use super::photometry::{
-    candela_grid, decode_text, finish, format_sig, mirror_planes, tokens, Opening, Panel,
-    Photometry, PhotometryError,
+    candela_grid, decode_text, finish, format_sig, mirror_planes, Opening, Panel, Photometry,
+    PhotometryError,
 };
 
 /// Text for the keyword lines of a written file.
@@ -174,32 +175,13 @@ fn ambiguous_comma(text: &str, first_line: usize) -> Option<(usize, String)> {
 
 /// [`read`] on text; `source` names the file in errors.
 pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
-    let fmt_err = |line: usize, message: String| PhotometryError::Format {
-        file: source.to_path_buf(),
-        line,
-        message,
-    };
     let lines: Vec<&str> = strip_bom(text).lines().collect();
-    let first = lines.iter().position(|l| !l.trim().is_empty()).unwrap_or(0);
-    let version = lines
-        .get(first)
-        .map(|l| l.trim())
-        .filter(|l| l.to_ascii_uppercase().starts_with("IES"))
-        .map(|l| l.to_string())
-        .unwrap_or_else(|| "IES LM-63-1986".into());
-    let Some(tilt) = lines
-        .iter()
-        .position(|l| l.trim_start().to_ascii_uppercase().starts_with("TILT="))
-    else {
-        return Err(fmt_err(
-            lines.len().max(1),
-            "no TILT= line: not an IES LM-63 file".into(),
-        ));
-    };
-    let tilt_value = lines[tilt].trim_start()[5..].trim().to_ascii_uppercase();
-    let rest = lines[tilt + 1..].join("\n");
-    if let Some((line, word)) = ambiguous_comma(&rest, tilt + 2) {
-        return Err(fmt_err(
+    let header = Header::read(&lines, source)?;
+    let rest = lines[header.tilt + 1..].join("\n");
+    let first_value_line = header.tilt + 2;
+    let mut values = Numbers::new(tokens(&rest, first_value_line), source, lines.len());
+    if let Some((line, word)) = ambiguous_comma(&rest, first_value_line) {
+        return Err(values.error(
             line,
             format!(
                 "'{}': a comma inside a value on a line of blank-separated values — a \
@@ -209,151 +191,250 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
             ),
         ));
     }
-    let toks = tokens(&rest, tilt + 2);
-    let pos = std::cell::Cell::new(0usize);
-    let last_line = lines.len();
-    let next = |what: &str| -> Result<(usize, f64), PhotometryError> {
-        let Some((line, t)) = toks.get(pos.get()) else {
-            return Err(fmt_err(last_line, format!("the file ends before {what}")));
+    if header.tilt_value == "INCLUDE" {
+        skip_tilt_table(&mut values)?;
+    }
+    let photometric = PhotometricLine::read(&mut values)?;
+    let (_, gammas) = values.take(photometric.n_vertical, "the vertical angles")?;
+    let (h_line, horizontal) = values.take(photometric.n_horizontal, "the horizontal angles")?;
+    let rows = candela_table(&mut values, &horizontal, &photometric)?;
+    let (symmetry, planes) = unfold(&values, h_line, horizontal, rows)?;
+    let (table, mut photometry) = finish(
+        header.version,
+        symmetry.into(),
+        photometric.n_horizontal,
+        photometric.opening(),
+        planes,
+        &gammas,
+    )
+    .map_err(|message| PhotometryError::Content {
+        file: source.to_path_buf(),
+        message,
+    })?;
+    photometry.labels = keywords(&lines[..header.tilt]);
+    Ok((table, photometry))
+}
+
+/// The lines before the numbers: the version and where the `TILT=` line is.
+struct Header {
+    version: String,
+    /// Index of the `TILT=` line.
+    tilt: usize,
+    /// What follows `TILT=`, upper case.
+    tilt_value: String,
+}
+
+impl Header {
+    fn read(lines: &[&str], source: &Path) -> Result<Header, PhotometryError> {
+        let first = lines.iter().position(|l| !l.trim().is_empty()).unwrap_or(0);
+        let version = lines
+            .get(first)
+            .map(|l| l.trim())
+            .filter(|l| l.to_ascii_uppercase().starts_with("IES"))
+            .map(|l| l.to_string())
+            .unwrap_or_else(|| "IES LM-63-1986".into());
+        let Some(tilt) = lines
+            .iter()
+            .position(|l| l.trim_start().to_ascii_uppercase().starts_with("TILT="))
+        else {
+            return Err(PhotometryError::Format {
+                file: source.to_path_buf(),
+                line: lines.len().max(1),
+                message: "no TILT= line: not an IES LM-63 file".into(),
+            });
         };
-        pos.set(pos.get() + 1);
-        t.parse::<f64>()
-            .map(|v| (*line, v))
-            .map_err(|_| fmt_err(*line, format!("{what}: '{}' is not a number", echo(t))))
-    };
-    if tilt_value == "INCLUDE" {
-        // Lamp-to-luminaire geometry, the number of tilt angles, the angles, the factors:
-        // they scale the lamp's output with its tilt, which a fixed panel does not have.
-        next("the tilt geometry")?;
-        let (count_line, n) = next("the number of tilt angles")?;
-        if n.is_nan() || n < 0.0 || n.fract() != 0.0 {
-            return Err(fmt_err(
-                count_line,
-                format!("the number of tilt angles {n} is not a count"),
-            ));
-        }
-        let mut last = (count_line, f64::NEG_INFINITY);
-        for k in 0..(n as usize).saturating_mul(2) {
-            let (line, v) = next("the TILT=INCLUDE table")?;
-            if (k as f64) < n && v <= last.1 {
-                return Err(fmt_err(
-                    line,
-                    format!(
-                        "the TILT=INCLUDE table's angles must increase: {}° then {v}° (its \
-                         count on line {count_line} says {n} angles, then {n} factors)",
-                        last.1
-                    ),
-                ));
-            }
-            last = (line, v);
-        }
-        // The line of lamps, lumens, multiplier, … starts a line of its own: a table that
-        // ends in the middle of a line has more or fewer values than its count says, and
-        // every number after it would be read as the wrong field.
-        if let Some((line, t)) = toks.get(pos.get()).filter(|(l, _)| *l == last.0) {
-            return Err(fmt_err(
-                *line,
+        let tilt_value = lines[tilt].trim_start()[5..].trim().to_ascii_uppercase();
+        Ok(Header {
+            version,
+            tilt,
+            tilt_value,
+        })
+    }
+}
+
+/// Reads past a `TILT=INCLUDE` table, checking its form. Lamp-to-luminaire geometry, the
+/// number of tilt angles, the angles, the factors: they scale the lamp's output with its
+/// tilt, which a fixed panel does not have.
+fn skip_tilt_table(values: &mut Numbers) -> Result<(), PhotometryError> {
+    values.next("the tilt geometry")?;
+    let (count_line, n) = values.next("the number of tilt angles")?;
+    if n.is_nan() || n < 0.0 || n.fract() != 0.0 {
+        return Err(values.error(
+            count_line,
+            format!("the number of tilt angles {n} is not a count"),
+        ));
+    }
+    let mut last = (count_line, f64::NEG_INFINITY);
+    for k in 0..(n as usize).saturating_mul(2) {
+        let (line, v) = values.next("the TILT=INCLUDE table")?;
+        if (k as f64) < n && v <= last.1 {
+            return Err(values.error(
+                line,
                 format!(
-                    "the TILT=INCLUDE table ends in the middle of line {line}, before '{}': its \
-                     count on line {count_line} says {n} angles and {n} factors, but the \
-                     values do not end with a line (one too few or too many?)",
-                    echo(t)
+                    "the TILT=INCLUDE table's angles must increase: {}° then {v}° (its \
+                     count on line {count_line} says {n} angles, then {n} factors)",
+                    last.1
                 ),
             ));
         }
+        last = (line, v);
     }
-    let count = |(line, v): (usize, f64), what: &str| -> Result<usize, PhotometryError> {
-        if v >= 1.0 && v.fract() == 0.0 {
-            Ok(v as usize)
-        } else {
-            Err(fmt_err(line, format!("{what} {v} is not a positive count")))
-        }
-    };
-    next("the number of lamps")?;
-    next("the lumens per lamp")?;
-    let (_, multiplier) = next("the candela multiplier")?;
-    let n_vertical = count(
-        next("the number of vertical angles")?,
-        "the number of vertical angles",
-    )?;
-    let n_horizontal = count(
-        next("the number of horizontal angles")?,
-        "the number of horizontal angles",
-    )?;
-    let (line, kind) = next("the photometric type")?;
-    if kind != 1.0 {
-        return Err(fmt_err(
-            line,
-            format!("photometric type {kind}: only type C (1) describes a panel by C-planes"),
-        ));
-    }
-    let (line, units) = next("the units type")?;
-    let metres = match units as i64 {
-        1 if units == 1.0 => 0.3048,
-        2 if units == 2.0 => 1.0,
-        _ => {
-            return Err(fmt_err(
-                line,
-                format!("units type {units}: expected 1 (feet) or 2 (metres)"),
-            ))
-        }
-    };
-    let (_, width) = next("the opening's width")?;
-    let (_, length) = next("the opening's length")?;
-    next("the opening's height")?;
-    next("the ballast factor")?;
-    next("the file generation type")?;
-    next("the input watts")?;
-    // The counts are the file's word: the lists grow with the numbers actually there, so a
-    // count of 4294967296 ends at the end of the file, not in a 34 GB allocation.
-    let read_n = |n: usize, what: &str| -> Result<(usize, Vec<f64>), PhotometryError> {
-        let mut v = Vec::new();
-        let mut first_line = 0;
-        for k in 0..n {
-            let (line, x) = next(what)?;
-            if k == 0 {
-                first_line = line;
-            }
-            v.push(x);
-        }
-        Ok((first_line, v))
-    };
-    let (_, gammas) = read_n(n_vertical, "the vertical angles")?;
-    let (h_line, horizontal) = read_n(n_horizontal, "the horizontal angles")?;
-    let mut rows = Vec::new();
-    for &c in &horizontal {
-        let (_, row) = read_n(n_vertical, &format!("the candela values of C-plane {c}°"))?;
-        rows.push(
-            row.into_iter()
-                .map(|v| v * multiplier)
-                .collect::<Vec<f64>>(),
-        );
-    }
-    // Every value the counts call for is read; more numbers mean a count or a value is
-    // wrong, and the table read would be shifted (a DOS end-of-file mark is not a value).
-    let extra: Vec<&(usize, String)> = toks[pos.get()..]
-        .iter()
-        .filter(|(_, t)| !t.chars().all(char::is_control))
-        .collect();
-    if let Some((line, t)) = extra.first() {
-        return Err(fmt_err(
+    // The line of lamps, lumens, multiplier, … starts a line of its own: a table that
+    // ends in the middle of a line has more or fewer values than its count says, and
+    // every number after it would be read as the wrong field.
+    if let Some((line, t)) = values.peek().filter(|(l, _)| *l == last.0) {
+        return Err(values.error(
             *line,
             format!(
-                "{} value(s) after the last candela value, from '{}' on: the counts \
-                 ({n_vertical} vertical × {n_horizontal} horizontal angles) do not match the \
-                 numbers in the file",
-                extra.len(),
+                "the TILT=INCLUDE table ends in the middle of line {line}, before '{}': its \
+                 count on line {count_line} says {n} angles and {n} factors, but the \
+                 values do not end with a line (one too few or too many?)",
                 echo(t)
             ),
         ));
     }
+    Ok(())
+}
+
+/// The thirteen numbers after the tilt: what the rest of the file is made of.
+struct PhotometricLine {
+    multiplier: f64,
+    n_vertical: usize,
+    n_horizontal: usize,
+    /// Metres per unit of the opening's dimensions.
+    metres: f64,
+    width: f64,
+    length: f64,
+}
+
+impl PhotometricLine {
+    fn read(values: &mut Numbers) -> Result<PhotometricLine, PhotometryError> {
+        let count = |values: &Numbers, (line, v): (usize, f64), what: &str| {
+            if v >= 1.0 && v.fract() == 0.0 {
+                Ok(v as usize)
+            } else {
+                Err(values.error(line, format!("{what} {v} is not a positive count")))
+            }
+        };
+        values.next("the number of lamps")?;
+        values.next("the lumens per lamp")?;
+        let multiplier = values.value("the candela multiplier")?;
+        let what = "the number of vertical angles";
+        let read = values.next(what)?;
+        let n_vertical = count(values, read, what)?;
+        let what = "the number of horizontal angles";
+        let read = values.next(what)?;
+        let n_horizontal = count(values, read, what)?;
+        let (line, kind) = values.next("the photometric type")?;
+        if kind != 1.0 {
+            return Err(values.error(
+                line,
+                format!("photometric type {kind}: only type C (1) describes a panel by C-planes"),
+            ));
+        }
+        let (line, units) = values.next("the units type")?;
+        let metres = match units as i64 {
+            1 if units == 1.0 => 0.3048,
+            2 if units == 2.0 => 1.0,
+            _ => {
+                return Err(values.error(
+                    line,
+                    format!("units type {units}: expected 1 (feet) or 2 (metres)"),
+                ))
+            }
+        };
+        let width = values.value("the opening's width")?;
+        let length = values.value("the opening's length")?;
+        values.next("the opening's height")?;
+        values.next("the ballast factor")?;
+        values.next("the file generation type")?;
+        values.next("the input watts")?;
+        Ok(PhotometricLine {
+            multiplier,
+            n_vertical,
+            n_horizontal,
+            metres,
+            width,
+            length,
+        })
+    }
+
+    /// The luminous opening in metres.
+    fn opening(&self) -> Opening {
+        let (w, l) = (self.width * self.metres, self.length * self.metres);
+        // Negative dimensions describe round openings (a circle or an ellipse).
+        let area = if w < 0.0 && l < 0.0 {
+            std::f64::consts::PI / 4.0 * w * l
+        } else {
+            (w * l).max(0.0)
+        };
+        Opening {
+            width_m: l.abs(),
+            height_m: w.abs(),
+            area_m2: area,
+        }
+    }
+}
+
+/// The candela values, one row per horizontal angle, times the multiplier; then the end of
+/// the file.
+fn candela_table(
+    values: &mut Numbers,
+    horizontal: &[f64],
+    photometric: &PhotometricLine,
+) -> Result<Vec<Vec<f64>>, PhotometryError> {
+    let mut rows = Vec::new();
+    for &c in horizontal {
+        let what = format!("the candela values of C-plane {c}°");
+        let (_, row) = values.take(photometric.n_vertical, &what)?;
+        rows.push(
+            row.into_iter()
+                .map(|v| v * photometric.multiplier)
+                .collect(),
+        );
+    }
+    // Every value the counts call for is read; more numbers mean a count or a value is
+    // wrong, and the table read would be shifted (a DOS end-of-file mark is not a value).
+    let extra: Vec<&(usize, String)> = values
+        .remaining()
+        .iter()
+        .filter(|(_, t)| !t.chars().all(char::is_control))
+        .collect();
+    if let Some((line, t)) = extra.first() {
+        return Err(values.error(
+            *line,
+            format!(
+                "{} value(s) after the last candela value, from '{}' on: the counts \
+                 ({} vertical × {} horizontal angles) do not match the numbers in the file",
+                extra.len(),
+                echo(t),
+                photometric.n_vertical,
+                photometric.n_horizontal
+            ),
+        ));
+    }
+    Ok(rows)
+}
+
+/// C-planes as (C, candela at each vertical angle).
+type Planes = Vec<(f64, Vec<f64>)>;
+
+/// The symmetry the horizontal angles say, and the stored planes mirrored into the full
+/// circle by it. `h_line` is the line of the first horizontal angle.
+fn unfold(
+    values: &Numbers,
+    h_line: usize,
+    horizontal: Vec<f64>,
+    rows: Vec<Vec<f64>>,
+) -> Result<(&'static str, Planes), PhotometryError> {
+    let n_horizontal = horizontal.len();
     let first_c = horizontal[0];
     let last_c = horizontal[n_horizontal - 1];
     if let Some(w) = horizontal
         .windows(2)
         .find(|w| w[1].is_nan() || w[1] <= w[0])
     {
-        return Err(fmt_err(
+        return Err(values.error(
             h_line,
             format!(
                 "the horizontal angles must increase: {}° then {}°",
@@ -361,7 +442,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
             ),
         ));
     }
-    let stored: Vec<(f64, Vec<f64>)> = horizontal.iter().copied().zip(rows).collect();
+    let stored: Vec<(f64, Vec<f64>)> = horizontal.into_iter().zip(rows).collect();
     type Mirror = fn(f64) -> f64;
     let (symmetry, mirrors): (&str, Vec<Mirror>) = if n_horizontal == 1 && first_c == 0.0 {
         ("rotationally symmetric", vec![])
@@ -377,7 +458,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     } else if first_c == 0.0 && last_c > 180.0 && last_c <= 360.0 {
         ("none", vec![])
     } else {
-        return Err(fmt_err(
+        return Err(values.error(
             h_line,
             format!(
                 "horizontal angles {first_c}…{last_c}°: type C files run 0, 0…90, 0…180, \
@@ -390,33 +471,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     } else {
         mirror_planes(stored, &mirrors)
     };
-    let (w, l) = (width * metres, length * metres);
-    // Negative dimensions describe round openings (a circle or an ellipse).
-    let area = if w < 0.0 && l < 0.0 {
-        std::f64::consts::PI / 4.0 * w * l
-    } else {
-        (w * l).max(0.0)
-    };
-    let opening = Opening {
-        width_m: l.abs(),
-        height_m: w.abs(),
-        area_m2: area,
-    };
-    let stored_planes = n_horizontal;
-    let (table, mut photometry) = finish(
-        version,
-        symmetry.into(),
-        stored_planes,
-        opening,
-        planes,
-        &gammas,
-    )
-    .map_err(|message| PhotometryError::Content {
-        file: source.to_path_buf(),
-        message,
-    })?;
-    photometry.labels = keywords(&lines[..tilt]);
-    Ok((table, photometry))
+    Ok((symmetry, planes))
 }
 
 #[cfg(test)]

@@ -25,8 +25,9 @@ use std::path::Path;
 use metamer_color::text::{echo, strip_bom};
 
 use super::cgamma::CGammaTable;
+use super::numbers::{tokens, Numbers};
 use super::photometry::{
-    candela_grid, decode_text, finish, flux_lm, format_sig, mirror_planes, tokens, Opening, Panel,
+    candela_grid, decode_text, finish, flux_lm, format_sig, mirror_planes, Opening, Panel,
     Photometry, PhotometryError,
 };
 
@@ -123,65 +124,160 @@ pub fn read(path: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
 
 /// [`read`] on text; `source` names the file in errors.
 pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), PhotometryError> {
-    let fmt_err = |line: usize, message: String| PhotometryError::Format {
-        file: source.to_path_buf(),
-        line,
-        message,
-    };
     let lines: Vec<&str> = strip_bom(text).lines().collect();
-    let line_of = |k: usize| -> Result<&str, PhotometryError> {
-        lines.get(k - 1).copied().ok_or_else(|| {
-            fmt_err(
-                lines.len().max(1),
-                format!(
-                    "the file ends at line {}, before line {k} of the header",
-                    lines.len()
-                ),
+    let header = Header::read(&HeaderLines {
+        lines: &lines,
+        source,
+    })?;
+    let data_start = 27 + 6 * header.sets;
+    let rest = lines.get(data_start - 1..).unwrap_or(&[]).join("\n");
+    let toks = tokens_decimal_comma(&rest, data_start);
+    let mut values = Numbers::new(toks, source, lines.len().max(1));
+    for _ in 0..10 {
+        values.next("the direct ratios")?;
+    }
+    let c_angles = c_angles(&mut values, header.mc)?;
+    let (_, gammas) = values.take(header.ng, "the γ angles")?;
+    let stored = StoredPlanes::of(&values, &header, &c_angles)?;
+    let planes = intensities(&mut values, &header, &stored, &c_angles)?;
+    let (table, mut photometry) = finish(
+        "EULUMDAT".into(),
+        stored.symmetry.into(),
+        stored.count,
+        header.opening(),
+        planes,
+        &gammas,
+    )
+    .map_err(|message| PhotometryError::Content {
+        file: source.to_path_buf(),
+        message,
+    })?;
+    photometry.labels = labels(&lines);
+    Ok((table, photometry))
+}
+
+/// The header's lines, one field each, read by line number (1-based, as the format counts).
+struct HeaderLines<'a> {
+    lines: &'a [&'a str],
+    source: &'a Path,
+}
+
+impl HeaderLines<'_> {
+    fn error(&self, line: usize, message: String) -> PhotometryError {
+        PhotometryError::Format {
+            file: self.source.to_path_buf(),
+            line,
+            message,
+        }
+    }
+
+    fn line(&self, k: usize) -> Result<&str, PhotometryError> {
+        let n = self.lines.len();
+        self.lines.get(k - 1).copied().ok_or_else(|| {
+            self.error(
+                n.max(1),
+                format!("the file ends at line {n}, before line {k} of the header"),
             )
         })
-    };
-    let number = |k: usize, what: &str| -> Result<f64, PhotometryError> {
-        let raw = line_of(k)?.trim();
+    }
+
+    fn number(&self, k: usize, what: &str) -> Result<f64, PhotometryError> {
+        let raw = self.line(k)?.trim();
         raw.replace(',', ".")
             .parse::<f64>()
-            .map_err(|_| fmt_err(k, format!("{what}: '{}' is not a number", echo(raw))))
-    };
-    let count = |k: usize, what: &str| -> Result<usize, PhotometryError> {
-        let v = number(k, what)?;
+            .map_err(|_| self.error(k, format!("{what}: '{}' is not a number", echo(raw))))
+    }
+
+    fn count(&self, k: usize, what: &str) -> Result<usize, PhotometryError> {
+        let v = self.number(k, what)?;
         if v >= 0.0 && v.fract() == 0.0 {
             Ok(v as usize)
         } else {
-            Err(fmt_err(k, format!("{what} {v} is not a count")))
+            Err(self.error(k, format!("{what} {v} is not a count")))
         }
-    };
-    let isym = count(3, "the symmetry indicator Isym")?;
-    let mc = count(4, "the number of C-planes Mc")?;
-    let ng = count(6, "the number of γ angles Ng")?;
-    if ng < 2 {
-        return Err(fmt_err(
-            6,
-            format!("Ng = {ng}: a distribution needs at least 2 γ angles"),
-        ));
     }
-    let length_mm = number(16, "the luminous area's length")?;
-    let width_mm = number(17, "the luminous area's width")?;
-    let conversion = number(24, "the intensity conversion factor")?;
-    let sets = count(26, "the number of lamp sets")?;
+}
+
+/// The header fields the distribution needs.
+struct Header {
+    /// The symmetry indicator Isym.
+    isym: usize,
+    /// The number of C-planes Mc.
+    mc: usize,
+    /// The number of γ angles Ng.
+    ng: usize,
+    length_mm: f64,
+    width_mm: f64,
+    /// The intensity conversion factor.
+    conversion: f64,
+    /// The number of lamp sets.
+    sets: usize,
+    /// The lamp sets' flux, lm.
+    total_flux: f64,
+}
+
+impl Header {
+    fn read(h: &HeaderLines) -> Result<Header, PhotometryError> {
+        let isym = h.count(3, "the symmetry indicator Isym")?;
+        let mc = h.count(4, "the number of C-planes Mc")?;
+        let ng = h.count(6, "the number of γ angles Ng")?;
+        if ng < 2 {
+            return Err(h.error(
+                6,
+                format!("Ng = {ng}: a distribution needs at least 2 γ angles"),
+            ));
+        }
+        let length_mm = h.number(16, "the luminous area's length")?;
+        let width_mm = h.number(17, "the luminous area's width")?;
+        let conversion = h.number(24, "the intensity conversion factor")?;
+        let sets = h.count(26, "the number of lamp sets")?;
+        let total_flux = lamp_flux(h, sets)?;
+        Ok(Header {
+            isym,
+            mc,
+            ng,
+            length_mm,
+            width_mm,
+            conversion,
+            sets,
+            total_flux,
+        })
+    }
+
+    /// The luminous area in metres.
+    fn opening(&self) -> Opening {
+        let (l, w) = (self.length_mm / 1000.0, self.width_mm / 1000.0);
+        // A width of 0 marks a round luminous area whose length is its diameter.
+        let area = if w == 0.0 {
+            std::f64::consts::PI / 4.0 * l * l
+        } else {
+            l * w
+        };
+        Opening {
+            width_m: if w == 0.0 { l } else { w },
+            height_m: l,
+            area_m2: area.abs(),
+        }
+    }
+}
+
+/// The total flux of the `sets` lamp sets, lm.
+fn lamp_flux(h: &HeaderLines, sets: usize) -> Result<f64, PhotometryError> {
     if sets == 0 {
-        return Err(fmt_err(
+        return Err(h.error(
             26,
             "no lamp sets: the cd/klm values cannot be scaled to candela".into(),
         ));
     }
     // Six lines per lamp set follow: a count the file cannot hold is a corrupt header (and
     // must not overflow the line arithmetic below).
-    if sets > lines.len() {
-        return Err(fmt_err(
+    if sets > h.lines.len() {
+        return Err(h.error(
             26,
             format!(
                 "{sets} lamp sets need {} more lines, but the file has {} lines",
                 sets.saturating_mul(6),
-                lines.len()
+                h.lines.len()
             ),
         ));
     }
@@ -189,36 +285,18 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
     let mut total_flux = 0.0;
     for k in 0..sets {
         let line = 27 + 2 * sets + k;
-        total_flux += number(line, "a lamp set's luminous flux")?.abs();
+        total_flux += h.number(line, "a lamp set's luminous flux")?.abs();
     }
     if total_flux.is_nan() || total_flux <= 0.0 {
-        return Err(fmt_err(
-            27 + 2 * sets,
-            "the lamps' luminous flux is 0".into(),
-        ));
+        return Err(h.error(27 + 2 * sets, "the lamps' luminous flux is 0".into()));
     }
-    let data_start = 27 + 6 * sets;
-    let rest = lines.get(data_start - 1..).unwrap_or(&[]).join("\n");
-    let toks = tokens_decimal_comma(&rest, data_start);
-    let pos = std::cell::Cell::new(0usize);
-    let next_at = |what: &str| -> Result<(usize, f64), PhotometryError> {
-        let Some((line, t)) = toks.get(pos.get()) else {
-            return Err(fmt_err(
-                lines.len().max(1),
-                format!("the file ends before {what}"),
-            ));
-        };
-        pos.set(pos.get() + 1);
-        t.parse::<f64>()
-            .map(|v| (*line, v))
-            .map_err(|_| fmt_err(*line, format!("{what}: '{}' is not a number", echo(t))))
-    };
-    let next = |what: &str| next_at(what).map(|(_, v)| v);
-    for _ in 0..10 {
-        next("the direct ratios")?;
-    }
+    Ok(total_flux)
+}
+
+/// The `mc` C angles, which must increase.
+fn c_angles(values: &mut Numbers, mc: usize) -> Result<Vec<f64>, PhotometryError> {
     let c_at: Vec<(usize, f64)> = (0..mc)
-        .map(|_| next_at("the C angles"))
+        .map(|_| values.next("the C angles"))
         .collect::<Result<_, _>>()?;
     // A plane listed twice (or out of order) would be dropped or mirrored over another
     // one's data without a word.
@@ -226,7 +304,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         .windows(2)
         .find(|w| w[1].1.partial_cmp(&w[0].1) != Some(std::cmp::Ordering::Greater))
     {
-        return Err(fmt_err(
+        return Err(values.error(
             w[1].0,
             format!(
                 "the C angles must increase: C{}° then C{}° (a plane listed twice, or out of \
@@ -235,87 +313,100 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
             ),
         ));
     }
-    let c_angles: Vec<f64> = c_at.iter().map(|c| c.1).collect();
-    let gammas: Vec<f64> = (0..ng)
-        .map(|_| next("the γ angles"))
-        .collect::<Result<_, _>>()?;
-    type Mirror = fn(f64) -> f64;
-    let (first, stored, symmetry, mirrors): (usize, usize, &str, Vec<Mirror>) = match isym {
-        0 => (0, mc, "none", vec![]),
-        1 => (0, 1, "rotationally symmetric", vec![]),
-        2 => (
-            0,
-            mc / 2 + 1,
-            "symmetric about the C0–C180 plane",
-            vec![|c| 360.0 - c],
-        ),
-        3 => {
-            let start = c_angles.iter().position(|&c| c >= 90.0).unwrap_or(0);
-            (
-                start,
+    Ok(c_at.iter().map(|c| c.1).collect())
+}
+
+/// Which C-planes Isym says the file stores, and how they mirror into the full circle.
+struct StoredPlanes {
+    /// Index of the first stored plane among the C angles.
+    first: usize,
+    count: usize,
+    symmetry: &'static str,
+    mirrors: Vec<fn(f64) -> f64>,
+}
+
+impl StoredPlanes {
+    fn of(values: &Numbers, header: &Header, c_angles: &[f64]) -> Result<Self, PhotometryError> {
+        let (isym, mc) = (header.isym, header.mc);
+        type Mirror = fn(f64) -> f64;
+        let (first, count, symmetry, mirrors): (usize, usize, &str, Vec<Mirror>) = match isym {
+            0 => (0, mc, "none", vec![]),
+            1 => (0, 1, "rotationally symmetric", vec![]),
+            2 => (
+                0,
                 mc / 2 + 1,
-                "symmetric about the C90–C270 plane",
-                vec![|c| 180.0 - c],
-            )
-        }
-        4 => (
-            0,
-            mc / 4 + 1,
-            "symmetric about C0–C180 and C90–C270",
-            vec![|c| 180.0 - c, |c| 180.0 + c, |c| 360.0 - c],
-        ),
-        _ => {
-            return Err(fmt_err(
-                3,
-                format!("symmetry indicator Isym = {isym}: expected 0 to 4"),
+                "symmetric about the C0–C180 plane",
+                vec![|c| 360.0 - c],
+            ),
+            3 => {
+                let start = c_angles.iter().position(|&c| c >= 90.0).unwrap_or(0);
+                (
+                    start,
+                    mc / 2 + 1,
+                    "symmetric about the C90–C270 plane",
+                    vec![|c| 180.0 - c],
+                )
+            }
+            4 => (
+                0,
+                mc / 4 + 1,
+                "symmetric about C0–C180 and C90–C270",
+                vec![|c| 180.0 - c, |c| 180.0 + c, |c| 360.0 - c],
+            ),
+            _ => {
+                return Err(values.error(
+                    3,
+                    format!("symmetry indicator Isym = {isym}: expected 0 to 4"),
+                ));
+            }
+        };
+        if isym != 1 && first + count > mc {
+            return Err(values.error(
+                4,
+                format!("Mc = {mc} C-planes cannot hold the {count} planes Isym = {isym} stores"),
             ));
         }
-    };
-    if isym != 1 && first + stored > mc {
-        return Err(fmt_err(
-            4,
-            format!("Mc = {mc} C-planes cannot hold the {stored} planes Isym = {isym} stores"),
-        ));
+        Ok(StoredPlanes {
+            first,
+            count,
+            symmetry,
+            mirrors,
+        })
     }
-    let scale = conversion * total_flux / 1000.0;
-    let mut planes = Vec::with_capacity(stored);
-    for k in 0..stored {
-        let c = if isym == 1 { 0.0 } else { c_angles[first + k] };
-        let row: Vec<f64> = (0..ng)
-            .map(|_| next(&format!("the intensities of C-plane {c}°")).map(|v| v * scale))
+}
+
+/// The stored planes' intensities in candela, mirrored into the full circle.
+fn intensities(
+    values: &mut Numbers,
+    header: &Header,
+    stored: &StoredPlanes,
+    c_angles: &[f64],
+) -> Result<Vec<(f64, Vec<f64>)>, PhotometryError> {
+    let rotational = header.isym == 1;
+    let scale = header.conversion * header.total_flux / 1000.0;
+    let mut planes = Vec::with_capacity(stored.count);
+    for k in 0..stored.count {
+        let c = if rotational {
+            0.0
+        } else {
+            c_angles[stored.first + k]
+        };
+        let what = format!("the intensities of C-plane {c}°");
+        let row: Vec<f64> = (0..header.ng)
+            .map(|_| values.value(&what).map(|v| v * scale))
             .collect::<Result<_, _>>()?;
         planes.push((c, row));
     }
-    let planes = if isym == 1 {
+    Ok(if rotational {
         planes
     } else {
-        mirror_planes(planes, &mirrors)
-    };
-    let (l, w) = (length_mm / 1000.0, width_mm / 1000.0);
-    // A width of 0 marks a round luminous area whose length is its diameter.
-    let area = if w == 0.0 {
-        std::f64::consts::PI / 4.0 * l * l
-    } else {
-        l * w
-    };
-    let opening = Opening {
-        width_m: if w == 0.0 { l } else { w },
-        height_m: l,
-        area_m2: area.abs(),
-    };
-    let (table, mut photometry) = finish(
-        "EULUMDAT".into(),
-        symmetry.into(),
-        stored,
-        opening,
-        planes,
-        &gammas,
-    )
-    .map_err(|message| PhotometryError::Content {
-        file: source.to_path_buf(),
-        message,
-    })?;
-    photometry.labels = [
+        mirror_planes(planes, &stored.mirrors)
+    })
+}
+
+/// The header's descriptive lines that are not blank.
+fn labels(lines: &[&str]) -> Vec<(String, String)> {
+    [
         (1, "company"),
         (8, "report"),
         (9, "luminaire"),
@@ -328,8 +419,7 @@ pub fn parse(text: &str, source: &Path) -> Result<(CGammaTable, Photometry), Pho
         let t = lines.get(k - 1)?.trim();
         (!t.is_empty()).then(|| (name.to_string(), echo(t)))
     })
-    .collect();
-    Ok((table, photometry))
+    .collect()
 }
 
 /// Tokens of the numeric block with decimal commas read as points (EULUMDAT separates

@@ -5,7 +5,9 @@ pub mod cgamma;
 pub mod chart;
 pub mod fit;
 pub mod ies;
+pub mod job;
 pub mod ldt;
+mod numbers;
 pub mod photometry;
 
 pub use cgamma::{CGammaError, CGammaTable};

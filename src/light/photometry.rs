@@ -278,19 +278,6 @@ pub(crate) fn candela_grid(table: &CGammaTable, panel: &Panel) -> Vec<Vec<f64>> 
         .collect()
 }
 
-/// Splits a photometric file into whitespace/comma separated tokens with their line
-/// numbers (both formats allow values wrapped across lines).
-pub(crate) fn tokens(text: &str, first_line: usize) -> Vec<(usize, String)> {
-    text.lines()
-        .enumerate()
-        .flat_map(|(i, l)| {
-            l.split(|c: char| c.is_whitespace() || c == ',')
-                .filter(|t| !t.is_empty())
-                .map(move |t| (first_line + i, t.to_string()))
-        })
-        .collect()
-}
-
 /// C-planes a file stores, mirrored by its symmetry into the full circle: each stored
 /// plane at C also stands for every `mirror(C)` the file does not store itself. Sorted,
 /// within [0°, 360°), 360° folded onto 0°.

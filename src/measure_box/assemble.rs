@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
-use super::plan::{BoxPlan, BoxStep, Stage, Target};
+use super::plan::{BoxPlan, BoxStep, Geometry, Plane, Stage, Target};
 use super::scene::{scene_json, BoxContents};
 use super::stats::{group, mean_spectrum, GroupStats, Repeatability, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
@@ -286,6 +286,74 @@ pub fn assemble(
     instruments: &BTreeMap<String, InstrumentRecord>,
     details: &BoxDetails,
 ) -> Result<Summary, AssembleError> {
+    let (stages, flags) = reduce_stages(entries)?;
+    let light = fit_light(&falloff_readings(&stages.falloff))?;
+    let g = &plan.geometry;
+    let materials = measured_materials(g, &stages.tiles, &stages.materials)?;
+    let date = iso_date(metamer_drivers::instrument::now_s());
+    let provenance = Provenance {
+        date: date.clone(),
+        journals: journal_digests(entries)?,
+        instruments: instruments.clone(),
+        instrument_specs: details.clone(),
+        distribution_fit: DistributionFit {
+            model: light.model,
+            why: light.why.clone(),
+            rms: light.chosen().and_then(|c| c.rms),
+            residuals: light.residuals.clone(),
+        },
+        outliers: flags,
+        nominal_patches: materials.nominal_patches,
+        clamped_values: materials.clamped_values,
+        nominal_frame_reflectance: super::scene::FRAME_REFLECTANCE,
+    };
+    let contents = BoxContents {
+        wall: materials.wall,
+        patches: materials.patches,
+        tiles: materials.tiles,
+        distribution: DistributionFile::CGamma {
+            table: light.table.clone(),
+        },
+        provenance: Some(
+            serde_json::to_value(&provenance).map_err(|e| io(dir)(std::io::Error::other(e)))?,
+        ),
+    };
+    let scene = scene_json(
+        "measured validation box",
+        "The validation box as measured by metamer measure-box: per-tile spectra, the fitted light distribution, measured materials.",
+        g,
+        &contents,
+    );
+    let mut policy = policy.clone();
+    policy.inputs(entries.stages.values().map(|(p, _)| p.as_path()));
+    let files = write_scene_files(&policy, dir, &scene, &light, g, &date[..10])?;
+    let spot_xyz = spot_xyz(&stages.spots);
+    let render = compare_render(&scene, &spot_xyz)?;
+    let summary = Summary {
+        tiles: stages.tiles.reduced,
+        falloff: stages.falloff.reduced,
+        materials: stages.materials.reduced,
+        spots: stages.spots.reduced,
+        spot_xyz,
+        light,
+        render,
+        provenance,
+        files,
+    };
+    write_json(&policy, &summary.files.summary, &summary)?;
+    Ok(summary)
+}
+
+/// The four stages, each reduced.
+struct Stages {
+    tiles: StageReduced,
+    falloff: StageReduced,
+    materials: StageReduced,
+    spots: StageReduced,
+}
+
+/// Every stage's groups reduced, and the groups flagged for outliers or spread.
+fn reduce_stages(entries: &StageEntries) -> Result<(Stages, Vec<Flagged>), AssembleError> {
     let get = |stage: Stage| {
         entries
             .stages
@@ -298,8 +366,18 @@ pub fn assemble(
     let falloff = reduce(Stage::Falloff, get(Stage::Falloff)?, false, &mut flags)?;
     let materials = reduce(Stage::Materials, get(Stage::Materials)?, true, &mut flags)?;
     let spots = reduce(Stage::Spots, get(Stage::Spots)?, false, &mut flags)?;
+    let stages = Stages {
+        tiles,
+        falloff,
+        materials,
+        spots,
+    };
+    Ok((stages, flags))
+}
 
-    let readings: Vec<_> = falloff
+/// The fall-off's mean luminance as (plane, signed angle, cd/m²).
+fn falloff_readings(falloff: &StageReduced) -> Vec<(Plane, f64, f64)> {
+    falloff
         .targets
         .iter()
         .zip(&falloff.reduced)
@@ -307,10 +385,28 @@ pub fn assemble(
             Target::Falloff { plane, angle_deg } => Some((*plane, *angle_deg, r.stats.xyz[1])),
             _ => None,
         })
-        .collect();
-    let light = fit_light(&readings)?;
+        .collect()
+}
 
-    let g = &plan.geometry;
+/// The box's measured spectra, clamped into their physical range.
+struct Materials {
+    /// Each tile's radiance, row by row.
+    tiles: Vec<Spectrum>,
+    wall: Spectrum,
+    /// The 24 patches' reflectance, measured or (where not measured) nominal.
+    patches: Vec<Spectrum>,
+    /// The patches not measured (1–24).
+    nominal_patches: Vec<usize>,
+    /// Values clamped: negative radiance, reflectance outside 0–1.
+    clamped_values: usize,
+}
+
+/// The tiles' and the materials' spectra of the reduced stages.
+fn measured_materials(
+    g: &Geometry,
+    tiles: &StageReduced,
+    materials: &StageReduced,
+) -> Result<Materials, AssembleError> {
     let mut clamped_values = 0;
     let mut tile_spectra = vec![None; g.rows * g.cols];
     for (t, s) in tiles.targets.iter().zip(&tiles.spectra) {
@@ -344,6 +440,17 @@ pub fn assemble(
         .zip(nominal)
         .map(|(m, n)| m.unwrap_or(n))
         .collect();
+    Ok(Materials {
+        tiles: tile_spectra,
+        wall,
+        patches,
+        nominal_patches,
+        clamped_values,
+    })
+}
+
+/// Each stage journal's SHA-256.
+fn journal_digests(entries: &StageEntries) -> Result<Vec<JournalDigest>, AssembleError> {
     let mut journals = Vec::new();
     for (stage, (path, _)) in &entries.stages {
         journals.push(JournalDigest {
@@ -352,42 +459,19 @@ pub fn assemble(
             sha256: sha256_file(path)?,
         });
     }
-    let date = iso_date(metamer_drivers::instrument::now_s());
-    let provenance = Provenance {
-        date: date.clone(),
-        journals,
-        instruments: instruments.clone(),
-        instrument_specs: details.clone(),
-        distribution_fit: DistributionFit {
-            model: light.model,
-            why: light.why.clone(),
-            rms: light.chosen().and_then(|c| c.rms),
-            residuals: light.residuals.clone(),
-        },
-        outliers: flags,
-        nominal_patches,
-        clamped_values,
-        nominal_frame_reflectance: super::scene::FRAME_REFLECTANCE,
-    };
-    let contents = BoxContents {
-        wall,
-        patches,
-        tiles: tile_spectra,
-        distribution: DistributionFile::CGamma {
-            table: light.table.clone(),
-        },
-        provenance: Some(
-            serde_json::to_value(&provenance).map_err(|e| io(dir)(std::io::Error::other(e)))?,
-        ),
-    };
-    let scene = scene_json(
-        "measured validation box",
-        "The validation box as measured by metamer measure-box: per-tile spectra, the fitted light distribution, measured materials.",
-        g,
-        &contents,
-    );
-    let mut policy = policy.clone();
-    policy.inputs(entries.stages.values().map(|(p, _)| p.as_path()));
+    Ok(journals)
+}
+
+/// Writes `scene.json`, `light.json` and the light's chart, IES and EULUMDAT files into
+/// `dir`; `summary.json` is checked with them and written last, by the caller.
+fn write_scene_files(
+    policy: &OutputPolicy,
+    dir: &Path,
+    scene: &serde_json::Value,
+    light: &LdcFit,
+    g: &Geometry,
+    date: &str,
+) -> Result<Files, AssembleError> {
     policy.dir(dir)?;
     let files = Files {
         scene: dir.join("scene.json"),
@@ -399,7 +483,7 @@ pub fn assemble(
     };
     // Every file is made and every target checked before any is written, so a fault or a
     // refusal leaves no half set.
-    let light_texts = light_files(&light, g, &date[..10])?;
+    let light_texts = light_files(light, g, date)?;
     for path in [
         &files.scene,
         &files.light,
@@ -410,13 +494,17 @@ pub fn assemble(
         policy.check(path)?;
     }
     policy.check(&files.summary)?;
-    write_json(&policy, &files.scene, &scene)?;
-    write_json(&policy, &files.light, &light)?;
+    write_json(policy, &files.scene, scene)?;
+    write_json(policy, &files.light, light)?;
     for (name, text) in &light_texts {
         policy.write(&dir.join(name), text.as_bytes())?;
     }
+    Ok(files)
+}
 
-    let spot_xyz: Vec<(usize, [f64; 3])> = spots
+/// The spot meter's mean XYZ of each ColorChecker patch.
+fn spot_xyz(spots: &StageReduced) -> Vec<(usize, [f64; 3])> {
+    spots
         .targets
         .iter()
         .zip(&spots.reduced)
@@ -424,22 +512,7 @@ pub fn assemble(
             Target::Spot { patch } => Some((*patch, r.stats.xyz)),
             _ => None,
         })
-        .collect();
-    let render = compare_render(&scene, &spot_xyz)?;
-
-    let summary = Summary {
-        tiles: tiles.reduced,
-        falloff: falloff.reduced,
-        materials: materials.reduced,
-        spots: spots.reduced,
-        spot_xyz,
-        light,
-        render,
-        provenance,
-        files,
-    };
-    write_json(&policy, &summary.files.summary, &summary)?;
-    Ok(summary)
+        .collect()
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@
 pub mod assemble;
 pub mod compare;
 pub mod falloff;
+pub mod job;
 pub mod plan;
 pub mod run;
 pub mod scene;

@@ -18,6 +18,8 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::MeasureMode;
 use serde::{Deserialize, Serialize};
 
+pub use crate::light::fit::Plane;
+
 use crate::color::COLORCHECKER_NAMES;
 use crate::session::{Prepare, SessionPlan, Step};
 
@@ -69,38 +71,6 @@ impl std::str::FromStr for Stage {
             .into_iter()
             .find(|st| st.name() == s)
             .ok_or_else(|| format!("unknown stage '{s}' (known: tiles, falloff, materials, spots)"))
-    }
-}
-
-/// A plane the fall-off is measured in (the C-plane convention of `light::cgamma`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Plane {
-    /// Rotation about the vertical axis: C = 0° (positive angles, towards the emitter's
-    /// `edge_u`, the back of the box) and C = 180°.
-    Horizontal,
-    /// Rotation about the horizontal axis: C = 90° (positive angles, towards `edge_v`,
-    /// downwards) and C = 270°.
-    Vertical,
-}
-
-impl Plane {
-    /// (C, γ) in degrees of a signed angle in this plane.
-    pub fn c_gamma(self, angle_deg: f64) -> (f64, f64) {
-        let c = match (self, angle_deg >= 0.0) {
-            (Plane::Horizontal, true) => 0.0,
-            (Plane::Horizontal, false) => 180.0,
-            (Plane::Vertical, true) => 90.0,
-            (Plane::Vertical, false) => 270.0,
-        };
-        (c, angle_deg.abs())
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Plane::Horizontal => "horizontal",
-            Plane::Vertical => "vertical",
-        }
     }
 }
 
@@ -254,134 +224,6 @@ impl BoxPlan {
         let plan: BoxPlan = serde_json::from_value(value).map_err(json)?;
         plan.validate()?;
         Ok(plan)
-    }
-
-    /// Checks every field; the first bad one is named.
-    pub fn validate(&self) -> Result<(), PlanError> {
-        for (field, n) in [
-            ("repeats", self.repeats),
-            ("material_repeats", self.material_repeats),
-            ("falloff_repeats", self.falloff_repeats),
-        ] {
-            if !(1..=MAX_REPEATS).contains(&n) {
-                return Err(invalid(
-                    field,
-                    format!("must be between 1 and {MAX_REPEATS}, got {n}"),
-                ));
-            }
-        }
-        let a = &self.falloff_angles_deg;
-        if a.is_empty() {
-            return Err(invalid("falloff_angles_deg", "needs at least one angle"));
-        }
-        if let Some(v) = a.iter().find(|v| !(v.is_finite() && v.abs() < 90.0)) {
-            return Err(invalid(
-                "falloff_angles_deg",
-                format!("{v:?} is not an angle off the normal: each must lie in (−90°, 90°)"),
-            ));
-        }
-        if let Some(w) = a.windows(2).find(|w| w[1] <= w[0]) {
-            return Err(invalid(
-                "falloff_angles_deg",
-                format!("must increase strictly: {} follows {}", w[1], w[0]),
-            ));
-        }
-        if !a.contains(&0.0) {
-            return Err(invalid(
-                "falloff_angles_deg",
-                "must contain 0 (the normal: the distribution is relative to it)",
-            ));
-        }
-        // The fit gives each half-plane (C0 and C90 on the positive side, C180 and C270
-        // on the negative) a curve of its own, and even the simplest model needs one
-        // reading off the normal in each: without it the fit fails after every stage has
-        // been measured.
-        if !(a.iter().any(|&v| v < 0.0) && a.iter().any(|&v| v > 0.0)) {
-            let missing = if a.iter().any(|&v| v > 0.0) {
-                "negative"
-            } else {
-                "positive"
-            };
-            return Err(invalid(
-                "falloff_angles_deg",
-                format!(
-                    "needs an angle on each side of the normal, and has no {missing} one: the fall-off fit makes a curve for each half-plane (positive angles are C0 and C90, negative ones C180 and C270), so {:?} cannot be fitted",
-                    a
-                ),
-            ));
-        }
-        if self.patches.is_empty() {
-            return Err(invalid("patches", "needs at least one patch"));
-        }
-        for (i, &p) in self.patches.iter().enumerate() {
-            if !(1..=24).contains(&p) {
-                return Err(invalid(
-                    "patches",
-                    format!("{p} is not a patch number 1–24"),
-                ));
-            }
-            if self.patches[..i].contains(&p) {
-                return Err(invalid("patches", format!("patch {p} is listed twice")));
-            }
-        }
-        let g = &self.geometry;
-        for (field, n) in [("geometry.rows", g.rows), ("geometry.cols", g.cols)] {
-            if !(1..=MAX_TILES_PER_SIDE).contains(&n) {
-                return Err(invalid(
-                    field,
-                    format!("must be between 1 and {MAX_TILES_PER_SIDE}, got {n}"),
-                ));
-            }
-        }
-        if let Some([r, c]) = self.falloff_tile {
-            if r >= g.rows || c >= g.cols {
-                return Err(invalid(
-                    "falloff_tile",
-                    format!(
-                        "tile [{r}, {c}] is outside the {} × {} grid",
-                        g.rows, g.cols
-                    ),
-                ));
-            }
-        }
-        // The chart (204 mm × 291 mm) must fit on the right wall.
-        if !(g.size_m.is_finite() && (0.3..=5.0).contains(&g.size_m)) {
-            return Err(invalid(
-                "geometry.size_m",
-                format!(
-                    "must be between 0.3 m (the chart must fit) and 5 m, got {:?}",
-                    g.size_m
-                ),
-            ));
-        }
-        let [y0, y1, z0, z1] = g.light_m;
-        let inside = |v: f64| v.is_finite() && (0.0..=g.size_m).contains(&v);
-        if !(inside(y0) && inside(y1) && inside(z0) && inside(z1) && y0 < y1 && z0 < z1) {
-            return Err(invalid(
-                "geometry.light_m",
-                format!(
-                    "[y_min, y_max, z_min, z_max] must be increasing pairs inside the {} m wall, got {:?}",
-                    g.size_m, g.light_m
-                ),
-            ));
-        }
-        let v = g.viewpoint_m;
-        if !(v.iter().all(|c| c.is_finite()) && v[2] < 0.0) {
-            return Err(invalid(
-                "geometry.viewpoint_m",
-                format!(
-                    "must be in front of the box's open front (z < 0), got {:?}",
-                    g.viewpoint_m
-                ),
-            ));
-        }
-        if !(g.acceptance_deg > 0.0 && g.acceptance_deg <= 10.0) {
-            return Err(invalid(
-                "geometry.acceptance_deg",
-                format!("must be in (0°, 10°], got {:?}", g.acceptance_deg),
-            ));
-        }
-        Ok(())
     }
 
     /// The tile whose fall-off is measured.
@@ -588,6 +430,8 @@ fn label(target: &Target, repeat: usize) -> String {
     };
     format!("{what} #{}", repeat + 1)
 }
+
+mod validate;
 
 #[cfg(test)]
 mod angle_tests;

@@ -60,9 +60,35 @@ pub fn chart_centre(g: &Geometry) -> [f64; 3] {
 
 /// The scene file of the box.
 pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) -> Value {
+    let mut surfaces = walls(g, &inline(&c.wall));
+    surfaces.extend(chart(g, &c.patches));
+    let centre = chart_centre(g);
+    let mut file = json!({
+        "name": name,
+        "description": description,
+        "surfaces": surfaces,
+        "emitters": [emitter(g, c)],
+        "camera": {
+            "position": g.viewpoint_m,
+            "look_at": centre,
+            "up": [0.0, 1.0, 0.0],
+            "vfov_deg": 15.71,
+            "width": 1014,
+            "height": 1014,
+        },
+        "meter": {"acceptance_deg": g.acceptance_deg},
+    });
+    if let Some(p) = &c.provenance {
+        file["provenance"] = p.clone();
+    }
+    file
+}
+
+/// The box's five walls in the wall paper `wall`: the left one around the light opening,
+/// in up to four pieces.
+fn walls(g: &Geometry, wall: &Value) -> Vec<Value> {
     let s = g.size_m;
     let [y0, y1, z0, z1] = g.light_m;
-    let wall = inline(&c.wall);
     let mut surfaces = vec![
         surface(
             "floor",
@@ -93,7 +119,6 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
             wall.clone(),
         ),
     ];
-    // The left wall around the light opening, in up to four pieces.
     let left = [
         (
             "left wall below the light",
@@ -126,8 +151,15 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
             surfaces.push(surface(n, corner, u, v, wall.clone()));
         }
     }
+    surfaces
+}
+
+/// The ColorChecker on the right wall: its frame, then the patches of `patches` (1–24 in
+/// order) in four rows of six.
+fn chart(g: &Geometry, patches: &[Spectrum]) -> Vec<Value> {
+    let s = g.size_m;
     let centre = chart_centre(g);
-    surfaces.push(surface(
+    let mut surfaces = vec![surface(
         "chart frame",
         [
             centre[0],
@@ -137,8 +169,8 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
         [0.0, 0.0, FRAME_W_M],
         [0.0, FRAME_H_M, 0.0],
         json!(FRAME_REFLECTANCE),
-    ));
-    for (i, refl) in c.patches.iter().enumerate() {
+    )];
+    for (i, refl) in patches.iter().enumerate() {
         let (r, col) = ((i / 6) as f64, (i % 6) as f64);
         let z = centre[2] + (r - 1.5) * PITCH_M;
         let y = centre[1] + (2.5 - col) * PITCH_M;
@@ -152,6 +184,12 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
         p["patch"] = json!(i + 1);
         surfaces.push(p);
     }
+    surfaces
+}
+
+/// The light: one emitter over the opening, its tiles' spectra and its distribution.
+fn emitter(g: &Geometry, c: &BoxContents) -> Value {
+    let [y0, y1, z0, z1] = g.light_m;
     let tiles: Vec<Value> = c
         .tiles
         .iter()
@@ -160,7 +198,7 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
             json!({"row": i / g.cols, "col": i % g.cols, "gain": 1.0, "spectrum": inline(spectrum)})
         })
         .collect();
-    let emitter = json!({
+    json!({
         "corner": [0.0, y1, z0],
         "edge_u": [0.0, 0.0, z1 - z0],
         "edge_v": [0.0, y0 - y1, 0.0],
@@ -168,26 +206,7 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
         "cols": g.cols,
         "tiles": tiles,
         "distribution": c.distribution,
-    });
-    let mut file = json!({
-        "name": name,
-        "description": description,
-        "surfaces": surfaces,
-        "emitters": [emitter],
-        "camera": {
-            "position": g.viewpoint_m,
-            "look_at": centre,
-            "up": [0.0, 1.0, 0.0],
-            "vfov_deg": 15.71,
-            "width": 1014,
-            "height": 1014,
-        },
-        "meter": {"acceptance_deg": g.acceptance_deg},
-    });
-    if let Some(p) = &c.provenance {
-        file["provenance"] = p.clone();
-    }
-    file
+    })
 }
 
 /// A scene file that does not make a scene: a fault of this module, said with the JSON

@@ -46,6 +46,27 @@ impl RigError {
     }
 }
 
+/// A light asked of the box that it cannot have.
+#[derive(Debug, thiserror::Error)]
+pub enum BoxLightError {
+    /// No simulated box light has this name.
+    #[error("{0}")]
+    Unknown(String),
+    /// The simulated box's light was asked of a real rig.
+    #[error("a real rig measures the real box under its own light; only the simulated box's light can be chosen")]
+    RealRig,
+}
+
+/// The simulated box's light named `name`, checked against the rig: a real rig is lit
+/// by whatever light it has. Checked before anything is opened.
+pub fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, BoxLightError> {
+    match (name, simulated) {
+        (None, _) => Ok(None),
+        (Some(n), true) => n.parse().map(Some).map_err(BoxLightError::Unknown),
+        (Some(_), false) => Err(BoxLightError::RealRig),
+    }
+}
+
 /// The plan of a session: the plan file's (the paper's without one), with `repeats`
 /// readings of each tile and spot when given, checked.
 pub fn load_plan(file: Option<&Path>, repeats: Option<usize>) -> Result<BoxPlan, PlanError> {

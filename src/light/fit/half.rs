@@ -5,15 +5,31 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Which plane.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// A plane the fall-off is measured in: the fit's readings and the box plan's fall-off
+/// steps name it alike.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Plane {
+    /// Rotation about the vertical axis: C = 0° (positive angles, towards the emitter's
+    /// `edge_u`, the back of the box) and C = 180°.
     Horizontal,
+    /// Rotation about the horizontal axis: C = 90° (positive angles, towards `edge_v`,
+    /// downwards) and C = 270°.
     Vertical,
 }
 
 impl Plane {
+    /// (C, γ) in degrees of a signed angle in this plane.
+    pub fn c_gamma(self, angle_deg: f64) -> (f64, f64) {
+        let c = match (self, angle_deg >= 0.0) {
+            (Plane::Horizontal, true) => 0.0,
+            (Plane::Horizontal, false) => 180.0,
+            (Plane::Vertical, true) => 90.0,
+            (Plane::Vertical, false) => 270.0,
+        };
+        (c, angle_deg.abs())
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Plane::Horizontal => "horizontal",

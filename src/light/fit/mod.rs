@@ -290,12 +290,7 @@ fn unmet(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Option<LdcError> {
 
 /// The C of a signed angle in a measured plane.
 pub fn plane_c(plane: Plane, angle_deg: f64) -> f64 {
-    match (plane, angle_deg >= 0.0) {
-        (Plane::Horizontal, true) => 0.0,
-        (Plane::Horizontal, false) => 180.0,
-        (Plane::Vertical, true) => 90.0,
-        (Plane::Vertical, false) => 270.0,
-    }
+    plane.c_gamma(angle_deg).0
 }
 
 fn candidate(model: LdcModel, halves: &[(Vec<f64>, Vec<f64>)]) -> Candidate {
