@@ -7,14 +7,10 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use metamer::display::ModelKind;
 use metamer::experiment::display::DisplayOptions;
-use metamer::experiment::measure_box::MeasureBox;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
-use metamer::experiment::validate::{ValidationResult, FILE};
-use metamer::experiment::{run, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
-use metamer::render::scene::Scene;
+use metamer::experiment::{BoxRequest, Progress, Request, RequestError, Stage, StageOutcome};
 use metamer::session::{on_ctrl_c, RunOptions};
-use metamer::validation::export::HTML_FILE;
 use metamer_drivers::Spec;
 
 use super::{CliError, CliResult};
@@ -97,58 +93,41 @@ pub struct Args {
 }
 
 pub fn run_cli(args: Args) -> CliResult {
+    let request = request(args)?;
+    let shown = StageProgress::default();
+    let outcome = request.run(&|p| shown.show(p));
+    shown.finish();
+    let outcome = outcome.map_err(refusal)?;
+    print_outcomes(&outcome.stages, outcome.given_box.as_deref());
+    for line in outcome.comparison_lines() {
+        println!("{line}");
+    }
+    if let Some(report) = &outcome.report {
+        println!("report: {}", report.display());
+    }
+    Ok(())
+}
+
+/// The flags as the library's request; the library checks and completes it.
+fn request(args: Args) -> Result<Request, CliError> {
     let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
     let stage: Option<Stage> = match &args.stage {
         Some(s) => Some(s.parse().map_err(CliError::Usage)?),
         None => None,
     };
-    if !(args.target_de > 0.0 && args.target_de.is_finite()) {
-        return Err(CliError::Usage("--target-de must be above 0".into()));
-    }
-    // As many as a box plan allows a reading of one thing; a billion was accepted and
-    // measured for days.
-    let most = metamer::measure_box::plan::MAX_REPEATS;
-    if !(1..=most).contains(&args.repeats) {
-        return Err(CliError::Usage(format!(
-            "--repeats must be from 1 to {most}, got {}",
-            args.repeats
-        )));
-    }
-    if args.image_size > 8192 {
-        return Err(CliError::Usage("--image-size must be at most 8192".into()));
-    }
-    if args.image_size > 0 && args.image_spp == 0 {
-        return Err(CliError::Usage("--image-spp must be at least 1".into()));
-    }
-    if args.out.exists() && !args.out.is_dir() {
-        return Err(CliError::Usage(format!(
-            "-o {}: exists and is not a directory",
-            args.out.display()
-        )));
-    }
-    check_inputs(&args)?;
-    let interrupt = on_ctrl_c();
-    let opts = ExperimentOptions {
+    let spot = Spec::new(args.spot.as_str());
+    Ok(Request {
         dir: args.out.clone(),
         box_source: match (args.box_scene, args.box_spots, args.spectral) {
-            (Some(scene), Some(spots), _) => BoxSource::Existing { scene, spots },
-            (_, _, Some(spectral)) => {
-                let (spectral, spot) = (Spec::new(spectral), Spec::new(args.spot.as_str()));
-                let simulated = spectral.is_simulated() && spot.is_simulated();
-                let light = super::rig::box_light(args.scenario.as_deref(), simulated)?;
-                BoxSource::Measure(MeasureBox {
-                    spectral,
-                    spot,
-                    plan: args.plan,
-                    repeats: args.box_repeats,
-                    seed: args.seed,
-                    light: if simulated {
-                        Some(light.unwrap_or_default())
-                    } else {
-                        light
-                    },
-                })
-            }
+            (Some(scene), Some(spots), _) => BoxRequest::Given { scene, spots },
+            (_, _, Some(spectral)) => BoxRequest::Measure {
+                spectral: Spec::new(spectral),
+                spot: spot.clone(),
+                plan: args.plan,
+                repeats: args.box_repeats,
+                seed: args.seed,
+                light: args.scenario,
+            },
             _ => {
                 return Err(CliError::Usage(
                     "give --spectral (measure the box) or --box-scene with --box-spots".into(),
@@ -166,7 +145,7 @@ pub fn run_cli(args: Args) -> CliResult {
         },
         display: DisplayOptions {
             screen: args.display,
-            spot: Spec::new(args.spot.as_str()),
+            spot,
             model,
         },
         reproduction: ReproductionOptions {
@@ -175,48 +154,24 @@ pub fn run_cli(args: Args) -> CliResult {
         },
         repeats: args.repeats,
         stage,
+        rerun_all: false,
         resume: args.resume,
         unattended: args.unattended,
         run: RunOptions {
             stop_after: None,
-            interrupt: Some(interrupt),
+            interrupt: Some(on_ctrl_c()),
         },
-    };
-    // Before any stage runs: a real rig with nobody to ask is refused.
-    let specs: Vec<&str> = match &opts.box_source {
-        BoxSource::Measure(m) => vec![
-            m.spectral.as_str(),
-            m.spot.as_str(),
-            opts.display.spot.as_str(),
-        ],
-        BoxSource::Existing { .. } => vec![opts.display.spot.as_str()],
-    };
-    metamer::session::attendance(&specs, args.unattended).map_err(super::rig::nobody_at_the_rig)?;
-    let shown = StageProgress::default();
-    let outcomes = run(&opts, &|p| shown.show(p));
-    shown.finish();
-    let given = match &opts.box_source {
-        BoxSource::Existing { spots, .. } => Some(spots.as_path()),
-        BoxSource::Measure(_) => None,
-    };
-    print_outcomes(&outcomes?, given);
-    print_comparisons(&args.out);
-    Ok(())
+    })
 }
 
-/// What the stages would read or open only after minutes of rendering and measuring: a
-/// given box's scene and readings, and the instruments' specs, checked before any work.
-fn check_inputs(args: &Args) -> CliResult {
-    if let (Some(scene), Some(spots)) = (&args.box_scene, &args.box_spots) {
-        Scene::load(scene)?;
-        // The reader refuses readings no instrument takes (X = −1e308 made every stage run
-        // and the validation draw an infinite colour difference).
-        metamer::experiment::readings::read_readings(spots)?;
+/// A refusal of the request in the words of the command line (exit 2), or what stopped
+/// the experiment.
+pub(super) fn refusal(e: RequestError) -> CliError {
+    match e {
+        RequestError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
+        e if e.is_usage() => CliError::Usage(e.to_string()),
+        e => CliError::from(e),
     }
-    for spec in std::iter::once(&args.spot).chain(&args.spectral) {
-        metamer_drivers::check_spec(spec)?;
-    }
-    Ok(())
 }
 
 /// The experiment's progress on the terminal: a line per stage, a bar while measuring.
@@ -278,26 +233,5 @@ pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>
             o.seconds,
             dir.display()
         );
-    }
-}
-
-/// The validation's three comparisons in a line each, in the report's words, and where
-/// the report is, when the validation stage has run.
-pub(super) fn print_comparisons(dir: &Path) {
-    let validation = dir.join(Stage::Validation.name());
-    if let Ok(text) = std::fs::read_to_string(validation.join(FILE)) {
-        if let Ok(v) = serde_json::from_str::<ValidationResult>(&text) {
-            for c in [
-                &v.display_vs_box,
-                &v.simulation_vs_box,
-                &v.display_vs_simulation,
-            ] {
-                println!("{}", c.summary());
-            }
-        }
-    }
-    let report = validation.join(HTML_FILE);
-    if report.exists() {
-        println!("report: {}", report.display());
     }
 }

@@ -2,13 +2,10 @@
 
 use std::path::PathBuf;
 
-use metamer::display::gamut::GamutMapping;
-use metamer::display::ModelKind;
-use metamer::experiment::lab::{run_lab, LabOptions, LabSummary, LAB_FILE};
-use metamer::rig::{Preset, Scenario};
+use metamer::experiment::lab::{run_lab, LabError, LabOptions, LabSummary, LAB_FILE};
 use metamer::session::{on_ctrl_c, RunOptions};
 
-use super::experiment::{print_outcomes, StageProgress};
+use super::experiment::{print_outcomes, refusal, StageProgress};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -61,42 +58,11 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let scenario: Scenario = args.scenario.parse().map_err(CliError::Usage)?;
-    let display: Preset = args.display.parse().map_err(CliError::Usage)?;
-    let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
-    let gamut: GamutMapping = args.gamut.parse().map_err(CliError::Usage)?;
-    if !(args.target_de > 0.0 && args.target_de.is_finite()) {
-        return Err(CliError::Usage("--target-de must be above 0".into()));
-    }
-    // As many as a box plan allows a reading of one thing; a billion was accepted and
-    // measured for days.
-    let most = metamer::measure_box::plan::MAX_REPEATS;
-    if !(1..=most).contains(&args.repeats) {
-        return Err(CliError::Usage(format!(
-            "--repeats must be from 1 to {most}, got {}",
-            args.repeats
-        )));
-    }
-    if args.box_repeats == Some(0) {
-        return Err(CliError::Usage("--box-repeats must be at least 1".into()));
-    }
-    if !(args.time_scale >= 0.0 && args.time_scale.is_finite()) {
-        return Err(CliError::Usage("--time-scale must be 0 or more".into()));
-    }
-    if args.image_size > 8192 {
-        return Err(CliError::Usage("--image-size must be at most 8192".into()));
-    }
-    if args.out.exists() && !args.out.is_dir() {
-        return Err(CliError::Usage(format!(
-            "-o {}: exists and is not a directory",
-            args.out.display()
-        )));
-    }
     let options = LabOptions {
-        scenario,
-        display,
-        model,
-        gamut,
+        scenario: args.scenario.parse().map_err(CliError::Usage)?,
+        display: args.display.parse().map_err(CliError::Usage)?,
+        model: args.model.parse().map_err(CliError::Usage)?,
+        gamut: args.gamut.parse().map_err(CliError::Usage)?,
         target_de: args.target_de,
         repeats: args.repeats,
         box_repeats: args.box_repeats,
@@ -113,7 +79,10 @@ pub fn run(args: Args) -> CliResult {
         shown.show(p)
     });
     shown.finish();
-    let (outcomes, summary) = summary?;
+    let (outcomes, summary) = summary.map_err(|e| match e {
+        LabError::Request(e) => refusal(e),
+        e => CliError::from(e),
+    })?;
     print_outcomes(&outcomes, None);
     print_summary(&summary);
     println!(

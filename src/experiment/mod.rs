@@ -6,7 +6,8 @@
 //! Each stage writes into its own directory and records the hashes of what it read and
 //! wrote ([`cache`]); a second run re-uses every stage whose inputs are unchanged and runs
 //! exactly those downstream of a change. Measuring stages are journalled sessions and
-//! resume after any interruption. [`lab`] is the experiment preset for the simulated rig.
+//! resume after any interruption. [`Request::run`] is the whole experiment as one call;
+//! [`lab`] is its preset for the simulated rig ([`lab::LabOptions::request`]).
 
 pub mod cache;
 pub mod display;
@@ -21,6 +22,7 @@ mod progress;
 pub mod readings;
 pub mod report_sections;
 pub mod reproduction;
+mod request;
 mod run;
 pub mod simulation;
 mod stage;
@@ -29,5 +31,6 @@ pub mod validate;
 pub use error::ExperimentError;
 pub use options::{BoxSource, ExperimentOptions};
 pub use progress::Progress;
+pub use request::{BoxRequest, Outcome, Request, RequestError, MAX_IMAGE_SIZE};
 pub use run::{run, StageOutcome};
 pub use stage::Stage;

@@ -305,37 +305,44 @@ fn tile_count(width: u64, height: u64, t: Tiles) -> u64 {
     }
 }
 
-/// One part's header: its attributes up to the empty name that ends them.
-fn header(
-    b: &mut Bytes<'_>,
-    max_name: usize,
-    tiled: bool,
-    multi: bool,
-    index: usize,
-) -> Result<Part, String> {
-    let mut window = None;
-    let mut channels = None;
-    let mut compression = None;
-    let mut line_order = None;
-    let mut tiles = None;
-    let mut chunk_count = None;
-    let mut kind: Option<Vec<u8>> = None;
-    loop {
-        let name = b.name(max_name, "an attribute name")?;
-        if name.is_empty() {
-            break;
+/// The attributes of one part's header this check reads; the others are skipped.
+#[derive(Default)]
+struct Attributes {
+    window: Option<[i32; 4]>,
+    channels: Option<u64>,
+    compression: Option<u8>,
+    line_order: Option<u8>,
+    tiles: Option<Tiles>,
+    chunk_count: Option<u64>,
+    kind: Option<Vec<u8>>,
+}
+
+impl Attributes {
+    /// The attributes up to the empty name that ends a header.
+    fn read(b: &mut Bytes<'_>, max_name: usize) -> Result<Attributes, String> {
+        let mut attributes = Attributes::default();
+        loop {
+            let name = b.name(max_name, "an attribute name")?;
+            if name.is_empty() {
+                return Ok(attributes);
+            }
+            let type_name = b.name(max_name, "an attribute type")?;
+            let size = b.i32("an attribute size")?;
+            let left = b.data.len() - b.at;
+            if size < 0 || size as usize > left {
+                return Err(format!(
+                    "attribute '{}' states {size} bytes, but {left} bytes are left in the file: \
+                     the file is truncated or corrupt",
+                    shown(name)
+                ));
+            }
+            let value = b.take(size as usize, "an attribute")?;
+            attributes.set(name, type_name, value)?;
         }
-        let type_name = b.name(max_name, "an attribute type")?;
-        let size = b.i32("an attribute size")?;
-        let left = b.data.len() - b.at;
-        if size < 0 || size as usize > left {
-            return Err(format!(
-                "attribute '{}' states {size} bytes, but {left} bytes are left in the file: \
-                 the file is truncated or corrupt",
-                shown(name)
-            ));
-        }
-        let value = b.take(size as usize, "an attribute")?;
+    }
+
+    /// One attribute's value, checked for its size and range where this check reads it.
+    fn set(&mut self, name: &[u8], type_name: &[u8], value: &[u8]) -> Result<(), String> {
         let expect = |n: usize| {
             if value.len() == n {
                 Ok(())
@@ -352,38 +359,26 @@ fn header(
         match name {
             b"dataWindow" => {
                 expect(16)?;
-                window = Some([int(0), int(4), int(8), int(12)]);
+                self.window = Some([int(0), int(4), int(8), int(12)]);
             }
-            b"channels" => channels = Some(channel_bytes(value)?),
+            b"channels" => self.channels = Some(channel_bytes(value)?),
             b"compression" => {
                 expect(1)?;
                 if value[0] > 11 {
                     return Err(format!("unknown compression {}", value[0]));
                 }
-                compression = Some(value[0]);
+                self.compression = Some(value[0]);
             }
             b"lineOrder" => {
                 expect(1)?;
                 if value[0] > 2 {
                     return Err(format!("unknown line order {}", value[0]));
                 }
-                line_order = Some(value[0]);
+                self.line_order = Some(value[0]);
             }
             b"tiles" => {
                 expect(9)?;
-                let (w, h) = (int(0) as u32, int(4) as u32);
-                let mode = value[8];
-                if w == 0 || h == 0 || mode & 0x0f > 2 || mode >> 4 > 1 {
-                    return Err(format!(
-                        "the tile description ({w}×{h}, mode {mode:#x}) is not a valid one"
-                    ));
-                }
-                tiles = Some(Tiles {
-                    width: u64::from(w),
-                    height: u64::from(h),
-                    levels: mode & 0x0f,
-                    round_up: mode >> 4 == 1,
-                });
+                self.tiles = Some(tile_description(int(0) as u32, int(4) as u32, value[8])?);
             }
             b"chunkCount" => {
                 expect(4)?;
@@ -391,28 +386,56 @@ fn header(
                 if n < 0 {
                     return Err(format!("its chunkCount attribute is {n}"));
                 }
-                chunk_count = Some(n as u64);
+                self.chunk_count = Some(n as u64);
             }
-            b"type" => kind = Some(value.strip_suffix(&[0]).unwrap_or(value).to_vec()),
+            b"type" => self.kind = Some(value.strip_suffix(&[0]).unwrap_or(value).to_vec()),
             _ => {}
         }
+        Ok(())
     }
+}
+
+/// A `tiles` attribute: the tile's size and the level mode and rounding byte.
+fn tile_description(w: u32, h: u32, mode: u8) -> Result<Tiles, String> {
+    if w == 0 || h == 0 || mode & 0x0f > 2 || mode >> 4 > 1 {
+        return Err(format!(
+            "the tile description ({w}×{h}, mode {mode:#x}) is not a valid one"
+        ));
+    }
+    Ok(Tiles {
+        width: u64::from(w),
+        height: u64::from(h),
+        levels: mode & 0x0f,
+        round_up: mode >> 4 == 1,
+    })
+}
+
+/// One part's header: its attributes up to the empty name that ends them, then the
+/// attributes every part needs and what they say of its layout.
+fn header(
+    b: &mut Bytes<'_>,
+    max_name: usize,
+    tiled: bool,
+    multi: bool,
+    index: usize,
+) -> Result<Part, String> {
+    let a = Attributes::read(b, max_name)?;
     let part = if multi {
         format!("part {index} ")
     } else {
         String::new()
     };
     let missing = |what: &str| format!("{part}has no {what} attribute: the header is corrupt");
-    let [x0, y0, x1, y1] = window.ok_or_else(|| missing("dataWindow"))?;
+    let [x0, y0, x1, y1] = a.window.ok_or_else(|| missing("dataWindow"))?;
     if x1 < x0 || y1 < y0 {
         return Err(format!(
             "{part}data window ({x0}, {y0})–({x1}, {y1}) is empty or inverted"
         ));
     }
-    let pixel_bytes = channels.ok_or_else(|| missing("channels"))?;
-    let compression = compression.ok_or_else(|| missing("compression"))?;
-    line_order.ok_or_else(|| missing("lineOrder"))?;
-    let is_tiled = match kind.as_deref() {
+    let pixel_bytes = a.channels.ok_or_else(|| missing("channels"))?;
+    let compression = a.compression.ok_or_else(|| missing("compression"))?;
+    a.line_order.ok_or_else(|| missing("lineOrder"))?;
+    let is_tiled = match a.kind.as_deref() {
         Some(b"tiledimage") => true,
         Some(b"scanlineimage") | None => tiled && !multi,
         Some(other) => {
@@ -422,7 +445,7 @@ fn header(
             ))
         }
     };
-    if is_tiled && tiles.is_none() {
+    if is_tiled && a.tiles.is_none() {
         return Err(missing("tiles"));
     }
     Ok(Part {
@@ -430,8 +453,8 @@ fn header(
         height: (i64::from(y1) - i64::from(y0) + 1) as u64,
         pixel_bytes,
         compression,
-        tiles: if is_tiled { tiles } else { None },
-        chunk_count,
+        tiles: if is_tiled { a.tiles } else { None },
+        chunk_count: a.chunk_count,
     })
 }
 

@@ -9,6 +9,9 @@ use std::time::Duration;
 
 use metamer_drivers::World;
 
+use crate::session;
+pub use crate::session::ScreenError;
+
 pub use super::image::{ImageError, RgbImage, ScreenSpot};
 
 /// Where an image landed on a screen, as fractions of the screen's width and height: its
@@ -56,18 +59,17 @@ impl MeterAim {
     }
 }
 
-/// Something that shows uniform colours in front of an instrument.
-pub trait Screen {
+/// Something that shows uniform colours (and images) in front of an instrument: a
+/// session's screen ([`session::Screen`], which shows a colour) with what opening,
+/// describing and aiming at a real or simulated monitor needs.
+pub trait Screen: session::Screen {
     /// The screen as named on the command line and in logs: `virtual:ips-lcd`, `window:0`.
     fn spec(&self) -> String;
     /// A longer human description (monitor name and geometry, preset parameters).
     fn describe(&self) -> String;
-    /// Shows the 8-bit drive values `rgb` over the whole measured area. Returns once the
-    /// display system has the new colour, which is before a physical panel has settled:
-    /// the caller waits [`Screen::default_settle`] (or the user's choice) before measuring.
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError>;
     /// Shows `image` full-screen, scaled to fit with its aspect ratio kept (black around
-    /// it); returns where it landed. The same wait as after [`Screen::show`] applies.
+    /// it); returns where it landed. The same wait as after showing a colour
+    /// ([`session::Screen::show`]) applies: [`Screen::default_settle`].
     fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError>;
     /// The wait between showing a colour and measuring it when the user gives none.
     fn default_settle(&self) -> Duration;
@@ -83,17 +85,17 @@ pub trait Screen {
     fn meter_aim(&self) -> Option<MeterAim> {
         None
     }
+    /// This screen as the session's screen it also is (`self`): Rust 1.85, the oldest this
+    /// crate builds with, does not convert a `dyn Screen` to its supertrait by itself.
+    fn as_show(&mut self) -> &mut dyn session::Screen;
 }
 
-/// A screen could not show a colour.
-#[derive(Debug, thiserror::Error)]
-pub enum ScreenError {
-    /// The backend failed (the X connection broke, a request was refused); the source says
-    /// how, in the backend's own terms.
-    #[error("{screen}: {source}")]
-    Backend {
-        screen: String,
-        #[source]
-        source: Box<dyn std::error::Error + Send + Sync>,
-    },
+/// A rig's screen as a session's screen, for callers written before every screen was one:
+/// [`Screen::as_show`] gives the same without this wrapper.
+pub struct DisplayScreen<'a>(pub &'a mut dyn Screen);
+
+impl session::Screen for DisplayScreen<'_> {
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
+        self.0.as_show().show(rgb)
+    }
 }

@@ -17,6 +17,7 @@ pub mod runner;
 pub mod screen;
 pub mod step;
 
+pub use crate::rig::DisplayScreen;
 pub use interrupt::on_ctrl_c;
 pub use journal::{
     duplicates_path, reading_problem, refuse_existing, torn_path, CalibrationRecord, Header,
@@ -30,5 +31,5 @@ pub use plan::{placements, Prepare, SessionPlan, Step};
 pub use progress::{BarProgress, NoProgress, ProgressSink, StageOf, StepProgress};
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
-pub use screen::{DisplayScreen, Screen};
+pub use screen::{Screen, ScreenError};
 pub use step::{Rig, StepFailure};

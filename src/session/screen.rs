@@ -1,18 +1,24 @@
-//! The screen a session shows drive values on, kept to the one thing the engine needs so
-//! sessions do not depend on how displays are built.
-
-use crate::rig;
+//! The screen a session shows drive values on: the one thing the engine needs from a
+//! display, and the supertrait of the rig's screens (`rig::Screen`), so every screen a
+//! rig opens is one and a session depends on no screen's implementation.
 
 /// Something that shows 8-bit drive values over the measured area.
 pub trait Screen {
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), Box<dyn std::error::Error + Send + Sync>>;
+    /// Shows the 8-bit drive values `rgb` over the whole measured area. Returns once the
+    /// display system has the new colour, which is before a physical panel has settled:
+    /// the caller waits the screen's settle time (or the user's choice) before measuring.
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError>;
 }
 
-/// A rig screen as a session's screen.
-pub struct DisplayScreen<'a>(pub &'a mut dyn rig::Screen);
-
-impl Screen for DisplayScreen<'_> {
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-        self.0.show(rgb).map_err(Into::into)
-    }
+/// A screen could not show a colour.
+#[derive(Debug, thiserror::Error)]
+pub enum ScreenError {
+    /// The backend failed (the X connection broke, a request was refused); the source says
+    /// how, in the backend's own terms.
+    #[error("{screen}: {source}")]
+    Backend {
+        screen: String,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }

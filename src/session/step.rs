@@ -246,7 +246,9 @@ where
         match &self.step.prepare {
             Prepare::Show { rgb } => {
                 let screen = self.rig.screen.as_mut().ok_or(StepFailure::NoScreen)?;
-                screen.show(*rgb).map_err(StepFailure::Screen)?;
+                screen
+                    .show(*rgb)
+                    .map_err(|e| StepFailure::Screen(Box::new(e)))?;
                 Ok(true)
             }
             Prepare::Operator { prompt } => {

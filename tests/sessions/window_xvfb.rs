@@ -11,6 +11,7 @@ use std::process::{Child, Command, Stdio};
 use metamer::rig::screen::RgbImage;
 use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
 use metamer::rig::{Placement, Screen};
+use metamer::session::Screen as _;
 
 use crate::support::unused_dir;
 

@@ -2,14 +2,14 @@
 
 use std::path::PathBuf;
 
-use crate::experiment::ExperimentError;
+use crate::experiment::RequestError;
 use crate::output::OutputError;
 
 /// Why a lab run failed.
 #[derive(Debug, thiserror::Error)]
 pub enum LabError {
     #[error(transparent)]
-    Experiment(#[from] ExperimentError),
+    Request(#[from] RequestError),
     #[error("{}: not the validation stage's result: {message}", file.display())]
     BadResult { file: PathBuf, message: String },
     #[error("{0}")]

@@ -18,11 +18,11 @@ use serde::Serialize;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
 use crate::experiment::display::DisplayOptions;
-use crate::experiment::measure_box::MeasureBox;
 use crate::experiment::reproduction::ReproductionOptions;
+use crate::experiment::request::{check_dir, check_image_size, check_repeats, check_target_de};
 use crate::experiment::simulation::{ImageSpec, SimulationOptions};
 use crate::experiment::validate::{ValidationResult, FILE as COMPARISONS_FILE};
-use crate::experiment::{self, BoxSource, ExperimentOptions, Progress, Stage, StageOutcome};
+use crate::experiment::{BoxRequest, Progress, Request, RequestError, Stage, StageOutcome};
 use crate::measure_box::BoxPlan;
 use crate::output::OutputPolicy;
 use crate::rig::{Preset, Scenario};
@@ -88,22 +88,37 @@ impl LabOptions {
         }
     }
 
-    /// The experiment these options describe, into `dir`. The box's instruments are seeded
-    /// by the box stage as `measure-box` seeds them (the spectral instrument with the seed,
-    /// the spot meter with seed + 1); the meter that reads the display gets seed + 2, so
-    /// its noise is independent of the box readings'.
-    pub fn experiment(&self, dir: &Path, resume: bool, run: RunOptions) -> ExperimentOptions {
-        let spot = self.instrument("cs100a", None);
-        ExperimentOptions {
+    /// The lab's own numbers, checked before the experiment's: the box's readings per
+    /// target and the instruments' pace.
+    fn check(&self, dir: &Path) -> Result<(), RequestError> {
+        check_target_de(self.target_de)?;
+        check_repeats(self.repeats)?;
+        if self.box_repeats == Some(0) {
+            return Err(RequestError::BoxRepeats);
+        }
+        if !(self.time_scale >= 0.0 && self.time_scale.is_finite()) {
+            return Err(RequestError::TimeScale);
+        }
+        check_image_size(self.image_size)?;
+        check_dir(dir)
+    }
+
+    /// The experiment these options describe, into `dir`: the preset. The box's
+    /// instruments are seeded by the box stage as `measure-box` seeds them (the spectral
+    /// instrument with the seed, the spot meter with seed + 1); the meter that reads the
+    /// display gets seed + 2, so its noise is independent of the box readings'. `force`
+    /// runs every stage again.
+    pub fn request(&self, dir: &Path, resume: bool, force: bool, run: RunOptions) -> Request {
+        Request {
             dir: dir.to_path_buf(),
-            box_source: BoxSource::Measure(MeasureBox {
+            box_source: BoxRequest::Measure {
                 spectral: self.instrument("i1pro", None),
-                spot,
+                spot: self.instrument("cs100a", None),
                 plan: None,
                 repeats: self.box_repeats,
                 seed: self.seed,
-                light: Some(self.scenario),
-            }),
+                light: Some(self.scenario.name().to_string()),
+            },
             simulation: SimulationOptions {
                 target_de: self.target_de,
                 seed: self.seed,
@@ -124,6 +139,7 @@ impl LabOptions {
             },
             repeats: self.repeats,
             stage: None,
+            rerun_all: force,
             resume,
             unattended: true,
             run,
@@ -227,6 +243,36 @@ pub struct LabSummary {
 /// Runs the lab into `dir`: every stage whose inputs changed (all of them with `force`),
 /// then `lab.json`. `resume` continues an interrupted measuring stage from its journal.
 /// Returns how each stage went and what `lab.json` says.
+///
+/// # Examples
+///
+/// The whole lab with its defaults (about a minute: the paper's 1014-pixel image is
+/// rendered, reproduced and shown):
+///
+/// ```no_run
+/// use metamer::display::ModelKind;
+/// use metamer::experiment::lab::{run_lab, LabOptions};
+/// use metamer::rig::{Preset, Scenario};
+/// use metamer::session::RunOptions;
+///
+/// let options = LabOptions {
+///     scenario: Scenario::default(),
+///     display: "ips-lcd".parse::<Preset>()?,
+///     model: ModelKind::Lut,
+///     gamut: "nearest-lab".parse()?,
+///     target_de: 0.1,
+///     repeats: 3,
+///     box_repeats: None,
+///     seed: 1,
+///     time_scale: 0.0,
+///     image_size: 1014,
+/// };
+/// let dir = std::path::Path::new("lab");
+/// let (stages, summary) = run_lab(dir, &options, false, false, RunOptions::default(), &|_| {})?;
+/// assert_eq!(stages.len(), 6);
+/// println!("{}", summary.display_vs_box.summary);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn run_lab(
     dir: &Path,
     opts: &LabOptions,
@@ -236,19 +282,8 @@ pub fn run_lab(
     progress: &dyn Fn(Progress),
 ) -> Result<(Vec<StageOutcome>, LabSummary), LabError> {
     let start = std::time::Instant::now();
-    let mut experiment_opts = opts.experiment(dir, resume, run);
-    let stages = if force {
-        // One stage at a time, each chosen: every one runs again (measuring stages' earlier
-        // journals are moved aside, never deleted).
-        let mut all = Vec::new();
-        for stage in Stage::ALL {
-            experiment_opts.stage = Some(stage);
-            all.extend(experiment::run(&experiment_opts, progress)?);
-        }
-        all
-    } else {
-        experiment::run(&experiment_opts, progress)?
-    };
+    opts.check(dir)?;
+    let stages = opts.request(dir, resume, force, run).run(progress)?.stages;
     let file = dir.join(Stage::Validation.name()).join(COMPARISONS_FILE);
     let bad = |message: String| LabError::BadResult {
         file: file.clone(),

@@ -41,6 +41,7 @@ pub use panel::{quantize, VirtualPanel};
 pub use presets::{PanelParams, Preset, Trc};
 
 use super::screen::{MeterAim, Placement, RgbImage, Screen, ScreenError, ScreenSpot};
+use crate::session;
 
 /// What the panel shows: one colour everywhere, or an image filling the screen.
 #[derive(Clone)]
@@ -144,11 +145,6 @@ impl Screen for VirtualDisplay {
         )
     }
 
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
-        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Colour(rgb);
-        Ok(())
-    }
-
     fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {
         *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) =
             Shown::Image(Arc::new(image.clone()));
@@ -166,5 +162,15 @@ impl Screen for VirtualDisplay {
 
     fn meter_aim(&self) -> Option<MeterAim> {
         Some(self.lit.aim.clone())
+    }
+    fn as_show(&mut self) -> &mut dyn session::Screen {
+        self
+    }
+}
+
+impl session::Screen for VirtualDisplay {
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Colour(rgb);
+        Ok(())
     }
 }

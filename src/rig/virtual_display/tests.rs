@@ -1,6 +1,7 @@
 //! The panel model against hand derivations.
 
 use super::*;
+use crate::session::Screen as _;
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]

@@ -26,6 +26,7 @@ use x11rb::wrapper::ConnectionExt as _;
 pub use pixels::PixelFormat;
 
 use super::screen::{Placement, RgbImage, Screen, ScreenError};
+use crate::session;
 
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]
@@ -355,7 +356,20 @@ impl Drop for WindowDisplay {
     }
 }
 
+impl session::Screen for WindowDisplay {
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
+        self.show_rgb(rgb).map_err(|e| ScreenError::Backend {
+            screen: self.spec(),
+            source: Box::new(e),
+        })
+    }
+}
+
 impl Screen for WindowDisplay {
+    fn as_show(&mut self) -> &mut dyn session::Screen {
+        self
+    }
+
     fn spec(&self) -> String {
         format!("window:{}", self.monitor_index)
     }
@@ -365,13 +379,6 @@ impl Screen for WindowDisplay {
             "full-screen window on monitor {} ({}) of X display '{}'",
             self.monitor_index, self.monitor, self.display
         )
-    }
-
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
-        self.show_rgb(rgb).map_err(|e| ScreenError::Backend {
-            screen: self.spec(),
-            source: Box::new(e),
-        })
     }
 
     fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {

@@ -4,7 +4,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use metamer::session::{Answer, Operator, OperatorError, Screen, ScriptedOperator};
+use metamer::session::{Answer, Operator, OperatorError, Screen, ScreenError, ScriptedOperator};
 use metamer_drivers::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, DriverError,
     Instrument, InstrumentInfo, MeasureMode, ModeInfo, Reading, Request,
@@ -25,7 +25,7 @@ pub type Shared = Arc<Mutex<World>>;
 pub struct FakeScreen(pub Shared);
 
 impl Screen for FakeScreen {
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
         self.0.lock().unwrap().rgb = rgb;
         Ok(())
     }
