@@ -1,20 +1,13 @@
 //! The refusals shared by the commands that open a rig (`measure-box`, `experiment`,
 //! `spot`, `characterize`), said with their flags.
 
-use metamer::measure_box::setup::{self, BoxLightError};
-use metamer::rig::Scenario;
+use metamer::measure_box::setup::BoxLightError;
 use metamer::session::NobodyAtTheRig;
 
 use super::CliError;
 
 fn usage(e: impl std::fmt::Display) -> CliError {
     CliError::Usage(e.to_string())
-}
-
-/// The simulated box's light named by `--scenario`; refused with real instruments, whose
-/// box is lit by whatever light it has.
-pub(super) fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, CliError> {
-    setup::box_light(name, simulated).map_err(box_light_refusal)
 }
 
 /// A `--scenario` the rig cannot have, in the words of the command line.

@@ -24,9 +24,8 @@ use super::reproduction::{PatchDrive, PatchRegion};
 use crate::rig::image::RgbImage;
 use crate::rig::{MeterAim, Placement, ScreenSpot};
 use crate::session::{
-    Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, Prepare, Readings, Recheck,
-    Rig, RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress,
-    TerminalOperator,
+    Answer, InstrumentRecord, Operator, OperatorError, Prepare, Readings, Recheck, Rig, RunEnd,
+    RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, TerminalOperator,
 };
 
 /// A display-spot step's own data in the journal.
@@ -300,12 +299,8 @@ pub fn measure(
             }
         }
     }
-    let mut shown = DisplayScreen(screen.as_mut());
     let mut rig = Rig {
-        screen: s
-            .image
-            .is_none()
-            .then_some(&mut shown as &mut dyn crate::session::Screen),
+        screen: s.image.is_none().then_some(screen.as_show()),
         instruments: vec![("spot".to_string(), meter.as_mut())],
         operator: &mut operator,
     };

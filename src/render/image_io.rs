@@ -185,6 +185,11 @@ pub fn write_xyz_image(
             let mut image = Image::from_channels((img.width, img.height), channels);
             image.attributes.chromaticities = Some(xyz_chromaticities());
             image.layer_data.attributes.white_luminance = Some(1.0);
+            // The encoder compresses chunks on several threads; with the default unspecified
+            // order it writes them as they finish, so one image gave other bytes from run to
+            // run (and another digest in the experiment's stage records). In increasing order
+            // the file is the same every time.
+            image.layer_data.encoding.line_order = LineOrder::Increasing;
             image
                 .write()
                 .to_buffered(&mut buf)
@@ -425,6 +430,62 @@ mod tests {
             assert_eq!(read_xyz_image(&p).unwrap(), img, "{name}");
         }
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// The EXR's chunks stand in increasing order and its header says so, whatever order
+    /// the encoder's threads finish them in: the same image is the same file.
+    #[test]
+    fn exr_chunks_are_written_in_increasing_order() {
+        let (w, h) = (300, 260);
+        let img = XyzImage {
+            width: w,
+            height: h,
+            pixels: (0..w * h)
+                .map(|i| [(i % 97) as f32, (i % 13) as f32 * 0.5, (i / w) as f32])
+                .collect(),
+        };
+        let dir = std::env::temp_dir().join(format!("metamer-exrorder-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("a.exr");
+        write_xyz_image(&p, &img, &OutputPolicy::new(true)).unwrap();
+        let b = std::fs::read(&p).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        // OpenEXR's layout: magic and version (8 bytes), then attributes (name NUL, type
+        // NUL, u32 size, value) up to an empty name, then one u64 offset per chunk.
+        let mut at = 8;
+        let mut line_order = None;
+        let cstr = |at: &mut usize| {
+            let end = *at + b[*at..].iter().position(|&c| c == 0).unwrap();
+            let s = String::from_utf8_lossy(&b[*at..end]).into_owned();
+            *at = end + 1;
+            s
+        };
+        loop {
+            let name = cstr(&mut at);
+            if name.is_empty() {
+                break;
+            }
+            cstr(&mut at);
+            let size = u32::from_le_bytes(b[at..at + 4].try_into().unwrap()) as usize;
+            at += 4;
+            if name == "lineOrder" {
+                line_order = Some(b[at]);
+            }
+            at += size;
+        }
+        // 0 is INCREASING_Y, 2 RANDOM_Y.
+        assert_eq!(line_order, Some(0));
+        let chunks = w.div_ceil(64) * h.div_ceil(64);
+        let offsets: Vec<u64> = (0..chunks)
+            .map(|i| u64::from_le_bytes(b[at + 8 * i..at + 8 * i + 8].try_into().unwrap()))
+            .collect();
+        assert!(offsets.windows(2).all(|o| o[0] < o[1]), "{offsets:?}");
+        // Each tile chunk starts with its tile's x and y: y never goes back.
+        let ys: Vec<i32> = offsets
+            .iter()
+            .map(|&o| i32::from_le_bytes(b[o as usize + 4..o as usize + 8].try_into().unwrap()))
+            .collect();
+        assert!(ys.windows(2).all(|y| y[0] <= y[1]), "{ys:?}");
     }
 
     /// An encoding that fails half-way (here: fewer pixels than the size says) leaves the

@@ -12,6 +12,6 @@ pub mod virtual_display;
 pub mod window;
 
 pub use scenario::Scenario;
-pub use screen::{DisplayScreen, MeterAim, Placement, Screen, ScreenError, ScreenSpot};
+pub use screen::{MeterAim, Placement, Screen, ScreenError, ScreenSpot};
 pub use spec::{OpenError, ScreenSpec};
 pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};

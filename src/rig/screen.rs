@@ -89,13 +89,3 @@ pub trait Screen: session::Screen {
     /// crate builds with, does not convert a `dyn Screen` to its supertrait by itself.
     fn as_show(&mut self) -> &mut dyn session::Screen;
 }
-
-/// A rig's screen as a session's screen, for callers written before every screen was one:
-/// [`Screen::as_show`] gives the same without this wrapper.
-pub struct DisplayScreen<'a>(pub &'a mut dyn Screen);
-
-impl session::Screen for DisplayScreen<'_> {
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
-        self.0.as_show().show(rgb)
-    }
-}

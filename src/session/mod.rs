@@ -17,7 +17,6 @@ pub mod runner;
 pub mod screen;
 pub mod step;
 
-pub use crate::rig::DisplayScreen;
 pub use interrupt::on_ctrl_c;
 pub use journal::{
     duplicates_path, reading_problem, refuse_existing, torn_path, CalibrationRecord, Header,

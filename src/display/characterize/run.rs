@@ -15,8 +15,8 @@ use crate::display::ModelKind;
 use crate::output::{OutputError, OutputPolicy};
 use crate::rig::Screen;
 use crate::session::{
-    Answer, DisplayScreen, InstrumentRecord, Operator, OperatorError, ProgressSink, Rig, RunEnd,
-    RunOptions, Session, SessionError,
+    Answer, InstrumentRecord, Operator, OperatorError, ProgressSink, Rig, RunEnd, RunOptions,
+    Session, SessionError,
 };
 
 /// The journal's file name inside the output directory.
@@ -175,9 +175,8 @@ pub fn run(
         }
     }
     let end = {
-        let mut screen = DisplayScreen(display);
         let mut rig = Rig {
-            screen: Some(&mut screen),
+            screen: Some(display.as_show()),
             instruments: vec![(METER.to_string(), &mut *instrument)],
             operator: &mut *operator,
         };
