@@ -80,6 +80,25 @@ pub const KNOWN_ADAPTERS: &[(u16, u16, &str)] = &[
 ];
 
 /// Lists serial ports and known instruments.
+///
+/// # Examples
+///
+/// `metamer devices --json` as one call: what is plugged in, and for each port or
+/// instrument whether this user may open it (with the fix when not).
+///
+/// ```
+/// use metamer_drivers::devices::{list_devices, Access};
+///
+/// let list = list_devices();
+/// for port in &list.serial_ports {
+///     if let Access::Denied { fix } = &port.access {
+///         println!("{}: {fix}", port.path);
+///     }
+/// }
+/// let json = serde_json::to_value(&list)?;
+/// assert!(json["serial_ports"].is_array() && json["instruments"].is_array());
+/// # Ok::<(), serde_json::Error>(())
+/// ```
 pub fn list_devices() -> DeviceList {
     let mut list = DeviceList::default();
     match serialport::available_ports() {

@@ -54,6 +54,28 @@ pub struct PtyMeter {
 
 impl PtyMeter {
     /// Starts the meter on a new pseudo-terminal; it answers from another thread.
+    ///
+    /// # Examples
+    ///
+    /// `metamer simulate cs100a --pty` as one call: serve the meter, then read it through
+    /// its device path as a real CS-100A on a serial port is read.
+    ///
+    /// ```
+    /// use metamer::rig::sim_meter::{PtyMeter, PtyMeterOptions};
+    /// use metamer_drivers::{MeasureMode, Request, Spec};
+    ///
+    /// let options = PtyMeterOptions {
+    ///     xyz: [19.0, 20.0, 21.8],
+    ///     noise: false,
+    ///     time_scale: 0.0,
+    ///     ..Default::default()
+    /// };
+    /// let meter = PtyMeter::start(&options)?;
+    /// let mut cs100a = Spec::new(format!("cs100a:{}", meter.path())).open(None)?;
+    /// let reading = cs100a.measure(&Request { mode: MeasureMode::Emissive })?;
+    /// assert!((reading.xyz[1] - 20.0).abs() < 0.1, "{:?}", reading.xyz);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn start(options: &PtyMeterOptions) -> Result<PtyMeter, PtyMeterError> {
         check_light(options.xyz)?;
         // The bound every simulated instrument has: beyond it one reading takes days, a

@@ -16,26 +16,7 @@ pub(super) fn calibration_table(
     from: usize,
 ) -> Result<Option<Vec<CalibrationEntry>>, (usize, String)> {
     let mut lines = text.lines().enumerate().skip(from);
-    let mut found = false;
-    for (_, raw) in lines.by_ref() {
-        match tokens(raw).ok().and_then(|t| t.first().cloned()) {
-            Some(t) if t == "CAL" => {
-                found = true;
-                break;
-            }
-            // Another table type that is not the calibration: nothing more is read.
-            Some(t)
-                if t.chars()
-                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
-                    && !t.contains('_')
-                    && raw.trim() == t =>
-            {
-                return Ok(None)
-            }
-            _ => {}
-        }
-    }
-    if !found {
+    if !cal_table_follows(&mut lines) {
         return Ok(None);
     }
     let mut fields: Vec<String> = Vec::new();
@@ -59,57 +40,9 @@ pub(super) fn calibration_table(
                 in_format = true;
                 fields.extend(toks[1..].iter().cloned());
             }
-            ("BEGIN_DATA", _) => {
-                let names = ["RGB_I", "RGB_R", "RGB_G", "RGB_B"];
-                let mut cols = [0; 4];
-                for (c, n) in cols.iter_mut().zip(names) {
-                    *c = fields.iter().position(|f| f == n).ok_or_else(|| {
-                        (
-                            line,
-                            format!(
-                                "the CAL table lacks the field {n} (found: {})",
-                                fields.join(" ")
-                            ),
-                        )
-                    })?;
-                }
-                columns = Some(cols);
-            }
+            ("BEGIN_DATA", _) => columns = Some(cal_columns(&fields, line)?),
             ("END_DATA", Some(_)) => return Ok(Some(out)),
-            (_, Some(cols)) => {
-                if toks.len() != fields.len() {
-                    return Err((
-                        line,
-                        format!(
-                            "the CAL table expects {} values, found {}",
-                            fields.len(),
-                            toks.len()
-                        ),
-                    ));
-                }
-                let v: Vec<f64> = cols
-                    .iter()
-                    .map(|&c| {
-                        toks[c]
-                            .parse::<f64>()
-                            .ok()
-                            .filter(|x| (0.0..=1.0).contains(x))
-                            .ok_or_else(|| {
-                                (
-                                    line,
-                                    format!(
-                                        "CAL field {} ('{}') is not a number in 0–1",
-                                        fields[c], toks[c]
-                                    ),
-                                )
-                            })
-                    })
-                    .collect::<Result<_, _>>()?;
-                out.push(CalibrationEntry {
-                    input: v[0],
-                    rgb: [v[1], v[2], v[3]],
-                });
-            }
+            (_, Some(cols)) => out.push(cal_row(&toks, &fields, cols, line)?),
             _ => {}
         }
     }
@@ -121,6 +54,85 @@ pub(super) fn calibration_table(
         text.lines().count().max(1),
         "the CAL table's END_DATA is missing: the file is cut short".into(),
     ))
+}
+
+/// Reads up to the identifier `CAL`; false at the end of the text or at another table's
+/// identifier, after which nothing more is read.
+fn cal_table_follows<'a>(lines: &mut impl Iterator<Item = (usize, &'a str)>) -> bool {
+    for (_, raw) in lines {
+        match tokens(raw).ok().and_then(|t| t.first().cloned()) {
+            Some(t) if t == "CAL" => return true,
+            Some(t)
+                if t.chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
+                    && !t.contains('_')
+                    && raw.trim() == t =>
+            {
+                return false
+            }
+            _ => {}
+        }
+    }
+    false
+}
+
+/// The columns of `RGB_I RGB_R RGB_G RGB_B` among the CAL table's fields.
+fn cal_columns(fields: &[String], line: usize) -> Result<[usize; 4], (usize, String)> {
+    let names = ["RGB_I", "RGB_R", "RGB_G", "RGB_B"];
+    let mut cols = [0; 4];
+    for (c, n) in cols.iter_mut().zip(names) {
+        *c = fields.iter().position(|f| f == n).ok_or_else(|| {
+            (
+                line,
+                format!(
+                    "the CAL table lacks the field {n} (found: {})",
+                    fields.join(" ")
+                ),
+            )
+        })?;
+    }
+    Ok(cols)
+}
+
+/// One row of the CAL table: each value a number in 0–1.
+fn cal_row(
+    toks: &[String],
+    fields: &[String],
+    cols: [usize; 4],
+    line: usize,
+) -> Result<CalibrationEntry, (usize, String)> {
+    if toks.len() != fields.len() {
+        return Err((
+            line,
+            format!(
+                "the CAL table expects {} values, found {}",
+                fields.len(),
+                toks.len()
+            ),
+        ));
+    }
+    let v: Vec<f64> = cols
+        .iter()
+        .map(|&c| {
+            toks[c]
+                .parse::<f64>()
+                .ok()
+                .filter(|x| (0.0..=1.0).contains(x))
+                .ok_or_else(|| {
+                    (
+                        line,
+                        format!(
+                            "CAL field {} ('{}') is not a number in 0–1",
+                            fields[c], toks[c]
+                        ),
+                    )
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(CalibrationEntry {
+        input: v[0],
+        rgb: [v[1], v[2], v[3]],
+    })
 }
 
 #[cfg(test)]

@@ -125,240 +125,287 @@ pub fn parse_ti3(text: &str, path: &Path) -> Result<Measurements, MeasurementsEr
     let text = metamer_color::text::strip_bom(text);
     let file = path.to_path_buf();
     // Messages quote fields of the file; any of them may be huge.
-    let err = |line: usize, message: String| MeasurementsError::Cgats {
+    let err = |(line, message): (usize, String)| MeasurementsError::Cgats {
         file: file.clone(),
         line,
         message: metamer_color::text::echo_message(&message),
     };
-    enum State {
-        Header,
-        Format,
-        Data,
-    }
-    let mut state = State::Header;
+    let mut table = Table::default();
     let mut seen_identifier = false;
-    let mut keywords: Vec<(String, String, usize)> = Vec::new();
-    let mut fields: Vec<String> = Vec::new();
-    let mut declared_fields: Option<(usize, usize)> = None;
-    let mut declared_sets: Option<(usize, usize)> = None;
-    let mut columns: Option<[usize; 6]> = None;
-    let mut rows: Vec<(usize, [f64; 6])> = Vec::new();
-    let mut spectral: Vec<(usize, f64)> = Vec::new();
-    let mut spectra: Vec<Vec<f64>> = Vec::new();
-    let mut end_line = 0;
-    let mut ended = false;
+    let mut end_data = None;
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
-        let toks = tokens(raw).map_err(|m| err(line, m))?;
+        let toks = tokens(raw).map_err(|m| err((line, m)))?;
         if toks.is_empty() {
             continue;
         }
         if !seen_identifier {
             if toks[0] != "CTI3" {
-                return Err(err(
+                return Err(err((
                     line,
                     format!(
                         "not an ArgyllCMS .ti3 file: it must start with 'CTI3', found '{}'",
                         toks[0]
                     ),
-                ));
+                )));
             }
             seen_identifier = true;
             continue;
         }
-        match state {
-            State::Header => match toks[0].as_str() {
-                "BEGIN_DATA_FORMAT" => {
-                    state = State::Format;
-                    fields.extend(toks[1..].iter().cloned());
-                }
-                "NUMBER_OF_FIELDS" | "NUMBER_OF_SETS" => {
-                    let n = toks
-                        .get(1)
-                        .and_then(|t| t.parse::<usize>().ok())
-                        .ok_or_else(|| err(line, format!("{} needs a whole number", toks[0])))?;
-                    if toks[0] == "NUMBER_OF_FIELDS" {
-                        declared_fields = Some((n, line));
-                    } else {
-                        declared_sets = Some((n, line));
-                    }
-                }
-                "BEGIN_DATA" => {
-                    let cols = find_columns(&fields).map_err(|m| err(line, m))?;
-                    if let Some((n, l)) = declared_fields {
-                        if n != fields.len() {
-                            return Err(err(
-                                l,
-                                format!(
-                                    "NUMBER_OF_FIELDS is {n} but the data format lists {} fields",
-                                    fields.len()
-                                ),
-                            ));
-                        }
-                    }
-                    columns = Some(cols);
-                    spectral = spectral_columns(&fields).map_err(|m| err(line, m))?;
-                    state = State::Data;
-                }
-                "KEYWORD" => {}
-                name => {
-                    let value = toks[1..].join(" ");
-                    keywords.push((name.to_string(), value, line));
-                }
-            },
-            State::Format => {
-                if toks[0] == "END_DATA_FORMAT" {
-                    state = State::Header;
-                } else {
-                    fields.extend(toks.iter().cloned());
-                }
-            }
-            State::Data => {
-                if toks[0] == "END_DATA" {
-                    ended = true;
-                    end_line = index;
-                    break;
-                }
-                let cols = columns.expect("set when the data began");
-                if toks.len() != fields.len() {
-                    return Err(err(
-                        line,
-                        format!(
-                            "expected {} values ({}), found {}",
-                            fields.len(),
-                            fields.join(" "),
-                            toks.len()
-                        ),
-                    ));
-                }
-                let mut v = [0.0; 6];
-                for (k, &c) in cols.iter().enumerate() {
-                    v[k] = toks[c]
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|x| x.is_finite())
-                        .ok_or_else(|| {
-                            err(
-                                line,
-                                format!("field {} ('{}') is not a number", fields[c], toks[c]),
-                            )
-                        })?;
-                }
-                for (k, name) in ["RGB_R", "RGB_G", "RGB_B"].iter().enumerate() {
-                    if !(0.0..=100.0).contains(&v[k]) {
-                        return Err(err(line, format!("{name} = {} is outside 0–100", v[k])));
-                    }
-                }
-                metamer_color::check_xyz([v[3], v[4], v[5]])
-                    .map_err(|e| err(line, format!("not a measurement: {e}")))?;
-                if !spectral.is_empty() {
-                    let mut row = Vec::with_capacity(spectral.len());
-                    for &(c, _) in &spectral {
-                        row.push(
-                            toks[c]
-                                .parse::<f64>()
-                                .ok()
-                                .filter(|x| x.is_finite())
-                                .ok_or_else(|| {
-                                    err(
-                                        line,
-                                        format!(
-                                            "field {} ('{}') is not a number",
-                                            fields[c], toks[c]
-                                        ),
-                                    )
-                                })?,
-                        );
-                    }
-                    spectra.push(row);
-                }
-                rows.push((line, v));
-            }
+        if table.line(line, &toks).map_err(err)? {
+            end_data = Some(index);
+            break;
         }
     }
-    let last = text.lines().count().max(1);
     if !seen_identifier {
         return Err(MeasurementsError::File {
             file,
             message: "the file is empty".into(),
         });
     }
-    if columns.is_none() {
-        return Err(err(
-            last,
-            "no BEGIN_DATA: the file holds no measurements".into(),
-        ));
-    }
-    if !ended {
-        return Err(err(
-            last,
-            "END_DATA is missing: the file is cut short".into(),
-        ));
-    }
-    if rows.is_empty() {
-        return Err(err(last, "the data table has no rows".into()));
-    }
-    if let Some((n, l)) = declared_sets {
-        if n != rows.len() {
-            return Err(err(
-                l,
-                format!(
-                    "NUMBER_OF_SETS is {n} but the data table has {} rows",
-                    rows.len()
-                ),
-            ));
-        }
-    }
-    let keyword = |name: &str| keywords.iter().find(|(k, _, _)| k == name);
-    if let Some((_, class, l)) = keyword("DEVICE_CLASS") {
-        if class != "DISPLAY" {
-            return Err(err(
-                *l,
-                format!("DEVICE_CLASS is \"{class}\"; display measurements need \"DISPLAY\""),
-            ));
-        }
-    }
-    let normalised = keyword("NORMALIZED_TO_Y_100").is_none_or(|(_, v, _)| v != "NO");
-    let (scale, absolute) = match (normalised, keyword("LUMINANCE_XYZ_CDM2")) {
-        (false, _) => (1.0, true),
-        (true, Some((_, value, l))) => {
-            let xyz: Vec<f64> = value
-                .split_whitespace()
-                .filter_map(|t| t.parse::<f64>().ok())
-                .collect();
-            if xyz.len() != 3
-                || xyz[1] <= 0.0
-                || metamer_color::check_xyz([xyz[0], xyz[1], xyz[2]]).is_err()
-            {
-                return Err(err(
-                    *l,
-                    format!("LUMINANCE_XYZ_CDM2 must be three numbers X Y Z with Y > 0, found \"{value}\""),
-                ));
-            }
-            (xyz[1] / 100.0, true)
-        }
-        (true, None) => (1.0, false),
-    };
-    let mut patches = Vec::with_capacity(rows.len());
-    for (line, v) in rows {
-        let xyz = [v[3] * scale, v[4] * scale, v[5] * scale];
-        // Each row passed alone; the white's luminance can still scale it past belief.
-        metamer_color::check_xyz(xyz)
-            .map_err(|e| err(line, format!("not a measurement once scaled to cd/m²: {e}")))?;
-        patches.push(Sample {
-            rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
-            xyz,
-        });
-    }
+    let last = text.lines().count().max(1);
+    let end_line = table.complete(end_data, last).map_err(err)?;
+    let (scale, absolute) = table.scale().map_err(err)?;
+    let patches = table.patches(scale).map_err(err)?;
     Ok(Measurements {
         patches,
         absolute,
-        spectra: (!spectral.is_empty()).then(|| Spectra {
-            wavelengths_nm: spectral.iter().map(|&(_, nm)| nm).collect(),
-            values: spectra,
+        spectra: (!table.spectral.is_empty()).then(|| Spectra {
+            wavelengths_nm: table.spectral.iter().map(|&(_, nm)| nm).collect(),
+            values: table.spectra,
         }),
-        calibration: calibration_table(text, end_line + 1).map_err(|(l, m)| err(l, m))?,
+        calibration: calibration_table(text, end_line + 1).map_err(err)?,
     })
+}
+
+/// Where a `.ti3`'s first table is being read: CGATS puts keywords, then the field names
+/// between `BEGIN_DATA_FORMAT` and `END_DATA_FORMAT`, then the rows up to `END_DATA`.
+#[derive(Default)]
+enum Section {
+    #[default]
+    Header,
+    Format,
+    Data,
+}
+
+/// A line's problem: its number and what is wrong.
+type LineError = (usize, String);
+
+/// What the first table's lines say, gathered line by line.
+#[derive(Default)]
+struct Table {
+    section: Section,
+    /// Keyword, value and line.
+    keywords: Vec<(String, String, usize)>,
+    fields: Vec<String>,
+    /// `NUMBER_OF_FIELDS` and `NUMBER_OF_SETS` with their lines.
+    declared_fields: Option<(usize, usize)>,
+    declared_sets: Option<(usize, usize)>,
+    /// Columns of RGB_R, RGB_G, RGB_B, XYZ_X, XYZ_Y, XYZ_Z; set at `BEGIN_DATA`.
+    columns: Option<[usize; 6]>,
+    rows: Vec<(usize, [f64; 6])>,
+    /// Columns and wavelengths of the `SPEC_nnn` fields, and each row's values there.
+    spectral: Vec<(usize, f64)>,
+    spectra: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// Reads one line after the identifier; true at `END_DATA`.
+    fn line(&mut self, line: usize, toks: &[String]) -> Result<bool, LineError> {
+        match self.section {
+            Section::Header => self.header_line(line, toks)?,
+            Section::Format => {
+                if toks[0] == "END_DATA_FORMAT" {
+                    self.section = Section::Header;
+                } else {
+                    self.fields.extend(toks.iter().cloned());
+                }
+            }
+            Section::Data => {
+                if toks[0] == "END_DATA" {
+                    return Ok(true);
+                }
+                self.row(line, toks)?;
+            }
+        }
+        Ok(false)
+    }
+
+    fn header_line(&mut self, line: usize, toks: &[String]) -> Result<(), LineError> {
+        match toks[0].as_str() {
+            "BEGIN_DATA_FORMAT" => {
+                self.section = Section::Format;
+                self.fields.extend(toks[1..].iter().cloned());
+            }
+            "NUMBER_OF_FIELDS" | "NUMBER_OF_SETS" => {
+                let n = toks
+                    .get(1)
+                    .and_then(|t| t.parse::<usize>().ok())
+                    .ok_or_else(|| (line, format!("{} needs a whole number", toks[0])))?;
+                if toks[0] == "NUMBER_OF_FIELDS" {
+                    self.declared_fields = Some((n, line));
+                } else {
+                    self.declared_sets = Some((n, line));
+                }
+            }
+            "BEGIN_DATA" => {
+                let cols = find_columns(&self.fields).map_err(|m| (line, m))?;
+                if let Some((n, l)) = self.declared_fields {
+                    if n != self.fields.len() {
+                        return Err((
+                            l,
+                            format!(
+                                "NUMBER_OF_FIELDS is {n} but the data format lists {} fields",
+                                self.fields.len()
+                            ),
+                        ));
+                    }
+                }
+                self.columns = Some(cols);
+                self.spectral = spectral_columns(&self.fields).map_err(|m| (line, m))?;
+                self.section = Section::Data;
+            }
+            "KEYWORD" => {}
+            name => {
+                let value = toks[1..].join(" ");
+                self.keywords.push((name.to_string(), value, line));
+            }
+        }
+        Ok(())
+    }
+
+    /// One data row: the device values and XYZ checked, the spectrum kept.
+    fn row(&mut self, line: usize, toks: &[String]) -> Result<(), LineError> {
+        let cols = self.columns.expect("set when the data began");
+        if toks.len() != self.fields.len() {
+            return Err((
+                line,
+                format!(
+                    "expected {} values ({}), found {}",
+                    self.fields.len(),
+                    self.fields.join(" "),
+                    toks.len()
+                ),
+            ));
+        }
+        let mut v = [0.0; 6];
+        for (k, &c) in cols.iter().enumerate() {
+            v[k] = self.number(line, toks, c)?;
+        }
+        for (k, name) in ["RGB_R", "RGB_G", "RGB_B"].iter().enumerate() {
+            if !(0.0..=100.0).contains(&v[k]) {
+                return Err((line, format!("{name} = {} is outside 0–100", v[k])));
+            }
+        }
+        metamer_color::check_xyz([v[3], v[4], v[5]])
+            .map_err(|e| (line, format!("not a measurement: {e}")))?;
+        if !self.spectral.is_empty() {
+            let row = self
+                .spectral
+                .iter()
+                .map(|&(c, _)| self.number(line, toks, c))
+                .collect::<Result<Vec<f64>, LineError>>()?;
+            self.spectra.push(row);
+        }
+        self.rows.push((line, v));
+        Ok(())
+    }
+
+    /// Field `c` of a row as a finite number.
+    fn number(&self, line: usize, toks: &[String], c: usize) -> Result<f64, LineError> {
+        toks[c]
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| {
+                (
+                    line,
+                    format!("field {} ('{}') is not a number", self.fields[c], toks[c]),
+                )
+            })
+    }
+
+    /// The table as a whole, once its lines are read (`end_data`: the index of its
+    /// `END_DATA` line, `last`: the file's last line); returns `end_data`.
+    fn complete(&self, end_data: Option<usize>, last: usize) -> Result<usize, LineError> {
+        if self.columns.is_none() {
+            return Err((last, "no BEGIN_DATA: the file holds no measurements".into()));
+        }
+        let Some(end_data) = end_data else {
+            return Err((last, "END_DATA is missing: the file is cut short".into()));
+        };
+        if self.rows.is_empty() {
+            return Err((last, "the data table has no rows".into()));
+        }
+        if let Some((n, l)) = self.declared_sets {
+            if n != self.rows.len() {
+                return Err((
+                    l,
+                    format!(
+                        "NUMBER_OF_SETS is {n} but the data table has {} rows",
+                        self.rows.len()
+                    ),
+                ));
+            }
+        }
+        Ok(end_data)
+    }
+
+    fn keyword(&self, name: &str) -> Option<&(String, String, usize)> {
+        self.keywords.iter().find(|(k, _, _)| k == name)
+    }
+
+    /// The factor from the file's XYZ to cd/m², and whether the result is absolute, from
+    /// the keywords (`DEVICE_CLASS`, `NORMALIZED_TO_Y_100`, `LUMINANCE_XYZ_CDM2`).
+    fn scale(&self) -> Result<(f64, bool), LineError> {
+        if let Some((_, class, l)) = self.keyword("DEVICE_CLASS") {
+            if class != "DISPLAY" {
+                return Err((
+                    *l,
+                    format!("DEVICE_CLASS is \"{class}\"; display measurements need \"DISPLAY\""),
+                ));
+            }
+        }
+        let normalised = self
+            .keyword("NORMALIZED_TO_Y_100")
+            .is_none_or(|(_, v, _)| v != "NO");
+        Ok(match (normalised, self.keyword("LUMINANCE_XYZ_CDM2")) {
+            (false, _) => (1.0, true),
+            (true, Some((_, value, l))) => {
+                let xyz: Vec<f64> = value
+                    .split_whitespace()
+                    .filter_map(|t| t.parse::<f64>().ok())
+                    .collect();
+                if xyz.len() != 3
+                    || xyz[1] <= 0.0
+                    || metamer_color::check_xyz([xyz[0], xyz[1], xyz[2]]).is_err()
+                {
+                    return Err((
+                        *l,
+                        format!("LUMINANCE_XYZ_CDM2 must be three numbers X Y Z with Y > 0, found \"{value}\""),
+                    ));
+                }
+                (xyz[1] / 100.0, true)
+            }
+            (true, None) => (1.0, false),
+        })
+    }
+
+    /// The rows as patches: drive 0–1, XYZ times `scale`.
+    fn patches(&self, scale: f64) -> Result<Vec<Sample>, LineError> {
+        let mut patches = Vec::with_capacity(self.rows.len());
+        for &(line, v) in &self.rows {
+            let xyz = [v[3] * scale, v[4] * scale, v[5] * scale];
+            // Each row passed alone; the white's luminance can still scale it past belief.
+            metamer_color::check_xyz(xyz)
+                .map_err(|e| (line, format!("not a measurement once scaled to cd/m²: {e}")))?;
+            patches.push(Sample {
+                rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
+                xyz,
+            });
+        }
+        Ok(patches)
+    }
 }
 
 /// Columns and wavelengths of `SPEC_nnn` fields, which must rise in wavelength.
