@@ -495,3 +495,46 @@ fn validate_refuses_a_white_or_readings_in_other_units() {
     assert!(!out.exists(), "nothing written");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A repeat count out of range is named where it was written: in the plan file as the
+/// plan's field, on the command line as the flag (so the user edits the right one).
+#[test]
+fn a_bad_repeat_count_is_named_where_it_was_written() {
+    let dir = fresh_dir("plan-repeats");
+    let plan = dir.join("plan.json");
+    std::fs::write(
+        &plan,
+        r#"{"repeats": 0, "geometry": {"rows": 3, "cols": 3}}"#,
+    )
+    .unwrap();
+    let sim = [
+        "--spectral",
+        "sim:i1pro?time_scale=0",
+        "--spot",
+        "sim:cs100a?time_scale=0",
+    ];
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    let in_plan = metamer_unscaled(
+        &[
+            &["measure-box", "-o", out, "--plan", plan.to_str().unwrap()][..],
+            &sim,
+        ]
+        .concat(),
+    );
+    assert_eq!(in_plan.status.code(), Some(2), "{}", stderr(&in_plan));
+    assert_eq!(
+        stderr(&in_plan).trim(),
+        "error: plan: repeats: must be between 1 and 100, got 0"
+    );
+    let on_flag =
+        metamer_unscaled(&[&["measure-box", "-o", out, "--repeats", "0"][..], &sim].concat());
+    assert_eq!(on_flag.status.code(), Some(2), "{}", stderr(&on_flag));
+    assert_eq!(
+        stderr(&on_flag).trim(),
+        "error: --repeats must be between 1 and 100, got 0"
+    );
+    // Refused before anything was written.
+    assert!(!Path::new(out).exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

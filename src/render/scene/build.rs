@@ -343,7 +343,55 @@ fn emitter(
 ) -> R<Emitter> {
     let rect = rect(p, e.corner, e.edge_u, e.edge_v)?;
     let n = e.rows * e.cols;
-    // No tiles listed: an untiled panel, every tile at gain 1.
+    let (mut gains, given) = tile_gains(p, e)?;
+    let absolute = e.tiles.iter().any(|t| t.spectrum.is_some());
+    let (spectra, tile_spectrum, scale) = if absolute {
+        absolute_spectra(p, e, loader, ybar, &given, &mut gains)?
+    } else {
+        let (spectrum, scale) = relative_spectrum(p, e, loader, ybar)?;
+        (vec![spectrum], vec![0; n], scale)
+    };
+    let mut brightest_tile: f64 = 0.0;
+    for (k, g) in gains.iter().enumerate() {
+        let lum = g * luminance(&spectra[tile_spectrum[k] as usize], ybar);
+        brightest_tile = brightest_tile.max(lum);
+        if lum.is_nan() || lum > MAX_LUMINANCE_CD_M2 {
+            return err(
+                format!("{p}.tiles[{}].gain", given[k].unwrap_or(0)),
+                format!(
+                    "gives the tile a luminance of {lum:e} cd/m², above {MAX_LUMINANCE_CD_M2:e}"
+                ),
+            );
+        }
+    }
+    let dp = format!("{p}.distribution");
+    let distribution = distribution(&dp, &e.distribution, loader)?;
+    if let Distribution::Table(table) = &distribution {
+        check_table_peak(&dp, &e.distribution, table, brightest_tile)?;
+    }
+    let reflectance = match &e.reflectance {
+        Some(r) => loader.reflectance(&format!("{p}.reflectance"), r, warnings)?,
+        None => constant_bins(0.0),
+    };
+    Ok(Emitter {
+        axis_u: rect.edge_u.normalized(),
+        axis_v: rect.edge_v.normalized(),
+        rect,
+        rows: e.rows,
+        cols: e.cols,
+        gains,
+        tile_spectrum,
+        spectra,
+        scale,
+        distribution,
+        reflectance,
+    })
+}
+
+/// Each tile's gain, row by row, and which entry of `tiles` gave it. No tiles listed: an
+/// untiled panel, every tile at gain 1; else every tile must be listed once.
+fn tile_gains(p: &str, e: &EmitterFile) -> R<(Vec<f64>, Vec<Option<usize>>)> {
+    let n = e.rows * e.cols;
     let fill = if e.tiles.is_empty() { 1.0 } else { f64::NAN };
     let mut gains = vec![fill; n];
     let mut given: Vec<Option<usize>> = vec![None; n];
@@ -371,123 +419,129 @@ fn emitter(
             format!("tile ({}, {}) is missing", i / e.cols, i % e.cols),
         );
     }
-    let absolute = e.tiles.iter().any(|t| t.spectrum.is_some());
-    let (spectra, tile_spectrum, scale) = if absolute {
-        if e.spectrum.is_some() {
+    Ok((gains, given))
+}
+
+/// Tiles with their own absolute spectral radiance: the distinct spectra, each tile's
+/// entry among them (its gain times the proportion to that entry), and the scale 1.
+fn absolute_spectra(
+    p: &str,
+    e: &EmitterFile,
+    loader: &mut Loader,
+    ybar: &[f64],
+    given: &[Option<usize>],
+    gains: &mut [f64],
+) -> R<(Vec<Vec<f64>>, Vec<u32>, f64)> {
+    if e.spectrum.is_some() {
+        return err(
+            format!("{p}.spectrum"),
+            "must be absent when the tiles carry their own (absolute) spectra",
+        );
+    }
+    if e.luminance_cd_m2.is_some() {
+        return err(
+            format!("{p}.luminance_cd_m2"),
+            "must be absent when the tiles carry absolute spectra: their luminance follows \
+             from the spectra",
+        );
+    }
+    let mut spectra: Vec<Vec<f64>> = Vec::new();
+    let mut sums: Vec<f64> = Vec::new();
+    let mut tile_spectrum = vec![0u32; given.len()];
+    for (k, g) in given.iter().enumerate() {
+        let i = g.expect("every tile is given");
+        let sp = format!("{p}.tiles[{i}].spectrum");
+        let Some(s) = &e.tiles[i].spectrum else {
             return err(
-                format!("{p}.spectrum"),
-                "must be absent when the tiles carry their own (absolute) spectra",
-            );
-        }
-        if e.luminance_cd_m2.is_some() {
-            return err(
-                format!("{p}.luminance_cd_m2"),
-                "must be absent when the tiles carry absolute spectra: their luminance follows \
-                 from the spectra",
-            );
-        }
-        let mut spectra: Vec<Vec<f64>> = Vec::new();
-        let mut sums: Vec<f64> = Vec::new();
-        let mut tile_spectrum = vec![0u32; n];
-        for (k, g) in given.iter().enumerate() {
-            let i = g.expect("every tile is given");
-            let sp = format!("{p}.tiles[{i}].spectrum");
-            let Some(s) = &e.tiles[i].spectrum else {
-                return err(
-                    sp,
-                    "missing: when one tile has a spectrum, every tile of the emitter needs one",
-                );
-            };
-            let s = loader.spectrum(&sp, s)?;
-            if s.iter().any(|v| *v < 0.0) {
-                return err(sp, "a spectral radiance must be ≥ 0");
-            }
-            let lum = luminance(&s, ybar);
-            if lum.is_nan() || lum > MAX_LUMINANCE_CD_M2 {
-                return err(
-                    sp,
-                    format!("luminance {lum:e} cd/m² is above {MAX_LUMINANCE_CD_M2:e}"),
-                );
-            }
-            // Proportional spectra share one entry: the radiosity solver solves once per
-            // entry, and a measured box's tiles often differ by brightness only.
-            let sum: f64 = s.iter().sum();
-            let found = spectra.iter().zip(&sums).position(|(c, cs)| {
-                *cs > 0.0 && {
-                    let r = sum / cs;
-                    let tol = 1e-12 * s.iter().cloned().fold(0.0, f64::max);
-                    c.iter().zip(&s).all(|(a, b)| (r * a - b).abs() <= tol)
-                }
-            });
-            match found {
-                Some(c) => {
-                    gains[k] *= sum / sums[c];
-                    tile_spectrum[k] = c as u32;
-                }
-                None => {
-                    if spectra.len() == MAX_TILE_SPECTRA {
-                        return err(
-                            sp,
-                            format!("more than {MAX_TILE_SPECTRA} distinct tile spectra"),
-                        );
-                    }
-                    tile_spectrum[k] = spectra.len() as u32;
-                    sums.push(sum);
-                    spectra.push(s);
-                }
-            }
-        }
-        (spectra, tile_spectrum, 1.0)
-    } else {
-        let sp = format!("{p}.spectrum");
-        let relative = match &e.spectrum {
-            Some(s) => loader.spectrum(&sp, s)?,
-            None => constant_bins(1.0),
-        };
-        if relative.iter().any(|v| *v < 0.0) {
-            return err(sp, "must be ≥ 0");
-        }
-        let lum = luminance(&relative, ybar) / K_M;
-        if !(lum > 0.0 && lum.is_finite()) {
-            return err(sp, "has no luminance (zero under ȳ)");
-        }
-        let lp = format!("{p}.luminance_cd_m2");
-        let Some(l) = e.luminance_cd_m2 else {
-            return err(
-                lp,
-                "missing: a relative spectrum needs the luminance it is scaled to \
-                 (or give every tile an absolute spectrum)",
+                sp,
+                "missing: when one tile has a spectrum, every tile of the emitter needs one",
             );
         };
-        if !(l >= 0.0 && l.is_finite()) {
-            return err(lp, "must be ≥ 0");
+        let s = loader.spectrum(&sp, s)?;
+        if s.iter().any(|v| *v < 0.0) {
+            return err(sp, "a spectral radiance must be ≥ 0");
         }
-        if l > MAX_LUMINANCE_CD_M2 {
-            return err(lp, format!("must be at most {MAX_LUMINANCE_CD_M2:e}"));
-        }
-        // s from Eq. 8 summed on the same grid as every reading.
-        let scale = l / (K_M * lum);
-        (
-            vec![relative.iter().map(|v| v * scale).collect()],
-            vec![0; n],
-            scale,
-        )
-    };
-    let mut brightest_tile: f64 = 0.0;
-    for (k, g) in gains.iter().enumerate() {
-        let lum = g * luminance(&spectra[tile_spectrum[k] as usize], ybar);
-        brightest_tile = brightest_tile.max(lum);
+        let lum = luminance(&s, ybar);
         if lum.is_nan() || lum > MAX_LUMINANCE_CD_M2 {
             return err(
-                format!("{p}.tiles[{}].gain", given[k].unwrap_or(0)),
-                format!(
-                    "gives the tile a luminance of {lum:e} cd/m², above {MAX_LUMINANCE_CD_M2:e}"
-                ),
+                sp,
+                format!("luminance {lum:e} cd/m² is above {MAX_LUMINANCE_CD_M2:e}"),
             );
         }
+        // Proportional spectra share one entry: the radiosity solver solves once per
+        // entry, and a measured box's tiles often differ by brightness only.
+        let sum: f64 = s.iter().sum();
+        let found = spectra.iter().zip(&sums).position(|(c, cs)| {
+            *cs > 0.0 && {
+                let r = sum / cs;
+                let tol = 1e-12 * s.iter().cloned().fold(0.0, f64::max);
+                c.iter().zip(&s).all(|(a, b)| (r * a - b).abs() <= tol)
+            }
+        });
+        match found {
+            Some(c) => {
+                gains[k] *= sum / sums[c];
+                tile_spectrum[k] = c as u32;
+            }
+            None => {
+                if spectra.len() == MAX_TILE_SPECTRA {
+                    return err(
+                        sp,
+                        format!("more than {MAX_TILE_SPECTRA} distinct tile spectra"),
+                    );
+                }
+                tile_spectrum[k] = spectra.len() as u32;
+                sums.push(sum);
+                spectra.push(s);
+            }
+        }
     }
-    let dp = format!("{p}.distribution");
-    let distribution = match &e.distribution {
+    Ok((spectra, tile_spectrum, 1.0))
+}
+
+/// One relative spectrum for every tile, scaled to the emitter's luminance: the absolute
+/// spectrum and the scale.
+fn relative_spectrum(
+    p: &str,
+    e: &EmitterFile,
+    loader: &mut Loader,
+    ybar: &[f64],
+) -> R<(Vec<f64>, f64)> {
+    let sp = format!("{p}.spectrum");
+    let relative = match &e.spectrum {
+        Some(s) => loader.spectrum(&sp, s)?,
+        None => constant_bins(1.0),
+    };
+    if relative.iter().any(|v| *v < 0.0) {
+        return err(sp, "must be ≥ 0");
+    }
+    let lum = luminance(&relative, ybar) / K_M;
+    if !(lum > 0.0 && lum.is_finite()) {
+        return err(sp, "has no luminance (zero under ȳ)");
+    }
+    let lp = format!("{p}.luminance_cd_m2");
+    let Some(l) = e.luminance_cd_m2 else {
+        return err(
+            lp,
+            "missing: a relative spectrum needs the luminance it is scaled to \
+             (or give every tile an absolute spectrum)",
+        );
+    };
+    if !(l >= 0.0 && l.is_finite()) {
+        return err(lp, "must be ≥ 0");
+    }
+    if l > MAX_LUMINANCE_CD_M2 {
+        return err(lp, format!("must be at most {MAX_LUMINANCE_CD_M2:e}"));
+    }
+    // s from Eq. 8 summed on the same grid as every reading.
+    let scale = l / (K_M * lum);
+    Ok((relative.iter().map(|v| v * scale).collect(), scale))
+}
+
+/// The emitter's angular distribution (`dp`: its JSON path), a photometric file read
+/// beside the scene file.
+fn distribution(dp: &str, d: &DistributionFile, loader: &Loader) -> R<Distribution> {
+    Ok(match d {
         DistributionFile::Lambertian => Distribution::Lambertian,
         DistributionFile::CosPower { exponent } => {
             if !(*exponent >= 0.0 && exponent.is_finite()) {
@@ -504,7 +558,7 @@ fn emitter(
                 );
             };
             let path = dir.join(file);
-            let read = if matches!(e.distribution, DistributionFile::Ies { .. }) {
+            let read = if matches!(d, DistributionFile::Ies { .. }) {
                 crate::light::ies::read(&path)
             } else {
                 crate::light::ldt::read(&path)
@@ -515,26 +569,6 @@ fn emitter(
             })?;
             Distribution::Table(Arc::new(table))
         }
-    };
-    if let Distribution::Table(table) = &distribution {
-        check_table_peak(&dp, &e.distribution, table, brightest_tile)?;
-    }
-    let reflectance = match &e.reflectance {
-        Some(r) => loader.reflectance(&format!("{p}.reflectance"), r, warnings)?,
-        None => constant_bins(0.0),
-    };
-    Ok(Emitter {
-        axis_u: rect.edge_u.normalized(),
-        axis_v: rect.edge_v.normalized(),
-        rect,
-        rows: e.rows,
-        cols: e.cols,
-        gains,
-        tile_spectrum,
-        spectra,
-        scale,
-        distribution,
-        reflectance,
     })
 }
 
