@@ -11,7 +11,6 @@ use super::error::ExperimentError;
 use super::measure_box::{self, MeasureBox};
 use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
-use super::readings::read_readings;
 use super::reproduction::{reproduce, Reproduction};
 use super::simulation::{simulate, SimulationSummary};
 use super::stage::Stage;
@@ -346,15 +345,8 @@ fn run_stage(
                 simulation: &sim_spots,
                 display: &display_spots,
             };
-            let (_, written) = validate::validate(
-                &sd.dir,
-                profile.white_xyz,
-                &files,
-                &read_readings(&box_spots)?,
-                &read_readings(&sim_spots)?,
-                &read_readings(&display_spots)?,
-                &r.out_of_gamut_patches,
-            )?;
+            let (_, written) =
+                validate::validate(&sd.dir, profile.white_xyz, &files, &r.out_of_gamut_patches)?;
             Ok(written)
         }
     }

@@ -5,7 +5,6 @@
 use std::path::Path;
 
 use super::error::ExperimentError;
-use super::readings::PatchStat;
 use super::report_sections::{gather, Layout};
 use crate::validation::job::{self, Context, Coverage, Request, White};
 use crate::validation::{AssessOptions, ReportInput, ValidationError};
@@ -100,15 +99,11 @@ pub fn report_input(
 
 /// Compares box, display and simulation: the point comparisons' CSV and ΔE chart each,
 /// then the assessments with uncertainty into `comparisons.json` and the report. The
-/// readings are read from `inputs`; the parsed `_box_spots`, `_simulation` and `_display`
-/// are the run's own reading of the same files, no longer needed here.
+/// readings are read from `inputs`, once, by the validation's reader.
 pub fn validate(
     dir: &Path,
     white: [f64; 3],
     inputs: &ReadingFiles<'_>,
-    _box_spots: &[PatchStat],
-    _simulation: &[PatchStat],
-    _display: &[PatchStat],
     out_of_gamut: &[usize],
 ) -> Result<(ValidationResult, Vec<String>), ExperimentError> {
     let outcome = job::validate(&request(dir, white, inputs, out_of_gamut)).map_err(stage_error)?;
