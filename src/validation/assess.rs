@@ -169,11 +169,7 @@ pub fn assess(
     white: Xyz,
     opts: &AssessOptions,
 ) -> Result<Assessment, ValidationError> {
-    if !(white.x > 0.0 && white.y > 0.0 && white.z > 0.0) {
-        return Err(ValidationError::BadWhite {
-            white: white.to_array(),
-        });
-    }
+    check_white(white)?;
     let common: Vec<usize> = reference
         .patches
         .keys()
@@ -188,23 +184,101 @@ pub fn assess(
     }
     // Spread over three axes so the expected squared length of the term is its ΔE².
     let model_lab = opts.model_term_de / 3f64.sqrt();
+    let pairs = common
+        .iter()
+        .map(|&k| PatchPair {
+            patch: k,
+            reference: side(&reference.patches[&k], white, 0.0),
+            test: side(&test.patches[&k], white, model_lab),
+            out_of_gamut: reference.patches[&k].out_of_gamut || test.patches[&k].out_of_gamut,
+        })
+        .collect();
+    Ok(compare_pairs(
+        reference_name,
+        test_name,
+        pairs,
+        white,
+        opts.propagation,
+    ))
+}
+
+/// CIELAB needs a white with positive X, Y and Z.
+pub(super) fn check_white(white: Xyz) -> Result<(), ValidationError> {
+    if white.x > 0.0 && white.y > 0.0 && white.z > 0.0 {
+        Ok(())
+    } else {
+        Err(ValidationError::BadWhite {
+            white: white.to_array(),
+        })
+    }
+}
+
+/// One patch's two readings as [`compare_pairs`] takes them.
+pub(super) struct PatchPair {
+    pub patch: usize,
+    pub reference: (Side, Uncertain),
+    pub test: (Side, Uncertain),
+    pub out_of_gamut: bool,
+}
+
+/// A side known exactly (no uncertainty of its own): what [`super::compare`] compares.
+pub(super) fn exact_side(xyz: Xyz, white: Xyz) -> (Side, Uncertain) {
+    (
+        Side {
+            xyz: xyz.to_array(),
+            u_xyz: [0.0; 3],
+            cov_xyz: covariance::ZERO,
+            dof: None,
+            u_lab: 0.0,
+            n: 1,
+            uncertainty: UncertaintySource::Unknown,
+            lab: xyz.to_lab(white).to_array(),
+        },
+        Uncertain {
+            xyz: xyz.to_array(),
+            factors: Vec::new(),
+            dof: None,
+            u_lab: 0.0,
+        },
+    )
+}
+
+/// The ColorChecker name of 1-based patch `k`, or "patch k" beyond the chart.
+fn patch_name(k: usize) -> String {
+    k.checked_sub(1)
+        .and_then(|i| COLORCHECKER_NAMES.get(i))
+        .map(|s| s.to_string())
+        .unwrap_or_else(|| format!("patch {k}"))
+}
+
+/// The one comparison: each pair in CIELAB relative to `white` (checked by the caller),
+/// its colour differences with their intervals and verdicts, and the summaries over the
+/// pairs.
+pub(super) fn compare_pairs(
+    reference_name: &str,
+    test_name: &str,
+    pairs: Vec<PatchPair>,
+    white: Xyz,
+    propagation: Propagation,
+) -> Assessment {
     // Patches are independent: their intervals are found in parallel.
-    let (patches, propagated): (Vec<PatchAssessment>, Vec<Propagated>) = common
-        .par_iter()
-        .map(|&k| {
-            let (r, ru) = side(&reference.patches[&k], white, 0.0);
-            let (t, tu) = side(&test.patches[&k], white, model_lab);
-            let p = propagate(&ru, &tu, white, opts.propagation, k);
+    let (patches, propagated): (Vec<PatchAssessment>, Vec<Propagated>) = pairs
+        .into_par_iter()
+        .map(|pair| {
+            let (r, ru) = pair.reference;
+            let (t, tu) = pair.test;
+            let k = pair.patch;
+            let p = propagate(&ru, &tu, white, propagation, k);
             let (rl, tl) = (p.reference_lab, p.test_lab);
             let a = PatchAssessment {
                 patch: k,
-                name: COLORCHECKER_NAMES[k - 1].to_string(),
+                name: patch_name(k),
                 de76: delta_e76(rl, tl),
                 de00: delta_e2000(rl, tl),
                 de76_interval: p.de76,
                 de00_interval: p.de00,
                 jnd: JndVerdict::of(p.de76),
-                out_of_gamut: reference.patches[&k].out_of_gamut || test.patches[&k].out_of_gamut,
+                out_of_gamut: pair.out_of_gamut,
                 reference: r,
                 test: t,
             };
@@ -219,7 +293,7 @@ pub fn assess(
             JndVerdict::Undecided => jnd.undecided += 1,
         }
     }
-    let seed = match opts.propagation {
+    let seed = match propagation {
         Propagation::MonteCarlo { seed, .. } => seed,
         Propagation::Linear => 0,
     };
@@ -258,11 +332,11 @@ pub fn assess(
     .map(stat)
     .collect();
     let [mean_de76, max_de76, mean_de00, max_de00] = [stats[0], stats[1], stats[2], stats[3]];
-    Ok(Assessment {
+    Assessment {
         reference: reference_name.into(),
         test: test_name.into(),
         white: white.to_array(),
-        propagation: opts.propagation.describe(),
+        propagation: propagation.describe(),
         below_jnd_point: patches.iter().filter(|p| p.de76 < JND_DE76).count(),
         patches,
         mean_de76,
@@ -270,7 +344,7 @@ pub fn assess(
         mean_de00,
         max_de00,
         jnd,
-    })
+    }
 }
 
 impl Stat {

@@ -126,3 +126,78 @@ fn draw(
     root.present().map_err(|e| chart_err(&e))?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Xyz;
+    use crate::validation::compare;
+
+    #[test]
+    fn a_chart_of_an_infinite_difference_is_refused_at_once() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let x = Xyz::new(10.0, 11.0, 12.0);
+        let mut c = compare("box", &[x], "display", &[x], white).unwrap();
+        // The experiment's box readings of X = −1e308 gave this, and plotters then
+        // searched an infinite axis for ticks without end.
+        c.patches[0].de76 = f64::INFINITY;
+        let file = std::env::temp_dir().join(format!("metamer-inf-{}.svg", std::process::id()));
+        let start = std::time::Instant::now();
+        let e = write_delta_e_chart(&c, &file, &crate::output::OutputPolicy::new(true))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a colour difference of inf cannot be drawn"),
+            "{e}"
+        );
+        assert!(start.elapsed().as_secs() < 5);
+        assert!(!file.exists());
+    }
+
+    #[test]
+    fn chart_has_two_bars_per_patch_and_the_jnd_line() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let reference: Vec<Xyz> = (0..24)
+            .map(|i| Xyz::new(10.0 + i as f64, 11.0 + i as f64, 12.0))
+            .collect();
+        let test: Vec<Xyz> = reference
+            .iter()
+            .enumerate()
+            .map(|(i, x)| x.scaled(1.0 + 0.01 * i as f64))
+            .collect();
+        let c = compare("box", &reference, "display", &test, white).unwrap();
+        let file = std::env::temp_dir().join(format!("metamer-chart-{}.svg", std::process::id()));
+        write_delta_e_chart(&c, &file, &crate::output::OutputPolicy::new(true)).unwrap();
+        let svg = std::fs::read_to_string(&file).unwrap();
+        write_delta_e_chart_shaded(
+            &c,
+            &[7, 16],
+            "out of gamut",
+            &file,
+            &crate::output::OutputPolicy::new(true),
+        )
+        .unwrap();
+        let shaded = std::fs::read_to_string(&file).unwrap();
+        assert!(shaded.contains("out of gamut") && !svg.contains("out of gamut"));
+        assert_eq!(
+            shaded.matches("<rect").count(),
+            svg.matches("<rect").count() + 3,
+            "two bands and their legend key"
+        );
+        if let Ok(dir) = std::env::var("METAMER_KEEP_CHART") {
+            std::fs::copy(&file, std::path::Path::new(&dir).join("chart.svg")).unwrap();
+        }
+        std::fs::remove_file(&file).ok();
+        assert!(svg.starts_with("<svg"));
+        // 48 bars + background rectangles; the caption carries the count.
+        assert!(
+            svg.matches("<rect").count() >= 48,
+            "{}",
+            svg.matches("<rect").count()
+        );
+        assert!(svg.contains(&format!(
+            "{} of 24 below JND by point estimate",
+            c.below_jnd_point
+        )));
+    }
+}

@@ -8,10 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use super::assess::Assessment;
 use super::chart::write_delta_e_chart_shaded;
-use super::compare;
+use super::compare::Comparison;
 use super::error::ValidationError;
-use super::readings::ReadingSet;
-use crate::color::Xyz;
 use crate::output::OutputPolicy;
 
 /// What the validation found, as `comparisons.json`: each comparison patch by patch with
@@ -39,30 +37,17 @@ pub const FILE: &str = "comparisons.json";
 /// earlier layout runs again.
 pub const RESULT_VERSION: u32 = 2;
 
-/// The point estimates of one comparison, `STEM.csv`, and its ΔE chart, `STEM.svg`, in
+/// The point estimates of `assessment`, `STEM.csv`, and its ΔE chart, `STEM.svg`, in
 /// `dir`, with the patches in `shaded` marked as outside the display's gamut. Returns the
 /// two file names.
 pub(super) fn write_point_files(
     dir: &Path,
     stem: &str,
-    (reference_name, reference): (&str, &ReadingSet),
-    (test_name, test): (&str, &ReadingSet),
-    white: Xyz,
+    assessment: &Assessment,
     shaded: &[usize],
     policy: &OutputPolicy,
 ) -> Result<[String; 2], ValidationError> {
-    // The sides hold the same patches here (the stage's coverage rule); their order is
-    // the patch order of both.
-    let xyz = |s: &ReadingSet| -> Vec<Xyz> {
-        s.patches.values().map(|p| Xyz::from_array(p.xyz)).collect()
-    };
-    let c = compare(
-        reference_name,
-        &xyz(reference),
-        test_name,
-        &xyz(test),
-        white,
-    )?;
+    let c = Comparison::from(assessment);
     let csv = format!("{stem}.csv");
     policy.write(&dir.join(&csv), c.to_csv().as_bytes())?;
     let svg = format!("{stem}.svg");

@@ -25,12 +25,13 @@ pub struct ValidationJson<'a> {
     pub report: &'a ReportInput,
 }
 
-/// The comparisons of `input`, in the order box vs display, box vs simulation, display vs
-/// simulation, each with a short key.
+/// The comparisons of `input`, display vs box, simulation vs box, display vs simulation,
+/// each with the key `validation.csv` names it by (the first two keep their older,
+/// reference-first keys).
 pub fn comparisons(input: &ReportInput) -> Vec<(&'static str, &Assessment)> {
     [
-        ("box_vs_display", &input.box_vs_display),
-        ("box_vs_simulation", &input.box_vs_simulation),
+        ("box_vs_display", &input.display_vs_box),
+        ("box_vs_simulation", &input.simulation_vs_box),
         ("display_vs_simulation", &input.display_vs_simulation),
     ]
     .into_iter()

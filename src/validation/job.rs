@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
 
-use super::assess::{assess, AssessOptions, Assessment};
+use super::assess::{assess, AssessOptions};
 use super::comparisons::{write_point_files, ValidationResult, FILE, RESULT_VERSION};
 use super::error::ValidationError;
 use super::export::write_report_files;
@@ -122,8 +122,8 @@ pub struct Outcome {
 
 /// The three sides as read.
 struct Sides {
-    reference: ReadingSet,
-    test: ReadingSet,
+    box_readings: ReadingSet,
+    display: ReadingSet,
     simulation: Option<ReadingSet>,
 }
 
@@ -135,8 +135,8 @@ pub fn read_sides(files: &ReadingFiles<'_>, check: bool) -> Result<(), Validatio
 
 fn read(files: &ReadingFiles<'_>, check: bool) -> Result<Sides, ValidationError> {
     let sides = Sides {
-        reference: read_readings(files.box_readings)?,
-        test: read_readings(files.display)?,
+        box_readings: read_readings(files.box_readings)?,
+        display: read_readings(files.display)?,
         simulation: files.simulation.map(read_readings).transpose()?,
     };
     if check {
@@ -149,7 +149,7 @@ fn read(files: &ReadingFiles<'_>, check: bool) -> Result<Sides, ValidationError>
 
 impl Sides {
     fn all(&self) -> Vec<&ReadingSet> {
-        [&self.reference, &self.test]
+        [&self.box_readings, &self.display]
             .into_iter()
             .chain(&self.simulation)
             .collect()
@@ -184,14 +184,14 @@ impl Sides {
 ///     out: &out,
 ///     force: true,
 /// })?;
-/// let a = outcome.report.box_vs_display.as_ref().unwrap();
+/// let a = outcome.report.display_vs_box.as_ref().unwrap();
 /// assert_eq!(a.patches.len(), 24);
 /// assert_eq!(outcome.files.len(), 3); // validation.json, validation.csv, report.html
 /// # std::fs::remove_dir_all(&out).ok();
 /// # Ok::<(), metamer::validation::ValidationError>(())
 /// ```
 pub fn validate(request: &Request<'_>) -> Result<Outcome, ValidationError> {
-    let (report, white, sides) = assess_all(request)?;
+    let (report, white) = assess_all(request)?;
     let mut policy = OutputPolicy::new(request.force);
     policy.inputs(
         [request.readings.box_readings, request.readings.display]
@@ -200,41 +200,29 @@ pub fn validate(request: &Request<'_>) -> Result<Outcome, ValidationError> {
     );
     let mut files = Vec::new();
     let mut result = None;
-    if let (true, Some(simulation)) = (request.point_files, &sides.simulation) {
+    if let (true, Some(display_vs_box), Some(simulation_vs_box), Some(display_vs_simulation)) = (
+        request.point_files,
+        &report.display_vs_box,
+        &report.simulation_vs_box,
+        &report.display_vs_simulation,
+    ) {
         policy.dir(request.out)?;
         let oog = &request.out_of_gamut[..];
-        for (stem, reference, test, shaded) in [
-            (
-                "display_vs_box",
-                ("box", &sides.reference),
-                ("display", &sides.test),
-                oog,
-            ),
-            (
-                "simulation_vs_box",
-                ("box", &sides.reference),
-                ("simulation", simulation),
-                &[][..],
-            ),
-            (
-                "display_vs_simulation",
-                ("simulation", simulation),
-                ("display", &sides.test),
-                oog,
-            ),
+        for (stem, assessment, shaded) in [
+            ("display_vs_box", display_vs_box, oog),
+            ("simulation_vs_box", simulation_vs_box, &[][..]),
+            ("display_vs_simulation", display_vs_simulation, oog),
         ] {
-            let names =
-                write_point_files(request.out, stem, reference, test, white, shaded, &policy)?;
+            let names = write_point_files(request.out, stem, assessment, shaded, &policy)?;
             files.extend(names.iter().map(|n| request.out.join(n)));
         }
-        let take = |a: &Option<Assessment>| a.clone().expect("all three were compared");
         let r = ValidationResult {
             version: RESULT_VERSION,
             white: white.to_array(),
             out_of_gamut_patches: request.out_of_gamut.clone(),
-            display_vs_box: take(&report.box_vs_display),
-            simulation_vs_box: take(&report.box_vs_simulation),
-            display_vs_simulation: take(&report.display_vs_simulation),
+            display_vs_box: display_vs_box.clone(),
+            simulation_vs_box: simulation_vs_box.clone(),
+            display_vs_simulation: display_vs_simulation.clone(),
         };
         let text = serde_json::to_string_pretty(&r).map_err(ValidationError::Json)?;
         policy.write(&request.out.join(FILE), text.as_bytes())?;
@@ -253,10 +241,10 @@ pub fn validate(request: &Request<'_>) -> Result<Outcome, ValidationError> {
 /// The report's data for `request` without writing anything: the readings read, the white
 /// chosen and the comparisons made.
 pub fn report(request: &Request<'_>) -> Result<ReportInput, ValidationError> {
-    assess_all(request).map(|(report, _, _)| report)
+    assess_all(request).map(|(report, _)| report)
 }
 
-fn assess_all(request: &Request<'_>) -> Result<(ReportInput, Xyz, Sides), ValidationError> {
+fn assess_all(request: &Request<'_>) -> Result<(ReportInput, Xyz), ValidationError> {
     let mut sides = read(&request.readings, request.check_readings)?;
     if request.coverage == Coverage::Same {
         same_patches(&sides)?;
@@ -272,7 +260,7 @@ fn assess_all(request: &Request<'_>) -> Result<(ReportInput, Xyz, Sides), Valida
             }
             uncertainty.push(("simulation".to_string(), u.description.clone()));
         }
-        for (side, set) in [("box", &sides.reference), ("display", &sides.test)] {
+        for (side, set) in [("box", &sides.box_readings), ("display", &sides.display)] {
             uncertainty.push((side.to_string(), repeatability(set)));
         }
     }
@@ -292,9 +280,9 @@ fn assess_all(request: &Request<'_>) -> Result<(ReportInput, Xyz, Sides), Valida
             a
         })
     };
-    let (b, d) = (&sides.reference, &sides.test);
-    let box_vs_display = run(b, "box", d, "display", true)?;
-    let (box_vs_simulation, display_vs_simulation) = match &sides.simulation {
+    let (b, d) = (&sides.box_readings, &sides.display);
+    let display_vs_box = run(b, "box", d, "display", true)?;
+    let (simulation_vs_box, display_vs_simulation) = match &sides.simulation {
         Some(s) => (
             Some(run(b, "box", s, "simulation", false)?),
             Some(run(s, "simulation", d, "display", true)?),
@@ -304,8 +292,8 @@ fn assess_all(request: &Request<'_>) -> Result<(ReportInput, Xyz, Sides), Valida
     let mut report = ReportInput {
         title: request.title.clone(),
         white_source,
-        box_vs_display: Some(box_vs_display),
-        box_vs_simulation,
+        display_vs_box: Some(display_vs_box),
+        simulation_vs_box,
         display_vs_simulation,
         out_of_gamut: request.out_of_gamut.clone(),
         uncertainty,
@@ -315,16 +303,16 @@ fn assess_all(request: &Request<'_>) -> Result<(ReportInput, Xyz, Sides), Valida
         Context::Files => files_context(&mut report, &sides, request.check_readings),
         Context::Stages(sections) => stages_context(&mut report, &sides, sections),
     }
-    Ok((report, white, sides))
+    Ok((report, white))
 }
 
 /// Under [`Coverage::Same`]: box and display, box and simulation, simulation and display
 /// each read the same patches.
 fn same_patches(sides: &Sides) -> Result<(), ValidationError> {
-    let mut pairs = vec![(("box", &sides.reference), ("display", &sides.test))];
+    let mut pairs = vec![(("box", &sides.box_readings), ("display", &sides.display))];
     if let Some(s) = &sides.simulation {
-        pairs.push((("box", &sides.reference), ("simulation", s)));
-        pairs.push((("simulation", s), ("display", &sides.test)));
+        pairs.push((("box", &sides.box_readings), ("simulation", s)));
+        pairs.push((("simulation", s), ("display", &sides.display)));
     }
     for ((first, a), (second, b)) in pairs {
         let first_patches: Vec<usize> = a.patches.keys().copied().collect();
@@ -344,8 +332,8 @@ fn same_patches(sides: &Sides) -> Result<(), ValidationError> {
 fn choose_white(white: &White, sides: &Sides) -> Result<(Xyz, String), ValidationError> {
     let sets = sides.all();
     let (xyz, source) = match white {
-        White::Display => sides.test.white_or_brightest(),
-        White::Box => sides.reference.white_or_brightest(),
+        White::Display => sides.display.white_or_brightest(),
+        White::Box => sides.box_readings.white_or_brightest(),
         White::Given(v) => {
             metamer_color::check_xyz(*v)
                 .map_err(|e| ValidationError::GivenWhite(format!("not a white: {e}")))?;
@@ -366,11 +354,11 @@ fn files_context(report: &mut ReportInput, sides: &Sides, check: bool) {
     if check {
         report
             .notes
-            .extend(plausible::scale_note(&sides.reference, &sides.test));
+            .extend(plausible::scale_note(&sides.box_readings, &sides.display));
     }
     for (role, set) in [
-        ("box", Some(&sides.reference)),
-        ("display", Some(&sides.test)),
+        ("box", Some(&sides.box_readings)),
+        ("display", Some(&sides.display)),
         ("simulation", sides.simulation.as_ref()),
     ] {
         let Some(set) = set else { continue };
@@ -400,9 +388,9 @@ fn files_context(report: &mut ReportInput, sides: &Sides, check: bool) {
 /// [`Context::Stages`]: the gathered sections, the readings' counts and notes.
 fn stages_context(report: &mut ReportInput, sides: &Sides, sections: &Sections) {
     let sets = [
-        Some(&sides.reference),
+        Some(&sides.box_readings),
         sides.simulation.as_ref(),
-        Some(&sides.test),
+        Some(&sides.display),
     ];
     let mut inputs = sections.inputs.clone();
     for (input, set) in inputs.iter_mut().zip(sets) {

@@ -72,20 +72,20 @@ pub fn render_html(input: &ReportInput) -> String {
         h,
         "<p>CIELAB relative to the white X, Y, Z = {}; {}. ΔE*ab is CIE 1976, ΔE00 CIEDE2000; the JND is ΔE*ab {JND_DE76}. Intervals are 95 %: {}. A patch is <span class=\"below\">below</span> the JND only where its interval's upper end is below {JND_DE76}, <span class=\"above\">above</span> only where the lower end is above; otherwise <span class=\"undecided\">undecided</span>.</p>",
         input
-            .box_vs_display
+            .display_vs_box
             .as_ref()
-            .or(input.box_vs_simulation.as_ref())
+            .or(input.simulation_vs_box.as_ref())
             .map(|a| a.white.map(|v| format!("{v:.4}")).join(", "))
             .unwrap_or_default(),
         esc(&input.white_source),
         input
-            .box_vs_display
+            .display_vs_box
             .as_ref()
-            .or(input.box_vs_simulation.as_ref())
+            .or(input.simulation_vs_box.as_ref())
             .map(|a| esc(&a.propagation))
             .unwrap_or_default()
     );
-    if let Some(a) = &input.box_vs_display {
+    if let Some(a) = &input.display_vs_box {
         bars(
             &mut h,
             a,
@@ -94,7 +94,7 @@ pub fn render_html(input: &ReportInput) -> String {
         );
         planes(&mut h, a, "fig5");
     }
-    if let Some(a) = &input.box_vs_simulation {
+    if let Some(a) = &input.simulation_vs_box {
         bars(
             &mut h,
             a,
@@ -106,8 +106,8 @@ pub fn render_html(input: &ReportInput) -> String {
         bars(&mut h, a, "fig7", &format!("{} vs {}", a.test, a.reference));
     }
     for a in [
-        &input.box_vs_display,
-        &input.box_vs_simulation,
+        &input.display_vs_box,
+        &input.simulation_vs_box,
         &input.display_vs_simulation,
     ]
     .into_iter()
@@ -341,7 +341,7 @@ mod tests {
         let a = assessment();
         let mut input = ReportInput {
             title: "T <1>".into(),
-            box_vs_display: Some(a.clone()),
+            display_vs_box: Some(a.clone()),
             ..ReportInput::default()
         };
         let bare = render_html(&input);
@@ -350,7 +350,7 @@ mod tests {
         assert!(!bare.contains("id=\"fig6\"") && !bare.contains("display-model"));
         assert!(!bare.contains("<script"));
         assert!(bare.contains("outside the display's gamut (2 light skin)"));
-        input.box_vs_simulation = Some(a);
+        input.simulation_vs_box = Some(a);
         input.display_model = Some(DisplayModelSection {
             model: "lut".into(),
             ..Default::default()

@@ -8,17 +8,22 @@ use serde::{Deserialize, Serialize};
 use super::assess::Assessment;
 use super::readings::{ReadingSet, UncertaintySource};
 
-/// Everything a report can show. `box_vs_display` is the paper's result and always there;
-/// the rest is drawn when given.
+/// Everything a report can show. `display_vs_box` is the paper's result and always there;
+/// the rest is drawn when given. The comparisons are named test first, as everywhere; two
+/// keep their older serialized names (`box_vs_display`, `box_vs_simulation`), which
+/// `validation.json` has always used.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReportInput {
     pub title: String,
     /// How CIELAB's white was chosen (for the reader).
     pub white_source: String,
-    /// Fig. 4 and 5: the box against the display showing the rendering.
-    pub box_vs_display: Option<Assessment>,
-    /// Fig. 6: the box against the simulation.
-    pub box_vs_simulation: Option<Assessment>,
+    /// Fig. 4 and 5: the display showing the rendering, tested against the box.
+    #[serde(rename = "box_vs_display")]
+    pub display_vs_box: Option<Assessment>,
+    /// Fig. 6: the simulation tested against the box.
+    #[serde(rename = "box_vs_simulation")]
+    pub simulation_vs_box: Option<Assessment>,
+    /// The display tested against the simulation.
     pub display_vs_simulation: Option<Assessment>,
     pub display_model: Option<DisplayModelSection>,
     pub light_fit: Option<LightFitSection>,

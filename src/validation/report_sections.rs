@@ -298,8 +298,8 @@ fn described(a: &Assessment, reference: bool) -> String {
 /// One line per comparison: what its intervals contain, side by side.
 pub fn uncertainty_section(h: &mut String, input: &ReportInput) {
     let list: Vec<&Assessment> = [
-        &input.box_vs_display,
-        &input.box_vs_simulation,
+        &input.display_vs_box,
+        &input.simulation_vs_box,
         &input.display_vs_simulation,
     ]
     .into_iter()

@@ -145,12 +145,12 @@ pub fn median_width(a: &Assessment) -> f64 {
 /// The verdict on box vs display (HTML-escaped text), with the simulation's comparisons
 /// used to say where an error arises.
 pub fn verdict_paragraph(input: &ReportInput) -> Option<String> {
-    let a = input.box_vs_display.as_ref()?;
+    let a = input.display_vs_box.as_ref()?;
     Some(verdict_with(
         a,
         &input.out_of_gamut,
         (
-            input.box_vs_simulation.as_ref(),
+            input.simulation_vs_box.as_ref(),
             input.display_vs_simulation.as_ref(),
         ),
     ))
@@ -379,8 +379,8 @@ mod tests {
         assert_eq!(origin, Origin::Display);
         assert!((s - 0.5).abs() < 1e-9 && (d - 4.5).abs() < 1e-9, "{s} {d}");
         let input = ReportInput {
-            box_vs_display: Some(bd),
-            box_vs_simulation: Some(bs),
+            display_vs_box: Some(bd),
+            simulation_vs_box: Some(bs),
             display_vs_simulation: Some(sd),
             ..ReportInput::default()
         };
