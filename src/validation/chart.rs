@@ -1,149 +1,81 @@
-//! The paper's per-patch figure: ΔE*ab and ΔE00 of each ColorChecker patch as bars, with the
-//! JND line, as an SVG (text is SVG <text>, so no font files are needed).
+//! A comparison's ΔE chart as a file of its own (`STEM.svg` beside its CSV): the report's bar
+//! figure ([`delta_e_bars`]: ΔE*ab per patch coloured by its JND verdict, its 95 %
+//! interval, ΔE00, the JND line, colours outside the display's gamut on a grey band), so the
+//! file and the report draw one figure.
 
 use std::path::Path;
 
-use plotters::prelude::*;
-
-use super::assess::JND_DE76;
+use super::assess::Assessment;
 use super::error::ValidationError;
-use super::Comparison;
+use super::figures::delta_e_bars;
 use crate::output::OutputPolicy;
 
-/// Writes the per-patch ΔE chart of `comparison` to `file` (SVG) under the output policy
-/// `out`.
+/// Writes the ΔE chart of `assessment` to `file` (SVG) under the output policy `out`. Its
+/// title names the comparison and how many patches are below the JND by point estimate.
 pub fn write_delta_e_chart(
-    comparison: &Comparison,
+    assessment: &Assessment,
     file: &Path,
     out: &OutputPolicy,
 ) -> Result<(), ValidationError> {
-    write_delta_e_chart_shaded(comparison, &[], "", file, out)
-}
-
-/// [`write_delta_e_chart`] with the 1-based patches in `shaded` on a grey band labelled
-/// `shaded_label` in the legend (the lab marks the colours the display cannot show, so a
-/// reader sees at once which errors no display model could remove).
-pub fn write_delta_e_chart_shaded(
-    comparison: &Comparison,
-    shaded: &[usize],
-    shaded_label: &str,
-    file: &Path,
-    out: &OutputPolicy,
-) -> Result<(), ValidationError> {
-    let mut svg = String::new();
-    draw(comparison, shaded, shaded_label, file, &mut svg)?;
-    Ok(out.write(file, svg.as_bytes())?)
-}
-
-fn draw(
-    comparison: &Comparison,
-    shaded: &[usize],
-    shaded_label: &str,
-    file: &Path,
-    svg: &mut String,
-) -> Result<(), ValidationError> {
-    let chart_err = |e: &dyn std::fmt::Display| ValidationError::Chart {
-        file: file.to_path_buf(),
-        message: e.to_string(),
-    };
-    let n = comparison.patches.len();
-    let top = comparison
+    // A reading that is not a colour (the experiment's box readings of X = −1e308 once
+    // gave ΔE = inf) has no place on an axis; say so rather than draw nonsense.
+    if let Some(v) = assessment
         .patches
         .iter()
-        .map(|p| p.de76.max(p.de00))
-        .fold(JND_DE76, f64::max)
-        * 1.15;
-    // plotters looks for axis ticks on an infinite range without end.
-    if !top.is_finite() {
-        return Err(chart_err(&format!(
-            "a colour difference of {top} cannot be drawn: a reading is not a colour"
-        )));
+        .flat_map(|p| [p.de76, p.de00, p.de76_interval.lo, p.de76_interval.hi])
+        .find(|v| !v.is_finite())
+    {
+        return Err(ValidationError::Chart {
+            file: file.to_path_buf(),
+            message: format!(
+                "a colour difference of {v} cannot be drawn: a reading is not a colour"
+            ),
+        });
     }
-    let root = SVGBackend::with_string(svg, (900, 420)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| chart_err(&e))?;
-    let caption = format!(
-        "{} vs {}: ΔE per patch (CIELAB units); {} of {} below JND by point estimate",
-        comparison.test, comparison.reference, comparison.below_jnd_point, n
+    let head = format!(
+        "{} vs {} ({} of {} below the JND by point estimate)",
+        assessment.test,
+        assessment.reference,
+        assessment.below_jnd_point,
+        assessment.patches.len()
     );
-    let mut chart = ChartBuilder::on(&root)
-        .caption(caption, ("sans-serif", 18))
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(48)
-        .build_cartesian_2d(0.5f64..n as f64 + 0.5, 0.0..top)
-        .map_err(|e| chart_err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("ColorChecker patch")
-        .y_desc("ΔE (CIELAB units)")
-        .x_labels(n)
-        .x_label_formatter(&|x| format!("{}", x.round() as i64))
-        .disable_x_mesh()
-        .draw()
-        .map_err(|e| chart_err(&e))?;
-    if !shaded.is_empty() {
-        let band = RGBColor(200, 200, 200).mix(0.6).filled();
-        chart
-            .draw_series(shaded.iter().map(|&k| {
-                let x = k as f64;
-                Rectangle::new([(x - 0.45, 0.0), (x + 0.45, top)], band)
-            }))
-            .map_err(|e| chart_err(&e))?
-            .label(shaded_label)
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], band));
-    }
-    let bars = |offset: f64, pick: fn(&super::PatchComparison) -> f64, style: ShapeStyle| {
-        comparison.patches.iter().map(move |p| {
-            let x = p.patch as f64 + offset;
-            Rectangle::new([(x - 0.17, 0.0), (x + 0.17, pick(p))], style)
-        })
-    };
-    chart
-        .draw_series(bars(-0.18, |p| p.de76, BLUE.mix(0.7).filled()))
-        .map_err(|e| chart_err(&e))?
-        .label("ΔE*ab")
-        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], BLUE.mix(0.7).filled()));
-    chart
-        .draw_series(bars(0.18, |p| p.de00, RED.mix(0.6).filled()))
-        .map_err(|e| chart_err(&e))?
-        .label("ΔE00")
-        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], RED.mix(0.6).filled()));
-    chart
-        .draw_series(LineSeries::new(
-            [(0.5, JND_DE76), (n as f64 + 0.5, JND_DE76)],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(|e| chart_err(&e))?
-        .label("JND 2.3")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 12, y)], BLACK));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| chart_err(&e))?;
-    root.present().map_err(|e| chart_err(&e))?;
-    Ok(())
+    let svg = delta_e_bars(assessment, "chart", &head);
+    Ok(out.write(file, svg.as_bytes())?)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::color::Xyz;
-    use crate::validation::compare;
+    use crate::validation::assess::{compare_pairs, exact_side, PatchPair};
+    use crate::validation::propagate::Propagation;
+
+    /// `test` against `reference`, both taken as exact, the patches in `oog` marked as
+    /// outside the display's gamut.
+    fn exact(reference: &[Xyz], test: &[Xyz], oog: &[usize]) -> Assessment {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let pairs = reference
+            .iter()
+            .zip(test)
+            .enumerate()
+            .map(|(i, (r, t))| PatchPair {
+                patch: i + 1,
+                reference: exact_side(*r, white),
+                test: exact_side(*t, white),
+                out_of_gamut: oog.contains(&(i + 1)),
+            })
+            .collect();
+        compare_pairs("box", "display", pairs, white, Propagation::Linear)
+    }
 
     #[test]
     fn a_chart_of_an_infinite_difference_is_refused_at_once() {
-        let white = Xyz::new(95.047, 100.0, 108.883);
         let x = Xyz::new(10.0, 11.0, 12.0);
-        let mut c = compare("box", &[x], "display", &[x], white).unwrap();
-        // The experiment's box readings of X = −1e308 gave this, and plotters then
-        // searched an infinite axis for ticks without end.
-        c.patches[0].de76 = f64::INFINITY;
+        let mut a = exact(&[x], &[x], &[]);
+        a.patches[0].de76 = f64::INFINITY;
         let file = std::env::temp_dir().join(format!("metamer-inf-{}.svg", std::process::id()));
         let start = std::time::Instant::now();
-        let e = write_delta_e_chart(&c, &file, &crate::output::OutputPolicy::new(true))
+        let e = write_delta_e_chart(&a, &file, &OutputPolicy::new(true))
             .unwrap_err()
             .to_string();
         assert!(
@@ -155,8 +87,7 @@ mod tests {
     }
 
     #[test]
-    fn chart_has_two_bars_per_patch_and_the_jnd_line() {
-        let white = Xyz::new(95.047, 100.0, 108.883);
+    fn chart_has_a_bar_per_patch_its_interval_and_the_jnd_line() {
         let reference: Vec<Xyz> = (0..24)
             .map(|i| Xyz::new(10.0 + i as f64, 11.0 + i as f64, 12.0))
             .collect();
@@ -165,39 +96,27 @@ mod tests {
             .enumerate()
             .map(|(i, x)| x.scaled(1.0 + 0.01 * i as f64))
             .collect();
-        let c = compare("box", &reference, "display", &test, white).unwrap();
         let file = std::env::temp_dir().join(format!("metamer-chart-{}.svg", std::process::id()));
-        write_delta_e_chart(&c, &file, &crate::output::OutputPolicy::new(true)).unwrap();
+        let policy = OutputPolicy::new(true);
+        let a = exact(&reference, &test, &[]);
+        write_delta_e_chart(&a, &file, &policy).unwrap();
         let svg = std::fs::read_to_string(&file).unwrap();
-        write_delta_e_chart_shaded(
-            &c,
-            &[7, 16],
-            "out of gamut",
-            &file,
-            &crate::output::OutputPolicy::new(true),
-        )
-        .unwrap();
+        write_delta_e_chart(&exact(&reference, &test, &[7, 16]), &file, &policy).unwrap();
         let shaded = std::fs::read_to_string(&file).unwrap();
-        assert!(shaded.contains("out of gamut") && !svg.contains("out of gamut"));
-        assert_eq!(
-            shaded.matches("<rect").count(),
-            svg.matches("<rect").count() + 3,
-            "two bands and their legend key"
-        );
         if let Ok(dir) = std::env::var("METAMER_KEEP_CHART") {
-            std::fs::copy(&file, std::path::Path::new(&dir).join("chart.svg")).unwrap();
+            std::fs::copy(&file, Path::new(&dir).join("chart.svg")).unwrap();
         }
         std::fs::remove_file(&file).ok();
         assert!(svg.starts_with("<svg"));
-        // 48 bars + background rectangles; the caption carries the count.
-        assert!(
-            svg.matches("<rect").count() >= 48,
-            "{}",
-            svg.matches("<rect").count()
-        );
+        assert_eq!(svg.matches(r#"class="bar""#).count(), 24);
+        assert_eq!(svg.matches(r#"class="errorbar""#).count(), 24);
+        assert_eq!(svg.matches(r#"class="jnd""#).count(), 1);
+        assert!(svg.contains("JND 2.3") && svg.contains("outside the display's gamut"));
+        assert_eq!(svg.matches(r#"class="oog""#).count(), 0);
+        assert_eq!(shaded.matches(r#"class="oog""#).count(), 2, "two bands");
         assert!(svg.contains(&format!(
-            "{} of 24 below JND by point estimate",
-            c.below_jnd_point
+            "display vs box ({} of 24 below the JND by point estimate)",
+            a.below_jnd_point
         )));
     }
 }

@@ -1,13 +1,13 @@
 //! The comparisons as the experiment's validation stage keeps them for later runs and for
 //! `metamer lab`: `comparisons.json` (the three assessments with their intervals and
-//! verdicts) and, per comparison, its point estimates as CSV with a ΔE chart.
+//! verdicts) and, per comparison, its point estimates as CSV with its ΔE chart.
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use super::assess::Assessment;
-use super::chart::write_delta_e_chart_shaded;
+use super::chart::write_delta_e_chart;
 use super::compare::Comparison;
 use super::error::ValidationError;
 use crate::output::OutputPolicy;
@@ -38,25 +38,19 @@ pub const FILE: &str = "comparisons.json";
 pub const RESULT_VERSION: u32 = 2;
 
 /// The point estimates of `assessment`, `STEM.csv`, and its ΔE chart, `STEM.svg`, in
-/// `dir`, with the patches in `shaded` marked as outside the display's gamut. Returns the
-/// two file names.
+/// `dir`. Returns the two file names.
 pub(super) fn write_point_files(
     dir: &Path,
     stem: &str,
     assessment: &Assessment,
-    shaded: &[usize],
     policy: &OutputPolicy,
 ) -> Result<[String; 2], ValidationError> {
-    let c = Comparison::from(assessment);
     let csv = format!("{stem}.csv");
-    policy.write(&dir.join(&csv), c.to_csv().as_bytes())?;
-    let svg = format!("{stem}.svg");
-    write_delta_e_chart_shaded(
-        &c,
-        shaded,
-        "outside the display's gamut",
-        &dir.join(&svg),
-        policy,
+    policy.write(
+        &dir.join(&csv),
+        Comparison::from(assessment).to_csv().as_bytes(),
     )?;
+    let svg = format!("{stem}.svg");
+    write_delta_e_chart(assessment, &dir.join(&svg), policy)?;
     Ok([csv, svg])
 }

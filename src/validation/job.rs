@@ -207,13 +207,12 @@ pub fn validate(request: &Request<'_>) -> Result<Outcome, ValidationError> {
         &report.display_vs_simulation,
     ) {
         policy.dir(request.out)?;
-        let oog = &request.out_of_gamut[..];
-        for (stem, assessment, shaded) in [
-            ("display_vs_box", display_vs_box, oog),
-            ("simulation_vs_box", simulation_vs_box, &[][..]),
-            ("display_vs_simulation", display_vs_simulation, oog),
+        for (stem, assessment) in [
+            ("display_vs_box", display_vs_box),
+            ("simulation_vs_box", simulation_vs_box),
+            ("display_vs_simulation", display_vs_simulation),
         ] {
-            let names = write_point_files(request.out, stem, assessment, shaded, &policy)?;
+            let names = write_point_files(request.out, stem, assessment, &policy)?;
             files.extend(names.iter().map(|n| request.out.join(n)));
         }
         let r = ValidationResult {

@@ -35,7 +35,7 @@ pub mod uncertain;
 pub mod verdict;
 
 pub use assess::{assess, AssessOptions, Assessment, JndVerdict, PatchAssessment, JND_DE76};
-pub use chart::{write_delta_e_chart, write_delta_e_chart_shaded};
+pub use chart::write_delta_e_chart;
 pub use compare::{compare, Comparison, PatchComparison};
 pub use error::ValidationError;
 pub use export::write_report_files;

@@ -3,7 +3,8 @@
 //! grey band, and each patch's two readings as swatches. Two drawings of the same data:
 //! [`delta_e_bars`] with vertical bars for a wide page and print, [`delta_e_rows`] with one
 //! row per patch for a phone, where 24 bars side by side would need text too small to
-//! read. The page shows one or the other by its width.
+//! read. The page shows one or the other by its width; the wide one is also each
+//! comparison's chart file beside its CSV (the experiment's `display_vs_box.svg`, …).
 
 use std::fmt::Write;
 
