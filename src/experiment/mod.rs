@@ -20,7 +20,7 @@ mod preflight;
 mod products;
 mod progress;
 pub mod readings;
-pub mod report_sections;
+pub mod report_input;
 pub mod reproduction;
 mod request;
 mod run;

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::error::ExperimentError;
-use super::report_sections::{gather, Layout};
+use super::report_input::{gather, Layout};
 use crate::validation::job::{self, Context, Coverage, Request, White};
 use crate::validation::{AssessOptions, ReportInput, ValidationError};
 
@@ -122,7 +122,7 @@ pub fn validate(
 mod tests {
     use super::*;
     use crate::color::Xyz;
-    use crate::experiment::report_sections::RenderUncertainty;
+    use crate::experiment::report_input::RenderUncertainty;
     use crate::validation::assess;
     use crate::validation::propagate::{render_lab_sigma, Propagation, RenderStatement};
     use crate::validation::readings::{parse_readings, UncertaintySource};

@@ -29,8 +29,7 @@ pub mod plausible;
 pub mod propagate;
 pub mod readings;
 pub mod report;
-mod report_input;
-mod report_sections;
+mod report_data;
 pub mod uncertain;
 pub mod verdict;
 

@@ -1,8 +1,12 @@
 //! The validation report: one self-contained HTML page (inline CSS and SVG, no scripts, no
-//! network) with the paper's figures, the per-patch table and a verdict, plus the optional
-//! sections the experiment pipeline fills (display model, light distribution fit, render
-//! confidence, instruments, gamut flags; [`super::report_sections`]). Each optional section
-//! is drawn when present.
+//! network) drawn from one [`ReportInput`]: the paper's figures, the per-patch table and a
+//! verdict, plus the optional sections the experiment fills (display model, light
+//! distribution fit, render confidence, instruments, gamut flags; drawn by [`sections`]).
+//! Each optional section is drawn when present. What the experiment's stages produced is
+//! gathered elsewhere (`experiment::report_input`), into [`Sections`], the one type that
+//! crosses from the gathering to the validation.
+
+mod sections;
 
 use std::fmt::Write;
 
@@ -12,13 +16,13 @@ use super::figures::{
     OWN_COLOUR,
 };
 use super::readings::UncertaintySource;
-use super::report_sections::{
+use super::verdict::verdict_paragraph;
+use sections::{
     display_section, inputs_section, instruments_section, light_section, render_section,
     uncertainty_section,
 };
-use super::verdict::verdict_paragraph;
 
-pub use super::report_input::{
+pub use super::report_data::{
     DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
     RenderUncertainty, ReportInput, Sections,
 };

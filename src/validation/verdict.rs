@@ -9,7 +9,7 @@ use std::fmt::Write;
 use super::assess::{Assessment, JndVerdict, PatchAssessment, JND_DE76};
 use super::figures::{decisive, esc, interval_text};
 use super::readings::UncertaintySource;
-use super::report_input::ReportInput;
+use super::report_data::ReportInput;
 
 /// CIELAB lightness below which a ColorChecker patch counts as dark (the black, 24, is
 /// about L* 20; the darkest chromatic patches, blue 13 and dark skin 1, about 30–38).

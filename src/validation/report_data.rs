@@ -1,5 +1,7 @@
 //! What a validation report shows, as data: the comparisons and the optional sections a
-//! caller fills (the experiment fills them all, `validate` what its files hold).
+//! caller fills (the experiment fills them all, `validate` what its files hold). The report
+//! draws a [`ReportInput`] (`super::report`); the experiment gathers its stages' files into
+//! [`Sections`] (`experiment::report_input`), which the validation turns into one.
 
 use std::collections::BTreeMap;
 

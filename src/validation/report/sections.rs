@@ -1,13 +1,14 @@
-//! The report's optional sections as HTML: the display model, the light distribution fit,
-//! the renders' confidence, the instruments with their calibrations, the inputs, and what
-//! each comparison's intervals contain.
+//! Drawing the report's optional sections as HTML: the display model, the light
+//! distribution fit, the renders' confidence, the instruments with their calibrations, the
+//! inputs, and what each comparison's intervals contain. They draw what a
+//! [`ReportInput`] holds; nothing here reads a file.
 
 use std::fmt::Write;
 
-use super::assess::Assessment;
-use super::figures::esc;
-use super::readings::UncertaintySource;
-use super::report_input::{
+use crate::validation::assess::Assessment;
+use crate::validation::figures::esc;
+use crate::validation::readings::UncertaintySource;
+use crate::validation::report_data::{
     DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
     ReportInput,
 };

@@ -1,4 +1,6 @@
-//! The report's optional sections from what the earlier stages wrote: the display model
+//! Gathering the report's input from what the earlier stages wrote, as the one type the
+//! validation takes from the experiment ([`Sections`]; the validation draws it, with the
+//! comparisons, in `validation::report`): the display model
 //! (`display/summary.json`), the light distribution fit (`box/light.json`, `light.svg`,
 //! the scene's provenance), the renders' confidence (`simulation/simulation.json`), the
 //! instruments and every calibration (the box, display and display-spots journals), and
