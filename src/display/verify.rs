@@ -1,6 +1,9 @@
 //! Checking a profile against measured patches, typically ones it was not fitted to: the
 //! profile's forward prediction of each patch against its measured XYZ, in CIELAB relative
-//! to the profile's white.
+//! to the profile's white ([`ProfileVerification`], `metamer verify`'s result). The
+//! characterization's own check of its fitted model on its held-out patches is another
+//! job with its own result (`characterize::verify::HeldOutVerification`); both refuse a
+//! prediction that is no colour the same way ([`check_prediction`]).
 
 use serde::Serialize;
 
@@ -44,15 +47,20 @@ pub struct PatchError {
     pub de76: f64,
 }
 
-/// A profile's prediction errors on a set of patches.
+/// A profile's prediction errors on a set of patches: what `metamer verify` prints (its
+/// `--json` is this, serialized).
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Verification {
+pub struct ProfileVerification {
     pub patches: usize,
     pub de00: Stats,
     pub de76: Stats,
     /// The [`WORST_SHOWN`] largest ΔE00, largest first.
     pub worst: Vec<PatchError>,
 }
+
+/// The older name of [`ProfileVerification`], kept so `display::Verification` still names
+/// it.
+pub type Verification = ProfileVerification;
 
 /// Why patches cannot be verified.
 #[derive(Debug, thiserror::Error)]
@@ -97,7 +105,10 @@ pub fn check_prediction(
 }
 
 /// Predicts every patch with `profile` and compares with what was measured.
-pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verification, VerifyError> {
+pub fn verify_profile(
+    profile: &Profile,
+    patches: &[Sample],
+) -> Result<ProfileVerification, VerifyError> {
     if patches.is_empty() {
         return Err(VerifyError::NoSamples);
     }
@@ -140,7 +151,7 @@ pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verificat
     let de76: Vec<f64> = errors.iter().map(|e| e.de76).collect();
     errors.sort_by(|a, b| b.de00.total_cmp(&a.de00));
     errors.truncate(WORST_SHOWN);
-    Ok(Verification {
+    Ok(ProfileVerification {
         patches: patches.len(),
         de00: Stats::of(&de00),
         de76: Stats::of(&de76),
@@ -148,7 +159,7 @@ pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verificat
     })
 }
 
-impl std::fmt::Display for Verification {
+impl std::fmt::Display for ProfileVerification {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(f, "{} patches", self.patches)?;
         for (name, s) in [("ΔE00 ", &self.de00), ("ΔE*ab", &self.de76)] {

@@ -98,9 +98,12 @@ pub struct VerifiedPatch {
     pub delta_e00: f64,
 }
 
-/// ΔE00 of the model over the verification patches.
+/// The characterization's own check: ΔE00 of the model it fitted over the patches it held
+/// out of the fit, relative to the white it measured (the summary's `verification`). A
+/// profile checked against readings afterwards is `metamer verify`'s job
+/// ([`crate::display::verify::ProfileVerification`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Verification {
+pub struct HeldOutVerification {
     /// The measured white CIELAB is taken relative to, cd/m².
     pub white_xyz: [f64; 3],
     pub patches: Vec<VerifiedPatch>,
@@ -110,6 +113,10 @@ pub struct Verification {
     pub max: f64,
 }
 
+/// The older name of [`HeldOutVerification`], kept so `characterize::Verification` still
+/// names it.
+pub type Verification = HeldOutVerification;
+
 /// Compares `predict` (the model's forward direction, drive 0–1 → XYZ) with the measured
 /// verification patches of `patches`. None if there are none; an error if the model
 /// predicts a patch as no colour (the same check as `metamer verify`'s), which would
@@ -118,7 +125,7 @@ pub fn verify(
     patches: &[AveragedPatch],
     white_xyz: [f64; 3],
     predict: &dyn Fn([f64; 3]) -> [f64; 3],
-) -> Result<Option<Verification>, VerifyError> {
+) -> Result<Option<HeldOutVerification>, VerifyError> {
     let white = Xyz::from_array(white_xyz);
     let verified: Vec<VerifiedPatch> = patches
         .iter()
@@ -146,7 +153,7 @@ pub fn verify(
     let mut sorted: Vec<f64> = verified.iter().map(|v| v.delta_e00).collect();
     sorted.sort_by(f64::total_cmp);
     let mean = sorted.iter().sum::<f64>() / sorted.len() as f64;
-    Ok(Some(Verification {
+    Ok(Some(HeldOutVerification {
         white_xyz,
         mean,
         p95: percentile(&sorted, 0.95),

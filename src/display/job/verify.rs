@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use crate::display::verify::VerifyError;
+use crate::display::verify::{ProfileVerification, VerifyError};
 use crate::display::{
-    read_measurement_file, verify_profile, MeasurementsError, Profile, ProfileError, Verification,
+    read_measurement_file, verify_profile, MeasurementsError, Profile, ProfileError,
 };
 
 /// The profile and the patches to check it against.
@@ -21,7 +21,7 @@ pub struct Request {
 #[derive(Clone, Debug)]
 pub struct Report {
     pub profile: Profile,
-    pub verification: Verification,
+    pub verification: ProfileVerification,
 }
 
 /// A check failed.
