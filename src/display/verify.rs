@@ -58,10 +58,6 @@ pub struct ProfileVerification {
     pub worst: Vec<PatchError>,
 }
 
-/// The older name of [`ProfileVerification`], kept so `display::Verification` still names
-/// it.
-pub type Verification = ProfileVerification;
-
 /// Why patches cannot be verified.
 #[derive(Debug, thiserror::Error)]
 pub enum VerifyError {

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
-use super::verify::{average, usable, verify, Verification};
+use super::verify::{average, usable, verify, HeldOutVerification};
 use crate::display::model::{FitError, Sample};
 use crate::display::{fit_profile, write_ti3, ModelKind, ProfileError, Residuals};
 use crate::output::{OutputError, OutputPolicy};
@@ -73,7 +73,7 @@ pub struct Summary {
     /// The model against the patches it was fitted to.
     pub fit_residuals: Residuals,
     /// The model against the held-out patches (ΔE00 relative to the measured white).
-    pub verification: Verification,
+    pub verification: HeldOutVerification,
     pub files: Files,
 }
 

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 
 use crate::output::{OutputError, OutputPolicy};
 
-use super::verify::{AveragedPatch, Verification};
+use super::verify::{AveragedPatch, HeldOutVerification};
 
 /// The report could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
@@ -28,7 +28,7 @@ pub struct Report<'a> {
     pub patches: &'a [AveragedPatch],
     /// The fitted model, drive 0–1 → XYZ, drawn over the measured TRCs.
     pub forward: Option<&'a dyn Fn([f64; 3]) -> [f64; 3]>,
-    pub verification: Option<&'a Verification>,
+    pub verification: Option<&'a HeldOutVerification>,
 }
 
 /// The ramps: red, green, blue and grey, each with the drive mask it varies.
@@ -196,7 +196,7 @@ fn draw_chromaticity(
     Ok(())
 }
 
-fn draw_delta_e(area: &DrawingArea<SVGBackend, Shift>, v: &Verification) -> DrawResult {
+fn draw_delta_e(area: &DrawingArea<SVGBackend, Shift>, v: &HeldOutVerification) -> DrawResult {
     let n = v.patches.len();
     let top = v.patches.iter().map(|p| p.delta_e00).fold(1.0, f64::max) * 1.15;
     let mut chart = ChartBuilder::on(area)

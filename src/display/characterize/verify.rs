@@ -113,10 +113,6 @@ pub struct HeldOutVerification {
     pub max: f64,
 }
 
-/// The older name of [`HeldOutVerification`], kept so `characterize::Verification` still
-/// names it.
-pub type Verification = HeldOutVerification;
-
 /// Compares `predict` (the model's forward direction, drive 0–1 → XYZ) with the measured
 /// verification patches of `patches`. None if there are none; an error if the model
 /// predicts a patch as no colour (the same check as `metamer verify`'s), which would
