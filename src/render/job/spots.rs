@@ -24,7 +24,7 @@ use crate::render::method::{Method, Resolved, Solver};
 use crate::render::radiosity::RadiosityResult;
 use crate::render::radiosity::{render_spots_radiosity_solved, LastLevels, RadiosityOptions};
 use crate::render::scene::Scene;
-use crate::render::spot::{render_spots_with_progress, SpotOptions, SpotResult};
+use crate::render::spot::{render_spots_with_progress, RenderedReading, SpotOptions, SpotResult};
 
 /// What to render.
 #[derive(Clone, Debug)]
@@ -66,6 +66,40 @@ pub enum Readings {
         /// The options they were solved with.
         options: RadiosityOptions,
     },
+}
+
+impl Readings {
+    /// The 24 readings, each with the uncertainty its solver states.
+    pub fn patches(&self) -> &[RenderedReading] {
+        match self {
+            Readings::PathTracer(r) => &r.patches,
+            Readings::Radiosity { result, .. } => &result.patches,
+        }
+    }
+
+    /// The reference white the readings' CIELAB is against.
+    pub fn white(&self) -> [f64; 3] {
+        match self {
+            Readings::PathTracer(r) => r.white,
+            Readings::Radiosity { result, .. } => result.white,
+        }
+    }
+
+    /// Every patch reached the target.
+    pub fn converged(&self) -> bool {
+        match self {
+            Readings::PathTracer(r) => r.converged,
+            Readings::Radiosity { result, .. } => result.converged,
+        }
+    }
+
+    /// Seconds the readings took.
+    pub fn seconds(&self) -> f64 {
+        match self {
+            Readings::PathTracer(r) => r.seconds,
+            Readings::Radiosity { result, .. } => result.seconds,
+        }
+    }
 }
 
 /// The finished readings with the scene and method they came from.
