@@ -375,3 +375,97 @@ fn remove_stale(path: &Path) -> Result<(), ExperimentError> {
         _ => Ok(()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Xyz;
+
+    /// The start of a `simulation.json` written by an earlier version (a lab run's, cut to
+    /// two spots and one image patch).
+    const EARLIER: &str = r#"{
+  "method": "radiosity",
+  "white": [
+    14.752569875088737,
+    15.4187196485702,
+    15.810067120402415
+  ],
+  "converged": true,
+  "seconds": 32.753173086,
+  "spots": [
+    {
+      "patch": 1,
+      "XYZ": [
+        1.5783418452126645,
+        1.4400834689409334,
+        0.882098113629156
+      ],
+      "de_uncertainty": 0.0028757631715769874
+    },
+    {
+      "patch": 2,
+      "XYZ": [
+        5.532494095587725,
+        5.100170977107341,
+        3.3444075847054937
+      ],
+      "de_uncertainty": 0.010348447574333602
+    }
+  ],
+  "image": "image.exr",
+  "image_method": "radiosity",
+  "image_patches": [
+    {
+      "patch": 1,
+      "x": 0.2912743551336303,
+      "y": 0.0903687556485967,
+      "radius": 0.0316280169639935,
+      "pixels": 3308,
+      "XYZ": [
+        1.5782964125838364,
+        1.4400410561349812,
+        0.8820685059457193
+      ],
+      "de_vs_spot": 0.000520376134755653
+    }
+  ]
+}"#;
+
+    #[test]
+    fn an_earlier_summary_reads_as_readings_and_writes_back_the_same_bytes() {
+        let s: SimulationSummary = serde_json::from_str(EARLIER).unwrap();
+        assert_eq!(serde_json::to_string_pretty(&s).unwrap(), EARLIER);
+        let r = &s.spots[1];
+        assert_eq!((r.patch, r.xyz[1]), (2, 5.100170977107341));
+        assert_eq!(
+            r.uncertainty,
+            Uncertainty::Bound {
+                de: 0.010348447574333602,
+                regular: None
+            }
+        );
+        let lab = Xyz::from_array(r.xyz).to_lab(Xyz::from_array(s.white));
+        assert_eq!(r.lab, lab.to_array());
+        assert_eq!(s.image_patches.len(), 1);
+    }
+
+    #[test]
+    fn a_path_traced_summary_without_the_image_fields_reads_as_half_widths() {
+        let text = r#"{"method":"path tracer","white":[17.4,15.6,4.2],"converged":false,
+            "seconds":21.1,"spots":[{"patch":7,"XYZ":[2.26,1.62,0.24],"de_uncertainty":0.5}],
+            "image":null}"#;
+        let s: SimulationSummary = serde_json::from_str(text).unwrap();
+        assert_eq!(
+            s.spots[0].uncertainty,
+            Uncertainty::HalfWidth95 {
+                de: 0.5,
+                sampling: None
+            }
+        );
+        assert_eq!((s.image_method, s.image_patches.len()), (None, 0));
+        let e = serde_json::from_str::<SimulationSummary>(r#"{"method":"radiosity"}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing field `white`"), "{e}");
+    }
+}
