@@ -1,10 +1,12 @@
 //! The 24 simulated 1° meter readings of a scene to a ΔE*ab target: `metamer render spots`
-//! and the experiment's simulation stage, one entry for both.
+//! and the experiment's simulation stage, one entry for both. Either solver gives each
+//! patch as a [`RenderedReading`] whose uncertainty says which statement it is.
 //!
-//! ```no_run
+//! ```
 //! use metamer::render::job::spots::{run, SpotsRequest};
 //! use metamer::render::job::RenderEvent;
 //!
+//! // The built-in validation box: `auto` takes the radiosity solver there (about a second).
 //! let request = SpotsRequest { target_de: 0.2, ..SpotsRequest::default() };
 //! let report = run(&request, &|event| {
 //!     if let RenderEvent::Method(m) = event {
@@ -13,6 +15,10 @@
 //!         }
 //!     }
 //! })?;
+//! for r in report.readings.patches() {
+//!     println!("patch {}: L* {:.2} ± {:.3} ΔE*ab", r.patch, r.lab[0], r.uncertainty.de_ab());
+//! }
+//! assert_eq!(report.readings.patches().len(), 24);
 //! println!("{}", report.to_json()?);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -90,14 +96,6 @@ impl Readings {
         match self {
             Readings::PathTracer(r) => r.converged,
             Readings::Radiosity { result, .. } => result.converged,
-        }
-    }
-
-    /// Seconds the readings took.
-    pub fn seconds(&self) -> f64 {
-        match self {
-            Readings::PathTracer(r) => r.seconds,
-            Readings::Radiosity { result, .. } => result.seconds,
         }
     }
 }
