@@ -13,8 +13,8 @@ use metamer::render::job::{self, RenderError, RenderEvent};
 use metamer::render::method::{self, Solver};
 use metamer::render::probes::ProbeOptions;
 use metamer::render::radiosity::probes::ProbeProgress;
-use metamer::render::radiosity::RadiosityResult;
-use metamer::render::{Scene, SpotResult};
+use metamer::render::spot::Uncertainty;
+use metamer::render::Scene;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -245,10 +245,7 @@ fn spots(a: SpotsArgs) -> CliResult {
         return Ok(());
     }
     print_provenance(&report.scene);
-    match &report.readings {
-        Readings::PathTracer(r) => print_path_spots(r),
-        Readings::Radiosity { result, .. } => print_radiosity_spots(result),
-    }
+    print_spots(&report.readings);
     Ok(())
 }
 
@@ -259,62 +256,62 @@ fn print_provenance(scene: &Scene) {
     }
 }
 
-fn print_path_spots(r: &SpotResult) {
-    println!(
-        "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
-        r.white[0],
-        r.white[1],
-        r.white[2],
-        r.seconds,
-        if r.converged {
-            ""
-        } else {
-            "  (time limit: not converged)"
+/// The run's white and time, then one row per patch with its uncertainty as its solver
+/// states it (the path tracer's 95 % half-width and samples, the radiosity bound).
+fn print_spots(readings: &Readings) {
+    let w = readings.white();
+    match readings {
+        Readings::PathTracer(r) => {
+            println!(
+                "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
+                w[0],
+                w[1],
+                w[2],
+                r.seconds,
+                if r.converged {
+                    ""
+                } else {
+                    "  (time limit: not converged)"
+                }
+            );
+            println!(
+                "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>10}",
+                "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "samples"
+            );
         }
-    );
-    println!(
-        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>10}",
-        "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "samples"
-    );
-    for p in &r.patches {
-        println!(
-            "{:>5} {:>10.4} {:>10.4} {:>10.4} {:>8.3} {:>8.3} {:>8.3} {:>8.4} {:>10}",
-            p.patch,
-            p.xyz[0],
-            p.xyz[1],
-            p.xyz[2],
-            p.lab[0],
-            p.lab[1],
-            p.lab[2],
-            p.de_ci95,
-            p.samples
-        );
+        Readings::Radiosity { result: r, .. } => {
+            println!(
+                "radiosity: white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.2} s, {} levels{}",
+                w[0],
+                w[1],
+                w[2],
+                r.seconds,
+                r.levels.len(),
+                if r.converged {
+                    ""
+                } else {
+                    "  (level or time limit reached: bound above the target)"
+                }
+            );
+            println!(
+                "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>9}",
+                "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE bound"
+            );
+        }
     }
-}
-
-fn print_radiosity_spots(r: &RadiosityResult) {
-    println!(
-        "radiosity: white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.2} s, {} levels{}",
-        r.white[0],
-        r.white[1],
-        r.white[2],
-        r.seconds,
-        r.levels.len(),
-        if r.converged {
-            ""
-        } else {
-            "  (level or time limit reached: bound above the target)"
-        }
-    );
-    println!(
-        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>9}",
-        "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE bound"
-    );
-    for p in &r.patches {
-        println!(
-            "{:>5} {:>10.4} {:>10.4} {:>10.4} {:>8.3} {:>8.3} {:>8.3} {:>9.5}",
-            p.patch, p.xyz[0], p.xyz[1], p.xyz[2], p.lab[0], p.lab[1], p.lab[2], p.de_bound
+    for p in readings.patches() {
+        let ([x, y, z], [l, a, b]) = (p.xyz, p.lab);
+        let row = format!(
+            "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3}",
+            p.patch
         );
+        match p.uncertainty {
+            Uncertainty::HalfWidth95 { de, sampling } => {
+                let samples = sampling.map(|s| s.samples.to_string());
+                println!("{row} {de:>8.4} {:>10}", samples.unwrap_or_default());
+            }
+            Uncertainty::Bound { de, .. } => println!("{row} {de:>9.5}"),
+        }
     }
 }
 

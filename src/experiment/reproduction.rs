@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::cache::write_atomic;
 use super::error::ExperimentError;
-use super::simulation::{ImagePatch, SimSpot};
+use super::simulation::ImagePatch;
 use crate::display::gamut::GamutMapping;
 use crate::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use crate::display::Profile;
@@ -88,7 +88,7 @@ pub const IMAGE_FILE: &str = "display.png";
 pub fn reproduce(
     dir: &Path,
     profile: &Profile,
-    spots: &[SimSpot],
+    spots: &[crate::render::spot::RenderedReading],
     image: Option<(&Path, &[ImagePatch])>,
     opts: &ReproductionOptions,
 ) -> Result<(Reproduction, Vec<&'static str>), ExperimentError> {

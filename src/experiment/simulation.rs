@@ -21,7 +21,7 @@ use crate::render::job::image::{self, Film, RadiosityLight};
 use crate::render::job::spots::{self, Readings, SpotsReport, SpotsRequest};
 use crate::render::job::{RenderError, RenderEvent};
 use crate::render::method::Method;
-use crate::render::spot::patch_aim;
+use crate::render::spot::{patch_aim, RenderedReading, Uncertainty};
 use crate::render::Scene;
 use crate::validation::propagate::{render_lab_sigma, RenderStatement};
 
@@ -66,33 +66,98 @@ pub struct ImagePatch {
     pub de_vs_spot: f64,
 }
 
-/// One rendered spot reading.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct SimSpot {
-    pub patch: usize,
-    #[serde(rename = "XYZ")]
-    pub xyz: [f64; 3],
-    /// The render's ΔE*ab uncertainty for this patch (see [`SimulationOptions::target_de`]).
-    pub de_uncertainty: f64,
-}
-
 /// What `simulation/simulation.json` holds.
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(into = "SummaryFile", from = "SummaryFile")]
 pub struct SimulationSummary {
     pub method: String,
     /// The scene's reference white (a perfect diffuser in place of patch 19), cd/m².
     pub white: [f64; 3],
     pub converged: bool,
     pub seconds: f64,
-    pub spots: Vec<SimSpot>,
+    /// The rendered readings. The file keeps each one's patch, XYZ and ΔE*ab
+    /// (`de_uncertainty`, see [`SimulationOptions::target_de`]); read back, its CIELAB is
+    /// computed against `white` as the renderers compute it, and its kind of uncertainty
+    /// follows `method` (a bound for `radiosity`, else a 95 % half-width) without the
+    /// sampling or regularity, which the file does not record.
+    pub spots: Vec<RenderedReading>,
     /// `image.exr` when an image was rendered.
     pub image: Option<String>,
     /// How the image was rendered (`radiosity`, `path tracer`).
-    #[serde(default)]
     pub image_method: Option<String>,
     /// The patches' spots in the image, when an image was rendered.
-    #[serde(default)]
     pub image_patches: Vec<ImagePatch>,
+}
+
+/// `simulation.json` as written: field names, order and the old type names in serde's
+/// messages are the file's, so files of earlier runs read and new ones are the same bytes.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(rename = "SimulationSummary")]
+struct SummaryFile {
+    method: String,
+    white: [f64; 3],
+    converged: bool,
+    seconds: f64,
+    spots: Vec<SpotFile>,
+    image: Option<String>,
+    #[serde(default)]
+    image_method: Option<String>,
+    #[serde(default)]
+    image_patches: Vec<ImagePatch>,
+}
+
+/// One reading as `simulation.json` keeps it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(rename = "SimSpot")]
+struct SpotFile {
+    patch: usize,
+    #[serde(rename = "XYZ")]
+    xyz: [f64; 3],
+    de_uncertainty: f64,
+}
+
+impl From<SimulationSummary> for SummaryFile {
+    fn from(s: SimulationSummary) -> Self {
+        let spots = s.spots.iter().map(|r| SpotFile {
+            patch: r.patch,
+            xyz: r.xyz,
+            de_uncertainty: r.uncertainty.de_ab(),
+        });
+        SummaryFile {
+            method: s.method,
+            white: s.white,
+            converged: s.converged,
+            seconds: s.seconds,
+            spots: spots.collect(),
+            image: s.image,
+            image_method: s.image_method,
+            image_patches: s.image_patches,
+        }
+    }
+}
+
+impl From<SummaryFile> for SimulationSummary {
+    fn from(f: SummaryFile) -> Self {
+        let uncertainty = |de| match f.method.as_str() {
+            "radiosity" => Uncertainty::Bound { de, regular: None },
+            _ => Uncertainty::HalfWidth95 { de, sampling: None },
+        };
+        let spots = f
+            .spots
+            .iter()
+            .map(|s| RenderedReading::new(s.patch, s.xyz, f.white, uncertainty(s.de_uncertainty)))
+            .collect();
+        SimulationSummary {
+            method: f.method,
+            white: f.white,
+            converged: f.converged,
+            seconds: f.seconds,
+            spots,
+            image: f.image,
+            image_method: f.image_method,
+            image_patches: f.image_patches,
+        }
+    }
 }
 
 pub const SPOTS_FILE: &str = "spots.csv";
@@ -130,33 +195,21 @@ pub fn simulate(
     })
     .map_err(from_render)?;
     let scene = &report.scene;
-    let (method, white, converged, spots) = match &report.readings {
-        Readings::Radiosity { result: r, .. } => {
-            let spots = r.patches.iter().map(|p| SimSpot {
-                patch: p.patch,
-                xyz: p.xyz,
-                de_uncertainty: p.de_bound,
-            });
-            ("radiosity", r.white, r.converged, spots.collect::<Vec<_>>())
-        }
-        Readings::PathTracer(r) => {
-            let spots = r.patches.iter().map(|p| SimSpot {
-                patch: p.patch,
-                xyz: p.xyz,
-                de_uncertainty: p.de_ci95,
-            });
-            ("path tracer", r.white, r.converged, spots.collect())
-        }
+    let method = match report.readings {
+        Readings::Radiosity { .. } => "radiosity",
+        Readings::PathTracer(_) => "path tracer",
     };
+    let (white, converged) = (report.readings.white(), report.readings.converged());
+    let spots = report.readings.patches().to_vec();
     if let Some(bad) = spots.iter().find(|s| !s.xyz.iter().all(|v| v.is_finite())) {
         return Err(ExperimentError::NotFinite {
             what: format!("the rendered reading of patch {}", bad.patch),
         });
     }
-    if let Some(bad) = spots
-        .iter()
-        .find(|s| !(s.de_uncertainty.is_finite() && s.de_uncertainty >= 0.0))
-    {
+    if let Some(bad) = spots.iter().find(|s| {
+        let de = s.uncertainty.de_ab();
+        !(de.is_finite() && de >= 0.0)
+    }) {
         return Err(ExperimentError::NotFinite {
             what: format!("the render's uncertainty of patch {}", bad.patch),
         });
@@ -174,7 +227,7 @@ pub fn simulate(
     let stats: Vec<PatchStat> = spots
         .iter()
         .map(|s| PatchStat {
-            u_lab: render_lab_sigma(s.de_uncertainty, statement),
+            u_lab: render_lab_sigma(s.uncertainty.de_ab(), statement),
             ..PatchStat::of(s.patch, &[s.xyz])
         })
         .collect();
@@ -271,7 +324,7 @@ fn from_render(e: RenderError) -> ExperimentError {
 fn patches_in_image(
     scene: &Scene,
     img: &XyzImage,
-    spots: &[SimSpot],
+    spots: &[RenderedReading],
     white: [f64; 3],
 ) -> Result<Vec<ImagePatch>, ExperimentError> {
     let cam = scene
@@ -320,5 +373,99 @@ fn remove_stale(path: &Path) -> Result<(), ExperimentError> {
             source: e,
         }),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Xyz;
+
+    /// The start of a `simulation.json` written by an earlier version (a lab run's, cut to
+    /// two spots and one image patch).
+    const EARLIER: &str = r#"{
+  "method": "radiosity",
+  "white": [
+    14.752569875088737,
+    15.4187196485702,
+    15.810067120402415
+  ],
+  "converged": true,
+  "seconds": 32.753173086,
+  "spots": [
+    {
+      "patch": 1,
+      "XYZ": [
+        1.5783418452126645,
+        1.4400834689409334,
+        0.882098113629156
+      ],
+      "de_uncertainty": 0.0028757631715769874
+    },
+    {
+      "patch": 2,
+      "XYZ": [
+        5.532494095587725,
+        5.100170977107341,
+        3.3444075847054937
+      ],
+      "de_uncertainty": 0.010348447574333602
+    }
+  ],
+  "image": "image.exr",
+  "image_method": "radiosity",
+  "image_patches": [
+    {
+      "patch": 1,
+      "x": 0.2912743551336303,
+      "y": 0.0903687556485967,
+      "radius": 0.0316280169639935,
+      "pixels": 3308,
+      "XYZ": [
+        1.5782964125838364,
+        1.4400410561349812,
+        0.8820685059457193
+      ],
+      "de_vs_spot": 0.000520376134755653
+    }
+  ]
+}"#;
+
+    #[test]
+    fn an_earlier_summary_reads_as_readings_and_writes_back_the_same_bytes() {
+        let s: SimulationSummary = serde_json::from_str(EARLIER).unwrap();
+        assert_eq!(serde_json::to_string_pretty(&s).unwrap(), EARLIER);
+        let r = &s.spots[1];
+        assert_eq!((r.patch, r.xyz[1]), (2, 5.100170977107341));
+        assert_eq!(
+            r.uncertainty,
+            Uncertainty::Bound {
+                de: 0.010348447574333602,
+                regular: None
+            }
+        );
+        let lab = Xyz::from_array(r.xyz).to_lab(Xyz::from_array(s.white));
+        assert_eq!(r.lab, lab.to_array());
+        assert_eq!(s.image_patches.len(), 1);
+    }
+
+    #[test]
+    fn a_path_traced_summary_without_the_image_fields_reads_as_half_widths() {
+        let text = r#"{"method":"path tracer","white":[17.4,15.6,4.2],"converged":false,
+            "seconds":21.1,"spots":[{"patch":7,"XYZ":[2.26,1.62,0.24],"de_uncertainty":0.5}],
+            "image":null}"#;
+        let s: SimulationSummary = serde_json::from_str(text).unwrap();
+        assert_eq!(
+            s.spots[0].uncertainty,
+            Uncertainty::HalfWidth95 {
+                de: 0.5,
+                sampling: None
+            }
+        );
+        assert_eq!((s.image_method, s.image_patches.len()), (None, 0));
+        let e = serde_json::from_str::<SimulationSummary>(r#"{"method":"radiosity"}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing field `white`"), "{e}");
     }
 }

@@ -53,7 +53,7 @@ pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedPatch>, [f64; 3], f64)
     Ok((
         r.patches
             .iter()
-            .map(|p| (p.patch, p.xyz, p.de_bound))
+            .map(|p| (p.patch, p.xyz, p.uncertainty.de_ab()))
             .collect(),
         r.white,
         r.seconds,

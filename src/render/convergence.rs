@@ -190,7 +190,10 @@ pub fn radiosity_points(
     }
     let n = done.len();
     let (finest, fw) = combine(&done, &opts);
-    let reference_bound = finest.iter().map(|a| a.de_bound).fold(0.0, f64::max);
+    let reference_bound = finest
+        .iter()
+        .map(|a| a.uncertainty.de_ab())
+        .fold(0.0, f64::max);
     log(&format!(
         "radiosity reference: levels 1–{n}, its own bound ΔE*ab {reference_bound:.5}"
     ));
@@ -205,7 +208,7 @@ pub fn radiosity_points(
             .zip(&finest)
             .map(|(a, b)| delta_e76(lab(a.xyz, w), lab(b.xyz, fw)))
             .collect();
-        let bounds: Vec<f64> = r.iter().map(|a| a.de_bound).collect();
+        let bounds: Vec<f64> = r.iter().map(|a| a.uncertainty.de_ab()).collect();
         let elements = done[m - 1].elements as u64;
         for (name, v) in [(RADIOSITY_BOUND, &bounds), (RADIOSITY_TRUE, &errors)] {
             points.push(Point {

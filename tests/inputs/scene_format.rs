@@ -133,11 +133,11 @@ fn radiosity_agrees_with_the_path_tracer_on_an_asymmetric_box_with_tile_spectra(
         let lab = |v: [f64; 3]| Lab::new(v[0], v[1], v[2]);
         let de = delta_e76(lab(r.lab), lab(p.lab));
         assert!(
-            de < p.de_ci95 + r.de_bound,
+            de < p.uncertainty.de_ab() + r.uncertainty.de_ab(),
             "patch {}: ΔE*ab {de:.3} vs half-width {:.3} + bound {:.4}",
             r.patch,
-            p.de_ci95,
-            r.de_bound
+            p.uncertainty.de_ab(),
+            r.uncertainty.de_ab()
         );
     }
     let dy = rad.white[1] / path.white[1] - 1.0;

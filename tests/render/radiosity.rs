@@ -42,13 +42,18 @@ fn cross_check(file: &str) {
         let lab = |v: [f64; 3]| Lab::new(v[0], v[1], v[2]);
         let de = delta_e76(lab(r.lab), lab(p.lab));
         assert!(
-            de < p.de_ci95 + r.de_bound,
+            de < p.uncertainty.de_ab() + r.uncertainty.de_ab(),
             "{file} patch {}: ΔE*ab {de:.3} vs half-width {:.3} + bound {:.4}",
             r.patch,
-            p.de_ci95,
-            r.de_bound
+            p.uncertainty.de_ab(),
+            r.uncertainty.de_ab()
         );
-        assert!(r.de_bound < 0.1, "patch {}: bound {}", r.patch, r.de_bound);
+        assert!(
+            r.uncertainty.de_ab() < 0.1,
+            "patch {}: bound {}",
+            r.patch,
+            r.uncertainty.de_ab()
+        );
     }
     // The white itself: the same luminance within the path tracer's noise (its white is
     // refined to a third of the target, i.e. ≈ 0.2 % in Y at 2σ).

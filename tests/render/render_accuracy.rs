@@ -334,12 +334,13 @@ fn spot_readings_agree_across_seeds_within_their_confidence() {
     let w = Xyz::from_array(white);
     let mut worst: f64 = 0.0;
     for (pa, pb) in a.patches.iter().zip(&b.patches) {
-        assert!(pa.de_ci95 < 0.4 && pb.de_ci95 < 0.4);
+        assert!(pa.uncertainty.de_ab() < 0.4 && pb.uncertainty.de_ab() < 0.4);
         let de = delta_e76(
             Xyz::from_array(pa.xyz).to_lab(w),
             Xyz::from_array(pb.xyz).to_lab(w),
         );
-        let allowed = 2.0 * (pa.de_ci95.powi(2) + pb.de_ci95.powi(2)).sqrt();
+        let allowed =
+            2.0 * (pa.uncertainty.de_ab().powi(2) + pb.uncertainty.de_ab().powi(2)).sqrt();
         worst = worst.max(de / allowed);
         assert!(
             de < allowed,

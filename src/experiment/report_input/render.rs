@@ -34,21 +34,22 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
     if let Some(bad) = s
         .spots
         .iter()
-        .find(|p| !(p.de_uncertainty.is_finite() && p.de_uncertainty >= 0.0))
+        .find(|p| !(p.uncertainty.de_ab().is_finite() && p.uncertainty.de_ab() >= 0.0))
     {
         return Err(unusable(
             WHAT,
             &file,
             format!(
                 "gives patch {} the uncertainty {}",
-                bad.patch, bad.de_uncertainty
+                bad.patch,
+                bad.uncertainty.de_ab()
             ),
         ));
     }
     let per_patch: Vec<(usize, f64)> = s
         .spots
         .iter()
-        .map(|p| (p.patch, p.de_uncertainty))
+        .map(|p| (p.patch, p.uncertainty.de_ab()))
         .collect();
     let sigma_lab = per_patch
         .iter()

@@ -1,10 +1,12 @@
 //! The 24 simulated 1° meter readings of a scene to a ΔE*ab target: `metamer render spots`
-//! and the experiment's simulation stage, one entry for both.
+//! and the experiment's simulation stage, one entry for both. Either solver gives each
+//! patch as a [`RenderedReading`] whose uncertainty says which statement it is.
 //!
-//! ```no_run
+//! ```
 //! use metamer::render::job::spots::{run, SpotsRequest};
 //! use metamer::render::job::RenderEvent;
 //!
+//! // The built-in validation box: `auto` takes the radiosity solver there (about a second).
 //! let request = SpotsRequest { target_de: 0.2, ..SpotsRequest::default() };
 //! let report = run(&request, &|event| {
 //!     if let RenderEvent::Method(m) = event {
@@ -13,6 +15,10 @@
 //!         }
 //!     }
 //! })?;
+//! for r in report.readings.patches() {
+//!     println!("patch {}: L* {:.2} ± {:.3} ΔE*ab", r.patch, r.lab[0], r.uncertainty.de_ab());
+//! }
+//! assert_eq!(report.readings.patches().len(), 24);
 //! println!("{}", report.to_json()?);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -24,7 +30,7 @@ use crate::render::method::{Method, Resolved, Solver};
 use crate::render::radiosity::RadiosityResult;
 use crate::render::radiosity::{render_spots_radiosity_solved, LastLevels, RadiosityOptions};
 use crate::render::scene::Scene;
-use crate::render::spot::{render_spots_with_progress, SpotOptions, SpotResult};
+use crate::render::spot::{render_spots_with_progress, RenderedReading, SpotOptions, SpotResult};
 
 /// What to render.
 #[derive(Clone, Debug)]
@@ -66,6 +72,32 @@ pub enum Readings {
         /// The options they were solved with.
         options: RadiosityOptions,
     },
+}
+
+impl Readings {
+    /// The 24 readings, each with the uncertainty its solver states.
+    pub fn patches(&self) -> &[RenderedReading] {
+        match self {
+            Readings::PathTracer(r) => &r.patches,
+            Readings::Radiosity { result, .. } => &result.patches,
+        }
+    }
+
+    /// The reference white the readings' CIELAB is against.
+    pub fn white(&self) -> [f64; 3] {
+        match self {
+            Readings::PathTracer(r) => r.white,
+            Readings::Radiosity { result, .. } => result.white,
+        }
+    }
+
+    /// Every patch reached the target.
+    pub fn converged(&self) -> bool {
+        match self {
+            Readings::PathTracer(r) => r.converged,
+            Readings::Radiosity { result, .. } => result.converged,
+        }
+    }
 }
 
 /// The finished readings with the scene and method they came from.

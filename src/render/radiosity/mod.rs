@@ -7,8 +7,8 @@
 //! form factors and no visibility (the scene must be convex, which [`qualifies`] checks),
 //! solved per wavelength band. The meter gathers over its cone as the path tracer's spot
 //! mode does. Readings on three successive refinements are extrapolated (Richardson) and
-//! the extrapolations' disagreement is each patch's bound in ΔE*ab; the mesh is refined
-//! until every bound is below the target.
+//! the extrapolations' disagreement is each patch's bound in ΔE*ab (a [`RenderedReading`]
+//! with [`Uncertainty::Bound`]); the mesh is refined until every bound is below the target.
 
 pub mod bound;
 pub mod direct;
@@ -31,8 +31,7 @@ use self::mesh::{check_convex, elements, faces, Face, FaceKind, Mesh, MAX_ELEMEN
 use self::solve::{sources, Bands, SolveFailure};
 use super::deadline::Deadline;
 use super::scene::Scene;
-use super::spot::{patch_aim, SpotError};
-use crate::color::{Lab, Xyz};
+use super::spot::{patch_aim, RenderedReading, SpotError, Uncertainty};
 
 /// Why the solver cannot run on a scene.
 #[derive(Debug, thiserror::Error)]
@@ -133,27 +132,15 @@ pub struct Level {
     pub white: [f64; 3],
 }
 
-/// One reading with its bound.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct RadiosityReading {
-    pub patch: usize,
-    #[serde(rename = "XYZ")]
-    pub xyz: [f64; 3],
-    #[serde(rename = "Lab")]
-    pub lab: [f64; 3],
-    /// ΔE*ab between the estimate and its alternatives (see [`bound`]).
-    pub de_bound: f64,
-    /// The last levels converged monotonically: false means the bound is a rough figure.
-    pub regular: bool,
-}
-
 /// All readings of a radiosity run.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct RadiosityResult {
     pub white: [f64; 3],
     pub seconds: f64,
     pub levels: Vec<Level>,
-    pub patches: Vec<RadiosityReading>,
+    /// Each with its bound ([`Uncertainty::Bound`], with whether it is regular; see
+    /// [`bound`]).
+    pub patches: Vec<RenderedReading>,
     /// Every bound is below the target (false if `max_level` or `max_seconds` came first).
     pub converged: bool,
 }
@@ -429,7 +416,7 @@ pub fn render_spots_radiosity_solved(
     }
     let p = Prepared::new(scene)?;
     let mut levels: Vec<Level> = Vec::new();
-    let mut best: Option<(Vec<RadiosityReading>, [f64; 3])> = None;
+    let mut best: Option<(Vec<RenderedReading>, [f64; 3])> = None;
     // The solutions of the last two levels (coarser first), and of the two before the
     // last level when that one has to be dropped.
     let mut solutions: LastLevels = Vec::new();
@@ -471,16 +458,17 @@ pub fn render_spots_radiosity_solved(
             continue;
         }
         let (patches, white) = combine(&levels, opts);
-        if let Some(r) = patches
-            .iter()
-            .find(|r| !r.xyz.iter().chain(&r.lab).all(|x| x.is_finite()) || r.de_bound.is_nan())
-        {
+        if let Some(r) = patches.iter().find(|r| {
+            !r.xyz.iter().chain(&r.lab).all(|x| x.is_finite()) || r.uncertainty.de_ab().is_nan()
+        }) {
             return Err(RadiosityError::NonFinite {
                 patch: r.patch,
                 xyz: r.xyz,
             });
         }
-        let converged = patches.iter().all(|r| r.de_bound < opts.target_de);
+        let converged = patches
+            .iter()
+            .all(|r| r.uncertainty.de_ab() < opts.target_de);
         let out_of_time = deadline.passed();
         if converged || out_of_time || level >= opts.max_level.max(3) {
             return Ok((
@@ -499,7 +487,7 @@ pub fn render_spots_radiosity_solved(
 }
 
 /// Readings and bounds from the last levels (three, or four for the step check).
-pub fn combine(levels: &[Level], opts: &RadiosityOptions) -> (Vec<RadiosityReading>, [f64; 3]) {
+pub fn combine(levels: &[Level], opts: &RadiosityOptions) -> (Vec<RenderedReading>, [f64; 3]) {
     let last = &levels[levels.len().saturating_sub(4)..];
     let h: Vec<f64> = last.iter().map(|l| l.h_m).collect();
     let whites: Vec<[f64; 3]> = last.iter().map(|l| l.white).collect();
@@ -509,14 +497,11 @@ pub fn combine(levels: &[Level], opts: &RadiosityOptions) -> (Vec<RadiosityReadi
             let patch: Vec<[f64; 3]> = last.iter().map(|l| l.patches[k]).collect();
             let e = extrapolate(&patch, &whites, &h, opts.order, opts.white);
             white = e.white;
-            let lab: Lab = Xyz::from_array(e.xyz).to_lab(Xyz::from_array(e.white));
-            RadiosityReading {
-                patch: k + 1,
-                xyz: e.xyz,
-                lab: lab.to_array(),
-                de_bound: e.de_bound,
-                regular: e.regular,
-            }
+            let uncertainty = Uncertainty::Bound {
+                de: e.de_bound,
+                regular: Some(e.regular),
+            };
+            RenderedReading::new(k + 1, e.xyz, e.white, uncertainty)
         })
         .collect();
     (patches, white)

@@ -4,7 +4,9 @@
 //! batches until the 95 % confidence half-width of every patch's ΔE*ab falls below the
 //! target; the half-width is 1.96 times the RMS of ΔE*ab of the mean, propagated from the
 //! covariance of the mean XYZ through the Jacobian of CIELAB (the reference white is
-//! treated as exact).
+//! treated as exact). A reading of either renderer is a [`RenderedReading`] (`reading`).
+
+pub mod reading;
 
 use std::time::Instant;
 
@@ -15,7 +17,8 @@ use super::geometry::{Vec3, VecOps};
 use super::integrator::{Strategy, Tracer};
 use super::scene::Scene;
 use super::spectral::Rng;
-use crate::color::{Lab, Xyz};
+use crate::color::Xyz;
+pub use reading::{RenderedReading, Sampling, Uncertainty};
 
 /// Running sums of XYZ samples.
 #[derive(Clone, Copy, Debug, Default)]
@@ -194,26 +197,13 @@ impl Default for SpotOptions {
     }
 }
 
-/// One simulated reading.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct PatchReading {
-    pub patch: usize,
-    #[serde(rename = "XYZ")]
-    pub xyz: [f64; 3],
-    #[serde(rename = "XYZ_stderr")]
-    pub xyz_stderr: [f64; 3],
-    #[serde(rename = "Lab")]
-    pub lab: [f64; 3],
-    pub de_ci95: f64,
-    pub samples: u64,
-}
-
 /// All readings of a spot run.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SpotResult {
     pub white: [f64; 3],
     pub seconds: f64,
-    pub patches: Vec<PatchReading>,
+    /// Each with its 95 % half-width ([`Uncertainty::HalfWidth95`], with its sampling).
+    pub patches: Vec<RenderedReading>,
     /// Every patch reached the target (false if `max_seconds` ran out first).
     #[serde(skip)]
     pub converged: bool,
@@ -405,24 +395,22 @@ pub fn render_spots_with_progress(
         .iter()
         .enumerate()
         .map(|(k, st)| {
-            let xyz = st.mean();
-            let lab: Lab = Xyz::from_array(xyz).to_lab(white);
-            PatchReading {
-                patch: k + 1,
-                xyz,
-                xyz_stderr: st.stderr(),
-                lab: lab.to_array(),
-                de_ci95: st.de_ci95(white),
-                samples: st.n,
-            }
+            let uncertainty = Uncertainty::HalfWidth95 {
+                de: st.de_ci95(white),
+                sampling: Some(Sampling {
+                    xyz_stderr: st.stderr(),
+                    samples: st.n,
+                }),
+            };
+            RenderedReading::new(k + 1, st.mean(), white.to_array(), uncertainty)
         })
-        .collect::<Vec<PatchReading>>();
-    if let Some(p) = patches.iter().find(|p| {
+        .collect::<Vec<RenderedReading>>();
+    if let Some((p, _)) = patches.iter().zip(&stats).find(|(p, st)| {
         !p.xyz
             .iter()
             .chain(&p.lab)
-            .chain(&p.xyz_stderr)
-            .chain([&p.de_ci95])
+            .chain(&st.stderr())
+            .chain([&p.uncertainty.de_ab()])
             .all(|x| x.is_finite())
     }) {
         return Err(SpotError::NonFinite {
