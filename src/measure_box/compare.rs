@@ -10,6 +10,7 @@ use serde_json::Value;
 use super::scene::{build, BuildError};
 use crate::color::{Xyz, COLORCHECKER_NAMES};
 use crate::render::radiosity::{render_spots_radiosity, RadiosityError, RadiosityOptions};
+use crate::render::spot::RenderedReading;
 use crate::validation::{compare, Comparison, ValidationError};
 
 /// The render's accuracy target, ΔE*ab: far below the meter's noise (≈ 0.1 ΔE*ab).
@@ -38,32 +39,22 @@ pub enum CompareError {
     NoPatch(usize),
 }
 
-/// One patch rendered: (patch, XYZ in cd/m², the ΔE*ab bound).
-pub type RenderedPatch = (usize, [f64; 3], f64);
-
 /// The 24 readings of a scene file by the radiosity solver, its reference white and the
 /// seconds it took.
-pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedPatch>, [f64; 3], f64), CompareError> {
+pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedReading>, [f64; 3], f64), CompareError> {
     let scene = build(scene)?;
     let opts = RadiosityOptions {
         target_de: RENDER_TARGET_DE,
         ..RadiosityOptions::default()
     };
     let r = render_spots_radiosity(&scene, &opts, &|_| {})?;
-    Ok((
-        r.patches
-            .iter()
-            .map(|p| (p.patch, p.xyz, p.uncertainty.de_ab()))
-            .collect(),
-        r.white,
-        r.seconds,
-    ))
+    Ok((r.patches, r.white, r.seconds))
 }
 
 /// Compares `box_xyz` (patch, XYZ) with `rendered` in CIELAB relative to `white`.
 pub fn compare_readings(
     box_xyz: &[(usize, [f64; 3])],
-    rendered: &[RenderedPatch],
+    rendered: &[RenderedReading],
     white: [f64; 3],
     test: &str,
 ) -> Result<(Comparison, Vec<f64>), CompareError> {
@@ -73,11 +64,11 @@ pub fn compare_readings(
     for &(patch, xyz) in box_xyz {
         let r = rendered
             .iter()
-            .find(|r| r.0 == patch)
+            .find(|r| r.patch == patch)
             .ok_or(CompareError::NoPatch(patch))?;
         reference.push(Xyz::from_array(xyz));
-        test_xyz.push(Xyz::from_array(r.1));
-        bound.push(r.2);
+        test_xyz.push(Xyz::from_array(r.xyz));
+        bound.push(r.uncertainty.de_ab());
     }
     let mut c = compare("box", &reference, test, &test_xyz, Xyz::from_array(white))?;
     // compare() numbers patches by position; a plan may read only some of them.

@@ -14,6 +14,7 @@ use metamer::measure_box::compare::{compare_readings, render_scene};
 use metamer::measure_box::scene::{scene_json, BoxContents};
 use metamer::measure_box::BoxPlan;
 use metamer::render::scene::DistributionFile;
+use metamer::render::spot::{RenderedReading, Uncertainty};
 use metamer::rig::simulated_box::SimulatedBox;
 use metamer::rig::Scenario;
 use serde_json::Value;
@@ -196,15 +197,14 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
             )
         })
         .collect();
-    let truth_spots: Vec<(usize, [f64; 3], f64)> = truth
+    let truth_xyz: Vec<(usize, [f64; 3])> = truth
         .spots()
         .unwrap()
         .iter()
         .enumerate()
-        .map(|(i, &x)| (i + 1, x, 0.0))
+        .map(|(i, &x)| (i + 1, x))
         .collect();
     let (limited, _, _) = render_scene(&band_limited(&truth, &plan)).unwrap();
-    let truth_xyz: Vec<(usize, [f64; 3])> = truth_spots.iter().map(|t| (t.0, t.1)).collect();
     let (sys, _) = compare_readings(&truth_xyz, &limited, white, "band-limited").unwrap();
     let measured = &summary["render"]["comparison"]["patches"];
     let bounds = &summary["render"]["render_bound"];
@@ -243,16 +243,20 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
         String::from_utf8_lossy(&nominal.stderr)
     );
     let n: Value = serde_json::from_slice(&nominal.stdout).unwrap();
-    let nominal_xyz: Vec<(usize, [f64; 3], f64)> = n["patches"]
+    let nominal_xyz: Vec<RenderedReading> = n["patches"]
         .as_array()
         .unwrap()
         .iter()
         .map(|p| {
             let x = &p["XYZ"];
-            (
+            RenderedReading::new(
                 p["patch"].as_u64().unwrap() as usize,
                 [0, 1, 2].map(|i| x[i].as_f64().unwrap()),
-                0.0,
+                white,
+                Uncertainty::Bound {
+                    de: 0.0,
+                    regular: None,
+                },
             )
         })
         .collect();
