@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::error::ExperimentError;
 use super::progress::Progress;
-use super::readings::{write_readings, PatchStat};
+use super::readings::{write_readings, PatchReading};
 use crate::measure_box::setup::{self, BoxRig, RigError, RigRequest};
 use crate::measure_box::{self, BoxDetails, Instruments, Options, Outcome};
 use crate::output::OutputPolicy;
@@ -132,7 +132,7 @@ pub fn measure(
     // a spot read once carries the meter's stated repeatability. The meter's model is the
     // one it reports, not a guess from its spec: `replay:box-spots.jsonl` names none.
     let stated = Repeatability::emissive_of(&spot_model);
-    let stats: Vec<PatchStat> = summary
+    let stats: Vec<(usize, PatchReading)> = summary
         .spot_xyz
         .iter()
         .zip(summary.spots.iter())
@@ -142,13 +142,7 @@ pub fn measure(
                 (1, Some(c)) => c,
                 _ => r.stats.cov,
             };
-            PatchStat {
-                patch: *patch,
-                xyz: *xyz,
-                cov,
-                n,
-                u_lab: 0.0,
-            }
+            (*patch, PatchReading::stated(*xyz, cov, n, 0.0))
         })
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
