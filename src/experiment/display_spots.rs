@@ -195,12 +195,15 @@ pub struct SpotSession<'a> {
     pub run: &'a RunOptions,
 }
 
+/// Each patch's readings by patch number, and the files written.
+pub type Measured = (Vec<(usize, PatchReading)>, Vec<&'static str>);
+
 /// Shows and reads every patch into `dir`.
 pub fn measure(
     dir: &Path,
     s: &SpotSession<'_>,
     progress: &dyn Fn(Progress),
-) -> Result<(Vec<(usize, PatchReading)>, Vec<&'static str>), ExperimentError> {
+) -> Result<Measured, ExperimentError> {
     let SpotSession {
         setting,
         spot_spec,
