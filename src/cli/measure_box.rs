@@ -77,6 +77,9 @@ pub fn run(args: Args) -> CliResult {
             stop_after: args.stop_after,
             interrupt: Some(on_ctrl_c()),
         },
+        // Asked as the flags and the terminal say; the spots stay in summary.json.
+        attendance: None,
+        spot_readings: false,
     };
     let outcome = job::measure(&request, &|n| eprintln!("{n}…"), &mut |shown| {
         Box::new(BarProgress::new("reading").attended(shown))
@@ -99,6 +102,8 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
         MeasureBoxJobError::Nobody(e) => nobody_at_the_rig(e),
         MeasureBoxJobError::Rig(e) if e.is_request() => usage(e),
         MeasureBoxJobError::Rig(e) => CliError::from(e),
+        // Not asked for by the command (`spot_readings: false`).
+        MeasureBoxJobError::SpotReadings(e) => CliError::from(e),
         MeasureBoxJobError::Measure(e) => match e.advice() {
             Some(t) => CliError::Failed(t.into()),
             None => CliError::from(e),

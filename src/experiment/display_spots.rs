@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
 use super::progress::Progress;
-use super::readings::{write_readings, PatchStat};
+use super::readings::{write_readings, PatchReading};
 use super::reproduction::{PatchDrive, PatchRegion};
 use crate::rig::image::RgbImage;
 use crate::rig::{MeterAim, Placement, ScreenSpot};
@@ -195,12 +195,15 @@ pub struct SpotSession<'a> {
     pub run: &'a RunOptions,
 }
 
+/// Each patch's readings by patch number, and the files written.
+pub type Measured = (Vec<(usize, PatchReading)>, Vec<&'static str>);
+
 /// Shows and reads every patch into `dir`.
 pub fn measure(
     dir: &Path,
     s: &SpotSession<'_>,
     progress: &dyn Fn(Progress),
-) -> Result<(Vec<PatchStat>, Vec<&'static str>), ExperimentError> {
+) -> Result<Measured, ExperimentError> {
     let SpotSession {
         setting,
         spot_spec,
@@ -322,7 +325,7 @@ pub fn measure(
     let entries = session.complete_entries().unwrap_or_default();
     let readings: Vec<(usize, &metamer_drivers::Reading)> =
         entries.iter().map(|e| (e.data.patch, &e.reading)).collect();
-    let stats = PatchStat::group(&readings);
+    let stats = PatchReading::group(&readings);
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
     let text = serde_json::to_string_pretty(&record).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(RECORD_FILE), text.as_bytes())?;

@@ -1,6 +1,7 @@
-//! The box stage: the `measure-box` session into the experiment's `box/` directory, on the
-//! simulated truth box when both instruments are simulated, on the real box otherwise; its
-//! measured scene and spot readings are what the later stages read.
+//! The box stage: the box measured into the experiment's `box/` directory by the one call
+//! `metamer measure-box` makes too ([`crate::measure_box::job::measure`]), on the simulated
+//! truth box when both instruments are simulated, on the real box otherwise; its measured
+//! scene and spot readings are what the later stages read.
 
 use std::path::{Path, PathBuf};
 
@@ -9,13 +10,13 @@ use serde::Serialize;
 
 use super::error::ExperimentError;
 use super::progress::Progress;
-use super::readings::{write_readings, PatchStat};
-use crate::measure_box::setup::{self, BoxRig, RigError, RigRequest};
-use crate::measure_box::{self, BoxDetails, Instruments, Options, Outcome};
-use crate::output::OutputPolicy;
+use crate::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
+use crate::measure_box::setup::RigError;
+use crate::measure_box::{Outcome, PlanError};
 use crate::rig::Scenario;
-use crate::session::repeats::Repeatability;
-use crate::session::{Operator, RunOptions, StepProgress, TerminalOperator, Unattended};
+use crate::session::{Attendance, RunOptions, StepProgress};
+
+pub use crate::measure_box::job::SPOTS_FILE;
 
 /// How the box is measured.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -36,10 +37,44 @@ pub struct MeasureBox {
 }
 
 pub const SCENE_FILE: &str = "scene.json";
-pub const SPOTS_FILE: &str = "spots.csv";
 
 fn bad(message: impl std::fmt::Display) -> ExperimentError {
     ExperimentError::Box(message.to_string())
+}
+
+impl MeasureBox {
+    /// The box measurement the stage asks for in `dir`: every stage of the plan, into a
+    /// directory that is the stage's own, at the terminal unless `unattended` (the
+    /// experiment's request refused a real instrument with nobody at the rig before its
+    /// first stage), and the spots' readings file the later stages read.
+    pub fn request(
+        &self,
+        dir: &Path,
+        resume: bool,
+        unattended: bool,
+        run: &RunOptions,
+    ) -> MeasureBoxRequest {
+        MeasureBoxRequest {
+            out: dir.to_path_buf(),
+            spectral: self.spectral.to_string(),
+            spot: self.spot.to_string(),
+            plan: self.plan.clone(),
+            repeats: self.repeats,
+            resume,
+            stage: None,
+            seed: self.seed,
+            scenario: self.light.map(|l| l.name().to_string()),
+            force: true,
+            unattended,
+            run: run.clone(),
+            attendance: Some(if unattended {
+                Attendance::Unattended
+            } else {
+                Attendance::Terminal
+            }),
+            spot_readings: true,
+        }
+    }
 }
 
 /// Measures the box into `dir`; returns the files the later stages read.
@@ -51,135 +86,77 @@ pub fn measure(
     run: &RunOptions,
     progress: &dyn Fn(Progress),
 ) -> Result<Vec<String>, ExperimentError> {
-    let plan = setup::load_plan(m.plan.as_deref(), m.repeats).map_err(bad)?;
-    let request = RigRequest {
-        plan: &plan,
-        spectral: &m.spectral,
-        spot: &m.spot,
-        seed: m.seed,
-        light: m.light,
-    };
-    // `--unattended` at a terminal: nobody is there to press Enter.
-    let operator = || -> Box<dyn Operator> {
-        if unattended {
-            Box::new(Unattended)
-        } else {
-            Box::new(TerminalOperator)
-        }
-    };
-    let BoxRig {
-        mut spectral,
-        mut spot,
-        mut operator,
-        rig_options,
-        ..
-    } = setup::open(&request, operator, &|n| progress(Progress::Note(n))).map_err(|e| match e {
-        RigError::Open(e) => ExperimentError::from(e),
-        e => bad(e),
-    })?;
-    let spot_model = spot.info().model;
-    let mut output = OutputPolicy::new(true);
-    if let Some(p) = &m.plan {
-        output.input(p);
-    }
-    let options = Options {
-        output,
-        dir: dir.to_path_buf(),
-        plan,
-        stage: None,
-        resume,
-        rig_options,
-        details: BoxDetails {
-            spectral: m.spectral.to_string(),
-            spot: m.spot.to_string(),
-        },
-        run: run.clone(),
-    };
-    let mut sink = |p: &StepProgress<'_>| {
-        progress(Progress::Readings {
-            done: p.done,
-            total: p.total,
+    let request = m.request(dir, resume, unattended, run);
+    let outcome = job::measure(&request, &|n| progress(Progress::Note(n)), &mut |_| {
+        Box::new(move |p: &StepProgress<'_>| {
+            progress(Progress::Readings {
+                done: p.done,
+                total: p.total,
+            })
         })
-    };
-    let outcome = measure_box::run(
-        &options,
-        Instruments {
-            spectral: spectral.as_mut(),
-            spot: spot.as_mut(),
-        },
-        operator.as_mut(),
-        &mut sink,
-    )
-    .map_err(bad)?;
-    let summary = match outcome {
-        Outcome::Finished(summary) => summary,
+    })
+    .map_err(stage_error)?;
+    match outcome {
+        Outcome::Finished(_) => Ok(["scene.json", "light.json", "summary.json", SPOTS_FILE]
+            .into_iter()
+            .map(String::from)
+            .collect()),
         Outcome::Incomplete {
             done, total, log, ..
-        } => {
-            return Err(ExperimentError::Incomplete {
-                stage: "box",
-                done,
-                total,
-                journal: log,
-            })
-        }
+        } => Err(ExperimentError::Incomplete {
+            stage: "box",
+            done,
+            total,
+            journal: log,
+        }),
         Outcome::StagesMissing(stages) => {
             let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
-            return Err(bad(format!("stage(s) {} not measured", names.join(", "))));
+            Err(bad(format!("stage(s) {} not measured", names.join(", "))))
         }
-    };
-    // Each spot's scatter in X, Y and Z together, over the repeats the reduction kept;
-    // a spot read once carries the meter's stated repeatability. The meter's model is the
-    // one it reports, not a guess from its spec: `replay:box-spots.jsonl` names none.
-    let stated = Repeatability::emissive_of(&spot_model);
-    let stats: Vec<PatchStat> = summary
-        .spot_xyz
-        .iter()
-        .zip(summary.spots.iter())
-        .map(|((patch, xyz), r)| {
-            let n = r.stats.n - r.stats.outliers.len();
-            let cov = match (n, stated.and_then(|s| s.covariance(*xyz))) {
-                (1, Some(c)) => c,
-                _ => r.stats.cov,
-            };
-            PatchStat {
-                patch: *patch,
-                xyz: *xyz,
-                cov,
-                n,
-                u_lab: 0.0,
-            }
-        })
-        .collect();
-    write_readings(&dir.join(SPOTS_FILE), &stats)?;
-    Ok(["scene.json", "light.json", "summary.json", SPOTS_FILE]
-        .into_iter()
-        .map(String::from)
-        .collect())
+    }
+}
+
+/// The measurement's failures in the stage's words: an instrument's and the readings
+/// file's as they are, the rest as the box measurements'.
+fn stage_error(e: MeasureBoxJobError) -> ExperimentError {
+    match e {
+        MeasureBoxJobError::Rig(RigError::Open(e)) => e.into(),
+        MeasureBoxJobError::SpotReadings(e) => e.into(),
+        // Told apart from a bad plan file for the command's `--repeats`; the stage says it
+        // as the plan's check does.
+        MeasureBoxJobError::Repeats(message) => bad(PlanError::Invalid {
+            field: "repeats".into(),
+            message,
+        }),
+        e => bad(e),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A replayed CS-100A whose file name says nothing of the model: the spec names no
-    /// meter, the opened instrument does, and its stated repeatability is the CS-100A's.
+    /// The stage asks for every stage of the plan, replaces what its directory holds,
+    /// writes the spots' readings and asks at the terminal unless unattended.
     #[test]
-    fn a_replayed_meter_is_known_by_the_model_it_reports() {
-        let dir = std::env::temp_dir().join(format!("metamer-box-stage-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("spot.jsonl");
-        let transcript = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/protocols/cs100a/transcripts/normal_session.jsonl"
-        );
-        std::fs::copy(transcript, &file).unwrap();
-        let spec = Spec::replay(&file);
-        assert!(Repeatability::emissive_of(spec.as_str()).is_none());
-        let meter = spec.open(None).unwrap();
-        let stated = Repeatability::emissive_of(&meter.info().model).unwrap();
-        let cs100a = Repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
-        assert_eq!(stated, cs100a);
-        std::fs::remove_dir_all(&dir).unwrap();
+    fn the_stage_asks_the_one_measurement_for_its_own_behaviour() {
+        let m = MeasureBox {
+            spectral: Spec::new("sim:i1pro?time_scale=0"),
+            spot: Spec::new("sim:cs100a?time_scale=0"),
+            plan: None,
+            repeats: Some(1),
+            seed: 3,
+            light: Some(Scenario::default()),
+        };
+        let dir = Path::new("box");
+        let r = m.request(dir, false, false, &RunOptions::default());
+        assert_eq!(r.stage, None);
+        assert!(r.force && r.spot_readings);
+        assert_eq!(r.attendance, Some(Attendance::Terminal));
+        assert_eq!(r.scenario.as_deref(), Some(Scenario::default().name()));
+        assert_eq!((r.spectral.as_str(), r.seed), ("sim:i1pro?time_scale=0", 3));
+        let r = m.request(dir, true, true, &RunOptions::default());
+        assert_eq!(r.attendance, Some(Attendance::Unattended));
+        assert!(r.resume);
     }
 }

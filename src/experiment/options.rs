@@ -11,6 +11,7 @@ use super::reproduction::ReproductionOptions;
 use super::simulation::SimulationOptions;
 use super::stage::Stage;
 use crate::session::RunOptions;
+use crate::validation::readings::ReadingSet;
 
 /// Where the box's measurements come from.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -26,6 +27,11 @@ pub enum BoxSource {
 pub struct ExperimentOptions {
     pub dir: PathBuf,
     pub box_source: BoxSource,
+    /// A given box's spot readings as [`Request`](super::Request) read them in its checks,
+    /// so the checks before the first stage use them rather than read the file again.
+    /// None for a measured box, or for options made without a request: those checks
+    /// then read the file themselves.
+    pub given_readings: Option<ReadingSet>,
     pub simulation: SimulationOptions,
     pub display: DisplayOptions,
     pub reproduction: ReproductionOptions,

@@ -7,7 +7,7 @@ use std::path::Path;
 use super::error::ExperimentError;
 use super::measure_box::MeasureBox;
 use super::options::{BoxSource, ExperimentOptions};
-use super::readings::read_readings;
+use super::readings::{read_readings, ReadingSet};
 use super::stage::Stage;
 use crate::measure_box::BoxPlan;
 use crate::render::Scene;
@@ -20,7 +20,9 @@ pub fn check(opts: &ExperimentOptions) -> Result<(), ExperimentError> {
     given_files_outside_stages(opts)?;
     match &opts.box_source {
         BoxSource::Measure(m) => measured_box(m),
-        BoxSource::Existing { scene, spots } => given_box(scene, spots),
+        BoxSource::Existing { scene, spots } => {
+            given_box(scene, spots, opts.given_readings.as_ref())
+        }
     }
 }
 
@@ -82,14 +84,27 @@ fn shown(plan: Option<&Path>) -> String {
         .unwrap_or_default()
 }
 
-/// A given box's readings must hold the patches its scene has, which are those the
-/// simulation renders and the validation compares.
-fn given_box(scene: &Path, spots: &Path) -> Result<(), ExperimentError> {
+/// A given box's readings (`given`: as the request's checks read them, else read here, by
+/// the validation's reader either way) must hold the patches its scene has, which are
+/// those the simulation renders and the validation compares. Whatever else the validation
+/// stage needs of the file its reader checks: patches 1–24 (or `white`), finite and
+/// plausible values; a repeated row is a repeat of its patch.
+fn given_box(
+    scene: &Path,
+    spots: &Path,
+    given: Option<&ReadingSet>,
+) -> Result<(), ExperimentError> {
     let s = Scene::load(scene)?;
     let in_scene: Vec<usize> = (1..=24).filter(|&k| s.patch_surface(k).is_some()).collect();
-    let mut read: Vec<usize> = read_readings(spots)?.iter().map(|p| p.patch).collect();
-    read.sort_unstable();
-    read.dedup();
+    let read_here;
+    let set = match given {
+        Some(set) => set,
+        None => {
+            read_here = read_readings(spots)?;
+            &read_here
+        }
+    };
+    let read: Vec<usize> = set.patches.keys().copied().collect();
     if read != in_scene {
         return Err(ExperimentError::GivenPatchesDiffer {
             spots: spots.to_path_buf(),

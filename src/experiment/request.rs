@@ -11,7 +11,7 @@ use super::error::ExperimentError;
 use super::measure_box::MeasureBox;
 use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
-use super::readings::{read_readings, ReadingsError};
+use super::readings::{read_readings, ReadingSet, ReadingsError};
 use super::reproduction::ReproductionOptions;
 use super::run::{run, StageOutcome};
 use super::simulation::SimulationOptions;
@@ -238,7 +238,7 @@ impl Request {
             }
         }
         check_dir(&self.dir)?;
-        self.check_inputs()?;
+        let given_readings = self.check_inputs()?;
         let box_source = match &self.box_source {
             BoxRequest::Given { scene, spots } => BoxSource::Existing {
                 scene: scene.clone(),
@@ -272,6 +272,7 @@ impl Request {
         Ok(ExperimentOptions {
             dir: self.dir.clone(),
             box_source,
+            given_readings,
             simulation: self.simulation.clone(),
             display: self.display.clone(),
             reproduction: self.reproduction.clone(),
@@ -284,22 +285,26 @@ impl Request {
     }
 
     /// What the stages would read or open only after minutes of rendering and measuring:
-    /// a given box's scene and readings, and the instruments' specs.
-    fn check_inputs(&self) -> Result<(), RequestError> {
+    /// a given box's scene and readings, and the instruments' specs. Returns a given box's
+    /// readings as read, for the checks before the first stage.
+    fn check_inputs(&self) -> Result<Option<ReadingSet>, RequestError> {
         let mut specs = vec![&self.display.spot];
+        let mut given = None;
         match &self.box_source {
             BoxRequest::Given { scene, spots } => {
                 Scene::load(scene)?;
-                // The reader refuses readings no instrument takes (X = −1e308 made every
-                // stage run and the validation draw an infinite colour difference).
-                read_readings(spots)?;
+                // Read by the reader the validation stage reads them with, so a file is
+                // accepted here exactly when that stage will accept it; the reader
+                // refuses readings no instrument takes (X = −1e308 made every stage run
+                // and the validation draw an infinite colour difference).
+                given = Some(read_readings(spots)?);
             }
             BoxRequest::Measure { spectral, spot, .. } => specs.extend([spectral, spot]),
         }
         for spec in specs {
             spec.check()?;
         }
-        Ok(())
+        Ok(given)
     }
 }
 

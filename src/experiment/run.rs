@@ -365,6 +365,7 @@ mod tests {
         ExperimentOptions {
             dir: dir.to_path_buf(),
             box_source: BoxSource::Existing { scene, spots },
+            given_readings: None,
             simulation: SimulationOptions {
                 target_de: 0.5,
                 seed: 1,

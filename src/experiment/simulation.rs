@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::ExperimentError;
 use super::progress::Progress;
-use super::readings::{write_readings, PatchStat};
+use super::readings::{write_readings, PatchReading};
 use crate::color::{delta_e76, Xyz};
 use crate::output::OutputPolicy;
 use crate::render::image::{spot_mean, Frame};
@@ -224,11 +224,11 @@ pub fn simulate(
         "radiosity" => RenderStatement::Bound,
         _ => RenderStatement::HalfWidth95,
     };
-    let stats: Vec<PatchStat> = spots
+    let stats: Vec<(usize, PatchReading)> = spots
         .iter()
-        .map(|s| PatchStat {
-            u_lab: render_lab_sigma(s.uncertainty.de_ab(), statement),
-            ..PatchStat::of(s.patch, &[s.xyz])
+        .map(|s| {
+            let u_lab = render_lab_sigma(s.uncertainty.de_ab(), statement);
+            (s.patch, PatchReading::rendered(s.xyz, u_lab))
         })
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;

@@ -1,7 +1,15 @@
-//! `metamer measure-box`'s whole job as one library call: the plan loaded, the rig checked
-//! and opened ([`super::setup`]), the stages measured and the scene written
-//! ([`super::run`]). Everything that can be refused without an instrument is refused
-//! before one is opened.
+//! The box measurement as one library call, [`measure`]: `metamer measure-box` and the
+//! experiment's box stage both make it. The plan loaded, the rig checked and opened
+//! ([`super::setup`]), the stages measured and the scene written ([`super::run`]), and for
+//! the experiment each spot's readings as the file its later stages read. Everything that
+//! can be refused without an instrument is refused before one is opened.
+//!
+//! Where the command and the stage behave differently, the difference is a field of
+//! [`MeasureBoxRequest`] that each sets: [`MeasureBoxRequest::attendance`] (who answers a
+//! real rig), [`MeasureBoxRequest::spot_readings`] (the stage's `spots.csv`),
+//! [`MeasureBoxRequest::force`] (the stage's directory is its own) and
+//! [`MeasureBoxRequest::stage`] (the command may measure one stage). Progress and notes
+//! are the caller's callbacks; a failure is a [`MeasureBoxJobError`] each words itself.
 
 use std::path::PathBuf;
 
@@ -10,9 +18,15 @@ use metamer_drivers::Spec;
 use super::plan::{BoxPlan, PlanError, Stage};
 use super::run::{run, Instruments, MeasureBoxError, Options, Outcome};
 use super::setup::{self, BoxLightError, RigError, RigRequest};
-use super::BoxDetails;
+use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
+use crate::session::repeats::Repeatability;
 use crate::session::{attendance, Attendance, NobodyAtTheRig, ProgressSink, RunOptions};
+use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
+
+/// The spots' readings file in the output directory, with
+/// [`MeasureBoxRequest::spot_readings`].
+pub const SPOTS_FILE: &str = "spots.csv";
 
 /// What `measure-box` is asked to do.
 #[derive(Clone, Debug, Default)]
@@ -30,18 +44,33 @@ pub struct MeasureBoxRequest {
     /// Continue the journals in `out`.
     pub resume: bool,
     /// Only this stage, by name (tiles, falloff, materials, spots). A name, not a
-    /// [`Stage`], because it is checked after the plan, as the command always did.
+    /// [`Stage`], because it is checked after the plan, as the command always did. The
+    /// experiment's box stage measures them all (None).
     pub stage: Option<String>,
     /// Seed of the simulated box and its instruments' noise.
     pub seed: u64,
     /// The simulated box's light, by name; checked once the rig is known to be simulated.
     pub scenario: Option<String>,
-    /// Replace an existing scene, light files or summary in `out`.
+    /// Replace an existing scene, light files or summary in `out`: the command's
+    /// `--force`; the experiment's box stage always, as its directory is its own.
     pub force: bool,
     /// Nobody is at the rig: take every reading without asking anyone.
     pub unattended: bool,
     /// When to stop early (a reading count, a Ctrl-C flag).
     pub run: RunOptions,
+    /// Who answers a real rig's requests to place, aim and calibrate the instruments (a
+    /// simulated box answers for itself). None: as [`attendance`] decides from
+    /// [`unattended`](Self::unattended), the specs and whether stdin is a terminal, a
+    /// physical instrument with nobody to ask refused (`measure-box`). Some: as the caller
+    /// decided and checked (the experiment's box stage: the terminal unless unattended,
+    /// its request having refused a physical instrument with nobody at the rig).
+    pub attendance: Option<Attendance>,
+    /// Also write [`SPOTS_FILE`] in `out` once the box is measured: each spot's mean, one
+    /// reading's covariance over the repeats kept (a spot read once: the meter's stated
+    /// repeatability) and their count, the readings file the experiment's later stages
+    /// and `validate` read. The experiment's box stage sets it; `measure-box` leaves the
+    /// spots in `summary.json`.
+    pub spot_readings: bool,
 }
 
 /// Why [`measure`] did not finish. Each refusal of the request has its own variant, so a
@@ -65,6 +94,9 @@ pub enum MeasureBoxJobError {
     Rig(#[from] RigError),
     #[error(transparent)]
     Measure(#[from] MeasureBoxError),
+    /// The spots' readings file ([`MeasureBoxRequest::spot_readings`]) was not written.
+    #[error(transparent)]
+    SpotReadings(#[from] ReadingsError),
 }
 
 /// Measures the box `request` names: what its journals lack, then, when every stage is
@@ -97,10 +129,10 @@ pub enum MeasureBoxJobError {
 /// assert!(out.join("tiles.jsonl").exists());
 /// # std::fs::remove_dir_all(&out).unwrap();
 /// ```
-pub fn measure(
+pub fn measure<'p>(
     request: &MeasureBoxRequest,
     note: &dyn Fn(String),
-    progress: &mut dyn FnMut(bool) -> Box<dyn ProgressSink>,
+    progress: &mut dyn FnMut(bool) -> Box<dyn ProgressSink + 'p>,
 ) -> Result<Outcome, MeasureBoxJobError> {
     let plan = plan(request)?;
     let stage: Option<Stage> = request
@@ -116,7 +148,10 @@ pub fn measure(
     let simulated = setup::is_simulated(&spectral, &spot)?;
     let light = setup::box_light(request.scenario.as_deref(), simulated)?;
     // Before anything is opened: a real rig with nobody to ask is refused.
-    let attended = attendance(&[&request.spectral, &request.spot], request.unattended)?;
+    let attended = match request.attendance {
+        Some(a) => a,
+        None => attendance(&[&request.spectral, &request.spot], request.unattended)?,
+    };
     let rig_request = RigRequest {
         plan: &plan,
         spectral: &spectral,
@@ -142,8 +177,11 @@ pub fn measure(
         },
         run: request.run.clone(),
     };
+    // The model the meter reports, not a guess from its spec: `replay:box-spots.jsonl`
+    // names none. Asked only where the readings file is written, as the stage always did.
+    let meter = request.spot_readings.then(|| rig.spot.info().model);
     let mut sink = progress(!rig.simulated && attended == Attendance::Terminal);
-    Ok(run(
+    let outcome = run(
         &options,
         Instruments {
             spectral: rig.spectral.as_mut(),
@@ -151,7 +189,34 @@ pub fn measure(
         },
         rig.operator.as_mut(),
         sink.as_mut(),
-    )?)
+    )?;
+    if let (Outcome::Finished(summary), Some(meter)) = (&outcome, meter) {
+        write_readings(
+            &request.out.join(SPOTS_FILE),
+            &spot_readings(summary, &meter),
+        )?;
+    }
+    Ok(outcome)
+}
+
+/// Each spot's mean with its scatter in X, Y and Z together, over the repeats the
+/// reduction kept, in the plan's order; a spot read once carries the stated repeatability
+/// of the `meter` (its model).
+fn spot_readings(summary: &Summary, meter: &str) -> Vec<(usize, PatchReading)> {
+    let stated = Repeatability::emissive_of(meter);
+    summary
+        .spot_xyz
+        .iter()
+        .zip(summary.spots.iter())
+        .map(|((patch, xyz), r)| {
+            let n = r.stats.n - r.stats.outliers.len();
+            let cov = match (n, stated.and_then(|s| s.covariance(*xyz))) {
+                (1, Some(c)) => c,
+                _ => r.stats.cov,
+            };
+            (*patch, PatchReading::stated(*xyz, cov, n, 0.0))
+        })
+        .collect()
 }
 
 /// The plan file's plan (checked as it is read), or the paper's, with the repeat count
@@ -171,4 +236,30 @@ fn plan(request: &MeasureBoxRequest) -> Result<BoxPlan, MeasureBoxJobError> {
         e => e.into(),
     })?;
     Ok(plan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A replayed CS-100A whose file name says nothing of the model: the spec names no
+    /// meter, the opened instrument does, and its stated repeatability is the CS-100A's.
+    #[test]
+    fn a_replayed_meter_is_known_by_the_model_it_reports() {
+        let dir = std::env::temp_dir().join(format!("metamer-box-stage-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("spot.jsonl");
+        let transcript = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/protocols/cs100a/transcripts/normal_session.jsonl"
+        );
+        std::fs::copy(transcript, &file).unwrap();
+        let spec = Spec::replay(&file);
+        assert!(Repeatability::emissive_of(spec.as_str()).is_none());
+        let meter = spec.open(None).unwrap();
+        let stated = Repeatability::emissive_of(&meter.info().model).unwrap();
+        let cs100a = Repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
+        assert_eq!(stated, cs100a);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

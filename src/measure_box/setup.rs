@@ -1,15 +1,14 @@
-//! Opening the box rig: the plan a session follows, and the instruments and operator it
-//! measures with — the simulated truth box when both instruments are simulated, the real
-//! box otherwise. `measure-box` and the experiment's box stage open their rig here, so
-//! both measure the same box the same way; each says the refusals in its own words.
+//! Opening the box rig: the instruments and operator a session measures with — the
+//! simulated truth box when both instruments are simulated, the real box otherwise.
+//! [`super::job::measure`], the one call of `measure-box` and of the experiment's box
+//! stage, opens its rig here, so both measure the same box the same way.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::sync::Arc;
 
 use metamer_drivers::{DriverError, Instrument, SharedWorld, Spec, View};
 
-use super::plan::{BoxPlan, PlanError};
+use super::plan::BoxPlan;
 use crate::rig::simulated_box::{BoxOperator, SimulatedBox, SimulatedBoxError};
 use crate::rig::Scenario;
 use crate::session::Operator;
@@ -65,20 +64,6 @@ pub fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>
         (Some(n), true) => n.parse().map(Some).map_err(BoxLightError::Unknown),
         (Some(_), false) => Err(BoxLightError::RealRig),
     }
-}
-
-/// The plan of a session: the plan file's (the paper's without one), with `repeats`
-/// readings of each tile and spot when given, checked.
-pub fn load_plan(file: Option<&Path>, repeats: Option<usize>) -> Result<BoxPlan, PlanError> {
-    let mut plan = match file {
-        Some(p) => BoxPlan::load(p)?,
-        None => BoxPlan::default(),
-    };
-    if let Some(n) = repeats {
-        plan.repeats = n;
-    }
-    plan.validate()?;
-    Ok(plan)
 }
 
 /// Whether the rig is the simulated box: a simulated instrument sees only that box, and

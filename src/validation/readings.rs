@@ -8,6 +8,10 @@
 //! Each patch ends with one mean XYZ and the full covariance of that mean, the degrees of
 //! freedom of the covariance where it was estimated from repeats, and where it came from,
 //! so a report can say how far it may be trusted.
+//!
+//! The experiment's stages build the same [`PatchReading`] from what they measured or
+//! rendered and write it with [`write_readings`] (see [`write`]); this reader is the one
+//! that reads those files back, in the validation and in the checks before a run.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -91,8 +95,16 @@ pub struct PatchReading {
     pub source: UncertaintySource,
     /// The input marks this colour as outside the display's gamut.
     pub out_of_gamut: bool,
-    /// Line of the first reading of this patch.
+    /// Line of the first reading of this patch; 0 for a patch built from readings taken
+    /// here ([`PatchReading::stated`]) rather than read from a file.
     pub line: usize,
+    /// The covariance of one reading, where a single row or reading states it (a CSV row's
+    /// sd and cov columns, an instrument's stated repeatability) or a stage estimated it
+    /// from its repeats: with [`PatchReading::n`] it is what a readings file's row holds
+    /// ([`write_readings`]). None where the readings were combined from several rows or
+    /// say nothing per reading.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reading_cov: Option<Cov3>,
 }
 
 /// All patches of one file.
@@ -158,6 +170,20 @@ pub enum ReadingsError {
     },
     #[error("{}: {message}", file.display())]
     Empty { file: PathBuf, message: String },
+    /// The readings file could not be written.
+    #[error("writing {}: {source}", file.display())]
+    Write {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The output policy refused the readings file.
+    #[error("{source}")]
+    Output {
+        file: PathBuf,
+        #[source]
+        source: crate::output::OutputError,
+    },
 }
 
 impl ReadingsError {
@@ -166,7 +192,9 @@ impl ReadingsError {
         match self {
             ReadingsError::Io { file, .. }
             | ReadingsError::Bad { file, .. }
-            | ReadingsError::Empty { file, .. } => file,
+            | ReadingsError::Empty { file, .. }
+            | ReadingsError::Write { file, .. }
+            | ReadingsError::Output { file, .. } => file,
         }
     }
 }
@@ -399,6 +427,9 @@ fn patch_id(v: &Value) -> Option<PatchId> {
 mod csv;
 mod json;
 mod rows;
+pub mod write;
+
+pub use write::write_readings;
 
 #[cfg(test)]
 mod tests;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use metamer::color::{delta_e76, Xyz};
-use metamer::experiment::readings::{write_readings, PatchStat};
+use metamer::experiment::readings::{write_readings, PatchReading};
 use metamer::render::image_io::read_xyz_image;
 use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
 use metamer::render::Scene;
@@ -22,10 +22,10 @@ const SCENE: &str = "data/scenes/validation-box.json";
 fn box_spots(dir: &Path) -> PathBuf {
     let scene = Scene::load(Path::new(SCENE)).unwrap();
     let r = render_spots_radiosity(&scene, &RadiosityOptions::default(), &|_| {}).unwrap();
-    let stats: Vec<PatchStat> = r
+    let stats: Vec<(usize, PatchReading)> = r
         .patches
         .iter()
-        .map(|p| PatchStat::of(p.patch, &[p.xyz]))
+        .map(|p| (p.patch, PatchReading::of(&[p.xyz])))
         .collect();
     let f = dir.join("box-spots.csv");
     write_readings(&f, &stats).unwrap();

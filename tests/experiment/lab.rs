@@ -78,10 +78,11 @@ fn least_linear_drive(dir: &Path) -> Vec<(usize, f64)> {
     .unwrap();
     read_readings(&dir.join("box/spots.csv"))
         .unwrap()
+        .patches
         .iter()
-        .map(|p| {
+        .map(|(&patch, p)| {
             let lin = inv * Vector3::from(p.xyz);
-            (p.patch, lin.min() / lin.max())
+            (patch, lin.min() / lin.max())
         })
         .collect()
 }
@@ -95,9 +96,10 @@ fn unreachable_on_the_panel(dir: &Path) -> Vec<usize> {
     let panel = VirtualPanel::preset(Preset::IpsLcd).with_white_luminance(white);
     read_readings(&dir.join("simulation/spots.csv"))
         .unwrap()
+        .patches
         .iter()
-        .filter(|p| panel.drive_for(p.xyz).is_none())
-        .map(|p| p.patch)
+        .filter(|(_, p)| panel.drive_for(p.xyz).is_none())
+        .map(|(&patch, _)| patch)
         .collect()
 }
 

@@ -190,7 +190,7 @@ fn the_experiment_checks_a_given_box_and_its_instruments_before_any_work() {
             &scene,
             &huge_spots,
             None,
-            "huge.csv, line 2: not a measurement: XYZ [-1e308",
+            "huge.csv:2: not a measurement: XYZ [-1e308",
         ),
         (
             &dark_scene,

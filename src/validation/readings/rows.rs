@@ -91,7 +91,7 @@ impl Parsed {
 /// covariance over k, with k − 1 degrees of freedom), else from a renderer's confidence,
 /// else, for one reading of a named instrument, from its stated repeatability; unknown (0)
 /// for one bare reading.
-fn combine(rows: &[&Row]) -> PatchReading {
+pub(super) fn combine(rows: &[&Row]) -> PatchReading {
     let k = rows.len() as f64;
     let mut mean = [0.0; 3];
     for r in rows {
@@ -101,6 +101,13 @@ fn combine(rows: &[&Row]) -> PatchReading {
     }
     let n: usize = rows.iter().map(|r| r.n).sum();
     let (u_factors, dof, source) = uncertainty_of(rows, mean);
+    // One row says what one reading's covariance is; several rows' statements, pooled, no
+    // longer would.
+    let reading_cov = match (rows, source) {
+        ([one], UncertaintySource::Given) => one.covariance(),
+        ([one], UncertaintySource::Instrument) => stated_covariance(one),
+        _ => None,
+    };
     let u_xyz = covariance::sd(&covariance::of_factors(&u_factors));
     // A ΔE statement stands for what the XYZ standard error does not say (a radiosity
     // solver's discretisation); with a standard error it would count the same noise twice.
@@ -126,7 +133,15 @@ fn combine(rows: &[&Row]) -> PatchReading {
         source,
         out_of_gamut: rows.iter().any(|r| r.out_of_gamut),
         line: rows[0].line,
+        reading_cov,
     }
+}
+
+/// The covariance of one emissive reading of `row`'s instrument, from its stated
+/// repeatability, where the row names an instrument that has one.
+fn stated_covariance(row: &Row) -> Option<Cov3> {
+    let rep = Repeatability::emissive_of(row.instrument.as_deref()?)?;
+    rep.covariance(row.xyz)
 }
 
 /// The uncertainty of the mean of `rows` (at `mean`) as factors, with its degrees of
@@ -147,11 +162,7 @@ fn uncertainty_of(
             .collect()
     };
     let stated = (rows.len() == 1)
-        .then(|| {
-            let r = rows[0];
-            let rep = Repeatability::emissive_of(r.instrument.as_deref()?)?;
-            rep.covariance(r.xyz)
-        })
+        .then(|| stated_covariance(rows[0]))
         .flatten();
     if let Some(given) = rows
         .iter()
