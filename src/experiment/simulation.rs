@@ -23,7 +23,7 @@ use crate::render::job::{RenderError, RenderEvent};
 use crate::render::method::Method;
 use crate::render::spot::{patch_aim, RenderedReading, Uncertainty};
 use crate::render::Scene;
-use crate::validation::propagate::{render_lab_sigma, RenderStatement};
+use crate::validation::propagate::render_lab_sigma;
 
 /// What the simulation stage renders.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -220,14 +220,10 @@ pub fn simulate(
     })?;
     // The render's own uncertainty goes with its readings, so `metamer validate` given
     // this file counts it as the experiment's validation does.
-    let statement = match method {
-        "radiosity" => RenderStatement::Bound,
-        _ => RenderStatement::HalfWidth95,
-    };
     let stats: Vec<(usize, PatchReading)> = spots
         .iter()
         .map(|s| {
-            let u_lab = render_lab_sigma(s.uncertainty.de_ab(), statement);
+            let u_lab = render_lab_sigma(s.uncertainty);
             (s.patch, PatchReading::rendered(s.xyz, u_lab))
         })
         .collect();

@@ -123,8 +123,9 @@ mod tests {
     use super::*;
     use crate::color::Xyz;
     use crate::experiment::report_input::RenderUncertainty;
+    use crate::render::spot::Uncertainty;
     use crate::validation::assess;
-    use crate::validation::propagate::{render_lab_sigma, Propagation, RenderStatement};
+    use crate::validation::propagate::{render_lab_sigma, Propagation};
     use crate::validation::readings::{parse_readings, UncertaintySource};
 
     /// One grey patch: the box at L* 50 read 4 times, the meter's repeats scaling X, Y and
@@ -166,7 +167,14 @@ mod tests {
         };
         let mut s = sim();
         let u = RenderUncertainty {
-            sigma_lab: [(7, render_lab_sigma(0.5, RenderStatement::HalfWidth95))].into(),
+            sigma_lab: [(
+                7,
+                render_lab_sigma(Uncertainty::HalfWidth95 {
+                    de: 0.5,
+                    sampling: None,
+                }),
+            )]
+            .into(),
             description: String::new(),
         };
         u.apply(&mut s);

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use super::montecarlo::{lab_noise, patch_interval, LabNoise, Metric};
 use super::uncertain::lab_of;
-pub use super::uncertain::{render_lab_sigma, Interval, RenderStatement, Uncertain, Z975};
+pub use super::uncertain::{render_lab_sigma, Interval, Uncertain, Z975};
 
 use crate::color::{delta_e2000, delta_e76, Lab, Xyz};
 

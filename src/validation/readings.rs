@@ -21,9 +21,10 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::covariance::{self, Cov3};
+use super::uncertain::render_lab_sigma;
 pub use super::uncertain::CHI3_95;
-use super::uncertain::{render_lab_sigma, RenderStatement};
 use crate::color::COLORCHECKER_NAMES;
+use crate::render::spot::Uncertainty;
 use crate::session::repeats::Repeatability;
 
 /// The number of patches of the chart.
@@ -220,7 +221,7 @@ struct Row {
     /// A renderer's standard error of XYZ.
     stderr: Option<[f64; 3]>,
     /// A renderer's 95 % ΔE*ab half-width or bound.
-    de95: Option<(f64, RenderStatement)>,
+    de95: Option<Uncertainty>,
     /// A renderer's per-axis CIELAB standard uncertainty.
     u_lab: Option<f64>,
     /// The instrument that took the reading, when the input names it.

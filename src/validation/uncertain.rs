@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::color::{Lab, Xyz};
+use crate::render::spot::Uncertainty;
 
 /// The 95th percentile of the length of a 3-D isotropic normal vector in units of its
 /// per-axis σ (√χ²₃(0.95) = √7.8147): converts a renderer's 95 % ΔE half-width to a
@@ -41,23 +42,14 @@ impl Interval {
 /// The 97.5th percentile of the standard normal.
 pub const Z975: f64 = 1.959_963_985;
 
-/// How a renderer states a patch's ΔE*ab uncertainty.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RenderStatement {
-    /// A path tracer's 95 % half-width, 1.96·√(tr Σ) of its estimate's CIELAB covariance.
-    HalfWidth95,
-    /// A deterministic solver's bound on the error vector's length.
-    Bound,
-}
-
 /// The per-axis standard uncertainty in CIELAB that a renderer's per-patch ΔE*ab statement
 /// stands for, the error taken as isotropic: a half-width h = 1.96·√(3σ²) gives
 /// σ = h / (1.96·√3); a bound is taken as the 95th percentile of the error's length,
 /// σ = b / √χ²₃(0.95).
-pub fn render_lab_sigma(de: f64, how: RenderStatement) -> f64 {
-    match how {
-        RenderStatement::HalfWidth95 => de / (Z975 * 3f64.sqrt()),
-        RenderStatement::Bound => de / CHI3_95,
+pub fn render_lab_sigma(statement: Uncertainty) -> f64 {
+    match statement {
+        Uncertainty::HalfWidth95 { de, .. } => de / (Z975 * 3f64.sqrt()),
+        Uncertainty::Bound { de, .. } => de / CHI3_95,
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::files::{read_json, unusable};
 use crate::experiment::simulation::{SimulationSummary, SUMMARY_FILE};
-use crate::validation::propagate::{render_lab_sigma, RenderStatement};
+use crate::validation::propagate::render_lab_sigma;
 use crate::validation::report::RenderConfidenceSection;
 pub use crate::validation::report::RenderUncertainty;
 
@@ -18,18 +18,14 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
     let v = read_json(&file).map_err(|why| unusable(WHAT, &file, why))?;
     let s: SimulationSummary = serde_json::from_value(v)
         .map_err(|e| unusable(WHAT, &file, format!("is not a render summary: {e}")))?;
-    let (how, measure, method) = if s.method == "radiosity" {
+    let bound = s.method == "radiosity";
+    let (measure, method) = if bound {
         (
-            RenderStatement::Bound,
             "ΔE*ab error bound (the mesh levels' extrapolation against its alternatives)",
             "deterministic radiosity solver",
         )
     } else {
-        (
-            RenderStatement::HalfWidth95,
-            "95 % ΔE*ab half-width",
-            "spectral path tracer",
-        )
+        ("95 % ΔE*ab half-width", "spectral path tracer")
     };
     if let Some(bad) = s
         .spots
@@ -51,18 +47,20 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
         .iter()
         .map(|p| (p.patch, p.uncertainty.de_ab()))
         .collect();
-    let sigma_lab = per_patch
+    let sigma_lab = s
+        .spots
         .iter()
-        .map(|&(k, d)| (k, render_lab_sigma(d, how)))
+        .map(|p| (p.patch, render_lab_sigma(p.uncertainty)))
         .collect();
     let worst = per_patch.iter().map(|p| p.1).fold(0.0, f64::max);
-    let description = match how {
-        RenderStatement::Bound => format!(
+    let description = if bound {
+        format!(
             "the radiosity solver's per-patch error bound b (largest {worst:.3} ΔE*ab), taken as the 95th percentile of an isotropic CIELAB error: σ = b/2.795 per axis"
-        ),
-        RenderStatement::HalfWidth95 => format!(
+        )
+    } else {
+        format!(
             "the path tracer's per-patch 95 % half-width h (largest {worst:.3} ΔE*ab), as isotropic CIELAB noise: σ = h/(1.96·√3) per axis"
-        ),
+        )
     };
     Ok((
         RenderConfidenceSection {

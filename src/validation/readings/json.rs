@@ -182,8 +182,8 @@ impl Parsed {
                 None => None,
             };
             let de95 = match (p["de_ci95"].as_f64(), p["de_bound"].as_f64()) {
-                (Some(h), _) => Some((h, RenderStatement::HalfWidth95)),
-                (None, Some(b)) => Some((b, RenderStatement::Bound)),
+                (Some(de), _) => Some(Uncertainty::HalfWidth95 { de, sampling: None }),
+                (None, Some(de)) => Some(Uncertainty::Bound { de, regular: None }),
                 (None, None) => None,
             };
             self.rows.push(Row {

@@ -37,7 +37,7 @@ impl Parsed {
                 ));
             }
         }
-        if let Some((de, _)) = r.de95 {
+        if let Some(de) = r.de95.map(|u| u.de_ab()) {
             if !(0.0..=MAX_DE95).contains(&de) {
                 return Err(self.bad(
                     r.line,
@@ -112,7 +112,7 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
     // A ΔE statement stands for what the XYZ standard error does not say (a radiosity
     // solver's discretisation); with a standard error it would count the same noise twice.
     let from_de = match rows[0].de95 {
-        Some((de, how)) if rows[0].stderr.is_none() && rows.len() == 1 => render_lab_sigma(de, how),
+        Some(u) if rows[0].stderr.is_none() && rows.len() == 1 => render_lab_sigma(u),
         _ => 0.0,
     };
     let given_lab = rows.iter().filter_map(|r| r.u_lab).fold(0.0, f64::max);
@@ -128,7 +128,7 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
         u_factors,
         dof,
         u_lab,
-        render_de95: rows[0].de95.map(|d| d.0),
+        render_de95: rows[0].de95.map(|u| u.de_ab()),
         n,
         source,
         out_of_gamut: rows.iter().any(|r| r.out_of_gamut),
