@@ -7,7 +7,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use metamer::display::gamut::GamutMapping;
 use metamer::display::reproduce::reproduce_image;
 use metamer::display::{fit_profile, read_measurements, ModelKind};
-use metamer::render::image_io::XyzImage;
+use metamer::image::XyzImage;
 
 fn bench(c: &mut Criterion) {
     let fixture = Path::new(concat!(

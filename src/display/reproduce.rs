@@ -16,8 +16,8 @@ use super::gamut::{map_to_gamut, GamutMapping};
 use super::model::Inverse;
 use super::profile::Profile;
 use crate::color::Xyz;
+use crate::image::{ImageError, XyzImage};
 use crate::numeric_csv::{CsvError, NumericCsv};
-use crate::render::image_io::{ImageIoError, XyzImage};
 
 /// One target's drive values after gamut handling.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -112,8 +112,8 @@ pub fn write_drive_png(
     image: &DriveImage,
     bits: u8,
     out: &OutputPolicy,
-) -> Result<(), ImageIoError> {
-    let png_err = |e: png::EncodingError| ImageIoError::Png {
+) -> Result<(), ImageError> {
+    let png_err = |e: png::EncodingError| ImageError::Png {
         file: path.to_path_buf(),
         message: e.to_string(),
     };
@@ -130,7 +130,7 @@ pub fn write_drive_png(
             .flatten()
             .collect(),
         other => {
-            return Err(ImageIoError::Png {
+            return Err(ImageError::Png {
                 file: path.to_path_buf(),
                 message: format!("{other} bits per channel: use 8 or 16"),
             })

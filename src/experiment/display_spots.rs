@@ -21,8 +21,8 @@ use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::{write_readings, PatchReading};
 use super::reproduction::{PatchDrive, PatchRegion};
-use crate::rig::image::RgbImage;
-use crate::rig::{MeterAim, Placement, ScreenSpot};
+use crate::image::{RgbImage, ScreenSpot};
+use crate::rig::{MeterAim, Placement};
 use crate::session::{
     Answer, InstrumentRecord, Operator, OperatorError, Prepare, Readings, Recheck, Rig, RunEnd,
     RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, TerminalOperator,

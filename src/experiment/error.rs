@@ -8,8 +8,8 @@ use super::cache::CacheError;
 use super::readings::ReadingsError;
 use crate::display::characterize::CharacterizeError;
 use crate::display::ProfileError;
-use crate::render::image::ImageError;
-use crate::render::image_io::ImageIoError;
+use crate::image::ImageError;
+use crate::render::image::ImageRenderError;
 use crate::render::radiosity::RadiosityError;
 use crate::render::spot::SpotError;
 use crate::render::SceneError;
@@ -26,9 +26,9 @@ pub enum ExperimentError {
     #[error(transparent)]
     Radiosity(#[from] RadiosityError),
     #[error(transparent)]
-    Image(#[from] ImageError),
+    Image(#[from] ImageRenderError),
     #[error(transparent)]
-    ImageIo(#[from] ImageIoError),
+    ImageIo(#[from] ImageError),
     #[error(transparent)]
     Instrument(#[from] DriverError),
     #[error(transparent)]

@@ -15,8 +15,8 @@ use super::simulation::ImagePatch;
 use crate::display::gamut::GamutMapping;
 use crate::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use crate::display::Profile;
+use crate::image::{read_xyz_image, XyzImage};
 use crate::output::OutputPolicy;
-use crate::render::image_io::{read_xyz_image, XyzImage};
 use crate::rig::virtual_display::quantize;
 
 /// How targets are reproduced.

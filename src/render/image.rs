@@ -4,11 +4,11 @@
 use rayon::prelude::*;
 
 use super::geometry::{Vec3, VecOps};
-use super::image_io::XyzImage;
 use super::integrator::{Strategy, Tracer};
 use super::scene::{Camera, Scene};
 use super::spectral::Rng;
 use super::spot::Aim;
+use crate::image::XyzImage;
 
 /// The camera's image plane at a given size: the scene camera's field of view is kept
 /// for any size (the vertical one; the horizontal follows the aspect ratio).
@@ -109,7 +109,7 @@ pub struct ImageOptions {
 
 /// Why an image cannot be rendered.
 #[derive(Debug, thiserror::Error)]
-pub enum ImageError {
+pub enum ImageRenderError {
     #[error("the scene has no camera")]
     NoCamera,
 }
@@ -119,8 +119,8 @@ pub fn render_image(
     scene: &Scene,
     opts: &ImageOptions,
     progress: &(dyn Fn(usize) + Sync),
-) -> Result<XyzImage, ImageError> {
-    let cam = scene.camera.ok_or(ImageError::NoCamera)?;
+) -> Result<XyzImage, ImageRenderError> {
+    let cam = scene.camera.ok_or(ImageRenderError::NoCamera)?;
     let tracer = Tracer::new(scene, opts.strategy);
     let frame = Frame::of(&cam, opts.width, opts.height);
     let (w, h) = (frame.width, frame.height);

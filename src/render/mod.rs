@@ -23,9 +23,7 @@ pub use spot::{
 };
 pub mod convergence;
 pub mod deadline;
-mod exr_layout;
 pub mod image;
-pub mod image_io;
 pub mod job;
 pub mod method;
 pub mod probes;

@@ -2,7 +2,6 @@
 //! uniform colours to be measured (a full-screen window on a monitor, or a simulated
 //! monitor); display mathematics (models, fitting, reproduction) stays in `display`.
 
-pub mod image;
 pub mod scenario;
 pub mod screen;
 pub mod sim_meter;
@@ -12,6 +11,6 @@ pub mod virtual_display;
 pub mod window;
 
 pub use scenario::Scenario;
-pub use screen::{MeterAim, Placement, Screen, ScreenError, ScreenSpot};
+pub use screen::{MeterAim, Placement, Screen, ScreenError};
 pub use spec::{OpenError, ScreenSpec};
 pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};

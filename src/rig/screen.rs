@@ -12,7 +12,7 @@ use metamer_drivers::World;
 use crate::session;
 pub use crate::session::ScreenError;
 
-pub use super::image::{ImageError, RgbImage, ScreenSpot};
+use crate::image::{RgbImage, ScreenSpot};
 
 /// Where an image landed on a screen, as fractions of the screen's width and height: its
 /// left and top edges and its width and height (the whole screen, or less when the image

@@ -17,11 +17,10 @@
 
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
-use std::io::{Seek, SeekFrom, Write};
+use std::io::Write;
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 
-use metamer_color::text::{echo, strip_bom};
 use metamer_drivers::{CalibrationCondition, MeasureMode};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -31,11 +30,12 @@ use crate::output::owned_file;
 mod entry;
 mod error;
 mod file;
+mod resume;
 
 pub use entry::{reading_problem, JournalEntry};
 use error::io;
 pub use error::JournalError;
-use file::{keep_aside, lock, open_locked, read_all, rewrite, sync_dir};
+use file::{lock, sync_dir};
 
 /// `format` of every journal's header line.
 pub const JOURNAL_FORMAT: &str = "metamer-session-journal";
@@ -157,175 +157,6 @@ where
         Ok(journal)
     }
 
-    /// Opens the journal at `path` to continue it: checks it was written for a plan with
-    /// `expected`'s kind, fingerprint and options, and returns what it holds. A last line
-    /// cut off by a crash is moved to [`torn_path`] and removed from the journal; later
-    /// entries of a step journalled twice are moved to [`duplicates_path`]; any other
-    /// damage is an error naming the line that leaves the file untouched. The journal is
-    /// locked from the moment it is opened: another session holding it is an error.
-    pub fn resume(
-        path: &Path,
-        expected: &Header<H>,
-    ) -> Result<(Self, Recovered<H, E>), JournalError> {
-        let mut file = open_locked(path)?;
-        let bytes = read_all(&file, path)?;
-        if let Some(what) = broken(&bytes) {
-            return Err(JournalError::Broken {
-                path: path.to_path_buf(),
-                what,
-            });
-        }
-        let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-        let tail = &bytes[complete..];
-        // A tail that parses is a whole line that lost only its newline: keep it.
-        let tail_json = if complete == 0 {
-            without_bom(tail)
-        } else {
-            tail
-        };
-        let tail_is_whole =
-            !tail.is_empty() && serde_json::from_slice::<Line<H, E>>(tail_json).is_ok();
-        let bad = |line: usize, message: String| JournalError::Bad {
-            path: path.to_path_buf(),
-            line,
-            message,
-        };
-        let text_end = if tail_is_whole { bytes.len() } else { complete };
-        let text = std::str::from_utf8(&bytes[..text_end]).map_err(|e| {
-            let line = 1 + bytes[..e.valid_up_to()]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
-            bad(line, "not UTF-8 text".into())
-        })?;
-        // Each line with its 1-based number and byte range. Blank lines carry nothing (an
-        // editor's trailing newline, a line a tool added): skipped. A byte-order mark (an
-        // editor's) is not part of the header line.
-        let mut at = 0;
-        let mut lines = Vec::new();
-        for (i, raw) in text.split_inclusive('\n').enumerate() {
-            let range = at..at + raw.len();
-            at = range.end;
-            let mut l = raw.strip_suffix('\n').unwrap_or(raw);
-            l = l.strip_suffix('\r').unwrap_or(l);
-            if i == 0 {
-                l = strip_bom(l);
-            }
-            if !l.trim().is_empty() {
-                lines.push((i + 1, range, l));
-            }
-        }
-        let mut lines = lines.into_iter();
-        let header = match lines.next() {
-            None => return Err(bad(1, "empty journal: no header line".into())),
-            Some((n, _, l)) => {
-                // The header's fixed fields first, so a journal of another format or
-                // version says so rather than failing on the caller's part.
-                let v: serde_json::Value = serde_json::from_str(l)
-                    .map_err(|e| bad(n, format!("not a journal header: {e}")))?;
-                if v["format"] != JOURNAL_FORMAT || v["version"] != JOURNAL_VERSION {
-                    return Err(bad(
-                        n,
-                        format!(
-                            "format {} version {} is not {JOURNAL_FORMAT} version {JOURNAL_VERSION}",
-                            echo(&v["format"].to_string()),
-                            echo(&v["version"].to_string())
-                        ),
-                    ));
-                }
-                match serde_json::from_value::<Line<H, E>>(v) {
-                    Ok(Line::Header(h)) => h,
-                    Ok(_) => return Err(bad(n, "the first line must be the header".into())),
-                    Err(e) => return Err(bad(n, format!("not a journal header: {e}"))),
-                }
-            }
-        };
-        check_same_plan(path, &header, expected)?;
-        let mut entries = Vec::new();
-        let mut calibrations = Vec::new();
-        let mut steps = std::collections::BTreeSet::new();
-        let mut duplicates = Vec::new();
-        let mut duplicate_ranges = Vec::new();
-        for (n, range, l) in lines {
-            match serde_json::from_str::<Line<H, E>>(l) {
-                Ok(Line::Entry(e)) => {
-                    if let Some(message) = e.problem() {
-                        return Err(JournalError::Entry {
-                            path: path.to_path_buf(),
-                            line: n,
-                            message,
-                        });
-                    }
-                    match e.step() {
-                        // A second session's reading of a step the first had taken.
-                        Some(step) if !steps.insert(step) => {
-                            duplicates.push((n, step));
-                            duplicate_ranges.push(range);
-                        }
-                        _ => entries.push((n, e)),
-                    }
-                }
-                Ok(Line::Calibration(c)) => calibrations.push(c),
-                Ok(Line::Header(_)) => return Err(bad(n, "a second header line".into())),
-                Err(e) => return Err(bad(n, format!("not an entry or calibration: {e}"))),
-            }
-        }
-        let mut torn_bytes = 0;
-        if !tail.is_empty() && !tail_is_whole {
-            // Keep the fragment before cutting it off: nothing measured is thrown away.
-            let mut kept = tail.to_vec();
-            kept.push(b'\n');
-            keep_aside(&torn_path(path), &kept)?;
-            torn_bytes = tail.len();
-        }
-        let mut duplicate_bytes = 0;
-        if !duplicate_ranges.is_empty() {
-            // Set aside first: if the rewrite fails, the journal is unchanged and the side
-            // file holds copies, never the only ones.
-            let mut aside = Vec::new();
-            let mut kept = Vec::with_capacity(text_end);
-            let mut from = 0;
-            for r in &duplicate_ranges {
-                kept.extend_from_slice(&bytes[from..r.start]);
-                aside.extend_from_slice(&bytes[r.clone()]);
-                if !aside.ends_with(b"\n") {
-                    aside.push(b'\n');
-                }
-                from = r.end;
-            }
-            kept.extend_from_slice(&bytes[from..text_end]);
-            if !kept.ends_with(b"\n") {
-                kept.push(b'\n');
-            }
-            keep_aside(&duplicates_path(path), &aside)?;
-            duplicate_bytes = duplicate_ranges.iter().map(|r| r.len()).sum();
-            file = rewrite(path, &file, &kept)?;
-        } else if tail_is_whole {
-            file.write_all(b"\n").map_err(io(path))?;
-            file.sync_data().map_err(io(path))?;
-        } else if !tail.is_empty() {
-            file.set_len(complete as u64).map_err(io(path))?;
-            file.sync_data().map_err(io(path))?;
-        }
-        file.seek(SeekFrom::End(0)).map_err(io(path))?;
-        let journal = Journal {
-            path: path.to_path_buf(),
-            file,
-            _types: PhantomData,
-        };
-        Ok((
-            journal,
-            Recovered {
-                header,
-                entries,
-                calibrations,
-                torn_bytes,
-                duplicates,
-                duplicate_bytes,
-            },
-        ))
-    }
-
     /// Appends one entry; it is on disk when this returns.
     pub fn append(&mut self, entry: &E) -> Result<(), JournalError> {
         self.append_line(&LineRef::<H, E>::Entry(entry))
@@ -353,43 +184,6 @@ where
     pub fn path(&self) -> &Path {
         &self.path
     }
-}
-
-/// Whether the journal's header `logged` was written for the plan `now` describes.
-fn check_same_plan<H>(
-    path: &Path,
-    logged: &Header<H>,
-    now: &Header<H>,
-) -> Result<(), JournalError> {
-    if logged.kind != now.kind {
-        return Err(JournalError::KindDiffers {
-            path: path.to_path_buf(),
-            logged: logged.kind.clone(),
-            now: now.kind.clone(),
-        });
-    }
-    if logged.fingerprint == now.fingerprint {
-        return Ok(());
-    }
-    let absent = || "(not set)".to_string();
-    let names: std::collections::BTreeSet<&String> =
-        logged.options.keys().chain(now.options.keys()).collect();
-    for name in names {
-        let (a, b) = (logged.options.get(name), now.options.get(name));
-        if a != b {
-            return Err(JournalError::OptionDiffers {
-                path: path.to_path_buf(),
-                option: name.clone(),
-                logged: a.cloned().unwrap_or_else(absent),
-                now: b.cloned().unwrap_or_else(absent),
-            });
-        }
-    }
-    Err(JournalError::StepsDiffer {
-        path: path.to_path_buf(),
-        logged: logged.fingerprint.clone(),
-        now: now.fingerprint.clone(),
-    })
 }
 
 /// The error [`Journal::create`] would give for `path`, checked before anything is opened

@@ -4,7 +4,7 @@
 use metamer::display::gamut::GamutMapping;
 use metamer::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use metamer::display::{fit_profile, read_measurements, ModelKind, Profile};
-use metamer::render::image_io::XyzImage;
+use metamer::image::XyzImage;
 
 use crate::support::{dispread_analytic, fresh_dir, metamer};
 
@@ -243,7 +243,7 @@ fn reproduce_an_exr_image_from_the_command_line() {
         .collect();
     pixels[w * h - 1] = analytic([1.0; 3]).map(|v| 2.0 * v as f32);
     let exr = dir.join("i.exr");
-    metamer::render::image_io::write_xyz_image(
+    metamer::image::write_xyz_image(
         &exr,
         &XyzImage {
             width: w,

@@ -8,7 +8,7 @@ use std::process::{Command, Output};
 
 use metamer::color::{delta_e76, Xyz};
 use metamer::experiment::readings::{write_readings, PatchReading};
-use metamer::render::image_io::read_xyz_image;
+use metamer::image::read_xyz_image;
 use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
 use metamer::render::Scene;
 use serde_json::Value;

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use metamer::render::image_io::{write_xyz_image, XyzImage};
+use metamer::image::{write_xyz_image, XyzImage};
 
 /// A valid w × h XYZ image as the program writes it.
 pub fn valid(dir: &Path, w: usize, h: usize) -> Vec<u8> {

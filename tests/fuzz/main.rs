@@ -182,7 +182,7 @@ fn corrupt_exr_layouts_are_refused_in_our_words_within_the_memory_cap() {
         let path = dir.join("corrupt.exr");
         std::fs::write(&path, &bytes).unwrap();
         alloc::reset_thread_largest();
-        let e = metamer::render::image_io::read_xyz_image(&path)
+        let e = metamer::image::read_xyz_image(&path)
             .expect_err(what)
             .to_string();
         let largest = alloc::thread_largest();

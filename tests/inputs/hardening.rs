@@ -7,7 +7,7 @@ use metamer::color::Xyz;
 use metamer::display::gamut::nearest_lab;
 use metamer::display::measurements::{parse_ti3, read_measurement_file};
 use metamer::display::{fit_profile, ModelKind, Profile};
-use metamer::render::image_io::{read_xyz_image, write_xyz_image, XyzImage};
+use metamer::image::{read_xyz_image, write_xyz_image, XyzImage};
 
 use crate::support::{dispread_analytic, fresh_dir, metamer_in_root, stderr};
 

@@ -8,7 +8,7 @@ use std::io::BufRead;
 use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
-use metamer::rig::screen::RgbImage;
+use metamer::image::RgbImage;
 use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
 use metamer::rig::{Placement, Screen};
 use metamer::session::Screen as _;

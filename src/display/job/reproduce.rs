@@ -10,9 +10,9 @@ use crate::display::reproduce::{
     read_targets, reproduce_image, reproduce_targets, write_drive_csv, write_drive_png,
 };
 use crate::display::{Profile, ProfileError};
+use crate::image::{read_xyz_image, ImageError};
 use crate::numeric_csv::CsvError;
 use crate::output::{OutputError, OutputPolicy};
-use crate::render::image_io::{read_xyz_image, ImageIoError};
 
 /// What to reproduce: exactly one of `xyz` and `image`.
 #[derive(Clone, Debug)]
@@ -71,7 +71,7 @@ pub enum Error {
     #[error(transparent)]
     Targets(#[from] CsvError),
     #[error(transparent)]
-    Image(#[from] ImageIoError),
+    Image(#[from] ImageError),
 }
 
 /// Reproduces the request's targets or image through its profile and writes the drive

@@ -25,9 +25,9 @@ use std::time::Instant;
 
 pub use super::ImageReport;
 use super::{load_scene, RenderError, RenderEvent};
+use crate::image::{write_srgb_preview, write_xyz_image, XyzImage};
 use crate::output::{OutputError, OutputPolicy};
 use crate::render::image::{render_image, ImageOptions};
-use crate::render::image_io::{write_srgb_preview, write_xyz_image, XyzImage};
 use crate::render::integrator::Strategy;
 use crate::render::method::{Method, Solver};
 use crate::render::radiosity::image::{

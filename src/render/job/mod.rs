@@ -15,11 +15,11 @@ pub mod spots;
 
 use std::path::{Path, PathBuf};
 
+use crate::image::ImageError;
 use crate::numeric_csv::CsvError;
 use crate::output::OutputError;
 use crate::render::convergence::ConvergenceError;
-use crate::render::image::ImageError;
-use crate::render::image_io::ImageIoError;
+use crate::render::image::ImageRenderError;
 use crate::render::method::{Resolved, Solver};
 use crate::render::probes::ProbeError;
 use crate::render::radiosity::probes::ProbeProgress;
@@ -45,9 +45,9 @@ pub enum RenderError {
     #[error(transparent)]
     Radiosity(#[from] RadiosityError),
     #[error(transparent)]
-    Image(#[from] ImageError),
+    Image(#[from] ImageRenderError),
     #[error(transparent)]
-    ImageIo(#[from] ImageIoError),
+    ImageIo(#[from] ImageError),
     #[error(transparent)]
     Convergence(#[from] ConvergenceError),
     #[error(transparent)]

@@ -15,7 +15,6 @@ use rayon::prelude::*;
 
 use super::super::geometry::{Vec3, VecOps};
 use super::super::image::{pixel_direction, Frame};
-use super::super::image_io::XyzImage;
 use super::super::spectral::N_BINS;
 use super::bound::richardson;
 use super::direct::irradiance_factor;
@@ -25,6 +24,7 @@ use super::mesh::{Face, FaceKind};
 use super::polygon::point_to_rect;
 use super::{solve_level, LastLevels, Prepared, RadiosityError, RadiosityOptions, Solved};
 use crate::color::K_M;
+use crate::image::XyzImage;
 use crate::render::deadline::Deadline;
 use crate::render::scene::Scene;
 use crate::render::spot::SpotError;

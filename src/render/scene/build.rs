@@ -1,150 +1,53 @@
 //! Validation of a parsed scene file into the render-ready [`Scene`]: geometry, spectra on
 //! the 1 nm grid, the emitters' tile spectra and distributions, and the limits.
 
-use std::collections::HashMap;
-use std::path::Path;
 use std::sync::Arc;
 
 use super::super::geometry::{Rect, Vec3, VecOps};
-use super::super::spectral::{bins, cmf_bins, constant_bins};
-use super::builtin;
-use super::file::{CameraFile, DistributionFile, EmitterFile, SceneFile, SpectrumRef};
+use super::super::spectral::{cmf_bins, constant_bins};
+use super::file::{CameraFile, DistributionFile, EmitterFile, SceneFile};
+use super::loader::{err, Files, Loader, R};
 use super::model::{
-    Camera, Distribution, Emitter, Scene, Surface, MAX_EMITTERS, MAX_LUMINANCE_CD_M2,
-    MAX_REFLECTANCE, MAX_SURFACES, MAX_TILES, MAX_TILES_PER_SIDE, MAX_TILE_SPECTRA,
+    Camera, Distribution, Emitter, Scene, Surface, MAX_EMITTERS, MAX_LUMINANCE_CD_M2, MAX_SURFACES,
+    MAX_TILES, MAX_TILES_PER_SIDE, MAX_TILE_SPECTRA,
 };
 use super::reader::PathError;
-use crate::color::{ObserverKind, Outside, SpectralTable, Spectrum, K_M};
+use crate::color::{ObserverKind, K_M};
 
-type R<T> = Result<T, PathError>;
-
-fn err<T>(path: impl Into<String>, message: impl Into<String>) -> R<T> {
-    Err(PathError {
-        path: path.into(),
-        message: message.into(),
-    })
-}
-
-/// Where the spectral CSV files a scene names are found.
-#[derive(Clone, Copy)]
-pub enum Files<'a> {
-    /// Relative to the scene file's directory.
-    Dir(&'a Path),
-    /// The data files compiled into the binary (the built-in scenes).
-    Builtin,
-}
-
-/// Spectra read so far: a file named by a thousand tiles is read once.
-struct Loader<'a> {
-    files: Files<'a>,
-    tables: HashMap<String, SpectralTable>,
-}
-
-impl Loader<'_> {
-    fn table(&mut self, p: &str, file: &str) -> R<&SpectralTable> {
-        if !self.tables.contains_key(file) {
-            let t = match self.files {
-                Files::Dir(dir) => SpectralTable::read(&dir.join(file)),
-                Files::Builtin => match builtin::data_file(file) {
-                    Some(text) => SpectralTable::parse(text, file),
-                    None => {
-                        return err(
-                            format!("{p}.file"),
-                            format!(
-                                "{file} is not one of the data files built into the program ({})",
-                                builtin::DATA_FILES.join(", ")
-                            ),
-                        )
-                    }
-                },
-            }
-            .map_err(|e| PathError {
-                path: format!("{p}.file"),
-                message: e.to_string(),
-            })?;
-            self.tables.insert(file.to_string(), t);
-        }
-        Ok(&self.tables[file])
-    }
-
-    /// A spectrum on the 1 nm grid; every value finite.
-    fn spectrum(&mut self, p: &str, s: &SpectrumRef) -> R<Vec<f64>> {
-        let sp = match s {
-            SpectrumRef::Constant(v) => {
-                if !v.is_finite() {
-                    return err(p, "must be finite");
-                }
-                return Ok(constant_bins(*v));
-            }
-            SpectrumRef::File {
-                file,
-                column,
-                outside,
-            } => {
-                let table = self.table(p, file)?;
-                let col = column.unwrap_or(1);
-                if col == 0 || col > table.columns.len() {
-                    return err(
-                        format!("{p}.column"),
-                        format!("must be 1–{}, got {col}", table.columns.len()),
-                    );
-                }
-                table
-                    .spectrum(col - 1)
-                    .with_outside(outside.unwrap_or(Outside::Zero))
-            }
-            SpectrumRef::Inline {
-                nm,
-                values,
-                outside,
-            } => Spectrum::new(nm.clone(), values.clone())
-                .map_err(|e| PathError {
-                    path: p.into(),
-                    message: e.to_string(),
-                })?
-                .with_outside(outside.unwrap_or(Outside::Zero)),
-        };
-        let b = bins(&sp);
-        if b.iter().any(|v| !v.is_finite()) {
-            return err(p, "must be finite");
-        }
-        Ok(b)
-    }
-
-    /// A reflectance: in [0, 1], or up to [`MAX_REFLECTANCE`] with a warning.
-    fn reflectance(&mut self, p: &str, s: &SpectrumRef, warnings: &mut Vec<String>) -> R<Vec<f64>> {
-        let r = self.spectrum(p, s)?;
-        let (i, max) = r
-            .iter()
-            .cloned()
-            .enumerate()
-            .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
-        if let Some(x) = r.iter().find(|x| **x < 0.0) {
-            return err(p, format!("reflectance must be in [0, 1], found {x}"));
-        }
-        if max > MAX_REFLECTANCE {
-            return err(
-                p,
-                format!(
-                    "reflectance must be in [0, 1] (up to {MAX_REFLECTANCE} is accepted as \
-                     measurement noise), found {max} at {} nm",
-                    380 + i
-                ),
-            );
-        }
-        if max > 1.0 {
-            warnings.push(format!(
-                "{p}: reflectance {max:.4} at {} nm is above 1; accepted as measurement noise \
-                 (limit {MAX_REFLECTANCE})",
-                380 + i
-            ));
-        }
-        Ok(r)
-    }
-}
-
-/// The whole scene.
+/// The whole scene: its sizes first, then the surfaces, the emitters, the camera and the
+/// meter, then what only the whole can show (emitters hidden in a surface, no light).
 pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
+    check_sizes(file)?;
+    let mut loader = Loader::new(files);
+    let mut warnings = Vec::new();
+    let surfaces = surfaces(file, &mut loader, &mut warnings)?;
+    let cmf = cmf_bins(ObserverKind::Cie1931);
+    let emitters = emitters(file, &mut loader, &cmf[1], &mut warnings)?;
+    let camera = match &file.camera {
+        Some(c) => Some(camera(c)?),
+        None => None,
+    };
+    let meter_acceptance_deg = match &file.meter {
+        Some(m) => Some(meter_acceptance(m.acceptance_deg)?),
+        None => None,
+    };
+    let scene = Scene {
+        name: file.name.clone(),
+        surfaces,
+        emitters,
+        camera,
+        meter_acceptance_deg,
+        cmf,
+        provenance: file.provenance.clone(),
+        warnings,
+    };
+    super::hidden::check(&scene.surfaces, &scene.emitters)?;
+    check_emits_light(&scene)?;
+    Ok(scene)
+}
+
+/// The counts of surfaces, emitters and tiles, before anything is allocated for them.
+fn check_sizes(file: &SceneFile) -> R<()> {
     if file.surfaces.len() > MAX_SURFACES {
         return err(
             "surfaces",
@@ -185,17 +88,17 @@ pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
             );
         }
     }
-    let mut loader = Loader {
-        files,
-        tables: HashMap::new(),
-    };
-    let mut warnings = Vec::new();
+    Ok(())
+}
+
+/// The surfaces: each rectangle, its reflectance and the patch it shows.
+fn surfaces(file: &SceneFile, loader: &mut Loader, warnings: &mut Vec<String>) -> R<Vec<Surface>> {
     let mut surfaces = Vec::with_capacity(file.surfaces.len());
     for (i, s) in file.surfaces.iter().enumerate() {
         let p = format!("surfaces[{i}]");
         let rect = rect(&p, s.corner, s.edge_u, s.edge_v)?;
         let reflectance =
-            loader.reflectance(&format!("{p}.reflectance"), &s.reflectance, &mut warnings)?;
+            loader.reflectance(&format!("{p}.reflectance"), &s.reflectance, warnings)?;
         if let Some(k) = s.patch {
             if !(1..=24).contains(&k) {
                 return err(format!("{p}.patch"), format!("must be 1–24, got {k}"));
@@ -208,17 +111,20 @@ pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
             patch: s.patch,
         });
     }
-    let cmf = cmf_bins(ObserverKind::Cie1931);
+    Ok(surfaces)
+}
+
+/// The emitters, with the count of distinct tile spectra over all of them bounded.
+fn emitters(
+    file: &SceneFile,
+    loader: &mut Loader,
+    ybar: &[f64],
+    warnings: &mut Vec<String>,
+) -> R<Vec<Emitter>> {
     let mut emitters = Vec::new();
     let mut distinct = 0;
     for (i, e) in file.emitters.iter().enumerate() {
-        let em = emitter(
-            &format!("emitters[{i}]"),
-            e,
-            &mut loader,
-            &cmf[1],
-            &mut warnings,
-        )?;
+        let em = emitter(&format!("emitters[{i}]"), e, loader, ybar, warnings)?;
         distinct += em.spectra.len();
         if distinct > MAX_TILE_SPECTRA {
             return err(
@@ -231,31 +137,19 @@ pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
         }
         emitters.push(em);
     }
-    let camera = match &file.camera {
-        Some(c) => Some(camera(c)?),
-        None => None,
-    };
-    let meter_acceptance_deg = match &file.meter {
-        Some(m) => {
-            let a = m.acceptance_deg;
-            if !(a > 0.0 && a < 90.0) {
-                return err("meter.acceptance_deg", "must be in (0, 90)");
-            }
-            Some(a)
-        }
-        None => None,
-    };
-    let scene = Scene {
-        name: file.name.clone(),
-        surfaces,
-        emitters,
-        camera,
-        meter_acceptance_deg,
-        cmf,
-        provenance: file.provenance.clone(),
-        warnings,
-    };
-    super::hidden::check(&scene.surfaces, &scene.emitters)?;
+    Ok(emitters)
+}
+
+/// The spot meter's acceptance angle.
+fn meter_acceptance(a: f64) -> R<f64> {
+    if !(a > 0.0 && a < 90.0) {
+        return err("meter.acceptance_deg", "must be in (0, 90)");
+    }
+    Ok(a)
+}
+
+/// A scene whose every reading would be 0/0 is refused.
+fn check_emits_light(scene: &Scene) -> R<()> {
     let intensity = scene.intensity_cd();
     if !(intensity > 0.0 && intensity.is_finite()) {
         return err(
@@ -266,7 +160,7 @@ pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
             ),
         );
     }
-    Ok(scene)
+    Ok(())
 }
 
 fn camera(c: &CameraFile) -> R<Camera> {

@@ -36,6 +36,7 @@ mod build;
 pub mod builtin;
 pub mod file;
 mod hidden;
+mod loader;
 mod model;
 pub mod reader;
 
@@ -96,7 +97,7 @@ impl Scene {
 
     /// Validates a parsed scene; files are resolved against `dir`.
     pub fn build(file: &SceneFile, dir: &Path) -> Result<Scene, PathError> {
-        build::scene(file, build::Files::Dir(dir))
+        build::scene(file, loader::Files::Dir(dir))
     }
 
     /// A box built into the program by name (`validation-box`, lit by the `ips-lcd`

@@ -40,7 +40,8 @@ use metamer_drivers::{Light, View, World};
 pub use panel::{quantize, VirtualPanel};
 pub use presets::{PanelParams, Preset, Trc};
 
-use super::screen::{MeterAim, Placement, RgbImage, Screen, ScreenError, ScreenSpot};
+use super::screen::{MeterAim, Placement, Screen, ScreenError};
+use crate::image::{RgbImage, ScreenSpot};
 use crate::session;
 
 /// What the panel shows: one colour everywhere, or an image filling the screen.

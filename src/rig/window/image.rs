@@ -9,7 +9,8 @@ use x11rb::protocol::xproto::{
 };
 
 use super::{perr, WindowDisplay, WindowError};
-use crate::rig::screen::{Placement, RgbImage};
+use crate::image::RgbImage;
+use crate::rig::screen::Placement;
 
 /// Where an image of `iw × ih` lands on a monitor of `mw × mh` when scaled to fit: left,
 /// top, width and height in monitor pixels.

@@ -25,7 +25,8 @@ use x11rb::wrapper::ConnectionExt as _;
 
 pub use pixels::PixelFormat;
 
-use super::screen::{Placement, RgbImage, Screen, ScreenError};
+use super::screen::{Placement, Screen, ScreenError};
+use crate::image::RgbImage;
 use crate::session;
 
 /// The window backend could not open or draw.

@@ -16,28 +16,12 @@
 //! `exr_layout`), and NaN or infinite pixels.
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use super::error::ImageError;
 use super::exr_layout;
-use crate::output::{OutputError, OutputPolicy};
-
-/// An XYZ image, rows top to bottom.
-#[derive(Clone, Debug, PartialEq)]
-pub struct XyzImage {
-    pub width: usize,
-    pub height: usize,
-    pub pixels: Vec<[f32; 3]>,
-}
-
-impl XyzImage {
-    pub fn at(&self, x: usize, y: usize) -> [f32; 3] {
-        self.pixels[y * self.width + x]
-    }
-}
-
-/// Largest image read, in pixels (12 bytes each in memory): 2²⁶, 8192 × 8192, far above
-/// the camera's 1014 × 1014, so a corrupt header cannot ask for an unbounded allocation.
-pub const MAX_PIXELS: usize = 1 << 26;
+use super::xyz::{XyzImage, MAX_PIXELS};
+use crate::output::OutputPolicy;
 
 /// Largest EXR file read: [`MAX_PIXELS`] of four float channels uncompressed, and room for
 /// the header and offset table.
@@ -54,61 +38,26 @@ fn xyz_chromaticities() -> exr::meta::attribute::Chromaticities {
     }
 }
 
-#[derive(Debug, thiserror::Error)]
-pub enum ImageIoError {
-    #[error("{file}: {source}")]
-    Io {
-        file: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{file}: not a colour PFM: {message}")]
-    Pfm { file: PathBuf, message: String },
-    #[error("{file}: {message}")]
-    Exr { file: PathBuf, message: String },
-    #[error("{file}: PNG: {message}")]
-    Png { file: PathBuf, message: String },
-    #[error("{file}: unknown image type (use .pfm or .exr)")]
-    UnknownType { file: PathBuf },
-    #[error("{0}")]
-    Output(#[from] OutputError),
-    #[error(
-        "{file}: {width}×{height} pixels is more than this reader accepts ({MAX_PIXELS} pixels); \
-         the header is corrupt or the image is not one metamer rendered"
-    )]
-    TooLarge {
-        file: PathBuf,
-        width: usize,
-        height: usize,
-    },
-    #[error("{file}: pixel ({x}, {y}) (from the top left) is {value:?}, not a finite XYZ")]
-    NotFinite {
-        file: PathBuf,
-        x: usize,
-        y: usize,
-        value: [f32; 3],
-    },
-}
-
 /// The size's pixel count, if it can be held.
-fn pixel_count(file: &Path, width: usize, height: usize) -> Result<usize, ImageIoError> {
+fn pixel_count(file: &Path, width: usize, height: usize) -> Result<usize, ImageError> {
     width
         .checked_mul(height)
         .filter(|&n| n <= MAX_PIXELS)
-        .ok_or_else(|| ImageIoError::TooLarge {
+        .ok_or_else(|| ImageError::TooLarge {
             file: file.to_path_buf(),
             width,
             height,
         })
 }
 
-fn check_finite(file: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
+fn check_finite(file: &Path, img: &XyzImage) -> Result<(), ImageError> {
     match img
         .pixels
         .iter()
         .position(|p| p.iter().any(|v| !v.is_finite()))
     {
         None => Ok(()),
-        Some(i) => Err(ImageIoError::NotFinite {
+        Some(i) => Err(ImageError::NotFinite {
             file: file.to_path_buf(),
             x: i % img.width.max(1),
             y: i / img.width.max(1),
@@ -118,14 +67,14 @@ fn check_finite(file: &Path, img: &XyzImage) -> Result<(), ImageIoError> {
 }
 
 /// An `exr` crate error in terms of what is wrong with the file.
-fn exr_error(file: &Path, e: exr::error::Error) -> ImageIoError {
+fn exr_error(file: &Path, e: exr::error::Error) -> ImageError {
     use exr::error::Error;
     let message = match e {
         Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             "the file ends early (truncated OpenEXR file)".to_string()
         }
         Error::Io(io) => {
-            return ImageIoError::Io {
+            return ImageError::Io {
                 file: file.to_path_buf(),
                 source: io,
             }
@@ -146,14 +95,14 @@ fn exr_error(file: &Path, e: exr::error::Error) -> ImageIoError {
         ),
         Error::Aborted => "reading was aborted".to_string(),
     };
-    ImageIoError::Exr {
+    ImageError::Exr {
         file: file.to_path_buf(),
         message,
     }
 }
 
-fn io(file: &Path) -> impl Fn(std::io::Error) -> ImageIoError + '_ {
-    move |source| ImageIoError::Io {
+fn io(file: &Path) -> impl Fn(std::io::Error) -> ImageError + '_ {
+    move |source| ImageError::Io {
         file: file.to_path_buf(),
         source,
     }
@@ -168,11 +117,7 @@ fn ext(path: &Path) -> String {
 
 /// Writes `.pfm` or `.exr` by extension, under the output policy `out`. The image is
 /// encoded in memory first, so an encoding error never touches the file.
-pub fn write_xyz_image(
-    path: &Path,
-    img: &XyzImage,
-    out: &OutputPolicy,
-) -> Result<(), ImageIoError> {
+pub fn write_xyz_image(path: &Path, img: &XyzImage, out: &OutputPolicy) -> Result<(), ImageError> {
     let bytes = match ext(path).as_str() {
         "pfm" => pfm_bytes(img),
         "exr" => {
@@ -197,7 +142,7 @@ pub fn write_xyz_image(
             buf.into_inner()
         }
         _ => {
-            return Err(ImageIoError::UnknownType {
+            return Err(ImageError::UnknownType {
                 file: path.to_path_buf(),
             })
         }
@@ -206,20 +151,20 @@ pub fn write_xyz_image(
 }
 
 /// Reads `.pfm` or `.exr` by extension.
-pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageIoError> {
+pub fn read_xyz_image(path: &Path) -> Result<XyzImage, ImageError> {
     match ext(path).as_str() {
         "pfm" => read_pfm(path),
         "exr" => read_exr(path),
-        _ => Err(ImageIoError::UnknownType {
+        _ => Err(ImageError::UnknownType {
             file: path.to_path_buf(),
         }),
     }
 }
 
 /// Reads an OpenEXR file whose layout [`exr_layout::check`] found safe to decode.
-fn read_exr(path: &Path) -> Result<XyzImage, ImageIoError> {
+fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
     use exr::prelude::*;
-    let bad = |message: String| ImageIoError::Exr {
+    let bad = |message: String| ImageError::Exr {
         file: path.to_path_buf(),
         message,
     };
@@ -285,8 +230,8 @@ fn pfm_bytes(img: &XyzImage) -> Vec<u8> {
     out
 }
 
-fn read_pfm(path: &Path) -> Result<XyzImage, ImageIoError> {
-    let bad = |message: String| ImageIoError::Pfm {
+fn read_pfm(path: &Path) -> Result<XyzImage, ImageError> {
+    let bad = |message: String| ImageError::Pfm {
         file: path.to_path_buf(),
         message: metamer_color::text::echo_message(&message),
     };
@@ -375,7 +320,7 @@ pub fn write_srgb_preview(
     img: &XyzImage,
     white_y: f64,
     out: &OutputPolicy,
-) -> Result<(), ImageIoError> {
+) -> Result<(), ImageError> {
     let enc = |v: f64| {
         let v = v.clamp(0.0, 1.0);
         let s = if v <= 0.003_130_8 {
@@ -394,7 +339,7 @@ pub fn write_srgb_preview(
         let b = 0.0557 * x - 0.2040 * y + 1.0570 * z;
         data.extend([enc(r), enc(g), enc(b)]);
     }
-    let png_err = |e: png::EncodingError| ImageIoError::Png {
+    let png_err = |e: png::EncodingError| ImageError::Png {
         file: path.to_path_buf(),
         message: e.to_string(),
     };
@@ -503,7 +448,7 @@ mod tests {
             pixels: vec![[1.0; 3]; 3],
         };
         let e = write_srgb_preview(&p, &short, 1.0, &OutputPolicy::new(true)).unwrap_err();
-        assert!(matches!(e, ImageIoError::Png { .. }), "{e}");
+        assert!(matches!(e, ImageError::Png { .. }), "{e}");
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "the earlier preview");
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
         std::fs::remove_dir_all(&dir).ok();

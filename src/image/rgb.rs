@@ -1,6 +1,9 @@
-//! An 8-bit RGB image for a screen, read from the PNG the reproduction writes.
+//! An 8-bit RGB image for a screen, read from the PNG the reproduction writes, and where a
+//! spot meter is aimed on it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use super::error::ImageError;
 
 /// Where a spot meter is aimed on a screen (or an image filling it): the centre as
 /// fractions of the width and height from the top-left corner, and the spot's radius as a
@@ -18,25 +21,6 @@ pub struct RgbImage {
     pub width: usize,
     pub height: usize,
     pub pixels: Vec<[u8; 3]>,
-}
-
-/// Why an image cannot be shown.
-#[derive(Debug, thiserror::Error)]
-pub enum ImageError {
-    #[error("reading {}: {source}", file.display())]
-    Io {
-        file: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{}: not a PNG image a screen can show: {message}", file.display())]
-    Png { file: PathBuf, message: String },
-    #[error("an image of {width}×{height} pixels needs {need} pixel values, got {got}")]
-    Size {
-        width: usize,
-        height: usize,
-        need: usize,
-        got: usize,
-    },
 }
 
 impl RgbImage {
@@ -58,11 +42,11 @@ impl RgbImage {
 
     /// An 8-bit RGB PNG (the reproduction's drive values).
     pub fn read_png(path: &Path) -> Result<RgbImage, ImageError> {
-        let bad = |message: String| ImageError::Png {
+        let bad = |message: String| ImageError::NotShowablePng {
             file: path.to_path_buf(),
             message,
         };
-        let file = std::fs::File::open(path).map_err(|source| ImageError::Io {
+        let file = std::fs::File::open(path).map_err(|source| ImageError::Read {
             file: path.to_path_buf(),
             source,
         })?;
