@@ -16,6 +16,7 @@ use super::simulation::{simulate, SimulationSummary};
 use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
 use crate::display::Profile;
+use crate::validation::job::ReadingFiles;
 
 /// How one stage went.
 #[derive(Clone, Debug, Serialize)]
@@ -340,10 +341,10 @@ fn run_stage(
                 read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
             let sim_spots = stage_path(opts, Stage::Simulation, simulation::SPOTS_FILE);
             let display_spots = stage_path(opts, Stage::DisplaySpots, display_spots::SPOTS_FILE);
-            let files = validate::ReadingFiles {
-                box_spots: &box_spots,
-                simulation: &sim_spots,
+            let files = ReadingFiles {
+                box_readings: &box_spots,
                 display: &display_spots,
+                simulation: Some(&sim_spots),
             };
             let (_, written) =
                 validate::validate(&sd.dir, profile.white_xyz, &files, &r.out_of_gamut_patches)?;

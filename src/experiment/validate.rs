@@ -6,17 +6,10 @@ use std::path::Path;
 
 use super::error::ExperimentError;
 use super::report_input::{gather, Layout};
-use crate::validation::job::{self, Context, Coverage, Request, White};
+use crate::validation::job::{self, Context, Coverage, ReadingFiles, Request, White};
 use crate::validation::{AssessOptions, ReportInput, ValidationError};
 
 pub use crate::validation::comparisons::{ValidationResult, FILE, RESULT_VERSION};
-
-/// The stage's readings files, for the report (which reads them with their uncertainties).
-pub struct ReadingFiles<'a> {
-    pub box_spots: &'a Path,
-    pub simulation: &'a Path,
-    pub display: &'a Path,
-}
 
 /// The stage's request: all three sides on the same patches, the display's measured white,
 /// the default propagation, no display model term, and the report's sections from the
@@ -29,22 +22,16 @@ fn request<'a>(
     out_of_gamut: &[usize],
 ) -> Request<'a> {
     let root = dir.parent().unwrap_or(dir);
-    let layout = Layout::of(root, files.box_spots);
+    let layout = Layout::of(root, files.box_readings);
     // The readings' patch counts are filled in by the validation once it has read them.
-    let sections = gather(
-        &layout,
-        &[
-            ("box", files.box_spots, 0),
-            ("simulation", files.simulation, 0),
-            ("display", files.display, 0),
-        ],
-    );
+    let mut sides = vec![("box", files.box_readings, 0)];
+    if let Some(simulation) = files.simulation {
+        sides.push(("simulation", simulation, 0));
+    }
+    sides.push(("display", files.display, 0));
+    let sections = gather(&layout, &sides);
     Request {
-        readings: job::ReadingFiles {
-            box_readings: files.box_spots,
-            display: files.display,
-            simulation: Some(files.simulation),
-        },
+        readings: *files,
         white: White::Measured {
             xyz: white,
             source: "the display's measured white (the paper's choice)".into(),

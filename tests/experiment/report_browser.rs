@@ -171,15 +171,16 @@ fn validate_report(dir: &Path) -> PathBuf {
 /// The experiment's report with every section, from the cut-down experiment directory
 /// `tests/data/report/` (a lab run lit by LED-RGB1), in `dir`.
 fn experiment_report(dir: &Path) -> PathBuf {
-    use metamer::experiment::validate::{report_input, ReadingFiles};
+    use metamer::experiment::validate::report_input;
     use metamer::output::OutputPolicy;
+    use metamer::validation::job::ReadingFiles;
     use metamer::validation::write_report_files;
 
     let exp = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/report/experiment");
     let files = ReadingFiles {
-        box_spots: &exp.join("box/spots.csv"),
-        simulation: &exp.join("simulation/spots.csv"),
+        box_readings: &exp.join("box/spots.csv"),
         display: &exp.join("display-spots/spots.csv"),
+        simulation: Some(&exp.join("simulation/spots.csv")),
     };
     let white = [29.424_122_518_279_695, 31.015, 34.538_708_337_905_01];
     let oog = [1, 4, 7, 9, 11, 12, 14, 15, 16];
