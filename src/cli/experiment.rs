@@ -39,8 +39,9 @@ pub struct Args {
         conflicts_with = "spectral"
     )]
     box_scene: Option<PathBuf>,
-    /// … and its spot readings (`patch,X,Y,Z,sd_X,sd_Y,sd_Z,n`).
-    #[arg(long, value_name = "CSV", requires = "box_scene")]
+    /// … and its spot readings: any readings file `validate` reads (an earlier
+    /// experiment's box/spots.csv, a CSV `patch,X,Y,Z`, a journal, `spot --json`).
+    #[arg(long, value_name = "READINGS", requires = "box_scene")]
     box_spots: Option<PathBuf>,
     /// The monitor that shows the simulation: window:N (a real monitor) or virtual:PRESET.
     #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
