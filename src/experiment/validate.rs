@@ -232,4 +232,47 @@ mod tests {
             "{m:?}"
         );
     }
+
+    /// The report names each readings file's format as it was read: a box's readings given
+    /// as `metamer spot --json` lines are not called a CSV.
+    #[test]
+    fn the_report_names_the_format_each_readings_file_was_read_in() {
+        let exp = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/report/experiment");
+        let csv = std::fs::read_to_string(exp.join("box/spots.csv")).unwrap();
+        let lines: String = csv
+            .lines()
+            .skip(1)
+            .map(|row| {
+                let f: Vec<&str> = row.split(',').collect();
+                format!(
+                    "{{\"patch\":{},\"XYZ\":[{},{},{}]}}\n",
+                    f[0], f[1], f[2], f[3]
+                )
+            })
+            .collect();
+        let dir = std::env::temp_dir().join(format!("metamer-formats-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let spot_json = dir.join("box.jsonl");
+        std::fs::write(&spot_json, lines).unwrap();
+        let files = ReadingFiles {
+            box_readings: &spot_json,
+            display: &exp.join("display-spots/spots.csv"),
+            simulation: Some(&exp.join("simulation/spots.csv")),
+        };
+        let white = [29.424_122_518_279_695, 31.015, 34.538_708_337_905_01];
+        let input = report_input(&exp.join("validation"), white, &files, &[]).unwrap();
+        let formats: Vec<(&str, &str, usize)> = input.inputs[..3]
+            .iter()
+            .map(|i| (i.role.as_str(), i.format.as_str(), i.patches))
+            .collect();
+        assert_eq!(
+            formats,
+            [
+                ("box", "readings (metamer spot --json)", 24),
+                ("simulation", "readings (CSV)", 24),
+                ("display", "readings (CSV)", 24),
+            ]
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

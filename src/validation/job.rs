@@ -73,7 +73,7 @@ pub enum Context {
     Files,
     /// The sections the caller gathered (the experiment's, from its earlier stages'
     /// files). Their first three inputs are the readings files, box, simulation and
-    /// display, whose patch counts are filled in from what was read. The render's
+    /// display, whose patch counts and formats are filled in from what was read. The render's
     /// uncertainty enters the simulation's readings where they carry none of their own,
     /// and each side's interval is described in words.
     Stages(Box<Sections>),
@@ -395,6 +395,8 @@ fn stages_context(report: &mut ReportInput, sides: &Sides, sections: &Sections) 
     for (input, set) in inputs.iter_mut().zip(sets) {
         if let Some(set) = set {
             input.patches = set.patches.len();
+            // A given box's readings may be a journal or `spot --json` as well as a CSV.
+            input.format = format!("readings ({})", set.format.name());
         }
     }
     let mut notes = sections.notes.clone();

@@ -89,7 +89,7 @@ pub fn gather(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Sections {
 fn inputs(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Vec<InputFile> {
     let mut files: Vec<InputFile> = readings
         .iter()
-        .map(|(role, path, patches)| input(role, path, "readings (CSV)", *patches))
+        .map(|(role, path, patches)| input(role, path, "readings", *patches))
         .collect();
     let others = [
         ("box", layout.box_dir.join("scene.json"), "measured scene"),
