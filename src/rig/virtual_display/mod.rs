@@ -10,7 +10,7 @@
 //! - the emitted light is black plus one term per channel, `K + Σ_c L_c(v'_c)`;
 //! - black `K` has its own chromaticity (LCD backlight leakage is bluish, not white);
 //! - each channel's tone response (TRC) is a blend of a power law and a normalised
-//!   logistic, so no single exponent fits it ([`Trc`]);
+//!   logistic, so no single exponent fits it ([`PanelTrc`]);
 //! - a channel's chromaticity drifts with its level, `xy_c(L) = xy_c + d_c (1 − L)`, where
 //!   `L` is the channel's normalised luminance (at full drive it is exactly the primary);
 //! - crosstalk: the effective drive of channel `c` is `v'_c = v_c + Σ_{d≠c} k_cd v_d (1 − v_c)`
@@ -38,7 +38,7 @@ use std::time::Duration;
 use metamer_drivers::{Light, View, World};
 
 pub use panel::{quantize, VirtualPanel};
-pub use presets::{PanelParams, Preset, Trc};
+pub use presets::{PanelParams, PanelTrc, Preset};
 
 use super::screen::{MeterAim, Placement, Screen, ScreenError};
 use crate::image::{RgbImage, ScreenSpot};

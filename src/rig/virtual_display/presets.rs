@@ -66,7 +66,11 @@ impl Preset {
                 primaries_xy: [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06]],
                 spectra: p22_phosphors(),
                 drift_xy: [[0.0; 2]; 3],
-                trc: [Trc::power(2.25), Trc::power(2.2), Trc::power(2.15)],
+                trc: [
+                    PanelTrc::power(2.25),
+                    PanelTrc::power(2.2),
+                    PanelTrc::power(2.15),
+                ],
                 crosstalk: [[0.0; 3]; 3],
             },
             Preset::IpsLcd => PanelParams {
@@ -78,9 +82,9 @@ impl Preset {
                 spectra: white_led_lcd(),
                 drift_xy: [[-0.030, 0.020], [0.020, -0.030], [0.015, 0.030]],
                 trc: [
-                    Trc::blend(2.1, 0.25, 0.55, 7.0),
-                    Trc::blend(2.2, 0.20, 0.50, 6.0),
-                    Trc::blend(2.3, 0.30, 0.45, 8.0),
+                    PanelTrc::blend(2.1, 0.25, 0.55, 7.0),
+                    PanelTrc::blend(2.2, 0.20, 0.50, 6.0),
+                    PanelTrc::blend(2.3, 0.30, 0.45, 8.0),
                 ],
                 crosstalk: [
                     [0.0, 0.015, 0.010],
@@ -97,9 +101,9 @@ impl Preset {
                 spectra: wide_gamut_ccfl(),
                 drift_xy: [[-0.060, 0.035], [0.040, -0.060], [0.030, 0.050]],
                 trc: [
-                    Trc::blend(2.0, 0.40, 0.55, 8.0),
-                    Trc::blend(2.3, 0.35, 0.50, 7.0),
-                    Trc::blend(2.5, 0.45, 0.40, 9.0),
+                    PanelTrc::blend(2.0, 0.40, 0.55, 8.0),
+                    PanelTrc::blend(2.3, 0.35, 0.50, 7.0),
+                    PanelTrc::blend(2.5, 0.45, 0.40, 9.0),
                 ],
                 crosstalk: [
                     [0.0, 0.025, 0.020],
@@ -210,11 +214,12 @@ impl FromStr for Preset {
     }
 }
 
-/// Tone response of one channel: normalised luminance 0–1 of drive 0–1,
+/// A simulated panel's true tone response of one channel (what a characterization's
+/// fitted `display::model::Trc` tries to recover): normalised luminance 0–1 of drive 0–1,
 /// `(1 − w) vᵞ + w S(v)` with `S` the logistic `1/(1 + e^(−slope (v − mid)))` rescaled to
 /// run from 0 at v = 0 to 1 at v = 1. Both terms rise monotonically, so the blend does.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Trc {
+pub struct PanelTrc {
     pub gamma: f64,
     /// Weight `w` of the logistic term; 0 is a pure power law.
     pub s_weight: f64,
@@ -222,10 +227,10 @@ pub struct Trc {
     pub s_slope: f64,
 }
 
-impl Trc {
+impl PanelTrc {
     /// A pure power law `vᵞ`.
-    pub const fn power(gamma: f64) -> Trc {
-        Trc {
+    pub const fn power(gamma: f64) -> PanelTrc {
+        PanelTrc {
             gamma,
             s_weight: 0.0,
             s_mid: 0.5,
@@ -233,8 +238,8 @@ impl Trc {
         }
     }
 
-    pub const fn blend(gamma: f64, s_weight: f64, s_mid: f64, s_slope: f64) -> Trc {
-        Trc {
+    pub const fn blend(gamma: f64, s_weight: f64, s_mid: f64, s_slope: f64) -> PanelTrc {
+        PanelTrc {
             gamma,
             s_weight,
             s_mid,
@@ -271,7 +276,7 @@ pub struct PanelParams {
     pub spectra: PanelSpectra,
     /// Shift of each channel's chromaticity as its level goes to zero.
     pub drift_xy: [[f64; 2]; 3],
-    pub trc: [Trc; 3],
+    pub trc: [PanelTrc; 3],
     /// `crosstalk[c][d]`: how much channel `d`'s drive raises channel `c`'s (diagonal 0).
     pub crosstalk: [[f64; 3]; 3],
 }

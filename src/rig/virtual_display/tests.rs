@@ -182,7 +182,7 @@ fn lcd_mixtures_are_not_additive_by_the_crosstalk() {
 #[test]
 fn lcd_trcs_are_not_power_laws() {
     // Local exponent d ln L / d ln v: constant γ for a power law.
-    let exponent = |t: &Trc, v: f64| {
+    let exponent = |t: &PanelTrc, v: f64| {
         let h = 1e-4;
         ((t.eval(v + h)).ln() - (t.eval(v - h)).ln()) / ((v + h).ln() - (v - h).ln())
     };
@@ -200,7 +200,7 @@ fn lcd_trcs_are_not_power_laws() {
             }
         }
     }
-    let t = Trc::power(2.2);
+    let t = PanelTrc::power(2.2);
     assert!((exponent(&t, 0.25) - 2.2).abs() < 1e-6 && (exponent(&t, 0.75) - 2.2).abs() < 1e-6);
 }
 
