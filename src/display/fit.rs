@@ -13,7 +13,7 @@ use super::model::{
     fit_plcc_gamma, fit_plvc, fit_shaper_matrix, is_measured_grid, DisplayModel, FitError,
     ModelKind, ModelParams,
 };
-use super::profile::{InputFile, Profile, PROFILE_FORMAT};
+use super::profile::{FittedFrom, Profile, PROFILE_FORMAT};
 use crate::color::{delta_e2000, Xyz};
 
 /// Choices beyond the model kind.
@@ -85,7 +85,7 @@ pub fn fit_profile_with(
                 file: path.to_path_buf(),
                 source: e,
             })?;
-            Some(InputFile {
+            Some(FittedFrom {
                 path: path.display().to_string(),
                 sha256: format!("{:x}", Sha256::digest(&bytes)),
                 patches: patches.len(),

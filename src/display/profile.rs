@@ -12,9 +12,9 @@ use super::model::{DisplayModel, Inverse, ModelKind, ModelParams};
 /// The `format` value of profiles this version writes and reads.
 pub const PROFILE_FORMAT: &str = "metamer-display-profile-1";
 
-/// Where the fitted patches came from.
+/// The measurements file a profile was fitted from: its path, SHA-256 and patch count.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct InputFile {
+pub struct FittedFrom {
     pub path: String,
     pub sha256: String,
     pub patches: usize,
@@ -31,7 +31,7 @@ pub struct Profile {
     pub black_xyz: [f64; 3],
     pub residuals: Residuals,
     pub diagnostics: Diagnostics,
-    pub input: Option<InputFile>,
+    pub input: Option<FittedFrom>,
 }
 
 /// Why a profile could not be saved or loaded.
