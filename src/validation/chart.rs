@@ -47,24 +47,15 @@ pub fn write_delta_e_chart(
 mod tests {
     use super::*;
     use crate::color::Xyz;
-    use crate::validation::assess::{compare_pairs, exact_side, PatchPair};
+    use crate::validation::assess::compare_pairs;
+    use crate::validation::compare::exact_pairs;
     use crate::validation::propagate::Propagation;
 
     /// `test` against `reference`, both taken as exact, the patches in `oog` marked as
     /// outside the display's gamut.
     fn exact(reference: &[Xyz], test: &[Xyz], oog: &[usize]) -> Assessment {
         let white = Xyz::new(95.047, 100.0, 108.883);
-        let pairs = reference
-            .iter()
-            .zip(test)
-            .enumerate()
-            .map(|(i, (r, t))| PatchPair {
-                patch: i + 1,
-                reference: exact_side(*r, white),
-                test: exact_side(*t, white),
-                out_of_gamut: oog.contains(&(i + 1)),
-            })
-            .collect();
+        let pairs = exact_pairs(reference, test, white, oog);
         compare_pairs("box", "display", pairs, white, Propagation::Linear)
     }
 

@@ -61,7 +61,21 @@ pub fn compare(
         });
     }
     check_white(white)?;
-    let pairs = reference
+    let pairs = exact_pairs(reference, test, white, &[]);
+    // Exact readings have no noise to propagate; the method is never used.
+    let a = compare_pairs(reference_name, test_name, pairs, white, Propagation::Linear);
+    Ok(Comparison::from(&a))
+}
+
+/// The i-th reading of each list as patch i + 1, both taken as exact, the patches in
+/// `out_of_gamut` marked as outside the display's gamut.
+pub(super) fn exact_pairs(
+    reference: &[Xyz],
+    test: &[Xyz],
+    white: Xyz,
+    out_of_gamut: &[usize],
+) -> Vec<PatchPair> {
+    reference
         .iter()
         .zip(test)
         .enumerate()
@@ -69,12 +83,9 @@ pub fn compare(
             patch: i + 1,
             reference: exact_side(*r, white),
             test: exact_side(*t, white),
-            out_of_gamut: false,
+            out_of_gamut: out_of_gamut.contains(&(i + 1)),
         })
-        .collect();
-    // Exact readings have no noise to propagate; the method is never used.
-    let a = compare_pairs(reference_name, test_name, pairs, white, Propagation::Linear);
-    Ok(Comparison::from(&a))
+        .collect()
 }
 
 impl From<&Assessment> for Comparison {
