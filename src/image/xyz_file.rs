@@ -21,6 +21,7 @@ use std::path::Path;
 use super::error::ImageError;
 use super::exr_layout;
 use super::xyz::{XyzImage, MAX_PIXELS};
+use crate::color::{srgb_encode, xyz_to_linear_srgb};
 use crate::output::OutputPolicy;
 
 /// Largest EXR file read: [`MAX_PIXELS`] of four float channels uncompressed, and room for
@@ -321,23 +322,11 @@ pub fn write_srgb_preview(
     white_y: f64,
     out: &OutputPolicy,
 ) -> Result<(), ImageError> {
-    let enc = |v: f64| {
-        let v = v.clamp(0.0, 1.0);
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0 + 0.5) as u8
-    };
+    let enc = |v: f64| (srgb_encode(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
     let mut data = Vec::with_capacity(img.pixels.len() * 3);
     for p in &img.pixels {
-        let [x, y, z] = p.map(|v| v as f64 / white_y);
-        // XYZ → linear sRGB, IEC 61966-2-1 matrix.
-        let r = 3.2406 * x - 1.5372 * y - 0.4986 * z;
-        let g = -0.9689 * x + 1.8758 * y + 0.0415 * z;
-        let b = 0.0557 * x - 0.2040 * y + 1.0570 * z;
-        data.extend([enc(r), enc(g), enc(b)]);
+        let linear = xyz_to_linear_srgb(p.map(|v| v as f64 / white_y));
+        data.extend(linear.map(enc));
     }
     let png_err = |e: png::EncodingError| ImageError::Png {
         file: path.to_path_buf(),

@@ -13,7 +13,7 @@ mod planes;
 pub use bars::{delta_e_bars, delta_e_rows};
 pub use planes::{lab_planes, Planes, MAX_OWN, MIN_DRAWN, OWN_COLOUR};
 
-use crate::color::{Lab, Xyz};
+use crate::color::{srgb_encode, xyz_to_linear_srgb, Lab, Xyz};
 
 use super::assess::JndVerdict;
 
@@ -43,26 +43,12 @@ const CLIP_TOLERANCE: f64 = 2e-3;
 /// is drawn as white.
 pub fn srgb_swatch(lab: [f64; 3]) -> Swatch {
     const D65: Xyz = Xyz::new(0.950_47, 1.0, 1.088_83);
-    const M: [[f64; 3]; 3] = [
-        [3.2406, -1.5372, -0.4986],
-        [-0.9689, 1.8758, 0.0415],
-        [0.0557, -0.2040, 1.0570],
-    ];
     let xyz = Lab::new(lab[0], lab[1], lab[2]).to_xyz(D65).to_array();
-    let linear = M.map(|row| row.iter().zip(xyz).map(|(m, v)| m * v).sum::<f64>());
+    let linear = xyz_to_linear_srgb(xyz);
     let clipped = linear
         .iter()
         .any(|v| !(-CLIP_TOLERANCE..=1.0 + CLIP_TOLERANCE).contains(v));
-    let enc = |v: f64| {
-        let v = v.clamp(0.0, 1.0);
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0).round() as u8
-    };
-    let [r, g, b] = linear.map(enc);
+    let [r, g, b] = linear.map(|v| (srgb_encode(v.clamp(0.0, 1.0)) * 255.0).round() as u8);
     Swatch {
         hex: format!("#{r:02x}{g:02x}{b:02x}"),
         clipped,

@@ -10,6 +10,7 @@ mod plausible;
 mod spectrum;
 mod spectrum_json;
 mod sprague;
+mod srgb;
 mod table;
 mod tables;
 pub mod text;
@@ -24,6 +25,7 @@ pub use describe::{describe, Description};
 pub use error::ColorError;
 pub use plausible::{check_xyz, check_yxy, plausible_spread, Implausible, MAX_CD_M2};
 pub use spectrum::{Interpolation, Outside, Quantity, Spectrum};
+pub use srgb::{srgb_encode, xyz_to_linear_srgb, XYZ_TO_LINEAR_SRGB};
 pub use table::SpectralTable;
 pub use tables::{
     colorchecker, observer, paper_white, ColorCheckerSet, Illuminant, Observer, ObserverKind,

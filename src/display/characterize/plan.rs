@@ -15,7 +15,9 @@ use std::time::Duration;
 use metamer_drivers::MeasureMode;
 use serde::{Deserialize, Serialize};
 
-use crate::color::{self, ColorCheckerSet, Illuminant, ObserverKind};
+use crate::color::{
+    self, srgb_encode, xyz_to_linear_srgb, ColorCheckerSet, Illuminant, ObserverKind,
+};
 use crate::display::ModelKind;
 use crate::session::{Prepare, SessionPlan, Step};
 
@@ -290,23 +292,8 @@ pub fn random_patches(n: usize, seed: u64) -> Vec<[u8; 3]> {
         .collect()
 }
 
-/// sRGB encoding of linear v (IEC 61966-2-1:1999 §5.2).
-fn srgb_encode(v: f64) -> f64 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// The 24 ColorChecker patches under D65 as 8-bit sRGB (out-of-gamut channels clipped).
 pub fn colorchecker_srgb() -> Vec<(&'static str, [u8; 3])> {
-    // XYZ (D65, Y = 1 for white) → linear sRGB, IEC 61966-2-1:1999 §5.2.
-    const M: [[f64; 3]; 3] = [
-        [3.2406, -1.5372, -0.4986],
-        [-0.9689, 1.8758, 0.0415],
-        [0.0557, -0.2040, 1.0570],
-    ];
     let d65 = Illuminant::D65.spectrum();
     color::colorchecker(ColorCheckerSet::BabelColorAverage)
         .iter()
@@ -315,10 +302,8 @@ pub fn colorchecker_srgb() -> Vec<(&'static str, [u8; 3])> {
             let xyz = color::reflectance_to_xyz(reflectance, &d65, ObserverKind::Cie1931)
                 .scaled(0.01)
                 .to_array();
-            let rgb = M.map(|row| {
-                let linear: f64 = row.iter().zip(xyz).map(|(m, v)| m * v).sum();
-                (srgb_encode(linear.clamp(0.0, 1.0)) * 255.0).round() as u8
-            });
+            let rgb = xyz_to_linear_srgb(xyz)
+                .map(|linear| (srgb_encode(linear.clamp(0.0, 1.0)) * 255.0).round() as u8);
             (name, rgb)
         })
         .collect()
