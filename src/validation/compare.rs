@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::color::Xyz;
 
-use super::assess::{check_white, compare_pairs, exact_side, Assessment, PatchPair, JND_DE76};
+use super::assess::{
+    check_white, compare_pairs, exact_side, Assessment, PatchPair, Stat, JND_DE76,
+};
 use super::error::ValidationError;
 use super::propagate::Propagation;
 
@@ -106,24 +108,19 @@ impl From<&Assessment> for Comparison {
                 de00: p.de00,
             })
             .collect();
-        let n = patches.len().max(1) as f64;
-        let stat = |f: fn(&PatchComparison) -> f64| {
-            let mean = patches.iter().map(f).sum::<f64>() / n;
-            let max = patches.iter().map(f).fold(0.0, f64::max);
-            (mean, max)
-        };
-        let (mean_de76, max_de76) = stat(|p| p.de76);
-        let (mean_de00, max_de00) = stat(|p| p.de00);
+        // The assessment's summaries of the point values; over no patches they are not
+        // numbers, and a comparison says 0.
+        let point = |s: Stat| if patches.is_empty() { 0.0 } else { s.value };
         Comparison {
             reference: a.reference.clone(),
             test: a.test.clone(),
             white: a.white,
-            below_jnd_point: patches.iter().filter(|p| p.de76 < JND_DE76).count(),
+            below_jnd_point: a.below_jnd_point,
+            mean_de76: point(a.mean_de76),
+            max_de76: point(a.max_de76),
+            mean_de00: point(a.mean_de00),
+            max_de00: point(a.max_de00),
             patches,
-            mean_de76,
-            max_de76,
-            mean_de00,
-            max_de00,
         }
     }
 }
