@@ -115,3 +115,57 @@ fn given_box(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A given box's spot readings are taken in every form the validation stage reads,
+    /// and must still hold the patches of its scene.
+    #[test]
+    fn a_given_box_is_read_as_the_validation_reads_it() {
+        let exp = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/report/experiment");
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes/validation-box.json");
+        let rows: Vec<Vec<String>> = std::fs::read_to_string(exp.join("box/spots.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|r| r.split(',').take(4).map(String::from).collect())
+            .collect();
+        assert_eq!(rows.len(), 24);
+        let dir = std::env::temp_dir().join(format!("metamer-preflight-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let plain = dir.join("plain.csv");
+        let csv: String = rows.iter().map(|r| r.join(",") + "\n").collect();
+        std::fs::write(&plain, format!("patch,X,Y,Z\n{csv}")).unwrap();
+        let spot_json = dir.join("spot.jsonl");
+        let lines: String = rows
+            .iter()
+            .map(|r| {
+                format!(
+                    "{{\"patch\":{},\"XYZ\":[{},{},{}]}}\n",
+                    r[0], r[1], r[2], r[3]
+                )
+            })
+            .collect();
+        std::fs::write(&spot_json, lines).unwrap();
+        for file in [&plain, &spot_json] {
+            given_box(&scene, file, None).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        }
+        // Read once by the request's checks and passed in: the same verdict.
+        let set = read_readings(&plain).unwrap();
+        given_box(&scene, &plain, Some(&set)).unwrap();
+        // Patch 24 left out: the scene has it, the readings do not.
+        let short = dir.join("short.csv");
+        let first23: String = rows[..23].iter().map(|r| r.join(",") + "\n").collect();
+        std::fs::write(&short, format!("patch,X,Y,Z\n{first23}")).unwrap();
+        match given_box(&scene, &short, None) {
+            Err(ExperimentError::GivenPatchesDiffer { read, in_scene, .. }) => {
+                assert_eq!(read, (1..=23).collect::<Vec<_>>());
+                assert_eq!(in_scene, (1..=24).collect::<Vec<_>>());
+            }
+            other => panic!("{other:?}"),
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
