@@ -5,7 +5,13 @@
 use serde::{Deserialize, Serialize};
 
 /// CIE XYZ tristimulus values (absolute cd/m² for emission, relative Y = 100 for objects).
+///
+/// In files it is the array `[X, Y, Z]`, the form every metamer JSON file already used for
+/// XYZ before this type crossed module boundaries, so a field can change from `[f64; 3]` to
+/// `Xyz` without changing a byte of what is written or read. `xyz[0]`, `xyz[1]`, `xyz[2]`
+/// are X, Y, Z.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(from = "[f64; 3]", into = "[f64; 3]")]
 pub struct Xyz {
     pub x: f64,
     pub y: f64,
@@ -97,6 +103,42 @@ impl Xyz {
     }
 }
 
+impl From<[f64; 3]> for Xyz {
+    fn from(v: [f64; 3]) -> Xyz {
+        Xyz::from_array(v)
+    }
+}
+
+impl From<Xyz> for [f64; 3] {
+    fn from(v: Xyz) -> [f64; 3] {
+        v.to_array()
+    }
+}
+
+impl std::ops::Index<usize> for Xyz {
+    type Output = f64;
+    /// X, Y, Z for 0, 1, 2; panics past 2 as an array does.
+    fn index(&self, i: usize) -> &f64 {
+        match i {
+            0 => &self.x,
+            1 => &self.y,
+            2 => &self.z,
+            _ => panic!("XYZ has three components, index {i} asked"),
+        }
+    }
+}
+
+impl std::ops::IndexMut<usize> for Xyz {
+    fn index_mut(&mut self, i: usize) -> &mut f64 {
+        match i {
+            0 => &mut self.x,
+            1 => &mut self.y,
+            2 => &mut self.z,
+            _ => panic!("XYZ has three components, index {i} asked"),
+        }
+    }
+}
+
 impl std::ops::Add for Xyz {
     type Output = Xyz;
     fn add(self, o: Xyz) -> Xyz {
@@ -185,6 +227,23 @@ mod tests {
     use proptest::prelude::*;
 
     const D65: Xyz = Xyz::new(95.047, 100.0, 108.883);
+
+    #[test]
+    fn xyz_is_the_array_x_y_z_in_files_and_by_index() {
+        let v = Xyz::new(41.24, 21.26, 1.93);
+        assert_eq!(serde_json::to_string(&v).unwrap(), "[41.24,21.26,1.93]");
+        let back: Xyz = serde_json::from_str("[41.24,21.26,1.93]").unwrap();
+        assert_eq!(back, v);
+        // The object form was never written to a file and is not read.
+        assert!(serde_json::from_str::<Xyz>(r#"{"x":1,"y":2,"z":3}"#).is_err());
+        assert!(serde_json::from_str::<Xyz>("[1,2]").is_err());
+        assert_eq!((v[0], v[1], v[2]), (41.24, 21.26, 1.93));
+        let mut m = v;
+        m[1] = 5.0;
+        assert_eq!(m.y, 5.0);
+        assert_eq!(<[f64; 3]>::from(v), [41.24, 21.26, 1.93]);
+        assert_eq!(Xyz::from([1.0, 2.0, 3.0]), Xyz::new(1.0, 2.0, 3.0));
+    }
 
     #[test]
     fn white_is_l100_and_known_values() {
