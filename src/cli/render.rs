@@ -9,6 +9,7 @@ use metamer::render::job::convergence::ConvergenceRequest;
 use metamer::render::job::image::ImageRequest;
 use metamer::render::job::probes::{ProbesReport, ProbesRequest};
 use metamer::render::job::spots::{Readings, SpotsRequest};
+use metamer::render::job::spots_from_image::Request as SpotsFromImageRequest;
 use metamer::render::job::{self, RenderError, RenderEvent};
 use metamer::render::method::{self, Solver};
 use metamer::render::probes::ProbeOptions;
@@ -46,6 +47,11 @@ enum Cmd {
     Spots(SpotsArgs),
     /// The camera's XYZ image (absolute cd/m², float) as .exr or .pfm.
     Image(ImageArgs),
+    /// The 24 meter readings read back from another renderer's XYZ image of the scene's
+    /// camera: each the image's mean over the meter's 1° cone (solid-angle weighted), with
+    /// a 95 % half-width from the pixels' spread; `--json` is what `validate --simulation`
+    /// reads.
+    SpotsFromImage(SpotsFromImageArgs),
     /// Illuminance (lux: direct, indirect, total) at points given as CSV rows
     /// x,y,z,nx,ny,nz (header line), the normal being the measuring surface's.
     Probes(ProbesArgs),
@@ -72,6 +78,29 @@ struct SpotsArgs {
     /// path: the path tracer; auto: radiosity when the scene qualifies.
     #[arg(long, value_enum, default_value_t = Method::Auto)]
     method: Method,
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct SpotsFromImageArgs {
+    /// The image (.exr or .pfm): absolute XYZ in cd/m², rows from the top, not mirrored.
+    image: PathBuf,
+    /// The scene the image is of (default: the validation box built into the program).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Reference white X,Y,Z for the readings' CIELAB (default: a perfect white diffuser
+    /// in place of patch 19, path traced).
+    #[arg(long, value_parser = parse_triple)]
+    white: Option<[f64; 3]>,
+    /// The traced white's 95 % half-width is driven below a third of this ΔE*ab.
+    #[arg(long, default_value_t = 0.1)]
+    target_de: f64,
+    /// Wall-clock limit (s) of tracing the white.
+    #[arg(long, default_value_t = 600.0)]
+    max_seconds: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
     #[arg(long)]
     json: bool,
 }
@@ -154,6 +183,7 @@ pub fn run(args: Args) -> CliResult {
     match args.command {
         Cmd::Spots(a) => spots(a),
         Cmd::Image(a) => image(a),
+        Cmd::SpotsFromImage(a) => spots_from_image(a),
         Cmd::Probes(a) => probes(a),
         Cmd::Convergence(a) => convergence(a),
     }
@@ -313,6 +343,49 @@ fn print_spots(readings: &Readings) {
             Uncertainty::Bound { de, .. } => println!("{row} {de:>9.5}"),
         }
     }
+}
+
+fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
+    let request = SpotsFromImageRequest {
+        white: a.white,
+        target_de: a.target_de,
+        max_seconds: a.max_seconds,
+        seed: a.seed,
+        ..SpotsFromImageRequest::new(a.image, a.scene)
+    };
+    let report = job::spots_from_image::run(&request, &print_event).map_err(cli_error)?;
+    if a.json {
+        println!("{}", report.to_json()?);
+        return Ok(());
+    }
+    print_provenance(&report.scene);
+    let w = report.white;
+    println!(
+        "{} ({}×{}, sha256 {}): white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s",
+        report.image.display(),
+        report.width,
+        report.height,
+        report.sha256,
+        w[0],
+        w[1],
+        w[2],
+        report.seconds
+    );
+    println!(
+        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>7} {:>9}",
+        "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "pixels", "effective"
+    );
+    for (p, c) in report.patches.iter().zip(&report.cones) {
+        let ([x, y, z], [l, a, b]) = (p.xyz, p.lab);
+        println!(
+            "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3} {:>8.4} {:>7} {:>9.1}",
+            p.patch,
+            p.uncertainty.de_ab(),
+            c.pixels,
+            c.effective
+        );
+    }
+    Ok(())
 }
 
 fn image(a: ImageArgs) -> CliResult {

@@ -12,6 +12,7 @@ pub mod convergence;
 pub mod image;
 pub mod probes;
 pub mod spots;
+pub mod spots_from_image;
 
 use std::path::{Path, PathBuf};
 
@@ -48,6 +49,9 @@ pub enum RenderError {
     Image(#[from] ImageRenderError),
     #[error(transparent)]
     ImageIo(#[from] ImageError),
+    /// An image that cannot be read back as the meter's readings.
+    #[error(transparent)]
+    ReadBack(#[from] spots_from_image::ReadBackError),
     #[error(transparent)]
     Convergence(#[from] ConvergenceError),
     #[error(transparent)]

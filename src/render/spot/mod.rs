@@ -6,6 +6,7 @@
 //! covariance of the mean XYZ through the Jacobian of CIELAB (the reference white is
 //! treated as exact). A reading of either renderer is a [`RenderedReading`] (`reading`).
 
+pub mod cone;
 pub mod reading;
 
 use std::time::Instant;
@@ -73,30 +74,34 @@ impl XyzStats {
     }
     /// 95 % half-width of ΔE*ab of the mean against `white`.
     pub fn de_ci95(&self, white: Xyz) -> f64 {
-        let m = self.mean();
-        let c = self.cov_mean();
-        let lab = |x: [f64; 3]| Xyz::from_array(x).to_lab(white).to_array();
-        let base = lab(m);
-        let mut jac = [[0.0; 3]; 3]; // jac[lab][xyz]
-        for k in 0..3 {
-            let h = 1e-6 * (m[k].abs() + white.to_array()[k] * 1e-3);
-            let mut p = m;
-            p[k] += h;
-            let l = lab(p);
-            for r in 0..3 {
-                jac[r][k] = (l[r] - base[r]) / h;
-            }
-        }
-        let mut var = 0.0;
-        for row in jac {
-            for i in 0..3 {
-                for j in 0..3 {
-                    var += row[i] * c[i][j] * row[j];
-                }
-            }
-        }
-        1.96 * var.max(0.0).sqrt()
+        de_ci95_of(self.mean(), self.cov_mean(), white)
     }
+}
+
+/// 95 % half-width of ΔE*ab of a mean XYZ `m` whose covariance is `c`, against `white`:
+/// 1.96 times the RMS ΔE*ab propagated through CIELAB's Jacobian (by finite differences).
+pub fn de_ci95_of(m: [f64; 3], c: [[f64; 3]; 3], white: Xyz) -> f64 {
+    let lab = |x: [f64; 3]| Xyz::from_array(x).to_lab(white).to_array();
+    let base = lab(m);
+    let mut jac = [[0.0; 3]; 3]; // jac[lab][xyz]
+    for k in 0..3 {
+        let h = 1e-6 * (m[k].abs() + white.to_array()[k] * 1e-3);
+        let mut p = m;
+        p[k] += h;
+        let l = lab(p);
+        for r in 0..3 {
+            jac[r][k] = (l[r] - base[r]) / h;
+        }
+    }
+    let mut var = 0.0;
+    for row in jac {
+        for i in 0..3 {
+            for j in 0..3 {
+                var += row[i] * c[i][j] * row[j];
+            }
+        }
+    }
+    1.96 * var.max(0.0).sqrt()
 }
 
 /// Direction of sample `u, v` uniform in solid angle inside a cone of half-angle whose

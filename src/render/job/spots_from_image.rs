@@ -1,0 +1,417 @@
+//! `metamer render spots-from-image`: the 24 meter readings taken from an image of the
+//! scene's camera that another renderer made, instead of traced, so its renderer can be
+//! validated as metamer's own are. Each patch's reading is the image's mean over the
+//! meter's cone — the aim at the patch centre from the camera's optical centre and the
+//! scene's acceptance angle, exactly as `render spots` aims — weighted by the solid angle
+//! of each pixel's part inside it, with a 95 % half-width of ΔE*ab from the pixels' spread
+//! (see [`crate::render::spot::cone`] for both and what the half-width assumes).
+//!
+//! The image is read as `render image` writes it: absolute XYZ in cd/m², rows from the
+//! top, not mirrored, the camera's vertical field of view at whatever size; its aspect
+//! ratio must be the camera's, since the horizontal field of view follows it.
+//!
+//! CIELAB needs a white the image does not show. The readings' Lab is against the scene's
+//! reference white by `render spots`' rule (a perfect white diffuser in place of patch 19,
+//! traced by the path tracer to a third of the target) or a white given. Only the XYZ and
+//! its uncertainty go on to `validate`, which computes every CIELAB against one white for
+//! all sides (the display's or the box's), so this white changes no comparison: it serves
+//! the printed Lab and the check of the image's units.
+//!
+//! Units: an image in another unit than cd/m² (W/(sr·m²) is 683 times smaller) cannot be
+//! told in general from a renderer that is wrong. What is checked: an OpenEXR
+//! `whiteLuminance` attribute, when present, must be 1 (values are cd/m²); no cone may be
+//! all zero; and patch 19, the chart's white, must read between a tenth and ten times the
+//! white diffuser. A smaller factor is left to the validation to find.
+//!
+//! ```
+//! use metamer::render::job::spots_from_image::{run, Request};
+//! # let dir = std::env::temp_dir().join(format!("metamer-doc-sfi-{}", std::process::id()));
+//! # std::fs::create_dir_all(&dir)?;
+//! # let image = dir.join("box.exr");
+//! # metamer::render::job::image::run(&metamer::render::job::image::ImageRequest {
+//! #     method: metamer::render::method::Method::Radiosity,
+//! #     level: 2,
+//! #     width: Some(128),
+//! #     height: Some(128),
+//! #     ..metamer::render::job::image::ImageRequest::new(1, image.clone())
+//! # }, &|_| {})?;
+//! // An image of the scene's camera by any renderer, as absolute XYZ.
+//! let request = Request {
+//!     target_de: 0.5,
+//!     ..Request::new(image, None) // None: the built-in validation box
+//! };
+//! let report = run(&request, &|_| {})?;
+//! for r in &report.patches {
+//!     println!("patch {}: Y {:.3} ± {:.3} ΔE*ab", r.patch, r.xyz[1], r.uncertainty.de_ab());
+//! }
+//! assert_eq!(report.patches.len(), 24);
+//! println!("{}", report.to_json()?);
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::{load_scene, RenderError, RenderEvent};
+use crate::image::{read_xyz_image, XyzImage};
+use crate::render::image::Frame;
+use crate::render::scene::Scene;
+use crate::render::spot::cone::{cone_mean, cone_pixels, ConeError, ConeMean};
+use crate::render::spot::{
+    de_ci95_of, patch_aim, reference_white, RenderedReading, Sampling, SpotOptions, Uncertainty,
+};
+
+/// What the readings' JSON names as their method: `validate` shows it as the
+/// instrument, "renderer (external image)".
+pub const METHOD: &str = "external image";
+
+/// The fewest effective pixels a cone must cover: below that its spread says little of
+/// the noise, and the rim's partial pixels dominate.
+pub const MIN_EFFECTIVE_PIXELS: f64 = 16.0;
+
+/// What to read back.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// The image, `.exr` or `.pfm`.
+    pub image: PathBuf,
+    /// The scene the image is of; None is the built-in validation box.
+    pub scene: Option<PathBuf>,
+    /// Reference white X,Y,Z (None: the scene's, by `render spots`' rule).
+    pub white: Option<[f64; 3]>,
+    /// The scene's white is traced to a third of this ΔE*ab, as `render spots` does.
+    pub target_de: f64,
+    /// Wall-clock limit (s) of tracing the white.
+    pub max_seconds: f64,
+    /// The path tracer's seed for the white.
+    pub seed: u64,
+}
+
+impl Request {
+    /// `render spots`' defaults for the white.
+    pub fn new(image: PathBuf, scene: Option<PathBuf>) -> Self {
+        Request {
+            image,
+            scene,
+            white: None,
+            target_de: 0.1,
+            max_seconds: 600.0,
+            seed: 1,
+        }
+    }
+}
+
+/// Why an image cannot be read back as the meter's readings.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadBackError {
+    #[error(
+        "{}: the image is {width}×{height} pixels, the scene camera's {camera_width}×\
+         {camera_height}: another aspect ratio is another horizontal field of view, so the \
+         pixels do not look where the camera does (render it at {camera_width}×\
+         {camera_height} or a size of the same aspect ratio)",
+        file.display()
+    )]
+    Aspect {
+        file: PathBuf,
+        width: usize,
+        height: usize,
+        camera_width: usize,
+        camera_height: usize,
+    },
+    #[error(
+        "{}: the scene has no meter (its acceptance angle), so there is no cone to read",
+        scene
+    )]
+    NoMeter { scene: String },
+    #[error("{}: patch {patch}'s 1° cone: {error}", file.display())]
+    Cone {
+        file: PathBuf,
+        patch: usize,
+        error: ConeError,
+    },
+    #[error(
+        "{}: patch {patch}'s cone covers {pixels} pixels, worth {effective:.1} equally \
+         weighted ones; at least {MIN_EFFECTIVE_PIXELS} are needed to estimate the noise: \
+         render the image larger",
+        file.display()
+    )]
+    TooCoarse {
+        file: PathBuf,
+        patch: usize,
+        pixels: usize,
+        effective: f64,
+    },
+    #[error(
+        "{}: every pixel in patch {patch}'s cone is zero: the image is black there (a light \
+         missing, or values in a unit far below cd/m²)",
+        file.display()
+    )]
+    Dark { file: PathBuf, patch: usize },
+    #[error(
+        "{}: the OpenEXR attribute whiteLuminance is {value}, so a value of 1 is not 1 cd/m²; \
+         the readings need absolute XYZ in cd/m² (whiteLuminance 1 or none)",
+        file.display()
+    )]
+    WhiteLuminance { file: PathBuf, value: f32 },
+    #[error(
+        "{}: patch 19 (the chart's white) reads Y = {patch:.4} against the white diffuser's \
+         {white:.4} cd/m², {ratio:.3} times it: outside 0.1–10, so the image is not in cd/m² \
+         of this scene (W/(sr·m²) would be 683 times too small) or not of this scene",
+        file.display()
+    )]
+    Units {
+        file: PathBuf,
+        patch: f64,
+        white: f64,
+        ratio: f64,
+    },
+}
+
+/// The readings taken from the image.
+#[derive(Debug)]
+pub struct Report {
+    pub scene: Scene,
+    pub image: PathBuf,
+    /// SHA-256 of the image file, tying the readings to the bytes read.
+    pub sha256: String,
+    pub width: usize,
+    pub height: usize,
+    /// The white the readings' CIELAB is against.
+    pub white: [f64; 3],
+    pub seconds: f64,
+    /// Each with its 95 % half-width, its standard errors and the pixels in its cone as
+    /// its samples.
+    pub patches: Vec<RenderedReading>,
+    /// Each patch's cone as the image covers it.
+    pub cones: Vec<ConeMean>,
+}
+
+/// The image a reading came from, as the JSON names it.
+#[derive(serde::Serialize)]
+struct Source<'a> {
+    file: &'a Path,
+    sha256: &'a str,
+    width: usize,
+    height: usize,
+    renderer: &'static str,
+}
+
+/// `render spots --json`'s shape, with the image in place of the solver's details.
+#[derive(serde::Serialize)]
+struct Json<'a> {
+    method: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    provenance: Option<&'a serde_json::Map<String, serde_json::Value>>,
+    image: Source<'a>,
+    white: [f64; 3],
+    seconds: f64,
+    patches: &'a [RenderedReading],
+}
+
+impl Report {
+    /// One JSON object in the shape of `render spots --json` (`method`, `provenance`,
+    /// `white`, `patches` with `XYZ`, `XYZ_stderr`, `de_ci95`, `samples`), plus `image`:
+    /// the file, its digest and size. `validate --simulation` reads it.
+    pub fn to_json(&self) -> Result<String, serde_json::Error> {
+        serde_json::to_string(&Json {
+            method: METHOD,
+            provenance: self.scene.provenance.as_ref(),
+            image: Source {
+                file: &self.image,
+                sha256: &self.sha256,
+                width: self.width,
+                height: self.height,
+                renderer: "external",
+            },
+            white: self.white,
+            seconds: self.seconds,
+            patches: &self.patches,
+        })
+    }
+}
+
+/// Checks the request, loads the scene and the image, reads the 24 cones, finds the
+/// white and checks the units. Nothing is written.
+pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, RenderError> {
+    let start = Instant::now();
+    let bad = |m: &str| Err(RenderError::BadRequest(m.into()));
+    if request.target_de.is_nan() || request.target_de <= 0.0 {
+        return bad("--target-de must be > 0");
+    }
+    if request.max_seconds.is_nan() || request.max_seconds <= 0.0 {
+        return bad("--max-seconds must be > 0");
+    }
+    if let Some(w) = request.white {
+        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
+            return bad("--white must be finite with Y > 0");
+        }
+    }
+    let name = request
+        .scene
+        .as_ref()
+        .map_or("the built-in scene".into(), |p| p.display().to_string());
+    let scene = load_scene(request.scene.as_deref(), events)?;
+    let camera = scene.camera.ok_or_else(|| RenderError::NoCamera {
+        scene: name.clone(),
+    })?;
+    if scene.meter_acceptance_deg.is_none() {
+        return Err(ReadBackError::NoMeter { scene: name }.into());
+    }
+    let file = request.image.clone();
+    let image = read_xyz_image(&file)?;
+    check_white_luminance(&file)?;
+    if image.width * camera.height != image.height * camera.width {
+        return Err(ReadBackError::Aspect {
+            file,
+            width: image.width,
+            height: image.height,
+            camera_width: camera.width,
+            camera_height: camera.height,
+        }
+        .into());
+    }
+    let cones = read_cones(&scene, &image, &file)?;
+    let white = match request.white {
+        Some(w) => w,
+        None => reference_white(
+            &scene,
+            &SpotOptions {
+                target_de: request.target_de,
+                max_seconds: request.max_seconds,
+                seed: request.seed,
+                ..SpotOptions::default()
+            },
+        )?,
+    };
+    let (patch, ratio) = (cones[18].xyz[1], cones[18].xyz[1] / white[1]);
+    if !(0.1..=10.0).contains(&ratio) {
+        return Err(ReadBackError::Units {
+            file,
+            patch,
+            white: white[1],
+            ratio,
+        }
+        .into());
+    }
+    let w = crate::color::Xyz::from_array(white);
+    let patches = cones
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let uncertainty = Uncertainty::HalfWidth95 {
+                de: de_ci95_of(c.xyz, c.cov_mean, w),
+                sampling: Some(Sampling {
+                    xyz_stderr: c.stderr(),
+                    samples: c.pixels as u64,
+                }),
+            };
+            RenderedReading::new(k + 1, c.xyz, white, uncertainty)
+        })
+        .collect();
+    let sha256 = crate::digest::sha256_file(&file).map_err(|source| {
+        RenderError::ImageIo(crate::image::ImageError::Io {
+            file: file.clone(),
+            source,
+        })
+    })?;
+    Ok(Report {
+        scene,
+        width: image.width,
+        height: image.height,
+        image: file,
+        sha256,
+        white,
+        seconds: start.elapsed().as_secs_f64(),
+        patches,
+        cones,
+    })
+}
+
+/// The 24 cones' means, patch 1 first.
+fn read_cones(scene: &Scene, image: &XyzImage, file: &Path) -> Result<Vec<ConeMean>, RenderError> {
+    let camera = scene
+        .camera
+        .ok_or(crate::render::spot::SpotError::NoCamera)?;
+    let frame = Frame::of(&camera, image.width, image.height);
+    let mut out = Vec::with_capacity(24);
+    for patch in 1..=24 {
+        let aim = patch_aim(scene, patch)?;
+        let cone_error = |error| ReadBackError::Cone {
+            file: file.to_path_buf(),
+            patch,
+            error,
+        };
+        let pixels = cone_pixels(&frame, &aim).map_err(cone_error)?;
+        let mean = cone_mean(image, &pixels).map_err(cone_error)?;
+        if mean.effective < MIN_EFFECTIVE_PIXELS {
+            return Err(ReadBackError::TooCoarse {
+                file: file.to_path_buf(),
+                patch,
+                pixels: mean.pixels,
+                effective: mean.effective,
+            }
+            .into());
+        }
+        if mean.xyz.iter().all(|&v| v == 0.0) {
+            return Err(ReadBackError::Dark {
+                file: file.to_path_buf(),
+                patch,
+            }
+            .into());
+        }
+        out.push(mean);
+    }
+    Ok(out)
+}
+
+/// An OpenEXR file's `whiteLuminance`, when it has one, must say its values are cd/m².
+/// The file has been read whole by then, so its header is known to be sound.
+fn check_white_luminance(file: &Path) -> Result<(), RenderError> {
+    let is_exr = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr {
+        return Ok(());
+    }
+    let meta = exr::meta::MetaData::read_from_file(file, false).map_err(|e| {
+        crate::image::ImageError::Exr {
+            file: file.to_path_buf(),
+            message: e.to_string(),
+        }
+    })?;
+    for header in meta.headers.iter() {
+        if let Some(value) = header.own_attributes.white_luminance {
+            if (value - 1.0).abs() > 1e-6 {
+                return Err(ReadBackError::WhiteLuminance {
+                    file: file.to_path_buf(),
+                    value,
+                }
+                .into());
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_bad_option_is_the_one_reported_before_anything_is_read() {
+        let r = Request {
+            target_de: 0.0,
+            white: Some([1.0, 0.0, 1.0]),
+            ..Request::new("none.exr".into(), Some("none.json".into()))
+        };
+        let e = run(&r, &|_| panic!("no event")).unwrap_err();
+        assert_eq!(e.to_string(), "--target-de must be > 0");
+        let r = Request {
+            white: Some([1.0, 0.0, 1.0]),
+            ..Request::new("none.exr".into(), Some("none.json".into()))
+        };
+        let e = run(&r, &|_| panic!("no event")).unwrap_err();
+        assert_eq!(e.to_string(), "--white must be finite with Y > 0");
+    }
+}
