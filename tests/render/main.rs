@@ -11,3 +11,4 @@ mod light_fit;
 mod radiosity;
 mod radiosity_bound;
 mod render_accuracy;
+mod spots_from_image;
