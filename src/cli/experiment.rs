@@ -67,6 +67,15 @@ pub struct Args {
     /// is noise-free).
     #[arg(long, default_value_t = 16, value_name = "N")]
     image_spp: u64,
+    /// Another renderer's XYZ image (.exr or .pfm, absolute cd/m²) of the measured scene's
+    /// camera: the simulation stage reads the 24 meter readings back from it (as `render
+    /// spots-from-image`) instead of rendering, and the display shows it.
+    #[arg(
+        long,
+        value_name = "IMAGE",
+        conflicts_with_all = ["image_size", "image_spp"]
+    )]
+    simulation_image: Option<PathBuf>,
     /// The simulated box's light (simulated instruments only; default display-white):
     /// display-white (the ips-lcd display's white, as the paper's box was lit by an LCD)
     /// or led-rgb1 (CIE LED-RGB1, whose saturated colours no virtual display can show).
@@ -143,6 +152,7 @@ fn request(args: Args) -> Result<Request, CliError> {
                 size: args.image_size,
                 spp: args.image_spp,
             }),
+            external_image: args.simulation_image,
         },
         display: DisplayOptions {
             screen: args.display,

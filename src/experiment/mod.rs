@@ -13,6 +13,7 @@ pub mod cache;
 pub mod display;
 pub mod display_spots;
 mod error;
+pub mod external_image;
 pub mod lab;
 pub mod measure_box;
 mod options;

@@ -178,7 +178,7 @@ impl Request {
     ///         seed: 1,
     ///         light: None,
     ///     },
-    ///     simulation: SimulationOptions { target_de: 0.1, seed: 1, max_seconds: 600.0, image: None },
+    ///     simulation: SimulationOptions { target_de: 0.1, seed: 1, max_seconds: 600.0, image: None, external_image: None },
     ///     display: DisplayOptions { screen: "virtual:ips-lcd".into(), spot: meter, model: ModelKind::Lut },
     ///     reproduction: ReproductionOptions { gamut: "nearest-lab".into(), mirror: true },
     ///     repeats: 3,

@@ -198,9 +198,16 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
                 _ => i,
             }
         }
-        Stage::Simulation => Inputs::new()
-            .file("scene", &need(stage, scene)?)?
-            .value("options", &opts.simulation),
+        Stage::Simulation => {
+            let i = Inputs::new()
+                .file("scene", &need(stage, scene)?)?
+                .value("options", &opts.simulation);
+            // The image's bytes, not only its name: a re-rendered image is a new input.
+            match &opts.simulation.external_image {
+                Some(image) => i.file("external image", image)?,
+                None => i,
+            }
+        }
         Stage::Display => {
             let i = Inputs::new().value("options", &opts.display);
             // A simulated monitor's white is set for the rendering; a real one is not.
@@ -368,6 +375,7 @@ mod tests {
             box_source: BoxSource::Existing { scene, spots },
             given_readings: None,
             simulation: SimulationOptions {
+                external_image: None,
                 target_de: 0.5,
                 seed: 1,
                 max_seconds: 60.0,

@@ -5,7 +5,7 @@
 //! tracer. Each patch's spot footprint in the image is read back and compared with its
 //! spot reading, and its place in the image recorded for aiming the meter at the display.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -37,6 +37,12 @@ pub struct SimulationOptions {
     /// The camera image (square, this many pixels a side) and its samples per pixel; None
     /// renders the spots only.
     pub image: Option<ImageSpec>,
+    /// Another renderer's XYZ image of the scene's camera: the stage reads its 24 meter
+    /// readings back (`render spots-from-image`) and shows it, instead of rendering; `image`
+    /// is then unused and `target_de` sets only the reference white's accuracy. Left out of
+    /// the options' record when None, so earlier runs' stages stay re-usable.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub external_image: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -87,6 +93,19 @@ pub struct SimulationSummary {
     pub image_method: Option<String>,
     /// The patches' spots in the image, when an image was rendered.
     pub image_patches: Vec<ImagePatch>,
+    /// Where the readings came from when metamer did not render them.
+    pub source: Option<ExternalSource>,
+}
+
+/// An external renderer's image the simulation's readings were read back from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExternalSource {
+    /// The image as given.
+    pub image: PathBuf,
+    /// SHA-256 of its bytes when read.
+    pub sha256: String,
+    /// "external renderer".
+    pub renderer: String,
 }
 
 /// `simulation.json` as written: field names, order and the old type names in serde's
@@ -104,6 +123,8 @@ struct SummaryFile {
     image_method: Option<String>,
     #[serde(default)]
     image_patches: Vec<ImagePatch>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    source: Option<ExternalSource>,
 }
 
 /// One reading as `simulation.json` keeps it.
@@ -132,6 +153,7 @@ impl From<SimulationSummary> for SummaryFile {
             image: s.image,
             image_method: s.image_method,
             image_patches: s.image_patches,
+            source: s.source,
         }
     }
 }
@@ -156,6 +178,7 @@ impl From<SummaryFile> for SimulationSummary {
             image: f.image,
             image_method: f.image_method,
             image_patches: f.image_patches,
+            source: f.source,
         }
     }
 }
@@ -171,6 +194,9 @@ pub fn simulate(
     dir: &Path,
     progress: &dyn Fn(Progress),
 ) -> Result<(SimulationSummary, Vec<&'static str>), ExperimentError> {
+    if let Some(image) = &opts.external_image {
+        return super::external_image::read_back(scene_file, image, opts, dir, progress);
+    }
     let start = Instant::now();
     // The same entry as `metamer render spots`, with the stage's options; `auto` picks the
     // solver, and its reason is not a stage note.
@@ -264,6 +290,7 @@ pub fn simulate(
         image_method: image.as_ref().map(|_| method.to_string()),
         image,
         image_patches,
+        source: None,
     };
     let text = serde_json::to_string_pretty(&summary).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SUMMARY_FILE), text.as_bytes())?;
@@ -301,7 +328,7 @@ fn render_image(
 
 /// The stage's error for a render job's: the same error the stage reported when it called
 /// the renderers itself.
-fn from_render(e: RenderError) -> ExperimentError {
+pub(super) fn from_render(e: RenderError) -> ExperimentError {
     match e {
         RenderError::Scene(e) => e.into(),
         RenderError::Spot(e) => e.into(),
@@ -317,7 +344,7 @@ fn from_render(e: RenderError) -> ExperimentError {
 
 /// Each patch's spot in `img`: where the meter aims, and the image's mean there against the
 /// spot reading.
-fn patches_in_image(
+pub(super) fn patches_in_image(
     scene: &Scene,
     img: &XyzImage,
     spots: &[RenderedReading],

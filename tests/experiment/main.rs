@@ -5,6 +5,7 @@
 mod support;
 
 mod experiment;
+mod experiment_external;
 mod experiment_image;
 mod experiment_kill;
 mod lab;

@@ -127,6 +127,7 @@ impl LabOptions {
                     size: self.image_size,
                     spp: IMAGE_SPP,
                 }),
+                external_image: None,
             },
             display: DisplayOptions {
                 screen: format!("virtual:{}", self.display.name()),

@@ -22,10 +22,20 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
     let (measure, method) = if bound {
         (
             "ΔE*ab error bound (the mesh levels' extrapolation against its alternatives)",
-            "deterministic radiosity solver",
+            "deterministic radiosity solver".to_string(),
+        )
+    } else if let Some(src) = &s.source {
+        (
+            "95 % ΔE*ab half-width (from the pixels' spread in each meter cone)",
+            format!(
+                "{}: the image {} (sha256 {}), read back",
+                src.renderer,
+                src.image.display(),
+                src.sha256
+            ),
         )
     } else {
-        ("95 % ΔE*ab half-width", "spectral path tracer")
+        ("95 % ΔE*ab half-width", "spectral path tracer".to_string())
     };
     if let Some(bad) = s
         .spots
@@ -59,7 +69,8 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
         )
     } else {
         format!(
-            "the path tracer's per-patch 95 % half-width h (largest {worst:.3} ΔE*ab), as isotropic CIELAB noise: σ = h/(1.96·√3) per axis"
+            "the {}'s per-patch 95 % half-width h (largest {worst:.3} ΔE*ab), as isotropic CIELAB noise: σ = h/(1.96·√3) per axis",
+            if s.source.is_some() { "read-back" } else { "path tracer" }
         )
     };
     Ok((
