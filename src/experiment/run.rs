@@ -285,7 +285,16 @@ fn run_stage(
         },
         Stage::Simulation => {
             let (scene, _) = box_files(opts);
-            let (_, files) = simulate(&scene, &opts.simulation, &sd.dir, progress)?;
+            let (_, files) = match &opts.simulation.external_image {
+                Some(image) => super::external_image::read_back(
+                    &scene,
+                    image,
+                    &opts.simulation,
+                    &sd.dir,
+                    progress,
+                )?,
+                None => simulate(&scene, &opts.simulation, &sd.dir, progress)?,
+            };
             Ok(owned(files))
         }
         Stage::Display => {

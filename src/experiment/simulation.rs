@@ -194,9 +194,6 @@ pub fn simulate(
     dir: &Path,
     progress: &dyn Fn(Progress),
 ) -> Result<(SimulationSummary, Vec<&'static str>), ExperimentError> {
-    if let Some(image) = &opts.external_image {
-        return super::external_image::read_back(scene_file, image, opts, dir, progress);
-    }
     let start = Instant::now();
     // The same entry as `metamer render spots`, with the stage's options; `auto` picks the
     // solver, and its reason is not a stage note.

@@ -26,6 +26,7 @@ use crate::render::probes::ProbeError;
 use crate::render::radiosity::probes::ProbeProgress;
 use crate::render::radiosity::{Level, RadiosityError};
 use crate::render::scene::{PathError, Scene, SceneError};
+use crate::render::spot::cone::ReadBackError;
 use crate::render::spot::{SpotError, SpotProgress};
 
 /// Why a render job did not finish. Wrapped errors show as they do on their own (their
@@ -51,7 +52,7 @@ pub enum RenderError {
     ImageIo(#[from] ImageError),
     /// An image that cannot be read back as the meter's readings.
     #[error(transparent)]
-    ReadBack(#[from] spots_from_image::ReadBackError),
+    ReadBack(#[from] ReadBackError),
     #[error(transparent)]
     Convergence(#[from] ConvergenceError),
     #[error(transparent)]

@@ -21,6 +21,8 @@
 //! the cone counts as noise and overstates it (a radiosity image has no noise at all and
 //! gets only that).
 
+use std::path::PathBuf;
+
 use super::Aim;
 use crate::image::XyzImage;
 use crate::render::image::{pixel_direction, Frame};
@@ -56,6 +58,76 @@ pub enum ConeError {
     },
     #[error("pixel ({x}, {y}) (from the top left) is {value:?}, not a finite XYZ ≥ 0")]
     BadPixel { x: usize, y: usize, value: [f32; 3] },
+}
+
+/// The fewest effective pixels a cone must cover: below that its spread says little of
+/// the noise, and the rim's partial pixels dominate.
+pub const MIN_EFFECTIVE_PIXELS: f64 = 16.0;
+
+/// Why an image cannot be read back as the meter's readings.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadBackError {
+    #[error(
+        "{}: the image is {width}×{height} pixels, the scene camera's {camera_width}×\
+         {camera_height}: another aspect ratio is another horizontal field of view, so the \
+         pixels do not look where the camera does (render it at {camera_width}×\
+         {camera_height} or a size of the same aspect ratio)",
+        file.display()
+    )]
+    Aspect {
+        file: PathBuf,
+        width: usize,
+        height: usize,
+        camera_width: usize,
+        camera_height: usize,
+    },
+    #[error(
+        "{}: the scene has no meter (its acceptance angle), so there is no cone to read",
+        scene
+    )]
+    NoMeter { scene: String },
+    #[error("{}: patch {patch}'s 1° cone: {error}", file.display())]
+    Cone {
+        file: PathBuf,
+        patch: usize,
+        error: ConeError,
+    },
+    #[error(
+        "{}: patch {patch}'s cone covers {pixels} pixels, worth {effective:.1} equally \
+         weighted ones; at least {MIN_EFFECTIVE_PIXELS} are needed to estimate the noise: \
+         render the image larger",
+        file.display()
+    )]
+    TooCoarse {
+        file: PathBuf,
+        patch: usize,
+        pixels: usize,
+        effective: f64,
+    },
+    #[error(
+        "{}: every pixel in patch {patch}'s cone is zero: the image is black there (a light \
+         missing, or values in a unit far below cd/m²)",
+        file.display()
+    )]
+    Dark { file: PathBuf, patch: usize },
+    #[error(
+        "{}: the OpenEXR attribute whiteLuminance is {value}, so a value of 1 is not 1 cd/m²; \
+         the readings need absolute XYZ in cd/m² (whiteLuminance 1 or none)",
+        file.display()
+    )]
+    WhiteLuminance { file: PathBuf, value: f32 },
+    #[error(
+        "{}: patch 19 (the chart's white) reads Y = {patch:.4} against the white diffuser's \
+         {white:.4} cd/m², {ratio:.3} times it: outside 0.1–10, so the image is not in cd/m² \
+         of this scene (W/(sr·m²) would be 683 times too small) or not of this scene",
+        file.display()
+    )]
+    Units {
+        file: PathBuf,
+        patch: f64,
+        white: f64,
+        ratio: f64,
+    },
 }
 
 /// The pixels of an image of `frame`'s size inside `aim`'s cone, each with its weight.
