@@ -15,10 +15,10 @@ pub(super) fn summary(a: &Approximation) -> String {
         }
         Measured::Done(d) => format!(
             "approximated: the emitter's angular distribution is written as Lambertian tiles \
-             with each tile's radiance towards the chart centre; metamer's radiosity solver \
-             puts the difference on the 24 patches at ΔE*ab max {:.3}, mean {:.3} (Y ratio \
-             {:.4}–{:.4})",
-            d.max_de, d.mean_de, d.luminance_ratio.0, d.luminance_ratio.1
+             with each tile's radiance towards the chart centre, scaled by {:.4} to fit the \
+             patches' luminance; metamer's radiosity solver puts the difference on the 24 \
+             patches at ΔE*ab max {:.3}, mean {:.3} (Y ratio {:.4}–{:.4})",
+            d.fit_scale, d.max_de, d.mean_de, d.luminance_ratio.0, d.luminance_ratio.1
         ),
         Measured::Skipped => "approximated: the emitter's angular distribution is written as \
              Lambertian tiles with each tile's radiance towards the chart centre; the \
@@ -142,9 +142,9 @@ fn emitter_section(a: &Approximation) -> String {
         "This scene's emitter has a non-Lambertian distribution (a `cos_power` or C-γ \
          table). It is written as Lambertian tiles, each with the radiance the distribution \
          gives towards {} ({}, {}, {}) m: tile t's gain is g_t·f(ω_t), with f from {} to {} \
-         over the tiles. The patches are lit almost wholly by the tiles' direct light along \
-         directions near these, so their readings change least; walls seen at larger angles \
-         receive too much light, which reaches the patches after a bounce.\n\n",
+         over the tiles. The patches' direct light leaves the tiles along directions near \
+         these, so it changes least; walls seen at larger angles receive too much light, \
+         which reaches the patches after a bounce.\n\n",
         if a.aim_is_chart {
             "the centre of the 24 ColorChecker patches"
         } else {
@@ -160,11 +160,24 @@ fn emitter_section(a: &Approximation) -> String {
         Measured::Done(d) => {
             let _ = writeln!(
                 s,
-                "**Measured difference** (metamer's radiosity solver, the scene as it is against \
-                 this Lambertian form, both against the exact scene's reference white, each \
-                 solve refined to a bound of {:.3} ΔE*ab, {:.0} s): ΔE*ab max **{:.3}**, mean \
-                 **{:.3}** over the 24 patches; Y(form)/Y(scene) from {:.4} to {:.4}. A renderer \
-                 of this export cannot agree with the box better than this.\n",
+                "Aimed at the chart alone, the tiles would send the walls more light than the \
+                 scene's distribution does, and the walls pass it on to the patches: metamer's \
+                 radiosity solver puts that form at ΔE*ab max {:.3}, mean {:.3} from the scene. \
+                 Every tile's gain is therefore multiplied by {} (`c`), the one factor that \
+                 makes the 24 patches' luminances agree with the scene's in least squares \
+                 (c = Σ Y·Y′ / Σ Y′², Y′ the aimed form's; light transport is linear in the \
+                 emission, so the written form's readings are c times the aimed form's). The \
+                 tiles' luminance towards the chart is then c times the scene's.\n\n\
+                 **Measured difference** of the written form (metamer's radiosity solver, the \
+                 scene as it is against this Lambertian form, both against the exact scene's \
+                 reference white, each solve refined to a bound of {:.3} ΔE*ab, {:.0} s): \
+                 ΔE*ab max **{:.3}**, mean **{:.3}** over the 24 patches; Y(form)/Y(scene) from \
+                 {:.4} to {:.4}. A renderer of this export cannot agree with the box better \
+                 than this, and its readings should be compared with `metamer render spots` of \
+                 the scene only within it.\n",
+                d.aimed_de.0,
+                d.aimed_de.1,
+                num(d.fit_scale),
                 d.solver_bound_de,
                 d.seconds,
                 d.max_de,
