@@ -42,10 +42,10 @@ fn render_section(to: Renderer, camera: &Camera) -> String {
              mi.set_variant(\"scalar_spectral\")\n\
              scene = mi.load_file(\"{file}\")            # spp=…, width=…, height=… override the defaults\n\
              image = mi.render(scene)\n\
-             mi.Bitmap(image, channel_names=[\"X\", \"Y\", \"Z\"]).write(\"image.exr\")\n\
+             mi.Bitmap(image).write(\"image.pfm\")     # X, Y, Z; rows bottom to top, as metamer's PFM\n\
              ```\n\n\
-             or `mitsuba -m scalar_spectral -o image.exr {file}` (`-D spp=1024` sets the \
-             samples per pixel).\n\n\
+             or `mitsuba -m scalar_spectral -D spp=1024 -o image.exr {file}`, which writes an \
+             OpenEXR file whose channels are named X, Y and Z.\n\n\
              ## The image\n\n\
              {w}×{h} pixels, vertical field of view {fov}°, from the scene camera, row 0 at the \
              top and x along the camera's right: the orientation of `metamer render image`, not \
