@@ -26,7 +26,7 @@
 
 use std::time::Instant;
 
-use super::ExportError;
+use super::error::ExportError;
 use crate::color::Xyz;
 use crate::render::geometry::Vec3;
 use crate::render::method::Method;

@@ -28,7 +28,8 @@ use std::collections::HashMap;
 use std::fmt::Write;
 use std::path::PathBuf;
 
-use super::{grid_nm, num, tiles, Approximation, File};
+use super::approximation::Approximation;
+use super::common::{grid_nm, num, tiles, File};
 use crate::render::scene::{Camera, Scene};
 
 /// The scene file's name in the export.

@@ -34,6 +34,8 @@
 //! ```
 
 pub mod approximation;
+mod common;
+mod error;
 mod mitsuba3;
 mod pbrt;
 mod readme;
@@ -41,28 +43,12 @@ mod readme;
 use std::path::{Path, PathBuf};
 
 use crate::output::{OutputError, OutputPolicy};
-use crate::render::scene::{PathError, Scene, SceneError};
+use crate::render::scene::Scene;
 
 pub use approximation::{Approximation, Difference, Measured};
-
-/// The renderers a scene can be exported to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Renderer {
-    /// Mitsuba 3, a spectral variant (`scalar_spectral`).
-    Mitsuba3,
-    /// pbrt-v4 (spectral by construction).
-    PbrtV4,
-}
-
-impl Renderer {
-    /// The name `--to` takes.
-    pub fn name(self) -> &'static str {
-        match self {
-            Renderer::Mitsuba3 => "mitsuba3",
-            Renderer::PbrtV4 => "pbrt-v4",
-        }
-    }
-}
+use common::File;
+pub use common::Renderer;
+pub use error::ExportError;
 
 /// The built-in boxes a request may name instead of a file.
 pub const BUILTIN_SCENES: [&str; 2] = ["validation-box", "validation-box-led-rgb1"];
@@ -110,35 +96,6 @@ pub struct ExportReport {
     pub summary: String,
 }
 
-/// Why an export failed.
-#[derive(Debug, thiserror::Error)]
-pub enum ExportError {
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// A built-in scene did not build: a defect of the program.
-    #[error("built-in scene {name}: {source}")]
-    Builtin { name: String, source: PathError },
-    #[error("{scene}: the scene has no camera, and an export needs one for the image")]
-    NoCamera { scene: String },
-    #[error("{scene}: emitter {emitter}: {what}")]
-    Emitter {
-        scene: String,
-        emitter: usize,
-        what: String,
-    },
-    #[error(
-        "refusing to export into {}: the directory is not empty (add --force to write into it)",
-        dir.display()
-    )]
-    NotEmpty { dir: PathBuf },
-    #[error("--spp must be at least 1")]
-    BadSpp,
-    #[error("{0}")]
-    Output(#[from] OutputError),
-    #[error("{scene}: measuring the Lambertian form's difference: {message}")]
-    Difference { scene: String, message: String },
-}
-
 /// The scene as `render spots` would load it, with the name errors use.
 fn load(scene: Option<&Path>) -> Result<(Scene, String), ExportError> {
     let builtin = |name: &str| {
@@ -177,12 +134,6 @@ fn is_non_empty(dir: &Path) -> Result<bool, ExportError> {
             source,
         })),
     }
-}
-
-/// One file of an export: its path inside the output directory and its text.
-pub(crate) struct File {
-    pub rel: PathBuf,
-    pub text: String,
 }
 
 /// Loads the scene, checks the output directory, chooses each emitter's form (measuring
@@ -229,69 +180,4 @@ pub fn run(request: &ExportRequest) -> Result<ExportReport, ExportError> {
         approximation,
         summary,
     })
-}
-
-/// A number with every digit it has: Rust's shortest representation that reads back to
-/// the same f64.
-pub(crate) fn num(x: f64) -> String {
-    if x == x.trunc() && x.abs() < 1e15 {
-        format!("{x:.1}")
-    } else {
-        format!("{x:e}")
-    }
-}
-
-/// The wavelength of bin `i` of the scene's 1 nm grid.
-pub(crate) fn grid_nm(i: usize) -> f64 {
-    (metamer_color::START_NM as usize + i) as f64
-}
-
-/// One emitter tile as both renderers write it: a rectangle radiating `radiance` (absolute,
-/// W·sr⁻¹·m⁻²·nm⁻¹ on the 1 nm grid, the written gain included) from its front.
-pub(crate) struct Tile<'a> {
-    pub emitter: usize,
-    pub row: usize,
-    pub col: usize,
-    pub corner: [f64; 3],
-    pub edge_u: [f64; 3],
-    pub edge_v: [f64; 3],
-    pub radiance: Vec<f64>,
-    /// The emitter's own reflectance (what its tiles reflect of the box's light).
-    pub reflectance: &'a [f64],
-}
-
-/// Every emitter's tiles, emitter by emitter, row by row.
-pub(crate) fn tiles<'a>(scene: &'a Scene, approximation: &Approximation) -> Vec<Tile<'a>> {
-    let mut out = Vec::new();
-    for (i, e) in scene.emitters.iter().enumerate() {
-        let (u, v) = (e.rect.edge_u / e.cols as f64, e.rect.edge_v / e.rows as f64);
-        for row in 0..e.rows {
-            for col in 0..e.cols {
-                let t = row * e.cols + col;
-                let gain = approximation.gains[i][t];
-                out.push(Tile {
-                    emitter: i,
-                    row,
-                    col,
-                    corner: (e.rect.corner + u * col as f64 + v * row as f64).to_array(),
-                    edge_u: u.to_array(),
-                    edge_v: v.to_array(),
-                    radiance: e.tile_spectrum(t).iter().map(|s| s * gain).collect(),
-                    reflectance: &e.reflectance,
-                });
-            }
-        }
-    }
-    out
-}
-
-/// The luminance (cd/m²) of a spectral radiance on the grid: 683 · Σ L · ȳ · 1 nm, the
-/// scene's own definition (paper Eq. 8).
-pub(crate) fn luminance(scene: &Scene, radiance: &[f64]) -> f64 {
-    metamer_color::K_M
-        * radiance
-            .iter()
-            .zip(&scene.cmf[1])
-            .map(|(l, y)| l * y)
-            .sum::<f64>()
 }

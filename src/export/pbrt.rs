@@ -33,7 +33,8 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 
-use super::{grid_nm, luminance, num, tiles, Approximation, File};
+use super::approximation::Approximation;
+use super::common::{grid_nm, luminance, num, tiles, File};
 use crate::render::scene::{Camera, Scene};
 
 /// The scene file's name in the export.

@@ -4,7 +4,8 @@
 use std::fmt::Write;
 
 use super::approximation::{Approximation, Measured};
-use super::{mitsuba3, num, pbrt, Renderer};
+use super::common::{num, Renderer};
+use super::{mitsuba3, pbrt};
 use crate::render::scene::Camera;
 
 /// One or two sentences on what the export approximates.

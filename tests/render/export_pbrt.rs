@@ -543,3 +543,32 @@ fn the_tokenizer_reads_pbrt_v4_comments_strings_and_brackets() {
         ]
     );
 }
+
+#[test]
+fn an_export_refuses_a_directory_that_holds_files_unless_forced() {
+    let dir = fresh_dir("export-refuse");
+    std::fs::write(dir.join("mine.txt"), "keep").unwrap();
+    let mut request = ExportRequest::new(
+        Some("validation-box-led-rgb1".into()),
+        Renderer::PbrtV4,
+        dir.clone(),
+    );
+    let err = export::run(&request).unwrap_err();
+    assert!(
+        matches!(&err, export::ExportError::NotEmpty { dir: d } if *d == dir),
+        "{err}"
+    );
+    assert!(err.to_string().contains("--force"), "{err}");
+    assert!(!dir.join("scene.pbrt").exists());
+    request.force = true;
+    let report = export::run(&request).unwrap();
+    assert_eq!(report.files.len(), 2);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("mine.txt")).unwrap(),
+        "keep"
+    );
+    // A scene that is neither a file nor a built-in name is an error naming it.
+    request.scene = Some(dir.join("no-such-scene.json"));
+    let err = export::run(&request).unwrap_err().to_string();
+    assert!(err.contains("no-such-scene.json"), "{err}");
+}
