@@ -11,6 +11,7 @@ pub mod color;
 pub mod digest;
 pub mod display;
 pub mod experiment;
+pub mod export;
 pub mod image;
 pub mod light;
 pub mod measure_box;

@@ -10,6 +10,7 @@ mod characterize;
 mod color;
 mod devices;
 mod experiment;
+mod export;
 mod fit;
 mod lab;
 mod light;
@@ -63,6 +64,8 @@ enum Command {
     Validate(validate::Args),
     /// Serve a simulated instrument to other programs (a CS-100A on a pseudo-terminal).
     Simulate(simulate::Args),
+    /// Write a scene for another renderer (Mitsuba 3, pbrt-v4), with a README beside it.
+    Export(export::Args),
 }
 
 /// A command's failure: usage errors exit 2, data and device errors exit 1.
@@ -97,6 +100,7 @@ pub fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Light(args) => light::run(args),
         Command::Validate(args) => validate::run(args),
+        Command::Export(args) => export::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

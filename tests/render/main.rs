@@ -6,6 +6,8 @@
 mod support;
 
 mod cie171;
+mod export_mitsuba;
+mod export_pbrt;
 mod light_files;
 mod light_fit;
 mod radiosity;
