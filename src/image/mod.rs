@@ -9,12 +9,16 @@
 //! another for its pixels. One error, [`ImageError`], says what is wrong with an image or
 //! its file.
 
+mod chromaticities;
 mod error;
 mod exr_layout;
+#[cfg(test)]
+mod foreign_exr_tests;
 mod rgb;
 mod xyz;
 mod xyz_file;
 
+pub use chromaticities::{Chromaticities, XYZ_CHROMATICITIES};
 pub use error::ImageError;
 pub use rgb::{RgbImage, ScreenSpot};
 pub use xyz::{XyzImage, MAX_PIXELS};

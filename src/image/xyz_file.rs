@@ -7,8 +7,12 @@
 //! (0,0,1) and (1,1,1) — is R = (1,0), G = (0,1), B = (0,0), W = (1/3,1/3): then (1,0,0) is
 //! pure X, and so on. `whiteLuminance`, the cd/m² of (1,1,1), is 1 because the values are
 //! cd/m² and (1,1,1) has Y = 1. A reader that honours the attributes converts to its display
-//! correctly; without them it would take XYZ for Rec. 709 RGB. Files are read back only
-//! when they carry these chromaticities or none (metamer wrote none before).
+//! correctly; without them it would take XYZ for Rec. 709 RGB.
+//!
+//! Read back are: R, G, B with these chromaticities or none (metamer wrote none before);
+//! R, G, B with another space's chromaticities, converted by the matrix they define (pbrt-v4
+//! can only write its film's RGB space and names it there); and channels named X, Y, Z
+//! (Mitsuba 3's XYZ films).
 //!
 //! Every reader refuses what would make the rest of the chain lie or stall: sizes whose
 //! pixel count overflows or exceeds [`MAX_PIXELS`], an OpenEXR file whose header, offset
@@ -18,6 +22,7 @@
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
+use super::chromaticities::{self, Chromaticities, XYZ_CHROMATICITIES};
 use super::error::ImageError;
 use super::exr_layout;
 use super::xyz::{XyzImage, MAX_PIXELS};
@@ -181,41 +186,144 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
     exr_layout::check(&bytes).map_err(bad)?;
     let meta = MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
         .map_err(|e| exr_error(path, e))?;
+    let mut layout = None;
     for header in meta.headers.iter() {
         let size = header.layer_size;
         pixel_count(path, size.width(), size.height())?;
-        let xyz = xyz_chromaticities();
-        if let Some(c) = header.shared_attributes.chromaticities {
-            if c != xyz {
-                return Err(bad(format!(
-                    "holds RGB with primaries R {:?}, G {:?}, B {:?} (white {:?}), not XYZ \
-                     (R (1,0), G (0,1), B (0,0), white (1/3,1/3))",
-                    c.red, c.green, c.blue, c.white
-                )));
-            }
+        if layout.is_none() {
+            layout = Some(exr_channels(header).map_err(bad)?);
         }
     }
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .rgba_channels(
-            |res, _| XyzImage {
-                width: res.width(),
-                height: res.height(),
-                pixels: vec![[0.0; 3]; res.width() * res.height()],
-            },
-            |img: &mut XyzImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                let w = img.width;
-                img.pixels[pos.y() * w + pos.x()] = [r, g, b];
-            },
-        )
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(std::io::Cursor::new(&bytes))
-        .map_err(|e| exr_error(path, e))?;
-    let img = image.layer_data.channel_data.pixels;
+    let layout = layout.ok_or_else(|| bad("holds no image".into()))?;
+    fn create(res: exr::math::Vec2<usize>) -> XyzImage {
+        XyzImage {
+            width: res.width(),
+            height: res.height(),
+            pixels: vec![[0.0; 3]; res.width() * res.height()],
+        }
+    }
+    fn set(img: &mut XyzImage, pos: exr::math::Vec2<usize>, v: [f32; 3]) {
+        let w = img.width;
+        img.pixels[pos.y() * w + pos.x()] = v;
+    }
+    let mut img = match layout {
+        ExrChannels::Xyz => {
+            read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .specific_channels()
+                .required("X")
+                .required("Y")
+                .required("Z")
+                .collect_pixels(
+                    |res, _| create(res),
+                    |img: &mut XyzImage, pos, (x, y, z): (f32, f32, f32)| set(img, pos, [x, y, z]),
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(std::io::Cursor::new(&bytes))
+                .map_err(|e| exr_error(path, e))?
+                .layer_data
+                .channel_data
+                .pixels
+        }
+        ExrChannels::Rgb(_) => {
+            read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .rgba_channels(
+                    |res, _| create(res),
+                    |img: &mut XyzImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                        set(img, pos, [r, g, b])
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(std::io::Cursor::new(&bytes))
+                .map_err(|e| exr_error(path, e))?
+                .layer_data
+                .channel_data
+                .pixels
+        }
+    };
+    if let ExrChannels::Rgb(Some(m)) = layout {
+        for p in &mut img.pixels {
+            *p = chromaticities::apply(&m, *p);
+        }
+    }
     check_finite(path, &img)?;
     Ok(img)
+}
+
+/// Which channels of an OpenEXR part hold the XYZ, and how.
+#[derive(Clone, Copy, Debug)]
+enum ExrChannels {
+    /// Channels named X, Y, Z (Mitsuba 3's `specfilm` with those names, its `hdrfilm`'s
+    /// `xyz` format).
+    Xyz,
+    /// R, G, B: XYZ itself (XYZ's chromaticities, or none), or RGB to convert by the matrix
+    /// its `chromaticities` attribute defines.
+    Rgb(Option<[[f64; 3]; 3]>),
+}
+
+/// The layout of the first part, or why it cannot be read as XYZ.
+fn exr_channels(header: &exr::meta::header::Header) -> Result<ExrChannels, String> {
+    let has = |name: &str| header.channels.list.iter().any(|c| c.name.eq(name));
+    let stated = header
+        .shared_attributes
+        .chromaticities
+        .map(|c| Chromaticities {
+            red: [f64::from(c.red.0), f64::from(c.red.1)],
+            green: [f64::from(c.green.0), f64::from(c.green.1)],
+            blue: [f64::from(c.blue.0), f64::from(c.blue.1)],
+            white: [f64::from(c.white.0), f64::from(c.white.1)],
+        });
+    let is_xyz = |c: &Chromaticities| {
+        let near =
+            |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
+        let x = XYZ_CHROMATICITIES;
+        near(c.red, x.red)
+            && near(c.green, x.green)
+            && near(c.blue, x.blue)
+            && near(c.white, x.white)
+    };
+    if has("X") && has("Y") && has("Z") {
+        return match stated {
+            Some(c) if !is_xyz(&c) => Err(format!(
+                "names its channels X, Y, Z but its chromaticities say RGB with primaries R \
+                 {:?}, G {:?}, B {:?} (white {:?})",
+                c.red, c.green, c.blue, c.white
+            )),
+            _ => Ok(ExrChannels::Xyz),
+        };
+    }
+    if !(has("R") && has("G") && has("B")) {
+        let names: Vec<String> = header
+            .channels
+            .list
+            .iter()
+            .map(|c| metamer_color::text::echo(&c.name.to_string()))
+            .collect();
+        return Err(format!(
+            "has the channels {} — an XYZ image needs X, Y, Z, or R, G, B with the \
+             chromaticities they hold",
+            names.join(", ")
+        ));
+    }
+    match stated {
+        None => Ok(ExrChannels::Rgb(None)),
+        Some(c) if is_xyz(&c) => Ok(ExrChannels::Rgb(None)),
+        Some(c) => c
+            .rgb_to_xyz()
+            .map(|m| ExrChannels::Rgb(Some(m)))
+            .ok_or_else(|| {
+                format!(
+                "holds RGB whose chromaticities (R {:?}, G {:?}, B {:?}, white {:?}) define no \
+                 conversion to XYZ",
+                c.red, c.green, c.blue, c.white
+            )
+            }),
+    }
 }
 
 fn pfm_bytes(img: &XyzImage) -> Vec<u8> {

@@ -8,6 +8,7 @@ mod support;
 mod cie171;
 mod export_mitsuba;
 mod export_pbrt;
+mod export_round_trip;
 mod light_files;
 mod light_fit;
 mod radiosity;
