@@ -61,7 +61,8 @@ enum Cmd {
 
 #[derive(clap::Args)]
 struct SpotsArgs {
-    /// The scene file (default: the validation box built into the program).
+    /// The scene file, or a built-in box by name (validation-box, validation-box-led-rgb1;
+    /// default: validation-box).
     scene: Option<PathBuf>,
     /// Stop when every patch's 95 % half-width of ΔE*ab is below this.
     #[arg(long, default_value_t = 0.1)]
@@ -86,7 +87,8 @@ struct SpotsArgs {
 struct SpotsFromImageArgs {
     /// The image (.exr or .pfm): absolute XYZ in cd/m², rows from the top, not mirrored.
     image: PathBuf,
-    /// The scene the image is of (default: the validation box built into the program).
+    /// The scene the image is of: a file, or a built-in box by name (validation-box,
+    /// validation-box-led-rgb1; default: validation-box).
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Reference white X,Y,Z for the readings' CIELAB (default: a perfect white diffuser
@@ -107,7 +109,8 @@ struct SpotsFromImageArgs {
 
 #[derive(clap::Args)]
 struct ImageArgs {
-    /// The scene file (default: the built-in validation box).
+    /// The scene file, or a built-in box by name (validation-box, validation-box-led-rgb1;
+    /// default: validation-box).
     scene: Option<PathBuf>,
     /// Samples per pixel (radiosity: a √spp × √spp grid of rays, spp rounded down to a
     /// square).
@@ -162,7 +165,8 @@ struct ProbesArgs {
 
 #[derive(clap::Args)]
 struct ConvergenceArgs {
-    /// The scene file (default: the built-in validation box).
+    /// The scene file, or a built-in box by name (validation-box, validation-box-led-rgb1;
+    /// default: validation-box).
     scene: Option<PathBuf>,
     #[arg(short, long)]
     output: PathBuf,

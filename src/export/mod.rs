@@ -50,9 +50,6 @@ use common::File;
 pub use common::Renderer;
 pub use error::ExportError;
 
-/// The built-in boxes a request may name instead of a file.
-pub const BUILTIN_SCENES: [&str; 2] = ["validation-box", "validation-box-led-rgb1"];
-
 /// What to export.
 #[derive(Clone, Debug)]
 pub struct ExportRequest {
@@ -107,14 +104,11 @@ fn load(scene: Option<&Path>) -> Result<(Scene, String), ExportError> {
             })
     };
     match scene {
-        None => builtin(BUILTIN_SCENES[0]),
-        Some(p) => {
-            let named = p.to_str().filter(|n| BUILTIN_SCENES.contains(n));
-            match named {
-                Some(name) if !p.exists() => builtin(name),
-                _ => Ok((Scene::load(p)?, p.display().to_string())),
-            }
-        }
+        None => builtin(crate::render::scene::builtin::NAMES[0]),
+        Some(p) => match Scene::builtin_named(p) {
+            Some(name) => builtin(name),
+            None => Ok((Scene::load(p)?, p.display().to_string())),
+        },
     }
 }
 

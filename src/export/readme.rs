@@ -224,9 +224,16 @@ pub(super) fn text(
     s.push_str(spectra_section(to));
     s.push('\n');
     s.push_str(&emitter_section(a));
-    s.push_str(
-        "\n## Reading the image back\n\n`metamer render spots-from-image` reads the image back \
-         as 24 meter readings; see `metamer render spots-from-image --help`.\n",
-    );
+    s.push_str(&format!(
+        "\n## Reading the image back\n\n`metamer render spots-from-image IMAGE --scene {} --json > \
+         readings.json` reads the image back as the 24 meter readings, each with its \
+         uncertainty from the pixels' spread; `metamer validate --reference SPOTS \
+         --simulation readings.json` compares them with the box, and `metamer experiment \
+         --simulation-image IMAGE` runs the whole chain with this renderer's image as the \
+         simulation.\n",
+        scene_name
+            .strip_prefix("built-in scene ")
+            .unwrap_or(scene_name)
+    ));
     s
 }

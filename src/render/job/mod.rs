@@ -117,11 +117,15 @@ pub struct ImageReport {
     pub preview: Option<PathBuf>,
 }
 
-/// The scene at `path`, or the built-in validation box; its warnings go to `events`.
+/// The scene at `path` (or the built-in box it names, see [`Scene::builtin_named`]), or the
+/// default built-in box; its warnings go to `events`.
 pub fn load_scene(path: Option<&Path>, events: &dyn Fn(RenderEvent)) -> Result<Scene, RenderError> {
     let scene = match path {
-        Some(p) => Scene::load(p)?,
-        None => Scene::builtin("validation-box")?,
+        Some(p) => match Scene::builtin_named(p) {
+            Some(name) => Scene::builtin(name)?,
+            None => Scene::load(p)?,
+        },
+        None => Scene::builtin(crate::render::scene::builtin::NAMES[0])?,
     };
     for w in &scene.warnings {
         events(RenderEvent::SceneWarning(w));

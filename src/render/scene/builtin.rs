@@ -34,6 +34,9 @@ pub fn data_file(name: &str) -> Option<&'static str> {
     })
 }
 
+/// The built-in boxes' names, the first the default.
+pub const NAMES: [&str; 2] = ["validation-box", "validation-box-led-rgb1"];
+
 /// The text of a built-in box by name (`validation-box`, `validation-box-led-rgb1`; any
 /// other name is the default box).
 pub fn scene_text(name: &str) -> &'static str {

@@ -106,6 +106,14 @@ impl Scene {
         build::builtin_scene(builtin::scene_text(name))
     }
 
+    /// The built-in box a scene argument names: one of [`builtin::NAMES`] when no file of
+    /// that name exists (a file always wins, so a scene saved under such a name still loads).
+    pub fn builtin_named(path: &Path) -> Option<&'static str> {
+        let name = path.to_str()?;
+        let known = builtin::NAMES.iter().find(|n| **n == name)?;
+        (!path.exists()).then_some(*known)
+    }
+
     /// The surface index of ColorChecker patch `k` (1–24).
     pub fn patch_surface(&self, k: usize) -> Option<usize> {
         self.surfaces.iter().position(|s| s.patch == Some(k))
@@ -118,5 +126,24 @@ impl Scene {
             .iter()
             .map(|e| e.intensity_cd(&self.cmf[1]))
             .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_built_in_name_names_its_box() {
+        assert_eq!(
+            Scene::builtin_named(Path::new("validation-box-led-rgb1")),
+            Some("validation-box-led-rgb1")
+        );
+        assert_eq!(Scene::builtin_named(Path::new("no-such-box")), None);
+        // The LED box is lit by the LED table, the default box by the display's white: two
+        // scenes, not one under two names.
+        let led = Scene::builtin("validation-box-led-rgb1").unwrap();
+        let default = Scene::builtin(builtin::NAMES[0]).unwrap();
+        assert_ne!(led.emitters[0].spectra, default.emitters[0].spectra);
     }
 }
