@@ -332,7 +332,7 @@ impl Study<'_> {
                 let reading = self.meter.measure(&Request::default())?;
                 patches.push(Sample {
                     rgb: rgb.map(|c| f64::from(c) / 255.0),
-                    xyz: reading.xyz,
+                    xyz: reading.xyz.to_array(),
                 });
             }
             let start = Instant::now();

@@ -106,7 +106,7 @@ impl Profile {
         // The white is the CIELAB reference of every colour reproduced: a zero or NaN white
         // makes every L*a*b* NaN.
         for (name, xyz) in [("white_xyz", p.white_xyz), ("black_xyz", p.black_xyz)] {
-            metamer_color::check_xyz(xyz).map_err(|e| ProfileError::Parameters {
+            metamer_color::check_xyz(xyz.into()).map_err(|e| ProfileError::Parameters {
                 file: file.clone(),
                 message: format!("{name}: {e}"),
             })?;

@@ -86,7 +86,7 @@ pub fn check_prediction(
     rgb: [f64; 3],
     predicted: [f64; 3],
 ) -> Result<(), VerifyError> {
-    match metamer_color::check_xyz(predicted) {
+    match metamer_color::check_xyz(predicted.into()) {
         Err(
             e @ (metamer_color::Implausible::NotFinite(_)
             | metamer_color::Implausible::TooBright { .. }),

@@ -107,7 +107,7 @@ pub fn group(readings: &[&Reading], noise: Repeatability) -> Result<GroupStats, 
         .map(|(_, r)| *r)
         .collect();
     let k = kept.len() as f64;
-    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz).collect();
+    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz.to_array()).collect();
     let (xyz, cov) = covariance::sample(&xs);
     let sd_y = cov[1][1].sqrt();
     let noise_y = noise.sigma_y(xyz[1]);

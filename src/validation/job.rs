@@ -334,9 +334,9 @@ fn choose_white(white: &White, sides: &Sides) -> Result<(Xyz, String), Validatio
         White::Display => sides.display.white_or_brightest(),
         White::Box => sides.box_readings.white_or_brightest(),
         White::Given(v) => {
-            metamer_color::check_xyz(*v)
-                .map_err(|e| ValidationError::GivenWhite(format!("not a white: {e}")))?;
             let white = Xyz::from_array(*v);
+            metamer_color::check_xyz(white)
+                .map_err(|e| ValidationError::GivenWhite(format!("not a white: {e}")))?;
             plausible::check_given_white(white)
                 .and_then(|()| plausible::check_white_against(white, &sets))
                 .map_err(|e| ValidationError::GivenWhite(e.to_string()))?;

@@ -54,7 +54,7 @@ pub fn scratch(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
 }
 
 fn finite_xyz(what: &str, xyz: [f64; 3]) -> Check {
-    check_xyz(xyz).map_err(|e| format!("{what} accepted: {e}"))
+    check_xyz(xyz.into()).map_err(|e| format!("{what} accepted: {e}"))
 }
 
 fn cs100a(bytes: &[u8], _: &Path) -> Check {

@@ -202,7 +202,7 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
         .unwrap()
         .iter()
         .enumerate()
-        .map(|(i, &x)| (i + 1, x))
+        .map(|(i, &x)| (i + 1, x.to_array()))
         .collect();
     let (limited, _, _) = render_scene(&band_limited(&truth, &plan)).unwrap();
     let (sys, _) = compare_readings(&truth_xyz, &limited, white, "band-limited").unwrap();

@@ -137,7 +137,7 @@ pub fn finish(
         .filter(|(p, r)| p.purpose == Purpose::Fit && usable(r))
         .map(|(p, r)| Sample {
             rgb: p.rgb.map(|c| f64::from(c) / 255.0),
-            xyz: r.xyz,
+            xyz: r.xyz.to_array(),
         })
         .collect();
     let profile = fit_profile(model, &training, Some(log))
@@ -151,7 +151,7 @@ pub fn finish(
         .filter(|(_, r)| usable(r))
         .map(|(p, r)| Sample {
             rgb: p.rgb.map(|c| f64::from(c) / 255.0),
-            xyz: r.xyz,
+            xyz: r.xyz.to_array(),
         })
         .collect();
     let description = format!(

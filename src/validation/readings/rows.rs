@@ -11,7 +11,7 @@ impl Parsed {
     /// is refused where it enters: downstream it becomes an infinite CIELAB and a figure
     /// whose axis never ends.
     fn plausible(&self, r: &Row) -> Result<(), ReadingsError> {
-        metamer_color::check_xyz(r.xyz)
+        metamer_color::check_xyz(r.xyz.into())
             .map_err(|e| self.bad(r.line, format!("not a measurement: {e}")))?;
         for (what, spread) in [("standard deviation", r.sd), ("standard error", r.stderr)] {
             if let Some(v) = spread {

@@ -66,11 +66,11 @@ impl PatchReading {
                     .filter(|(q, _)| *q == p)
                     .map(|(_, r)| *r)
                     .collect();
-                let xs: Vec<[f64; 3]> = of_patch.iter().map(|r| r.xyz).collect();
+                let xs: Vec<[f64; 3]> = of_patch.iter().map(|r| r.xyz.to_array()).collect();
                 let (xyz, mut cov) = covariance::sample(&xs);
                 if let [one] = of_patch.as_slice() {
                     if let Some(c) = Repeatability::emissive_of(&one.instrument)
-                        .and_then(|r| r.covariance(one.xyz))
+                        .and_then(|r| r.covariance(one.xyz.to_array()))
                     {
                         cov = c;
                     }
@@ -167,7 +167,7 @@ mod tests {
         );
         let stated = Repeatability::emissive_of("cs100a")
             .unwrap()
-            .covariance(one.xyz)
+            .covariance(one.xyz.to_array())
             .unwrap();
         assert_eq!(g[0].1.reading_covariance(), stated);
         assert!(
