@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::cache::write_atomic;
 use super::error::ExperimentError;
 use super::simulation::ImagePatch;
+use crate::color::Xyz;
 use crate::display::gamut::GamutMapping;
 use crate::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use crate::display::Profile;
@@ -93,7 +94,7 @@ pub fn reproduce(
     opts: &ReproductionOptions,
 ) -> Result<(Reproduction, Vec<&'static str>), ExperimentError> {
     let mapping = opts.mapping()?;
-    let targets: Vec<[f64; 3]> = spots.iter().map(|s| s.xyz).collect();
+    let targets: Vec<Xyz> = spots.iter().map(|s| s.xyz.into()).collect();
     let drives = reproduce_targets(profile, &targets, mapping);
     let patches: Vec<PatchDrive> = spots
         .iter()
@@ -101,7 +102,7 @@ pub fn reproduce(
         .map(|(s, d)| PatchDrive {
             patch: s.patch,
             target_xyz: s.xyz,
-            unclipped_rgb: profile.inverse(s.xyz).unclipped,
+            unclipped_rgb: profile.inverse(s.xyz.into()).unclipped,
             out_of_gamut: d.out_of_gamut,
             rgb8: d.rgb.map(quantize),
         })
@@ -161,7 +162,10 @@ fn region(profile: &Profile, img: &XyzImage, p: &ImagePatch, mirror: bool) -> Pa
                 continue;
             }
             pixels += 1;
-            if profile.inverse(img.at(x, y).map(f64::from)).out_of_gamut {
+            if profile
+                .inverse(Xyz::from(img.at(x, y).map(f64::from)))
+                .out_of_gamut
+            {
                 out += 1;
             }
         }

@@ -107,6 +107,11 @@ impl Xyz {
         self.to_array().into_iter()
     }
 
+    /// Each component through `f`, as an array's `map` does.
+    pub fn map(self, mut f: impl FnMut(f64) -> f64) -> Xyz {
+        Xyz::new(f(self.x), f(self.y), f(self.z))
+    }
+
     /// Whether X, Y and Z are all finite numbers.
     pub fn is_finite(&self) -> bool {
         self.x.is_finite() && self.y.is_finite() && self.z.is_finite()

@@ -99,8 +99,8 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
                     ),
                 });
             }
-            let xyz = [v[3], v[4], v[5]];
-            metamer_color::check_xyz(xyz.into()).map_err(|e| MeasurementsError::Cgats {
+            let xyz = Xyz::new(v[3], v[4], v[5]);
+            metamer_color::check_xyz(xyz).map_err(|e| MeasurementsError::Cgats {
                 file: path.to_path_buf(),
                 line: *line,
                 message: format!("not a measurement: {e}"),
@@ -396,9 +396,9 @@ impl Table {
     fn patches(&self, scale: f64) -> Result<Vec<Sample>, LineError> {
         let mut patches = Vec::with_capacity(self.rows.len());
         for &(line, v) in &self.rows {
-            let xyz = [v[3] * scale, v[4] * scale, v[5] * scale];
+            let xyz = Xyz::new(v[3] * scale, v[4] * scale, v[5] * scale);
             // Each row passed alone; the white's luminance can still scale it past belief.
-            metamer_color::check_xyz(xyz.into())
+            metamer_color::check_xyz(xyz)
                 .map_err(|e| (line, format!("not a measurement once scaled to cd/m²: {e}")))?;
             patches.push(Sample {
                 rgb: [v[0] / 100.0, v[1] / 100.0, v[2] / 100.0],
@@ -554,7 +554,7 @@ DESCRIPTOR "Argyll Device Calibration State"
             p[1],
             Sample {
                 rgb: [0.5, 0.0, 0.0],
-                xyz: [10.0, 5.0, 0.5]
+                xyz: Xyz::new(10.0, 5.0, 0.5)
             }
         );
         std::fs::write(&path, "r,g,b,X,Y,Z\n1,1,1,95,100,108\n2,0,0,10,5,0.5\n").unwrap();
