@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Subcommand;
 
 use super::{parse_triple, CliError, CliResult};
+use metamer::color::Xyz;
 use metamer::render::job::convergence::ConvergenceRequest;
 use metamer::render::job::image::ImageRequest;
 use metamer::render::job::probes::{ProbesReport, ProbesRequest};
@@ -211,7 +212,7 @@ fn spots(a: SpotsArgs) -> CliResult {
         scene: a.scene,
         method: a.method.into(),
         target_de: a.target_de,
-        white: a.white,
+        white: a.white.map(Xyz::from),
         max_seconds: a.max_seconds,
         seed: a.seed,
     };
@@ -300,7 +301,7 @@ fn print_spots(readings: &Readings) {
         }
     }
     for p in readings.patches() {
-        let ([x, y, z], [l, a, b]) = (p.xyz, p.lab);
+        let (Xyz { x, y, z }, [l, a, b]) = (p.xyz, p.lab);
         let row = format!(
             "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3}",
             p.patch

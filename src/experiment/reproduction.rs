@@ -45,7 +45,7 @@ impl ReproductionOptions {
 pub struct PatchDrive {
     pub patch: usize,
     #[serde(rename = "target_XYZ")]
-    pub target_xyz: [f64; 3],
+    pub target_xyz: Xyz,
     /// The inverse model's drive values before gamut handling (outside 0–1 when out of gamut).
     pub unclipped_rgb: [f64; 3],
     pub out_of_gamut: bool,
@@ -94,7 +94,7 @@ pub fn reproduce(
     opts: &ReproductionOptions,
 ) -> Result<(Reproduction, Vec<&'static str>), ExperimentError> {
     let mapping = opts.mapping()?;
-    let targets: Vec<Xyz> = spots.iter().map(|s| s.xyz.into()).collect();
+    let targets: Vec<Xyz> = spots.iter().map(|s| s.xyz).collect();
     let drives = reproduce_targets(profile, &targets, mapping);
     let patches: Vec<PatchDrive> = spots
         .iter()
@@ -102,7 +102,7 @@ pub fn reproduce(
         .map(|(s, d)| PatchDrive {
             patch: s.patch,
             target_xyz: s.xyz,
-            unclipped_rgb: profile.inverse(s.xyz.into()).unclipped,
+            unclipped_rgb: profile.inverse(s.xyz).unclipped,
             out_of_gamut: d.out_of_gamut,
             rgb8: d.rgb.map(quantize),
         })

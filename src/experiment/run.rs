@@ -283,7 +283,7 @@ fn run_stage(
             Ok(owned(files))
         }
         Stage::Display => {
-            let targets: Vec<Xyz> = sim_summary()?.spots.iter().map(|s| s.xyz.into()).collect();
+            let targets: Vec<Xyz> = sim_summary()?.spots.iter().map(|s| s.xyz).collect();
             let (_, files) = characterize_display(
                 &sd.dir,
                 &opts.display,

@@ -179,7 +179,7 @@ impl SimulatedBox {
         let (rendered, _, _) = render_scene(&self.scene_json())?;
         Ok(self
             .spots
-            .get_or_init(|| rendered.iter().map(|r| r.xyz.into()).collect()))
+            .get_or_init(|| rendered.iter().map(|r| r.xyz).collect()))
     }
 
     /// The truth as a scene file.

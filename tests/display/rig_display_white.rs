@@ -77,7 +77,7 @@ fn ips_lcd_reach(scene: &str) -> Vec<(usize, [f64; 3], bool)> {
         ..RadiosityOptions::default()
     };
     let r = render_spots_radiosity(&scene, &opts, &|_| {}).unwrap();
-    let targets: Vec<Xyz> = r.patches.iter().map(|p| Xyz::from(p.xyz)).collect();
+    let targets: Vec<Xyz> = r.patches.iter().map(|p| p.xyz).collect();
     let panel = VirtualPanel::preset(Preset::IpsLcd);
     let panel = panel.with_white_luminance(white_luminance_for(&panel, &targets));
     let black = Vector3::from(panel.xyz([0; 3]).to_array());
@@ -92,11 +92,11 @@ fn ips_lcd_reach(scene: &str) -> Vec<(usize, [f64; 3], bool)> {
     r.patches
         .iter()
         .map(|p| {
-            let lin = inv * (Vector3::from(p.xyz) - black);
+            let lin = inv * (Vector3::from(p.xyz.to_array()) - black);
             (
                 p.patch,
                 [lin[0], lin[1], lin[2]],
-                panel.drive_for(p.xyz.into()).is_some(),
+                panel.drive_for(p.xyz).is_some(),
             )
         })
         .collect()

@@ -141,7 +141,7 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
 /// repeatability, where the row names an instrument that has one.
 fn stated_covariance(row: &Row) -> Option<Cov3> {
     let rep = Repeatability::emissive_of(row.instrument.as_deref()?)?;
-    rep.covariance(row.xyz)
+    rep.covariance(row.xyz.into())
 }
 
 /// The uncertainty of the mean of `rows` (at `mean`) as factors, with its degrees of

@@ -70,7 +70,7 @@ impl PatchReading {
                 let (xyz, mut cov) = covariance::sample(&xs);
                 if let [one] = of_patch.as_slice() {
                     if let Some(c) = Repeatability::emissive_of(&one.instrument)
-                        .and_then(|r| r.covariance(one.xyz.to_array()))
+                        .and_then(|r| r.covariance(one.xyz))
                     {
                         cov = c;
                     }
@@ -167,7 +167,7 @@ mod tests {
         );
         let stated = Repeatability::emissive_of("cs100a")
             .unwrap()
-            .covariance(one.xyz.to_array())
+            .covariance(one.xyz)
             .unwrap();
         assert_eq!(g[0].1.reading_covariance(), stated);
         assert!(
