@@ -27,7 +27,10 @@ fn bench(c: &mut Criterion) {
                     (i % n) as f64 / (n - 1) as f64,
                     (i / n) as f64 / (n - 1) as f64,
                 );
-                profile.forward([x, y, (x + y) / 2.0]).map(|v| v as f32)
+                profile
+                    .forward([x, y, (x + y) / 2.0])
+                    .to_array()
+                    .map(|v| v as f32)
             })
             .collect();
         let image = XyzImage {

@@ -5,7 +5,7 @@
 //! [`CalibrationCondition`] asks for ("put the meter on its white tile"), then calls
 //! [`Instrument::calibrate`] with that condition; the instrument may answer with another.
 
-use metamer_color::{Spectrum, XyY};
+use metamer_color::{Spectrum, XyY, Xyz};
 use serde::{Deserialize, Serialize};
 
 pub use crate::mode::{CalibrationCondition, MeasureMode};
@@ -139,7 +139,7 @@ impl Flag {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Reading {
     /// CIE 1931 XYZ: cd/m² for emissive readings, Y = 100 for white in reflective mode.
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Chromaticity and luminance as the instrument reports them (x, y, Y).
     pub xyy: [f64; 3],
     /// The spectrum where the instrument measures one, tagged with its quantity (radiance,
@@ -158,7 +158,7 @@ impl Reading {
     /// Builds a reading from Yxy as colorimeters report it, converted by the colour core's
     /// [`XyY::to_xyz`] (no chromaticity: X and Z are NaN).
     pub fn from_yxy(luminance: f64, x: f64, y: f64, instrument: &str) -> Reading {
-        let xyz = XyY { x, y, luminance }.to_xyz().to_array();
+        let xyz = XyY { x, y, luminance }.to_xyz();
         Reading {
             xyz,
             xyy: [x, y, luminance],
@@ -175,7 +175,7 @@ impl Reading {
     /// reflectance, the XYZ under D65 with white at Y = 100, the spectrum's ends held.
     /// None for a spectrum that does not say what it measures. A reading read back from a
     /// file whose XYZ is not this was edited or damaged.
-    pub fn xyz_of_spectrum(spectrum: &Spectrum) -> Option<[f64; 3]> {
+    pub fn xyz_of_spectrum(spectrum: &Spectrum) -> Option<Xyz> {
         use metamer_color::{
             radiance_to_xyz, reflectance_to_xyz, Illuminant, ObserverKind, Outside, Quantity,
         };
@@ -189,7 +189,7 @@ impl Reading {
                 radiance_to_xyz(spectrum, ObserverKind::Cie1931)
             }
         };
-        Some(xyz.to_array())
+        Some(xyz)
     }
 }
 
@@ -284,7 +284,7 @@ mod tests {
                                "quantity": "radiance"})
         );
         // X = 0.3·30/0.6 = 15, Z = 0.1·30/0.6 = 5.
-        for (got, want) in reading.xyz.iter().zip([15.0, 30.0, 5.0]) {
+        for (got, want) in reading.xyz.to_array().iter().zip([15.0, 30.0, 5.0]) {
             assert!((got - want).abs() < 1e-12, "{:?}", reading.xyz);
         }
         let back: Reading = serde_json::from_value(json).unwrap();

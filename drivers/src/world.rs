@@ -6,7 +6,7 @@
 
 use std::sync::RwLock;
 
-use metamer_color::{radiance_to_xyz, ObserverKind, Quantity, Spectrum};
+use metamer_color::{radiance_to_xyz, ObserverKind, Quantity, Spectrum, Xyz};
 
 use crate::DriverError;
 
@@ -14,13 +14,14 @@ use crate::DriverError;
 /// of CIE illuminant LED-RGB1 (x, y) = (0.45576, 0.42110), computed from
 /// `data/illuminant_led_rgb1.csv` with the CIE 1931 2° observer by `metamer color xyz`
 /// (checked by `tests/cs100a_sim.rs`).
-pub const DEFAULT_STIMULUS_XYZ: [f64; 3] = [108.229_360_132_203_85, 100.0, 29.242_246_576_178_09];
+pub const DEFAULT_STIMULUS_XYZ: Xyz =
+    Xyz::new(108.229_360_132_203_85, 100.0, 29.242_246_576_178_09);
 
 /// Light arriving from a source.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     /// CIE 1931 XYZ in cd/m², for simulations that know only the colour.
-    Xyz([f64; 3]),
+    Xyz(Xyz),
     /// Spectral radiance in W·sr⁻¹·m⁻²·nm⁻¹ (tagged [`Quantity::Radiance`]).
     Radiance(Spectrum),
 }
@@ -28,10 +29,10 @@ pub enum Light {
 impl Light {
     /// CIE 1931 XYZ in cd/m², from the radiance by the colour core (paper Eq. 8) when the
     /// light is spectral.
-    pub fn xyz(&self) -> [f64; 3] {
+    pub fn xyz(&self) -> Xyz {
         match self {
             Light::Xyz(xyz) => *xyz,
-            Light::Radiance(s) => radiance_to_xyz(s, ObserverKind::Cie1931).to_array(),
+            Light::Radiance(s) => radiance_to_xyz(s, ObserverKind::Cie1931),
         }
     }
 
@@ -60,7 +61,7 @@ pub enum View {
 
 impl View {
     /// Light of this CIE 1931 XYZ in cd/m².
-    pub fn xyz(xyz: [f64; 3]) -> View {
+    pub fn xyz(xyz: Xyz) -> View {
         View::Emissive(Light::Xyz(xyz))
     }
 
@@ -89,9 +90,16 @@ impl View {
 }
 
 /// A bare XYZ is light of that colour, so code that knows only XYZ stays short.
+impl From<Xyz> for View {
+    fn from(xyz: Xyz) -> View {
+        View::xyz(xyz)
+    }
+}
+
+/// The array form of [`Xyz`], as tests and literal stimuli write it.
 impl From<[f64; 3]> for View {
     fn from(xyz: [f64; 3]) -> View {
-        View::xyz(xyz)
+        View::xyz(xyz.into())
     }
 }
 
@@ -174,6 +182,9 @@ mod tests {
             .unwrap();
         assert_eq!(world.view(), View::Capped);
         world.set([4.0, 5.0, 6.0]);
-        assert_eq!(world.view().light(), Some(&Light::Xyz([4.0, 5.0, 6.0])));
+        assert_eq!(
+            world.view().light(),
+            Some(&Light::Xyz(Xyz::new(4.0, 5.0, 6.0)))
+        );
     }
 }

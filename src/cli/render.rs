@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Subcommand;
 
 use super::{parse_triple, CliError, CliResult};
+use metamer::color::Xyz;
 use metamer::render::job::convergence::ConvergenceRequest;
 use metamer::render::job::image::ImageRequest;
 use metamer::render::job::probes::{ProbesReport, ProbesRequest};
@@ -245,7 +246,7 @@ fn spots(a: SpotsArgs) -> CliResult {
         scene: a.scene,
         method: a.method.into(),
         target_de: a.target_de,
-        white: a.white,
+        white: a.white.map(Xyz::from),
         max_seconds: a.max_seconds,
         seed: a.seed,
     };
@@ -334,7 +335,7 @@ fn print_spots(readings: &Readings) {
         }
     }
     for p in readings.patches() {
-        let ([x, y, z], [l, a, b]) = (p.xyz, p.lab);
+        let (Xyz { x, y, z }, [l, a, b]) = (p.xyz, p.lab);
         let row = format!(
             "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3}",
             p.patch
@@ -351,7 +352,7 @@ fn print_spots(readings: &Readings) {
 
 fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
     let request = SpotsFromImageRequest {
-        white: a.white,
+        white: a.white.map(Xyz::from),
         target_de: a.target_de,
         max_seconds: a.max_seconds,
         seed: a.seed,
@@ -380,7 +381,7 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
         "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "pixels", "effective"
     );
     for (p, c) in report.patches.iter().zip(&report.cones) {
-        let ([x, y, z], [l, a, b]) = (p.xyz, p.lab);
+        let ([x, y, z], [l, a, b]) = (p.xyz.to_array(), p.lab);
         println!(
             "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3} {:>8.4} {:>7} {:>9.1}",
             p.patch,

@@ -4,6 +4,7 @@
 use std::io::Write;
 
 use clap::{Subcommand, ValueEnum};
+use metamer::color::Xyz;
 use metamer::rig::sim_meter::{PtyMeter, PtyMeterError, PtyMeterOptions};
 
 use super::{parse_triple, CliError, CliResult};
@@ -60,7 +61,7 @@ fn cs100a(args: Cs100aArgs) -> CliResult {
     }
     let defaults = PtyMeterOptions::default();
     let options = PtyMeterOptions {
-        xyz: args.xyz.unwrap_or(defaults.xyz),
+        xyz: args.xyz.map(Xyz::from).unwrap_or(defaults.xyz),
         noise: matches!(args.noise, OnOff::On),
         seed: args.seed,
         time_scale: args.time_scale,

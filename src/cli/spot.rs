@@ -5,6 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
+use metamer::color::Xyz;
 use metamer::spot::{self, SpotEvent, SpotRequest, SpotRunError};
 use metamer_drivers::{MeasureMode, Reading, Speed};
 
@@ -128,7 +129,7 @@ fn json_line(r: &Reading) -> String {
     #[derive(serde::Serialize)]
     struct Line<'a> {
         #[serde(rename = "XYZ")]
-        xyz: [f64; 3],
+        xyz: Xyz,
         #[serde(rename = "xyY")]
         xyy: [f64; 3],
         flags: Vec<&'static str>,

@@ -86,7 +86,7 @@ pub fn run(args: Args) -> CliResult {
         "test" => White::Display,
         "reference" => White::Box,
         s => match parse_triple(s) {
-            Ok(v) => White::Given(v),
+            Ok(v) => White::Given(v.into()),
             // A file that cannot be read is said before a malformed white.
             Err(e) => {
                 read_sides(&readings, true)?;

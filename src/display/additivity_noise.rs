@@ -64,11 +64,11 @@ impl std::fmt::Display for NoiseSource {
 /// read more than once; None without such repeats.
 pub fn repeat_reading_noise(patches: &[Sample]) -> Option<ReadingNoise> {
     let key = |p: &Sample| p.rgb.map(|d| (d * 1e6).round() as i64);
-    let mut groups: std::collections::BTreeMap<[i64; 3], Vec<[f64; 3]>> = Default::default();
+    let mut groups: std::collections::BTreeMap<[i64; 3], Vec<Xyz>> = Default::default();
     for p in patches {
         groups.entry(key(p)).or_default().push(p.xyz);
     }
-    let mean_y = |g: &[[f64; 3]]| g.iter().map(|v| v[1]).sum::<f64>() / g.len() as f64;
+    let mean_y = |g: &[Xyz]| g.iter().map(|v| v[1]).sum::<f64>() / g.len() as f64;
     let brightest = groups.values().map(|g| mean_y(g)).fold(0.0, f64::max);
     let (mut sxy, mut sy, mut dof) = (0.0, 0.0, 0usize);
     // Dark repeats (black above all) scatter in chromaticity far more than the bright
@@ -163,7 +163,7 @@ pub fn check_noise_de00(set: &SortedSamples, noise: ReadingNoise, white: Xyz) ->
     let prim = [set.primaries[0]?, set.primaries[1]?, set.primaries[2]?];
     let count = |c: usize| set.ramp_readings[c].last().copied().unwrap_or(1).max(1) as f64;
     let mut rng = metamer_drivers::noise::SplitMix64::new(SEED);
-    let mut shift = |v: [f64; 3], n: f64| -> [f64; 3] {
+    let mut shift = |v: Xyz, n: f64| -> [f64; 3] {
         let s = v[0] + v[1] + v[2];
         let scale = 1.0 / n.sqrt();
         let y = v[1] * (1.0 + noise.y_rel * scale * rng.normal());
@@ -180,16 +180,13 @@ pub fn check_noise_de00(set: &SortedSamples, noise: ReadingNoise, white: Xyz) ->
         let moved: [f64; 3] = std::array::from_fn(|k| {
             measured[k] + dw[k] - (dp[0][k] + dp[1][k] + dp[2][k] - 2.0 * dk[k])
         });
-        let e = delta_e2000(
-            Xyz::from_array(moved).to_lab(white),
-            Xyz::from_array(measured).to_lab(white),
-        );
+        let e = delta_e2000(Xyz::from(moved).to_lab(white), measured.to_lab(white));
         sum2 += e * e;
     }
     Some((sum2 / DRAWS as f64).sqrt()).filter(|e| e.is_finite())
 }
 
-fn xy(v: [f64; 3]) -> [f64; 2] {
+fn xy(v: Xyz) -> [f64; 2] {
     let s = v[0] + v[1] + v[2];
     [v[0] / s, v[1] / s]
 }
@@ -215,7 +212,7 @@ mod tests {
         };
         let mut out = vec![Sample {
             rgb: [0.0; 3],
-            xyz: read(black),
+            xyz: read(black).into(),
         }];
         for c in 0..3 {
             for k in 1..=levels {
@@ -225,14 +222,14 @@ mod tests {
                 rgb[c] = d;
                 out.push(Sample {
                     rgb,
-                    xyz: read(std::array::from_fn(|i| black[i] + l * prim[c][i])),
+                    xyz: read(std::array::from_fn(|i| black[i] + l * prim[c][i])).into(),
                 });
             }
         }
         let white = std::array::from_fn(|i| black[i] + (0..3).map(|c| prim[c][i]).sum::<f64>());
         out.push(Sample {
             rgb: [1.0; 3],
-            xyz: read(white),
+            xyz: read(white).into(),
         });
         out
     }
@@ -262,7 +259,10 @@ mod tests {
     /// x and y do not move. The black read twice (Y 0.05 and 0.10) is too dark to count.
     #[test]
     fn repeats_give_the_spread_of_bright_readings_by_hand() {
-        let p = |rgb: [f64; 3], xyz: [f64; 3]| Sample { rgb, xyz };
+        let p = |rgb: [f64; 3], xyz: [f64; 3]| Sample {
+            rgb,
+            xyz: xyz.into(),
+        };
         let patches = [
             p([1.0; 3], [95.0, 100.0, 108.0]),
             p([1.0; 3], [96.9, 102.0, 110.16]),
@@ -283,7 +283,7 @@ mod tests {
     #[test]
     fn the_checks_noise_is_nil_without_noise_and_scales_with_it() {
         let set = SortedSamples::new(&ramp_set(16, 0.0, 0.0, 1));
-        let white = Xyz::from_array(set.white.unwrap());
+        let white = set.white.unwrap();
         let at = |xy, y_rel| {
             let source = NoiseSource::Ramps(1);
             check_noise_de00(&set, ReadingNoise { xy, y_rel, source }, white).unwrap()

@@ -180,8 +180,8 @@ pub fn run_budget_study(
     let mut points = Vec::new();
     for &preset in presets {
         let panel = VirtualPanel::preset(preset);
-        let white = Xyz::from_array(panel.xyz([255; 3]));
-        let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
+        let white = panel.xyz([255; 3]);
+        let targets: Vec<Xyz> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
         let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
         let mut meter = cs100a_at_once(seed).open(Some(stimulus.clone()))?;
         let mut study = Study {
@@ -266,12 +266,12 @@ pub fn run_mixture_study(
     let mut points = Vec::new();
     for &preset in presets {
         let panel = VirtualPanel::preset(preset);
-        let targets: Vec<[f64; 3]> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
+        let targets: Vec<Xyz> = targets_rgb.iter().map(|&c| panel.xyz(c)).collect();
         let stimulus = Arc::new(SharedWorld::new([0.0; 3]));
         let mut meter = cs100a_at_once(seed).open(Some(stimulus.clone()))?;
         let mut study = Study {
             panel: &panel,
-            white: Xyz::from_array(panel.xyz([255; 3])),
+            white: panel.xyz([255; 3]),
             targets: &targets,
             stimulus: &stimulus,
             meter: meter.as_mut(),
@@ -307,7 +307,7 @@ pub fn run_mixture_study(
 struct Study<'a> {
     panel: &'a VirtualPanel,
     white: Xyz,
-    targets: &'a [[f64; 3]],
+    targets: &'a [Xyz],
     stimulus: &'a SharedWorld,
     meter: &'a mut dyn metamer_drivers::Instrument,
     trials: usize,
@@ -342,11 +342,8 @@ impl Study<'_> {
             fit_ms += start.elapsed().as_secs_f64() * 1e3;
             errors.extend(self.targets.iter().map(|&t| {
                 let rgb = profile.inverse(t).rgb;
-                let shown = Xyz::from_array(self.panel.xyz_of_drive(rgb));
-                delta_e2000(
-                    shown.to_lab(self.white),
-                    Xyz::from_array(t).to_lab(self.white),
-                )
+                let shown = self.panel.xyz_of_drive(rgb);
+                delta_e2000(shown.to_lab(self.white), t.to_lab(self.white))
             }));
         }
         Ok(Some((errors, fit_ms / self.trials as f64)))

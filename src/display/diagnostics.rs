@@ -104,7 +104,7 @@ pub const REPEAT_Y_TOLERANCE: f64 = 0.01;
 pub const REPEAT_XY_TOLERANCE: f64 = 0.005;
 
 /// Why a patch's repeats disagree beyond the instruments' repeatability, if they do.
-fn disagreement(rgb: [f64; 3], xyzs: &[[f64; 3]]) -> Option<String> {
+fn disagreement(rgb: [f64; 3], xyzs: &[Xyz]) -> Option<String> {
     let ys: Vec<f64> = xyzs.iter().map(|x| x[1]).collect();
     let (lo, hi) = ys
         .iter()
@@ -137,10 +137,10 @@ fn disagreement(rgb: [f64; 3], xyzs: &[[f64; 3]]) -> Option<String> {
 
 /// The scatter of repeated readings: RMS ΔE00 of each reading from its patch's mean, with
 /// n − 1 degrees of freedom per patch; None when no patch was measured twice.
-pub fn repeat_noise(patches: &[Sample], white: [f64; 3]) -> Option<Noise> {
-    let w = Xyz::from_array(white);
+pub fn repeat_noise(patches: &[Sample], white: Xyz) -> Option<Noise> {
+    let w = white;
     let key = |p: &Sample| p.rgb.map(|d| (d * 1e6).round() as i64);
-    let mut groups: std::collections::HashMap<[i64; 3], Vec<[f64; 3]>> = Default::default();
+    let mut groups: std::collections::HashMap<[i64; 3], Vec<Xyz>> = Default::default();
     for p in patches {
         groups.entry(key(p)).or_default().push(p.xyz);
     }
@@ -167,14 +167,11 @@ pub fn repeat_noise(patches: &[Sample], white: [f64; 3]) -> Option<Noise> {
     })
 }
 
-fn de(a: [f64; 3], b: [f64; 3], white: Xyz) -> f64 {
-    delta_e2000(
-        Xyz::from_array(a).to_lab(white),
-        Xyz::from_array(b).to_lab(white),
-    )
+fn de(a: impl Into<Xyz>, b: impl Into<Xyz>, white: Xyz) -> f64 {
+    delta_e2000(a.into().to_lab(white), b.into().to_lab(white))
 }
 
-fn xy(v: [f64; 3]) -> (f64, f64) {
+fn xy(v: impl std::ops::Index<usize, Output = f64>) -> (f64, f64) {
     let s = v[0] + v[1] + v[2];
     (v[0] / s, v[1] / s)
 }
@@ -202,18 +199,18 @@ impl Diagnostics {
     pub fn compute(
         set: &SortedSamples,
         model: ModelKind,
-        white: [f64; 3],
+        white: Xyz,
         residuals: Residuals,
         noise: Option<Noise>,
         mixed: usize,
         folded: Option<(usize, usize)>,
     ) -> Diagnostics {
-        let w = Xyz::from_array(white);
+        let w = white;
         let mut channels = Vec::new();
         let mut additivity = None;
         let mut condition = None;
         let black_share = set.black.map(|b| b[1] / white[1]);
-        let primaries: Option<Vec<[f64; 3]>> = set.primaries.iter().copied().collect();
+        let primaries: Option<Vec<Xyz>> = set.primaries.iter().copied().collect();
         if let (Some(black), Some(prims)) = (set.black, primaries) {
             let col = |c: usize| -> [f64; 3] { std::array::from_fn(|k| prims[c][k] - black[k]) };
             let m: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| col(c)[r]));

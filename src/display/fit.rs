@@ -151,17 +151,14 @@ pub fn fit_params(
 }
 
 /// ΔE00 (relative to `white`) and XYZ differences between the model and every patch.
-pub fn residuals(model: &dyn DisplayModel, patches: &[Sample], white: [f64; 3]) -> Residuals {
-    let w = Xyz::from_array(white);
+pub fn residuals(model: &dyn DisplayModel, patches: &[Sample], white: Xyz) -> Residuals {
+    let w = white;
     let mut des = Vec::with_capacity(patches.len());
     let mut sq = 0.0;
     let mut worst = (0.0, [0.0; 3]);
     for p in patches {
         let f = model.forward(p.rgb);
-        let e = delta_e2000(
-            Xyz::from_array(f).to_lab(w),
-            Xyz::from_array(p.xyz).to_lab(w),
-        );
+        let e = delta_e2000(f.to_lab(w), p.xyz.to_lab(w));
         sq += (0..3).map(|k| (f[k] - p.xyz[k]).powi(2)).sum::<f64>();
         if e > worst.0 || des.is_empty() {
             worst = (e, p.rgb);

@@ -43,8 +43,8 @@ impl std::fmt::Display for GamutMapping {
     }
 }
 
-fn lab_of(forward: &dyn Fn([f64; 3]) -> [f64; 3], rgb: [f64; 3], white: Xyz) -> Vector3<f64> {
-    let Lab { l, a, b } = Xyz::from_array(forward(rgb)).to_lab(white);
+fn lab_of(forward: &dyn Fn([f64; 3]) -> Xyz, rgb: [f64; 3], white: Xyz) -> Vector3<f64> {
+    let Lab { l, a, b } = forward(rgb).to_lab(white);
     Vector3::new(l, a, b)
 }
 
@@ -61,7 +61,7 @@ fn clamp01(v: [f64; 3]) -> [f64; 3] {
 /// the cube (or piecewise linear), so this converges in a handful of iterations; the test
 /// against an exhaustive grid search checks it finds the global optimum on real shapes.
 pub fn nearest_lab(
-    forward: &dyn Fn([f64; 3]) -> [f64; 3],
+    forward: &dyn Fn([f64; 3]) -> Xyz,
     start: [f64; 3],
     target: Xyz,
     white: Xyz,
@@ -145,7 +145,7 @@ pub fn nearest_lab(
 /// solution.
 pub fn map_to_gamut(
     mapping: GamutMapping,
-    forward: &dyn Fn([f64; 3]) -> [f64; 3],
+    forward: &dyn Fn([f64; 3]) -> Xyz,
     unclipped: [f64; 3],
     target: Xyz,
     white: Xyz,
@@ -163,7 +163,7 @@ mod tests {
 
     /// An additive display with sRGB primaries (IEC 61966-2-1 matrix), a 2.2 power law
     /// and 100 cd/m² white.
-    fn display(rgb: [f64; 3]) -> [f64; 3] {
+    fn display(rgb: [f64; 3]) -> Xyz {
         let m = [
             [0.4124, 0.3576, 0.1805],
             [0.2126, 0.7152, 0.0722],
@@ -174,24 +174,21 @@ mod tests {
         for i in 0..3 {
             out[i] = 100.0 * (m[i][0] * lin[0] + m[i][1] * lin[1] + m[i][2] * lin[2]);
         }
-        out
+        out.into()
     }
 
     fn white() -> Xyz {
-        Xyz::from_array(display([1.0; 3]))
+        display([1.0; 3])
     }
 
     fn de(rgb: [f64; 3], target: Xyz) -> f64 {
-        delta_e76(
-            Xyz::from_array(display(rgb)).to_lab(white()),
-            target.to_lab(white()),
-        )
+        delta_e76(display(rgb).to_lab(white()), target.to_lab(white()))
     }
 
     #[test]
     fn an_in_gamut_target_is_reached_exactly() {
         let rgb = [0.3, 0.7, 0.2];
-        let target = Xyz::from_array(display(rgb));
+        let target = display(rgb);
         let got = nearest_lab(&display, [0.5; 3], target, white());
         assert!(de(got, target) < 1e-6, "ΔE {}", de(got, target));
         for k in 0..3 {
@@ -255,7 +252,7 @@ mod tests {
 
     #[test]
     fn nearest_lab_is_never_worse_than_clipping() {
-        let target = Xyz::from_array([12.0, 19.0, 42.0]);
+        let target = Xyz::new(12.0, 19.0, 42.0);
         let clipped = [0.0, 0.55, 1.0];
         let got = map_to_gamut(
             GamutMapping::NearestLab,

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::diagnostics::{Diagnostics, Residuals};
 use super::model::{DisplayModel, Inverse, ModelKind, ModelParams};
+use crate::color::Xyz;
 
 /// The `format` value of profiles this version writes and reads.
 pub const PROFILE_FORMAT: &str = "metamer-display-profile-1";
@@ -27,8 +28,8 @@ pub struct Profile {
     pub model: ModelKind,
     pub parameters: ModelParams,
     /// The display white (measured when a white patch was), cd/m²; the CIELAB reference.
-    pub white_xyz: [f64; 3],
-    pub black_xyz: [f64; 3],
+    pub white_xyz: Xyz,
+    pub black_xyz: Xyz,
     pub residuals: Residuals,
     pub diagnostics: Diagnostics,
     pub input: Option<FittedFrom>,
@@ -68,12 +69,12 @@ impl Profile {
     }
 
     /// Drive values 0–1 → absolute XYZ, cd/m².
-    pub fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+    pub fn forward(&self, rgb: [f64; 3]) -> Xyz {
         self.model().forward(rgb)
     }
 
     /// XYZ → drive values, with out-of-gamut reported.
-    pub fn inverse(&self, xyz: [f64; 3]) -> Inverse {
+    pub fn inverse(&self, xyz: Xyz) -> Inverse {
         self.model().inverse(xyz)
     }
 
@@ -116,7 +117,7 @@ impl Profile {
                 file,
                 message: format!(
                     "white_xyz {:?} has no luminance; the white must have Y > 0",
-                    p.white_xyz
+                    p.white_xyz.to_array()
                 ),
             });
         }

@@ -27,7 +27,7 @@ pub struct Drive {
     pub out_of_gamut: bool,
 }
 
-fn drive_of(profile: &Profile, xyz: [f64; 3], mapping: GamutMapping) -> Drive {
+fn drive_of(profile: &Profile, xyz: Xyz, mapping: GamutMapping) -> Drive {
     let Inverse {
         rgb,
         unclipped,
@@ -38,8 +38,8 @@ fn drive_of(profile: &Profile, xyz: [f64; 3], mapping: GamutMapping) -> Drive {
             mapping,
             &|d| profile.forward(d),
             unclipped,
-            Xyz::from_array(xyz),
-            Xyz::from_array(profile.white_xyz),
+            xyz,
+            profile.white_xyz,
         )
     } else {
         rgb
@@ -48,11 +48,7 @@ fn drive_of(profile: &Profile, xyz: [f64; 3], mapping: GamutMapping) -> Drive {
 }
 
 /// Drive values for each target, in order.
-pub fn reproduce_targets(
-    profile: &Profile,
-    targets: &[[f64; 3]],
-    mapping: GamutMapping,
-) -> Vec<Drive> {
+pub fn reproduce_targets(profile: &Profile, targets: &[Xyz], mapping: GamutMapping) -> Vec<Drive> {
     targets
         .par_iter()
         .map(|&xyz| drive_of(profile, xyz, mapping))
@@ -85,7 +81,7 @@ pub fn reproduce_image(
             for (x, out) in row.iter_mut().enumerate() {
                 let sx = if mirror { w - 1 - x } else { x };
                 let p = image.pixels[y * w + sx];
-                let d = drive_of(profile, p.map(f64::from), mapping);
+                let d = drive_of(profile, Xyz::from(p.map(f64::from)), mapping);
                 count += usize::from(d.out_of_gamut);
                 *out = d.rgb.map(|v| v as f32);
             }
@@ -152,11 +148,11 @@ pub fn write_drive_png(
 }
 
 /// Reads a targets CSV with the header `X,Y,Z` (cd/m²).
-pub fn read_targets(path: &Path) -> Result<Vec<[f64; 3]>, CsvError> {
+pub fn read_targets(path: &Path) -> Result<Vec<Xyz>, CsvError> {
     let t = NumericCsv::read(path, &["X", "Y", "Z"])?;
     Ok(t.rows
         .into_iter()
-        .map(|(_, v)| [v[0], v[1], v[2]])
+        .map(|(_, v)| Xyz::new(v[0], v[1], v[2]))
         .collect())
 }
 

@@ -199,7 +199,7 @@ pub fn select_model(
     let reading_noise = repeat_reading_noise(patches).or_else(|| ramp_noise(&full));
     let additivity_noise_de00 = white
         .zip(reading_noise)
-        .and_then(|(w, n)| check_noise_de00(&full, n, Xyz::from_array(w)).map(|e| (e, n.source)));
+        .and_then(|(w, n)| check_noise_de00(&full, n, w).map(|e| (e, n.source)));
     // Two white readings differ by σ√2, and the white and the sum of four readings by what
     // the ramps' noise propagates to; beyond twice the larger the model, not the meter, is
     // to blame.
@@ -211,8 +211,7 @@ pub fn select_model(
     let mixtures = MixtureEvidence {
         mixed: n_mixed,
         few: n_mixed < MIN_MIXED,
-        additivity_de00: white
-            .and_then(|w| Additivity::check(&full, Xyz::from_array(w)).map(|a| a.de00)),
+        additivity_de00: white.and_then(|w| Additivity::check(&full, w).map(|a| a.de00)),
         additivity_noise_de00,
         allowance_de00: TOLERANCE_DE00 + 2.0 * spread,
     };
@@ -310,9 +309,8 @@ pub fn select_model(
 }
 
 /// ΔE00 between two XYZ, CIELAB relative to `white`.
-fn de(a: [f64; 3], b: [f64; 3], white: [f64; 3]) -> f64 {
-    let w = Xyz::from_array(white);
-    delta_e2000(Xyz::from_array(a).to_lab(w), Xyz::from_array(b).to_lab(w))
+fn de(a: Xyz, b: Xyz, white: Xyz) -> f64 {
+    delta_e2000(a.to_lab(white), b.to_lab(white))
 }
 
 /// Fewest free parameters first: a power law, gain-offset-gamma (two, three per channel),
@@ -413,12 +411,9 @@ fn cross_validate(
         let set = SortedSamples::new(&train);
         let params = fit_params(kind, &set, &train, options).map_err(|e| e.to_string())?;
         let model = params.model();
-        let white = Xyz::from_array(set.white.unwrap_or_else(|| model.forward([1.0; 3])));
+        let white = set.white.unwrap_or_else(|| model.forward([1.0; 3]));
         for (i, p) in patches.iter().enumerate().filter(|(i, _)| held_out[*i]) {
-            let e = delta_e2000(
-                Xyz::from_array(model.forward(p.rgb)).to_lab(white),
-                Xyz::from_array(p.xyz).to_lab(white),
-            );
+            let e = delta_e2000(model.forward(p.rgb).to_lab(white), p.xyz.to_lab(white));
             per_patch[i] = e;
             sum += e;
             count += 1;

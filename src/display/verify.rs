@@ -41,8 +41,8 @@ pub struct PatchError {
     /// Index of the patch in the file, from 1.
     pub index: usize,
     pub rgb: [f64; 3],
-    pub measured_xyz: [f64; 3],
-    pub predicted_xyz: [f64; 3],
+    pub measured_xyz: Xyz,
+    pub predicted_xyz: Xyz,
     pub de00: f64,
     pub de76: f64,
 }
@@ -81,11 +81,7 @@ pub enum VerifyError {
 /// error it makes, which the ΔE shows. Only what is no number, or brighter than any
 /// display, is not: its ΔE would be NaN or infinite, and a mean over it NaN while the
 /// maximum hides it.
-pub fn check_prediction(
-    index: usize,
-    rgb: [f64; 3],
-    predicted: [f64; 3],
-) -> Result<(), VerifyError> {
+pub fn check_prediction(index: usize, rgb: [f64; 3], predicted: Xyz) -> Result<(), VerifyError> {
     match metamer_color::check_xyz(predicted) {
         Err(
             e @ (metamer_color::Implausible::NotFinite(_)
@@ -93,7 +89,7 @@ pub fn check_prediction(
         ) => Err(VerifyError::BadPrediction {
             index,
             rgb,
-            predicted,
+            predicted: predicted.to_array(),
             why: e.to_string(),
         }),
         _ => Ok(()),
@@ -108,7 +104,7 @@ pub fn verify_profile(
     if patches.is_empty() {
         return Err(VerifyError::NoSamples);
     }
-    let white = Xyz::from_array(profile.white_xyz);
+    let white = profile.white_xyz;
     let mut errors = Vec::with_capacity(patches.len());
     for (i, p) in patches.iter().enumerate() {
         let ok =
@@ -121,16 +117,13 @@ pub fn verify_profile(
         }
         let predicted = profile.forward(p.rgb);
         check_prediction(i + 1, p.rgb, predicted)?;
-        let (a, b) = (
-            Xyz::from_array(predicted).to_lab(white),
-            Xyz::from_array(p.xyz).to_lab(white),
-        );
+        let (a, b) = (predicted.to_lab(white), p.xyz.to_lab(white));
         let (de00, de76) = (delta_e2000(a, b), delta_e76(a, b));
         if !(de00.is_finite() && de76.is_finite()) {
             return Err(VerifyError::BadPrediction {
                 index: i + 1,
                 rgb: p.rgb,
-                predicted,
+                predicted: predicted.to_array(),
                 why: format!("its ΔE00 is {de00}, its ΔE*ab {de76}"),
             });
         }

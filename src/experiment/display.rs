@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::ExperimentError;
 use super::progress::Progress;
+use crate::color::Xyz;
 use crate::display::characterize::{self, default_grid_steps, CharacterizeError, PlanOptions};
 use crate::display::{ModelKind, Profile};
 use crate::rig::{Screen, ScreenSpec, VirtualPanel};
@@ -35,7 +36,7 @@ pub struct DisplaySetting {
     /// A simulated monitor's full-white luminance, set for the rendering (cd/m²).
     pub virtual_white_cd_m2: Option<f64>,
     /// The measured white, cd/m².
-    pub white_xyz: [f64; 3],
+    pub white_xyz: Xyz,
     /// The lowest full-white luminance at which every rendered patch whose chromaticity the
     /// display can show fits without clipping (cd/m²).
     pub needed_white_cd_m2: f64,
@@ -65,9 +66,10 @@ const LUMINANCE_HEADROOM: f64 = 1.05;
 /// mapping is needed. The panel's own primaries at its nominal setting give the linear
 /// drives (paper Eq. 9 without the TRC); targets outside the primaries' triangle need gamut
 /// mapping whatever the luminance, so they do not raise it.
-pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
-    let black = Vector3::from(panel.xyz([0; 3]));
-    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb)) - black;
+pub fn white_luminance_for(panel: &VirtualPanel, targets: &[Xyz]) -> f64 {
+    let vector = |v: Xyz| Vector3::new(v.x, v.y, v.z);
+    let black = vector(panel.xyz([0; 3]));
+    let column = |rgb: [u8; 3]| vector(panel.xyz(rgb)) - black;
     let m = Matrix3::from_columns(&[
         column([255, 0, 0]),
         column([0, 255, 0]),
@@ -79,7 +81,7 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[[f64; 3]]) -> f64 {
     };
     let needed = targets
         .iter()
-        .map(|t| inv * Vector3::from(*t))
+        .map(|t| inv * vector(*t))
         .filter(|lin| lin.iter().all(|&c| c >= 0.0))
         .map(|lin| lin.max())
         .fold(0.0, f64::max);
@@ -107,7 +109,7 @@ pub fn open_meter(
 /// The factor by which the display's white must at least be raised so that `target` fits:
 /// the largest scale s ≤ 1 at which s·target is inside the profile's gamut, inverted. None
 /// when no scale brings it inside (a chromaticity the primaries cannot make).
-fn brightness_needed(profile: &Profile, target: [f64; 3]) -> Option<f64> {
+fn brightness_needed(profile: &Profile, target: Xyz) -> Option<f64> {
     let inside = |s: f64| !profile.inverse(target.map(|v| v * s)).out_of_gamut;
     if inside(1.0) {
         return Some(1.0);
@@ -129,7 +131,7 @@ fn brightness_needed(profile: &Profile, target: [f64; 3]) -> Option<f64> {
 }
 
 /// The white luminance the rendering needs on the display `profile` describes.
-pub fn needed_white(profile: &Profile, targets: &[[f64; 3]]) -> f64 {
+pub fn needed_white(profile: &Profile, targets: &[Xyz]) -> f64 {
     let factor = targets
         .iter()
         .filter_map(|t| brightness_needed(profile, *t))
@@ -167,7 +169,7 @@ impl<F: FnMut(&StepProgress<'_>)> characterize::Listener for StageListener<F> {
 pub fn characterize_display(
     dir: &Path,
     opts: &DisplayOptions,
-    targets: &[[f64; 3]],
+    targets: &[Xyz],
     resume: bool,
     unattended: bool,
     run: &RunOptions,
@@ -255,13 +257,13 @@ mod tests {
         let white = panel.xyz([255; 3]);
         let black = panel.xyz([0; 3]);
         let w_minus_k = [0, 1, 2].map(|k| white[k] - black[k]);
-        let at = |s: f64| w_minus_k.map(|c| c * s);
+        let at = |s: f64| Xyz::from(w_minus_k.map(|c| c * s));
         let one = white_luminance_for(&panel, &[at(1.0)]);
         assert!((one - white[1] * LUMINANCE_HEADROOM).abs() < 1e-9 * white[1]);
         let two = white_luminance_for(&panel, &[at(1.0), at(2.0)]);
         assert!((two / one - 2.0).abs() < 1e-9);
         // Beyond the primaries: ignored.
-        let outside = white_luminance_for(&panel, &[at(1.0), [-5.0, 80.0, 0.0]]);
+        let outside = white_luminance_for(&panel, &[at(1.0), Xyz::new(-5.0, 80.0, 0.0)]);
         assert!((outside - one).abs() < 1e-9);
     }
 
@@ -294,8 +296,8 @@ mod tests {
         let white = panel.xyz([255; 3]);
         let black = panel.xyz([0; 3]);
         // Black plus twice (white − black): the display's own colour, twice as bright.
-        let twice = [0, 1, 2].map(|k| black[k] + 2.0 * (white[k] - black[k]));
-        let half = [0, 1, 2].map(|k| black[k] + 0.5 * (white[k] - black[k]));
+        let twice = Xyz::from([0, 1, 2].map(|k| black[k] + 2.0 * (white[k] - black[k])));
+        let half = Xyz::from([0, 1, 2].map(|k| black[k] + 0.5 * (white[k] - black[k])));
         let needed = needed_white(&profile, &[half, twice]);
         // s·twice is inside while s·(black + 2(w − b)) ≤ w, i.e. s ≤ 1/(2 − k/w) with k
         // the black's Y: that scale, inverted, times the white.

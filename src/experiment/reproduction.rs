@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::cache::write_atomic;
 use super::error::ExperimentError;
 use super::simulation::ImagePatch;
+use crate::color::Xyz;
 use crate::display::gamut::GamutMapping;
 use crate::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use crate::display::Profile;
@@ -44,7 +45,7 @@ impl ReproductionOptions {
 pub struct PatchDrive {
     pub patch: usize,
     #[serde(rename = "target_XYZ")]
-    pub target_xyz: [f64; 3],
+    pub target_xyz: Xyz,
     /// The inverse model's drive values before gamut handling (outside 0–1 when out of gamut).
     pub unclipped_rgb: [f64; 3],
     pub out_of_gamut: bool,
@@ -93,7 +94,7 @@ pub fn reproduce(
     opts: &ReproductionOptions,
 ) -> Result<(Reproduction, Vec<&'static str>), ExperimentError> {
     let mapping = opts.mapping()?;
-    let targets: Vec<[f64; 3]> = spots.iter().map(|s| s.xyz).collect();
+    let targets: Vec<Xyz> = spots.iter().map(|s| s.xyz).collect();
     let drives = reproduce_targets(profile, &targets, mapping);
     let patches: Vec<PatchDrive> = spots
         .iter()
@@ -161,7 +162,10 @@ fn region(profile: &Profile, img: &XyzImage, p: &ImagePatch, mirror: bool) -> Pa
                 continue;
             }
             pixels += 1;
-            if profile.inverse(img.at(x, y).map(f64::from)).out_of_gamut {
+            if profile
+                .inverse(Xyz::from(img.at(x, y).map(f64::from)))
+                .out_of_gamut
+            {
                 out += 1;
             }
         }

@@ -15,6 +15,7 @@ use super::reproduction::{reproduce, Reproduction};
 use super::simulation::{simulate, SimulationSummary};
 use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
+use crate::color::Xyz;
 use crate::display::Profile;
 use crate::validation::job::ReadingFiles;
 
@@ -298,7 +299,7 @@ fn run_stage(
             Ok(owned(files))
         }
         Stage::Display => {
-            let targets: Vec<[f64; 3]> = sim_summary()?.spots.iter().map(|s| s.xyz).collect();
+            let targets: Vec<Xyz> = sim_summary()?.spots.iter().map(|s| s.xyz).collect();
             let (_, files) = characterize_display(
                 &sd.dir,
                 &opts.display,

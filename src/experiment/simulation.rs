@@ -67,7 +67,7 @@ pub struct ImagePatch {
     pub pixels: usize,
     /// The image's mean over the spot (solid-angle weighted), cd/m².
     #[serde(rename = "XYZ")]
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// ΔE*ab of that mean against the patch's spot reading (the scene's reference white).
     pub de_vs_spot: f64,
 }
@@ -78,7 +78,7 @@ pub struct ImagePatch {
 pub struct SimulationSummary {
     pub method: String,
     /// The scene's reference white (a perfect diffuser in place of patch 19), cd/m².
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub converged: bool,
     pub seconds: f64,
     /// The rendered readings. The file keeps each one's patch, XYZ and ΔE*ab
@@ -114,7 +114,7 @@ pub struct ExternalSource {
 #[serde(rename = "SimulationSummary")]
 struct SummaryFile {
     method: String,
-    white: [f64; 3],
+    white: Xyz,
     converged: bool,
     seconds: f64,
     spots: Vec<SpotFile>,
@@ -133,7 +133,7 @@ struct SummaryFile {
 struct SpotFile {
     patch: usize,
     #[serde(rename = "XYZ")]
-    xyz: [f64; 3],
+    xyz: Xyz,
     de_uncertainty: f64,
 }
 
@@ -247,7 +247,7 @@ pub fn simulate(
         .iter()
         .map(|s| {
             let u_lab = render_lab_sigma(s.uncertainty);
-            (s.patch, PatchReading::rendered(s.xyz, u_lab))
+            (s.patch, PatchReading::rendered(s.xyz.into(), u_lab))
         })
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
@@ -345,13 +345,13 @@ pub(super) fn patches_in_image(
     scene: &Scene,
     img: &XyzImage,
     spots: &[RenderedReading],
-    white: [f64; 3],
+    white: Xyz,
 ) -> Result<Vec<ImagePatch>, ExperimentError> {
     let cam = scene
         .camera
         .ok_or(crate::render::spot::SpotError::NoCamera)?;
     let frame = Frame::of(&cam, img.width, img.height);
-    let w = Xyz::from_array(white);
+    let w = white;
     let mut out = Vec::with_capacity(spots.len());
     for s in spots {
         let aim = patch_aim(scene, s.patch)?;
@@ -369,17 +369,14 @@ pub(super) fn patches_in_image(
                     img.width, img.height, s.patch
                 ),
             })?;
-        let de = delta_e76(
-            Xyz::from_array(xyz).to_lab(w),
-            Xyz::from_array(s.xyz).to_lab(w),
-        );
+        let de = delta_e76(Xyz::from(xyz).to_lab(w), s.xyz.to_lab(w));
         out.push(ImagePatch {
             patch: s.patch,
             x: cx / img.width as f64,
             y: cy / img.height as f64,
             radius: (aim.acceptance_deg.to_radians() / 2.0).tan() / (2.0 * frame.half_h),
             pixels,
-            xyz,
+            xyz: xyz.into(),
             de_vs_spot: de,
         });
     }
@@ -399,7 +396,6 @@ fn remove_stale(path: &Path) -> Result<(), ExperimentError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::color::Xyz;
 
     /// The start of a `simulation.json` written by an earlier version (a lab run's, cut to
     /// two spots and one image patch).
@@ -464,7 +460,7 @@ mod tests {
                 regular: None
             }
         );
-        let lab = Xyz::from_array(r.xyz).to_lab(Xyz::from_array(s.white));
+        let lab = r.xyz.to_lab(s.white);
         assert_eq!(r.lab, lab.to_array());
         assert_eq!(s.image_patches.len(), 1);
     }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::error::ExperimentError;
 use super::report_input::{gather, Layout};
+use crate::color::Xyz;
 use crate::validation::job::{self, Context, Coverage, ReadingFiles, Request, White};
 use crate::validation::{AssessOptions, ReportInput, ValidationError};
 
@@ -17,7 +18,7 @@ pub use crate::validation::comparisons::{ValidationResult, FILE, RESULT_VERSION}
 /// experiment's.
 fn request<'a>(
     dir: &'a Path,
-    white: [f64; 3],
+    white: Xyz,
     files: &ReadingFiles<'a>,
     out_of_gamut: &[usize],
 ) -> Request<'a> {
@@ -77,7 +78,7 @@ fn stage_error(e: ValidationError) -> ExperimentError {
 /// the experiment's.
 pub fn report_input(
     dir: &Path,
-    white: [f64; 3],
+    white: Xyz,
     files: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
 ) -> Result<ReportInput, ExperimentError> {
@@ -89,7 +90,7 @@ pub fn report_input(
 /// readings are read from `inputs`, once, by the validation's reader.
 pub fn validate(
     dir: &Path,
-    white: [f64; 3],
+    white: Xyz,
     inputs: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
 ) -> Result<(ValidationResult, Vec<String>), ExperimentError> {
@@ -108,7 +109,6 @@ pub fn validate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::color::Xyz;
     use crate::experiment::report_input::RenderUncertainty;
     use crate::render::spot::Uncertainty;
     use crate::validation::assess;
@@ -259,7 +259,7 @@ mod tests {
             display: &exp.join("display-spots/spots.csv"),
             simulation: Some(&exp.join("simulation/spots.csv")),
         };
-        let white = [29.424_122_518_279_695, 31.015, 34.538_708_337_905_01];
+        let white = Xyz::new(29.424_122_518_279_695, 31.015, 34.538_708_337_905_01);
         let input = report_input(&exp.join("validation"), white, &files, &[]).unwrap();
         let formats: Vec<(&str, &str, usize)> = input.inputs[..3]
             .iter()

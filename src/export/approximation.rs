@@ -218,7 +218,7 @@ fn measure_difference(
         ..options
     };
     let aimed = render_spots_radiosity(&lambertian, &options, &|_| {}).map_err(failed)?;
-    let pairs: Vec<([f64; 3], [f64; 3])> = exact
+    let pairs: Vec<(Xyz, Xyz)> = exact
         .patches
         .iter()
         .zip(&aimed.patches)
@@ -233,12 +233,9 @@ fn measure_difference(
         ));
     }
     let c = num / den;
-    let white = Xyz::from(exact.white);
-    let de = |a: [f64; 3], b: [f64; 3], k: f64| {
-        let (la, lb) = (
-            Xyz::from(a).to_lab(white),
-            Xyz::from([k * b[0], k * b[1], k * b[2]]).to_lab(white),
-        );
+    let white = exact.white;
+    let de = |a: Xyz, b: Xyz, k: f64| {
+        let (la, lb) = (a.to_lab(white), b.scaled(k).to_lab(white));
         ((la.l - lb.l).powi(2) + (la.a - lb.a).powi(2) + (la.b - lb.b).powi(2)).sqrt()
     };
     let n = pairs.len().max(1) as f64;

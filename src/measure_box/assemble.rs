@@ -18,7 +18,7 @@ use super::falloff::{fit_light, light_files, LightFilesError};
 use super::plan::{BoxPlan, BoxStep, Geometry, Plane, Stage, Target};
 use super::scene::{scene_json, BoxContents};
 use super::stats::{group, mean_spectrum, GroupStats, Repeatability, StatsError};
-use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum};
+use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
 use crate::render::scene::DistributionFile;
@@ -115,7 +115,7 @@ pub struct Summary {
     pub materials: Vec<Reduced>,
     pub spots: Vec<Reduced>,
     /// Mean spot reading of each patch in the plan's order, cd/m².
-    pub spot_xyz: Vec<(usize, [f64; 3])>,
+    pub spot_xyz: Vec<(usize, Xyz)>,
     pub light: LdcFit,
     /// The measured scene rendered against the box's spot readings.
     pub render: RenderComparison,
@@ -503,7 +503,7 @@ fn write_scene_files(
 }
 
 /// The spot meter's mean XYZ of each ColorChecker patch.
-fn spot_xyz(spots: &StageReduced) -> Vec<(usize, [f64; 3])> {
+fn spot_xyz(spots: &StageReduced) -> Vec<(usize, Xyz)> {
     spots
         .targets
         .iter()

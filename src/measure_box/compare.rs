@@ -41,7 +41,7 @@ pub enum CompareError {
 
 /// The 24 readings of a scene file by the radiosity solver, its reference white and the
 /// seconds it took.
-pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedReading>, [f64; 3], f64), CompareError> {
+pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedReading>, Xyz, f64), CompareError> {
     let scene = build(scene)?;
     let opts = RadiosityOptions {
         target_de: RENDER_TARGET_DE,
@@ -53,9 +53,9 @@ pub fn render_scene(scene: &Value) -> Result<(Vec<RenderedReading>, [f64; 3], f6
 
 /// Compares `box_xyz` (patch, XYZ) with `rendered` in CIELAB relative to `white`.
 pub fn compare_readings(
-    box_xyz: &[(usize, [f64; 3])],
+    box_xyz: &[(usize, Xyz)],
     rendered: &[RenderedReading],
-    white: [f64; 3],
+    white: Xyz,
     test: &str,
 ) -> Result<(Comparison, Vec<f64>), CompareError> {
     let mut reference = Vec::new();
@@ -66,11 +66,11 @@ pub fn compare_readings(
             .iter()
             .find(|r| r.patch == patch)
             .ok_or(CompareError::NoPatch(patch))?;
-        reference.push(Xyz::from_array(xyz));
-        test_xyz.push(Xyz::from_array(r.xyz));
+        reference.push(xyz);
+        test_xyz.push(r.xyz);
         bound.push(r.uncertainty.de_ab());
     }
-    let mut c = compare("box", &reference, test, &test_xyz, Xyz::from_array(white))?;
+    let mut c = compare("box", &reference, test, &test_xyz, white)?;
     // compare() numbers patches by position; a plan may read only some of them.
     for (p, &(patch, _)) in c.patches.iter_mut().zip(box_xyz) {
         p.patch = patch;
@@ -82,7 +82,7 @@ pub fn compare_readings(
 /// Renders `scene` and compares it with the box's spot readings.
 pub fn compare_render(
     scene: &Value,
-    box_xyz: &[(usize, [f64; 3])],
+    box_xyz: &[(usize, Xyz)],
 ) -> Result<RenderComparison, CompareError> {
     let (rendered, white, seconds) = render_scene(scene)?;
     let (comparison, render_bound) = compare_readings(box_xyz, &rendered, white, "measured scene")?;

@@ -17,7 +17,7 @@
 use metamer_drivers::Reading;
 use serde::{Deserialize, Serialize};
 
-use crate::color::Spectrum;
+use crate::color::{Spectrum, Xyz};
 pub use crate::session::repeats::Repeatability;
 use crate::validation::covariance::{self, Cov3};
 
@@ -40,7 +40,7 @@ pub struct GroupStats {
     /// Readings in the group.
     pub n: usize,
     /// Mean XYZ of the readings kept.
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Standard deviation of Y of the readings kept (0 for one reading).
     pub sd_y: f64,
     /// Sample covariance of X, Y, Z of one reading among those kept (0 for one reading):
@@ -107,13 +107,13 @@ pub fn group(readings: &[&Reading], noise: Repeatability) -> Result<GroupStats, 
         .map(|(_, r)| *r)
         .collect();
     let k = kept.len() as f64;
-    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz).collect();
+    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz.to_array()).collect();
     let (xyz, cov) = covariance::sample(&xs);
     let sd_y = cov[1][1].sqrt();
     let noise_y = noise.sigma_y(xyz[1]);
     Ok(GroupStats {
         n: readings.len(),
-        xyz,
+        xyz: xyz.into(),
         sd_y,
         cov,
         noise_y,

@@ -96,7 +96,7 @@ pub fn run(
     seconds_per_strategy: f64,
     seed: u64,
     log: &dyn Fn(&str),
-) -> Result<(Vec<Point>, [f64; 3]), ConvergenceError> {
+) -> Result<(Vec<Point>, Xyz), ConvergenceError> {
     check_seconds(seconds_per_strategy)?;
     let reference = render_spots(
         scene,
@@ -106,7 +106,7 @@ pub fn run(
             ..SpotOptions::default()
         },
     )?;
-    let white = Xyz::from_array(reference.white);
+    let white = reference.white;
     log(&format!(
         "reference: ΔE95 < {reference_de} in {:.1} s",
         reference.seconds
@@ -127,10 +127,7 @@ pub fn run(
                 .map(|(k, aim)| {
                     let m = sample_cone(&tracer, *aim, seed, k as u64 + 1, 0, n).mean();
                     let r = reference.patches[k].xyz;
-                    delta_e76(
-                        Xyz::from_array(m).to_lab(white),
-                        Xyz::from_array(r).to_lab(white),
-                    )
+                    delta_e76(m.to_lab(white), r.to_lab(white))
                 })
                 .collect();
             let seconds = t.elapsed().as_secs_f64();
@@ -197,7 +194,7 @@ pub fn radiosity_points(
     log(&format!(
         "radiosity reference: levels 1–{n}, its own bound ΔE*ab {reference_bound:.5}"
     ));
-    let lab = |x: [f64; 3], w: [f64; 3]| Xyz::from_array(x).to_lab(Xyz::from_array(w));
+    let lab = |x: Xyz, w: Xyz| x.to_lab(w);
     let mut points = Vec::new();
     // A level's error is measured against a reference two or more levels finer: one level
     // finer, the reference's own error (its bound) is as large as the error it measures.

@@ -5,6 +5,7 @@
 
 use std::sync::Arc;
 
+use metamer_color::Xyz;
 use metamer_drivers::cs100a::emulator::{Cs100aEmulator, EmulatorConfig};
 use metamer_drivers::cs100a::pty::PtyEmulator;
 use metamer_drivers::{DriverError, SharedWorld, DEFAULT_STIMULUS_XYZ};
@@ -13,7 +14,7 @@ use metamer_drivers::{DriverError, SharedWorld, DEFAULT_STIMULUS_XYZ};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PtyMeterOptions {
     /// The light in front of the meter, XYZ in cd/m².
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Add the meter's repeatability noise to each reading.
     pub noise: bool,
     /// Seed of the noise; the same seed gives the same readings.
@@ -61,11 +62,12 @@ impl PtyMeter {
     /// its device path as a real CS-100A on a serial port is read.
     ///
     /// ```
+    /// use metamer::color::Xyz;
     /// use metamer::rig::sim_meter::{PtyMeter, PtyMeterOptions};
     /// use metamer_drivers::{MeasureMode, Request, Spec};
     ///
     /// let options = PtyMeterOptions {
-    ///     xyz: [19.0, 20.0, 21.8],
+    ///     xyz: Xyz::new(19.0, 20.0, 21.8),
     ///     noise: false,
     ///     time_scale: 0.0,
     ///     ..Default::default()
@@ -104,7 +106,8 @@ impl PtyMeter {
     }
 }
 
-fn check_light(xyz: [f64; 3]) -> Result<(), PtyMeterError> {
+fn check_light(xyz: Xyz) -> Result<(), PtyMeterError> {
+    let xyz = xyz.to_array();
     if xyz.iter().all(|v| v.is_finite() && *v >= 0.0) {
         Ok(())
     } else {
@@ -126,7 +129,7 @@ mod tests {
             [1.0, 1.0, f64::INFINITY],
         ] {
             let options = PtyMeterOptions {
-                xyz,
+                xyz: xyz.into(),
                 ..PtyMeterOptions::default()
             };
             let e = PtyMeter::start(&options).err().unwrap();
@@ -180,7 +183,7 @@ mod tests {
     fn a_plain_file_client_reads_the_light() {
         let (x, y, lum) = (0.3127, 0.3290, 50.0);
         let options = PtyMeterOptions {
-            xyz: [x / y * lum, lum, (1.0 - x - y) / y * lum],
+            xyz: Xyz::new(x / y * lum, lum, (1.0 - x - y) / y * lum),
             noise: false,
             seed: 1,
             time_scale: 0.0,

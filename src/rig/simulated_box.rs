@@ -36,7 +36,7 @@ use std::sync::{Arc, OnceLock};
 
 use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 
-use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum};
+use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::{CGammaError, CGammaTable};
 use crate::measure_box::compare::{render_scene, CompareError};
 use crate::measure_box::plan::{BoxPlan, Stage, Target};
@@ -74,7 +74,7 @@ pub struct SimulatedBox {
     pub patches: Vec<Spectrum>,
     /// The light at each patch seen from the viewpoint, cd/m², patches 1–24: rendered when
     /// first needed ([`SimulatedBox::spots`]), since only the spots stage needs it.
-    spots: OnceLock<Vec<[f64; 3]>>,
+    spots: OnceLock<Vec<Xyz>>,
     plan: BoxPlan,
     falloff_tile: usize,
 }
@@ -172,7 +172,7 @@ impl SimulatedBox {
 
     /// The light at each patch 1–24 seen from the viewpoint, cd/m² (rendered on the first
     /// call).
-    pub fn spots(&self) -> Result<&[[f64; 3]], SimulatedBoxError> {
+    pub fn spots(&self) -> Result<&[Xyz], SimulatedBoxError> {
         if let Some(s) = self.spots.get() {
             return Ok(s);
         }

@@ -26,6 +26,7 @@
 use metamer_drivers::i1pro::emulator;
 use metamer_drivers::{MeasureMode, Reading};
 
+use crate::color::Xyz;
 use crate::validation::covariance::{self, Cov3};
 
 /// How far from the earlier readings' mean, in σ of the difference, a reading is flagged.
@@ -156,7 +157,7 @@ impl Repeatability {
     /// Z = (1 − x − y)Y/y, J·diag(σx², σy², σY²)·Jᵀ with J the derivatives of (X, Y, Z) by
     /// (x, y, Y), the last digit's rounding counted as a uniform error (variance d²/12).
     /// None without a chromaticity (X + Y + Z ≤ 0, Y ≤ 0) or without a stated x, y figure.
-    pub fn covariance(&self, xyz: [f64; 3]) -> Option<Cov3> {
+    pub fn covariance(&self, xyz: Xyz) -> Option<Cov3> {
         let s = xyz[0] + xyz[1] + xyz[2];
         if !(s > 0.0 && xyz[1] > 0.0) {
             return None;
@@ -378,7 +379,7 @@ mod tests {
         // A saturated yellow (ColorChecker 16 under a white display): x 0.45, y 0.50,
         // where Z = (1 − x − y)Y/y is small and chromaticity noise moves it by a lot.
         let (x, y, big_y) = (0.45, 0.50, 10.0);
-        let xyz = [x * big_y / y, big_y, (1.0 - x - y) * big_y / y];
+        let xyz = Xyz::new(x * big_y / y, big_y, (1.0 - x - y) * big_y / y);
         let c = r.covariance(xyz).unwrap();
         // By hand: σY² = (0.1 % of 10)² + 0.01²/12 (four digits of 10.00) = 1.08333e-4;
         // σZ from x and y: ∂Z/∂x = −Y/y = −20, ∂Z/∂y = −(1−x)Y/y² = −22, ∂Z/∂Y = 0.1:
@@ -409,7 +410,7 @@ mod tests {
                 );
             }
         }
-        assert_eq!(r.covariance([0.0, 0.0, 0.0]), None);
+        assert_eq!(r.covariance(Xyz::default()), None);
     }
 
     /// The i1Pro's figure depends on the level: at 25 cd/m² σY/Y is 0.30447 % (0.15 % ·
@@ -422,7 +423,7 @@ mod tests {
         assert!((r.sigma_y(25.0) - 25.0 * 0.003_044_7).abs() < 1e-5);
         assert!((r.sigma_y(400.0) / 400.0 - 0.0015).abs() < 1e-6);
         assert!((r.sigma_xy(25.0).unwrap() - 0.3 * 0.003_044_7).abs() < 1e-7);
-        let c = r.covariance([20.0, 25.0, 30.0]).unwrap();
+        let c = r.covariance(Xyz::new(20.0, 25.0, 30.0)).unwrap();
         assert!((c[1][1] - r.sigma_y(25.0).powi(2)).abs() < 1e-12);
         // A dim reading 1.2 % off the one before it is noise at 5 cd/m² (σ 0.72 %, 5σ·√2
         // = 5.1 %) but not at 200 cd/m² (σ 0.15 %: 5σ·√2 = 1.06 %).

@@ -161,7 +161,7 @@ fn yellow(de: f64, noise: f64, k_reference: usize, k_test: usize) -> Truth {
     let reference = [9.0356, 9.9766, 1.2852];
     let one = Repeatability::emissive_of("cs100a")
         .unwrap()
-        .covariance(reference)
+        .covariance(reference.into())
         .unwrap();
     let cov = covariance::scaled(&one, noise * noise);
     Truth {

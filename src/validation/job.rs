@@ -57,10 +57,10 @@ pub enum White {
     Box,
     /// A white the user gives in the readings' unit: checked to be a white and to be in
     /// the readings' units ([`ValidationError::GivenWhite`] otherwise).
-    Given([f64; 3]),
+    Given(Xyz),
     /// A white measured with the readings (the experiment's display profile), taken as it
     /// is; `source` says what it is for the report.
-    Measured { xyz: [f64; 3], source: String },
+    Measured { xyz: Xyz, source: String },
 }
 
 /// What the report says beside the comparisons.
@@ -333,16 +333,16 @@ fn choose_white(white: &White, sides: &Sides) -> Result<(Xyz, String), Validatio
     let (xyz, source) = match white {
         White::Display => sides.display.white_or_brightest(),
         White::Box => sides.box_readings.white_or_brightest(),
-        White::Given(v) => {
-            metamer_color::check_xyz(*v)
+        White::Given(white) => {
+            let white = *white;
+            metamer_color::check_xyz(white)
                 .map_err(|e| ValidationError::GivenWhite(format!("not a white: {e}")))?;
-            let white = Xyz::from_array(*v);
             plausible::check_given_white(white)
                 .and_then(|()| plausible::check_white_against(white, &sets))
                 .map_err(|e| ValidationError::GivenWhite(e.to_string()))?;
             return Ok((white, "given on the command line".to_string()));
         }
-        White::Measured { xyz, source } => return Ok((Xyz::from_array(*xyz), source.clone())),
+        White::Measured { xyz, source } => return Ok((*xyz, source.clone())),
     };
     plausible::check_white_against(xyz, &sets)?;
     Ok((xyz, source))

@@ -42,14 +42,15 @@ fn ideal() -> Analytic {
 }
 
 impl Analytic {
-    fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+    fn forward(&self, rgb: [f64; 3]) -> Xyz {
         let l: [f64; 3] = std::array::from_fn(|c| rgb[c].powf(self.gamma[c]));
         let k = 1.0 - self.interaction * (l[0] * l[1] + l[1] * l[2] + l[2] * l[0]) / 3.0;
         let b = rgb[2];
         let drift = [8.0, 6.0, -8.0].map(|v| v * self.blue_drift * 4.0 * b * (1.0 - b) * l[2]);
-        std::array::from_fn(|k2| {
+        let xyz: [f64; 3] = std::array::from_fn(|k2| {
             self.black[k2] + k * (0..3).map(|c| self.cols[c][k2] * l[c]).sum::<f64>() + drift[k2]
-        })
+        });
+        xyz.into()
     }
 
     /// Black, white, ramps per channel and a 5³ grid, each drive triple once.
@@ -96,7 +97,7 @@ impl Analytic {
     }
 
     fn white(&self) -> Xyz {
-        Xyz::from_array(self.forward([1.0; 3]))
+        self.forward([1.0; 3])
     }
 }
 
@@ -112,11 +113,8 @@ fn drives(n: usize) -> Vec<[f64; 3]> {
     (0..n).map(|_| [next(), next(), next()]).collect()
 }
 
-fn de00(a: [f64; 3], b: [f64; 3], white: Xyz) -> f64 {
-    delta_e2000(
-        Xyz::from_array(a).to_lab(white),
-        Xyz::from_array(b).to_lab(white),
-    )
+fn de00(a: Xyz, b: Xyz, white: Xyz) -> f64 {
+    delta_e2000(a.to_lab(white), b.to_lab(white))
 }
 
 /// Largest ΔE00 between a target the display can show and what the display shows for the
@@ -272,7 +270,7 @@ fn out_of_gamut_and_negative_targets_are_reported_not_hidden() {
         assert_eq!(inv.rgb, [1.0; 3], "{kind}");
         assert!(inv.unclipped.iter().all(|&v| v > 1.0), "{kind} {inv:?}");
         // negative XYZ: below black, flagged, clipped into 0–1, never NaN
-        let inv = p.inverse([-1.0, -2.0, -3.0]);
+        let inv = p.inverse(Xyz::new(-1.0, -2.0, -3.0));
         assert!(inv.out_of_gamut, "{kind}");
         assert!(
             inv.rgb.iter().all(|v| (0.0..=1.0).contains(v)),
@@ -285,13 +283,13 @@ fn out_of_gamut_and_negative_targets_are_reported_not_hidden() {
         assert!(inv.unclipped.iter().any(|&v| v < 0.0), "{kind} {inv:?}");
         // a saturated green beyond the primary's chromaticity: one channel negative
         let g = d.forward([0.0, 0.6, 0.0]);
-        let inv = p.inverse([g[0] - 5.0, g[1], g[2] - 3.0]);
+        let inv = p.inverse(Xyz::new(g[0] - 5.0, g[1], g[2] - 3.0));
         assert!(
             inv.out_of_gamut && inv.unclipped.iter().any(|&v| v < 0.0),
             "{kind} {inv:?}"
         );
         // black itself is in gamut
-        let inv = p.inverse(d.black);
+        let inv = p.inverse(d.black.into());
         assert!(!inv.out_of_gamut, "{kind} {inv:?}");
         assert!(inv.rgb.iter().all(|&v| v.abs() < 1e-6), "{kind} {inv:?}");
     }
@@ -429,10 +427,10 @@ fn lut_fills_a_grid_with_a_missing_patch() {
     let hole = [0.5, 0.75, 0.25];
     let patches: Vec<Sample> = d.patches(4).into_iter().filter(|p| p.rgb != hole).collect();
     let profile = fit_profile(ModelKind::Lut, &patches, None).unwrap();
-    let white = Xyz::from_array(d.forward([1.0; 3]));
+    let white = d.forward([1.0; 3]);
     let e = delta_e2000(
-        Xyz::from_array(profile.forward(hole)).to_lab(white),
-        Xyz::from_array(d.forward(hole)).to_lab(white),
+        profile.forward(hole).to_lab(white),
+        d.forward(hole).to_lab(white),
     );
     assert!(e < 0.5, "ΔE00 {e} at the missing patch");
 }
@@ -493,7 +491,7 @@ fn noise_is_estimated_from_repeated_patches() {
     let n = metamer::display::diagnostics::repeat_noise(&patches, white).unwrap();
     assert_eq!(n.source, "1 repeated patches");
     // three readings at 1, 1.005, 0.995: deviations 0, ±0.5 %; σ² = Σ ΔE² / (3 − 1)
-    let w = Xyz::from_array(white);
+    let w = white;
     let e = de00(grey.map(|v| v * 1.005), grey, w);
     let e2 = de00(grey.map(|v| v * 0.995), grey, w);
     let want = ((e * e + e2 * e2) / 2.0).sqrt();
@@ -554,7 +552,7 @@ fn grid_with_white(levels: &[f64], white: [f64; 3]) -> Vec<Sample> {
                 };
                 out.push(Sample {
                     rgb: [i, j, k],
-                    xyz,
+                    xyz: xyz.into(),
                 });
             }
         }
@@ -565,7 +563,7 @@ fn grid_with_white(levels: &[f64], white: [f64; 3]) -> Vec<Sample> {
             rgb[c] = 0.5;
             out.push(Sample {
                 rgb,
-                xyz: std::array::from_fn(|k| black[k] + 0.5 * p[k]),
+                xyz: Xyz::from(std::array::from_fn::<f64, 3, _>(|k| black[k] + 0.5 * p[k])),
             });
         }
     }

@@ -1,6 +1,7 @@
 //! `metamer fit` and `metamer reproduce` end to end on the dispread-format fixture, and the
 //! reproduction library: targets, images (mirror, out-of-gamut count) and PNG depths.
 
+use metamer::color::Xyz;
 use metamer::display::gamut::GamutMapping;
 use metamer::display::reproduce::{reproduce_image, reproduce_targets, write_drive_png};
 use metamer::display::{fit_profile, read_measurements, ModelKind, Profile};
@@ -148,7 +149,7 @@ fn profile() -> Profile {
 #[test]
 fn targets_report_out_of_gamut_and_nearest_lab_stays_in_the_cube() {
     let p = profile();
-    let targets = [analytic([0.3, 0.6, 0.9]), [300.0, 10.0, 5.0]];
+    let targets = [analytic([0.3, 0.6, 0.9]).into(), Xyz::new(300.0, 10.0, 5.0)];
     let clipped = reproduce_targets(&p, &targets, GamutMapping::Clip);
     assert!(!clipped[0].out_of_gamut && clipped[1].out_of_gamut);
     for (got, want) in clipped[0].rgb.iter().zip([0.3, 0.6, 0.9]) {

@@ -37,8 +37,8 @@ fn fitted(kind: ModelKind) -> (Profile, Vec<[f64; 3]>) {
     (fit_profile(kind, &m.patches, Some(&ti3())).unwrap(), drives)
 }
 
-fn lab_d50(xyz: [f64; 3]) -> metamer::color::Lab {
-    Xyz::from_array(xyz).to_lab(Xyz::from_array(D50))
+fn lab_d50(xyz: impl Into<Xyz>) -> metamer::color::Lab {
+    xyz.into().to_lab(D50)
 }
 
 const MATRIX_MODELS: [ModelKind; 3] = [
@@ -196,7 +196,7 @@ fn a_black_outside_the_primaries_cone_is_clipped_and_reported() {
     let metamer::display::model::ModelParams::MatrixTrc(m) = &mut profile.parameters else {
         panic!("plcc is a matrix model");
     };
-    m.black = [0.0, 0.0, 2.0];
+    m.black = Xyz::new(0.0, 0.0, 2.0);
     m.prepare(ModelKind::Plcc).unwrap();
     let icc = encode_icc(&profile, IccVersion::V4, "x").unwrap();
     assert!(icc.summary.clipped_black[0] > 0.0, "{:?}", icc.summary);

@@ -117,22 +117,22 @@ fn read_with_lcms(
     std::fs::write(&path, &icc.bytes).unwrap();
     let file = path.to_str().unwrap();
     let pcs = profile_pcs(profile).unwrap();
-    let white = Xyz::from_array(profile.white_xyz);
-    let lab = |xyz: [f64; 3]| Xyz::from_array(xyz).to_lab(white);
+    let white = profile.white_xyz;
+    let lab = |xyz: Xyz| xyz.to_lab(white);
 
     let rgb: Vec<[f64; 3]> = held_out.iter().map(|p| p.rgb.map(|v| v * 255.0)).collect();
     let theirs = transicc(&["-i", file, "-o", "*XYZ"], &rgb);
     let verify = verify_profile(profile, held_out).unwrap().de00.mean;
     let (mut sum, mut gap) = (0.0, 0.0f64);
     for (p, t) in held_out.iter().zip(&theirs) {
-        let xyz = pcs.from_pcs(t.map(|v| v / 100.0));
+        let xyz = pcs.from_pcs(Xyz::from(t.map(|v| v / 100.0)));
         let de = delta_e2000(lab(xyz), lab(p.xyz));
         sum += de;
         gap = gap.max((de - delta_e2000(lab(profile.forward(p.rgb)), lab(p.xyz))).abs());
     }
     let forward = sum / held_out.len() as f64;
 
-    let targets: Vec<[f64; 3]> = held_out
+    let targets: Vec<Xyz> = held_out
         .iter()
         .map(|p| p.xyz)
         .filter(|&x| !profile.inverse(x).out_of_gamut)
@@ -140,7 +140,7 @@ fn read_with_lcms(
     let ours = reproduce_targets(profile, &targets, GamutMapping::Clip);
     let pcs_in: Vec<[f64; 3]> = targets
         .iter()
-        .map(|&x| pcs.to_pcs(x).map(|v| v * 100.0))
+        .map(|&x| pcs.to_pcs(x).map(|v| v * 100.0).to_array())
         .collect();
     let back = transicc(&["-i", "*XYZ", "-o", file], &pcs_in);
     let (mut r, mut inv, mut inv_max) = (0.0, 0.0, 0.0f64);

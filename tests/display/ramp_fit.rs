@@ -48,7 +48,7 @@ fn with_meter_noise(patches: &[Sample], seed: u64) -> Vec<Sample> {
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let [x, y, z] = p.xyz;
+            let Xyz { x, y, z } = p.xyz;
             let sum = x + y + z;
             let mut rng = SplitMix64::new(stream_seed(seed, i as u64, 0));
             let lum = y * (1.0 + SIGMA_Y_REL * rng.normal());
@@ -56,7 +56,7 @@ fn with_meter_noise(patches: &[Sample], seed: u64) -> Vec<Sample> {
             let cy = y / sum + SIGMA_XY * rng.normal();
             Sample {
                 rgb: p.rgb,
-                xyz: [cx / cy * lum, lum, (1.0 - cx - cy) / cy * lum],
+                xyz: Xyz::new(cx / cy * lum, lum, (1.0 - cx - cy) / cy * lum),
             }
         })
         .collect()
@@ -64,18 +64,15 @@ fn with_meter_noise(patches: &[Sample], seed: u64) -> Vec<Sample> {
 
 /// Mean ΔE00 of the round trip: the target's true XYZ → the model's inverse → the drive
 /// shown (8-bit) on the true display → its XYZ, relative to the display's true white.
-fn inverse_error(panel: &VirtualPanel, inverse: &dyn Fn([f64; 3]) -> [f64; 3]) -> f64 {
-    let white = Xyz::from_array(panel.xyz([255; 3]));
+fn inverse_error(panel: &VirtualPanel, inverse: &dyn Fn(Xyz) -> [f64; 3]) -> f64 {
+    let white = panel.xyz([255; 3]);
     let targets = mixed_targets();
     let sum: f64 = targets
         .iter()
         .map(|&code| {
             let t = panel.xyz(code);
             let shown = panel.xyz_of_drive(inverse(t));
-            delta_e2000(
-                Xyz::from_array(shown).to_lab(white),
-                Xyz::from_array(t).to_lab(white),
-            )
+            delta_e2000(shown.to_lab(white), t.to_lab(white))
         })
         .sum();
     sum / targets.len() as f64
@@ -116,7 +113,7 @@ fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path
         .output()
         .unwrap();
     assert!(status.status.success(), "{status:?}");
-    let targets: Vec<[f64; 3]> = mixed_targets().iter().map(|&c| panel.xyz(c)).collect();
+    let targets: Vec<Xyz> = mixed_targets().iter().map(|&c| panel.xyz(c)).collect();
     let input: String = targets
         .iter()
         .map(|t| format!("{:.8} {:.8} {:.8}\n", t[0], t[1], t[2]))
@@ -150,16 +147,13 @@ fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path
         })
         .collect();
     assert_eq!(rgbs.len(), targets.len(), "{text}");
-    let white = Xyz::from_array(panel.xyz([255; 3]));
+    let white = panel.xyz([255; 3]);
     let sum: f64 = targets
         .iter()
         .zip(&rgbs)
         .map(|(t, rgb)| {
             let shown = panel.xyz_of_drive(*rgb);
-            delta_e2000(
-                Xyz::from_array(shown).to_lab(white),
-                Xyz::from_array(*t).to_lab(white),
-            )
+            delta_e2000(shown.to_lab(white), t.to_lab(white))
         })
         .sum();
     Some(sum / targets.len() as f64)
@@ -245,7 +239,7 @@ fn print_white_share_study() {
         let held: Vec<Sample> = m.patches.iter().copied().filter(|p| !single(p)).collect();
         let profile = fit_profile(ModelKind::Plvc, &fit, None).unwrap();
         let model = profile.model();
-        let w = Xyz::from_array(profile.white_xyz);
+        let w = profile.white_xyz;
         let k = model.forward([0.0; 3]);
         let add_white = model.forward([1.0; 3]);
         let dw: [f64; 3] = std::array::from_fn(|i| profile.white_xyz[i] - add_white[i]);
@@ -275,14 +269,11 @@ fn print_white_share_study() {
             ("min", Box::new(|l: [f64; 3]| l[0].min(l[1]).min(l[2]))),
         ];
         let set = metamer::display::model::samples::SortedSamples::new(&fit);
-        let prim: Vec<[f64; 3]> = (0..3).map(|c| set.primaries[c].unwrap()).collect();
+        let prim: Vec<Xyz> = (0..3).map(|c| set.primaries[c].unwrap()).collect();
         let kk = set.black.unwrap();
         let addw: [f64; 3] =
             std::array::from_fn(|i| prim[0][i] + prim[1][i] + prim[2][i] - 2.0 * kk[i]);
-        let ade = delta_e2000(
-            Xyz::from_array(addw).to_lab(w),
-            Xyz::from_array(profile.white_xyz).to_lab(w),
-        );
+        let ade = delta_e2000(Xyz::from_array(addw).to_lab(w), profile.white_xyz.to_lab(w));
         let mut line = format!(
             "{}: fit {} held {} white-add ΔY {:+.2}% ΔE00 {ade:.2}",
             &f.file_name().unwrap().to_string_lossy()[..12],
@@ -297,10 +288,7 @@ fn print_white_share_study() {
                     let a = model.forward(p.rgb);
                     let s = wf(lvl(p.rgb));
                     let x: [f64; 3] = std::array::from_fn(|i| a[i] + s * dw[i]);
-                    delta_e2000(
-                        Xyz::from_array(x).to_lab(w),
-                        Xyz::from_array(p.xyz).to_lab(w),
-                    )
+                    delta_e2000(Xyz::from_array(x).to_lab(w), p.xyz.to_lab(w))
                 })
                 .sum::<f64>()
                 / held.len() as f64;
@@ -376,7 +364,9 @@ fn the_white_sets_models_aside_only_beyond_the_noise() {
     let (_, mut patches) = ramp_set(Preset::IdealCrt, Some(1));
     let black = patches.iter().find(|p| p.rgb == [0.0; 3]).unwrap().xyz;
     for p in patches.iter_mut().filter(|p| p.rgb == [1.0; 3]) {
-        p.xyz = std::array::from_fn(|k| black[k] + 0.85 * (p.xyz[k] - black[k]));
+        p.xyz = Xyz::from(std::array::from_fn::<f64, 3, _>(|k| {
+            black[k] + 0.85 * (p.xyz[k] - black[k])
+        }));
     }
     let sel = select_model(&patches, 5, &FitOptions::default()).unwrap();
     for kind in [ModelKind::Plcc, ModelKind::PlccGamma, ModelKind::Gog] {
@@ -401,7 +391,9 @@ fn the_white_breaks_a_tie_on_the_ramps() {
     let mut darker = patches.clone();
     let black = darker.iter().find(|p| p.rgb == [0.0; 3]).unwrap().xyz;
     for p in darker.iter_mut().filter(|p| p.rgb == [1.0; 3]) {
-        p.xyz = std::array::from_fn(|k| black[k] + 0.99 * (p.xyz[k] - black[k]));
+        p.xyz = Xyz::from(std::array::from_fn::<f64, 3, _>(|k| {
+            black[k] + 0.99 * (p.xyz[k] - black[k])
+        }));
     }
     let sel = select_model(&darker, 5, &FitOptions::default()).unwrap();
     assert_eq!(sel.model, ModelKind::Plvc, "{sel}");
@@ -432,11 +424,8 @@ fn the_fit_report_on_ramps_says_mixtures_were_not_measured() {
         panel.xyz([0, 0, 255]),
     );
     let sum: [f64; 3] = std::array::from_fn(|i| r[i] + g[i] + b[i] - 2.0 * k[i]);
-    let white = Xyz::from_array(w);
-    let de = delta_e2000(
-        Xyz::from_array(sum).to_lab(white),
-        Xyz::from_array(w).to_lab(white),
-    );
+    let white = w;
+    let de = delta_e2000(Xyz::from_array(sum).to_lab(white), w.to_lab(white));
     assert!(de > 0.1, "the preset's crosstalk shows at white: {de}");
     let v = &d.verdict;
     assert!(v.contains("Mixed colours were not measured"), "{v}");

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use metamer::color::{radiance_to_xyz, ObserverKind, SpectralTable};
+use metamer::color::{radiance_to_xyz, ObserverKind, SpectralTable, Xyz};
 use metamer::experiment::display::white_luminance_for;
 use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
 use metamer::render::Scene;
@@ -77,11 +77,11 @@ fn ips_lcd_reach(scene: &str) -> Vec<(usize, [f64; 3], bool)> {
         ..RadiosityOptions::default()
     };
     let r = render_spots_radiosity(&scene, &opts, &|_| {}).unwrap();
-    let targets: Vec<[f64; 3]> = r.patches.iter().map(|p| p.xyz).collect();
+    let targets: Vec<Xyz> = r.patches.iter().map(|p| p.xyz).collect();
     let panel = VirtualPanel::preset(Preset::IpsLcd);
     let panel = panel.with_white_luminance(white_luminance_for(&panel, &targets));
-    let black = Vector3::from(panel.xyz([0; 3]));
-    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb)) - black;
+    let black = Vector3::from(panel.xyz([0; 3]).to_array());
+    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb).to_array()) - black;
     let inv = Matrix3::from_columns(&[
         column([255, 0, 0]),
         column([0, 255, 0]),
@@ -92,7 +92,7 @@ fn ips_lcd_reach(scene: &str) -> Vec<(usize, [f64; 3], bool)> {
     r.patches
         .iter()
         .map(|p| {
-            let lin = inv * (Vector3::from(p.xyz) - black);
+            let lin = inv * (Vector3::from(p.xyz.to_array()) - black);
             (
                 p.patch,
                 [lin[0], lin[1], lin[2]],

@@ -29,7 +29,7 @@ fn with_meter_noise(patches: &[Sample], seed: u64) -> Vec<Sample> {
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let [x, y, z] = p.xyz;
+            let Xyz { x, y, z } = p.xyz;
             let sum = x + y + z;
             if !(sum > 0.0 && y > 0.0) {
                 return *p;
@@ -40,7 +40,7 @@ fn with_meter_noise(patches: &[Sample], seed: u64) -> Vec<Sample> {
             let cy = y / sum + SIGMA_XY * rng.normal();
             Sample {
                 rgb: p.rgb,
-                xyz: [cx / cy * lum, lum, (1.0 - cx - cy) / cy * lum],
+                xyz: Xyz::new(cx / cy * lum, lum, (1.0 - cx - cy) / cy * lum),
             }
         })
         .collect()
@@ -55,14 +55,14 @@ fn held_out(panel: &VirtualPanel, kind: ModelKind, patches: &[Sample]) -> f64 {
 fn try_held_out(panel: &VirtualPanel, kind: ModelKind, patches: &[Sample]) -> Option<f64> {
     let set = SortedSamples::new(patches);
     let params = fit_params(kind, &set, patches, &FitOptions::default()).ok()?;
-    let white = Xyz::from_array(panel.xyz([255; 3]));
+    let white = panel.xyz([255; 3]);
     let test = measure(panel, &random_patches(500, 77));
     let sum = test
         .iter()
         .map(|p| {
             delta_e2000(
-                Xyz::from_array(params.model().forward(p.rgb)).to_lab(white),
-                Xyz::from_array(p.xyz).to_lab(white),
+                params.model().forward(p.rgb).to_lab(white),
+                p.xyz.to_lab(white),
             )
         })
         .sum::<f64>();

@@ -67,8 +67,8 @@ const STAGES: [&str; 6] = [
 /// triangle; the scale of the white does not change the sign.
 fn least_linear_drive(dir: &Path) -> Vec<(usize, f64)> {
     let panel = VirtualPanel::preset(Preset::IpsLcd);
-    let black = Vector3::from(panel.xyz([0; 3]));
-    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb)) - black;
+    let black = Vector3::from(panel.xyz([0; 3]).to_array());
+    let column = |rgb: [u8; 3]| Vector3::from(panel.xyz(rgb).to_array()) - black;
     let inv = Matrix3::from_columns(&[
         column([255, 0, 0]),
         column([0, 255, 0]),
@@ -98,7 +98,7 @@ fn unreachable_on_the_panel(dir: &Path) -> Vec<usize> {
         .unwrap()
         .patches
         .iter()
-        .filter(|(_, p)| panel.drive_for(p.xyz).is_none())
+        .filter(|(_, p)| panel.drive_for(p.xyz.into()).is_none())
         .map(|(&patch, _)| patch)
         .collect()
 }

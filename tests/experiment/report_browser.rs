@@ -182,7 +182,7 @@ fn experiment_report(dir: &Path) -> PathBuf {
         display: &exp.join("display-spots/spots.csv"),
         simulation: Some(&exp.join("simulation/spots.csv")),
     };
-    let white = [29.424_122_518_279_695, 31.015, 34.538_708_337_905_01];
+    let white = metamer::color::Xyz::new(29.424_122_518_279_695, 31.015, 34.538_708_337_905_01);
     let oog = [1, 4, 7, 9, 11, 12, 14, 15, 16];
     let input = report_input(&exp.join("validation"), white, &files, &oog).unwrap();
     write_report_files(dir, &input, &OutputPolicy::new(true)).unwrap();

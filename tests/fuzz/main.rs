@@ -221,8 +221,12 @@ fn a_lut_fit_of_10000_scattered_patches_stays_within_the_memory_cap() {
                 _ => std::array::from_fn(|_| (rng.uniform() * 1000.0).round() / 1000.0),
             };
             let lin = rgb.map(|d| d.powf(2.2));
-            let xyz = std::array::from_fn(|r| 0.2 + (0..3).map(|k| m[r][k] * lin[k]).sum::<f64>());
-            Sample { rgb, xyz }
+            let xyz: [f64; 3] =
+                std::array::from_fn(|r| 0.2 + (0..3).map(|k| m[r][k] * lin[k]).sum::<f64>());
+            Sample {
+                rgb,
+                xyz: xyz.into(),
+            }
         })
         .collect();
     let before = alloc::stats().0;

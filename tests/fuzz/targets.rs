@@ -53,7 +53,7 @@ pub fn scratch(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     p
 }
 
-fn finite_xyz(what: &str, xyz: [f64; 3]) -> Check {
+fn finite_xyz(what: &str, xyz: metamer::color::Xyz) -> Check {
     check_xyz(xyz).map_err(|e| format!("{what} accepted: {e}"))
 }
 
@@ -118,12 +118,12 @@ fn profile(bytes: &[u8], dir: &Path) -> Check {
     let Ok(p) = Profile::load(&path) else {
         return Ok(());
     };
-    let white = metamer::color::Xyz::from_array(p.white_xyz);
+    let white = p.white_xyz;
     // An in-gamut grey, a colour out of every gamut, black, and a far too bright one.
     for target in [
         p.white_xyz.map(|v| 0.2 * v),
-        [0.9 * p.white_xyz[1], 0.05 * p.white_xyz[1], 0.01],
-        [0.0; 3],
+        metamer::color::Xyz::new(0.9 * p.white_xyz[1], 0.05 * p.white_xyz[1], 0.01),
+        metamer::color::Xyz::default(),
         p.white_xyz.map(|v| 10.0 * v),
     ] {
         let inv = p.inverse(target);
@@ -131,7 +131,7 @@ fn profile(bytes: &[u8], dir: &Path) -> Check {
             GamutMapping::NearestLab,
             &|d| p.forward(d),
             inv.unclipped,
-            metamer::color::Xyz::from_array(target),
+            target,
             white,
         );
         if rgb.iter().any(|v| !(0.0..=1.0).contains(v)) {

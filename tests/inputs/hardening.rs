@@ -55,7 +55,7 @@ fn a_profile_with_a_zero_or_nan_white_is_refused() {
 
 #[test]
 fn nearest_lab_answers_at_once_for_non_finite_targets_and_whites() {
-    let forward = |rgb: [f64; 3]| rgb.map(|v| 100.0 * v);
+    let forward = |rgb: [f64; 3]| Xyz::from(rgb.map(|v| 100.0 * v));
     let white = Xyz::from_array([100.0; 3]);
     let start = std::time::Instant::now();
     for (target, white) in [

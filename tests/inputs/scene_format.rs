@@ -37,7 +37,7 @@ fn absolute_tiles(v: &mut Value, old: &Scene) {
     }
 }
 
-fn level_readings(scene: &Scene, level: usize) -> Vec<[f64; 3]> {
+fn level_readings(scene: &Scene, level: usize) -> Vec<metamer::color::Xyz> {
     let p = Prepared::new(scene).unwrap();
     let l = run_level(&p, &RadiosityOptions::default(), level, Deadline::never()).unwrap();
     let mut out = l.patches;

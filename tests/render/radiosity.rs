@@ -199,13 +199,11 @@ fn radiosity_agrees_with_pooled_mitsuba() {
     // The Mitsuba runs were of the box lit by LED-RGB1.
     let scene = build(&load("validation-box-led-rgb1.json"));
     let rad = render_spots_radiosity(&scene, &RadiosityOptions::default(), &|_| {}).unwrap();
-    let to_lab = |x: [f64; 3], w: [f64; 3]| {
-        metamer::color::Xyz::from_array(x).to_lab(metamer::color::Xyz::from_array(w))
-    };
+    let to_lab = |x: metamer::color::Xyz, w: metamer::color::Xyz| x.to_lab(w);
     let mut worst: f64 = 0.0;
     for (k, r) in rad.patches.iter().enumerate() {
         let m = mean(&|run| &run["patches"][k]["XYZ"]);
-        let de = delta_e76(to_lab(r.xyz, rad.white), to_lab(m, white));
+        let de = delta_e76(to_lab(r.xyz, rad.white), to_lab(m.into(), white.into()));
         worst = worst.max(de);
         assert!(
             de < 0.083,

@@ -305,7 +305,7 @@ fn spot_readings_agree_across_seeds_within_their_confidence() {
     // (≈ 4 σ) so 24 patches pass by chance with probability > 99.8 %, while a biased or
     // seed-dependent estimator (or a wrong half-width) fails. A shared white keeps the
     // comparison about the patches.
-    use metamer::color::{delta_e76, Xyz};
+    use metamer::color::delta_e76;
     use metamer::render::{render_spots, SpotOptions};
     let scene = build(&box_json());
     let white = metamer::render::reference_white(
@@ -331,14 +331,11 @@ fn spot_readings_agree_across_seeds_within_their_confidence() {
     };
     let (a, b) = (run(11), run(12));
     assert!(a.converged && b.converged);
-    let w = Xyz::from_array(white);
+    let w = white;
     let mut worst: f64 = 0.0;
     for (pa, pb) in a.patches.iter().zip(&b.patches) {
         assert!(pa.uncertainty.de_ab() < 0.4 && pb.uncertainty.de_ab() < 0.4);
-        let de = delta_e76(
-            Xyz::from_array(pa.xyz).to_lab(w),
-            Xyz::from_array(pb.xyz).to_lab(w),
-        );
+        let de = delta_e76(pa.xyz.to_lab(w), pb.xyz.to_lab(w));
         let allowed =
             2.0 * (pa.uncertainty.de_ab().powi(2) + pb.uncertainty.de_ab().powi(2)).sqrt();
         worst = worst.max(de / allowed);

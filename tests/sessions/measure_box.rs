@@ -183,9 +183,9 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     // each of L*, a*, b* (√3), 4σ; (c) the render's own bound.
     let white = {
         let w = &summary["render"]["comparison"]["white"];
-        [0, 1, 2].map(|i| w[i].as_f64().unwrap())
+        Xyz::from([0, 1, 2].map(|i| w[i].as_f64().unwrap()))
     };
-    let box_xyz: Vec<(usize, [f64; 3])> = summary["spot_xyz"]
+    let box_xyz: Vec<(usize, Xyz)> = summary["spot_xyz"]
         .as_array()
         .unwrap()
         .iter()
@@ -193,11 +193,11 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
             let xyz = &p[1];
             (
                 p[0].as_u64().unwrap() as usize,
-                [0, 1, 2].map(|i| xyz[i].as_f64().unwrap()),
+                Xyz::from([0, 1, 2].map(|i| xyz[i].as_f64().unwrap())),
             )
         })
         .collect();
-    let truth_xyz: Vec<(usize, [f64; 3])> = truth
+    let truth_xyz: Vec<(usize, Xyz)> = truth
         .spots()
         .unwrap()
         .iter()
@@ -210,7 +210,7 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
     let bounds = &summary["render"]["render_bound"];
     for (i, p) in measured.as_array().unwrap().iter().enumerate() {
         let de = p["de76"].as_f64().unwrap();
-        let t = Xyz::from_array(box_xyz[i].1).y / white[1];
+        let t = box_xyz[i].1.y / white[1];
         let rel = ((0.001f64 / 2f64.sqrt()).powi(2) * 2.0 + (0.002 / t).powi(2)).sqrt();
         let sigma_l = 116.0 / 3.0 * t.powf(1.0 / 3.0) * rel;
         let tol = sys.patches[i].de76 + 4.0 * 3f64.sqrt() * sigma_l + bounds[i].as_f64().unwrap();
@@ -251,7 +251,7 @@ fn a_simulated_session_recovers_the_truth_and_its_scene_renders_the_box() {
             let x = &p["XYZ"];
             RenderedReading::new(
                 p["patch"].as_u64().unwrap() as usize,
-                [0, 1, 2].map(|i| x[i].as_f64().unwrap()),
+                Xyz::from([0, 1, 2].map(|i| x[i].as_f64().unwrap())),
                 white,
                 Uncertainty::Bound {
                     de: 0.0,

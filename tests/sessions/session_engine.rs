@@ -214,7 +214,7 @@ fn calibrations_are_asked_for_when_due_and_everything_is_journalled() {
 
     let all = entries(&ran.session);
     assert_eq!(all.len(), 8);
-    let by_label: BTreeMap<&str, [f64; 3]> = all
+    let by_label: BTreeMap<&str, metamer::color::Xyz> = all
         .iter()
         .map(|e| (e.label.as_str(), e.reading.xyz))
         .collect();

@@ -17,6 +17,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use metamer_color::Xyz;
 use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
 
 use super::Speed;
@@ -127,7 +128,15 @@ impl Cs100aEmulator {
 
     /// One measurement of what the meter sees now, by the light model in the module doc.
     pub fn measure(&mut self) -> (Status, Option<Yxy>) {
-        let [x_, y_, z_] = self.world.view().light().map_or([0.0; 3], |l| l.xyz());
+        let Xyz {
+            x: x_,
+            y: y_,
+            z: z_,
+        } = self
+            .world
+            .view()
+            .light()
+            .map_or(Xyz::default(), |l| l.xyz());
         let lum = if y_.is_finite() { y_.max(0.0) } else { 0.0 };
         if lum > 2.0 * MAX_LUMINANCE {
             return (Status::Er10, None);

@@ -17,7 +17,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use metamer_color::{radiance_to_xyz, Illuminant, ObserverKind, Spectrum};
+use metamer_color::{radiance_to_xyz, Illuminant, ObserverKind, Spectrum, Xyz};
 use metamer_protocols::i1pro::commands::EP_DATA_IN;
 use metamer_protocols::i1pro::inverse;
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Exposure};
@@ -179,7 +179,7 @@ fn light_bands(light: &Light) -> Bands {
 
 /// A smooth spectrum of this XYZ (cd/m²), for worlds that know only the colour: a blend of
 /// three broad bands at 450, 540 and 610 nm.
-pub fn metamer_for(xyz: [f64; 3]) -> Spectrum {
+pub fn metamer_for(xyz: Xyz) -> Spectrum {
     let basis: Vec<Spectrum> = [450.0, 540.0, 610.0]
         .iter()
         .map(|c| {
@@ -191,12 +191,12 @@ pub fn metamer_for(xyz: [f64; 3]) -> Spectrum {
             Spectrum::new(nm, v).expect("an even grid")
         })
         .collect();
-    let m: Vec<[f64; 3]> = basis
+    let m: Vec<Xyz> = basis
         .iter()
-        .map(|b| radiance_to_xyz(b, ObserverKind::Cie1931).to_array())
+        .map(|b| radiance_to_xyz(b, ObserverKind::Cie1931))
         .collect();
     // Solve Σ_k a_k m_k = xyz (3×3, Cramer's rule).
-    let det = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+    let det = |a: Xyz, b: Xyz, c: Xyz| {
         a[0] * (b[1] * c[2] - b[2] * c[1]) - b[0] * (a[1] * c[2] - a[2] * c[1])
             + c[0] * (a[1] * b[2] - a[2] * b[1])
     };

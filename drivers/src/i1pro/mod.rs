@@ -248,7 +248,7 @@ impl<L: UsbLink> I1Pro<L> {
         };
         let xyy = xyz.to_xyy();
         Reading {
-            xyz: xyz.to_array(),
+            xyz,
             xyy: [xyy.x, xyy.y, xyy.luminance],
             spectrum: Some(spectrum),
             flags: Vec::<Flag>::new(),

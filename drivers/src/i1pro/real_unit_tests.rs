@@ -384,13 +384,8 @@ fn the_dark_references_noise_is_a_third_of_a_measurements_at_most() {
 }
 
 /// x, y and Y of a reading.
-fn xy_y(xyz: [f64; 3]) -> [f64; 3] {
-    let v = Xyz {
-        x: xyz[0],
-        y: xyz[1],
-        z: xyz[2],
-    }
-    .to_xyy();
+fn xy_y(xyz: Xyz) -> [f64; 3] {
+    let v = xyz.to_xyy();
     [v.x, v.y, v.luminance]
 }
 

@@ -63,7 +63,7 @@ fn replay_transcript(path: &str) {
             if let Some(xyz) = step.get("XYZ") {
                 // The expected XYZ were computed by hand (Python) from the Yxy in the
                 // transcript and rounded to 6 decimals.
-                check_triple(&reading.xyz, xyz, 1e-5, &at);
+                check_triple(&reading.xyz.to_array(), xyz, 1e-5, &at);
             }
             let flags: Vec<&str> = reading.flags.iter().map(|f| f.name()).collect();
             let want: Vec<&str> = step["flags"]

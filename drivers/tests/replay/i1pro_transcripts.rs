@@ -89,10 +89,10 @@ fn replay_transcript(path: &str) {
                 .iter()
                 .map(|v| v.as_f64().unwrap())
                 .collect();
-            assert_eq!(r.xyz.to_vec(), xyz, "{at}");
+            assert_eq!(r.xyz.to_array().to_vec(), xyz, "{at}");
             assert_eq!(r.integration_s, step["integration_s"].as_f64(), "{at}");
             if let Some(exact) = step.get("exact_XYZ").and_then(Value::as_array) {
-                for (g, w) in r.xyz.iter().zip(exact) {
+                for (g, w) in r.xyz.to_array().iter().zip(exact) {
                     let w = w.as_f64().unwrap();
                     assert!((g - w).abs() / w < 3e-4, "{at}: {:?} vs {exact:?}", r.xyz);
                 }

@@ -101,6 +101,37 @@ impl Xyz {
     pub fn scaled(self, k: f64) -> Xyz {
         Xyz::new(self.x * k, self.y * k, self.z * k)
     }
+
+    /// X, Y, Z in turn, by value, as an array's `iter().copied()` gives them.
+    pub fn iter(&self) -> std::array::IntoIter<f64, 3> {
+        self.to_array().into_iter()
+    }
+
+    /// Each component through `f`, as an array's `map` does.
+    pub fn map(self, mut f: impl FnMut(f64) -> f64) -> Xyz {
+        Xyz::new(f(self.x), f(self.y), f(self.z))
+    }
+
+    /// Whether X, Y and Z are all finite numbers.
+    pub fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite()
+    }
+}
+
+impl IntoIterator for Xyz {
+    type Item = f64;
+    type IntoIter = std::array::IntoIter<f64, 3>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.to_array().into_iter()
+    }
+}
+
+impl IntoIterator for &Xyz {
+    type Item = f64;
+    type IntoIter = std::array::IntoIter<f64, 3>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.to_array().into_iter()
+    }
 }
 
 impl From<[f64; 3]> for Xyz {

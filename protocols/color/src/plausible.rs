@@ -4,6 +4,8 @@
 //! triangle x ≥ 0, y ≥ 0, x + y ≤ 1 (a negative tristimulus value) is refused where it
 //! enters, instead of becoming a white of 5e307 cd/m² downstream.
 
+use crate::Xyz;
+
 /// Brightest plausible reading, cd/m²: the solar disc is about 1.6·10⁹ cd/m², so 10¹⁰ only
 /// refuses numbers no instrument can have measured.
 pub const MAX_CD_M2: f64 = 1e10;
@@ -29,7 +31,9 @@ pub enum Implausible {
 }
 
 /// Checks one XYZ reading (any unit in which 1 is about 1 cd/m², or white-relative Y = 100).
-pub fn check_xyz(xyz: [f64; 3]) -> Result<(), Implausible> {
+pub fn check_xyz(xyz: Xyz) -> Result<(), Implausible> {
+    // The refusal shows the array as every file writes it.
+    let xyz = xyz.to_array();
     if xyz.iter().any(|v| !v.is_finite()) {
         return Err(Implausible::NotFinite(xyz));
     }
@@ -68,6 +72,10 @@ pub fn check_yxy(luminance: f64, x: f64, y: f64) -> Result<(), Implausible> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn check_xyz(xyz: [f64; 3]) -> Result<(), Implausible> {
+        super::check_xyz(Xyz::from_array(xyz))
+    }
 
     #[test]
     fn real_readings_pass() {

@@ -10,6 +10,7 @@ use serde::Serialize;
 use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
 use super::verify::{average, usable, verify, HeldOutVerification};
+use crate::color::Xyz;
 use crate::display::model::{FitError, Sample};
 use crate::display::{fit_profile, write_ti3, ModelKind, ProfileError, Residuals};
 use crate::output::{OutputError, OutputPolicy};
@@ -68,8 +69,8 @@ pub struct Summary {
     pub failures: Vec<String>,
     pub readings: usize,
     pub fit_patches: usize,
-    pub white_xyz: [f64; 3],
-    pub black_xyz: [f64; 3],
+    pub white_xyz: Xyz,
+    pub black_xyz: Xyz,
     /// The model against the patches it was fitted to.
     pub fit_residuals: Residuals,
     /// The model against the held-out patches (ΔE00 relative to the measured white).
@@ -129,7 +130,7 @@ pub fn finish(
     let black = averaged
         .iter()
         .find(|p| p.rgb8 == [0; 3])
-        .map_or([0.0; 3], |p| p.xyz);
+        .map_or(Xyz::default(), |p| p.xyz);
     // Every usable reading, not the averages: the fit averages repeats itself and needs them
     // to estimate the meter's noise for its verdict.
     let training: Vec<Sample> = readings

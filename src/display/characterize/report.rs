@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::color::Xyz;
 use crate::output::{OutputError, OutputPolicy};
 
 use super::verify::{AveragedPatch, HeldOutVerification};
@@ -27,7 +28,7 @@ pub struct Report<'a> {
     pub title: String,
     pub patches: &'a [AveragedPatch],
     /// The fitted model, drive 0–1 → XYZ, drawn over the measured TRCs.
-    pub forward: Option<&'a dyn Fn([f64; 3]) -> [f64; 3]>,
+    pub forward: Option<&'a dyn Fn([f64; 3]) -> Xyz>,
     pub verification: Option<&'a HeldOutVerification>,
 }
 
@@ -40,8 +41,8 @@ const RAMPS: [(&str, [u8; 3], RGBColor); 4] = [
 ];
 
 /// (drive 0–1, XYZ) of the patches on ramp `mask`, black and full drive included, sorted.
-fn ramp(patches: &[AveragedPatch], mask: [u8; 3]) -> Vec<(f64, [f64; 3])> {
-    let mut pts: Vec<(f64, [f64; 3])> = patches
+fn ramp(patches: &[AveragedPatch], mask: [u8; 3]) -> Vec<(f64, Xyz)> {
+    let mut pts: Vec<(f64, Xyz)> = patches
         .iter()
         .filter(|p| {
             let v = p.rgb8.iter().copied().max().unwrap_or(0);
@@ -58,12 +59,12 @@ fn ramp(patches: &[AveragedPatch], mask: [u8; 3]) -> Vec<(f64, [f64; 3])> {
     pts
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+fn sub(a: Xyz, b: Xyz) -> Xyz {
+    a - b
 }
 
 /// Chromaticity of a black-subtracted term, None where it has no light.
-fn chromaticity(xyz: [f64; 3]) -> Option<(f64, f64)> {
+fn chromaticity(xyz: Xyz) -> Option<(f64, f64)> {
     let s = xyz[0] + xyz[1] + xyz[2];
     (s > 1e-9 && xyz[1] > 0.0).then(|| (xyz[0] / s, xyz[1] / s))
 }
@@ -91,7 +92,7 @@ fn draw_report(report: &Report, file: &Path, svg: &mut String) -> Result<(), Rep
         .patches
         .iter()
         .find(|p| p.rgb8 == [0, 0, 0])
-        .map_or([0.0; 3], |p| p.xyz);
+        .map_or(Xyz::default(), |p| p.xyz);
     draw_trc(&panels[0], report, black).map_err(|e| fail(&e))?;
     for (k, name) in ["x", "y"].into_iter().enumerate() {
         draw_chromaticity(&panels[1 + k], report.patches, black, k, name).map_err(|e| fail(&e))?;
@@ -105,7 +106,7 @@ fn draw_report(report: &Report, file: &Path, svg: &mut String) -> Result<(), Rep
 
 type DrawResult = Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
-fn draw_trc(area: &DrawingArea<SVGBackend, Shift>, report: &Report, black: [f64; 3]) -> DrawResult {
+fn draw_trc(area: &DrawingArea<SVGBackend, Shift>, report: &Report, black: Xyz) -> DrawResult {
     let mut chart = ChartBuilder::on(area)
         .caption("tone response (black subtracted)", ("sans-serif", 16))
         .margin(10)
@@ -126,7 +127,7 @@ fn draw_trc(area: &DrawingArea<SVGBackend, Shift>, report: &Report, black: [f64;
         if span <= 0.0 {
             continue;
         }
-        let rel = |xyz: [f64; 3]| (xyz[1] - black[1]) / span;
+        let rel = |xyz: Xyz| (xyz[1] - black[1]) / span;
         chart
             .draw_series(
                 pts.iter()
@@ -155,7 +156,7 @@ fn draw_trc(area: &DrawingArea<SVGBackend, Shift>, report: &Report, black: [f64;
 fn draw_chromaticity(
     area: &DrawingArea<SVGBackend, Shift>,
     patches: &[AveragedPatch],
-    black: [f64; 3],
+    black: Xyz,
     which: usize,
     name: &str,
 ) -> DrawResult {
@@ -264,7 +265,7 @@ mod tests {
             label: String::new(),
             rgb8,
             purpose: Purpose::Fit,
-            xyz: [y; 3],
+            xyz: Xyz::new(y, y, y),
             readings: 1,
         };
         let patches = [
@@ -284,8 +285,8 @@ mod tests {
             grey.iter().map(|q| q.1[1]).collect::<Vec<_>>(),
             vec![0.1, 2.0]
         );
-        assert_eq!(chromaticity([0.0; 3]), None);
-        assert_eq!(chromaticity([1.0, 2.0, 1.0]), Some((0.25, 0.5)));
+        assert_eq!(chromaticity(Xyz::default()), None);
+        assert_eq!(chromaticity(Xyz::new(1.0, 2.0, 1.0)), Some((0.25, 0.5)));
     }
 
     #[test]

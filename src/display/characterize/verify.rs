@@ -21,7 +21,7 @@ pub struct AveragedPatch {
     pub rgb8: [u8; 3],
     pub purpose: Purpose,
     /// Mean XYZ over the usable readings, cd/m².
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Usable readings averaged.
     pub readings: usize,
 }
@@ -60,13 +60,11 @@ pub fn average(readings: &[(&DriveStep, &Reading)]) -> Result<Vec<AveragedPatch>
             label: p.label.clone(),
             rgb8: p.rgb,
             purpose: p.purpose,
-            xyz: [0.0; 3],
+            xyz: Xyz::default(),
             readings: 0,
         });
         if usable(r) {
-            for (s, v) in slot.xyz.iter_mut().zip(r.xyz) {
-                *s += v;
-            }
+            slot.xyz = slot.xyz + r.xyz;
             slot.readings += 1;
         }
     }
@@ -93,8 +91,8 @@ pub fn average(readings: &[(&DriveStep, &Reading)]) -> Result<Vec<AveragedPatch>
 pub struct VerifiedPatch {
     pub label: String,
     pub rgb8: [u8; 3],
-    pub measured_xyz: [f64; 3],
-    pub predicted_xyz: [f64; 3],
+    pub measured_xyz: Xyz,
+    pub predicted_xyz: Xyz,
     pub delta_e00: f64,
 }
 
@@ -105,7 +103,7 @@ pub struct VerifiedPatch {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct HeldOutVerification {
     /// The measured white CIELAB is taken relative to, cd/m².
-    pub white_xyz: [f64; 3],
+    pub white_xyz: Xyz,
     pub patches: Vec<VerifiedPatch>,
     pub mean: f64,
     /// 95th percentile, linear between order statistics (rank 0.95·(n − 1)).
@@ -119,10 +117,10 @@ pub struct HeldOutVerification {
 /// otherwise make the mean NaN and the summary's statistics `null`.
 pub fn verify(
     patches: &[AveragedPatch],
-    white_xyz: [f64; 3],
-    predict: &dyn Fn([f64; 3]) -> [f64; 3],
+    white_xyz: Xyz,
+    predict: &dyn Fn([f64; 3]) -> Xyz,
 ) -> Result<Option<HeldOutVerification>, VerifyError> {
-    let white = Xyz::from_array(white_xyz);
+    let white = white_xyz;
     let verified: Vec<VerifiedPatch> = patches
         .iter()
         .filter(|p| p.purpose == Purpose::Verify)
@@ -130,10 +128,7 @@ pub fn verify(
             let rgb = p.to_patch().rgb;
             let predicted = predict(rgb);
             check_prediction(p.patch + 1, rgb, predicted)?;
-            let de = delta_e2000(
-                Xyz::from_array(p.xyz).to_lab(white),
-                Xyz::from_array(predicted).to_lab(white),
-            );
+            let de = delta_e2000(p.xyz.to_lab(white), predicted.to_lab(white));
             Ok(VerifiedPatch {
                 label: p.label.clone(),
                 rgb8: p.rgb8,
@@ -198,7 +193,7 @@ mod tests {
         // A prediction that scales XYZ by k leaves a, b at 0 for a neutral patch and moves
         // L* only: ΔE00 of a pure ΔL at L ≈ 50 is ΔL/S_L with S_L = 1 (CIEDE2000, Sharma
         // et al. 2005 Eq. 13: S_L = 1 + 0.015(L̄−50)²/√(20+(L̄−50)²)).
-        let white = [95.047, 100.0, 108.883];
+        let white = Xyz::new(95.047, 100.0, 108.883);
         let grey_y = 18.418_651_851_244_416; // L* = 50 exactly: ((50+16)/116)³·100
         let patches: Vec<AveragedPatch> = (0..21)
             .map(|i| AveragedPatch {
@@ -246,7 +241,7 @@ mod tests {
         // a NaN mean.
         let broken = |rgb: [f64; 3]| {
             if (rgb[0] * 255.0).round() == 7.0 {
-                [f64::NAN; 3]
+                Xyz::new(f64::NAN, f64::NAN, f64::NAN)
             } else {
                 predict(rgb)
             }

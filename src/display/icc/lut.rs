@@ -23,6 +23,7 @@ use moxcms::{LutDataType, LutStore, LutType, LutWarehouse, Matrix3d};
 
 use super::encode::{unit_u16, xyz_u16, IccError, CURVE_ENTRIES};
 use super::pcs::{self, Mat3, Pcs};
+use crate::color::Xyz;
 use crate::display::model::{DisplayModel, Lut3d};
 
 /// Most CLUT nodes per axis A2B0's subdivision aims at (33³ × 3 × 2 bytes ≈ 215 kB): its
@@ -219,7 +220,7 @@ pub(super) fn a2b(lut: &Lut3d, pcs: &Pcs) -> LutWarehouse {
     for &r in &drives[0] {
         for &g in &drives[1] {
             for &b in &drives[2] {
-                clut.extend(pcs.to_pcs(lut.forward([r, g, b])).map(xyz_u16));
+                clut.extend(pcs.to_pcs(lut.forward([r, g, b])).into_iter().map(xyz_u16));
             }
         }
     }
@@ -247,7 +248,7 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<LutWarehouse, IccError> {
     // somewhere in the gamut (crosstalk, or a black outside the primaries' cone) gets a
     // share of Y added (Y ≥ 0 everywhere): the grid is then sheared, not cut.
     let surface = cube_surface();
-    let points: Vec<[f64; 3]> = surface.iter().map(|&d| at(d)).collect();
+    let points: Vec<Xyz> = surface.iter().map(|&d| at(d)).collect();
     for c in 0..3 {
         let low = points
             .iter()
@@ -318,7 +319,7 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<LutWarehouse, IccError> {
             for &lb in &nodes[2] {
                 let l = [lr, lg, lb];
                 let t: [f64; 3] = std::array::from_fn(|c| k[c] + gain[c] * l[c]);
-                let xyz = pcs.from_pcs(pcs::mul(&qinv, t));
+                let xyz = pcs.from_pcs(pcs::mul(&qinv, t).into());
                 let drive = lut.inverse(xyz).unclipped;
                 clut.extend((0..3).map(|c| {
                     let s = axes[c].forward(drive[c]);
@@ -363,7 +364,7 @@ fn cube_surface() -> Vec<[f64; 3]> {
 /// drive minus black, scaled per channel so that full drive on all three is the model's
 /// white (a display that does not add its channels exactly needs a little of that), with
 /// the black folded into the curves as for the matrix models.
-pub(super) fn matrix_approximation(lut: &Lut3d) -> ([[f64; 3]; 3], [f64; 3], [Vec<f64>; 3]) {
+pub(super) fn matrix_approximation(lut: &Lut3d) -> ([[f64; 3]; 3], Xyz, [Vec<f64>; 3]) {
     let axes: [Axis; 3] = std::array::from_fn(|c| Axis::new(lut, c));
     let black = lut.forward([0.0; 3]);
     let white = lut.forward([1.0; 3]);

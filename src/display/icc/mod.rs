@@ -35,6 +35,7 @@ use moxcms::{
 
 use super::model::ModelParams;
 use super::profile::Profile;
+use crate::color::Xyz;
 pub use encode::IccError;
 use encode::{unit_u16, CURVE_ENTRIES};
 pub use pcs::Pcs;
@@ -91,14 +92,14 @@ pub struct IccProfile {
 }
 
 /// The white of a profile's ICC form: the model at full drive, cd/m².
-pub fn icc_white(profile: &Profile) -> [f64; 3] {
+pub fn icc_white(profile: &Profile) -> Xyz {
     profile.forward([1.0; 3])
 }
 
 /// The PCS of a profile's ICC form: its white ([`icc_white`]) adapted to D50.
 pub fn profile_pcs(profile: &Profile) -> Result<Pcs, IccError> {
     let white = icc_white(profile);
-    Pcs::new(white).ok_or(IccError::White(white[1]))
+    Pcs::new(white).ok_or(IccError::White(white.y))
 }
 
 /// Encodes `profile` as an ICC display profile; `description` becomes its `desc` tag.
@@ -117,7 +118,7 @@ pub fn encode_icc(
     icc.white_point = xyzd(pcs::D50);
     icc.media_white_point = Some(xyzd(match version {
         IccVersion::V4 => pcs::D50,
-        IccVersion::V2_4 => white.map(|v| v / white[1]),
+        IccVersion::V2_4 => white.map(|v| v / white.y),
     }));
     icc.chromatic_adaptation = Some(Matrix3d { v: pcs.chad });
     icc.luminance = Some(xyzd(white));
@@ -159,11 +160,11 @@ pub fn encode_icc(
     })
 }
 
-fn xyzd(v: [f64; 3]) -> Xyzd {
+fn xyzd(v: Xyz) -> Xyzd {
     Xyzd {
-        x: v[0],
-        y: v[1],
-        z: v[2],
+        x: v.x,
+        y: v.y,
+        z: v.z,
     }
 }
 
@@ -175,7 +176,7 @@ const CHANNELS: [&str; 3] = ["red", "green", "blue"];
 fn matrix_trc(
     icc: &mut ColorProfile,
     matrix: &pcs::Mat3,
-    black: [f64; 3],
+    black: Xyz,
     curves: [Vec<f64>; 3],
     pcs: &Pcs,
 ) -> Result<[f64; 3], IccError> {
@@ -203,9 +204,9 @@ fn matrix_trc(
         ));
         columns[c] = std::array::from_fn(|r| mp[r][c] * scale);
     }
-    icc.red_colorant = xyzd(columns[0]);
-    icc.green_colorant = xyzd(columns[1]);
-    icc.blue_colorant = xyzd(columns[2]);
+    icc.red_colorant = xyzd(columns[0].into());
+    icc.green_colorant = xyzd(columns[1].into());
+    icc.blue_colorant = xyzd(columns[2].into());
     let mut trcs = trcs.into_iter();
     icc.red_trc = trcs.next();
     icc.green_trc = trcs.next();

@@ -2,9 +2,11 @@
 //! PCS illuminant by the linearised Bradford transform, as ICC.1:2010 Annex E recommends
 //! for the chromaticAdaptationTag.
 
+use crate::color::Xyz;
+
 /// The PCS illuminant, ICC.1:2010 7.2.16 (s15Fixed16 values 0x0000F6D6, 0x00010000,
 /// 0x0000D32D).
-pub const D50: [f64; 3] = [0.9642, 1.0, 0.8249];
+pub const D50: Xyz = Xyz::new(0.9642, 1.0, 0.8249);
 
 /// Lam's cone-response matrix of the Bradford transform (ICC.1:2010 Annex E, Eq. E.3).
 const BRADFORD: [[f64; 3]; 3] = [
@@ -15,7 +17,8 @@ const BRADFORD: [[f64; 3]; 3] = [
 
 pub type Mat3 = [[f64; 3]; 3];
 
-pub fn mul(m: &Mat3, v: [f64; 3]) -> [f64; 3] {
+/// `m·v` for a column `v` given as an array or as [`Xyz`].
+pub fn mul(m: &Mat3, v: impl std::ops::Index<usize, Output = f64>) -> [f64; 3] {
     std::array::from_fn(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
 }
 
@@ -33,10 +36,10 @@ pub fn inverse(m: &Mat3) -> Option<Mat3> {
 /// The linearised Bradford matrix taking colours seen under `source` white to those seen
 /// under `target` white (both XYZ with any scale; only their chromaticities matter after
 /// Y normalisation).
-pub fn bradford(source: [f64; 3], target: [f64; 3]) -> Mat3 {
+pub fn bradford(source: Xyz, target: Xyz) -> Mat3 {
     let inv = inverse(&BRADFORD).expect("Bradford's matrix is regular");
-    let s = mul(&BRADFORD, source.map(|v| v / source[1]));
-    let t = mul(&BRADFORD, target.map(|v| v / target[1]));
+    let s = mul(&BRADFORD, source.map(|v| v / source.y));
+    let t = mul(&BRADFORD, target.map(|v| v / target.y));
     let gain: Mat3 =
         std::array::from_fn(|r| std::array::from_fn(|c| if r == c { t[r] / s[r] } else { 0.0 }));
     mat_mul(&inv, &mat_mul(&gain, &BRADFORD))
@@ -54,8 +57,8 @@ pub struct Pcs {
 
 impl Pcs {
     /// `white`: the display white, cd/m²; its luminance must be positive.
-    pub fn new(white: [f64; 3]) -> Option<Pcs> {
-        if !(white[1] > 0.0 && white.iter().all(|v| v.is_finite())) {
+    pub fn new(white: Xyz) -> Option<Pcs> {
+        if !(white.y > 0.0 && white.is_finite()) {
             return None;
         }
         let chad = bradford(white, D50);
@@ -68,12 +71,12 @@ impl Pcs {
         })
     }
 
-    pub fn to_pcs(&self, xyz: [f64; 3]) -> [f64; 3] {
-        mul(&self.to_pcs, xyz)
+    pub fn to_pcs(&self, xyz: Xyz) -> Xyz {
+        mul(&self.to_pcs, xyz).into()
     }
 
-    pub fn from_pcs(&self, pcs: [f64; 3]) -> [f64; 3] {
-        mul(&self.from_pcs, pcs)
+    pub fn from_pcs(&self, pcs: Xyz) -> Xyz {
+        mul(&self.from_pcs, pcs).into()
     }
 
     /// The matrix absolute XYZ → PCS XYZ.
@@ -90,7 +93,10 @@ mod tests {
     /// Adaptation", with his D65 0.95047/1/1.08883 and D50 0.96422/1/0.82521).
     #[test]
     fn bradford_d65_to_d50_matches_the_published_matrix() {
-        let m = bradford([0.95047, 1.0, 1.08883], [0.96422, 1.0, 0.82521]);
+        let m = bradford(
+            Xyz::new(0.95047, 1.0, 1.08883),
+            Xyz::new(0.96422, 1.0, 0.82521),
+        );
         let published = [
             [1.0478112, 0.0228866, -0.0501270],
             [0.0295424, 0.9904844, -0.0170491],
@@ -109,7 +115,7 @@ mod tests {
 
     #[test]
     fn the_white_maps_to_d50_and_back() {
-        let white = [180.0, 200.0, 230.0];
+        let white = Xyz::new(180.0, 200.0, 230.0);
         let pcs = Pcs::new(white).unwrap();
         let w = pcs.to_pcs(white);
         for c in 0..3 {
@@ -119,6 +125,6 @@ mod tests {
         for c in 0..3 {
             assert!((back[c] - white[c]).abs() < 1e-9);
         }
-        assert!(Pcs::new([1.0, 0.0, 1.0]).is_none());
+        assert!(Pcs::new(Xyz::new(1.0, 0.0, 1.0)).is_none());
     }
 }

@@ -4,6 +4,7 @@
 //! tetrahedral interpolation in the CLUT, as LittleCMS interpolates three inputs. It tells
 //! whether a written profile says what the model says.
 
+use crate::color::Xyz;
 use moxcms::{ColorProfile, LutDataType, LutStore, LutWarehouse, ToneCurveEvaluator};
 
 /// Why a profile could not be read back.
@@ -159,15 +160,16 @@ impl IccForward {
     }
 
     /// PCS XYZ (D50, white Y = 1) for drive values 0–1.
-    pub fn pcs_xyz(&self, rgb: [f64; 3]) -> [f64; 3] {
-        match self {
+    pub fn pcs_xyz(&self, rgb: [f64; 3]) -> Xyz {
+        let v: [f64; 3] = match self {
             IccForward::Matrix { colorants, curves } => {
                 let lin: [f64; 3] =
                     std::array::from_fn(|c| curves[c].evaluate_value(rgb[c] as f32) as f64);
                 std::array::from_fn(|r| (0..3).map(|c| colorants[r][c] * lin[c]).sum())
             }
             IccForward::Lut16(lut) => lut.eval(rgb, false).map(|v| v * 65535.0 / 32768.0),
-        }
+        };
+        v.into()
     }
 }
 
@@ -185,8 +187,10 @@ impl IccInverse {
     }
 
     /// Drive values 0–1 for a PCS XYZ (D50, white Y = 1).
-    pub fn rgb(&self, pcs_xyz: [f64; 3]) -> [f64; 3] {
-        self.0.eval(pcs_xyz.map(|v| v * 32768.0 / 65535.0), true)
+    pub fn rgb(&self, pcs_xyz: Xyz) -> [f64; 3] {
+        let scale = |v: f64| v * 32768.0 / 65535.0;
+        self.0
+            .eval([scale(pcs_xyz.x), scale(pcs_xyz.y), scale(pcs_xyz.z)], true)
     }
 }
 
@@ -205,14 +209,14 @@ pub fn agreement(
     profile: &crate::display::Profile,
     drives: &[[f64; 3]],
 ) -> Result<Agreement, IccReadError> {
-    use crate::color::{delta_e2000, Xyz};
+    use crate::color::delta_e2000;
     let forward = IccForward::parse(bytes)?;
     let pcs = super::profile_pcs(profile).map_err(|_| IccReadError::Malformed("white"))?;
-    let d50 = Xyz::from_array(super::pcs::D50);
+    let d50 = super::pcs::D50;
     let (mut sum, mut max) = (0.0, 0.0f64);
     for &rgb in drives {
-        let ours = Xyz::from_array(pcs.to_pcs(profile.forward(rgb))).to_lab(d50);
-        let theirs = Xyz::from_array(forward.pcs_xyz(rgb)).to_lab(d50);
+        let ours = pcs.to_pcs(profile.forward(rgb)).to_lab(d50);
+        let theirs = forward.pcs_xyz(rgb).to_lab(d50);
         let de = delta_e2000(ours, theirs);
         sum += de;
         max = max.max(de);
@@ -233,18 +237,15 @@ pub fn inverse_agreement(
     profile: &crate::display::Profile,
     drives: &[[f64; 3]],
 ) -> Result<Agreement, IccReadError> {
-    use crate::color::{delta_e2000, Xyz};
+    use crate::color::delta_e2000;
     let inverse = IccInverse::parse(bytes)?;
     let pcs = super::profile_pcs(profile).map_err(|_| IccReadError::Malformed("white"))?;
-    let d50 = Xyz::from_array(super::pcs::D50);
+    let d50 = super::pcs::D50;
     let (mut sum, mut max) = (0.0, 0.0f64);
     for &rgb in drives {
         let want = pcs.to_pcs(profile.forward(rgb));
         let back = pcs.to_pcs(profile.forward(inverse.rgb(want)));
-        let de = delta_e2000(
-            Xyz::from_array(want).to_lab(d50),
-            Xyz::from_array(back).to_lab(d50),
-        );
+        let de = delta_e2000(want.to_lab(d50), back.to_lab(d50));
         sum += de;
         max = max.max(de);
     }

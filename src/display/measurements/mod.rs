@@ -25,6 +25,7 @@ use tokens::tokens;
 pub use write::write_ti3;
 
 use super::model::Sample;
+use crate::color::Xyz;
 use crate::numeric_csv::{CsvError, NumericCsv};
 
 /// What is wrong with a measurement file; every variant names the file, most the line.
@@ -98,7 +99,7 @@ pub fn read_measurement_file(path: &Path) -> Result<Measurements, MeasurementsEr
                     ),
                 });
             }
-            let xyz = [v[3], v[4], v[5]];
+            let xyz = Xyz::new(v[3], v[4], v[5]);
             metamer_color::check_xyz(xyz).map_err(|e| MeasurementsError::Cgats {
                 file: path.to_path_buf(),
                 line: *line,
@@ -297,7 +298,7 @@ impl Table {
                 return Err((line, format!("{name} = {} is outside 0–100", v[k])));
             }
         }
-        metamer_color::check_xyz([v[3], v[4], v[5]])
+        metamer_color::check_xyz(Xyz::new(v[3], v[4], v[5]))
             .map_err(|e| (line, format!("not a measurement: {e}")))?;
         if !self.spectral.is_empty() {
             let row = self
@@ -378,7 +379,7 @@ impl Table {
                     .collect();
                 if xyz.len() != 3
                     || xyz[1] <= 0.0
-                    || metamer_color::check_xyz([xyz[0], xyz[1], xyz[2]]).is_err()
+                    || metamer_color::check_xyz(Xyz::new(xyz[0], xyz[1], xyz[2])).is_err()
                 {
                     return Err((
                         *l,
@@ -395,7 +396,7 @@ impl Table {
     fn patches(&self, scale: f64) -> Result<Vec<Sample>, LineError> {
         let mut patches = Vec::with_capacity(self.rows.len());
         for &(line, v) in &self.rows {
-            let xyz = [v[3] * scale, v[4] * scale, v[5] * scale];
+            let xyz = Xyz::new(v[3] * scale, v[4] * scale, v[5] * scale);
             // Each row passed alone; the white's luminance can still scale it past belief.
             metamer_color::check_xyz(xyz)
                 .map_err(|e| (line, format!("not a measurement once scaled to cd/m²: {e}")))?;
@@ -553,7 +554,7 @@ DESCRIPTOR "Argyll Device Calibration State"
             p[1],
             Sample {
                 rgb: [0.5, 0.0, 0.0],
-                xyz: [10.0, 5.0, 0.5]
+                xyz: Xyz::new(10.0, 5.0, 0.5)
             }
         );
         std::fs::write(&path, "r,g,b,X,Y,Z\n1,1,1,95,100,108\n2,0,0,10,5,0.5\n").unwrap();

@@ -6,11 +6,12 @@ use std::path::Path;
 
 use crate::output::OutputPolicy;
 
+use crate::color::Xyz;
 use crate::display::model::Sample;
 
 /// The white used to normalise a `.ti3`: the brightest patch driven at full on all channels,
 /// or the brightest patch when none is.
-fn white_of(patches: &[Sample]) -> Option<[f64; 3]> {
+fn white_of(patches: &[Sample]) -> Option<Xyz> {
     let brightest = |it: &mut dyn Iterator<Item = &Sample>| {
         it.max_by(|a, b| a.xyz[1].total_cmp(&b.xyz[1]))
             .map(|p| p.xyz)
@@ -120,15 +121,15 @@ mod tests {
         let patches = vec![
             Sample {
                 rgb: [0.0, 0.0, 0.0],
-                xyz: [0.2, 0.21, 0.3],
+                xyz: Xyz::new(0.2, 0.21, 0.3),
             },
             Sample {
                 rgb: [1.0, 1.0, 1.0],
-                xyz: [152.0, 160.0, 174.2],
+                xyz: Xyz::new(152.0, 160.0, 174.2),
             },
             Sample {
                 rgb: [128.0 / 255.0, 0.25, 1.0],
-                xyz: [30.5, 20.25, 90.125],
+                xyz: Xyz::new(30.5, 20.25, 90.125),
             },
         ];
         let dir = std::env::temp_dir().join(format!("metamer-ti3-{}", std::process::id()));

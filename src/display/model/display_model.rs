@@ -1,6 +1,8 @@
 //! What every display model is: forward (drive RGB 0–1 → absolute XYZ cd/m²) and inverse
 //! (XYZ → drive RGB, reporting out-of-gamut targets instead of clipping silently).
 
+use crate::color::Xyz;
+
 /// A target whose channel output (R′, G′, B′ in Eq. 9, normalised so full drive gives 1)
 /// lies further than this outside the range that drive values 0–1 produce is out of gamut.
 /// It is judged on the output, not on the drive value, because a TRC's inverse magnifies
@@ -13,9 +15,9 @@ pub const GAMUT_TOLERANCE: f64 = 1e-5;
 pub trait DisplayModel: Send + Sync {
     fn name(&self) -> &'static str;
     /// Drive values 0–1 → absolute XYZ, cd/m².
-    fn forward(&self, rgb: [f64; 3]) -> [f64; 3];
+    fn forward(&self, rgb: [f64; 3]) -> Xyz;
     /// XYZ → drive values; never clips silently (see [`Inverse`]).
-    fn inverse(&self, xyz: [f64; 3]) -> Inverse;
+    fn inverse(&self, xyz: Xyz) -> Inverse;
 }
 
 /// The drive values for a target.

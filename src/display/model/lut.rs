@@ -19,6 +19,7 @@ use super::samples::Sample;
 use super::samples::{SortedSamples, CHANNEL_NAMES, SAME_DRIVE};
 use super::trc::fit_power_gamma;
 use super::{condition_number, DisplayModel, FastInverse, Inverse, ModelKind, Trc, MAX_CONDITION};
+use crate::color::Xyz;
 
 /// Ramp levels from which the shaper interpolates the ramp instead of fitting a power law.
 const TABLE_SHAPER_LEVELS: usize = 8;
@@ -192,13 +193,14 @@ impl DisplayModel for Lut3d {
         ModelKind::Lut.name()
     }
 
-    fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
+    fn forward(&self, rgb: [f64; 3]) -> Xyz {
         let s = std::array::from_fn(|c| self.shaper[c].eval(rgb[c]));
-        self.eval_shaped(s).0.into()
+        let v = self.eval_shaped(s).0;
+        Xyz::new(v[0], v[1], v[2])
     }
 
-    fn inverse(&self, xyz: [f64; 3]) -> Inverse {
-        let target = Vector3::from(xyz);
+    fn inverse(&self, xyz: Xyz) -> Inverse {
+        let target = Vector3::new(xyz.x, xyz.y, xyz.z);
         let scale = self.scale;
         // Start from the linear map through black and the three full-on primaries.
         let (black, start) = &self.start;

@@ -171,7 +171,7 @@ fn fit_on_base(
     for &r in &levels[0] {
         for &g in &levels[1] {
             for &b in &levels[2] {
-                base_nodes.push(base.model.forward([r, g, b]));
+                base_nodes.push(base.model.forward([r, g, b]).into());
             }
         }
     }
@@ -195,7 +195,7 @@ fn fit_on_base(
         .collect();
     let scale = slope(0.2 * yw).powi(2);
     let problem = Problem { grid, scale };
-    let wl = Xyz::from_array(white);
+    let wl = white;
     let mut cv = Vec::new();
     for &l in lambdas {
         let mut sum = 0.0;
@@ -211,10 +211,7 @@ fn fit_on_base(
             for (i, (row, p)) in rows.iter().zip(patches).enumerate() {
                 if fold_of(i) % FOLDS == fold {
                     let f = predict(row, &base_nodes, &c);
-                    sum += delta_e2000(
-                        Xyz::from_array(f).to_lab(wl),
-                        Xyz::from_array(p.xyz).to_lab(wl),
-                    );
+                    sum += delta_e2000(Xyz::from(f).to_lab(wl), p.xyz.to_lab(wl));
                     count += 1;
                 }
             }

@@ -50,5 +50,5 @@ pub fn fit_matrix_lsq(set: &SortedSamples, patches: &[Sample]) -> Result<MatrixT
         }
         offset[k] = x[3];
     }
-    MatrixTrc::new(kind, offset, fitted, trc).map_err(singular)
+    MatrixTrc::new(kind, offset.into(), fitted, trc).map_err(singular)
 }

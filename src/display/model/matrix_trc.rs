@@ -4,13 +4,15 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::color::Xyz;
+
 use super::{DisplayModel, FastInverse, Inverse, ModelKind, Trc, GAMUT_TOLERANCE};
 
 /// Black offset, matrix and one curve per channel.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MatrixTrc {
     /// XYZ₀, cd/m².
-    pub black: [f64; 3],
+    pub black: Xyz,
     /// Rows X, Y, Z; columns R, G, B (cd/m² per unit R′, G′, B′).
     pub matrix: [[f64; 3]; 3],
     pub trc: [Trc; 3],
@@ -46,7 +48,7 @@ impl MatrixTrc {
     /// Builds the model; `Err(condition number)` when M cannot be inverted safely.
     pub fn new(
         kind: ModelKind,
-        black: [f64; 3],
+        black: Xyz,
         matrix: [[f64; 3]; 3],
         trc: [Trc; 3],
     ) -> Result<Self, f64> {
@@ -92,12 +94,11 @@ impl DisplayModel for MatrixTrc {
         self.kind.map_or("matrix-trc", ModelKind::name)
     }
 
-    fn forward(&self, rgb: [f64; 3]) -> [f64; 3] {
-        let l = mul(&self.matrix, self.linear(rgb));
-        std::array::from_fn(|c| self.black[c] + l[c])
+    fn forward(&self, rgb: [f64; 3]) -> Xyz {
+        self.black + Xyz::from(mul(&self.matrix, self.linear(rgb)))
     }
 
-    fn inverse(&self, xyz: [f64; 3]) -> Inverse {
+    fn inverse(&self, xyz: Xyz) -> Inverse {
         let d = std::array::from_fn(|c| xyz[c] - self.black[c]);
         let lin = mul(&self.inverse_matrix, d);
         Inverse::from_outputs(&self.fast, lin)

@@ -65,7 +65,7 @@ impl ModelParams {
                         .check()
                         .map_err(|e| format!("the {name} tone curve is unusable: {e}"))?;
                 }
-                let numbers = m.black.iter().chain(m.matrix.iter().flatten());
+                let numbers = m.black.iter().chain(m.matrix.iter().flatten().copied());
                 if let Some(v) = numbers.into_iter().find(|v| !v.is_finite()) {
                     return Err(format!(
                         "the model's black or matrix holds {v}, not a finite number"

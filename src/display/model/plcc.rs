@@ -12,12 +12,13 @@ use super::error::FitError;
 use super::samples::{SortedSamples, CHANNEL_NAMES};
 use super::trc::fit_power_gamma;
 use super::{MatrixTrc, ModelKind, Trc};
+use crate::color::Xyz;
 
 /// Black and the Eq. 9 matrix (columns: full-on primaries minus black).
 pub fn black_and_primaries(
     set: &SortedSamples,
     kind: ModelKind,
-) -> Result<([f64; 3], [[f64; 3]; 3]), FitError> {
+) -> Result<(Xyz, [[f64; 3]; 3]), FitError> {
     let black = set.black.ok_or_else(|| FitError::Missing {
         model: kind,
         what: "the black patch (r,g,b = 0,0,0)".into(),
@@ -39,7 +40,7 @@ pub fn black_and_primaries(
 /// black-corrected XYZ projected on M's column `c`.
 pub fn ramp_points(
     set: &SortedSamples,
-    black: [f64; 3],
+    black: Xyz,
     m: &[[f64; 3]; 3],
     c: usize,
 ) -> Vec<(f64, f64)> {
@@ -73,7 +74,7 @@ pub fn fit_plcc(set: &SortedSamples) -> Result<MatrixTrc, FitError> {
 pub fn ramp_tables(
     set: &SortedSamples,
     kind: ModelKind,
-    black: [f64; 3],
+    black: Xyz,
     m: &[[f64; 3]; 3],
 ) -> Result<[Trc; 3], FitError> {
     if let Some(c) = (0..3).find(|&c| set.intermediate_levels(c) == 0) {

@@ -113,6 +113,7 @@ fn thin<T: Copy>(points: Vec<T>, max: usize) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::color::Xyz;
     use crate::display::model::{DisplayModel, Sample};
 
     /// A display whose red drifts from its primary's chromaticity towards a bluish leak as
@@ -131,7 +132,7 @@ mod tests {
         };
         let mut patches = vec![Sample {
             rgb: [0.0; 3],
-            xyz: black,
+            xyz: black.into(),
         }];
         for c in 0..3 {
             for k in 1..=8 {
@@ -141,7 +142,7 @@ mod tests {
                 let l = channel(c, d);
                 patches.push(Sample {
                     rgb,
-                    xyz: std::array::from_fn(|i| black[i] + l[i]),
+                    xyz: Xyz::from(std::array::from_fn::<f64, 3, _>(|i| black[i] + l[i])),
                 });
             }
         }
@@ -177,7 +178,7 @@ mod tests {
         let black = [0.2, 0.2, 0.3];
         let mut patches = vec![Sample {
             rgb: [0.0; 3],
-            xyz: black,
+            xyz: black.into(),
         }];
         for (c, p) in primaries.iter().enumerate() {
             for k in 1..=4 {
@@ -188,7 +189,7 @@ mod tests {
                 let y = d * d;
                 patches.push(Sample {
                     rgb,
-                    xyz: std::array::from_fn(|i| black[i] + y * p[i]),
+                    xyz: Xyz::from(std::array::from_fn::<f64, 3, _>(|i| black[i] + y * p[i])),
                 });
             }
         }
@@ -197,7 +198,7 @@ mod tests {
         let white: [f64; 3] = std::array::from_fn(|i| black[i] + 0.95 * (sum[i] - black[i]));
         patches.push(Sample {
             rgb: [1.0; 3],
-            xyz: white,
+            xyz: white.into(),
         });
         let lut = fit_plvc(&SortedSamples::new(&patches)).unwrap();
         for p in &patches {
@@ -224,7 +225,10 @@ mod tests {
 
     #[test]
     fn refuses_a_channel_without_a_ramp() {
-        let p = |rgb: [f64; 3], xyz: [f64; 3]| Sample { rgb, xyz };
+        let p = |rgb: [f64; 3], xyz: [f64; 3]| Sample {
+            rgb,
+            xyz: xyz.into(),
+        };
         let patches = vec![
             p([0.0; 3], [0.1; 3]),
             p([1.0, 0.0, 0.0], [40.0, 20.0, 2.0]),

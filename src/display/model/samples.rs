@@ -4,11 +4,13 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::color::Xyz;
+
 /// One measurement of a display: drive values 0–1 per channel and the XYZ measured, cd/m².
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Sample {
     pub rgb: [f64; 3],
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
 }
 
 /// Drive values closer than this count as equal (finer than a 16-bit step).
@@ -17,12 +19,12 @@ pub const SAME_DRIVE: f64 = 1e-6;
 /// Black, white, primaries and ramps of a set of samples, each averaged over repeats.
 #[derive(Clone, Debug, Default)]
 pub struct SortedSamples {
-    pub black: Option<[f64; 3]>,
-    pub white: Option<[f64; 3]>,
+    pub black: Option<Xyz>,
+    pub white: Option<Xyz>,
     /// Full-on red, green, blue alone.
-    pub primaries: [Option<[f64; 3]>; 3],
+    pub primaries: [Option<Xyz>; 3],
     /// Per channel: (drive, XYZ) with only that channel on, drive in (0, 1], sorted, averaged.
-    pub ramps: [Vec<(f64, [f64; 3])>; 3],
+    pub ramps: [Vec<(f64, Xyz)>; 3],
     /// Readings averaged into each ramp entry (the last, at drive 1, is the primary).
     pub ramp_readings: [Vec<usize>; 3],
     /// Readings averaged into the white.
@@ -35,29 +37,28 @@ fn is(v: f64, target: f64) -> bool {
     (v - target).abs() < SAME_DRIVE
 }
 
-fn mean(xs: &[[f64; 3]]) -> Option<[f64; 3]> {
+fn mean(xs: &[Xyz]) -> Option<Xyz> {
     if xs.is_empty() {
         return None;
     }
     let n = xs.len() as f64;
-    Some(std::array::from_fn(|c| {
-        xs.iter().map(|x| x[c]).sum::<f64>() / n
-    }))
+    let component = |c: usize| xs.iter().map(|x| x[c]).sum::<f64>() / n;
+    Some(Xyz::new(component(0), component(1), component(2)))
 }
 
 impl SortedSamples {
     pub fn new(patches: &[Sample]) -> SortedSamples {
-        let pick = |f: &dyn Fn(&Sample) -> bool| -> Vec<[f64; 3]> {
+        let pick = |f: &dyn Fn(&Sample) -> bool| -> Vec<Xyz> {
             patches.iter().filter(|p| f(p)).map(|p| p.xyz).collect()
         };
         let blacks = pick(&|p| p.rgb.iter().all(|&d| is(d, 0.0)));
         let black = mean(&blacks);
         let whites = pick(&|p| p.rgb.iter().all(|&d| is(d, 1.0)));
         let white = mean(&whites);
-        let mut ramps: [Vec<(f64, [f64; 3])>; 3] = Default::default();
+        let mut ramps: [Vec<(f64, Xyz)>; 3] = Default::default();
         let mut ramp_readings: [Vec<usize>; 3] = Default::default();
         for (c, ramp) in ramps.iter_mut().enumerate() {
-            let mut pts: Vec<(f64, [f64; 3])> = patches
+            let mut pts: Vec<(f64, Xyz)> = patches
                 .iter()
                 .filter(|p| {
                     p.rgb[c] > SAME_DRIVE && (0..3).filter(|&o| o != c).all(|o| is(p.rgb[o], 0.0))
@@ -71,7 +72,7 @@ impl SortedSamples {
                 while j < pts.len() && is(pts[j].0, pts[i].0) {
                     j += 1;
                 }
-                let xyz: Vec<[f64; 3]> = pts[i..j].iter().map(|p| p.1).collect();
+                let xyz: Vec<Xyz> = pts[i..j].iter().map(|p| p.1).collect();
                 ramp.push((pts[i].0, mean(&xyz).expect("non-empty group")));
                 ramp_readings[c].push(j - i);
                 i = j;
@@ -122,7 +123,7 @@ mod tests {
     fn sorts_and_averages() {
         let p = |rgb: [f64; 3], y: f64| Sample {
             rgb,
-            xyz: [y, y, y],
+            xyz: Xyz::new(y, y, y),
         };
         let set = SortedSamples::new(&[
             p([0.0, 0.0, 0.0], 1.0),
@@ -133,10 +134,19 @@ mod tests {
             p([0.5, 0.0, 0.0], 7.0),
             p([0.5, 0.5, 0.0], 9.0),
         ]);
-        assert_eq!(set.black, Some([2.0; 3]));
-        assert_eq!(set.white, Some([100.0; 3]));
-        assert_eq!(set.primaries, [Some([20.0; 3]), None, None]);
-        assert_eq!(set.ramps[0], vec![(0.5, [6.0; 3]), (1.0, [20.0; 3])]);
+        assert_eq!(set.black, Some(Xyz::new(2.0, 2.0, 2.0)));
+        assert_eq!(set.white, Some(Xyz::new(100.0, 100.0, 100.0)));
+        assert_eq!(
+            set.primaries,
+            [Some(Xyz::new(20.0, 20.0, 20.0)), None, None]
+        );
+        assert_eq!(
+            set.ramps[0],
+            vec![
+                (0.5, Xyz::new(6.0, 6.0, 6.0)),
+                (1.0, Xyz::new(20.0, 20.0, 20.0))
+            ]
+        );
         assert_eq!(set.ramp_readings[0], vec![2, 1]);
         assert_eq!(set.white_readings, 1);
         assert_eq!(set.intermediate_levels(0), 1);

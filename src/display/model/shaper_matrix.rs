@@ -92,9 +92,11 @@ fn fit_stages(
         })?;
     // The CIELAB reference stays fixed during the fit: the measured white if there is one,
     // otherwise the start model's white.
-    let white = set
-        .white
-        .unwrap_or_else(|| std::array::from_fn(|r| black0[r] + m0[r].iter().sum::<f64>()));
+    let white = set.white.unwrap_or_else(|| {
+        Xyz::from(std::array::from_fn(|r| {
+            black0[r] + m0[r].iter().sum::<f64>()
+        }))
+    });
     let yw = white[1];
     if !(yw.is_finite() && yw > 0.0) {
         return Err(FitError::Failed {
@@ -102,11 +104,8 @@ fn fit_stages(
             message: format!("the white has no positive luminance (Y = {yw})"),
         });
     }
-    let w = Xyz::from_array(white);
-    let measured: Vec<Lab> = patches
-        .iter()
-        .map(|p| Xyz::from_array(p.xyz).to_lab(w))
-        .collect();
+    let w = white;
+    let measured: Vec<Lab> = patches.iter().map(|p| p.xyz.to_lab(w)).collect();
     let lab_residual = |predict: &dyn Fn([f64; 3]) -> [f64; 3]| -> Vec<f64> {
         let mut r = Vec::with_capacity(3 * patches.len());
         for (p, m) in patches.iter().zip(&measured) {
@@ -120,7 +119,7 @@ fn fit_stages(
         let mut r = Vec::with_capacity(3 * patches.len());
         for p in patches {
             let q = predict(p.rgb);
-            r.extend(reading_residual(q, p.xyz, floor));
+            r.extend(reading_residual(q, p.xyz.into(), floor));
         }
         r
     };
@@ -209,7 +208,7 @@ fn fit_stages(
     };
     let model = |p: &[f64]| {
         let (m, b) = unpack(&p[3 * free..]);
-        MatrixTrc::new(kind, b, m, tables(p)).map_err(singular)
+        MatrixTrc::new(kind, b.into(), m, tables(p)).map_err(singular)
     };
     let noise = match p1_noise {
         Some(p) => {
@@ -219,7 +218,7 @@ fn fit_stages(
                 value: drive.iter().map(|d| d.powf(p[c])).collect(),
                 exponent: p[c],
             });
-            Some(MatrixTrc::new(kind, b, m, trc).map_err(singular)?)
+            Some(MatrixTrc::new(kind, b.into(), m, trc).map_err(singular)?)
         }
         None => None,
     };
@@ -291,7 +290,7 @@ fn choose_stage(
     let mut order: Vec<usize> = (0..patches.len()).collect();
     order.sort_by_key(|&i| fold_of(i));
     let chosen: Vec<usize> = order.into_iter().take(CV_PATCHES).collect();
-    let white = Xyz::from_array(set.white.unwrap_or_else(|| knotted.forward([1.0; 3])));
+    let white = set.white.unwrap_or_else(|| knotted.forward([1.0; 3]));
     let mut error = [0.0f64; 2];
     for fold in 0..FOLDS {
         let held = |i: usize| !corner(&patches[i]) && fold_of(i) % FOLDS == fold;
@@ -305,12 +304,9 @@ fn choose_stage(
             return false;
         };
         for &i in chosen.iter().filter(|&&i| held(i)) {
-            let measured = Xyz::from_array(patches[i].xyz).to_lab(white);
+            let measured = patches[i].xyz.to_lab(white);
             for (e, m) in error.iter_mut().zip([&one, &two]) {
-                *e += delta_e2000(
-                    Xyz::from_array(m.forward(patches[i].rgb)).to_lab(white),
-                    measured,
-                );
+                *e += delta_e2000(m.forward(patches[i].rgb).to_lab(white), measured);
             }
         }
     }
@@ -384,7 +380,7 @@ mod tests {
                 let rgb = [halton(i, 2), halton(i, 3), halton(i, 5)];
                 Sample {
                     rgb,
-                    xyz: truth(rgb),
+                    xyz: truth(rgb).into(),
                 }
             })
             .collect();
@@ -435,7 +431,10 @@ mod tests {
                 let xyz = std::array::from_fn(|r| {
                     k * (0.2 + (0..3).map(|c| m[r][c] * lin[c]).sum::<f64>())
                 });
-                Sample { rgb, xyz }
+                Sample {
+                    rgb,
+                    xyz: xyz.into(),
+                }
             })
             .collect()
     }
@@ -484,7 +483,7 @@ mod tests {
                 let d = i as f64 / 19.0;
                 Sample {
                     rgb: [d, 0.0, 0.0],
-                    xyz: [40.0 * d * d, 20.0 * d * d, 2.0 * d * d],
+                    xyz: Xyz::new(40.0 * d * d, 20.0 * d * d, 2.0 * d * d),
                 }
             })
             .collect();

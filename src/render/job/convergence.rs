@@ -17,6 +17,7 @@
 use std::path::PathBuf;
 
 use super::{load_scene, RenderError, RenderEvent};
+use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::render::convergence::{self, Point, CSV_FILE, SVG_FILE};
 
@@ -55,7 +56,7 @@ impl ConvergenceRequest {
 pub struct ConvergenceReport {
     pub points: Vec<Point>,
     /// The reference run's white.
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub csv: PathBuf,
     pub svg: PathBuf,
 }

@@ -26,6 +26,7 @@
 use std::path::PathBuf;
 
 use super::{load_scene, RenderError, RenderEvent};
+use crate::color::Xyz;
 use crate::render::method::{Method, Resolved, Solver};
 use crate::render::radiosity::RadiosityResult;
 use crate::render::radiosity::{render_spots_radiosity_solved, LastLevels, RadiosityOptions};
@@ -42,7 +43,7 @@ pub struct SpotsRequest {
     /// half-width) is driven below this.
     pub target_de: f64,
     /// Reference white X,Y,Z (None: a perfect white diffuser in place of patch 19).
-    pub white: Option<[f64; 3]>,
+    pub white: Option<Xyz>,
     /// Wall-clock limit (s): the readings so far are reported, marked not converged.
     pub max_seconds: f64,
     /// The path tracer's seed.
@@ -84,7 +85,7 @@ impl Readings {
     }
 
     /// The reference white the readings' CIELAB is against.
-    pub fn white(&self) -> [f64; 3] {
+    pub fn white(&self) -> Xyz {
         match self {
             Readings::PathTracer(r) => r.white,
             Readings::Radiosity { result, .. } => result.white,
@@ -223,7 +224,7 @@ mod tests {
             scene: Some("no such scene.json".into()),
             target_de: 0.0,
             max_seconds: 0.0,
-            white: Some([1.0, 0.0, 1.0]),
+            white: Some(Xyz::new(1.0, 0.0, 1.0)),
             ..SpotsRequest::default()
         });
         assert!(e.is_bad_request());
@@ -231,13 +232,13 @@ mod tests {
         let e = refusal(SpotsRequest {
             scene: Some("no such scene.json".into()),
             max_seconds: f64::NAN,
-            white: Some([1.0, 0.0, 1.0]),
+            white: Some(Xyz::new(1.0, 0.0, 1.0)),
             ..SpotsRequest::default()
         });
         assert_eq!(e.to_string(), "--max-seconds must be > 0");
         let e = refusal(SpotsRequest {
             scene: Some("no such scene.json".into()),
-            white: Some([1.0, 0.0, 1.0]),
+            white: Some(Xyz::new(1.0, 0.0, 1.0)),
             ..SpotsRequest::default()
         });
         assert_eq!(e.to_string(), "--white must be finite with Y > 0");

@@ -54,6 +54,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{load_scene, RenderError, RenderEvent};
+use crate::color::Xyz;
 use crate::image::{read_xyz_image, XyzImage};
 use crate::render::image::Frame;
 use crate::render::scene::Scene;
@@ -75,7 +76,7 @@ pub struct Request {
     /// The scene the image is of; None is the built-in validation box.
     pub scene: Option<PathBuf>,
     /// Reference white X,Y,Z (None: the scene's, by `render spots`' rule).
-    pub white: Option<[f64; 3]>,
+    pub white: Option<Xyz>,
     /// The scene's white is traced to a third of this ΔE*ab, as `render spots` does.
     pub target_de: f64,
     /// Wall-clock limit (s) of tracing the white.
@@ -108,7 +109,7 @@ pub struct Report {
     pub width: usize,
     pub height: usize,
     /// The white the readings' CIELAB is against.
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub seconds: f64,
     /// Each with its 95 % half-width, its standard errors and the pixels in its cone as
     /// its samples.
@@ -134,7 +135,7 @@ struct Json<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     provenance: Option<&'a serde_json::Map<String, serde_json::Value>>,
     image: Source<'a>,
-    white: [f64; 3],
+    white: Xyz,
     seconds: f64,
     patches: &'a [RenderedReading],
 }
@@ -224,13 +225,12 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
         }
         .into());
     }
-    let w = crate::color::Xyz::from_array(white);
     let patches = cones
         .iter()
         .enumerate()
         .map(|(k, c)| {
             let uncertainty = Uncertainty::HalfWidth95 {
-                de: de_ci95_of(c.xyz, c.cov_mean, w),
+                de: de_ci95_of(c.xyz, c.cov_mean, white),
                 sampling: Some(Sampling {
                     xyz_stderr: c.stderr(),
                     samples: c.pixels as u64,
@@ -283,7 +283,7 @@ fn read_cones(scene: &Scene, image: &XyzImage, file: &Path) -> Result<Vec<ConeMe
             }
             .into());
         }
-        if mean.xyz.iter().all(|&v| v == 0.0) {
+        if mean.xyz.iter().all(|v| v == 0.0) {
             return Err(ReadBackError::Dark {
                 file: file.to_path_buf(),
                 patch,
@@ -333,13 +333,13 @@ mod tests {
     fn the_first_bad_option_is_the_one_reported_before_anything_is_read() {
         let r = Request {
             target_de: 0.0,
-            white: Some([1.0, 0.0, 1.0]),
+            white: Some(Xyz::new(1.0, 0.0, 1.0)),
             ..Request::new("none.exr".into(), Some("none.json".into()))
         };
         let e = run(&r, &|_| panic!("no event")).unwrap_err();
         assert_eq!(e.to_string(), "--target-de must be > 0");
         let r = Request {
-            white: Some([1.0, 0.0, 1.0]),
+            white: Some(Xyz::new(1.0, 0.0, 1.0)),
             ..Request::new("none.exr".into(), Some("none.json".into()))
         };
         let e = run(&r, &|_| panic!("no event")).unwrap_err();

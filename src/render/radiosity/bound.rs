@@ -149,8 +149,8 @@ pub fn extrapolated_with_bound(v: &[f64], h: &[f64], p: f64, abs_err: f64) -> (f
 /// One patch's estimate from its levels (coarsest first) of the patch and the white.
 #[derive(Clone, Copy, Debug)]
 pub struct Extrapolated {
-    pub xyz: [f64; 3],
-    pub white: [f64; 3],
+    pub xyz: Xyz,
+    pub white: Xyz,
     /// ΔE*ab between the estimate and its furthest alternative, each against its own white.
     pub de_bound: f64,
     /// Every component converged regularly (see [`estimate`]).
@@ -160,13 +160,13 @@ pub struct Extrapolated {
 /// Extrapolates the patch and the white over levels of sizes `h` (decreasing, at least
 /// three); with `fixed_white` the white is not refined.
 pub fn extrapolate(
-    patch: &[[f64; 3]],
-    white: &[[f64; 3]],
+    patch: &[Xyz],
+    white: &[Xyz],
     h: &[f64],
     p: f64,
-    fixed_white: Option<[f64; 3]>,
+    fixed_white: Option<Xyz>,
 ) -> Extrapolated {
-    let comps = |levels: &[[f64; 3]]| -> [Estimate; 3] {
+    let comps = |levels: &[Xyz]| -> [Estimate; 3] {
         std::array::from_fn(|k| {
             let v: Vec<f64> = levels.iter().map(|x| x[k]).collect();
             estimate(&v, h, p)
@@ -174,7 +174,7 @@ pub fn extrapolate(
     };
     let pe = comps(patch);
     let we = match fixed_white {
-        Some(w) => w.map(|x| Estimate {
+        Some(w) => [w.x, w.y, w.z].map(|x| Estimate {
             value: x,
             alt: x,
             previous: Some(x),
@@ -182,10 +182,10 @@ pub fn extrapolate(
         }),
         None => comps(white),
     };
-    let pick = |e: &[Estimate; 3], f: &dyn Fn(&Estimate) -> f64| -> [f64; 3] {
-        std::array::from_fn(|k| f(&e[k]))
+    let pick = |e: &[Estimate; 3], f: &dyn Fn(&Estimate) -> f64| -> Xyz {
+        Xyz::new(f(&e[0]), f(&e[1]), f(&e[2]))
     };
-    let lab = |x: [f64; 3], w: [f64; 3]| Xyz::from_array(x).to_lab(Xyz::from_array(w));
+    let lab = |x: Xyz, w: Xyz| x.to_lab(w);
     let value = lab(pick(&pe, &|e| e.value), pick(&we, &|e| e.value));
     let alt = lab(pick(&pe, &|e| e.alt), pick(&we, &|e| e.alt));
     let mut de_bound = delta_e76(value, alt);
@@ -232,12 +232,12 @@ mod tests {
     /// one is closer to R∞ than that difference: the bound holds.
     #[test]
     fn bound_covers_a_higher_order_term() {
-        let f = |h: f64| [10.0 + 2.0 * h * h + 3.0 * h.powi(3), 10.0, 10.0];
+        let f = |h: f64| Xyz::new(10.0 + 2.0 * h * h + 3.0 * h.powi(3), 10.0, 10.0);
         let h = [1.0, 0.5, 1.0 / 3.0];
-        let w = [[100.0; 3]; 3];
+        let w = [Xyz::new(100.0, 100.0, 100.0); 3];
         let e = extrapolate(&[f(h[0]), f(h[1]), f(h[2])], &w, &h, 2.0, None);
         let truth = Xyz::from_array([10.0, 10.0, 10.0]).to_lab(Xyz::from_array([100.0; 3]));
-        let got = Xyz::from_array(e.xyz).to_lab(Xyz::from_array(e.white));
+        let got = e.xyz.to_lab(e.white);
         let err = delta_e76(truth, got);
         assert!(err < e.de_bound, "error {err} vs bound {}", e.de_bound);
         assert!(e.regular);

@@ -16,7 +16,7 @@ use super::lights::Lights;
 use super::mesh::{Face, FaceKind, Mesh};
 use super::polygon::{gauss_legendre, point_to_rect};
 use super::solve::Bands;
-use crate::color::K_M;
+use crate::color::{Xyz, K_M};
 use crate::render::scene::Scene;
 
 /// Nodes of the cone cubature: (radial Gauss nodes, azimuth steps).
@@ -145,7 +145,7 @@ pub fn reading(
     face_refl: &[&[f64]],
     bands: &Bands,
     l: &[Vec<f64>],
-) -> [f64; 3] {
+) -> Xyz {
     let nb = bands.len();
     let mut radiance = vec![0.0; N_BINS];
     for (e, comp) in lights.comps.iter().enumerate() {
@@ -168,7 +168,7 @@ pub fn reading(
             }
         }
     }
-    let mut xyz = [0.0; 3];
+    let mut xyz = Xyz::default();
     for (k, c) in scene.cmf.iter().enumerate() {
         xyz[k] = K_M * radiance.iter().zip(c).map(|(r, c)| r * c).sum::<f64>();
     }

@@ -32,6 +32,7 @@ use self::solve::{sources, Bands, SolveFailure};
 use super::deadline::Deadline;
 use super::scene::Scene;
 use super::spot::{patch_aim, RenderedReading, SpotError, Uncertainty};
+use crate::color::Xyz;
 
 /// Why the solver cannot run on a scene.
 #[derive(Debug, thiserror::Error)]
@@ -78,7 +79,7 @@ pub fn qualifies(scene: &Scene) -> Result<(), RadiosityError> {
 #[derive(Clone, Copy, Debug)]
 pub struct RadiosityOptions {
     pub target_de: f64,
-    pub white: Option<[f64; 3]>,
+    pub white: Option<Xyz>,
     /// Spacing of the wavelength nodes the system is solved at.
     pub band_nm: usize,
     /// Element size of level 1 (m; default half the longest face edge); level m divides
@@ -127,15 +128,15 @@ pub struct Level {
     pub sweeps: usize,
     pub seconds: f64,
     #[serde(skip)]
-    pub patches: Vec<[f64; 3]>,
+    pub patches: Vec<Xyz>,
     #[serde(skip)]
-    pub white: [f64; 3],
+    pub white: Xyz,
 }
 
 /// All readings of a radiosity run.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct RadiosityResult {
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub seconds: f64,
     pub levels: Vec<Level>,
     /// Each with its bound ([`Uncertainty::Bound`], with whether it is regular; see
@@ -410,13 +411,13 @@ pub fn render_spots_radiosity_solved(
         }
     }
     if let Some(w) = opts.white {
-        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
-            return Err(SpotError::BadWhite(w).into());
+        if !(w.is_finite() && w[1] > 0.0) {
+            return Err(SpotError::BadWhite(w.to_array()).into());
         }
     }
     let p = Prepared::new(scene)?;
     let mut levels: Vec<Level> = Vec::new();
-    let mut best: Option<(Vec<RenderedReading>, [f64; 3])> = None;
+    let mut best: Option<(Vec<RenderedReading>, Xyz)> = None;
     // The solutions of the last two levels (coarser first), and of the two before the
     // last level when that one has to be dropped.
     let mut solutions: LastLevels = Vec::new();
@@ -449,7 +450,7 @@ pub fn render_spots_radiosity_solved(
             }
             Err(e) => return Err(e),
         };
-        if !(l.white.iter().all(|x| x.is_finite()) && l.white[1] > 0.0) {
+        if !(l.white.is_finite() && l.white[1] > 0.0) {
             return Err(RadiosityError::DarkWhite(l.white[1]));
         }
         progress(&l);
@@ -459,11 +460,12 @@ pub fn render_spots_radiosity_solved(
         }
         let (patches, white) = combine(&levels, opts);
         if let Some(r) = patches.iter().find(|r| {
-            !r.xyz.iter().chain(&r.lab).all(|x| x.is_finite()) || r.uncertainty.de_ab().is_nan()
+            !(r.xyz.is_finite() && r.lab.iter().all(|x| x.is_finite()))
+                || r.uncertainty.de_ab().is_nan()
         }) {
             return Err(RadiosityError::NonFinite {
                 patch: r.patch,
-                xyz: r.xyz,
+                xyz: r.xyz.to_array(),
             });
         }
         let converged = patches
@@ -487,14 +489,14 @@ pub fn render_spots_radiosity_solved(
 }
 
 /// Readings and bounds from the last levels (three, or four for the step check).
-pub fn combine(levels: &[Level], opts: &RadiosityOptions) -> (Vec<RenderedReading>, [f64; 3]) {
+pub fn combine(levels: &[Level], opts: &RadiosityOptions) -> (Vec<RenderedReading>, Xyz) {
     let last = &levels[levels.len().saturating_sub(4)..];
     let h: Vec<f64> = last.iter().map(|l| l.h_m).collect();
-    let whites: Vec<[f64; 3]> = last.iter().map(|l| l.white).collect();
+    let whites: Vec<Xyz> = last.iter().map(|l| l.white).collect();
     let mut white = last[last.len() - 1].white;
     let patches = (0..24)
         .map(|k| {
-            let patch: Vec<[f64; 3]> = last.iter().map(|l| l.patches[k]).collect();
+            let patch: Vec<Xyz> = last.iter().map(|l| l.patches[k]).collect();
             let e = extrapolate(&patch, &whites, &h, opts.order, opts.white);
             white = e.white;
             let uncertainty = Uncertainty::Bound {

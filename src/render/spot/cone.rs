@@ -24,6 +24,7 @@
 use std::path::PathBuf;
 
 use super::Aim;
+use crate::color::Xyz;
 use crate::image::XyzImage;
 use crate::render::image::{pixel_direction, Frame};
 
@@ -198,7 +199,7 @@ pub fn cone_pixels(frame: &Frame, aim: &Aim) -> Result<Vec<ConePixel>, ConeError
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConeMean {
     /// The mean XYZ (the image's unit).
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// The covariance of the mean, from the pixels' spread (see the module comment).
     pub cov_mean: [[f64; 3]; 3],
     /// Pixels with a part inside the cone.
@@ -262,7 +263,7 @@ pub fn cone_mean(image: &XyzImage, cone: &[ConePixel]) -> Result<ConeMean, ConeE
         })
     });
     Ok(ConeMean {
-        xyz: mean,
+        xyz: mean.into(),
         cov_mean,
         pixels: cone.len(),
         effective: 1.0 / sum_w2.max(f64::MIN_POSITIVE),

@@ -49,9 +49,9 @@ impl XyzStats {
             }
         }
     }
-    pub fn mean(&self) -> [f64; 3] {
+    pub fn mean(&self) -> Xyz {
         let n = self.n.max(1) as f64;
-        [self.sum[0] / n, self.sum[1] / n, self.sum[2] / n]
+        Xyz::new(self.sum[0] / n, self.sum[1] / n, self.sum[2] / n)
     }
     /// Covariance of the mean.
     pub fn cov_mean(&self) -> [[f64; 3]; 3] {
@@ -80,12 +80,12 @@ impl XyzStats {
 
 /// 95 % half-width of ΔE*ab of a mean XYZ `m` whose covariance is `c`, against `white`:
 /// 1.96 times the RMS ΔE*ab propagated through CIELAB's Jacobian (by finite differences).
-pub fn de_ci95_of(m: [f64; 3], c: [[f64; 3]; 3], white: Xyz) -> f64 {
-    let lab = |x: [f64; 3]| Xyz::from_array(x).to_lab(white).to_array();
+pub fn de_ci95_of(m: Xyz, c: [[f64; 3]; 3], white: Xyz) -> f64 {
+    let lab = |x: Xyz| x.to_lab(white).to_array();
     let base = lab(m);
     let mut jac = [[0.0; 3]; 3]; // jac[lab][xyz]
     for k in 0..3 {
-        let h = 1e-6 * (m[k].abs() + white.to_array()[k] * 1e-3);
+        let h = 1e-6 * (m[k].abs() + white[k] * 1e-3);
         let mut p = m;
         p[k] += h;
         let l = lab(p);
@@ -181,7 +181,7 @@ pub fn sample_cone_until(
 #[derive(Clone, Copy, Debug)]
 pub struct SpotOptions {
     pub target_de: f64,
-    pub white: Option<[f64; 3]>,
+    pub white: Option<Xyz>,
     pub max_seconds: f64,
     pub seed: u64,
     pub strategy: Strategy,
@@ -205,7 +205,7 @@ impl Default for SpotOptions {
 /// All readings of a spot run.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SpotResult {
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub seconds: f64,
     /// Each with its 95 % half-width ([`Uncertainty::HalfWidth95`], with its sampling).
     pub patches: Vec<RenderedReading>,
@@ -272,7 +272,7 @@ pub struct SpotProgress {
 /// The reference white: a perfect white diffuser in place of patch 19, seen by the meter and
 /// refined to a third of `opts.target_de`. Its error shifts every patch alike and is not in
 /// the patches' half-widths, so it has to be well below theirs.
-pub fn reference_white(scene: &Scene, opts: &SpotOptions) -> Result<[f64; 3], SpotError> {
+pub fn reference_white(scene: &Scene, opts: &SpotOptions) -> Result<Xyz, SpotError> {
     check_options(opts)?;
     reference_white_until(scene, opts, Deadline::after(opts.max_seconds))
 }
@@ -291,7 +291,7 @@ fn reference_white_until(
     scene: &Scene,
     opts: &SpotOptions,
     deadline: Deadline,
-) -> Result<[f64; 3], SpotError> {
+) -> Result<Xyz, SpotError> {
     let ws = white_scene(scene)?;
     let wt = Tracer::new(&ws, opts.strategy);
     let aim = patch_aim(&ws, 19)?;
@@ -308,16 +308,16 @@ fn reference_white_until(
             });
         }
         let white = st.mean();
-        if !(white[1] > 0.0 && white.iter().all(|x| x.is_finite())) {
+        if !(white[1] > 0.0 && white.is_finite()) {
             return Err(SpotError::DarkWhite(white[1]));
         }
-        if deadline.passed() || st.de_ci95(Xyz::from_array(white)) < opts.target_de / 3.0 {
+        if deadline.passed() || st.de_ci95(white) < opts.target_de / 3.0 {
             break;
         }
         batch = st.n;
     }
     let white = st.mean();
-    if !(white[1] > 0.0 && white.iter().all(|x| x.is_finite())) {
+    if !(white[1] > 0.0 && white.is_finite()) {
         return Err(SpotError::DarkWhite(white[1]));
     }
     Ok(white)
@@ -343,12 +343,12 @@ pub fn render_spots_with_progress(
     let tracer = Tracer::new(scene, opts.strategy);
     let white = match opts.white {
         Some(w) => {
-            if !(w[1] > 0.0 && w.iter().all(|x| x.is_finite())) {
-                return Err(SpotError::BadWhite(w));
+            if !(w[1] > 0.0 && w.is_finite()) {
+                return Err(SpotError::BadWhite(w.to_array()));
             }
-            Xyz::from_array(w)
+            w
         }
-        None => Xyz::from_array(reference_white_until(scene, opts, deadline)?),
+        None => reference_white_until(scene, opts, deadline)?,
     };
     let mut stats = vec![XyzStats::default(); 24];
     let mut batch = [opts.first_batch; 24];
@@ -407,24 +407,24 @@ pub fn render_spots_with_progress(
                     samples: st.n,
                 }),
             };
-            RenderedReading::new(k + 1, st.mean(), white.to_array(), uncertainty)
+            RenderedReading::new(k + 1, st.mean(), white, uncertainty)
         })
         .collect::<Vec<RenderedReading>>();
     if let Some((p, _)) = patches.iter().zip(&stats).find(|(p, st)| {
-        !p.xyz
-            .iter()
-            .chain(&p.lab)
-            .chain(&st.stderr())
-            .chain([&p.uncertainty.de_ab()])
-            .all(|x| x.is_finite())
+        !(p.xyz.is_finite()
+            && p.lab
+                .iter()
+                .chain(&st.stderr())
+                .chain([&p.uncertainty.de_ab()])
+                .all(|x| x.is_finite()))
     }) {
         return Err(SpotError::NonFinite {
             patch: p.patch,
-            xyz: p.xyz,
+            xyz: p.xyz.to_array(),
         });
     }
     Ok(SpotResult {
-        white: white.to_array(),
+        white,
         seconds: start.elapsed().as_secs_f64(),
         patches,
         converged,

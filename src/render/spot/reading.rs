@@ -20,7 +20,7 @@ pub struct RenderedReading {
     /// The patch, 1–24.
     pub patch: usize,
     /// Absolute XYZ, cd/m².
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// CIELAB against the run's reference white.
     pub lab: [f64; 3],
     pub uncertainty: Uncertainty,
@@ -67,8 +67,8 @@ impl Uncertainty {
 
 impl RenderedReading {
     /// A reading of `patch` with its CIELAB against `white`, as both renderers compute it.
-    pub fn new(patch: usize, xyz: [f64; 3], white: [f64; 3], uncertainty: Uncertainty) -> Self {
-        let lab = Xyz::from_array(xyz).to_lab(Xyz::from_array(white));
+    pub fn new(patch: usize, xyz: Xyz, white: Xyz, uncertainty: Uncertainty) -> Self {
+        let lab = xyz.to_lab(white);
         RenderedReading {
             patch,
             xyz,
@@ -119,7 +119,7 @@ mod tests {
     fn reading(uncertainty: Uncertainty) -> RenderedReading {
         RenderedReading {
             patch: 3,
-            xyz: [1.5, 2.0, 0.25],
+            xyz: Xyz::new(1.5, 2.0, 0.25),
             lab: [10.0, -1.0, 0.5],
             uncertainty,
         }
@@ -174,7 +174,7 @@ mod tests {
 
     #[test]
     fn the_lab_is_against_the_white_given() {
-        let w = [95.047, 100.0, 108.883];
+        let w = Xyz::new(95.047, 100.0, 108.883);
         let r = RenderedReading::new(
             19,
             w,

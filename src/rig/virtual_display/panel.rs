@@ -12,7 +12,7 @@
 //! - crosstalk, tone curves and 8-bit quantisation act on the drive values as before the
 //!   spectra existed, so the XYZ is what the XYZ-only model gave for the same primaries.
 
-use metamer_color::{radiance_to_xyz, ObserverKind, Spectrum};
+use metamer_color::{radiance_to_xyz, ObserverKind, Spectrum, Xyz};
 use nalgebra::{Matrix3, Vector3};
 
 use super::presets::{PanelParams, Preset};
@@ -174,17 +174,18 @@ impl VirtualPanel {
     }
 
     /// Emitted XYZ (cd/m²) for drive values 0–1 taken as they are (no quantisation).
-    pub fn xyz_at(&self, v: [f64; 3]) -> [f64; 3] {
-        (self.basis_xyz * Vector3::from(self.weights(v))).into()
+    pub fn xyz_at(&self, v: [f64; 3]) -> Xyz {
+        let xyz = self.basis_xyz * Vector3::from(self.weights(v));
+        Xyz::new(xyz[0], xyz[1], xyz[2])
     }
 
     /// Emitted XYZ (cd/m²) for 8-bit drive values.
-    pub fn xyz(&self, rgb: [u8; 3]) -> [f64; 3] {
+    pub fn xyz(&self, rgb: [u8; 3]) -> Xyz {
         self.xyz_at(rgb.map(|c| f64::from(c) / 255.0))
     }
 
     /// Emitted XYZ for drive values 0–1, quantised to 8 bits first as the display does.
-    pub fn xyz_of_drive(&self, rgb: [f64; 3]) -> [f64; 3] {
+    pub fn xyz_of_drive(&self, rgb: [f64; 3]) -> Xyz {
         self.xyz(rgb.map(quantize))
     }
 
@@ -219,17 +220,18 @@ impl VirtualPanel {
 
     /// The drive values 0–1 (continuous, before quantisation) at which the panel emits
     /// `xyz`, or None when no drive values in 0–1 do: the colour is outside its gamut.
-    pub fn drive_for(&self, xyz: [f64; 3]) -> Option<[f64; 3]> {
-        let target = Vector3::from(xyz);
+    pub fn drive_for(&self, xyz: Xyz) -> Option<[f64; 3]> {
+        let vector = |v: Xyz| Vector3::new(v.x, v.y, v.z);
+        let target = vector(xyz);
         let inv = self.basis_xyz.try_inverse()?;
         // Start from the linear model without crosstalk and drift, a 2.2 power law.
-        let lin = inv * (target - Vector3::from(self.xyz_at([0.0; 3])));
+        let lin = inv * (target - vector(self.xyz_at([0.0; 3])));
         let mut v: [f64; 3] =
             std::array::from_fn(|c| (lin[c] / self.channel_max_cd_m2[c]).clamp(1e-3, 1.0));
         v = v.map(|l| l.powf(1.0 / 2.2));
         let scale = self.params.white_cd_m2;
         for _ in 0..100 {
-            let f = Vector3::from(self.xyz_at(v));
+            let f = vector(self.xyz_at(v));
             let r = target - f;
             if r.norm() < 1e-10 * scale {
                 return Some(v);

@@ -1,19 +1,23 @@
 //! The panel model against hand derivations.
 
 use super::*;
+use crate::color::Xyz;
 use crate::session::Screen as _;
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+fn sub(a: impl Into<[f64; 3]>, b: impl Into<[f64; 3]>) -> [f64; 3] {
+    let (a, b) = (a.into(), b.into());
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn close(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
+fn close(a: impl Into<[f64; 3]>, b: impl Into<[f64; 3]>, tol: f64) -> bool {
+    let (a, b): ([f64; 3], [f64; 3]) = (a.into(), b.into());
     a.iter()
         .zip(b)
         .all(|(x, y)| (x - y).abs() <= tol * y.abs().max(1.0))
 }
 
-fn xy(v: [f64; 3]) -> [f64; 2] {
+fn xy(v: impl Into<[f64; 3]>) -> [f64; 2] {
+    let v = v.into();
     let s = v[0] + v[1] + v[2];
     [v[0] / s, v[1] / s]
 }
@@ -49,7 +53,7 @@ fn full_white_is_the_preset_white_exactly() {
             let mut rgb = [0u8; 3];
             rgb[c] = 255;
             let t = sub(panel.xyz(rgb), k);
-            [acc[0] + t[0], acc[1] + t[1], acc[2] + t[2]]
+            Xyz::new(acc[0] + t[0], acc[1] + t[1], acc[2] + t[2])
         });
         if p == Preset::IdealCrt {
             assert!(close(w, sum, 1e-12), "{w:?} vs {sum:?}");
@@ -107,7 +111,7 @@ fn ideal_crt_is_plcc_exactly() {
             let mut alone = [0u8; 3];
             alone[c] = rgb[c];
             let t = sub(crt.xyz(alone), k);
-            sum = [sum[0] + t[0], sum[1] + t[1], sum[2] + t[2]];
+            sum = Xyz::new(sum[0] + t[0], sum[1] + t[1], sum[2] + t[2]);
         }
         assert!(close(crt.xyz(rgb), sum, 1e-12), "{rgb:?}");
     }
@@ -336,7 +340,7 @@ fn drive_values_come_back_from_their_colour_and_outside_colours_have_none() {
         let w = panel.xyz([255; 3]);
         assert_eq!(panel.drive_for(w.map(|c| c * 1.1)), None, "{}", p.name());
         let locus = xyy(0.0743, 0.8338, 10.0);
-        assert_eq!(panel.drive_for(locus), None, "{}", p.name());
+        assert_eq!(panel.drive_for(locus.into()), None, "{}", p.name());
     }
 }
 

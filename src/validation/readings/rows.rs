@@ -11,7 +11,7 @@ impl Parsed {
     /// is refused where it enters: downstream it becomes an infinite CIELAB and a figure
     /// whose axis never ends.
     fn plausible(&self, r: &Row) -> Result<(), ReadingsError> {
-        metamer_color::check_xyz(r.xyz)
+        metamer_color::check_xyz(r.xyz.into())
             .map_err(|e| self.bad(r.line, format!("not a measurement: {e}")))?;
         for (what, spread) in [("standard deviation", r.sd), ("standard error", r.stderr)] {
             if let Some(v) = spread {
@@ -141,7 +141,7 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
 /// repeatability, where the row names an instrument that has one.
 fn stated_covariance(row: &Row) -> Option<Cov3> {
     let rep = Repeatability::emissive_of(row.instrument.as_deref()?)?;
-    rep.covariance(row.xyz)
+    rep.covariance(row.xyz.into())
 }
 
 /// The uncertainty of the mean of `rows` (at `mean`) as factors, with its degrees of

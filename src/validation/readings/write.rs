@@ -66,7 +66,7 @@ impl PatchReading {
                     .filter(|(q, _)| *q == p)
                     .map(|(_, r)| *r)
                     .collect();
-                let xs: Vec<[f64; 3]> = of_patch.iter().map(|r| r.xyz).collect();
+                let xs: Vec<[f64; 3]> = of_patch.iter().map(|r| r.xyz.to_array()).collect();
                 let (xyz, mut cov) = covariance::sample(&xs);
                 if let [one] = of_patch.as_slice() {
                     if let Some(c) = Repeatability::emissive_of(&one.instrument)
