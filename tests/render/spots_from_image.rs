@@ -247,22 +247,23 @@ fn an_image_that_does_not_fit_the_scene_is_refused_naming_what_differs() {
         "{e}"
     );
 
-    // Channels named X, Y, Z (as some renderers write them) are not what the reader takes.
-    let p = dir.join("xyz-channels.exr");
+    // Neither X, Y, Z nor R, G, B: a luminance-only image holds no colour to read.
+    let p = dir.join("luminance.exr");
     {
         use exr::prelude::*;
         let channels = SpecificChannels::build()
-            .with_channel("X")
-            .with_channel("Y")
-            .with_channel("Z")
-            .with_pixel_fn(|_: Vec2<usize>| (17.0f32, 17.0f32, 17.0f32));
+            .with_channel("L")
+            .with_pixel_fn(|_: Vec2<usize>| (17.0f32,));
         Image::from_channels((128, 128), channels)
             .write()
             .to_file(&p)
             .unwrap();
     }
     let e = refusal(&p, None);
-    assert!(e.contains("xyz-channels.exr"), "{e}");
+    assert!(
+        e.contains("luminance.exr") && e.contains("has the channels L"),
+        "{e}"
+    );
 
     let good = dir.join("good.pfm");
     write(&good, 128, 128, [17.0; 3]);
