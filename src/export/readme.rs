@@ -4,9 +4,19 @@
 use std::fmt::Write;
 
 use super::approximation::{Approximation, Measured};
-use super::common::{num, Renderer};
+use super::common::Renderer;
 use super::{mitsuba3, pbrt};
 use crate::render::scene::Camera;
+
+/// A number for people: six significant digits (the files themselves hold every digit).
+fn shown(x: f64) -> String {
+    let r = format!("{:.5e}", x).parse::<f64>().unwrap_or(x);
+    if r == 0.0 || (1e-3..1e6).contains(&r.abs()) {
+        format!("{r}")
+    } else {
+        format!("{r:e}")
+    }
+}
 
 /// One or two sentences on what the export approximates.
 pub(super) fn summary(a: &Approximation) -> String {
@@ -62,7 +72,7 @@ fn render_section(to: Renderer, camera: &Camera) -> String {
             file = mitsuba3::SCENE_FILE,
             w = camera.width,
             h = camera.height,
-            fov = num(camera.vfov_deg),
+            fov = shown(camera.vfov_deg),
         ),
         Renderer::PbrtV4 => format!(
             "## Rendering\n\n\
@@ -80,7 +90,7 @@ fn render_section(to: Renderer, camera: &Camera) -> String {
              luminance, see below). pbrt-v4's `rgb` film has no XYZ output: it writes RGB in \
              the film's colour space, here `{cs}`, whose primaries and white pbrt records in \
              the EXR's `chromaticities` attribute. XYZ is that attribute's RGB→XYZ matrix times \
-             the pixel (R, G, B) — a fixed linear map, nothing clipped (ACES2065-1's primaries \
+             the pixel (R, G, B), which metamer applies when it reads the file: a fixed linear map, nothing clipped (ACES2065-1's primaries \
              enclose every real colour) and 32-bit floats (`savefp16` false).\n\n\
              ## Lights\n\n\
              pbrt-v4's `diffuse` area light divides its `scale` by the photometric value \
@@ -93,8 +103,8 @@ fn render_section(to: Renderer, camera: &Camera) -> String {
             image = pbrt::IMAGE_FILE,
             w = camera.width,
             h = camera.height,
-            fov = num(camera.vfov_deg),
-            pfov = num(pbrt::fov_deg(camera)),
+            fov = shown(camera.vfov_deg),
+            pfov = shown(pbrt::fov_deg(camera)),
             cs = pbrt::COLOR_SPACE,
         ),
     }
@@ -151,11 +161,11 @@ fn emitter_section(a: &Approximation) -> String {
         } else {
             "the centre of the scene's surfaces"
         },
-        num(a.aim[0]),
-        num(a.aim[1]),
-        num(a.aim[2]),
-        num(lo),
-        num(hi)
+        shown(a.aim[0]),
+        shown(a.aim[1]),
+        shown(a.aim[2]),
+        shown(lo),
+        shown(hi)
     );
     match &a.difference {
         Measured::Done(d) => {
@@ -178,7 +188,7 @@ fn emitter_section(a: &Approximation) -> String {
                  the scene only within it.\n",
                 d.aimed_de.0,
                 d.aimed_de.1,
-                num(d.fit_scale),
+                shown(d.fit_scale),
                 d.solver_bound_de,
                 d.seconds,
                 d.max_de,
