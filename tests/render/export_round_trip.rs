@@ -228,16 +228,15 @@ fn mitsuba_reads_back_the_measured_box_within_its_emitters_stated_difference() {
         stated.iter().sum::<f64>() / 24.0,
         stated.iter().cloned().fold(0.0, f64::max)
     );
-    for k in 0..24 {
+    for (k, form) in stated.iter().enumerate() {
         // Mitsuba renders the written form; the form is `stated` from the scene.
-        let allowed = stated[k] + SIGMAS / 1.96 * a.half_width[k];
+        let allowed = form + SIGMAS / 1.96 * a.half_width[k];
         assert!(
             a.de[k] <= allowed,
-            "patch {}: ΔE*ab {:.3} from render spots, more than the form's {:.3} plus the \
+            "patch {}: ΔE*ab {:.3} from render spots, more than the form's {form:.3} plus the \
              image's noise ({})",
             k + 1,
             a.de[k],
-            stated[k],
             summary(&a)
         );
     }
