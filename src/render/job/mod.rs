@@ -16,6 +16,7 @@ pub mod spots_from_image;
 
 use std::path::{Path, PathBuf};
 
+use crate::color::Xyz;
 use crate::image::ImageError;
 use crate::numeric_csv::CsvError;
 use crate::output::OutputError;
@@ -115,6 +116,28 @@ pub struct ImageReport {
     pub output: PathBuf,
     /// The preview, once written.
     pub preview: Option<PathBuf>,
+}
+
+/// The checks a request that may trace a reference white shares, in the order reported:
+/// the white's precision and time limit, then a given white.
+pub(crate) fn check_white_request(
+    target_de: f64,
+    max_seconds: f64,
+    white: Option<Xyz>,
+) -> Result<(), RenderError> {
+    let bad = |m: &str| Err(RenderError::BadRequest(m.into()));
+    if target_de.is_nan() || target_de <= 0.0 {
+        return bad("--target-de must be > 0");
+    }
+    if max_seconds.is_nan() || max_seconds <= 0.0 {
+        return bad("--max-seconds must be > 0");
+    }
+    if let Some(w) = white {
+        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
+            return bad("--white must be finite with Y > 0");
+        }
+    }
+    Ok(())
 }
 
 /// The scene at `path` (or the built-in box it names, see [`Scene::builtin_named`]), or the

@@ -25,7 +25,7 @@
 
 use std::path::PathBuf;
 
-use super::{load_scene, RenderError, RenderEvent};
+use super::{check_white_request, load_scene, RenderError, RenderEvent};
 use crate::color::Xyz;
 use crate::render::method::{Method, Resolved, Solver};
 use crate::render::radiosity::RadiosityResult;
@@ -153,18 +153,7 @@ pub fn run(
     request: &SpotsRequest,
     events: &dyn Fn(RenderEvent),
 ) -> Result<SpotsReport, RenderError> {
-    let bad = |m: &str| Err(RenderError::BadRequest(m.into()));
-    if request.target_de.is_nan() || request.target_de <= 0.0 {
-        return bad("--target-de must be > 0");
-    }
-    if request.max_seconds.is_nan() || request.max_seconds <= 0.0 {
-        return bad("--max-seconds must be > 0");
-    }
-    if let Some(w) = request.white {
-        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
-            return bad("--white must be finite with Y > 0");
-        }
-    }
+    check_white_request(request.target_de, request.max_seconds, request.white)?;
     let scene = load_scene(request.scene.as_deref(), events)?;
     let resolved = request.method.resolve(&scene)?;
     events(RenderEvent::Method(&resolved));

@@ -53,7 +53,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::{load_scene, RenderError, RenderEvent};
+use super::{check_white_request, load_scene, RenderError, RenderEvent};
 use crate::color::Xyz;
 use crate::image::{read_xyz_image, XyzImage};
 use crate::render::image::Frame;
@@ -166,18 +166,7 @@ impl Report {
 /// white and checks the units. Nothing is written.
 pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, RenderError> {
     let start = Instant::now();
-    let bad = |m: &str| Err(RenderError::BadRequest(m.into()));
-    if request.target_de.is_nan() || request.target_de <= 0.0 {
-        return bad("--target-de must be > 0");
-    }
-    if request.max_seconds.is_nan() || request.max_seconds <= 0.0 {
-        return bad("--max-seconds must be > 0");
-    }
-    if let Some(w) = request.white {
-        if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
-            return bad("--white must be finite with Y > 0");
-        }
-    }
+    check_white_request(request.target_de, request.max_seconds, request.white)?;
     let name = request
         .scene
         .as_ref()
