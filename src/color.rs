@@ -71,7 +71,7 @@ pub struct XyzRequest {
     pub illuminant: String,
     pub observer: ObserverKind,
     /// Reference white for CIELAB (default for reflectance: the illuminant's white).
-    pub white: Option<[f64; 3]>,
+    pub white: Option<Xyz>,
     /// Only this column.
     pub column: Option<String>,
     pub method: Integration,
@@ -130,7 +130,7 @@ pub fn spectra_xyz(
             .zip(table.all(Outside::Zero))
             .collect(),
     };
-    let white = request.white.map(Xyz::from_array);
+    let white = request.white;
     let named = columns.len() > 1 || request.column.is_some();
     for (name, spectrum) in columns {
         let spectrum = match request.method {

@@ -114,7 +114,7 @@ fn xyz(a: XyzArgs) -> CliResult {
         },
         illuminant: a.illuminant,
         observer: a.observer,
-        white: a.white,
+        white: a.white.map(Into::into),
         column: a.column,
         method: match a.method {
             MethodArg::Cie15 => Integration::Cie15,

@@ -54,7 +54,7 @@ pub fn read_back(
         .iter()
         .map(|s| {
             let u_lab = render_lab_sigma(s.uncertainty);
-            (s.patch, PatchReading::rendered(s.xyz.into(), u_lab))
+            (s.patch, PatchReading::rendered(s.xyz, u_lab))
         })
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;

@@ -247,7 +247,7 @@ pub fn simulate(
         .iter()
         .map(|s| {
             let u_lab = render_lab_sigma(s.uncertainty);
-            (s.patch, PatchReading::rendered(s.xyz.into(), u_lab))
+            (s.patch, PatchReading::rendered(s.xyz, u_lab))
         })
         .collect();
     write_readings(&dir.join(SPOTS_FILE), &stats)?;

@@ -214,7 +214,7 @@ fn spot_readings(summary: &Summary, meter: &str) -> Vec<(usize, PatchReading)> {
                 (1, Some(c)) => c,
                 _ => r.stats.cov,
             };
-            (*patch, PatchReading::stated((*xyz).into(), cov, n, 0.0))
+            (*patch, PatchReading::stated(*xyz, cov, n, 0.0))
         })
         .collect()
 }

@@ -107,13 +107,13 @@ pub fn group(readings: &[&Reading], noise: Repeatability) -> Result<GroupStats, 
         .map(|(_, r)| *r)
         .collect();
     let k = kept.len() as f64;
-    let xs: Vec<[f64; 3]> = kept.iter().map(|r| r.xyz.to_array()).collect();
+    let xs: Vec<Xyz> = kept.iter().map(|r| r.xyz).collect();
     let (xyz, cov) = covariance::sample(&xs);
     let sd_y = cov[1][1].sqrt();
     let noise_y = noise.sigma_y(xyz[1]);
     Ok(GroupStats {
         n: readings.len(),
-        xyz: xyz.into(),
+        xyz,
         sd_y,
         cov,
         noise_y,

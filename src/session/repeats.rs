@@ -388,14 +388,14 @@ mod tests {
         assert!((c[2][2] - 2.220_833e-4).abs() < 1e-9, "{}", c[2][2]);
         let (sxy, sy) = (0.0005, c[1][1].sqrt());
         let mut rng = metamer_drivers::noise::SplitMix64::new(7);
-        let draws: Vec<[f64; 3]> = (0..200_000)
+        let draws: Vec<Xyz> = (0..200_000)
             .map(|_| {
                 let (xx, yy, ly) = (
                     x + sxy * rng.normal(),
                     y + sxy * rng.normal(),
                     big_y + sy * rng.normal(),
                 );
-                [xx * ly / yy, ly, (1.0 - xx - yy) * ly / yy]
+                Xyz::new(xx * ly / yy, ly, (1.0 - xx - yy) * ly / yy)
             })
             .collect();
         let (_, s) = covariance::sample(&draws);

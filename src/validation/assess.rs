@@ -50,7 +50,7 @@ impl JndVerdict {
 /// One side's reading of a patch as the assessment keeps it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Side {
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Standard uncertainty of the mean in X, Y and Z (the square roots of `cov_xyz`'s
     /// diagonal).
     pub u_xyz: [f64; 3],
@@ -105,7 +105,7 @@ pub struct Assessment {
     pub reference: String,
     pub test: String,
     /// CIELAB's reference white.
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub propagation: String,
     pub patches: Vec<PatchAssessment>,
     pub mean_de76: Stat,
@@ -148,7 +148,7 @@ fn side(p: &PatchReading, white: Xyz, extra_lab: f64) -> (Side, Uncertain) {
             u_lab,
             n: p.n,
             uncertainty: p.source,
-            lab: Xyz::from_array(p.xyz).to_lab(white).to_array(),
+            lab: p.xyz.to_lab(white).to_array(),
         },
         Uncertain {
             xyz: p.xyz,
@@ -225,7 +225,7 @@ pub(super) struct PatchPair {
 pub(super) fn exact_side(xyz: Xyz, white: Xyz) -> (Side, Uncertain) {
     (
         Side {
-            xyz: xyz.to_array(),
+            xyz,
             u_xyz: [0.0; 3],
             cov_xyz: covariance::ZERO,
             dof: None,
@@ -235,7 +235,7 @@ pub(super) fn exact_side(xyz: Xyz, white: Xyz) -> (Side, Uncertain) {
             lab: xyz.to_lab(white).to_array(),
         },
         Uncertain {
-            xyz: xyz.to_array(),
+            xyz,
             factors: Vec::new(),
             dof: None,
             u_lab: 0.0,
@@ -335,7 +335,7 @@ pub(super) fn compare_pairs(
     Assessment {
         reference: reference_name.into(),
         test: test_name.into(),
-        white: white.to_array(),
+        white,
         propagation: propagation.describe(),
         below_jnd_point: patches.iter().filter(|p| p.de76 < JND_DE76).count(),
         patches,

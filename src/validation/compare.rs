@@ -19,8 +19,8 @@ pub struct PatchComparison {
     /// 1-based ColorChecker patch number.
     pub patch: usize,
     pub name: String,
-    pub reference_xyz: [f64; 3],
-    pub test_xyz: [f64; 3],
+    pub reference_xyz: Xyz,
+    pub test_xyz: Xyz,
     pub reference_lab: [f64; 3],
     pub test_lab: [f64; 3],
     pub de76: f64,
@@ -34,7 +34,7 @@ pub struct Comparison {
     pub reference: String,
     pub test: String,
     /// Reference white of CIELAB, cd/m².
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub patches: Vec<PatchComparison>,
     pub mean_de76: f64,
     pub max_de76: f64,
@@ -134,11 +134,11 @@ impl Comparison {
         for p in &self.patches {
             let nums: Vec<String> = p
                 .reference_xyz
-                .iter()
-                .chain(&p.test_xyz)
-                .chain(&p.reference_lab)
-                .chain(&p.test_lab)
-                .chain([&p.de76, &p.de00])
+                .into_iter()
+                .chain(p.test_xyz)
+                .chain(p.reference_lab)
+                .chain(p.test_lab)
+                .chain([p.de76, p.de00])
                 .map(|v| format!("{v:.6}"))
                 .collect();
             s += &format!("{},{},{}\n", p.patch, p.name, nums.join(","));

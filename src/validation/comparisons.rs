@@ -10,6 +10,7 @@ use super::assess::Assessment;
 use super::chart::write_delta_e_chart;
 use super::compare::Comparison;
 use super::error::ValidationError;
+use crate::color::Xyz;
 use crate::output::OutputPolicy;
 
 /// What the validation found, as `comparisons.json`: each comparison patch by patch with
@@ -22,7 +23,7 @@ pub struct ValidationResult {
     /// The file's layout ([`RESULT_VERSION`]).
     pub version: u32,
     /// CIELAB's reference white, cd/m².
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub out_of_gamut_patches: Vec<usize>,
     pub display_vs_box: Assessment,
     pub simulation_vs_box: Assessment,

@@ -6,6 +6,8 @@
 
 use nalgebra::{Matrix3, SymmetricEigen};
 
+use crate::color::Xyz;
+
 /// A covariance of X, Y and Z, row-major.
 pub type Cov3 = [[f64; 3]; 3];
 
@@ -14,17 +16,30 @@ pub const ZERO: Cov3 = [[0.0; 3]; 3];
 
 /// The mean of `readings` and their sample covariance (divisor k − 1; zero for fewer than
 /// two readings).
-pub fn sample(readings: &[[f64; 3]]) -> ([f64; 3], Cov3) {
-    let k = readings.len();
+pub fn sample(readings: &[Xyz]) -> (Xyz, Cov3) {
+    let (mean, c) = mean_and_covariance(readings);
+    (mean.into(), c)
+}
+
+/// The sample covariance of triples other than an XYZ (CIELAB differences), as
+/// [`sample`]'s.
+pub fn spread(rows: &[[f64; 3]]) -> Cov3 {
+    mean_and_covariance(rows).1
+}
+
+fn mean_and_covariance<T: Copy + Into<[f64; 3]>>(rows: &[T]) -> ([f64; 3], Cov3) {
+    let k = rows.len();
     let mut mean = [0.0; 3];
-    for r in readings {
+    for r in rows {
+        let r: [f64; 3] = (*r).into();
         for (m, v) in mean.iter_mut().zip(r) {
             *m += v / k.max(1) as f64;
         }
     }
     let mut c = ZERO;
     if k > 1 {
-        for r in readings {
+        for r in rows {
+            let r: [f64; 3] = (*r).into();
             let d = [0, 1, 2].map(|i| r[i] - mean[i]);
             for (i, row) in c.iter_mut().enumerate() {
                 for (j, v) in row.iter_mut().enumerate() {
@@ -146,16 +161,20 @@ mod tests {
         // X: 1, 2, 3; Y: 2, 4, 6 (= 2X); Z: 0, 0, 3. Means 2, 4, 1. Deviations
         // X −1, 0, 1; Y −2, 0, 2; Z −1, −1, 2: var X 1, var Y 4, cov XY 2, var Z 3,
         // cov XZ (1 + 0 + 2)/2 = 1.5, cov YZ 3.
-        let (m, c) = sample(&[[1.0, 2.0, 0.0], [2.0, 4.0, 0.0], [3.0, 6.0, 3.0]]);
+        let (m, c) = sample(&[
+            Xyz::new(1.0, 2.0, 0.0),
+            Xyz::new(2.0, 4.0, 0.0),
+            Xyz::new(3.0, 6.0, 3.0),
+        ]);
         let near = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
-        assert!(near(&m, &[2.0, 4.0, 1.0]), "{m:?}");
+        assert!(near(&m.to_array(), &[2.0, 4.0, 1.0]), "{m:?}");
         let want = [[1.0, 2.0, 1.5], [2.0, 4.0, 3.0], [1.5, 3.0, 3.0]];
         assert!(near(c.as_flattened(), want.as_flattened()), "{c:?}");
         assert!(near(&sd(&c), &[1.0, 2.0, 3f64.sqrt()]));
         assert!(near(&off_diagonal(&c), &[2.0, 1.5, 3.0]));
         let back = from_parts(sd(&c), off_diagonal(&c));
         assert!(near(back.as_flattened(), c.as_flattened()));
-        assert_eq!(sample(&[[1.0, 2.0, 3.0]]).1, ZERO);
+        assert_eq!(sample(&[Xyz::new(1.0, 2.0, 3.0)]).1, ZERO);
     }
 
     #[test]

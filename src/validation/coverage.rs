@@ -33,8 +33,8 @@ const WHITE: Xyz = Xyz::new(15.573, 16.34, 18.356);
 /// each, with the repeats each mean is of.
 #[derive(Clone)]
 struct Truth {
-    reference: [f64; 3],
-    test: [f64; 3],
+    reference: Xyz,
+    test: Xyz,
     cov_reference: Cov3,
     cov_test: Cov3,
     k_reference: usize,
@@ -43,23 +43,20 @@ struct Truth {
 
 impl Truth {
     fn de76(&self) -> f64 {
-        delta_e76(
-            Xyz::from_array(self.reference).to_lab(WHITE),
-            Xyz::from_array(self.test).to_lab(WHITE),
-        )
+        delta_e76(self.reference.to_lab(WHITE), self.test.to_lab(WHITE))
     }
 }
 
 /// `k` readings about `mean` with one reading's covariance `cov`.
-fn readings(mean: [f64; 3], cov: &Cov3, k: usize, rng: &mut SplitMix64) -> Vec<[f64; 3]> {
+fn readings(mean: Xyz, cov: &Cov3, k: usize, rng: &mut SplitMix64) -> Vec<Xyz> {
     let f = covariance::factors(cov);
     (0..k)
         .map(|_| {
             let mut x = mean;
             for v in &f {
                 let z = rng.normal();
-                for (xi, vi) in x.iter_mut().zip(v) {
-                    *xi += vi * z;
+                for (i, vi) in v.iter().enumerate() {
+                    x[i] += vi * z;
                 }
             }
             x
@@ -79,7 +76,7 @@ enum Stated {
     EstimatedAsKnown,
 }
 
-fn side(mean: [f64; 3], cov: &Cov3, k: usize, how: Stated, rng: &mut SplitMix64) -> Uncertain {
+fn side(mean: Xyz, cov: &Cov3, k: usize, how: Stated, rng: &mut SplitMix64) -> Uncertain {
     let r = readings(mean, cov, k, rng);
     let (xyz, sample) = covariance::sample(&r);
     let of_mean = |c: &Cov3| covariance::factors(&covariance::scaled(c, 1.0 / k as f64));
@@ -108,11 +105,7 @@ fn trial(truth: &Truth, how: Stated, draws: usize, seed: u64) -> (Lab, Lab, LabN
     );
     let t = side(truth.test, &truth.cov_test, truth.k_test, how, &mut rng);
     let noise = lab_noise(&r, &t, WHITE, draws, &mut rng);
-    (
-        Xyz::from_array(r.xyz).to_lab(WHITE),
-        Xyz::from_array(t.xyz).to_lab(WHITE),
-        noise,
-    )
+    (r.xyz.to_lab(WHITE), t.xyz.to_lab(WHITE), noise)
 }
 
 /// The share of trials whose ΔE*ab interval holds the truth; and of the percentile
@@ -143,8 +136,8 @@ fn coverage(truth: &Truth, how: Stated, seed: u64) -> (f64, f64) {
 }
 
 /// A colour `de` ΔE*ab from `from` along the unit CIELAB direction `dir`.
-fn moved(from: [f64; 3], dir: [f64; 3], de: f64) -> [f64; 3] {
-    let l = Xyz::from_array(from).to_lab(WHITE);
+fn moved(from: Xyz, dir: [f64; 3], de: f64) -> Xyz {
+    let l = from.to_lab(WHITE);
     let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
     Lab::new(
         l.l + de * dir[0] / n,
@@ -152,16 +145,15 @@ fn moved(from: [f64; 3], dir: [f64; 3], de: f64) -> [f64; 3] {
         l.b + de * dir[2] / n,
     )
     .to_xyz(WHITE)
-    .to_array()
 }
 
 /// ColorChecker 16 (yellow) as the default lab's box shows it, and the CS-100A's stated
 /// repeatability of one reading of it, scaled by `noise`.
 fn yellow(de: f64, noise: f64, k_reference: usize, k_test: usize) -> Truth {
-    let reference = [9.0356, 9.9766, 1.2852];
+    let reference = Xyz::new(9.0356, 9.9766, 1.2852);
     let one = Repeatability::emissive_of("cs100a")
         .unwrap()
-        .covariance(reference.into())
+        .covariance(reference)
         .unwrap();
     let cov = covariance::scaled(&one, noise * noise);
     Truth {

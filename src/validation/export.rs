@@ -59,19 +59,19 @@ pub fn to_csv(input: &ReportInput) -> String {
             let nums: Vec<String> = p
                 .reference
                 .xyz
-                .iter()
-                .chain(&p.reference.u_xyz)
-                .chain(&p.test.xyz)
-                .chain(&p.test.u_xyz)
-                .chain(&p.reference.lab)
-                .chain(&p.test.lab)
+                .into_iter()
+                .chain(p.reference.u_xyz)
+                .chain(p.test.xyz)
+                .chain(p.test.u_xyz)
+                .chain(p.reference.lab)
+                .chain(p.test.lab)
                 .chain([
-                    &p.de76,
-                    &p.de76_interval.lo,
-                    &p.de76_interval.hi,
-                    &p.de00,
-                    &p.de00_interval.lo,
-                    &p.de00_interval.hi,
+                    p.de76,
+                    p.de76_interval.lo,
+                    p.de76_interval.hi,
+                    p.de00,
+                    p.de00_interval.lo,
+                    p.de00_interval.hi,
                 ])
                 .map(|v| format!("{v:.6}"))
                 .collect();

@@ -217,7 +217,7 @@ pub fn validate(request: &Request<'_>) -> Result<Outcome, ValidationError> {
         }
         let r = ValidationResult {
             version: RESULT_VERSION,
-            white: white.to_array(),
+            white,
             out_of_gamut_patches: request.out_of_gamut.clone(),
             display_vs_box: display_vs_box.clone(),
             simulation_vs_box: simulation_vs_box.clone(),

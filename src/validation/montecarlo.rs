@@ -104,10 +104,7 @@ pub fn lab_noise(
     draws: usize,
     rng: &mut SplitMix64,
 ) -> LabNoise {
-    let (rl, tl) = (
-        Xyz::from_array(reference.xyz).to_lab(white),
-        Xyz::from_array(test.xyz).to_lab(white),
-    );
+    let (rl, tl) = (reference.xyz.to_lab(white), test.xyz.to_lab(white));
     let mut noise = LabNoise {
         reference: Vec::with_capacity(draws),
         test: Vec::with_capacity(draws),
@@ -157,7 +154,7 @@ fn difference_covariance(noise: &LabNoise) -> Cov3 {
         .zip(&noise.test)
         .map(|(r, t)| [t[0] - r[0], t[1] - r[1], t[2] - r[2]])
         .collect();
-    covariance::sample(&d).1
+    covariance::spread(&d)
 }
 
 /// One patch's family of true differences (module docs): the observed difference `d`

@@ -119,10 +119,7 @@ pub fn propagate(
     let n = model.len();
     let zero = vec![0.0; n];
     let (d76, d00) = model.eval(&zero);
-    let (rl, tl) = (
-        Xyz::from_array(reference.xyz).to_lab(white),
-        Xyz::from_array(test.xyz).to_lab(white),
-    );
+    let (rl, tl) = (reference.xyz.to_lab(white), test.xyz.to_lab(white));
     let uncertain = !reference.factors.is_empty()
         || !test.factors.is_empty()
         || reference.u_lab > 0.0
@@ -180,7 +177,7 @@ mod tests {
 
     const WHITE: Xyz = Xyz::new(95.047, 100.0, 108.883);
 
-    fn exact(xyz: [f64; 3]) -> Uncertain {
+    fn exact(xyz: Xyz) -> Uncertain {
         Uncertain {
             xyz,
             factors: Vec::new(),
@@ -197,7 +194,7 @@ mod tests {
     /// ΔE about the readings would sit 0.025 above it.
     #[test]
     fn isotropic_lab_noise_gives_the_noncentral_chi_interval() {
-        let g = |y: f64| [WHITE.x * y, WHITE.y * y, WHITE.z * y];
+        let g = |y: f64| WHITE.scaled(y);
         let r = exact(g(0.184_186_52));
         let t = Uncertain {
             u_lab: 0.5,
@@ -226,13 +223,13 @@ mod tests {
     #[test]
     fn monte_carlo_and_linearisation_agree_far_from_zero() {
         let r = Uncertain {
-            xyz: [21.0, 12.0, 5.0],
+            xyz: Xyz::new(21.0, 12.0, 5.0),
             factors: vec![[0.04, 0.0, 0.0], [0.0, 0.024, 0.0], [0.0, 0.0, 0.01]],
             dof: None,
             u_lab: 0.0,
         };
         let t = Uncertain {
-            xyz: [19.0, 12.5, 6.5],
+            xyz: Xyz::new(19.0, 12.5, 6.5),
             ..r.clone()
         };
         let how = Propagation::MonteCarlo {
@@ -261,7 +258,7 @@ mod tests {
     /// alone, so the half-width is t₂(0.975)·σ = 4.3027σ against 1.96σ when σ is known.
     #[test]
     fn an_estimated_covariance_widens_the_interval_by_students_t() {
-        let g = |y: f64| [WHITE.x * y, WHITE.y * y, WHITE.z * y];
+        let g = |y: f64| WHITE.scaled(y);
         // σ of Y 0.05 along the grey axis (a* and b* stay 0).
         let axis = [0.950_47 * 0.05, 0.05, 1.088_83 * 0.05];
         let t = |dof| Uncertain {
@@ -289,7 +286,7 @@ mod tests {
 
     #[test]
     fn no_uncertainty_gives_a_point() {
-        let r = exact([20.0, 21.0, 22.0]);
+        let r = exact(Xyz::new(20.0, 21.0, 22.0));
         let p = propagate(&r, &r, WHITE, Propagation::default(), 2);
         assert_eq!(p.de76, Interval { lo: 0.0, hi: 0.0 });
         assert!(p.noise.is_none());

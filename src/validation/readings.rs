@@ -23,7 +23,7 @@ use serde_json::Value;
 use super::covariance::{self, Cov3};
 use super::uncertain::render_lab_sigma;
 pub use super::uncertain::CHI3_95;
-use crate::color::COLORCHECKER_NAMES;
+use crate::color::{Xyz, COLORCHECKER_NAMES};
 use crate::render::spot::Uncertainty;
 use crate::session::repeats::Repeatability;
 
@@ -71,7 +71,7 @@ pub enum UncertaintySource {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PatchReading {
     /// Mean XYZ, in the readings' units (cd/m² from a meter).
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Standard uncertainty of the mean in X, Y and Z.
     pub u_xyz: [f64; 3],
     /// The uncertainty of the mean as independent standard-normal factors, each moving XYZ
@@ -134,7 +134,7 @@ impl ReadingSet {
     pub fn white_or_brightest(&self) -> (crate::color::Xyz, String) {
         if let Some(w) = &self.white {
             return (
-                crate::color::Xyz::from_array(w.xyz),
+                w.xyz,
                 format!("the white reading of {}", self.file.display()),
             );
         }
@@ -144,7 +144,7 @@ impl ReadingSet {
             .max_by(|a, b| a.1.xyz[1].total_cmp(&b.1.xyz[1]))
             .expect("a reading set has at least one patch");
         (
-            crate::color::Xyz::from_array(p.xyz),
+            p.xyz,
             format!(
                 "the brightest reading of {} (patch {k}, {}), which has no white reading",
                 self.file.display(),

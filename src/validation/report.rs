@@ -79,7 +79,13 @@ pub fn render_html(input: &ReportInput) -> String {
             .display_vs_box
             .as_ref()
             .or(input.simulation_vs_box.as_ref())
-            .map(|a| a.white.map(|v| format!("{v:.4}")).join(", "))
+            .map(|a| {
+                a.white
+                    .iter()
+                    .map(|v| format!("{v:.4}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            })
             .unwrap_or_default(),
         esc(&input.white_source),
         input

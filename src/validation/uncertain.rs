@@ -15,7 +15,7 @@ pub const CHI3_95: f64 = 2.795_483;
 /// One side of a comparison with its uncertainty.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Uncertain {
-    pub xyz: [f64; 3],
+    pub xyz: Xyz,
     /// Independent standard-normal factors, each moving XYZ along its vector: their
     /// Σ f fᵀ is the covariance of the mean.
     pub factors: Vec<[f64; 3]>,
@@ -57,11 +57,11 @@ pub fn render_lab_sigma(statement: Uncertainty) -> f64 {
 pub fn lab_of(side: &Uncertain, z: &[f64], zl: &[f64], white: Xyz) -> Lab {
     let mut xyz = side.xyz;
     for (f, zi) in side.factors.iter().zip(z) {
-        for (x, v) in xyz.iter_mut().zip(f) {
-            *x += v * zi;
+        for (i, v) in f.iter().enumerate() {
+            xyz[i] += v * zi;
         }
     }
-    let l = Xyz::from_array(xyz).to_lab(white);
+    let l = xyz.to_lab(white);
     Lab::new(
         l.l + side.u_lab * zl[0],
         l.a + side.u_lab * zl[1],

@@ -25,7 +25,7 @@ fn box_spots(dir: &Path) -> PathBuf {
     let stats: Vec<(usize, PatchReading)> = r
         .patches
         .iter()
-        .map(|p| (p.patch, PatchReading::of(&[p.xyz.to_array()])))
+        .map(|p| (p.patch, PatchReading::of(&[p.xyz])))
         .collect();
     let f = dir.join("box-spots.csv");
     write_readings(&f, &stats).unwrap();

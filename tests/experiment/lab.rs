@@ -81,7 +81,7 @@ fn least_linear_drive(dir: &Path) -> Vec<(usize, f64)> {
         .patches
         .iter()
         .map(|(&patch, p)| {
-            let lin = inv * Vector3::from(p.xyz);
+            let lin = inv * Vector3::from(p.xyz.to_array());
             (patch, lin.min() / lin.max())
         })
         .collect()

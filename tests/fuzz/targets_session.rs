@@ -56,7 +56,7 @@ fn readings(bytes: &[u8], _: &Path) -> Check {
         return Ok(());
     };
     for (n, p) in set.patches.iter().chain(set.white.iter().map(|w| (&0, w))) {
-        if p.xyz.iter().chain(&p.u_xyz).any(|v| !v.is_finite()) {
+        if p.xyz.iter().chain(p.u_xyz).any(|v| !v.is_finite()) {
             return Err(format!("patch {n} read as {:?} ± {:?}", p.xyz, p.u_xyz));
         }
     }

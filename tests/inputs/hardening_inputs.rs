@@ -64,7 +64,10 @@ fn a_byte_order_mark_is_not_part_of_the_first_line() {
     // JSON spot lines behind a BOM were read as a CSV without a header.
     let lines = "{\"patch\": 1, \"XYZ\": [10, 11, 12]}\n{\"patch\": 2, \"XYZ\": [20, 21, 22]}\n";
     let marked = parse_readings(&format!("{BOM}{lines}"), Path::new("spots.jsonl")).unwrap();
-    assert_eq!(marked.patches[&2].xyz, [20.0, 21.0, 22.0]);
+    assert_eq!(
+        marked.patches[&2].xyz,
+        metamer::color::Xyz::new(20.0, 21.0, 22.0)
+    );
 
     // An IES file behind a BOM was read as the 1986 format (no version line).
     let (ies_text, _) = photometric_files();
@@ -183,7 +186,10 @@ fn readings_no_instrument_can_have_taken_are_refused_where_they_enter() {
     assert!(e.contains("a 95 % ΔE*ab bound of 1e300"), "{e}");
     // A dark patch's noise below zero is a reading, not an impossibility.
     let ok = parse_readings("patch,X,Y,Z\n1,0.004,-0.003,0.002\n", Path::new("r.csv")).unwrap();
-    assert_eq!(ok.patches[&1].xyz, [0.004, -0.003, 0.002]);
+    assert_eq!(
+        ok.patches[&1].xyz,
+        metamer::color::Xyz::new(0.004, -0.003, 0.002)
+    );
 }
 
 /// A scene whose light table reaches 1e300 was accepted, and the renderer then blamed the

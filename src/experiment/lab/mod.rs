@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::Spec;
 use serde::Serialize;
 
+use crate::color::Xyz;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
 use crate::experiment::display::DisplayOptions;
@@ -232,7 +233,7 @@ pub struct LabSummary {
     /// Wall time of this call, s (a fully re-used run takes next to none).
     pub seconds: f64,
     /// CIELAB's reference white: the display's measured white, cd/m².
-    pub white: [f64; 3],
+    pub white: Xyz,
     pub out_of_gamut_patches: Vec<usize>,
     pub display_vs_box: ComparisonSummary,
     pub simulation_vs_box: ComparisonSummary,

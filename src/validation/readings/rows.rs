@@ -123,7 +123,7 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
         source
     };
     PatchReading {
-        xyz: mean,
+        xyz: mean.into(),
         u_xyz,
         u_factors,
         dof,

@@ -12,11 +12,11 @@ fn csv_repeats_give_the_standard_error_of_their_mean() {
     let s = parse("patch,X,Y,Z\n1,1,10,1\n1,1,12,1\n1,1,14,1\nwhite,95,100,108\n").unwrap();
     assert_eq!(s.format, Format::Csv);
     let p = &s.patches[&1];
-    assert_eq!(p.xyz, [1.0, 12.0, 1.0]);
+    assert_eq!(p.xyz, Xyz::new(1.0, 12.0, 1.0));
     assert!((p.u_xyz[1] - 1.154_700_5).abs() < 1e-6);
     assert_eq!(p.u_xyz[0], 0.0);
     assert_eq!((p.n, p.source), (3, UncertaintySource::Repeats));
-    assert_eq!(s.white.unwrap().xyz, [95.0, 100.0, 108.0]);
+    assert_eq!(s.white.unwrap().xyz, Xyz::new(95.0, 100.0, 108.0));
 }
 
 #[test]

@@ -21,13 +21,13 @@ impl PatchReading {
     /// The mean `xyz` of `n` readings (at least one) with one reading's covariance `cov`
     /// and a render's CIELAB standard uncertainty `u_lab` (0 for a measurement): a row of
     /// the stages' readings file.
-    pub fn stated(xyz: [f64; 3], cov: Cov3, n: usize, u_lab: f64) -> PatchReading {
+    pub fn stated(xyz: Xyz, cov: Cov3, n: usize, u_lab: f64) -> PatchReading {
         let row = Row {
             sd: Some(covariance::sd(&cov)),
             cov: covariance::off_diagonal(&cov),
             n: n.max(1),
             u_lab: Some(u_lab),
-            ..Row::reading(0, PatchId::Number(0), xyz)
+            ..Row::reading(0, PatchId::Number(0), xyz.into())
         };
         PatchReading {
             // Kept as given, not as its standard deviations squared, and the count as
@@ -40,14 +40,14 @@ impl PatchReading {
 
     /// The mean and sample covariance of `readings` (at least one; one reading's
     /// covariance is 0: nothing is known of it).
-    pub fn of(readings: &[[f64; 3]]) -> PatchReading {
+    pub fn of(readings: &[Xyz]) -> PatchReading {
         let (xyz, cov) = covariance::sample(readings);
         PatchReading::stated(xyz, cov, readings.len(), 0.0)
     }
 
     /// One rendered reading, without scatter, with the render's CIELAB standard
     /// uncertainty `u_lab`.
-    pub fn rendered(xyz: [f64; 3], u_lab: f64) -> PatchReading {
+    pub fn rendered(xyz: Xyz, u_lab: f64) -> PatchReading {
         let (xyz, cov) = covariance::sample(&[xyz]);
         PatchReading::stated(xyz, cov, 1, u_lab)
     }
@@ -66,7 +66,7 @@ impl PatchReading {
                     .filter(|(q, _)| *q == p)
                     .map(|(_, r)| *r)
                     .collect();
-                let xs: Vec<[f64; 3]> = of_patch.iter().map(|r| r.xyz.to_array()).collect();
+                let xs: Vec<Xyz> = of_patch.iter().map(|r| r.xyz).collect();
                 let (xyz, mut cov) = covariance::sample(&xs);
                 if let [one] = of_patch.as_slice() {
                     if let Some(c) = Repeatability::emissive_of(&one.instrument)
@@ -140,8 +140,12 @@ mod tests {
     fn mean_and_sample_sd() {
         // X: 1, 2, 3 → mean 2, s = 1; Y constant → 0; Z 0, 0, 3: s = √3, cov XZ
         // ((−1)(−1) + 0 + (1)(2))/2 = 1.5.
-        let s = PatchReading::of(&[[1.0, 5.0, 0.0], [2.0, 5.0, 0.0], [3.0, 5.0, 3.0]]);
-        assert_eq!(s.xyz, [2.0, 5.0, 1.0]);
+        let s = PatchReading::of(&[
+            Xyz::new(1.0, 5.0, 0.0),
+            Xyz::new(2.0, 5.0, 0.0),
+            Xyz::new(3.0, 5.0, 3.0),
+        ]);
+        assert_eq!(s.xyz, Xyz::new(2.0, 5.0, 1.0));
         assert!((s.reading_sd()[0] - 1.0).abs() < 1e-12);
         assert_eq!(s.reading_sd()[1], 0.0);
         assert!((s.reading_sd()[2] - 3f64.sqrt()).abs() < 1e-12);
@@ -188,8 +192,11 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("metamer-readings-{}", std::process::id()));
         let p = dir.join("r.csv");
         let stats = vec![
-            (1, PatchReading::of(&[[0.1, 0.2, 0.3]])),
-            (2, PatchReading::of(&[[1.0, 2.0, 3.0], [1.5, 2.5, 3.5]])),
+            (1, PatchReading::of(&[Xyz::new(0.1, 0.2, 0.3)])),
+            (
+                2,
+                PatchReading::of(&[Xyz::new(1.0, 2.0, 3.0), Xyz::new(1.5, 2.5, 3.5)]),
+            ),
         ];
         // The covariance's diagonal is written as standard deviations: back to within
         // rounding.
@@ -243,7 +250,7 @@ mod tests {
     /// render's.
     #[test]
     fn a_rendered_patch_carries_its_lab_uncertainty() {
-        let r = PatchReading::rendered([1.0, 2.0, 3.0], 0.25);
+        let r = PatchReading::rendered(Xyz::new(1.0, 2.0, 3.0), 0.25);
         assert_eq!((r.u_lab, r.source), (0.25, UncertaintySource::Render));
         let dir = std::env::temp_dir().join(format!("metamer-rendered-{}", std::process::id()));
         let p = dir.join("spots.csv");
