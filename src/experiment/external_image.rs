@@ -12,15 +12,14 @@ use std::time::Instant;
 
 use super::error::ExperimentError;
 use super::progress::Progress;
-use super::readings::{write_readings, PatchReading};
+use super::readings::write_readings;
 use super::simulation::{
-    from_render, patches_in_image, ExternalSource, SimulationOptions, SimulationSummary,
-    IMAGE_FILE, SPOTS_FILE, SUMMARY_FILE,
+    as_readings, from_render, patches_in_image, ExternalSource, SimulationOptions,
+    SimulationSummary, IMAGE_FILE, SPOTS_FILE, SUMMARY_FILE,
 };
 use crate::image::{read_xyz_image, write_xyz_image};
 use crate::output::OutputPolicy;
 use crate::render::job::spots_from_image::{self, Request, METHOD};
-use crate::validation::propagate::render_lab_sigma;
 
 /// What the summary and report call the source.
 pub const RENDERER: &str = "external renderer";
@@ -49,15 +48,7 @@ pub fn read_back(
         file: dir.to_path_buf(),
         source,
     })?;
-    let stats: Vec<(usize, PatchReading)> = report
-        .patches
-        .iter()
-        .map(|s| {
-            let u_lab = render_lab_sigma(s.uncertainty);
-            (s.patch, PatchReading::rendered(s.xyz, u_lab))
-        })
-        .collect();
-    write_readings(&dir.join(SPOTS_FILE), &stats)?;
+    write_readings(&dir.join(SPOTS_FILE), &as_readings(&report.patches))?;
     // The reproduction shows the stage's own image.exr: the image as read, re-encoded.
     let img = read_xyz_image(image)?;
     let image_patches = patches_in_image(&report.scene, &img, &report.patches, report.white)?;

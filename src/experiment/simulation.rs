@@ -241,16 +241,7 @@ pub fn simulate(
         file: dir.to_path_buf(),
         source,
     })?;
-    // The render's own uncertainty goes with its readings, so `metamer validate` given
-    // this file counts it as the experiment's validation does.
-    let stats: Vec<(usize, PatchReading)> = spots
-        .iter()
-        .map(|s| {
-            let u_lab = render_lab_sigma(s.uncertainty);
-            (s.patch, PatchReading::rendered(s.xyz, u_lab))
-        })
-        .collect();
-    write_readings(&dir.join(SPOTS_FILE), &stats)?;
+    write_readings(&dir.join(SPOTS_FILE), &as_readings(&spots))?;
     let mut files = vec![SPOTS_FILE, SUMMARY_FILE];
     let mut image_patches = Vec::new();
     let image = match opts.image {
@@ -324,6 +315,19 @@ fn render_image(
 }
 
 /// The stage's error for a render job's: the same error the stage reported when it called
+/// The stage's readings of rendered patches. The render's own uncertainty goes with its
+/// readings, so `metamer validate` given the file counts it as the experiment's validation
+/// does.
+pub(super) fn as_readings(spots: &[RenderedReading]) -> Vec<(usize, PatchReading)> {
+    spots
+        .iter()
+        .map(|s| {
+            let u_lab = render_lab_sigma(s.uncertainty);
+            (s.patch, PatchReading::rendered(s.xyz, u_lab))
+        })
+        .collect()
+}
+
 /// the renderers itself.
 pub(super) fn from_render(e: RenderError) -> ExperimentError {
     match e {

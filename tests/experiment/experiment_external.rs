@@ -84,7 +84,7 @@ fn an_external_image_is_the_simulation_read_back_named_and_reused_by_its_digest(
     let stats: Vec<(usize, PatchReading)> = r
         .patches
         .iter()
-        .map(|p| (p.patch, PatchReading::of(&[p.xyz.into()])))
+        .map(|p| (p.patch, PatchReading::of(&[p.xyz])))
         .collect();
     let spots = dir.join("box-spots.csv");
     write_readings(&spots, &stats).unwrap();

@@ -98,7 +98,7 @@ fn unreachable_on_the_panel(dir: &Path) -> Vec<usize> {
         .unwrap()
         .patches
         .iter()
-        .filter(|(_, p)| panel.drive_for(p.xyz.into()).is_none())
+        .filter(|(_, p)| panel.drive_for(p.xyz).is_none())
         .map(|(&patch, _)| patch)
         .collect()
 }
