@@ -368,8 +368,8 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
     println!(
         "{} ({}×{}, sha256 {}): white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s",
         report.image.display(),
-        report.width,
-        report.height,
+        report.pixels.width,
+        report.pixels.height,
         report.sha256,
         w[0],
         w[1],

@@ -17,7 +17,7 @@ use super::simulation::{
     as_readings, from_render, patches_in_image, ExternalSource, SimulationOptions,
     SimulationSummary, IMAGE_FILE, SPOTS_FILE, SUMMARY_FILE,
 };
-use crate::image::{read_xyz_image, write_xyz_image};
+use crate::image::write_xyz_image;
 use crate::output::OutputPolicy;
 use crate::render::job::spots_from_image::{self, Request, METHOD};
 
@@ -50,9 +50,9 @@ pub fn read_back(
     })?;
     write_readings(&dir.join(SPOTS_FILE), &as_readings(&report.patches))?;
     // The reproduction shows the stage's own image.exr: the image as read, re-encoded.
-    let img = read_xyz_image(image)?;
-    let image_patches = patches_in_image(&report.scene, &img, &report.patches, report.white)?;
-    write_xyz_image(&dir.join(IMAGE_FILE), &img, &OutputPolicy::new(true))?;
+    let img = &report.pixels;
+    let image_patches = patches_in_image(&report.scene, img, &report.patches, report.white)?;
+    write_xyz_image(&dir.join(IMAGE_FILE), img, &OutputPolicy::new(true))?;
     let summary = SimulationSummary {
         method: METHOD.into(),
         white: report.white,

@@ -13,11 +13,12 @@ use metamer::render::Scene;
 
 use crate::support::unused_dir;
 
-const SCENE: &str = "data/scenes/validation-box.json";
+/// The validation box the experiment tests run on.
+pub(crate) const SCENE: &str = "data/scenes/validation-box.json";
 
 /// The box's spot readings: the deterministic render of the scene, as a box measured
 /// without meter noise would read.
-fn box_spots(dir: &Path) -> PathBuf {
+pub(crate) fn box_spots(dir: &Path) -> PathBuf {
     let scene = Scene::load(Path::new(SCENE)).unwrap();
     let r = render_spots_radiosity(&scene, &RadiosityOptions::default(), &|_| {}).unwrap();
     let stats: Vec<(usize, PatchReading)> = r

@@ -7,14 +7,10 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use metamer::experiment::readings::{write_readings, PatchReading};
-use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
-use metamer::render::Scene;
 use serde_json::Value;
 
+use crate::experiment::{box_spots, SCENE};
 use crate::support::{fresh_dir, stderr, text};
-
-const SCENE: &str = "data/scenes/validation-box.json";
 
 fn metamer(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_metamer"))
@@ -79,15 +75,7 @@ fn how(o: &Output, stage: &str) -> String {
 #[test]
 fn an_external_image_is_the_simulation_read_back_named_and_reused_by_its_digest() {
     let dir = fresh_dir("external");
-    let scene = Scene::load(Path::new(SCENE)).unwrap();
-    let r = render_spots_radiosity(&scene, &RadiosityOptions::default(), &|_| {}).unwrap();
-    let stats: Vec<(usize, PatchReading)> = r
-        .patches
-        .iter()
-        .map(|p| (p.patch, PatchReading::of(&[p.xyz])))
-        .collect();
-    let spots = dir.join("box-spots.csv");
-    write_readings(&spots, &stats).unwrap();
+    let spots = box_spots(&dir);
     let img = dir.join("renderer.exr");
     image(&img, "2");
     let out = dir.join("exp");

@@ -3,34 +3,15 @@
 //! shown whole on the simulated monitor and read patch by patch where the patches lie on
 //! the screen.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use metamer::color::{delta_e76, Xyz};
-use metamer::experiment::readings::{write_readings, PatchReading};
 use metamer::image::read_xyz_image;
-use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
-use metamer::render::Scene;
 use serde_json::Value;
 
+use crate::experiment::{box_spots, SCENE};
 use crate::support::{fresh_dir, json};
-
-const SCENE: &str = "data/scenes/validation-box.json";
-
-/// The box's spot readings: the deterministic render of the scene (a box read without
-/// meter noise).
-fn box_spots(dir: &Path) -> PathBuf {
-    let scene = Scene::load(Path::new(SCENE)).unwrap();
-    let r = render_spots_radiosity(&scene, &RadiosityOptions::default(), &|_| {}).unwrap();
-    let stats: Vec<(usize, PatchReading)> = r
-        .patches
-        .iter()
-        .map(|p| (p.patch, PatchReading::of(&[p.xyz])))
-        .collect();
-    let f = dir.join("box-spots.csv");
-    write_readings(&f, &stats).unwrap();
-    f
-}
 
 fn run(out: &Path, spots: &Path, extra: &[&str]) -> Output {
     let o = Command::new(env!("CARGO_BIN_EXE_metamer"))

@@ -106,8 +106,9 @@ pub struct Report {
     pub image: PathBuf,
     /// SHA-256 of the image file, tying the readings to the bytes read.
     pub sha256: String,
-    pub width: usize,
-    pub height: usize,
+    /// The image as read (XYZ in cd/m²), so a caller that shows or re-encodes it need not
+    /// decode the file again.
+    pub pixels: XyzImage,
     /// The white the readings' CIELAB is against.
     pub white: Xyz,
     pub seconds: f64,
@@ -151,8 +152,8 @@ impl Report {
             image: Source {
                 file: &self.image,
                 sha256: &self.sha256,
-                width: self.width,
-                height: self.height,
+                width: self.pixels.width,
+                height: self.pixels.height,
                 renderer: "external",
             },
             white: self.white,
@@ -236,8 +237,7 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
     })?;
     Ok(Report {
         scene,
-        width: image.width,
-        height: image.height,
+        pixels: image,
         image: file,
         sha256,
         white,
