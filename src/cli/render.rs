@@ -226,7 +226,7 @@ fn cli_error(e: RenderError) -> CliError {
 
 /// The events every command shows the same way.
 fn print_event(e: RenderEvent) {
-    if let RenderEvent::SceneWarning(w) = e {
+    if let RenderEvent::SceneWarning(w) | RenderEvent::Warning(w) = e {
         eprintln!("warning: {w}");
     }
 }

@@ -219,10 +219,11 @@ pub(super) fn text(
     summary: &str,
 ) -> String {
     let mut s = format!(
-        "# {scene_name} for {}\n\n\
+        "# {} for {}\n\n\
          Written by `metamer export --to {}`. Geometry in metres; every surface a Lambertian \
          reflector with the scene's spectral reflectance; every emitter tile an area light \
          of its absolute spectral radiance.\n\n**In short:** {summary}.\n\n",
+        super::common::one_line(scene_name),
         match to {
             Renderer::Mitsuba3 => "Mitsuba 3",
             Renderer::PbrtV4 => "pbrt-v4",

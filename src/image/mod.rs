@@ -11,6 +11,7 @@
 
 mod chromaticities;
 mod error;
+mod exr_header;
 mod exr_layout;
 #[cfg(test)]
 mod foreign_exr_tests;
@@ -20,6 +21,7 @@ mod xyz_file;
 
 pub use chromaticities::{Chromaticities, XYZ_CHROMATICITIES};
 pub use error::ImageError;
+pub use exr_header::REC709_CHROMATICITIES;
 pub use rgb::{RgbImage, ScreenSpot};
 pub use xyz::{XyzImage, MAX_PIXELS};
 pub use xyz_file::{read_xyz_image, write_srgb_preview, write_xyz_image};
