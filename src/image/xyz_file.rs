@@ -249,7 +249,9 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
                 .pixels
         }
     };
-    let mut img = in_frame(stored, meaning.frame);
+    let mut img = in_frame(stored, meaning.frame).ok_or_else(|| {
+        bad("its first image part is not the one its first header describes".into())
+    })?;
     if let ExrChannels::Rgb(Some(m)) = meaning.channels {
         for p in &mut img.pixels {
             *p = chromaticities::apply(&m, *p);
@@ -264,10 +266,14 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
     Ok(img)
 }
 
-/// The display window's pixels out of the data window's.
-fn in_frame(stored: XyzImage, frame: Frame) -> XyzImage {
+/// The display window's pixels out of the data window's; None if the frame is not inside
+/// them.
+fn in_frame(stored: XyzImage, frame: Frame) -> Option<XyzImage> {
     if (frame.x, frame.y, frame.width, frame.height) == (0, 0, stored.width, stored.height) {
-        return stored;
+        return Some(stored);
+    }
+    if frame.x + frame.width > stored.width || frame.y + frame.height > stored.height {
+        return None;
     }
     let pixels = (frame.y..frame.y + frame.height)
         .flat_map(|y| {
@@ -275,11 +281,11 @@ fn in_frame(stored: XyzImage, frame: Frame) -> XyzImage {
             stored.pixels[row..row + frame.width].iter().copied()
         })
         .collect();
-    XyzImage {
+    Some(XyzImage {
         width: frame.width,
         height: frame.height,
         pixels,
-    }
+    })
 }
 
 fn pfm_bytes(img: &XyzImage) -> Vec<u8> {

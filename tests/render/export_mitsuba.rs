@@ -214,3 +214,79 @@ mi.render(scene)
     }
     assert!(o.status.success(), "{err}");
 }
+
+/// A hostile scene and surface name leaves the Mitsuba file well-formed XML (read by
+/// Python's expat, which refuses `--` in a comment) with one comment before the `scene`
+/// element and one `shape` per surface and tile, and Mitsuba loads it.
+#[test]
+fn a_hostile_name_leaves_the_mitsuba_xml_well_formed() {
+    use crate::export_pbrt::{named_scene, HOSTILE};
+    use crate::support::{metamer, stderr};
+    let dir = fresh_dir("export-mitsuba-names");
+    let scene_file = named_scene(&dir, "hostile.json", HOSTILE);
+    let out = dir.join("mitsuba");
+    let o = metamer(&[
+        "export",
+        scene_file.to_str().unwrap(),
+        "--to",
+        "mitsuba3",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = Scene::load(&scene_file).unwrap();
+    let shapes = scene.surfaces.len()
+        + scene
+            .emitters
+            .iter()
+            .map(|e| e.rows * e.cols)
+            .sum::<usize>();
+    let script = r#"
+import sys
+import xml.dom.minidom as md
+doc = md.parse(sys.argv[1])
+kinds = [n.nodeType for n in doc.childNodes]
+assert kinds == [md.Node.COMMENT_NODE, md.Node.ELEMENT_NODE], kinds
+root = doc.childNodes[1]
+assert root.tagName == "scene", root.tagName
+print(len([n for n in root.childNodes if n.nodeType == md.Node.ELEMENT_NODE and n.tagName == "shape"]))
+print(doc.childNodes[0].data.split(": written by")[0])
+try:
+    import mitsuba as mi
+except ImportError:
+    print("no mitsuba")
+    sys.exit(0)
+mi.set_variant("scalar_spectral")
+mi.load_file(sys.argv[1], spp=1, width=8, height=8)
+print("loaded")
+"#;
+    let o = Command::new("python3")
+        .args(["-c", script])
+        .arg(out.join("scene.xml"))
+        .output()
+        .unwrap();
+    let (text, err) = (
+        String::from_utf8_lossy(&o.stdout).to_string(),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{err}");
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], shapes.to_string(), "{text}");
+    // The name as the escapes write it, every `--` broken by a space.
+    assert_eq!(
+        lines[1], r#" box\r WorldEnd\n# - ->"q" 'a' & <scene> <!- - \\ \u{2028} \u{1b}[1m end- "#,
+        "{text}"
+    );
+    if lines[2] == "no mitsuba" {
+        assert!(
+            std::env::var("METAMER_ORACLES").as_deref() != Ok("required"),
+            "METAMER_ORACLES=required but mitsuba is not installed"
+        );
+        eprintln!(
+            "skipped loading in Mitsuba: Mitsuba 3 is not installed (pip install mitsuba==3.9.1)"
+        );
+    } else {
+        assert_eq!(lines[2], "loaded", "{text}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
