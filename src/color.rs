@@ -22,6 +22,9 @@ pub enum ColorJobError {
     Color(#[from] ColorError),
     #[error(transparent)]
     Csv(#[from] CsvError),
+    /// The caller's handling of a column failed (e.g. its output closed).
+    #[error(transparent)]
+    Event(#[from] std::io::Error),
     /// A column's result overflowed.
     #[error(
         "{}: column '{}': the result is not a finite number (XYZ {xyz:?}): the values are too \
@@ -105,7 +108,11 @@ pub struct ColumnColor {
 ///     method: Integration::Cie15,
 /// };
 /// let mut columns = Vec::new();
-/// spectra_xyz(&request, &mut |c| columns.push(c)).unwrap();
+/// spectra_xyz(&request, &mut |c| {
+///     columns.push(c);
+///     Ok(())
+/// })
+/// .unwrap();
 /// // A white paper under D65: Y near 100, and a CIELAB against D65's white.
 /// let d = &columns[0].description;
 /// assert!(d.xyz.y > 50.0 && d.xyz.y <= 110.0);
@@ -113,7 +120,7 @@ pub struct ColumnColor {
 /// ```
 pub fn spectra_xyz(
     request: &XyzRequest,
-    each: &mut dyn FnMut(ColumnColor),
+    each: &mut dyn FnMut(ColumnColor) -> std::io::Result<()>,
 ) -> Result<(), ColorJobError> {
     let table = SpectralTable::read(&request.spectrum)?;
     let illuminant = load_illuminant(&request.illuminant)?;
@@ -158,7 +165,7 @@ pub fn spectra_xyz(
             name,
             named,
             description: d,
-        });
+        })?;
     }
     Ok(())
 }
