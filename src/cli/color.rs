@@ -97,9 +97,10 @@ pub fn run(args: Args) -> CliResult {
 fn color_error(e: ColorJobError) -> CliError {
     match e {
         ColorJobError::UnknownIlluminant(_) => CliError::Usage(e.to_string()),
-        ColorJobError::NotFinite { .. } | ColorJobError::PairNotFinite { .. } => {
-            CliError::Failed(e.to_string().into())
-        }
+        ColorJobError::NotFinite { .. }
+        | ColorJobError::PairNotFinite { .. }
+        | ColorJobError::OneSample { .. }
+        | ColorJobError::OutsideSummation { .. } => CliError::Failed(e.to_string().into()),
         ColorJobError::Color(e) => CliError::from(e),
         ColorJobError::Csv(e) => CliError::from(e),
         ColorJobError::Event(e) => CliError::from(e),
