@@ -1,6 +1,5 @@
 //! `metamer characterize`: show and measure patches on a display, fit and verify a profile.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -109,7 +108,7 @@ pub fn run(args: Args) -> CliResult {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
         (_, text) => {
-            println!("{}", text.unwrap_or_default());
+            outln!("{}", text.unwrap_or_default())?;
             Ok(())
         }
     }
@@ -120,10 +119,10 @@ struct Printer(Option<BarProgress>);
 
 impl Listener for Printer {
     fn note(&mut self, text: &str) {
-        eprintln!("note: {text}");
+        super::console::reported_at_exit(errln!("note: {text}"));
     }
     fn warning(&mut self, text: &str) {
-        eprintln!("warning: {text}");
+        super::console::reported_at_exit(errln!("warning: {text}"));
     }
     fn progress(&mut self, attended: bool) -> &mut dyn ProgressSink {
         self.0.insert(BarProgress::new("patch").attended(attended))
@@ -159,25 +158,27 @@ fn plan_usage(e: &PlanError) -> String {
 }
 
 fn print_summary(s: &Summary) -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
     let v = &s.verification;
-    writeln!(
-        out,
+    outln!(
         "measured {} readings of {} with {} ({})",
-        s.readings, s.display, s.instrument_info.model, s.instrument
+        s.readings,
+        s.display,
+        s.instrument_info.model,
+        s.instrument
     )?;
-    writeln!(
-        out,
+    outln!(
         "white {:.2} cd/m², black {:.3} cd/m²",
-        s.white_xyz[1], s.black_xyz[1]
+        s.white_xyz[1],
+        s.black_xyz[1]
     )?;
-    writeln!(
-        out,
+    outln!(
         "model {}: fit on {} patches, ΔE00 mean {:.2}, max {:.2}",
-        s.model, s.fit_patches, s.fit_residuals.mean_de00, s.fit_residuals.max_de00
+        s.model,
+        s.fit_patches,
+        s.fit_residuals.mean_de00,
+        s.fit_residuals.max_de00
     )?;
-    writeln!(
-        out,
+    outln!(
         "verification on {} held-out patches: ΔE00 mean {:.2}, p95 {:.2}, max {:.2}",
         v.patches.len(),
         v.mean,
@@ -185,9 +186,8 @@ fn print_summary(s: &Summary) -> Result<(), CliError> {
         v.max
     )?;
     // The verdict already names every failed assumption.
-    writeln!(out, "verdict: {}", s.verdict)?;
-    writeln!(
-        out,
+    outln!("verdict: {}", s.verdict)?;
+    outln!(
         "wrote {}, {}, {}, {} (log {})",
         s.files.profile.display(),
         s.files.ti3.display(),

@@ -1,8 +1,6 @@
 //! `metamer devices`: serial ports and known USB/HID instruments on this machine, with the
 //! fix for any the user may not open.
 
-use std::io::Write;
-
 use metamer_drivers::devices::{list_devices, Access, DeviceList};
 use metamer_drivers::registry;
 
@@ -17,11 +15,10 @@ pub struct Args {
 
 pub fn run(args: Args) -> CliResult {
     let list = list_devices();
-    let mut out = std::io::stdout().lock();
     if args.json {
-        writeln!(out, "{}", serde_json::to_string_pretty(&list)?)?;
+        outln!("{}", serde_json::to_string_pretty(&list)?)?;
     } else {
-        write!(out, "{}", human(&list))?;
+        out!("{}", human(&list))?;
     }
     Ok(())
 }

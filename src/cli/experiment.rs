@@ -108,12 +108,12 @@ pub fn run_cli(args: Args) -> CliResult {
     let outcome = request.run(&|p| shown.show(p));
     shown.finish();
     let outcome = outcome.map_err(refusal)?;
-    print_outcomes(&outcome.stages, outcome.given_box.as_deref());
+    print_outcomes(&outcome.stages, outcome.given_box.as_deref())?;
     for line in outcome.comparison_lines() {
-        println!("{line}");
+        outln!("{line}")?;
     }
     if let Some(report) = &outcome.report {
-        println!("report: {}", report.display());
+        outln!("report: {}", report.display())?;
     }
     Ok(())
 }
@@ -197,9 +197,9 @@ impl StageProgress {
             Progress::Stage { stage, reused } => {
                 self.finish();
                 if reused {
-                    eprintln!("{stage}: unchanged inputs, re-used");
+                    super::console::reported_at_exit(errln!("{stage}: unchanged inputs, re-used"));
                 } else {
-                    eprintln!("{stage}: running");
+                    super::console::reported_at_exit(errln!("{stage}: running"));
                 }
             }
             Progress::Readings { done, total } => {
@@ -217,7 +217,7 @@ impl StageProgress {
             }
             Progress::Note(text) => match self.bar.borrow().as_ref() {
                 Some(b) => b.println(format!("  {text}")),
-                None => eprintln!("  {text}"),
+                None => super::console::reported_at_exit(errln!("  {text}")),
             },
         }
     }
@@ -231,18 +231,19 @@ impl StageProgress {
 
 /// One line per stage: ran, re-used or (a box measured earlier or elsewhere) given, how
 /// long, where.
-pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>) {
+pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>) -> CliResult {
     for o in outcomes {
         let (how, dir) = match given_box {
             Some(spots) if o.stage == Stage::Box => ("given", spots),
             _ => (if o.reused { "re-used" } else { "ran" }, o.dir.as_path()),
         };
-        println!(
+        outln!(
             "{:<14} {:<8} {:>8.1} s  {}",
             o.stage.name(),
             how,
             o.seconds,
             dir.display()
-        );
+        )?;
     }
+    Ok(())
 }

@@ -83,18 +83,18 @@ pub fn run(args: Args) -> CliResult {
         LabError::Request(e) => refusal(e),
         e => CliError::from(e),
     })?;
-    print_outcomes(&outcomes, None);
-    print_summary(&summary);
-    println!(
+    print_outcomes(&outcomes, None)?;
+    print_summary(&summary)?;
+    outln!(
         "report: {}; summary: {}",
         args.out.join(&summary.report).display(),
         args.out.join(LAB_FILE).display()
-    );
+    )?;
     Ok(())
 }
 
-fn print_summary(s: &LabSummary) {
-    println!(
+fn print_summary(s: &LabSummary) -> CliResult {
+    outln!(
         "box lit by {}; display virtual:{}, model {}; {} of 24 simulated colours out of its gamut{}",
         s.options.scenario,
         s.options.display.name(),
@@ -113,13 +113,14 @@ fn print_summary(s: &LabSummary) {
                 s.options.gamut
             )
         }
-    );
+    )?;
     for c in [
         &s.display_vs_box,
         &s.simulation_vs_box,
         &s.display_vs_simulation,
     ] {
-        println!("{}", c.summary);
+        outln!("{}", c.summary)?;
     }
-    println!("total {:.1} s", s.seconds);
+    outln!("total {:.1} s", s.seconds)?;
+    Ok(())
 }

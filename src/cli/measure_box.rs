@@ -1,6 +1,5 @@
 //! `metamer measure-box`: the guided, resumable measurement of the validation box.
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
@@ -81,9 +80,11 @@ pub fn run(args: Args) -> CliResult {
         attendance: None,
         spot_readings: false,
     };
-    let outcome = job::measure(&request, &|n| eprintln!("{n}…"), &mut |shown| {
-        Box::new(BarProgress::new("reading").attended(shown))
-    })
+    let outcome = job::measure(
+        &request,
+        &|n| super::console::reported_at_exit(errln!("{n}…")),
+        &mut |shown| Box::new(BarProgress::new("reading").attended(shown)),
+    )
     .map_err(refusal)?;
     report(outcome)
 }
@@ -117,17 +118,15 @@ fn report(outcome: Outcome) -> CliResult {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
         (_, text) => {
-            println!("{}", text.unwrap_or_default());
+            outln!("{}", text.unwrap_or_default())?;
             Ok(())
         }
     }
 }
 
 fn print_summary(s: &Summary) -> CliResult {
-    let mut out = std::io::stdout().lock();
     let c = &s.render.comparison;
-    writeln!(
-        out,
+    outln!(
         "tiles: {} · fall-off: {} angles, {} LDC (rms {}) · materials: {} · spots: {}",
         s.tiles.len(),
         s.falloff.len(),
@@ -141,14 +140,10 @@ fn print_summary(s: &Summary) -> CliResult {
     )?;
     let flagged = &s.provenance.outliers;
     if flagged.is_empty() {
-        writeln!(
-            out,
-            "no outliers; every group's spread within the instruments' noise"
-        )?;
+        outln!("no outliers; every group's spread within the instruments' noise")?;
     }
     for f in flagged {
-        writeln!(
-            out,
+        outln!(
             "flagged: {} {}: outlier repeats {:?}{}",
             f.stage,
             f.what,
@@ -160,9 +155,7 @@ fn print_summary(s: &Summary) -> CliResult {
             }
         )?;
     }
-    writeln!(
-        out,
-        "measured scene rendered vs box spots: ΔE*ab mean {:.2}, max {:.2}; ΔE00 mean {:.2}, max {:.2}; {} of {} below the JND by point estimate",
+    outln!("measured scene rendered vs box spots: ΔE*ab mean {:.2}, max {:.2}; ΔE00 mean {:.2}, max {:.2}; {} of {} below the JND by point estimate",
         c.mean_de76,
         c.max_de76,
         c.mean_de00,
@@ -171,8 +164,7 @@ fn print_summary(s: &Summary) -> CliResult {
         c.patches.len()
     )?;
     let f = &s.files;
-    writeln!(
-        out,
+    outln!(
         "wrote {}, {}, {}, {}, {}, {}",
         f.scene.display(),
         f.light.display(),

@@ -1,7 +1,6 @@
 //! `metamer spot`: spot readings from an instrument (real, replayed or simulated), with the
 //! instrument's calibrations negotiated at the terminal.
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
@@ -88,21 +87,20 @@ pub fn run(args: Args) -> CliResult {
         unattended: args.unattended,
     };
     let json = args.json;
-    let mut out = std::io::stdout().lock();
     spot::run(&request, &mut |event| match event {
-        SpotEvent::Opened(info) if !json => writeln!(out, "{} on {}", info.model, info.connection),
+        SpotEvent::Opened(info) if !json => Ok(outln!("{} on {}", info.model, info.connection)?),
         SpotEvent::Opened(_) => Ok(()),
         SpotEvent::Reading { n, reading } => {
             if json {
-                writeln!(out, "{}", json_line(reading))?;
+                outln!("{}", json_line(reading))?;
             } else {
-                writeln!(out, "{}", human_line(n, mode, reading))?;
+                outln!("{}", human_line(n, mode, reading))?;
             }
             // Each reading is shown as it arrives: a later failure must not hide earlier ones.
-            out.flush()
+            Ok(super::console::flush()?)
         }
         SpotEvent::Stopped { done, of } => {
-            eprintln!("stopped at your request after {done} of {of} readings");
+            errln!("stopped at your request after {done} of {of} readings")?;
             Ok(())
         }
     })

@@ -2,7 +2,9 @@
 //! aim the meter) and to confirm when done, or to abort the session; and whether anybody
 //! is there to ask at all.
 
-use std::io::{BufRead, IsTerminal, Write};
+use std::io::{BufRead, IsTerminal};
+
+use crate::output::console;
 
 /// The operator's answer to a request.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,12 +92,11 @@ fn read_answer(prompt: &str) -> Result<Option<String>, OperatorError> {
     if !stdin.is_terminal() {
         return Ok(None);
     }
-    eprint!("{prompt} ");
-    std::io::stderr().flush()?;
+    console::err_part(format_args!("{prompt} ")).map_err(std::io::Error::from)?;
     let mut line = String::new();
     if stdin.lock().read_line(&mut line)? == 0 {
         // End of input (Ctrl-D) stops, as `q` does; end the prompt's line.
-        eprintln!();
+        console::err_fmt(format_args!("")).map_err(std::io::Error::from)?;
         return Ok(Some("q".into()));
     }
     Ok(Some(line.trim().to_lowercase()))

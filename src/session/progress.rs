@@ -179,7 +179,11 @@ impl ProgressSink for BarProgress {
 
     fn note(&mut self, text: &str) {
         if self.bar.is_hidden() {
-            eprintln!("{text}");
+            // A note cannot fail the reading it comes with; a failed write is remembered
+            // and the command reports it when it ends.
+            crate::output::console::reported_at_exit(crate::output::console::err_fmt(
+                format_args!("{text}"),
+            ));
         } else {
             self.bar.println(text);
         }

@@ -36,7 +36,7 @@ use metamer::rig::{Preset, VirtualPanel};
 
 use crate::support::fresh_dir;
 
-fn transicc_installed() -> bool {
+pub(crate) fn transicc_installed() -> bool {
     let found = std::env::var_os("PATH")
         .map(|p| std::env::split_paths(&p).any(|d| d.join("transicc").is_file()))
         .unwrap_or(false);
@@ -53,7 +53,7 @@ fn transicc_installed() -> bool {
 }
 
 /// Runs `transicc -n -c0 -t1 ARGS` on one triple per line; its triples back.
-fn transicc(args: &[&str], input: &[[f64; 3]]) -> Vec<[f64; 3]> {
+pub(crate) fn transicc(args: &[&str], input: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let mut child = Command::new("transicc")
         .args(["-n", "-c0", "-t1"])
         .args(args)
