@@ -9,7 +9,7 @@ use std::time::Duration;
 use metamer_drivers::Instrument;
 use serde::{Deserialize, Serialize};
 
-use super::finish::{files, finish, FinishError, Provenance, Summary};
+use super::finish::{files, finish, FinishError, MeasuredBy, Summary};
 use super::plan::{DriveStep, Plan, PlanError, PlanOptions, METER};
 use crate::display::ModelKind;
 use crate::output::{OutputError, OutputPolicy};
@@ -176,7 +176,7 @@ pub fn run(
     }
     let end = {
         let mut rig = Rig {
-            screen: Some(display.as_show()),
+            screen: Some(display),
             instruments: vec![(METER.to_string(), &mut *instrument)],
             operator: &mut *operator,
         };
@@ -196,7 +196,7 @@ pub fn run(
         session.journal_path(),
         &readings,
         options.model,
-        &Provenance {
+        &MeasuredBy {
             display: &details.display,
             display_description: &details.display_description,
             instrument: &details.instrument,
@@ -284,8 +284,8 @@ mod tests {
         };
         // Noise is off: the same readings, so the same fit and verification.
         assert_eq!(a.readings, b.readings);
-        assert_eq!(a.verification.mean, b.verification.mean);
-        assert_eq!(a.verification.max, b.verification.max);
+        assert_eq!(a.verification.de00.mean, b.verification.de00.mean);
+        assert_eq!(a.verification.de00.max, b.verification.de00.max);
         std::fs::remove_dir_all(&straight.dir).unwrap();
         std::fs::remove_dir_all(&first.dir).unwrap();
     }

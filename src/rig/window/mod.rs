@@ -25,9 +25,8 @@ use x11rb::wrapper::ConnectionExt as _;
 
 pub use pixels::PixelFormat;
 
-use super::screen::{Placement, Screen, ScreenError};
-use crate::image::RgbImage;
-use crate::session;
+use super::{Placement, Screen, ScreenError};
+use crate::image::Drive8Image;
 
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]
@@ -357,18 +356,12 @@ impl Drop for WindowDisplay {
     }
 }
 
-impl session::Screen for WindowDisplay {
+impl Screen for WindowDisplay {
     fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
         self.show_rgb(rgb).map_err(|e| ScreenError::Backend {
             screen: self.spec(),
             source: Box::new(e),
         })
-    }
-}
-
-impl Screen for WindowDisplay {
-    fn as_show(&mut self) -> &mut dyn session::Screen {
-        self
     }
 
     fn spec(&self) -> String {
@@ -382,7 +375,7 @@ impl Screen for WindowDisplay {
         )
     }
 
-    fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {
+    fn show_image(&mut self, image: &Drive8Image) -> Result<Placement, ScreenError> {
         self.show_scaled(image).map_err(|e| ScreenError::Backend {
             screen: self.spec(),
             source: Box::new(e),
