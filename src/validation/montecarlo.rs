@@ -61,16 +61,16 @@ impl Metric {
 
 /// A statistic over patches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Summary {
+pub enum Statistic {
     Mean,
     Max,
 }
 
-impl Summary {
+impl Statistic {
     pub fn of(self, v: &[f64]) -> f64 {
         match self {
-            Summary::Mean => v.iter().sum::<f64>() / v.len() as f64,
-            Summary::Max => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Statistic::Mean => v.iter().sum::<f64>() / v.len() as f64,
+            Statistic::Max => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         }
     }
 }
@@ -324,7 +324,7 @@ pub fn patch_interval(r: Lab, t: Lab, noise: &LabNoise, metric: Metric, seed: u6
 pub fn summary_interval(
     patches: &[PatchDraws<'_>],
     metric: Metric,
-    summary: Summary,
+    summary: Statistic,
     seed: u64,
 ) -> Option<Interval> {
     let n = patches
@@ -353,13 +353,13 @@ pub fn summary_interval(
     // intervals carry their t: its draws take the covariances as known, and its bounds
     // then hold every patch's own (the max is at least each patch's difference).
     let nu = match summary {
-        Summary::Mean => effective_dof(
+        Statistic::Mean => effective_dof(
             &parts
                 .iter()
                 .flat_map(|p| [(1.0, p[0]), (1.0, p[1])])
                 .collect::<Vec<_>>(),
         ),
-        Summary::Max => None,
+        Statistic::Max => None,
     };
     let scale = t_scales(nu, n, seed);
     let top = lengths.iter().copied().fold(0.0, f64::max);
@@ -370,7 +370,7 @@ pub fn summary_interval(
             return vec![c; patches.len()];
         }
         match summary {
-            Summary::Mean => {
+            Statistic::Mean => {
                 let most = lengths
                     .iter()
                     .zip(&sigma2)
@@ -383,7 +383,7 @@ pub fn summary_interval(
                     .map(|(l, s)| (l - lambda * s).max(0.0))
                     .collect()
             }
-            Summary::Max => {
+            Statistic::Max => {
                 let cap = c * top;
                 let mut v: Vec<f64> = lengths.iter().map(|l| l.min(cap)).collect();
                 if c > 1.0 {
@@ -447,7 +447,7 @@ pub fn summary_interval(
         |c| value(&truths(c), None),
         SUMMARY_TOLERANCE,
     );
-    if summary == Summary::Max {
+    if summary == Statistic::Max {
         for i in patches.iter().filter_map(|p| p.interval) {
             interval.lo = interval.lo.max(i.lo);
             interval.hi = interval.hi.max(i.hi);

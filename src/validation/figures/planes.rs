@@ -10,7 +10,7 @@
 
 use std::fmt::Write;
 
-use super::labels::{disc_boxes, place, segment_boxes, Label, Rect};
+use super::labels::{disc_boxes, place, segment_boxes, Label, LabelBox};
 use super::{esc, srgb_swatch, tick_step, ticks, trim};
 use crate::validation::assess::{Assessment, JND_DE76};
 
@@ -281,9 +281,9 @@ fn plane(
         let (bx1, by) = (x1 - 10.0, y1 - 10.0);
         (bx1 - jnd_len, bx1, by)
     });
-    let mut obstacles: Vec<Rect> = Vec::new();
+    let mut obstacles: Vec<LabelBox> = Vec::new();
     if let Some((bx0, bx1, by)) = bar {
-        obstacles.push(Rect {
+        obstacles.push(LabelBox {
             x0: bx0 - 2.0,
             y0: by - 20.0,
             x1: bx1 + 2.0,
@@ -386,7 +386,7 @@ fn plane(
             radius: DISC,
         })
         .collect();
-    let frame = Rect {
+    let frame = LabelBox {
         x0: LEFT,
         y0: TOP,
         x1,
