@@ -24,7 +24,7 @@ use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Exposure};
 use metamer_protocols::i1pro::replies::MeasChar;
 use metamer_protocols::i1pro::{
     commands::{Setup, Transfer},
-    readings, Bands, Calibration, Gain, RawReading, Request, Revision, BANDS, CELLS,
+    readings, GridSpectrum, Calibration, Gain, RawReading, Request, Revision, BANDS, CELLS,
     SHIELDED_CELLS, START_NM, STEP_NM,
 };
 use metamer_protocols::transcript::TransferKind;
@@ -165,7 +165,7 @@ pub struct I1ProEmulator {
 }
 
 /// The light a world gives as the instrument's 36 bands, mW·m⁻²·sr⁻¹·nm⁻¹.
-fn light_bands(light: &Light) -> Bands {
+fn light_bands(light: &Light) -> GridSpectrum {
     let s = match light {
         Light::Radiance(s) => s.clone(),
         Light::Xyz(xyz) => metamer_for(*xyz),
@@ -311,7 +311,7 @@ impl I1ProEmulator {
     }
 
     /// The resampled, uncalibrated values the instrument sees now.
-    fn seen(&self, lamp_on: bool) -> Result<Bands, String> {
+    fn seen(&self, lamp_on: bool) -> Result<GridSpectrum, String> {
         let cal = &self.cal;
         let err = |e: pipeline::PipelineError| e.to_string();
         let zero = [0.0; BANDS];

@@ -12,9 +12,9 @@ use super::calibration::Calibration;
 use super::linalg::solve;
 use super::pipeline::{drift_corrected_dark, scale, AbsRaw, Exposure, PipelineError};
 use super::readings::{value_range, RawReading};
-use super::{Bands, Revision, BANDS, CELLS, SHIELDED_CELLS, START_NM, STEP_NM};
+use super::{GridSpectrum, Revision, BANDS, CELLS, SHIELDED_CELLS, START_NM, STEP_NM};
 
-fn divide(s: &Bands, f: &Bands, what: &'static str) -> Result<Bands, PipelineError> {
+fn divide(s: &GridSpectrum, f: &GridSpectrum, what: &'static str) -> Result<GridSpectrum, PipelineError> {
     let mut out = [0.0; BANDS];
     for (band, ((o, a), b)) in out.iter_mut().zip(s).zip(f).enumerate() {
         if *b == 0.0 {
@@ -30,12 +30,12 @@ fn divide(s: &Bands, f: &Bands, what: &'static str) -> Result<Bands, PipelineErr
 }
 
 /// Spectral radiance → the resampled spectrum the emissive factors turn into it.
-pub fn uncalibrate_emissive(cal: &Calibration, radiance: &Bands) -> Result<Bands, PipelineError> {
+pub fn uncalibrate_emissive(cal: &Calibration, radiance: &GridSpectrum) -> Result<GridSpectrum, PipelineError> {
     divide(radiance, &cal.emissive, "the emissive calibration factor")
 }
 
 /// Ambient irradiance → the resampled spectrum.
-pub fn uncalibrate_ambient(cal: &Calibration, ambient: &Bands) -> Result<Bands, PipelineError> {
+pub fn uncalibrate_ambient(cal: &Calibration, ambient: &GridSpectrum) -> Result<GridSpectrum, PipelineError> {
     let a = cal.ambient.as_ref().ok_or(PipelineError::NoAmbient)?;
     let s = divide(ambient, a, "the ambient calibration factor")?;
     uncalibrate_emissive(cal, &s)
@@ -43,16 +43,16 @@ pub fn uncalibrate_ambient(cal: &Calibration, ambient: &Bands) -> Result<Bands, 
 
 /// Reflectance → the resampled spectrum, given the factors of a white calibration.
 pub fn uncalibrate_reflective(
-    reflectance: &Bands,
-    factors: &Bands,
-) -> Result<Bands, PipelineError> {
+    reflectance: &GridSpectrum,
+    factors: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     divide(reflectance, factors, "the reflective calibration factor")
 }
 
 /// Dark-subtracted cell values (absraw) whose resampling — and stray-light correction on
 /// Rev E — gives `s`. On Rev A–D the junk cells 0 and 127 are copies of cells 1 and 126 by
 /// the time the filter sees them, so they are solved for as one with their neighbours.
-pub fn cells_for(cal: &Calibration, s: &Bands) -> Result<[f64; CELLS], PipelineError> {
+pub fn cells_for(cal: &Calibration, s: &GridSpectrum) -> Result<[f64; CELLS], PipelineError> {
     let target: Vec<f64> = match &cal.rev_e {
         Some(e) => {
             let m = e.stray_light_matrix();
@@ -168,7 +168,7 @@ pub fn counts_for(
 pub fn emissive_reading(
     cal: &Calibration,
     e: &Exposure,
-    radiance: &Bands,
+    radiance: &GridSpectrum,
     dark: &AbsRaw,
     shielded: Option<[u16; SHIELDED_CELLS]>,
     max_positive: u16,
