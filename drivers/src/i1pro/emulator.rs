@@ -24,7 +24,7 @@ use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Exposure};
 use metamer_protocols::i1pro::replies::MeasChar;
 use metamer_protocols::i1pro::{
     commands::{Setup, Transfer},
-    readings, GridSpectrum, Calibration, Gain, RawReading, Request, Revision, BANDS, CELLS,
+    readings, Calibration, Gain, GridSpectrum, RawReading, Request, Revision, BANDS, CELLS,
     SHIELDED_CELLS, START_NM, STEP_NM,
 };
 use metamer_protocols::transcript::TransferKind;

@@ -3,7 +3,7 @@
 //! the order the instrument needs them).
 
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Averaged, Exposure};
-use metamer_protocols::i1pro::{GridSpectrum, Calibration, Gain, RawReading, Revision, CELLS};
+use metamer_protocols::i1pro::{Calibration, Gain, GridSpectrum, RawReading, Revision, CELLS};
 
 use super::error::I1ProError;
 use super::wire::{Shot, Wire};

@@ -26,8 +26,8 @@ use metamer_protocols::i1pro::pipeline::{self, AbsRaw};
 use metamer_protocols::i1pro::replies::{MeasChar, Misc};
 use metamer_protocols::i1pro::timing::ClockUnit;
 use metamer_protocols::i1pro::{
-    commands, eeprom, replies, wavelength, GridSpectrum, Calibration, Eeprom, Model, Request, Revision,
-    BANDS, START_NM, STEP_NM,
+    commands, eeprom, replies, wavelength, Calibration, Eeprom, GridSpectrum, Model, Request,
+    Revision, BANDS, START_NM, STEP_NM,
 };
 
 pub use clock::{Clock, ManualClock, ScaledClock, SystemClock};

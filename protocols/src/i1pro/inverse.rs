@@ -14,7 +14,11 @@ use super::pipeline::{drift_corrected_dark, scale, AbsRaw, Exposure, PipelineErr
 use super::readings::{value_range, RawReading};
 use super::{GridSpectrum, Revision, BANDS, CELLS, SHIELDED_CELLS, START_NM, STEP_NM};
 
-fn divide(s: &GridSpectrum, f: &GridSpectrum, what: &'static str) -> Result<GridSpectrum, PipelineError> {
+fn divide(
+    s: &GridSpectrum,
+    f: &GridSpectrum,
+    what: &'static str,
+) -> Result<GridSpectrum, PipelineError> {
     let mut out = [0.0; BANDS];
     for (band, ((o, a), b)) in out.iter_mut().zip(s).zip(f).enumerate() {
         if *b == 0.0 {
@@ -30,12 +34,18 @@ fn divide(s: &GridSpectrum, f: &GridSpectrum, what: &'static str) -> Result<Grid
 }
 
 /// Spectral radiance → the resampled spectrum the emissive factors turn into it.
-pub fn uncalibrate_emissive(cal: &Calibration, radiance: &GridSpectrum) -> Result<GridSpectrum, PipelineError> {
+pub fn uncalibrate_emissive(
+    cal: &Calibration,
+    radiance: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     divide(radiance, &cal.emissive, "the emissive calibration factor")
 }
 
 /// Ambient irradiance → the resampled spectrum.
-pub fn uncalibrate_ambient(cal: &Calibration, ambient: &GridSpectrum) -> Result<GridSpectrum, PipelineError> {
+pub fn uncalibrate_ambient(
+    cal: &Calibration,
+    ambient: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     let a = cal.ambient.as_ref().ok_or(PipelineError::NoAmbient)?;
     let s = divide(ambient, a, "the ambient calibration factor")?;
     uncalibrate_emissive(cal, &s)

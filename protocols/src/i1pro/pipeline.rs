@@ -345,7 +345,10 @@ pub const MIN_WHITE_READING: f64 = 1000.0;
 
 /// Reflective calibration factors from a white-tile reading: `white reference / white
 /// reading`, the reading clamped to at least [`MIN_WHITE_READING`].
-pub fn reflective_factors(cal: &Calibration, white: &GridSpectrum) -> Result<GridSpectrum, PipelineError> {
+pub fn reflective_factors(
+    cal: &Calibration,
+    white: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     let r = cal
         .white_reference
         .as_ref()

@@ -9,7 +9,7 @@ use super::pipeline::{self, Exposure};
 use super::readings::{self, RawReading};
 use super::replies::Misc;
 use super::timing::clocks;
-use super::{fixture, inverse, GridSpectrum, Calibration, Model, Revision, BANDS, CELLS};
+use super::{fixture, inverse, Calibration, GridSpectrum, Model, Revision, BANDS, CELLS};
 
 /// The simulated instrument: answers each transfer from its EEPROM image and the light.
 struct Device {
