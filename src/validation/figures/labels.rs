@@ -102,19 +102,7 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[LabelBox], frame: LabelBo
     // those of one crowded cluster all start at it).
     let mut label_boxes: Vec<LabelBox> = Vec::new();
     let mut placed: Vec<Option<Placed>> = vec![None; labels.len()];
-    // 32 directions, upper right first, then those nearest it.
-    let angles: Vec<f64> = {
-        let mut a: Vec<f64> = (0..32)
-            .map(|k| k as f64 * std::f64::consts::TAU / 32.0)
-            .collect();
-        let pref = -std::f64::consts::FRAC_PI_4;
-        let dist = |x: f64| {
-            let d = (x - pref).rem_euclid(std::f64::consts::TAU);
-            d.min(std::f64::consts::TAU - d)
-        };
-        a.sort_by(|x, y| dist(*x).total_cmp(&dist(*y)));
-        a
-    };
+    let angles = directions();
     for i in order {
         let l = &labels[i];
         let half_w = DIGIT_EM * font * l.text.chars().count() as f64 / 2.0;
@@ -189,6 +177,20 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[LabelBox], frame: LabelBo
         .into_iter()
         .map(|p| p.expect("every label placed"))
         .collect()
+}
+
+/// The directions a label is tried in: 32, upper right first, then those nearest it.
+fn directions() -> Vec<f64> {
+    let mut a: Vec<f64> = (0..32)
+        .map(|k| k as f64 * std::f64::consts::TAU / 32.0)
+        .collect();
+    let pref = -std::f64::consts::FRAC_PI_4;
+    let dist = |x: f64| {
+        let d = (x - pref).rem_euclid(std::f64::consts::TAU);
+        d.min(std::f64::consts::TAU - d)
+    };
+    a.sort_by(|x, y| dist(*x).total_cmp(&dist(*y)));
+    a
 }
 
 /// The point of `r` nearest to `p`.
