@@ -25,13 +25,8 @@ REASON = re.compile(r"^\s*//\s*Over 100 lines:\s*\S")
 # "FILE:FUNCTION". Each is a debt: split it by its sections, then delete its entry (the
 # script says when one has become stale).
 KNOWN = {
-    "src/display/characterize/run.rs:run",
     "src/display/diagnostics.rs:judge",
     "src/display/icc/lut.rs:b2a",
-    "src/display/model/lut_unfold.rs:unfold",
-    "src/display/model/shaper_matrix.rs:fit_stages",
-    "src/display/select.rs:select_model",
-    "src/display/select_chart.rs:draw",
     "src/experiment/display_spots.rs:measure",
     "src/experiment/report_input/display.rs:section",
     "src/experiment/report_input/light.rs:section",
@@ -39,20 +34,9 @@ KNOWN = {
     "src/export/mitsuba3.rs:files",
     "src/light/chart.rs:draw",
     "src/light/chart.rs:draw_scores",
-    "src/measure_box/run.rs:run",
     "src/render/radiosity/image.rs:render_image_from",
     "src/render/radiosity/mod.rs:render_spots_radiosity_solved",
     "src/render/radiosity/probes.rs:probe_illuminance",
-    "src/render/spot/mod.rs:render_spots_with_progress",
-    "src/rig/window/mod.rs:open",
-    "src/session/runner.rs:open",
-    "src/session/runner.rs:run_steps",
-    "src/validation/figures/bars.rs:delta_e_bars",
-    "src/validation/figures/bars.rs:delta_e_rows",
-    "src/validation/figures/labels.rs:place",
-    "src/validation/figures/planes.rs:plane",
-    "src/validation/montecarlo.rs:summary_interval",
-    "src/validation/verdict.rs:verdict_with",
 }
 
 FN = re.compile(r"\bfn\s+(\w+)")

@@ -274,27 +274,10 @@ pub fn run(
             });
         }
     }
-    // Every stage's readings, from the journals (earlier runs' included).
-    let mut missing = Vec::new();
-    let mut loaded: BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)> = BTreeMap::new();
-    for stage in BoxStage::ALL {
-        let path = stage.journal(&options.dir);
-        if !path.exists() {
-            missing.push(stage);
-            continue;
-        }
-        let session = open_stage(options, stage, &records, true)?;
-        match session.complete_entries() {
-            Some(entries) => {
-                loaded.insert(stage, (path, entries.into_iter().cloned().collect()));
-            }
-            None => missing.push(stage),
-        }
-    }
-    if !missing.is_empty() {
-        return Ok(Outcome::StagesMissing(missing));
-    }
-    let entries = StageEntries { stages: loaded };
+    let entries = match completed_stages(options, &records)? {
+        Ok(entries) => entries,
+        Err(missing) => return Ok(Outcome::StagesMissing(missing)),
+    };
     let owned = options.output.force() || options.resume || options.stage.is_some();
     let policy = options.output.with_force(owned);
     let summary = assemble(
@@ -306,4 +289,32 @@ pub fn run(
         &options.details,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+/// Every stage's readings, from the journals (earlier runs' included), or the stages that
+/// have no complete journal yet.
+fn completed_stages(
+    options: &BoxOptions,
+    records: &BTreeMap<String, InstrumentRecord>,
+) -> Result<Result<StageEntries, Vec<BoxStage>>, MeasureBoxError> {
+    let mut missing = Vec::new();
+    let mut loaded: BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)> = BTreeMap::new();
+    for stage in BoxStage::ALL {
+        let path = stage.journal(&options.dir);
+        if !path.exists() {
+            missing.push(stage);
+            continue;
+        }
+        let session = open_stage(options, stage, records, true)?;
+        match session.complete_entries() {
+            Some(entries) => {
+                loaded.insert(stage, (path, entries.into_iter().cloned().collect()));
+            }
+            None => missing.push(stage),
+        }
+    }
+    if !missing.is_empty() {
+        return Ok(Err(missing));
+    }
+    Ok(Ok(StageEntries { stages: loaded }))
 }

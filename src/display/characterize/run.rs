@@ -141,21 +141,8 @@ pub fn run(
     for f in files(&options.dir, session.journal_path()).outputs() {
         out.check(f)?;
     }
-    if session.recovered > 0 || session.torn_bytes > 0 {
-        let torn = if session.torn_bytes > 0 {
-            format!(
-                " ({} bytes of a reading cut off by the interruption were set aside in {})",
-                session.torn_bytes,
-                crate::session::torn_path(session.journal_path()).display()
-            )
-        } else {
-            String::new()
-        };
-        progress.note(&format!(
-            "resuming: {} of {total} readings in {}{torn}",
-            session.recovered,
-            session.journal_path().display()
-        ));
+    if let Some(note) = resuming_note(&session) {
+        progress.note(&note);
     }
     let incomplete = |session: &Session<LogDetails, DriveStep>, end| Outcome::Incomplete {
         end,
@@ -205,6 +192,29 @@ pub fn run(
         &out,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+/// What resuming `session` found in its journal (readings, a torn last line set aside),
+/// if it resumed one.
+fn resuming_note(session: &Session<LogDetails, DriveStep>) -> Option<String> {
+    if session.recovered == 0 && session.torn_bytes == 0 {
+        return None;
+    }
+    let torn = if session.torn_bytes > 0 {
+        format!(
+            " ({} bytes of a reading cut off by the interruption were set aside in {})",
+            session.torn_bytes,
+            crate::session::torn_path(session.journal_path()).display()
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "resuming: {} of {} readings in {}{torn}",
+        session.recovered,
+        session.plan().steps.len(),
+        session.journal_path().display()
+    ))
 }
 
 #[cfg(test)]

@@ -123,37 +123,7 @@ impl WindowDisplay {
                     .join(", "),
             })?;
 
-        // An invisible pointer: a 1×1 cursor whose mask pixel is 0, so the pointer parked
-        // in the middle of the screen does not stand in front of the meter.
-        let pixmap = conn
-            .generate_id()
-            .map_err(perr(&display, "allocating an id"))?;
-        conn.create_pixmap(1, pixmap, screen.root, 1, 1)
-            .map_err(perr(&display, "CreatePixmap"))?;
-        let gc = conn
-            .generate_id()
-            .map_err(perr(&display, "allocating an id"))?;
-        conn.create_gc(gc, pixmap, &CreateGCAux::new().foreground(0))
-            .map_err(perr(&display, "CreateGC"))?;
-        conn.poly_fill_rectangle(
-            pixmap,
-            gc,
-            &[Rectangle {
-                x: 0,
-                y: 0,
-                width: 1,
-                height: 1,
-            }],
-        )
-        .map_err(perr(&display, "PolyFillRectangle"))?;
-        let cursor = conn
-            .generate_id()
-            .map_err(perr(&display, "allocating an id"))?;
-        conn.create_cursor(cursor, pixmap, pixmap, 0, 0, 0, 0, 0, 0, 0, 0)
-            .map_err(perr(&display, "CreateCursor"))?;
-        conn.free_gc(gc).map_err(perr(&display, "FreeGC"))?;
-        conn.free_pixmap(pixmap)
-            .map_err(perr(&display, "FreePixmap"))?;
+        let cursor = invisible_cursor(&conn, screen.root, &display)?;
 
         let window = conn
             .generate_id()
@@ -409,6 +379,41 @@ pub fn list_monitors(display: Option<&str>) -> Result<Vec<Monitor>, WindowError>
     let (conn, display, screen_num) = connect(display)?;
     let screen = conn.setup().roots[screen_num].clone();
     monitors_of(&conn, &screen, &display)
+}
+
+/// An invisible pointer: a 1×1 cursor whose mask pixel is 0, so the pointer parked in the
+/// middle of the screen does not stand in front of the meter.
+fn invisible_cursor(conn: &RustConnection, root: u32, display: &str) -> Result<u32, WindowError> {
+    let pixmap = conn
+        .generate_id()
+        .map_err(perr(display, "allocating an id"))?;
+    conn.create_pixmap(1, pixmap, root, 1, 1)
+        .map_err(perr(display, "CreatePixmap"))?;
+    let gc = conn
+        .generate_id()
+        .map_err(perr(display, "allocating an id"))?;
+    conn.create_gc(gc, pixmap, &CreateGCAux::new().foreground(0))
+        .map_err(perr(display, "CreateGC"))?;
+    conn.poly_fill_rectangle(
+        pixmap,
+        gc,
+        &[Rectangle {
+            x: 0,
+            y: 0,
+            width: 1,
+            height: 1,
+        }],
+    )
+    .map_err(perr(display, "PolyFillRectangle"))?;
+    let cursor = conn
+        .generate_id()
+        .map_err(perr(display, "allocating an id"))?;
+    conn.create_cursor(cursor, pixmap, pixmap, 0, 0, 0, 0, 0, 0, 0, 0)
+        .map_err(perr(display, "CreateCursor"))?;
+    conn.free_gc(gc).map_err(perr(display, "FreeGC"))?;
+    conn.free_pixmap(pixmap)
+        .map_err(perr(display, "FreePixmap"))?;
+    Ok(cursor)
 }
 
 fn connect(display: Option<&str>) -> Result<(RustConnection, String, usize), WindowError> {
