@@ -181,9 +181,9 @@ fn print_summary(s: &Summary) -> Result<(), CliError> {
     outln!(
         "verification on {} held-out patches: ΔE00 mean {:.2}, p95 {:.2}, max {:.2}",
         v.patches.len(),
-        v.mean,
-        v.p95,
-        v.max
+        v.de00.mean,
+        v.de00.p95,
+        v.de00.max
     )?;
     // The verdict already names every failed assumption.
     outln!("verdict: {}", s.verdict)?;

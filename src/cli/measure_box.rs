@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
 use metamer::measure_box::setup::RigError;
-use metamer::measure_box::{Outcome, PlanError, Summary};
+use metamer::measure_box::{BoxPlanError, Outcome, Summary};
 use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
 
 use super::rig::{box_light_refusal, nobody_at_the_rig};
@@ -92,7 +92,7 @@ pub fn run(args: Args) -> CliResult {
 /// A failure in the command's words: its flags named where the request was wrong.
 fn refusal(e: MeasureBoxJobError) -> CliError {
     match e {
-        MeasureBoxJobError::Plan(e @ PlanError::Io { .. }) => CliError::from(e),
+        MeasureBoxJobError::Plan(e @ BoxPlanError::Io { .. }) => CliError::from(e),
         MeasureBoxJobError::Repeats(message) => usage(format!("--repeats {message}")),
         MeasureBoxJobError::Plan(e) => usage(e),
         MeasureBoxJobError::UnknownStage(message) => usage(message),

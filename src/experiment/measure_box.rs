@@ -12,7 +12,7 @@ use super::error::ExperimentError;
 use super::progress::Progress;
 use crate::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
 use crate::measure_box::setup::RigError;
-use crate::measure_box::{Outcome, PlanError};
+use crate::measure_box::{BoxPlanError, Outcome};
 use crate::rig::Scenario;
 use crate::session::{Attendance, RunOptions, StepProgress};
 
@@ -124,7 +124,7 @@ fn stage_error(e: MeasureBoxJobError) -> ExperimentError {
         MeasureBoxJobError::SpotReadings(e) => e.into(),
         // Told apart from a bad plan file for the command's `--repeats`; the stage says it
         // as the plan's check does.
-        MeasureBoxJobError::Repeats(message) => bad(PlanError::Invalid {
+        MeasureBoxJobError::Repeats(message) => bad(BoxPlanError::Invalid {
             field: "repeats".into(),
             message,
         }),

@@ -15,8 +15,8 @@ use std::path::PathBuf;
 
 use metamer_drivers::Spec;
 
-use super::plan::{BoxPlan, PlanError, Stage};
-use super::run::{run, Instruments, MeasureBoxError, Options, Outcome};
+use super::plan::{BoxPlan, BoxPlanError, BoxStage};
+use super::run::{run, BoxOptions, Instruments, MeasureBoxError, Outcome};
 use super::setup::{self, BoxLightError, RigError, RigRequest};
 use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
@@ -44,7 +44,7 @@ pub struct MeasureBoxRequest {
     /// Continue the journals in `out`.
     pub resume: bool,
     /// Only this stage, by name (tiles, falloff, materials, spots). A name, not a
-    /// [`Stage`], because it is checked after the plan, as the command always did. The
+    /// [`BoxStage`], because it is checked after the plan, as the command always did. The
     /// experiment's box stage measures them all (None).
     pub stage: Option<String>,
     /// Seed of the simulated box and its instruments' noise.
@@ -79,7 +79,7 @@ pub struct MeasureBoxRequest {
 pub enum MeasureBoxJobError {
     /// The plan file cannot be read or is not a valid plan.
     #[error(transparent)]
-    Plan(#[from] PlanError),
+    Plan(#[from] BoxPlanError),
     /// The repeat count asked for ([`MeasureBoxRequest::repeats`]) is out of range.
     #[error("repeats {0}")]
     Repeats(String),
@@ -135,7 +135,7 @@ pub fn measure<'p>(
     progress: &mut dyn FnMut(bool) -> Box<dyn ProgressSink + 'p>,
 ) -> Result<Outcome, MeasureBoxJobError> {
     let plan = plan(request)?;
-    let stage: Option<Stage> = request
+    let stage: Option<BoxStage> = request
         .stage
         .as_deref()
         .map(str::parse)
@@ -164,7 +164,7 @@ pub fn measure<'p>(
     if let Some(p) = &request.plan {
         output.input(p);
     }
-    let options = Options {
+    let options = BoxOptions {
         output,
         dir: request.out.clone(),
         plan,
@@ -230,7 +230,7 @@ fn plan(request: &MeasureBoxRequest) -> Result<BoxPlan, MeasureBoxJobError> {
         plan.repeats = n;
     }
     plan.validate().map_err(|e| match e {
-        PlanError::Invalid { field, message } if field == "repeats" => {
+        BoxPlanError::Invalid { field, message } if field == "repeats" => {
             MeasureBoxJobError::Repeats(message)
         }
         e => e.into(),

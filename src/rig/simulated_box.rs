@@ -39,7 +39,7 @@ use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::{CGammaError, CGammaTable};
 use crate::measure_box::compare::{render_scene, CompareError};
-use crate::measure_box::plan::{BoxPlan, Stage, Target};
+use crate::measure_box::plan::{BoxPlan, BoxStage, Target};
 use crate::measure_box::scene::{scene_json, BoxContents};
 use crate::render::scene::DistributionFile;
 use crate::rig::Scenario;
@@ -245,7 +245,7 @@ impl BoxOperator {
     /// The operator of the truth box's plan, moving what `world` shows.
     pub fn new(truth: SimulatedBox, world: Arc<SharedWorld>) -> BoxOperator {
         let mut targets = HashMap::new();
-        for stage in Stage::ALL {
+        for stage in BoxStage::ALL {
             for step in truth.plan.steps(stage) {
                 targets
                     .entry(truth.plan.prompt(&step.data.target))

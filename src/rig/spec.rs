@@ -1,9 +1,9 @@
 //! Opening a screen by the name the command line and the logs use: `window[:N]` (a
 //! full-screen window on monitor N) or `virtual[:PRESET]` (a simulated monitor).
 
-use super::screen::Screen;
 use super::virtual_display::{Preset, VirtualDisplay};
 use super::window::{WindowDisplay, WindowError};
+use super::Screen;
 
 /// A screen could not be named or opened.
 #[derive(Debug, thiserror::Error)]

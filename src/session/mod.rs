@@ -23,12 +23,12 @@ pub use journal::{
     Journal, JournalEntry, JournalError,
 };
 pub use operator::{
-    attendance, Answer, Attendance, NobodyAtTheRig, Operator, OperatorError, Readings, Recheck,
-    ScriptedOperator, TerminalOperator, Unattended,
+    attendance, Answer, Attendance, NobodyAtTheRig, Operator, OperatorError, PlacementReadings,
+    Recheck, ScriptedOperator, TerminalOperator, Unattended,
 };
 pub use plan::{placements, Prepare, SessionPlan, Step};
 pub use progress::{BarProgress, NoProgress, ProgressSink, StageOf, StepProgress};
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
-pub use screen::{Screen, ScreenError};
+pub use screen::{MeterAim, Placement, Screen, ScreenError};
 pub use step::{Rig, StepFailure};

@@ -29,7 +29,7 @@ pub enum Recheck {
 
 /// The readings one placement is for, so a request can say how many are coming.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Readings {
+pub struct PlacementReadings {
     /// The first reading this request is for, 1-based (above 1 when a placement is asked
     /// again: after a calibration, or when a resumed session continues mid-placement).
     pub first: usize,
@@ -37,7 +37,7 @@ pub struct Readings {
     pub of: usize,
 }
 
-impl std::fmt::Display for Readings {
+impl std::fmt::Display for PlacementReadings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match (self.first, self.of) {
             (_, 1) => f.write_str("1 reading"),
@@ -49,7 +49,7 @@ impl std::fmt::Display for Readings {
 }
 
 /// A placement request as the terminal shows it: `{what} — 5 readings`.
-pub fn placement_prompt(what: &str, readings: Readings) -> String {
+pub fn placement_prompt(what: &str, readings: PlacementReadings) -> String {
     format!("{what} — {readings}")
 }
 
@@ -66,7 +66,11 @@ pub trait Operator {
     /// Asks for the placement `what` (the plan's words, the same for each of its readings)
     /// before `readings` of it are taken. By default [`Operator::ask`] with `what` alone:
     /// a simulated rig acts on the plan's words.
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         let _ = readings;
         self.ask(what)
     }
@@ -116,7 +120,11 @@ impl Operator for TerminalOperator {
         )
     }
 
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         self.ask(&placement_prompt(what, readings))
     }
 
@@ -230,7 +238,11 @@ impl Operator for ScriptedOperator {
         Ok(self.answers.pop_front().unwrap_or(Answer::Confirmed))
     }
 
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         self.ask(&placement_prompt(what, readings))
     }
 }
@@ -241,7 +253,7 @@ mod tests {
 
     #[test]
     fn a_placement_says_how_many_readings_it_is_for() {
-        let p = |first, of| placement_prompt("aim at patch 1", Readings { first, of });
+        let p = |first, of| placement_prompt("aim at patch 1", PlacementReadings { first, of });
         assert_eq!(p(1, 1), "aim at patch 1 — 1 reading");
         assert_eq!(p(1, 5), "aim at patch 1 — 5 readings");
         assert_eq!(p(3, 5), "aim at patch 1 — readings 3–5 of 5");

@@ -12,7 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use super::journal::{CalibrationRecord, JournalError};
-use super::operator::{Answer, Operator, OperatorError, Readings};
+use super::operator::{Answer, Operator, OperatorError, PlacementReadings};
 use super::plan::{Prepare, Step};
 use super::progress::ProgressSink;
 use super::record::SessionJournal;
@@ -258,7 +258,7 @@ where
                 if *self.placed == Some(range.start) {
                     return Ok(true);
                 }
-                let readings = Readings {
+                let readings = PlacementReadings {
                     first: self.index - range.start + 1,
                     of: range.len(),
                 };

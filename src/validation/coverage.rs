@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::covariance::{self, Cov3};
 use super::montecarlo::{
-    lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Summary,
+    lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Statistic,
 };
 use super::propagate::{Interval, Uncertain};
 use crate::color::{delta_e76, Lab, Xyz};
@@ -248,7 +248,7 @@ fn six_patches(noise: f64) -> Vec<Truth> {
         .collect()
 }
 
-fn summary_coverage(patches: &[Truth], summary: Summary, how: Stated, seed: u64) -> f64 {
+fn summary_coverage(patches: &[Truth], summary: Statistic, how: Stated, seed: u64) -> f64 {
     let values: Vec<f64> = patches.iter().map(Truth::de76).collect();
     let truth = summary.of(&values);
     let hits: u64 = (0..SUMMARY_TRIALS)
@@ -283,7 +283,7 @@ fn check_summary(name: &str, got: f64) {
 
 #[test]
 fn the_mean_and_max_over_patches_are_covered() {
-    for (summary, seed) in [(Summary::Mean, 7), (Summary::Max, 8)] {
+    for (summary, seed) in [(Statistic::Mean, 7), (Statistic::Max, 8)] {
         let got = summary_coverage(&six_patches(1.0), summary, Stated::Known, seed);
         check_summary(&format!("the {summary:?} ΔE*ab of 6 patches"), got);
     }
@@ -293,7 +293,7 @@ fn the_mean_and_max_over_patches_are_covered() {
 /// mean's interval nearly the normal one; the max holds its patches' t intervals.
 #[test]
 fn the_mean_and_max_with_estimated_covariances_are_covered() {
-    for (summary, seed) in [(Summary::Mean, 9), (Summary::Max, 12)] {
+    for (summary, seed) in [(Statistic::Mean, 9), (Statistic::Max, 12)] {
         let got = summary_coverage(&six_patches(1.0), summary, Stated::Estimated, seed);
         check_summary(
             &format!("the {summary:?} ΔE*ab of 6 patches, covariances from repeats"),
@@ -305,7 +305,7 @@ fn the_mean_and_max_with_estimated_covariances_are_covered() {
 /// Where noise swamps most patches.
 #[test]
 fn the_mean_and_max_of_patches_lost_in_noise_are_covered() {
-    for (summary, seed) in [(Summary::Mean, 10), (Summary::Max, 11)] {
+    for (summary, seed) in [(Statistic::Mean, 10), (Statistic::Max, 11)] {
         let got = summary_coverage(&six_patches(4.0), summary, Stated::Known, seed);
         check_summary(
             &format!("the {summary:?} ΔE*ab of 6 patches lost in noise"),

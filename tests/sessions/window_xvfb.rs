@@ -8,10 +8,9 @@ use std::io::BufRead;
 use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
-use metamer::image::RgbImage;
+use metamer::image::Drive8Image;
 use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
 use metamer::rig::{Placement, Screen};
-use metamer::session::Screen as _;
 
 use crate::support::unused_dir;
 
@@ -121,7 +120,7 @@ fn an_image_is_shown_whole_scaled_to_fit() {
     let Some(x) = xvfb(640, 480) else { return };
     let mut window = WindowDisplay::open(Some(&x.display), 0).unwrap();
     let (a, b, c, d) = ([255, 0, 0], [0, 255, 0], [0, 0, 255], [10, 20, 30]);
-    let image = RgbImage::new(2, 2, vec![a, b, c, d]).unwrap();
+    let image = Drive8Image::new(2, 2, vec![a, b, c, d]).unwrap();
     let placement = window.show_image(&image).unwrap();
     assert_eq!(
         placement,

@@ -3,7 +3,7 @@
 //! the order the instrument needs them).
 
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Averaged, Exposure};
-use metamer_protocols::i1pro::{Calibration, Gain, RawReading, Revision, Spectrum, CELLS};
+use metamer_protocols::i1pro::{Calibration, Gain, GridSpectrum, RawReading, Revision, CELLS};
 
 use super::error::I1ProError;
 use super::wire::{Shot, Wire};
@@ -97,7 +97,7 @@ impl DarkPair {
 
 /// A finished emissive or reflective shot: the resampled spectrum and what averaging saw.
 pub struct Processed {
-    pub spectrum: Spectrum,
+    pub spectrum: GridSpectrum,
     pub averaged: Averaged,
     pub integration_s: f64,
     pub readings: usize,
@@ -325,7 +325,7 @@ pub fn white<L: UsbLink>(
     wire: &mut Wire<L>,
     cal: &Calibration,
     dark: &AbsRaw,
-) -> Result<Spectrum, DriverError> {
+) -> Result<GridSpectrum, DriverError> {
     let t = quantize(wire, REFLECTIVE_S)?;
     let p = process(wire, cal, t, REFLECTIVE_READINGS, true, dark)?;
     if p.averaged.saturated {
@@ -350,8 +350,8 @@ pub fn reflective<L: UsbLink>(
     wire: &mut Wire<L>,
     cal: &Calibration,
     dark: &AbsRaw,
-    factors: &Spectrum,
-) -> Result<(Spectrum, Processed), DriverError> {
+    factors: &GridSpectrum,
+) -> Result<(GridSpectrum, Processed), DriverError> {
     let t = quantize(wire, REFLECTIVE_S)?;
     let p = check(process(wire, cal, t, REFLECTIVE_READINGS, true, dark)?)?;
     Ok((pipeline::reflective(&p.spectrum, factors), p))

@@ -18,4 +18,4 @@ pub use plan::{
 pub use report::{write_report, Report, ReportError};
 pub use request::{characterize, open_screen, Attend, Listener, Request, SimulatedMeter};
 pub use run::{log_path, run, CharacterizeError, LogDetails, Options, Outcome, LOG_FILE};
-pub use verify::{average, verify, AveragedPatch, HeldOutVerification};
+pub use verify::{average, verify_held_out, AveragedPatch};

@@ -129,7 +129,7 @@ pub trait Listener {
 ///     panic!("nothing stops a simulated session");
 /// };
 /// assert!(summary.files.profile.is_file());
-/// assert!(summary.verification.mean < 1.0, "ΔE00 {}", summary.verification.mean);
+/// assert!(summary.verification.de00.mean < 1.0, "ΔE00 {}", summary.verification.de00.mean);
 /// # std::fs::remove_dir_all(&out)?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```

@@ -107,7 +107,7 @@ impl Scene {
 
     /// Validates a parsed scene; files are resolved against `dir`.
     pub fn build(file: &SceneFile, dir: &Path) -> Result<Scene, PathError> {
-        build::scene(file, loader::Files::Dir(dir))
+        build::scene(file, loader::SpectrumFiles::Dir(dir))
     }
 
     /// A box built into the program by name (`validation-box`, lit by the `ips-lcd`

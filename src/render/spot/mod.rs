@@ -444,7 +444,19 @@ pub fn render_spots_with_progress(
             RenderedReading::new(k + 1, st.mean(), white, uncertainty)
         })
         .collect::<Vec<RenderedReading>>();
-    if let Some((p, _)) = patches.iter().zip(&stats).find(|(p, st)| {
+    check_finite(&patches, &stats)?;
+    Ok(SpotResult {
+        white,
+        seconds: start.elapsed().as_secs_f64(),
+        patches,
+        converged,
+    })
+}
+
+/// Refuses a reading that is no number (its XYZ, CIELAB, standard errors or uncertainty),
+/// naming its patch.
+fn check_finite(patches: &[RenderedReading], stats: &[XyzStats]) -> Result<(), SpotError> {
+    if let Some((p, _)) = patches.iter().zip(stats).find(|(p, st)| {
         !(p.xyz.is_finite()
             && p.lab
                 .iter()
@@ -457,10 +469,5 @@ pub fn render_spots_with_progress(
             xyz: p.xyz.to_array(),
         });
     }
-    Ok(SpotResult {
-        white,
-        seconds: start.elapsed().as_secs_f64(),
-        patches,
-        converged,
-    })
+    Ok(())
 }
