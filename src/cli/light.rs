@@ -176,7 +176,7 @@ fn print_fit(source: &std::path::Path, fit: &LdcFit) {
     }
     println!("chose {}", fit.why);
     if let Some(e) = fit.extrapolation() {
-        println!("not measured: {}", e.sentence());
+        println!("note: {}", e.sentence());
     }
     println!("residuals (reading/normal − fitted):");
     for plane in [Plane::Horizontal, Plane::Vertical] {

@@ -234,8 +234,9 @@ impl LdcFit {
         self.candidates.iter().find(|c| c.model == self.model)
     }
 
-    /// Where the table is the model's extrapolation: None when every half-plane was read
-    /// to 90° (or the fit does not say how far it was read).
+    /// Where the table is the model's extrapolation. Readings stop short of 90° (the light
+    /// is seen from the front), so every fit has one; None only for a fit written before
+    /// it kept how far it was read.
     pub fn extrapolation(&self) -> Option<Extrapolation> {
         let measured_to_deg = self.measured_to_deg?;
         let beyond_deg = measured_to_deg.iter().copied().fold(90.0, f64::min);
