@@ -117,14 +117,28 @@ fn run_fit(a: FitArgs) -> CliResult {
             };
             super::console::reported_at_exit(outln!("{what} written to {}", path.display()));
         }
-        FitEvent::Panel { panel, flux_lm } => super::console::reported_at_exit(outln!(
-            "panel {} m × {} m at {} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
-            panel.width_m,
-            panel.height_m,
-            panel.normal_luminance_cd_m2,
-            panel.normal_intensity_cd(),
-            flux_lm
-        )),
+        FitEvent::Panel {
+            panel,
+            flux_lm,
+            extrapolated,
+        } => {
+            super::console::reported_at_exit(outln!(
+                "panel {} m × {} m at {} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
+                panel.width_m,
+                panel.height_m,
+                panel.normal_luminance_cd_m2,
+                panel.normal_intensity_cd(),
+                flux_lm
+            ));
+            if let Some(e) = extrapolated {
+                super::console::reported_at_exit(outln!(
+                    "  of which {:.4} lm ({:.1} %) above γ = {}°, where the table is extrapolated",
+                    e.flux_lm,
+                    100.0 * e.flux_lm / flux_lm,
+                    e.beyond_deg
+                ));
+            }
+        }
     })
     .map_err(light_error)?;
     Ok(())
@@ -165,6 +179,9 @@ fn print_fit(source: &std::path::Path, fit: &LdcFit) -> Result<(), super::consol
         }
     }
     outln!("chose {}", fit.why)?;
+    if let Some(e) = fit.extrapolation() {
+        outln!("note: {}", e.sentence())?;
+    }
     outln!("residuals (reading/normal − fitted):")?;
     for plane in [Plane::Horizontal, Plane::Vertical] {
         let cells: Vec<String> = fit
