@@ -6,7 +6,7 @@ use metamer_drivers::DriverError;
 
 use super::cache::CacheError;
 use super::readings::ReadingsError;
-use crate::display::characterize::CharacterizeError;
+use crate::display::characterize::{CharacterizeError, SimulatedMeterOnRealScreen};
 use crate::display::ProfileError;
 use crate::image::ImageError;
 use crate::render::image::ImageRenderError;
@@ -69,8 +69,8 @@ pub enum ExperimentError {
         total: usize,
         journal: PathBuf,
     },
-    #[error("the simulated meter {meter} cannot see the real screen {screen}; use a real meter, or a virtual display")]
-    SimulatedMeterOnRealScreen { meter: String, screen: String },
+    #[error(transparent)]
+    SimulatedMeterOnRealScreen(#[from] SimulatedMeterOnRealScreen),
     #[error("the display's white is {white_cd_m2:.1} cd/m², but the rendering needs at least {needed_cd_m2:.1} cd/m² to be shown without tone mapping: raise the monitor's brightness (backlight) until full white reads at least that, then move {} aside and run the display stage again", dir.display())]
     DisplayTooDim {
         white_cd_m2: f64,

@@ -14,9 +14,6 @@ use crate::render::Scene;
 
 /// Every check, in the order a user would fix them.
 pub fn check(opts: &ExperimentOptions) -> Result<(), ExperimentError> {
-    // An option the reproduction stage reads, which would otherwise fail only after the
-    // box, the simulation and the display have been measured.
-    opts.reproduction.mapping()?;
     given_files_outside_stages(opts)?;
     match &opts.box_source {
         BoxSource::Measure(m) => measured_box(m),

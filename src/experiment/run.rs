@@ -17,6 +17,7 @@ use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
 use crate::color::Xyz;
 use crate::display::Profile;
+use crate::rig::ScreenSpec;
 use crate::validation::job::ReadingFiles;
 
 /// How one stage went.
@@ -212,7 +213,7 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
         Stage::Display => {
             let i = Inputs::new().value("options", &opts.display);
             // A simulated monitor's white is set for the rendering; a real one is not.
-            if opts.display.screen.starts_with("virtual") {
+            if matches!(opts.display.screen, ScreenSpec::Virtual(_)) {
                 i.file("spots", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
             } else {
                 i
@@ -392,12 +393,12 @@ mod tests {
                 image: None,
             },
             display: DisplayOptions {
-                screen: "virtual:ips-lcd".into(),
+                screen: ScreenSpec::Virtual(crate::rig::Preset::IpsLcd),
                 spot: "sim:cs100a?time_scale=0".into(),
                 model: ModelKind::MatrixLsq,
             },
             reproduction: ReproductionOptions {
-                gamut: "clip".into(),
+                gamut: crate::display::gamut::GamutMapping::Clip,
                 mirror: true,
             },
             repeats: 1,
