@@ -15,7 +15,7 @@ use super::progress::Progress;
 use crate::color::Xyz;
 use crate::display::characterize::{self, CharacterizeError, PlanOptions};
 use crate::display::{ModelKind, Profile};
-use crate::rig::{Screen, ScreenSpec, VirtualPanel};
+use crate::rig::{OpenError, Screen, ScreenSpec, VirtualPanel};
 use crate::session::{ProgressSink, RunOptions, StepProgress};
 
 /// The monitor and how it is characterized.
@@ -53,6 +53,18 @@ pub fn open_screen(
     virtual_white_cd_m2: Option<f64>,
 ) -> Result<Box<dyn Screen>, ExperimentError> {
     Ok(characterize::open_screen(spec, virtual_white_cd_m2)?)
+}
+
+/// The display stage's checks (and the display-spots stage's, which opens the same screen
+/// and meter) before the experiment's first reading: the meter can see the screen, and a
+/// real monitor's X display can be reached (without it the box was measured and the scene
+/// rendered before the display stage failed).
+pub(super) fn preflight(opts: &DisplayOptions) -> Result<(), ExperimentError> {
+    characterize::meter_sees(&opts.spot, &opts.screen)?;
+    if let ScreenSpec::Window { .. } = opts.screen {
+        crate::rig::window::list_monitors(None).map_err(OpenError::Window)?;
+    }
+    Ok(())
 }
 
 /// Headroom above the brightest in-gamut target, so no channel sits at its very end.

@@ -17,6 +17,7 @@ use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
 use crate::color::Xyz;
 use crate::display::Profile;
+use crate::render::deadline::cancellable;
 use crate::rig::ScreenSpec;
 use crate::validation::job::ReadingFiles;
 
@@ -154,6 +155,11 @@ pub fn run(
             });
             continue;
         }
+        if interrupted(opts) {
+            return Err(ExperimentError::InterruptedBefore {
+                stage: stage.name(),
+            });
+        }
         progress(Progress::Stage {
             stage,
             reused: false,
@@ -169,6 +175,13 @@ pub fn run(
             sd.invalidate()?;
         }
         let files = run_stage(stage, opts, &sd, progress)?;
+        // A stage that takes no readings is cut short by Ctrl-C (the render stops at its
+        // next check): what it wrote is not this stage's result, so it is not recorded.
+        if interrupted(opts) {
+            return Err(ExperimentError::Interrupted {
+                stage: stage.name(),
+            });
+        }
         let seconds = start.elapsed().as_secs_f64();
         sd.finish(&inputs, &files, seconds)?;
         outcomes.push(StageOutcome {
@@ -180,6 +193,13 @@ pub fn run(
         });
     }
     Ok(outcomes)
+}
+
+fn interrupted(opts: &ExperimentOptions) -> bool {
+    opts.run
+        .interrupt
+        .as_ref()
+        .is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst))
 }
 
 fn stage_path(opts: &ExperimentOptions, stage: Stage, file: &str) -> PathBuf {
@@ -287,16 +307,19 @@ fn run_stage(
         },
         Stage::Simulation => {
             let (scene, _) = box_files(opts);
-            let (_, files) = match &opts.simulation.external_image {
+            let (_, files) = cancellable(opts.run.interrupt.as_ref(), || match &opts
+                .simulation
+                .external_image
+            {
                 Some(image) => super::external_image::read_back(
                     &scene,
                     image,
                     &opts.simulation,
                     &sd.dir,
                     progress,
-                )?,
-                None => simulate(&scene, &opts.simulation, &sd.dir, progress)?,
-            };
+                ),
+                None => simulate(&scene, &opts.simulation, &sd.dir, progress),
+            })?;
             Ok(owned(files))
         }
         Stage::Display => {

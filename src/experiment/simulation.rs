@@ -72,6 +72,47 @@ impl SimulationOptions {
     }
 }
 
+/// The simulation stage's checks before the experiment's first reading: another renderer's
+/// image (`external_image`) must be an image metamer reads, of the aspect ratio of the
+/// scene's camera (`camera`: width and height in pixels) and outside the stage's
+/// directory `stage_dir`, where the stage writes its own copy over it. A scene without a
+/// camera (None) is refused by the read-back itself.
+pub(super) fn preflight(
+    opts: &SimulationOptions,
+    camera: Option<[usize; 2]>,
+    stage_dir: &Path,
+) -> Result<(), ExperimentError> {
+    let Some(file) = &opts.external_image else {
+        return Ok(());
+    };
+    if let (Ok(dir), Ok(f)) = (
+        std::fs::canonicalize(stage_dir),
+        std::fs::canonicalize(file),
+    ) {
+        if f.starts_with(dir) {
+            return Err(ExperimentError::ImageInStage {
+                file: file.clone(),
+                dir: stage_dir.to_path_buf(),
+            });
+        }
+    }
+    let image = crate::image::read_xyz_image(file)?;
+    let Some([camera_width, camera_height]) = camera else {
+        return Ok(());
+    };
+    if image.width * camera_height != image.height * camera_width {
+        return Err(crate::render::spot::cone::ReadBackError::Aspect {
+            file: file.clone(),
+            width: image.width,
+            height: image.height,
+            camera_width,
+            camera_height,
+        }
+        .into());
+    }
+    Ok(())
+}
+
 /// Where the simulation's readings came from, as `simulation.json` names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum SimulationMethod {
