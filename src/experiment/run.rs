@@ -164,7 +164,7 @@ pub fn run(
             stage,
             reused: false,
         });
-        if matches!(stage, Stage::Box | Stage::Display | Stage::DisplaySpots) {
+        if stage.measures() {
             if let Some(aside) = set_aside_stale(&sd)? {
                 progress(Progress::Note(format!(
                     "the {stage} stage's inputs changed: its earlier measurements are kept in {}",
@@ -174,14 +174,17 @@ pub fn run(
         } else {
             sd.invalidate()?;
         }
-        let files = run_stage(stage, opts, &sd, progress)?;
+        let files = run_stage(stage, opts, &sd, progress);
         // A stage that takes no readings is cut short by Ctrl-C (the render stops at its
-        // next check): what it wrote is not this stage's result, so it is not recorded.
-        if interrupted(opts) {
+        // next check, with a result or with "no result in time"): what it wrote is not
+        // this stage's result, so it is not recorded. A measuring stage says itself where
+        // its journal stopped.
+        if interrupted(opts) && !stage.measures() {
             return Err(ExperimentError::Interrupted {
                 stage: stage.name(),
             });
         }
+        let files = files?;
         let seconds = start.elapsed().as_secs_f64();
         sd.finish(&inputs, &files, seconds)?;
         outcomes.push(StageOutcome {
@@ -307,18 +310,17 @@ fn run_stage(
         },
         Stage::Simulation => {
             let (scene, _) = box_files(opts);
-            let (_, files) = cancellable(opts.run.interrupt.as_ref(), || match &opts
-                .simulation
-                .external_image
-            {
-                Some(image) => super::external_image::read_back(
-                    &scene,
-                    image,
-                    &opts.simulation,
-                    &sd.dir,
-                    progress,
-                ),
-                None => simulate(&scene, &opts.simulation, &sd.dir, progress),
+            let (_, files) = cancellable(opts.run.interrupt.as_ref(), || {
+                match &opts.simulation.external_image {
+                    Some(image) => super::external_image::read_back(
+                        &scene,
+                        image,
+                        &opts.simulation,
+                        &sd.dir,
+                        progress,
+                    ),
+                    None => simulate(&scene, &opts.simulation, &sd.dir, progress),
+                }
             })?;
             Ok(owned(files))
         }
