@@ -161,7 +161,7 @@ pub fn spectra_csv(readings: &[Reading]) -> Option<String> {
 #[derive(Clone, Debug)]
 pub struct SpotRequest {
     /// The instrument's spec (`cs100a:PORT`, `i1pro`, `replay:FILE`, `sim:…`).
-    pub instrument: String,
+    pub instrument: Spec,
     pub mode: MeasureMode,
     /// Response speed, for instruments that have one; `None` keeps the instrument's.
     pub speed: Option<Speed>,
@@ -267,7 +267,7 @@ pub fn run(
             path.display()
         ));
     }
-    let spec = Spec::new(request.instrument.as_str());
+    let spec = &request.instrument;
     let mut policy = OutputPolicy::new(request.force);
     policy.inputs(
         spec.replay_file()
@@ -279,12 +279,12 @@ pub fn run(
         policy.check(path)?;
     }
     // Before the instrument is opened: a real one with nobody to place it is refused.
-    let attended = attendance(&[&request.instrument], request.unattended)?;
+    let attended = attendance(&[spec], request.unattended)?;
     let hands = spec
         .is_simulated()
         .then(|| simulated_target(request.mode))
         .transpose()?;
-    let mut instrument = open(request, &spec, hands.as_ref())?;
+    let mut instrument = open(request, spec, hands.as_ref())?;
     let info = instrument.info();
     events(SpotEvent::Opened(&info))?;
     let mut operator = attended.operator();

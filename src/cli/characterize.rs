@@ -6,8 +6,8 @@ use std::time::Duration;
 use clap::ValueEnum;
 use metamer::display::characterize::finish::Summary;
 use metamer::display::characterize::{
-    self, default_grid_steps, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions,
-    Request, SimulatedMeter, DEFAULT_RAMP_STEPS,
+    self, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions, Request,
+    SimulatedMeter, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::ModelKind;
 use metamer::rig::ScreenSpec;
@@ -85,11 +85,7 @@ pub fn run(args: Args) -> CliResult {
             SpeedArg::Fast => Speed::Fast,
             SpeedArg::Slow => Speed::Slow,
         }),
-        plan: PlanOptions {
-            ramp_steps: args.ramp_steps,
-            repeats: args.repeats,
-            grid_steps: (args.grid_steps).unwrap_or(default_grid_steps(model, args.ramp_steps)),
-        },
+        plan: PlanOptions::for_model(model, args.ramp_steps, args.repeats, args.grid_steps),
         model,
         settle: args.settle_ms.map(Duration::from_millis),
         resume: args.resume,

@@ -3,9 +3,10 @@
 use std::path::PathBuf;
 
 use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
-use metamer::measure_box::setup::RigError;
 use metamer::measure_box::{BoxPlanError, Outcome, Summary};
+use metamer::rig::Scenario;
 use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
+use metamer_drivers::Spec;
 
 use super::rig::{box_light_refusal, nobody_at_the_rig};
 use super::{CliError, CliResult};
@@ -18,10 +19,10 @@ pub struct Args {
     out: PathBuf,
     /// The spectral instrument: i1pro, i1pro:SERIAL, replay:FILE.jsonl or sim:i1pro.
     #[arg(long, value_name = "SPEC")]
-    spectral: String,
+    spectral: Spec,
     /// The spot meter: cs100a:PORT, replay:FILE.jsonl or sim:cs100a.
     #[arg(long, value_name = "SPEC")]
-    spot: String,
+    spot: Spec,
     /// A plan file (JSON) changing counts, angles and geometry; default the paper's plan.
     #[arg(long, value_name = "FILE.json")]
     plan: Option<PathBuf>,
@@ -42,7 +43,7 @@ pub struct Args {
     /// ips-lcd display's white, as the paper's box was lit by an LCD) or led-rgb1 (CIE
     /// LED-RGB1, a warm light whose saturated colours no virtual display can show).
     #[arg(long, value_name = "LIGHT")]
-    scenario: Option<String>,
+    scenario: Option<Scenario>,
     /// Replace an existing scene.json, light.json/.svg/.ies/.ldt or summary.json in DIR.
     #[arg(long)]
     force: bool,
@@ -96,9 +97,6 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
         MeasureBoxJobError::Repeats(message) => usage(format!("--repeats {message}")),
         MeasureBoxJobError::Plan(e) => usage(e),
         MeasureBoxJobError::UnknownStage(message) => usage(message),
-        MeasureBoxJobError::Rig(RigError::Mixed) => usage(
-            "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
-        ),
         MeasureBoxJobError::BoxLight(e) => box_light_refusal(e),
         MeasureBoxJobError::Nobody(e) => nobody_at_the_rig(e),
         MeasureBoxJobError::Rig(e) if e.is_request() => usage(e),

@@ -10,10 +10,12 @@ fn usage(e: impl std::fmt::Display) -> CliError {
     CliError::Usage(e.to_string())
 }
 
-/// A `--scenario` the rig cannot have, in the words of the command line.
+/// Instruments and a `--scenario` that make no box rig, in the words of the command line.
 pub(super) fn box_light_refusal(e: BoxLightError) -> CliError {
     match e {
-        BoxLightError::Unknown(message) => usage(message),
+        BoxLightError::Mixed => usage(
+            "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
+        ),
         BoxLightError::RealRig => usage(
             "--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light",
         ),

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 use metamer::color::Xyz;
 use metamer::spot::{self, SpotEvent, SpotRequest, SpotRunError};
-use metamer_drivers::{MeasureMode, Reading, Speed};
+use metamer_drivers::{MeasureMode, Reading, Spec, Speed};
 
 use super::{CliError, CliResult};
 
@@ -73,7 +73,7 @@ pub fn run(args: Args) -> CliResult {
         ModeArg::Ambient => MeasureMode::Ambient,
     };
     let request = SpotRequest {
-        instrument: args.instrument,
+        instrument: Spec::new(args.instrument),
         mode,
         speed: args.speed.map(|s| match s {
             SpeedArg::Fast => Speed::Fast,

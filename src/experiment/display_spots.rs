@@ -219,7 +219,7 @@ pub fn measure(
         ..
     } = *s;
     let mut screen = open_screen(&setting.screen, setting.virtual_white_cd_m2)?;
-    let mut meter = open_meter(spot_spec, screen.as_ref())?;
+    let mut meter = open_meter(spot_spec, &setting.screen, screen.as_ref())?;
     // A real monitor takes a moment to settle after a change; a simulated one does not.
     let settle = if setting.virtual_white_cd_m2.is_some() {
         std::time::Duration::ZERO
@@ -263,7 +263,7 @@ pub fn measure(
         &journal,
         plan,
         SpotHeader {
-            screen: setting.screen.clone(),
+            screen: setting.screen.canonical(),
             virtual_white_cd_m2: setting.virtual_white_cd_m2,
         },
         instruments,

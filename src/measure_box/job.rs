@@ -20,6 +20,7 @@ use super::run::{run, BoxOptions, Instruments, MeasureBoxError, Outcome};
 use super::setup::{self, BoxLightError, RigError, RigRequest};
 use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
+use crate::rig::Scenario;
 use crate::session::repeats::Repeatability;
 use crate::session::{attendance, Attendance, NobodyAtTheRig, ProgressSink, RunOptions};
 use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
@@ -29,14 +30,14 @@ use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
 pub const SPOTS_FILE: &str = "spots.csv";
 
 /// What `measure-box` is asked to do.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct MeasureBoxRequest {
     /// Output directory: the stage journals, scene, light files and summary.
     pub out: PathBuf,
-    /// The spectral instrument's spec.
-    pub spectral: String,
-    /// The spot meter's spec.
-    pub spot: String,
+    /// The spectral instrument.
+    pub spectral: Spec,
+    /// The spot meter.
+    pub spot: Spec,
     /// A plan file; `None`: the paper's plan.
     pub plan: Option<PathBuf>,
     /// Readings of each tile and each spot; `None`: the plan's.
@@ -49,8 +50,9 @@ pub struct MeasureBoxRequest {
     pub stage: Option<String>,
     /// Seed of the simulated box and its instruments' noise.
     pub seed: u64,
-    /// The simulated box's light, by name; checked once the rig is known to be simulated.
-    pub scenario: Option<String>,
+    /// The simulated box's light (None: the default); refused on a real rig
+    /// ([`setup::box_light`]).
+    pub scenario: Option<Scenario>,
     /// Replace an existing scene, light files or summary in `out`: the command's
     /// `--force`; the experiment's box stage always, as its directory is its own.
     pub force: bool,
@@ -86,6 +88,7 @@ pub enum MeasureBoxJobError {
     /// No stage has this name.
     #[error("{0}")]
     UnknownStage(String),
+    /// The instruments and the light make no rig ([`setup::box_light`]).
     #[error(transparent)]
     BoxLight(#[from] BoxLightError),
     #[error(transparent)]
@@ -111,17 +114,24 @@ pub enum MeasureBoxJobError {
 /// ```
 /// use metamer::measure_box::job::{measure, MeasureBoxRequest};
 /// use metamer::measure_box::Outcome;
-/// use metamer::session::NoProgress;
+/// use metamer::session::{NoProgress, RunOptions};
 ///
 /// let out = std::env::temp_dir().join(format!("metamer-doc-box-{}", std::process::id()));
 /// let request = MeasureBoxRequest {
 ///     out: out.clone(),
 ///     spectral: "sim:i1pro?time_scale=0".into(),
 ///     spot: "sim:cs100a?time_scale=0".into(),
+///     plan: None,
 ///     repeats: Some(1),
+///     resume: false,
 ///     stage: Some("tiles".into()),
 ///     seed: 1,
-///     ..MeasureBoxRequest::default()
+///     scenario: None,
+///     force: false,
+///     unattended: false,
+///     run: RunOptions::default(),
+///     attendance: None,
+///     spot_readings: false,
 /// };
 /// let outcome = measure(&request, &|_| {}, &mut |_| Box::new(NoProgress)).unwrap();
 /// // The other stages are still to measure before the scene can be assembled.
@@ -141,21 +151,17 @@ pub fn measure<'p>(
         .map(str::parse)
         .transpose()
         .map_err(MeasureBoxJobError::UnknownStage)?;
-    let (spectral, spot) = (
-        Spec::new(request.spectral.as_str()),
-        Spec::new(request.spot.as_str()),
-    );
-    let simulated = setup::is_simulated(&spectral, &spot)?;
-    let light = setup::box_light(request.scenario.as_deref(), simulated)?;
+    let (spectral, spot) = (&request.spectral, &request.spot);
+    let light = setup::box_light(spectral, spot, request.scenario)?;
     // Before anything is opened: a real rig with nobody to ask is refused.
     let attended = match request.attendance {
         Some(a) => a,
-        None => attendance(&[&request.spectral, &request.spot], request.unattended)?,
+        None => attendance(&[spectral, spot], request.unattended)?,
     };
     let rig_request = RigRequest {
         plan: &plan,
-        spectral: &spectral,
-        spot: &spot,
+        spectral,
+        spot,
         seed: request.seed,
         light,
     };
@@ -172,8 +178,8 @@ pub fn measure<'p>(
         resume: request.resume,
         rig_options: std::mem::take(&mut rig.rig_options),
         details: BoxDetails {
-            spectral: request.spectral.clone(),
-            spot: request.spot.clone(),
+            spectral: request.spectral.to_string(),
+            spot: request.spot.to_string(),
         },
         run: request.run.clone(),
     };

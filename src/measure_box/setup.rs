@@ -16,12 +16,9 @@ use crate::session::Operator;
 /// The rig could not be opened.
 #[derive(Debug, thiserror::Error)]
 pub enum RigError {
-    /// One instrument is simulated and the other is not.
-    #[error("the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box")]
-    Mixed,
-    /// A simulated box's light was asked of a real rig.
-    #[error("the light '{0}' is the simulated box's; real instruments measure the real box, lit by its own light")]
-    LightOnRealBox(Scenario),
+    /// The instruments and the light asked for make no rig ([`box_light`]).
+    #[error(transparent)]
+    Light(#[from] BoxLightError),
     /// The simulated box could not be made.
     #[error(transparent)]
     Truth(#[from] SimulatedBoxError),
@@ -36,8 +33,7 @@ impl RigError {
     pub fn is_request(&self) -> bool {
         matches!(
             self,
-            RigError::Mixed
-                | RigError::LightOnRealBox(_)
+            RigError::Light(_)
                 | RigError::Open(
                     DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. }
                 )
@@ -45,33 +41,32 @@ impl RigError {
     }
 }
 
-/// A light asked of the box that it cannot have.
+/// Instruments and a light that make no box rig.
 #[derive(Debug, thiserror::Error)]
 pub enum BoxLightError {
-    /// No simulated box light has this name.
-    #[error("{0}")]
-    Unknown(String),
+    /// One instrument is simulated and the other is not.
+    #[error("the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box")]
+    Mixed,
     /// The simulated box's light was asked of a real rig.
     #[error("a real rig measures the real box under its own light; only the simulated box's light can be chosen")]
     RealRig,
 }
 
-/// The simulated box's light named `name`, checked against the rig: a real rig is lit
-/// by whatever light it has. Checked before anything is opened.
-pub fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, BoxLightError> {
-    match (name, simulated) {
-        (None, _) => Ok(None),
-        (Some(n), true) => n.parse().map(Some).map_err(BoxLightError::Unknown),
-        (Some(_), false) => Err(BoxLightError::RealRig),
-    }
-}
-
-/// Whether the rig is the simulated box: a simulated instrument sees only that box, and
-/// a real one only the real box, so the two must agree.
-pub fn is_simulated(spectral: &Spec, spot: &Spec) -> Result<bool, RigError> {
-    match (spectral.is_simulated(), spot.is_simulated()) {
-        (a, b) if a == b => Ok(a),
-        _ => Err(RigError::Mixed),
+/// The box the instruments measure, and its light: the simulated box (both instruments
+/// simulated: a simulated instrument sees only that box) under `light` or the default
+/// light, or the real box (both real), which has its own light, so none may be asked of
+/// it. `measure-box`, the experiment's checks and [`open`] decide it here, before anything
+/// is opened; None is the real box.
+pub fn box_light(
+    spectral: &Spec,
+    spot: &Spec,
+    light: Option<Scenario>,
+) -> Result<Option<Scenario>, BoxLightError> {
+    match (spectral.is_simulated(), spot.is_simulated(), light) {
+        (true, true, light) => Ok(Some(light.unwrap_or_default())),
+        (false, false, None) => Ok(None),
+        (false, false, Some(_)) => Err(BoxLightError::RealRig),
+        _ => Err(BoxLightError::Mixed),
     }
 }
 
@@ -95,7 +90,7 @@ pub struct RigRequest<'a> {
     /// Seeds the simulated box; its spectral instrument draws noise from this seed and its
     /// spot meter from the next, unless their specs name their own.
     pub seed: u64,
-    /// The simulated box's light (None: the default); refused on a real rig.
+    /// The simulated box's light (None: the default); refused on a real rig ([`box_light`]).
     pub light: Option<Scenario>,
 }
 
@@ -107,21 +102,17 @@ pub fn open(
     operator: impl FnOnce() -> Box<dyn Operator>,
     note: &dyn Fn(String),
 ) -> Result<BoxRig, RigError> {
-    let simulated = is_simulated(request.spectral, request.spot)?;
     let mut rig_options = BTreeMap::new();
-    if !simulated {
-        if let Some(light) = request.light {
-            return Err(RigError::LightOnRealBox(light));
-        }
+    let Some(light) = box_light(request.spectral, request.spot, request.light)? else {
         return Ok(BoxRig {
             spectral: request.spectral.open(None)?,
             spot: request.spot.open(None)?,
             operator: operator(),
             rig_options,
-            simulated,
+            simulated: false,
         });
-    }
-    let (seed, light) = (request.seed, request.light.unwrap_or_default());
+    };
+    let seed = request.seed;
     rig_options.insert("seed".to_string(), seed.to_string());
     rig_options.insert("light".to_string(), light.name().to_string());
     note(format!("simulating the box (seed {seed}, lit by {light})"));
@@ -140,7 +131,7 @@ pub fn open(
         spot,
         operator: Box::new(BoxOperator::new(truth, world)),
         rig_options,
-        simulated,
+        simulated: true,
     })
 }
 
@@ -149,17 +140,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_rig_is_simulated_only_as_a_whole() {
+    fn a_rig_is_simulated_only_as_a_whole_and_only_the_simulated_box_takes_a_light() {
         let sim = Spec::new("sim:cs100a");
         let real = Spec::new("cs100a:/dev/ttyUSB0");
         let replayed = Spec::new("replay:spots.jsonl");
-        assert!(is_simulated(&sim, &sim).unwrap());
-        assert!(!is_simulated(&real, &replayed).unwrap());
-        assert!(matches!(is_simulated(&sim, &real), Err(RigError::Mixed)));
+        let led = Some(Scenario::LedRgb1);
+        assert_eq!(
+            box_light(&sim, &sim, None).unwrap(),
+            Some(Scenario::default())
+        );
+        assert_eq!(box_light(&sim, &sim, led).unwrap(), led);
+        assert_eq!(box_light(&real, &replayed, None).unwrap(), None);
         assert!(matches!(
-            is_simulated(&replayed, &sim),
-            Err(RigError::Mixed)
+            box_light(&real, &replayed, led),
+            Err(BoxLightError::RealRig)
         ));
+        for light in [None, led] {
+            assert!(matches!(
+                box_light(&sim, &real, light),
+                Err(BoxLightError::Mixed)
+            ));
+            assert!(matches!(
+                box_light(&replayed, &sim, light),
+                Err(BoxLightError::Mixed)
+            ));
+        }
     }
 
     #[test]
@@ -209,7 +214,7 @@ mod tests {
             light: Some(Scenario::default()),
         };
         let e = open(&request, || unreachable!(), &|_| {}).err().unwrap();
-        assert!(matches!(e, RigError::LightOnRealBox(_)), "{e}");
+        assert!(matches!(e, RigError::Light(BoxLightError::RealRig)), "{e}");
         assert!(e.is_request());
         let e = open(
             &RigRequest {

@@ -151,61 +151,6 @@ impl Operator for Unattended {
     }
 }
 
-/// Who answers a session's requests.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Attendance {
-    /// Somebody at the terminal: ask them ([`TerminalOperator`]).
-    Terminal,
-    /// Nobody: the user said so, or no terminal and nothing physical measured (simulated
-    /// or replayed instruments), so every request counts as done.
-    Unattended,
-}
-
-impl Attendance {
-    /// The operator that answers for this attendance.
-    pub fn operator(self) -> Box<dyn Operator> {
-        match self {
-            Attendance::Terminal => Box::new(TerminalOperator),
-            Attendance::Unattended => Box::new(Unattended),
-        }
-    }
-}
-
-/// A physical instrument would be driven with nobody to place, aim or calibrate it.
-#[derive(Debug, thiserror::Error)]
-#[error("{spec} is a real instrument and stdin is not a terminal: nobody can be asked to place, aim or calibrate it, and it would measure wherever it points")]
-pub struct NobodyAtTheRig {
-    /// The first physical instrument's spec.
-    pub spec: String,
-}
-
-/// Who answers the requests of a session with the instruments `specs` (as the user named
-/// them): refused when one is physical, stdin is no terminal and the user did not say
-/// `unattended`; nothing is opened, so the refusal comes before any reading.
-pub fn attendance(specs: &[&str], unattended: bool) -> Result<Attendance, NobodyAtTheRig> {
-    attendance_with(specs, unattended, std::io::stdin().is_terminal())
-}
-
-/// [`attendance`] with the terminal's presence given (for tests).
-pub fn attendance_with(
-    specs: &[&str],
-    unattended: bool,
-    terminal: bool,
-) -> Result<Attendance, NobodyAtTheRig> {
-    if unattended {
-        return Ok(Attendance::Unattended);
-    }
-    if terminal {
-        return Ok(Attendance::Terminal);
-    }
-    match specs.iter().find(|s| metamer_drivers::is_physical(s)) {
-        Some(spec) => Err(NobodyAtTheRig {
-            spec: spec.to_string(),
-        }),
-        None => Ok(Attendance::Unattended),
-    }
-}
-
 /// An operator that follows a script and remembers every prompt it was shown: for tests
 /// and simulated rigs, where nothing has to be done by hand. Placement requests are
 /// remembered as the terminal shows them (with their reading count).
@@ -258,35 +203,5 @@ mod tests {
         assert_eq!(p(1, 5), "aim at patch 1 — 5 readings");
         assert_eq!(p(3, 5), "aim at patch 1 — readings 3–5 of 5");
         assert_eq!(p(5, 5), "aim at patch 1 — reading 5 of 5");
-    }
-
-    #[test]
-    fn a_real_instrument_needs_a_terminal_or_unattended() {
-        let real = ["sim:i1pro", "cs100a:/dev/ttyUSB0"];
-        let e = attendance_with(&real, false, false).unwrap_err();
-        assert_eq!(e.spec, "cs100a:/dev/ttyUSB0");
-        assert_eq!(
-            attendance_with(&real, true, false).unwrap(),
-            Attendance::Unattended
-        );
-        assert_eq!(
-            attendance_with(&real, false, true).unwrap(),
-            Attendance::Terminal
-        );
-        // Said unattended at a terminal: nobody is asked.
-        assert_eq!(
-            attendance_with(&real, true, true).unwrap(),
-            Attendance::Unattended
-        );
-        // Simulated and replayed instruments measure nothing real.
-        let played = ["sim:cs100a", "replay:a.jsonl"];
-        assert_eq!(
-            attendance_with(&played, false, false).unwrap(),
-            Attendance::Unattended
-        );
-        assert_eq!(
-            attendance_with(&played, false, true).unwrap(),
-            Attendance::Terminal
-        );
     }
 }

@@ -5,12 +5,14 @@
 
 mod advice;
 pub mod finish;
+pub mod meter;
 pub mod plan;
 pub mod report;
 pub mod request;
 pub mod run;
 pub mod verify;
 
+pub use meter::{meter_sees, SimulatedMeterOnRealScreen};
 pub use plan::{
     default_grid_steps, plan_advice, DriveStep, Plan, PlanError, PlanOptions, Purpose,
     DEFAULT_RAMP_STEPS,

@@ -10,6 +10,7 @@ use std::time::Duration;
 use metamer_drivers::{Instrument, Spec, Speed};
 
 use super::finish::files;
+use super::meter::meter_sees;
 use super::plan::{plan_advice, Plan, PlanOptions};
 use super::run::{log_path, run, CharacterizeError, Options, Outcome};
 use crate::display::ModelKind;
@@ -144,7 +145,7 @@ pub fn characterize(
     }
     let attended = match request.attend {
         Attend::Terminal { unattended } => {
-            attendance(&[request.instrument.as_str()], unattended)? == Attendance::Terminal
+            attendance(&[&request.instrument], unattended)? == Attendance::Terminal
         }
         Attend::Stage { unattended } => {
             !unattended && !matches!(request.screen, ScreenSpec::Virtual(_))
@@ -211,13 +212,12 @@ fn open_meter(
     display: &dyn Screen,
     listener: &mut dyn Listener,
 ) -> Result<Box<dyn Instrument>, CharacterizeError> {
-    let blind = request.instrument.is_simulated() && display.stimulus().is_none();
-    if blind && request.simulated_meter == SimulatedMeter::Refuse {
-        return Err(CharacterizeError::SimulatedMeterOnRealScreen {
-            meter: request.instrument.to_string(),
-            screen: display.spec(),
-        });
-    }
+    let blind = match meter_sees(&request.instrument, &request.screen) {
+        Err(e) if request.simulated_meter == SimulatedMeter::Refuse => {
+            return Err(CharacterizeError::SimulatedMeterOnRealScreen(e))
+        }
+        seen => seen.is_err(),
+    };
     let mut instrument = request
         .instrument
         .open(display.stimulus())

@@ -91,8 +91,8 @@ pub enum CharacterizeError {
     /// The meter refused the requested response speed.
     #[error(transparent)]
     Speed(metamer_drivers::DriverError),
-    #[error("the simulated meter {meter} cannot see the real screen {screen}; use a real meter, or a virtual display")]
-    SimulatedMeterOnRealScreen { meter: String, screen: String },
+    #[error(transparent)]
+    SimulatedMeterOnRealScreen(super::meter::SimulatedMeterOnRealScreen),
 }
 
 /// The journal of a characterization in `dir`.
