@@ -5,7 +5,6 @@
 //! and wire time), not the rig's (a display's settle time, an operator's hands).
 
 use crate::instrument::MeasureMode;
-use crate::registry;
 use crate::DriverError;
 
 /// What a planner asks: a reading in `mode` of a light of about `luminance_cd_m2`
@@ -71,30 +70,10 @@ impl TimeBudget {
 /// A model's budget from its facts.
 pub type TimeBudgetFn = fn(&TimeQuery) -> Result<TimeBudget, DriverError>;
 
-/// The time budget of model `name` (a registry name: `i1pro`, `cs100a`).
-pub fn time_budget(name: &str, query: &TimeQuery) -> Result<TimeBudget, DriverError> {
-    let model = registry::by_name(name).ok_or_else(|| DriverError::UnknownSpec {
-        spec: name.to_string(),
-        expected: registry::spec_forms(),
-    })?;
-    let budget = model.time_budget.ok_or_else(|| DriverError::Unsupported {
-        instrument: name.to_string(),
-        what: "a time budget (metamer has no driver for it)".into(),
-    })?;
-    if !query.luminance_cd_m2.is_finite() || query.luminance_cd_m2 < 0.0 {
-        return Err(DriverError::BadOption {
-            instrument: name.to_string(),
-            option: "expected luminance".into(),
-            value: query.luminance_cd_m2.to_string(),
-            message: "expected a luminance of 0 or more".into(),
-        });
-    }
-    budget(query)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::registry::time_budget;
 
     /// A session of 100 readings of 30 s each (3000 s) with a calibration of 10 s valid for
     /// 1800 s: one at the start and one after 1800 s, so 3020 s.

@@ -23,7 +23,7 @@ pub mod simulated;
 pub mod spec;
 pub mod world;
 
-pub use budget::{time_budget, TimeBudget, TimeQuery};
+pub use budget::{TimeBudget, TimeQuery};
 pub use cs100a::Cs100aError;
 pub use cs100a::Speed;
 pub use error::DriverError;
@@ -34,6 +34,7 @@ pub use instrument::{
 };
 pub use open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
 pub use permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};
+pub use registry::time_budget;
 pub use spec::{
     check_spec, is_physical, open_instrument, open_instrument_with, Spec, MAX_TIME_SCALE,
 };

@@ -238,6 +238,30 @@ pub fn spec_forms() -> String {
     }
 }
 
+/// The time budget of model `name` (a registry name: `i1pro`, `cs100a`).
+pub fn time_budget(
+    name: &str,
+    query: &crate::budget::TimeQuery,
+) -> Result<crate::budget::TimeBudget, DriverError> {
+    let model = by_name(name).ok_or_else(|| DriverError::UnknownSpec {
+        spec: name.to_string(),
+        expected: spec_forms(),
+    })?;
+    let budget = model.time_budget.ok_or_else(|| DriverError::Unsupported {
+        instrument: name.to_string(),
+        what: "a time budget (metamer has no driver for it)".into(),
+    })?;
+    if !query.luminance_cd_m2.is_finite() || query.luminance_cd_m2 < 0.0 {
+        return Err(DriverError::BadOption {
+            instrument: name.to_string(),
+            option: "expected luminance".into(),
+            value: query.luminance_cd_m2.to_string(),
+            message: "expected a luminance of 0 or more".into(),
+        });
+    }
+    budget(query)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -142,11 +142,11 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::budget::time_budget as budget_of;
     use crate::i1pro::emulator::{default_light, EmulatorConfig, I1ProEmulator};
     use crate::i1pro::{Clock, I1Pro, ManualClock};
     use crate::instrument::{CalibrationCondition, Instrument};
     use crate::link::usb_pair::usb_pair;
+    use crate::registry::time_budget as budget_of;
     use crate::world::{SharedWorld, View, World};
     use crate::Request;
 

@@ -108,4 +108,67 @@ mod tests {
         assert_eq!(hands.view(), lit);
         assert_eq!(quiet.prompts.len(), 2);
     }
+
+    /// `characterize` with a simulated i1Pro on every simulated monitor: its dark is taken
+    /// on its tile, so each black is read as the preset's (ideal-crt 0.05, ips-lcd 0.22,
+    /// wide-gamut-ccfl 0.40 cd/m²), not "too dark"; the CRT's, too dim for one reading, is
+    /// read six times. Within 5σ of the simulated unit's own noise at 2 s (0.013 cd/m²).
+    #[test]
+    fn an_i1pro_characterizes_every_simulated_monitor_black_included() {
+        use crate::display::characterize::{
+            characterize, Attend, Listener, Outcome, PlanOptions, Request, SimulatedMeter,
+        };
+        use crate::display::ModelKind;
+        use crate::rig::{Preset, ScreenSpec};
+        use crate::session::{NoProgress, ProgressSink, RunOptions};
+
+        struct Quiet(NoProgress);
+        impl Listener for Quiet {
+            fn note(&mut self, _: &str) {}
+            fn warning(&mut self, _: &str) {}
+            fn progress(&mut self, _: bool) -> &mut dyn ProgressSink {
+                &mut self.0
+            }
+        }
+        for preset in Preset::ALL {
+            let out = std::env::temp_dir().join(format!(
+                "metamer-hands-{}-{}",
+                preset.name(),
+                std::process::id()
+            ));
+            let _ = std::fs::remove_dir_all(&out);
+            let request = Request {
+                out: out.clone(),
+                screen: ScreenSpec::Virtual(preset),
+                virtual_white_cd_m2: None,
+                instrument: "sim:i1pro?time_scale=0".into(),
+                speed: None,
+                plan: PlanOptions {
+                    ramp_steps: 3,
+                    repeats: 1,
+                    grid_steps: 0,
+                },
+                model: ModelKind::Plcc,
+                settle: Some(std::time::Duration::ZERO),
+                resume: false,
+                force: false,
+                attend: Attend::Terminal { unattended: true },
+                simulated_meter: SimulatedMeter::Warn,
+                run: RunOptions::default(),
+            };
+            let outcome = characterize(&request, &mut Quiet(NoProgress))
+                .unwrap_or_else(|e| panic!("{}: {e}", preset.name()));
+            let Outcome::Finished(summary) = outcome else {
+                panic!("{}: nothing stops a simulated session", preset.name())
+            };
+            let want = preset.params().black_cd_m2;
+            let got = summary.black_xyz.y;
+            assert!(
+                (got - want).abs() < 5.0 * 0.013,
+                "{}: black Y {got}, the preset's {want}",
+                preset.name()
+            );
+            std::fs::remove_dir_all(&out).unwrap();
+        }
+    }
 }
