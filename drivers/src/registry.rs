@@ -73,6 +73,9 @@ pub struct Model {
     pub sim: Option<OpenSim>,
     /// Options of its simulation beyond `time_scale`, `seed` and `noise`.
     pub sim_options: &'static [&'static str],
+    /// How long its readings and calibrations take, from its protocol facts
+    /// ([`crate::budget`]); None while metamer has no driver for it.
+    pub time_budget: Option<crate::budget::TimeBudgetFn>,
 }
 
 /// Every known model. USB IDs from ArgyllCMS `usb/55-Argyll.rules` (facts only).
@@ -90,6 +93,7 @@ pub const MODELS: &[Model] = &[
         replay: Some(crate::cs100a::open::replay),
         sim: Some(crate::cs100a::open::sim),
         sim_options: &[],
+        time_budget: Some(crate::cs100a::budget::time_budget),
     },
     Model {
         name: crate::i1pro::MODEL,
@@ -108,6 +112,7 @@ pub const MODELS: &[Model] = &[
         replay: Some(crate::i1pro::open::replay),
         sim: Some(crate::i1pro::open::sim),
         sim_options: &["rev", "diffuser"],
+        time_budget: Some(crate::i1pro::budget::time_budget),
     },
     Model {
         name: "i1pro3",
@@ -122,6 +127,7 @@ pub const MODELS: &[Model] = &[
         replay: None,
         sim: None,
         sim_options: &[],
+        time_budget: None,
     },
     Model {
         name: "colormunki",
@@ -136,6 +142,7 @@ pub const MODELS: &[Model] = &[
         replay: None,
         sim: None,
         sim_options: &[],
+        time_budget: None,
     },
     Model {
         name: "i1d3",
@@ -150,6 +157,7 @@ pub const MODELS: &[Model] = &[
         replay: None,
         sim: None,
         sim_options: &[],
+        time_budget: None,
     },
 ];
 
@@ -228,6 +236,30 @@ pub fn spec_forms() -> String {
         Some((last, [])) => last.clone(),
         Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
     }
+}
+
+/// The time budget of model `name` (a registry name: `i1pro`, `cs100a`).
+pub fn time_budget(
+    name: &str,
+    query: &crate::budget::TimeQuery,
+) -> Result<crate::budget::TimeBudget, DriverError> {
+    let model = by_name(name).ok_or_else(|| DriverError::UnknownSpec {
+        spec: name.to_string(),
+        expected: spec_forms(),
+    })?;
+    let budget = model.time_budget.ok_or_else(|| DriverError::Unsupported {
+        instrument: name.to_string(),
+        what: "a time budget (metamer has no driver for it)".into(),
+    })?;
+    if !query.luminance_cd_m2.is_finite() || query.luminance_cd_m2 < 0.0 {
+        return Err(DriverError::BadOption {
+            instrument: name.to_string(),
+            option: "expected luminance".into(),
+            value: query.luminance_cd_m2.to_string(),
+            message: "expected a luminance of 0 or more".into(),
+        });
+    }
+    budget(query)
 }
 
 #[cfg(test)]

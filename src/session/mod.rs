@@ -33,4 +33,4 @@ pub use progress::{BarProgress, NoProgress, ProgressSink, StageOf, StepProgress}
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
 pub use screen::{MeterAim, Placement, Screen, ScreenError};
-pub use step::{Rig, StepFailure};
+pub use step::{Rig, StepFailure, AIM_AT_SCREEN_AGAIN};

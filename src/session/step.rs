@@ -72,6 +72,11 @@ pub enum StepFailure {
     Journal(#[from] JournalError),
 }
 
+/// What the operator is asked after a calibration moved the instrument (onto its tile, under
+/// a cap) before a step that shows a colour: the screen step has no placement prompt of its
+/// own, so without it the instrument would read its tile or its cap.
+pub const AIM_AT_SCREEN_AGAIN: &str = "aim the instrument at the screen again";
+
 /// Noise streams with this bit set are calibrations' (see [`StepTaker::calibrate`]); plan
 /// indices never reach it.
 const CALIBRATION_NOISE: u64 = 1 << 63;
@@ -186,7 +191,9 @@ where
         noise_step: usize,
     ) -> Result<bool, StepFailure> {
         let (role, mode) = (self.step.role.clone(), self.step.mode);
+        let mut moved = false;
         for _ in 0..CALIBRATION_ATTEMPTS {
+            moved |= condition != CalibrationCondition::OnTarget;
             let model = self.instrument()?.info().model;
             let prompt = format!(
                 "{role} instrument ({model}), {mode} calibration: {}",
@@ -215,6 +222,10 @@ where
                     self.progress.note(&format!(
                         "calibrated the {role} instrument ({model}) for {mode} readings {how}"
                     ));
+                    if moved && matches!(self.step.prepare, Prepare::Show { .. }) {
+                        let prompt = format!("{role} instrument ({model}): {AIM_AT_SCREEN_AGAIN}");
+                        return Ok(self.ask(&prompt)? == Answer::Confirmed);
+                    }
                     return Ok(true);
                 }
                 CalibrationOutcome::Needs(next) => {

@@ -6,6 +6,7 @@
 //! requested speed differs from the one last set, then `MES` per reading. Every exchange
 //! discards stale input first (PP and VCC do the same, [C2]).
 
+pub mod budget;
 pub mod emulator;
 pub mod error;
 pub mod open;

@@ -162,6 +162,9 @@ pub struct I1ProEmulator {
     noise: crate::noise::NoiseCursor,
     /// In low power; after the power-up reset, the GetMisc answers still to come in it.
     low_power: Option<(bool, u32)>,
+    /// The instrument's own time at the real unit's pace, whatever the time scale: every
+    /// measurement's integration (and lamp warm-up) adds to it.
+    real_pace: super::ManualClock,
 }
 
 /// The light a world gives as the instrument's 36 bands, mW·m⁻²·sr⁻¹·nm⁻¹.
@@ -249,7 +252,14 @@ impl I1ProEmulator {
             mode: 1,
             pending: None,
             measurements: 0,
+            real_pace: super::ManualClock::new(),
         })
+    }
+
+    /// The clock the simulated unit's measurements advance at the real unit's pace (a
+    /// session's instrument time, also when it runs at `time_scale` 0).
+    pub fn real_pace_clock(&self) -> super::ManualClock {
+        self.real_pace.clone()
     }
 
     /// The handle a session moves the noise stream with (see
@@ -388,6 +398,7 @@ impl I1ProEmulator {
                     } else {
                         0.0
                     };
+                self.real_pace.advance(t);
                 let delay = crate::link::duration_s(t * self.config.time_scale);
                 self.measurements += 1;
                 self.pending = Some((delay, bytes));

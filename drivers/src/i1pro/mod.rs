@@ -8,6 +8,7 @@
 //! Not done: the Rev E wavelength re-calibration with its LED (the factory mapping from the
 //! EEPROM is used as it is), high gain, scans, and restoring calibrations from the EEPROM.
 
+pub mod budget;
 pub mod clock;
 pub mod emulator;
 mod engine;

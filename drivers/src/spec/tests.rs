@@ -207,6 +207,7 @@ const FAKE: &[Model] = &[Model {
     replay: None,
     sim: None,
     sim_options: &[],
+    time_budget: None,
 }];
 
 #[test]

@@ -5,6 +5,7 @@
 
 mod advice;
 pub mod finish;
+mod hands;
 pub mod meter;
 pub mod plan;
 pub mod report;

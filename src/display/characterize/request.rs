@@ -5,11 +5,13 @@
 //! so that it is visible in one place rather than in two copies of the same steps.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
-use metamer_drivers::{Instrument, Spec, Speed};
+use metamer_drivers::{Instrument, Spec, Speed, World};
 
 use super::finish::files;
+use super::hands::{Hands, HandsOperator};
 use super::meter::meter_sees;
 use super::plan::{plan_advice, Plan, PlanOptions};
 use super::run::{log_path, run, CharacterizeError, Options, Outcome};
@@ -167,7 +169,10 @@ pub fn characterize(
     for warning in display.warnings() {
         listener.warning(&warning);
     }
-    let mut instrument = open_meter(request, display.as_ref(), listener)?;
+    // A simulated monitor's meter is moved onto its tile for calibrations and back.
+    let hands = display.stimulus().map(Hands::new);
+    let seen = hands.clone().map(|h| h as Arc<dyn World>);
+    let mut instrument = open_meter(request, seen, listener)?;
     let options = Options {
         dir: out.to_path_buf(),
         plan: request.plan,
@@ -184,11 +189,22 @@ pub fn characterize(
         (Attend::Stage { .. }, true) => Box::new(TerminalOperator),
         (Attend::Stage { .. }, false) => Box::new(ScriptedOperator::confirming()),
     };
+    let mut moved;
+    let operator: &mut dyn Operator = match hands {
+        Some(hands) => {
+            moved = HandsOperator {
+                hands,
+                inner: operator.as_mut(),
+            };
+            &mut moved
+        }
+        None => operator.as_mut(),
+    };
     run(
         &options,
         display.as_mut(),
         instrument.as_mut(),
-        operator.as_mut(),
+        operator,
         listener.progress(attended),
     )
 }
@@ -206,10 +222,11 @@ pub fn open_screen(
     })
 }
 
-/// The request's meter, aimed at `display`, at the requested speed.
+/// The request's meter, aimed at `display` (a simulated meter sees `seen`), at the
+/// requested speed.
 fn open_meter(
     request: &Request,
-    display: &dyn Screen,
+    seen: Option<Arc<dyn World>>,
     listener: &mut dyn Listener,
 ) -> Result<Box<dyn Instrument>, CharacterizeError> {
     let blind = match meter_sees(&request.instrument, &request.screen) {
@@ -220,7 +237,7 @@ fn open_meter(
     };
     let mut instrument = request
         .instrument
-        .open(display.stimulus())
+        .open(seen)
         .map_err(CharacterizeError::Instrument)?;
     if blind {
         listener.warning(
