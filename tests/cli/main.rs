@@ -9,6 +9,7 @@ mod color_cli;
 mod devices_cli;
 mod i1pro_spot_cli;
 mod light_cli;
+mod oracle_probe;
 mod output_policy_cli;
 mod simulate_cli;
 mod spot_cli;

@@ -9,6 +9,7 @@ use metamer::display::{fit_profile, select_model, write_ti3, FitOptions, ModelKi
 use metamer::rig::{Preset, VirtualPanel};
 use metamer_drivers::cs100a::emulator::{SIGMA_XY, SIGMA_Y_REL};
 use metamer_drivers::noise::{stream_seed, SplitMix64};
+use crate::support::oracle::{COLPROF, XICCLU};
 
 /// Black, white and 16 steps of each primary (1/16 … 16/16 of full drive, as 8-bit codes).
 fn ramp_codes() -> Vec<[u8; 3]> {
@@ -95,10 +96,11 @@ fn ramp_set(preset: Preset, noise_seed: Option<u64>) -> (VirtualPanel, Vec<Sampl
 }
 
 /// ArgyllCMS `colprof -qm -as` on the same set and its inverse (`xicclu -fb -iA -pX`), run as
-/// an external program when it is installed; None otherwise.
+/// an external program when it is installed; None (with the reason printed) otherwise.
 fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path) -> Option<f64> {
     use std::process::Command;
-    Command::new("colprof").arg("-?").output().ok()?;
+    let colprof = COLPROF.find()?;
+    let xicclu = XICCLU.find()?;
     std::fs::create_dir_all(dir).unwrap();
     write_ti3(
         &dir.join("ramps.ti3"),
@@ -107,7 +109,7 @@ fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path
         &metamer::output::OutputPolicy::new(true),
     )
     .unwrap();
-    let status = Command::new("colprof")
+    let status = Command::new(colprof)
         .args(["-qm", "-as", "-D", "ramps", "ramps"])
         .current_dir(dir)
         .output()
@@ -118,7 +120,7 @@ fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path
         .iter()
         .map(|t| format!("{:.8} {:.8} {:.8}\n", t[0], t[1], t[2]))
         .collect();
-    let mut child = Command::new("xicclu")
+    let mut child = Command::new(xicclu)
         .args(["-v0", "-fb", "-iA", "-pX", "ramps.icc"])
         .current_dir(dir)
         .stdin(std::process::Stdio::piped())
