@@ -7,6 +7,7 @@ mod support;
 mod characterize_cli;
 mod color_cli;
 mod devices_cli;
+mod docs_commands;
 mod i1pro_spot_cli;
 mod light_cli;
 mod oracle_probe;
