@@ -101,6 +101,10 @@ pub fn run(args: Args) -> CliResult {
             // Each reading is shown as it arrives: a later failure must not hide earlier ones.
             out.flush()
         }
+        SpotEvent::Note(text) => {
+            eprintln!("note: {text}");
+            Ok(())
+        }
         SpotEvent::Stopped { done, of } => {
             eprintln!("stopped at your request after {done} of {of} readings");
             Ok(())

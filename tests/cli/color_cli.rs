@@ -214,7 +214,11 @@ print(json.dumps(out))
         .arg(method)
         .output()
         .expect("python3 runs");
-    assert!(o.status.success(), "colour-science's script failed: {}", stderr(&o));
+    assert!(
+        o.status.success(),
+        "colour-science's script failed: {}",
+        stderr(&o)
+    );
     Some(serde_json::from_slice(&o.stdout).unwrap())
 }
 

@@ -147,7 +147,9 @@ pub fn parse(text: &str) -> Result<(Vec<Block>, Vec<Figure>), String> {
                     lines: join_lines(&body),
                 });
             } else if marks != Marks::default() {
-                return Err(format!("line {fence}: doc-test marks on a block that is not `sh`"));
+                return Err(format!(
+                    "line {fence}: doc-test marks on a block that is not `sh`"
+                ));
             }
             marks = Marks::default();
         } else if !trimmed.is_empty() && marks != Marks::default() {
@@ -325,8 +327,7 @@ pub fn runnable(text: &str, with: &[(String, String)]) -> Runnable {
     let simulated = |model: &str| format!("'sim:{model}?time_scale=0'");
     for i in 0..words.len() {
         let w = &words[i];
-        if w.contains('|') && w != "|" && w != "||" && !w.starts_with('\'') && !w.starts_with('"')
-        {
+        if w.contains('|') && w != "|" && w != "||" && !w.starts_with('\'') && !w.starts_with('"') {
             words[i] = w.split('|').next().unwrap_or_default().to_string();
         }
         if let Some((_, value)) = with.iter().find(|(name, _)| *name == words[i]) {
@@ -363,7 +364,9 @@ fn subcommand(command: &str) -> Vec<String> {
         .split_whitespace()
         .skip(1)
         .take_while(|w| {
-            !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-')
+            !w.is_empty()
+                && w.chars().all(|c| c.is_ascii_lowercase() || c == '-')
+                && !w.starts_with('-')
         })
         .map(str::to_string)
         .collect()
@@ -422,7 +425,8 @@ fn run_shell(command: &str, dir: &Path, log: &str) -> Ran {
         }
         std::thread::sleep(Duration::from_millis(50));
     };
-    let read = |p: &Path| String::from_utf8_lossy(&std::fs::read(p).unwrap_or_default()).into_owned();
+    let read =
+        |p: &Path| String::from_utf8_lossy(&std::fs::read(p).unwrap_or_default()).into_owned();
     Ran {
         ok: status == "exit status: 0",
         status,
@@ -533,7 +537,10 @@ fn run_document(doc: &str) -> Vec<String> {
                 root().join(from)
             };
             if let Err(e) = copy(&source, &dir.join(path)) {
-                failures.push(format!("{at}: copy {path}={from}: {}: {e}", source.display()));
+                failures.push(format!(
+                    "{at}: copy {path}={from}: {}: {e}",
+                    source.display()
+                ));
                 prepared = false;
             }
         }
@@ -689,7 +696,10 @@ fn every_document_is_run() {
     found.sort();
     let mut listed: Vec<String> = DOCUMENTS.iter().map(|d| d.to_string()).collect();
     listed.sort();
-    assert_eq!(found, listed, "DOCUMENTS in tests/cli/docs_commands.rs lists every document");
+    assert_eq!(
+        found, listed,
+        "DOCUMENTS in tests/cli/docs_commands.rs lists every document"
+    );
 }
 
 #[test]
@@ -720,7 +730,10 @@ fn the_other_documents_commands_run_as_written() {
 
 #[test]
 fn a_documented_command_is_read_as_its_header_says() {
-    let with = [("FILE.ti3".to_string(), "tests/data/dispread_cal.ti3".to_string())];
+    let with = [(
+        "FILE.ti3".to_string(),
+        "tests/data/dispread_cal.ti3".to_string(),
+    )];
     assert_eq!(
         runnable(
             "metamer fit --measurements FILE.ti3|FILE.csv --model plcc|lut [--folds 5] \
@@ -728,8 +741,9 @@ fn a_documented_command_is_read_as_its_header_says() {
             &with
         ),
         Runnable {
-            command: "metamer fit --measurements tests/data/dispread_cal.ti3 --model plcc -o P.json"
-                .into(),
+            command:
+                "metamer fit --measurements tests/data/dispread_cal.ti3 --model plcc -o P.json"
+                    .into(),
             optional_flags: vec![
                 "--folds".into(),
                 "--icc".into(),
@@ -749,10 +763,17 @@ fn a_documented_command_is_read_as_its_header_says() {
     );
     // Simulated specs and redirections are left as written.
     assert_eq!(
-        runnable("metamer spot --instrument 'sim:i1pro?time_scale=0' --json > a.json", &[]).command,
+        runnable(
+            "metamer spot --instrument 'sim:i1pro?time_scale=0' --json > a.json",
+            &[]
+        )
+        .command,
         "metamer spot --instrument 'sim:i1pro?time_scale=0' --json > a.json"
     );
-    assert_eq!(subcommand("metamer render spots-from-image image.exr"), ["render", "spots-from-image"]);
+    assert_eq!(
+        subcommand("metamer render spots-from-image image.exr"),
+        ["render", "spots-from-image"]
+    );
 }
 
 #[test]
@@ -791,7 +812,10 @@ fn marks_blocks_and_figures_are_read_from_the_markdown() {
     );
     assert_eq!(blocks[0].marks.with.len(), 2);
     assert_eq!(
-        figures.iter().map(|f| (f.number, f.value.as_str())).collect::<Vec<_>>(),
+        figures
+            .iter()
+            .map(|f| (f.number, f.value.as_str()))
+            .collect::<Vec<_>>(),
         [(10, "0.25"), (10, "-3")]
     );
     assert!(parse("<!-- doc-test: skip: -->\n```sh\nx\n```\n")

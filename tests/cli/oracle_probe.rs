@@ -48,7 +48,12 @@ fn a_program_off_path_is_missing_with_its_name() {
 #[test]
 fn a_program_that_fails_its_probe_is_missing_with_its_last_error_line() {
     let dir = fresh_dir("fake-oracle");
-    script(&dir, "metamer-fake-oracle", "fake: the library it needs is gone", 3);
+    script(
+        &dir,
+        "metamer-fake-oracle",
+        "fake: the library it needs is gone",
+        3,
+    );
     let why = FAKE.probe(&[("PATH", dir.as_os_str())]).unwrap_err();
     let exe = dir.join("metamer-fake-oracle");
     assert_eq!(

@@ -2,6 +2,7 @@
 //! primary, no mixtures): which model `--model auto` picks, judged as a rendering uses the
 //! profile, by the inverse round trip through the true display on mixed colours.
 
+use crate::support::oracle::{COLPROF, XICCLU};
 use metamer::color::{delta_e2000, Xyz};
 use metamer::display::characterize::plan::{colorchecker_srgb, random_patches};
 use metamer::display::characterize::plan::{RANDOM_VERIFICATION, VERIFICATION_SEED};
@@ -9,7 +10,6 @@ use metamer::display::{fit_profile, select_model, write_ti3, FitOptions, ModelKi
 use metamer::rig::{Preset, VirtualPanel};
 use metamer_drivers::cs100a::emulator::{SIGMA_XY, SIGMA_Y_REL};
 use metamer_drivers::noise::{stream_seed, SplitMix64};
-use crate::support::oracle::{COLPROF, XICCLU};
 
 /// Black, white and 16 steps of each primary (1/16 … 16/16 of full drive, as 8-bit codes).
 fn ramp_codes() -> Vec<[u8; 3]> {

@@ -494,11 +494,9 @@ fn report_prints_to_pdf_without_splitting_a_figure() {
     let Some(browser) = browser() else {
         return;
     };
-    let (Some(pdftotext), Some(pdfinfo), Some(pdftoppm)) = (
-        PDFTOTEXT.find(),
-        PDFINFO.find(),
-        PDFTOPPM.find(),
-    ) else {
+    let (Some(pdftotext), Some(pdfinfo), Some(pdftoppm)) =
+        (PDFTOTEXT.find(), PDFINFO.find(), PDFTOPPM.find())
+    else {
         return;
     };
     let dir = fresh("report-print");

@@ -31,7 +31,10 @@ pub struct Oracle {
 pub const MITSUBA: Oracle = Oracle {
     name: "Mitsuba 3",
     programs: &["python3"],
-    probe: &["-c", "import mitsuba as mi; mi.set_variant('scalar_spectral')"],
+    probe: &[
+        "-c",
+        "import mitsuba as mi; mi.set_variant('scalar_spectral')",
+    ],
     install: "python3 -m pip install mitsuba==3.9.1",
 };
 
@@ -238,9 +241,7 @@ impl Oracle {
 /// `program` as a file: itself when it is a path, else the first match on `path`.
 fn locate(program: &str, path: &OsString) -> Option<PathBuf> {
     if program.contains('/') {
-        return Path::new(program)
-            .is_file()
-            .then(|| PathBuf::from(program));
+        return Path::new(program).is_file().then(|| PathBuf::from(program));
     }
     std::env::split_paths(path)
         .map(|d| d.join(program))
