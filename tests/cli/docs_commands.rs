@@ -17,7 +17,8 @@
 //!
 //! Marks, each an HTML comment on its own line just above the block (blank lines allowed):
 //! - `<!-- doc-test: skip: WHY -->` — the block is not run (hardware, root, a long run);
-//! - ``<!-- doc-test: skip `PREFIX`: WHY -->`` — its commands that begin with PREFIX are not;
+//! - ``<!-- doc-test: skip `PREFIX`: WHY -->`` — its commands that begin with PREFIX are not
+//!   (`PREFIX$`: the command that is exactly PREFIX);
 //! - `<!-- doc-test: with NAME=VALUE … -->` — a placeholder's value (whole words only);
 //! - `<!-- doc-test: copy PATH=FROM -->` — the scratch folder gets FROM (a path in the shared
 //!   lab run `lab-out/…`, or the repository's) as PATH before the block runs;
@@ -235,6 +236,15 @@ fn last_number(text: &str) -> Option<String> {
         start -= 1;
     }
     Some(text[start..end].trim_start_matches('.').to_string())
+}
+
+/// Whether a skip mark's `prefix` names `command`: its beginning, or with a final `$`
+/// the whole of it.
+fn skips(prefix: &str, command: &str) -> bool {
+    match prefix.strip_suffix('$') {
+        Some(whole) => command == whole,
+        None => command.starts_with(prefix),
+    }
 }
 
 /// Joins continuation lines and drops comments and blank lines.
@@ -553,7 +563,7 @@ fn run_document(doc: &str) -> Vec<String> {
                 .marks
                 .skip_prefixes
                 .iter()
-                .find(|(prefix, _)| line.text.starts_with(prefix.as_str()))
+                .find(|(prefix, _)| skips(prefix, &line.text))
             {
                 eprintln!("{where_}: skipped `{}`: {why}", line.text);
                 continue;
@@ -824,6 +834,9 @@ fn marks_blocks_and_figures_are_read_from_the_markdown() {
     assert!(parse("<!-- doc-test: skip: why -->\ntext\n```sh\nx\n```\n")
         .unwrap_err()
         .starts_with("line 2: doc-test marks must stand just above"));
+    assert!(skips("metamer b", "metamer b --json"));
+    assert!(skips("metamer b$", "metamer b"));
+    assert!(!skips("metamer b$", "metamer b --json"));
     assert!(contains_number("mean 0.25, max 0.84.", "0.25"));
     assert!(contains_number("mean 0.25, max 0.84.", "0.84"));
     assert!(!contains_number("mean 0.253", "0.25"));

@@ -167,6 +167,7 @@ impl Oracle {
                 .clone()
         };
         self.decide(found, required())
+            .unwrap_or_else(|message| panic!("{message}"))
     }
 
     /// Probes the oracle with `env` added to this process's environment (a variable set to
@@ -220,19 +221,25 @@ impl Oracle {
         Err(reasons.join("; "))
     }
 
-    /// What [`Oracle::find`] does with a probe's result: the program, a skip, or a panic.
-    #[track_caller]
-    pub fn decide(&self, probed: Result<PathBuf, String>, required: bool) -> Option<PathBuf> {
+    /// What [`Oracle::find`] does with a probe's result: the program, a skip (None, with
+    /// the reason printed), or, when the oracle is required, the failure's message.
+    pub fn decide(
+        &self,
+        probed: Result<PathBuf, String>,
+        required: bool,
+    ) -> Result<Option<PathBuf>, String> {
         match probed {
-            Ok(exe) => Some(exe),
+            Ok(exe) => Ok(Some(exe)),
             Err(why) => {
                 let message = format!(
                     "{} is missing: {why} (install: {}; .ci/run installs it)",
                     self.name, self.install
                 );
-                assert!(!required, "METAMER_ORACLES=required but {message}");
+                if required {
+                    return Err(format!("METAMER_ORACLES=required but {message}"));
+                }
                 eprintln!("skipped: {message}");
-                None
+                Ok(None)
             }
         }
     }
