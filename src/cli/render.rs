@@ -282,16 +282,42 @@ fn spots(a: SpotsArgs) -> CliResult {
         outln!("{}", report.to_json()?)?;
         return Ok(());
     }
-    print_provenance(&report.scene)?;
-    print_spots(&report.readings)
+    print_spots(&report.readings)?;
+    print_provenance(&report.scene)
 }
 
-/// The scene's provenance, one line, ahead of the readings.
+/// The scene's provenance in one short line after the readings (the answer comes first):
+/// its plain values in full, a nested object or list by its size; `--json` carries it all.
 fn print_provenance(scene: &Scene) -> CliResult {
     if let Some(p) = &scene.provenance {
-        outln!("provenance: {}", serde_json::Value::Object(p.clone()))?;
+        outln!(
+            "provenance (in full with --json): {}",
+            provenance_summary(p)
+        )?;
     }
     Ok(())
+}
+
+fn provenance_summary(p: &serde_json::Map<String, serde_json::Value>) -> String {
+    use serde_json::Value;
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    let shown = |v: &Value| match v {
+        Value::String(s) if s.chars().count() <= 60 => s.clone(),
+        Value::String(s) => format!("{}…", s.chars().take(60).collect::<String>()),
+        Value::Object(o)
+            if o.values().all(|v| !v.is_object() && !v.is_array()) && v.to_string().len() <= 80 =>
+        {
+            v.to_string()
+        }
+        Value::Object(o) => format!("{{{} field{}}}", o.len(), plural(o.len())),
+        Value::Array(a) if a.is_empty() => "none".into(),
+        Value::Array(a) => format!("[{} item{}]", a.len(), plural(a.len())),
+        other => other.to_string(),
+    };
+    p.iter()
+        .map(|(k, v)| format!("{k} {}", shown(v)))
+        .collect::<Vec<_>>()
+        .join(" · ")
 }
 
 /// The run's white and time, then one row per patch with its uncertainty as its solver
@@ -382,7 +408,6 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
         outln!("{}", report.to_json()?)?;
         return Ok(());
     }
-    print_provenance(&report.scene)?;
     let w = report.white;
     outln!(
         "{} ({}×{}, sha256 {}): white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s",
@@ -418,7 +443,7 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
             c.effective
         )?;
     }
-    Ok(())
+    print_provenance(&report.scene)
 }
 
 fn image(a: ImageArgs) -> CliResult {
@@ -530,4 +555,28 @@ fn print_probes(report: &ProbesReport) -> CliResult {
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::provenance_summary;
+
+    #[test]
+    fn the_provenance_line_shows_plain_values_and_sizes_the_rest() {
+        let p: serde_json::Value = serde_json::json!({
+            "date": "2026-12-07T17:11:19Z",
+            "clamped_values": 0,
+            "instrument_specs": {"spot": "sim:cs100a"},
+            "instruments": {"spot": {"model": "cs100a"}},
+            "journals": [{"file": "a"}, {"file": "b"}],
+            "outliers": [],
+        });
+        // serde_json's map keeps its keys sorted.
+        assert_eq!(
+            provenance_summary(p.as_object().unwrap()),
+            "clamped_values 0 · date 2026-12-07T17:11:19Z · instrument_specs \
+             {\"spot\":\"sim:cs100a\"} · instruments {1 field} · journals [2 items] · \
+             outliers none"
+        );
+    }
 }

@@ -99,6 +99,10 @@ pub fn run(args: Args) -> CliResult {
             // Each reading is shown as it arrives: a later failure must not hide earlier ones.
             Ok(super::console::flush()?)
         }
+        SpotEvent::Note(text) => {
+            errln!("note: {text}")?;
+            Ok(())
+        }
         SpotEvent::Stopped { done, of } => {
             errln!("stopped at your request after {done} of {of} readings")?;
             Ok(())

@@ -239,9 +239,10 @@ pub(super) fn text(
         "\n## Reading the image back\n\n`metamer render spots-from-image IMAGE --scene {} --json > \
          readings.json` reads the image back as the 24 meter readings, each with its \
          uncertainty from the pixels' spread; `metamer validate --reference SPOTS \
-         --simulation readings.json` compares them with the box, and `metamer experiment \
-         --simulation-image IMAGE` runs the whole chain with this renderer's image as the \
-         simulation.\n",
+         --test readings.json -o DIR` compares them with the box's spot readings (SPOTS: \
+         the box's `spots.jsonl`, or an experiment's `box/spots.csv`), and `metamer \
+         experiment -o DIR --box-scene SCENE --box-spots SPOTS --simulation-image IMAGE` \
+         runs the whole chain with this renderer's image as the simulation.\n",
         scene_name
             .strip_prefix("built-in scene ")
             .unwrap_or(scene_name)

@@ -165,6 +165,9 @@ pub fn measure<'p>(
         seed: request.seed,
         light,
     };
+    if let Some(pace) = crate::session::pace_note(&[&spectral, &spot]) {
+        note(pace);
+    }
     let mut rig = setup::open(&rig_request, || attended.operator(), note)?;
     let mut output = OutputPolicy::new(request.force);
     if let Some(p) = &request.plan {

@@ -29,7 +29,9 @@ pub use operator::{
     TerminalOperator, Unattended,
 };
 pub use plan::{placements, Prepare, SessionPlan, Step};
-pub use progress::{BarProgress, NoProgress, ProgressSink, StageOf, StepProgress};
+pub use progress::{
+    pace_note, BarProgress, Heartbeat, NoProgress, ProgressSink, StageOf, StepProgress,
+};
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
 pub use screen::{MeterAim, Placement, Screen, ScreenError};

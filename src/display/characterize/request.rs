@@ -142,9 +142,6 @@ pub fn characterize(
 ) -> Result<Outcome, CharacterizeError> {
     let out = request.out.as_path();
     let plan = Plan::new(request.plan)?;
-    if let Some(advice) = plan_advice(&plan) {
-        listener.note(&advice);
-    }
     let attended = match request.attend {
         Attend::Terminal { unattended } => {
             attendance(&[&request.instrument], unattended)? == Attendance::Terminal
@@ -163,6 +160,14 @@ pub fn characterize(
                 policy.check(f)?;
             }
         }
+    }
+    if let Some(pace) = crate::session::pace_note(&[&request.instrument]) {
+        listener.note(&pace);
+    }
+    // After every refusal: a note on what the plan can judge is no answer to a command
+    // that will not run.
+    if let Some(advice) = plan_advice(&plan) {
+        listener.note(&advice);
     }
     let mut display = open_screen(&request.screen, request.virtual_white_cd_m2)
         .map_err(CharacterizeError::OpenScreen)?;
