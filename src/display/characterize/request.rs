@@ -182,7 +182,7 @@ pub fn characterize(
         dir: out.to_path_buf(),
         plan: request.plan,
         model: request.model,
-        instrument: request.instrument.to_string(),
+        instrument: request.instrument.clone(),
         settle: request.settle,
         resume: request.resume,
         force: request.force,

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use metamer_drivers::Instrument;
+use metamer_drivers::{Instrument, Spec};
 use serde::{Deserialize, Serialize};
 
 use super::finish::{files, finish, FinishError, MeasuredBy, Summary};
@@ -40,7 +40,7 @@ pub struct Options {
     pub plan: PlanOptions,
     pub model: ModelKind,
     /// The instrument as named by the user, for the files' provenance.
-    pub instrument: String,
+    pub instrument: Spec,
     /// Wait between showing a colour and measuring it; None: the display's default.
     pub settle: Option<Duration>,
     /// Continue the journal in `dir` instead of refusing it.
@@ -117,7 +117,7 @@ pub fn run(
     let details = LogDetails {
         display: display_name.clone(),
         display_description: display.describe(),
-        instrument: options.instrument.clone(),
+        instrument: options.instrument.to_string(),
     };
     let instruments = [(METER.to_string(), InstrumentRecord::of(instrument))].into();
     let mut session: Session<LogDetails, DriveStep> = Session::open(
