@@ -24,6 +24,14 @@ FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
 # error says which option, the command maps it to its flag), then delete the entry (the
 # script says when one has become stale).
 KNOWN = {
+    "src/color.rs: --method",
+    "src/experiment/error.rs: --simulation-image",
+    "src/export/readme.rs: --test",
+    "src/export/readme.rs: --box-scene",
+    "src/export/readme.rs: --box-spots",
+    "src/render/job/spots_from_image.rs: --target-de",
+    "src/render/job/spots_from_image.rs: --white",
+    "src/render/job/spots_from_image.rs: --max-seconds",
     "src/display/characterize/advice.rs: --instrument",
     "src/display/characterize/advice.rs: --resume",
     "src/display/characterize/advice.rs: --speed",
@@ -34,9 +42,6 @@ KNOWN = {
     "src/experiment/request.rs: --image-size",
     "src/experiment/request.rs: --image-spp",
     "src/experiment/request.rs: --repeats",
-    "src/experiment/request.rs: --scenario",
-    "src/experiment/request.rs: --spectral",
-    "src/experiment/request.rs: --spot",
     "src/experiment/request.rs: --target-de",
     "src/experiment/request.rs: --time-scale",
     "src/export/error.rs: --force",
@@ -44,7 +49,6 @@ KNOWN = {
     "src/export/readme.rs: --json",
     "src/export/readme.rs: --reference",
     "src/export/readme.rs: --scene",
-    "src/export/readme.rs: --simulation",
     "src/export/readme.rs: --simulation-image",
     "src/export/readme.rs: --spp",
     "src/export/readme.rs: --to",

@@ -30,6 +30,7 @@ KNOWN = {
     "src/experiment/display_spots.rs:measure",
     "src/experiment/report_input/display.rs:section",
     "src/experiment/report_input/light.rs:section",
+    "src/experiment/run.rs:run",
     "src/experiment/run.rs:run_stage",
     "src/export/mitsuba3.rs:files",
     "src/light/chart.rs:draw",
