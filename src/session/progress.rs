@@ -178,8 +178,11 @@ pub fn pace_note(specs: &[&Spec]) -> Option<String> {
         .collect();
     let (_, scale) = paced.first()?;
     let names: Vec<&str> = paced.iter().map(|(n, _)| n.as_str()).collect();
-    let pace = if paced.iter().all(|(_, s)| s == scale) && *scale == 1.0 {
+    let same = paced.iter().all(|(_, s)| s == scale);
+    let pace = if same && *scale == 1.0 {
         "at their real pace, as long as real ones take".to_string()
+    } else if same {
+        format!("at {scale} times their real pace")
     } else {
         let scales: Vec<String> = paced.iter().map(|(_, s)| format!("{s}")).collect();
         format!("at {} times their real pace", scales.join(", "))
@@ -333,5 +336,25 @@ mod tests {
             reading_summary(MeasureMode::Emissive, &dark),
             "Y 0.01230 cd/m² · xy —"
         );
+    }
+
+    #[test]
+    fn a_paced_simulation_is_named_and_an_instant_or_real_one_is_not() {
+        let instant = Spec::new("sim:cs100a?time_scale=0");
+        let real = Spec::new("cs100a:/dev/ttyUSB0");
+        let paced = Spec::new("sim:i1pro?time_scale=1");
+        let slow = Spec::new("sim:cs100a?time_scale=2");
+        assert_eq!(pace_note(&[&instant, &real]), None);
+        assert_eq!(
+            pace_note(&[&paced, &instant]).as_deref(),
+            Some(
+                "the simulated instruments (sim:i1pro?time_scale=1) run at their real pace, as \
+                 long as real ones take; `?time_scale=0` in a spec (or METAMER_SIM_TIME_SCALE=0) \
+                 makes them answer at once"
+            )
+        );
+        assert!(pace_note(&[&paced, &slow])
+            .unwrap()
+            .contains("(sim:i1pro?time_scale=1, sim:cs100a?time_scale=2) run at 1, 2 times"));
     }
 }

@@ -258,7 +258,9 @@ fn locate(program: &str, path: &OsString) -> Option<PathBuf> {
 fn shell_words(args: &[&str]) -> String {
     args.iter()
         .map(|a| {
-            if a.contains(' ') || a.contains(';') {
+            if a.contains('\'') {
+                format!("\"{a}\"")
+            } else if a.contains(' ') || a.contains(';') {
                 format!("'{a}'")
             } else {
                 a.to_string()
