@@ -295,7 +295,7 @@ pub fn run(
         .is_simulated()
         .then(|| simulated_target(request.mode))
         .transpose()?;
-    if let Some(pace) = crate::session::pace_note(&[&spec]) {
+    if let Some(pace) = crate::session::pace_note(&[spec]) {
         events(SpotEvent::Note(pace))?;
     }
     let mut instrument = open(request, spec, hands.as_ref())?;

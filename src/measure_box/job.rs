@@ -165,7 +165,7 @@ pub fn measure<'p>(
         seed: request.seed,
         light,
     };
-    if let Some(pace) = crate::session::pace_note(&[&spectral, &spot]) {
+    if let Some(pace) = crate::session::pace_note(&[spectral, spot]) {
         note(pace);
     }
     let mut rig = setup::open(&rig_request, || attended.operator(), note)?;
