@@ -30,6 +30,7 @@ pub mod propagate;
 pub mod readings;
 pub mod report;
 mod report_data;
+pub mod sequential;
 pub mod uncertain;
 pub mod verdict;
 
