@@ -43,7 +43,7 @@ fn diff(a: Lab, b: Lab) -> [f64; 3] {
 
 /// Whether the 95 % region of the mean of `taken` (n readings, one reading's CIELAB
 /// covariance from `noise` at their mean) holds `truth`.
-fn region_holds(taken: &[Xyz], noise: &Noise, truth: Xyz) -> bool {
+fn region_holds(taken: &[Xyz], noise: &RepeatNoise, truth: Xyz) -> bool {
     let (mean, _) = covariance::sample(taken);
     let c = noise.lab_covariance(mean, WHITE).unwrap();
     let d = diff(mean.to_lab(WHITE), truth.to_lab(WHITE));
@@ -64,9 +64,9 @@ fn check(name: &str, got: f64, mean_n: f64) {
 
 /// The yellow with the CS-100A's stated figure times `scale`, its one-reading
 /// covariance and the figure the rule is told.
-fn noisy_yellow(scale: f64) -> (Truth, Noise) {
+fn noisy_yellow(scale: f64) -> (Truth, RepeatNoise) {
     let t = yellow(2.3, scale, 5, 3);
-    let noise = Noise {
+    let noise = RepeatNoise {
         stated: cs100a(),
         scale2: scale * scale,
         dof: None,
@@ -162,7 +162,7 @@ fn pooled_session(targets: &[Xyz], scale: f64, session: u64) -> (Pool, Vec<bool>
         let one = covariance::scaled(&stated.covariance(truth).unwrap(), scale * scale);
         let all = readings(truth, &one, most, &mut rng);
         // The stopping figure: the pool's point estimate, taken as known.
-        let so_far = Noise {
+        let so_far = RepeatNoise {
             dof: None,
             ..pool.noise(stated)
         };
@@ -234,7 +234,7 @@ fn the_pooled_figure_is_honest_and_its_regions_are_covered() {
             let truth = targets[0];
             let one = covariance::scaled(&cs100a().covariance(truth).unwrap(), scale * scale);
             let all = readings(truth, &one, 3, &mut rng);
-            u64::from(region_holds(&all, &Noise::stated(cs100a()), truth))
+            u64::from(region_holds(&all, &RepeatNoise::stated(cs100a()), truth))
         })
         .sum::<u64>();
     let stated = share(stated, SESSIONS);
@@ -250,7 +250,7 @@ fn the_pooled_figure_is_honest_and_its_regions_are_covered() {
 /// the count, and whether the fixed-count interval (1.96 σ) at the same rule's stop would.
 fn verdict_session(
     t: &Truth,
-    noise: &Noise,
+    noise: &RepeatNoise,
     margin: f64,
     most: usize,
     s: u64,
@@ -299,7 +299,7 @@ fn the_verdict_rule_is_covered_at_the_jnd_and_beyond() {
     let stated = cs100a();
     // The meter's own noise: the first-order interval's domain (see the module's notes).
     let scale = 1.0;
-    let noise = Noise {
+    let noise = RepeatNoise {
         stated,
         scale2: scale * scale,
         dof: None,

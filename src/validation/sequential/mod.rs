@@ -156,16 +156,16 @@ impl RepeatRule {
 /// One reading's noise: the stated repeatability times `scale2`, known (`dof` None) or
 /// estimated with `dof` degrees of freedom.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Noise {
+pub struct RepeatNoise {
     pub stated: Repeatability,
     pub scale2: f64,
     pub dof: Option<f64>,
 }
 
-impl Noise {
+impl RepeatNoise {
     /// The stated figure, taken as known.
-    pub fn stated(stated: Repeatability) -> Noise {
-        Noise {
+    pub fn stated(stated: Repeatability) -> RepeatNoise {
+        RepeatNoise {
             stated,
             scale2: 1.0,
             dof: None,
@@ -222,7 +222,7 @@ pub fn region_quantile(dof: Option<f64>) -> f64 {
 
 /// The 95 % half-width in CIELAB of the mean of `n` readings at `level` (the radius of
 /// the ball holding the region); None without a chromaticity.
-pub fn half_width(level: Xyz, noise: &Noise, white: Xyz, n: usize) -> Option<f64> {
+pub fn half_width(level: Xyz, noise: &RepeatNoise, white: Xyz, n: usize) -> Option<f64> {
     let c = noise.lab_covariance(level, white)?;
     let (values, _) = covariance::eigen_decomposition(&c);
     let largest = values.iter().copied().fold(0.0, f64::max);
@@ -237,7 +237,7 @@ pub fn width_decided(
     half_width_jnd: f64,
     most: usize,
     readings: &[Xyz],
-    noise: &Noise,
+    noise: &RepeatNoise,
     white: Xyz,
 ) -> bool {
     let n = readings.len();
@@ -315,7 +315,7 @@ pub fn verdict(
     most: usize,
     reference: &Reference,
     readings: &[Xyz],
-    noise: &Noise,
+    noise: &RepeatNoise,
     white: Xyz,
 ) -> Option<VerdictLook> {
     let n = readings.len();
@@ -412,7 +412,7 @@ mod tests {
     fn the_width_rule_reads_until_the_half_width_is_reached() {
         let white = Xyz::new(95.047, 100.0, 108.883);
         let grey = Xyz::new(0.95047 * 20.0, 20.0, 1.08883 * 20.0);
-        let noise = Noise::stated(Repeatability::stated("cs100a", MeasureMode::Emissive));
+        let noise = RepeatNoise::stated(Repeatability::stated("cs100a", MeasureMode::Emissive));
         let h1 = half_width(grey, &noise, white, 1).unwrap();
         // The half-width of n readings is h1/√n.
         let h4 = half_width(grey, &noise, white, 4).unwrap();

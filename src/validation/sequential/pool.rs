@@ -12,7 +12,7 @@
 //! stated); the tests draw readings with a scale of 1 and of 2 and find it within its
 //! χ² interval at the stated rate.
 
-use super::Noise;
+use super::RepeatNoise;
 use crate::color::Xyz;
 use crate::session::repeats::Repeatability;
 use crate::validation::covariance;
@@ -46,11 +46,11 @@ impl Pool {
 
     /// The pooled factor on the stated covariance, with its degrees of freedom; the stated
     /// figure itself, known, while the pool is empty.
-    pub fn noise(&self, stated: Repeatability) -> Noise {
+    pub fn noise(&self, stated: Repeatability) -> RepeatNoise {
         if self.dof == 0 {
-            return Noise::stated(stated);
+            return RepeatNoise::stated(stated);
         }
-        Noise {
+        RepeatNoise {
             stated,
             scale2: self.sum / self.dof as f64,
             dof: Some(self.dof as f64),
