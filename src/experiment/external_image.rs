@@ -44,6 +44,11 @@ pub fn read_back(
         ..Request::new(image.to_path_buf(), Some(scene_file.to_path_buf()))
     };
     let report = spots_from_image::run(&request, &|_| {}).map_err(from_render)?;
+    // The read-back's warnings (a reference white cut short) are the operator's to see: the
+    // readings' XYZ stand, their printed CIELAB does not.
+    for w in &report.warnings {
+        progress(Progress::Note(format!("warning: {w}")));
+    }
     std::fs::create_dir_all(dir).map_err(|source| ExperimentError::Io {
         file: dir.to_path_buf(),
         source,
@@ -67,8 +72,67 @@ pub fn read_back(
             sha256: report.sha256.clone(),
             renderer: RENDERER.to_string(),
         }),
+        warnings: report.warnings.clone(),
     };
     let text = serde_json::to_string_pretty(&summary).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SUMMARY_FILE), text.as_bytes())?;
     Ok((summary, vec![SPOTS_FILE, SUMMARY_FILE, IMAGE_FILE]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::job::image::{run as render_image, ImageRequest};
+    use crate::render::method::Method;
+    use std::cell::RefCell;
+
+    /// A reference white that stops at its time limit short of its target is stated: a
+    /// warning line for the operator and the same words in `simulation.json`, which reads
+    /// back with them. Its target here (a third of 0.0003 ΔE*ab) would take hours.
+    #[test]
+    fn a_white_cut_short_is_printed_and_kept_in_the_summary() {
+        let dir = std::env::temp_dir().join(format!("metamer-ext-white-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let image = dir.join("box.exr");
+        // The built-in box, by the name a scene argument may give.
+        let scene = std::path::PathBuf::from("validation-box");
+        render_image(
+            &ImageRequest {
+                method: Method::Radiosity,
+                level: 1,
+                width: Some(128),
+                height: Some(128),
+                ..ImageRequest::new(1, image.clone())
+            },
+            &|_| {},
+        )
+        .unwrap();
+        let opts = SimulationOptions {
+            max_seconds: 1.0,
+            ..SimulationOptions::new(0.0003, 1, 0, 0, Some(image.clone()))
+        };
+        let notes = RefCell::new(Vec::new());
+        let (summary, _) = read_back(&scene, &image, &opts, &dir.join("stage"), &|p| {
+            if let Progress::Note(n) = p {
+                notes.borrow_mut().push(n)
+            }
+        })
+        .unwrap();
+        assert_eq!(summary.warnings.len(), 1, "{:?}", summary.warnings);
+        let w = &summary.warnings[0];
+        assert!(
+            w.starts_with("the reference white stopped at the time limit (1 s)"),
+            "{w}"
+        );
+        assert!(!w.contains("  "), "{w}");
+        assert!(
+            notes.borrow().contains(&format!("warning: {w}")),
+            "{:?}",
+            notes.borrow()
+        );
+        let text = std::fs::read_to_string(dir.join("stage").join(SUMMARY_FILE)).unwrap();
+        let back: SimulationSummary = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.warnings, summary.warnings);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -195,6 +195,9 @@ pub struct SimulationSummary {
     pub image_patches: Vec<ImagePatch>,
     /// Where the readings came from when metamer did not render them.
     pub source: Option<ExternalSource>,
+    /// What the operator must know of the readings (an external image's reference white
+    /// cut short by the time limit), as the stage printed it.
+    pub warnings: Vec<String>,
 }
 
 /// An external renderer's image the simulation's readings were read back from.
@@ -225,6 +228,8 @@ struct SummaryFile {
     image_patches: Vec<ImagePatch>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     source: Option<ExternalSource>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    warnings: Vec<String>,
 }
 
 /// One reading as `simulation.json` keeps it.
@@ -254,6 +259,7 @@ impl From<SimulationSummary> for SummaryFile {
             image_method: s.image_method,
             image_patches: s.image_patches,
             source: s.source,
+            warnings: s.warnings,
         }
     }
 }
@@ -281,6 +287,7 @@ impl From<SummaryFile> for SimulationSummary {
             image_method: f.image_method,
             image_patches: f.image_patches,
             source: f.source,
+            warnings: f.warnings,
         }
     }
 }
@@ -381,6 +388,7 @@ pub fn simulate(
         image,
         image_patches,
         source: None,
+        warnings: Vec::new(),
     };
     let text = serde_json::to_string_pretty(&summary).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(SUMMARY_FILE), text.as_bytes())?;

@@ -291,7 +291,10 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
 /// operator.
 fn short_white_warning(t: &TracedWhite) -> String {
     format!(
-        "the reference white stopped at the time limit ({} s) with a ΔE*ab 95 % half-width of          {:.3}, above its target of {:.3} (a third of --target-de): the readings' XYZ are as          read, but their CIELAB and ΔE95 carry the white's extra noise; give --white, or more          --max-seconds or a larger --target-de",
+        "the reference white stopped at the time limit ({} s) with a ΔE*ab 95 % half-width of \
+         {:.3}, above its target of {:.3} (a third of --target-de): the readings' XYZ are as \
+         read, but their CIELAB and ΔE95 carry the white's extra noise; give --white, or more \
+         --max-seconds or a larger --target-de",
         t.max_seconds, t.de_ci95, t.target_de
     )
 }
