@@ -5,19 +5,12 @@
 //! it, and the flags only a rendering stage uses are refused.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
 use crate::experiment::{box_spots, SCENE};
-use crate::support::{fresh_dir, stderr, text};
-
-fn metamer(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_metamer"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use crate::support::{fresh_dir, metamer, stderr, text};
 
 /// A radiosity image of the box's camera at `level` (another level, another image).
 fn image(path: &Path, level: &str) {
