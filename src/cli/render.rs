@@ -339,16 +339,8 @@ fn print_spots(readings: &Readings) -> CliResult {
                 }
             )?;
             outln!(
-                "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>10}",
-                "patch",
-                "X",
-                "Y",
-                "Z",
-                "L*",
-                "a*",
-                "b*",
-                "ΔE95",
-                "samples"
+                "{}",
+                reading_header(&format!("{:>8} {:>10}", "ΔE95", "samples"))
             )?;
         }
         Readings::Radiosity { result: r, .. } => {
@@ -365,25 +357,11 @@ fn print_spots(readings: &Readings) -> CliResult {
                     "  (level or time limit reached: bound above the target)"
                 }
             )?;
-            outln!(
-                "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>9}",
-                "patch",
-                "X",
-                "Y",
-                "Z",
-                "L*",
-                "a*",
-                "b*",
-                "ΔE bound"
-            )?;
+            outln!("{}", reading_header(&format!("{:>9}", "ΔE bound")))?;
         }
     }
     for p in readings.patches() {
-        let (Xyz { x, y, z }, [l, a, b]) = (p.xyz, p.lab);
-        let row = format!(
-            "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3}",
-            p.patch
-        );
+        let row = reading_row(p.patch, p.xyz, p.lab);
         match p.uncertainty {
             Uncertainty::HalfWidth95 { de, sampling } => {
                 let samples = sampling.map(|s| s.samples.to_string());
@@ -393,6 +371,21 @@ fn print_spots(readings: &Readings) -> CliResult {
         }?;
     }
     Ok(())
+}
+
+/// The header of a table of spot readings: the columns every such table starts with (patch,
+/// X, Y, Z, L*, a*, b*) and then `extra`, the table's own, as [`reading_row`] aligns them.
+fn reading_header(extra: &str) -> String {
+    format!(
+        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {extra}",
+        "patch", "X", "Y", "Z", "L*", "a*", "b*"
+    )
+}
+
+/// A reading's common columns under [`reading_header`].
+fn reading_row(patch: usize, xyz: Xyz, [l, a, b]: [f64; 3]) -> String {
+    let Xyz { x, y, z } = xyz;
+    format!("{patch:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3}")
 }
 
 fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
@@ -420,24 +413,12 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
         w[2],
         report.seconds
     )?;
-    outln!(
-        "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>7} {:>9}",
-        "patch",
-        "X",
-        "Y",
-        "Z",
-        "L*",
-        "a*",
-        "b*",
-        "ΔE95",
-        "pixels",
-        "effective"
-    )?;
+    let extra = format!("{:>8} {:>7} {:>9}", "ΔE95", "pixels", "effective");
+    outln!("{}", reading_header(&extra))?;
     for (p, c) in report.patches.iter().zip(&report.cones) {
-        let ([x, y, z], [l, a, b]) = (p.xyz.to_array(), p.lab);
         outln!(
-            "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3} {:>8.4} {:>7} {:>9.1}",
-            p.patch,
+            "{} {:>8.4} {:>7} {:>9.1}",
+            reading_row(p.patch, p.xyz, p.lab),
             p.uncertainty.de_ab(),
             c.pixels,
             c.effective
