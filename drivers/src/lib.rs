@@ -7,6 +7,7 @@
 //! the models and how each is opened are rows of the [`registry`].
 
 pub mod cs100a;
+pub mod describe;
 pub mod devices;
 pub mod i1pro;
 
