@@ -42,7 +42,7 @@ pub struct Description {
 /// A simulated unit's capabilities, standing for a kind of real unit.
 #[derive(Clone, Debug, Serialize)]
 pub struct Unit {
-    /// What kind of unit it stands for (`an i1Pro 2 (Rev E) with the diffuser`).
+    /// What kind of unit it stands for (`i1Pro 2 (Rev E) with the diffuser`).
     pub stands_for: &'static str,
     /// The spec it was opened with.
     pub spec: String,

@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
     display: String,
     /// The spot meter that reads the box (fall-off, spots) and the display.
-    #[arg(long, default_value = "sim:cs100a?time_scale=0", value_name = "SPEC")]
+    #[arg(long, default_value = metamer::experiment::DEFAULT_SPOT, value_name = "SPEC")]
     spot: String,
     /// Display model (see `metamer fit --help`).
     #[arg(long, default_value = "lut", value_name = "MODEL")]

@@ -4,7 +4,6 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
-use metamer::measure_box::setup::RigError;
 use metamer::measure_box::{Outcome, PlanError, Summary};
 use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
 
@@ -95,9 +94,6 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
         MeasureBoxJobError::Repeats(message) => usage(format!("--repeats {message}")),
         MeasureBoxJobError::Plan(e) => usage(e),
         MeasureBoxJobError::UnknownStage(message) => usage(message),
-        MeasureBoxJobError::Rig(RigError::Mixed) => usage(
-            "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
-        ),
         MeasureBoxJobError::BoxLight(e) => box_light_refusal(e),
         MeasureBoxJobError::Nobody(e) => nobody_at_the_rig(e),
         MeasureBoxJobError::Rig(e) if e.is_request() => usage(e),

@@ -17,10 +17,15 @@ use super::run::{run, StageOutcome};
 use super::simulation::SimulationOptions;
 use super::stage::Stage;
 use super::validate::{ValidationResult, FILE as COMPARISONS_FILE};
+use crate::measure_box::setup::{is_simulated, mixed_rig};
 use crate::render::{Scene, SceneError};
 use crate::rig::Scenario;
 use crate::session::{NobodyAtTheRig, RunOptions};
 use crate::validation::export::HTML_FILE;
+
+/// The spot meter of `metamer experiment` when `--spot` is not given: the simulated CS-100A
+/// at once, so the experiment runs on the simulated rig with no flags.
+pub const DEFAULT_SPOT: &str = "sim:cs100a?time_scale=0";
 
 /// The largest camera image the experiment renders, a side in pixels.
 pub const MAX_IMAGE_SIZE: usize = 8192;
@@ -252,7 +257,21 @@ impl Request {
                 seed,
                 light,
             } => BoxSource::Measure(MeasureBox {
-                spectral: spectral.clone(),
+                spectral: {
+                    if is_simulated(spectral, spot).is_err() {
+                        let default = spot.as_str() == DEFAULT_SPOT;
+                        return Err(RequestError::MixedRig(mixed_rig(
+                            spectral,
+                            spot,
+                            if default {
+                                " (the default when --spot is not given)"
+                            } else {
+                                ""
+                            },
+                        )));
+                    }
+                    spectral.clone()
+                },
                 spot: spot.clone(),
                 plan: plan.clone(),
                 repeats: *repeats,
@@ -343,6 +362,11 @@ pub enum RequestError {
     ImageSpp,
     #[error("-o {}: exists and is not a directory", .0.display())]
     OutNotDir(PathBuf),
+    /// One of the box's instruments is simulated and the other not (the message names
+    /// both, and a spot meter left at [`DEFAULT_SPOT`] as the default, since the user never
+    /// wrote it).
+    #[error("{0}")]
+    MixedRig(String),
     /// A simulated box's light was named for a real rig.
     #[error("--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light")]
     LightOnRealBox,
@@ -375,6 +399,7 @@ impl RequestError {
                 | RequestError::ImageSize
                 | RequestError::ImageSpp
                 | RequestError::OutNotDir(_)
+                | RequestError::MixedRig(_)
                 | RequestError::LightOnRealBox
                 | RequestError::UnknownLight(_)
                 | RequestError::NobodyAtTheRig(_)

@@ -20,9 +20,9 @@ use super::run::{run, Instruments, MeasureBoxError, Options, Outcome};
 use super::setup::{self, BoxLightError, RigError, RigRequest};
 use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
-use crate::session::repeats::Repeatability;
 use crate::session::{attendance, Attendance, NobodyAtTheRig, ProgressSink, RunOptions};
 use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
+use crate::validation::repeatability;
 
 /// The spots' readings file in the output directory, with
 /// [`MeasureBoxRequest::spot_readings`].
@@ -145,6 +145,10 @@ pub fn measure<'p>(
         Spec::new(request.spectral.as_str()),
         Spec::new(request.spot.as_str()),
     );
+    // As written, before a simulated box is made and its seed appended to the specs.
+    for spec in [&spectral, &spot] {
+        spec.check().map_err(RigError::Open)?;
+    }
     let simulated = setup::is_simulated(&spectral, &spot)?;
     let light = setup::box_light(request.scenario.as_deref(), simulated)?;
     // Before anything is opened: a real rig with nobody to ask is refused.
@@ -203,14 +207,14 @@ pub fn measure<'p>(
 /// reduction kept, in the plan's order; a spot read once carries the stated repeatability
 /// of the `meter` (its model).
 fn spot_readings(summary: &Summary, meter: &str) -> Vec<(usize, PatchReading)> {
-    let stated = Repeatability::emissive_of(meter);
+    let stated = repeatability::emissive_of(meter);
     summary
         .spot_xyz
         .iter()
         .zip(summary.spots.iter())
         .map(|((patch, xyz), r)| {
             let n = r.stats.n - r.stats.outliers.len();
-            let cov = match (n, stated.and_then(|s| s.covariance(*xyz))) {
+            let cov = match (n, stated.and_then(|s| repeatability::covariance(&s, *xyz))) {
                 (1, Some(c)) => c,
                 _ => r.stats.cov,
             };
@@ -255,10 +259,10 @@ mod tests {
         );
         std::fs::copy(transcript, &file).unwrap();
         let spec = Spec::replay(&file);
-        assert!(Repeatability::emissive_of(spec.as_str()).is_none());
+        assert!(repeatability::emissive_of(spec.as_str()).is_none());
         let meter = spec.open(None).unwrap();
-        let stated = Repeatability::emissive_of(&meter.info().model).unwrap();
-        let cs100a = Repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
+        let stated = repeatability::emissive_of(&meter.info().model).unwrap();
+        let cs100a = repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
         assert_eq!(stated, cs100a);
         std::fs::remove_dir_all(&dir).unwrap();
     }

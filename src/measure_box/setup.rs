@@ -9,16 +9,16 @@ use std::sync::Arc;
 use metamer_drivers::{DriverError, Instrument, SharedWorld, Spec, View};
 
 use super::plan::BoxPlan;
-use crate::rig::simulated_box::{BoxOperator, SimulatedBox, SimulatedBoxError};
+use super::simulated_box::{BoxOperator, SimulatedBox, SimulatedBoxError};
 use crate::rig::Scenario;
 use crate::session::Operator;
 
 /// The rig could not be opened.
 #[derive(Debug, thiserror::Error)]
 pub enum RigError {
-    /// One instrument is simulated and the other is not.
-    #[error("the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box")]
-    Mixed,
+    /// One instrument is simulated and the other is not ([`mixed_rig`] names both).
+    #[error("{0}")]
+    Mixed(String),
     /// A simulated box's light was asked of a real rig.
     #[error("the light '{0}' is the simulated box's; real instruments measure the real box, lit by its own light")]
     LightOnRealBox(Scenario),
@@ -34,15 +34,37 @@ impl RigError {
     /// Whether the request itself is wrong (a misnamed instrument or a mixed or mislit
     /// rig), as opposed to something that failed while opening what was asked for.
     pub fn is_request(&self) -> bool {
-        matches!(
-            self,
-            RigError::Mixed
-                | RigError::LightOnRealBox(_)
-                | RigError::Open(
-                    DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. }
-                )
-        )
+        matches!(self, RigError::Mixed(_) | RigError::LightOnRealBox(_))
+            || matches!(self, RigError::Open(e) if e.is_spec())
     }
+}
+
+/// Why `spectral` and `spot` make no rig: one is simulated and the other is not. `spot_is`
+/// says more of the spot meter's spec where the user did not write it (a default). When
+/// only the spot meter is simulated, says how its model is named on real hardware.
+pub fn mixed_rig(spectral: &Spec, spot: &Spec, spot_is: &str) -> String {
+    let kind = |s: &Spec| {
+        if s.is_simulated() {
+            "simulated"
+        } else if s.replay_file().is_some() {
+            "a replayed transcript"
+        } else {
+            "real"
+        }
+    };
+    let mut s = format!(
+        "--spectral {spectral} is {} and --spot {spot}{spot_is} is {}: both must be simulated \
+         (sim:…) or neither, as a simulated instrument sees only the simulated box",
+        kind(spectral),
+        kind(spot)
+    );
+    if let (true, Some(real)) = (
+        spot.is_simulated(),
+        spot.model().and_then(|m| m.real_spec()),
+    ) {
+        s.push_str(&format!("; name the real spot meter with --spot {real}"));
+    }
+    s
 }
 
 /// A light asked of the box that it cannot have.
@@ -71,7 +93,7 @@ pub fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>
 pub fn is_simulated(spectral: &Spec, spot: &Spec) -> Result<bool, RigError> {
     match (spectral.is_simulated(), spot.is_simulated()) {
         (a, b) if a == b => Ok(a),
-        _ => Err(RigError::Mixed),
+        _ => Err(RigError::Mixed(mixed_rig(spectral, spot, ""))),
     }
 }
 
@@ -155,11 +177,18 @@ mod tests {
         let replayed = Spec::new("replay:spots.jsonl");
         assert!(is_simulated(&sim, &sim).unwrap());
         assert!(!is_simulated(&real, &replayed).unwrap());
-        assert!(matches!(is_simulated(&sim, &real), Err(RigError::Mixed)));
-        assert!(matches!(
-            is_simulated(&replayed, &sim),
-            Err(RigError::Mixed)
-        ));
+        assert_eq!(
+            is_simulated(&sim, &real).unwrap_err().to_string(),
+            "--spectral sim:cs100a is simulated and --spot cs100a:/dev/ttyUSB0 is real: both \
+             must be simulated (sim:…) or neither, as a simulated instrument sees only the \
+             simulated box"
+        );
+        assert_eq!(
+            is_simulated(&replayed, &sim).unwrap_err().to_string(),
+            "--spectral replay:spots.jsonl is a replayed transcript and --spot sim:cs100a is \
+             simulated: both must be simulated (sim:…) or neither, as a simulated instrument \
+             sees only the simulated box; name the real spot meter with --spot cs100a:PORT"
+        );
     }
 
     #[test]

@@ -5,7 +5,6 @@
 pub mod scenario;
 pub mod screen;
 pub mod sim_meter;
-pub mod simulated_box;
 pub mod spec;
 pub mod virtual_display;
 pub mod window;

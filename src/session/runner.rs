@@ -21,8 +21,9 @@ use super::operator::Recheck;
 use super::plan::{placements, Prepare, SessionPlan};
 use super::progress::{reading_summary, ProgressSink, StepProgress};
 use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
-use super::repeats::{deviation, Repeatability};
+use super::repeats::deviation;
 use super::step::{Rig, StepFailure, StepTaker};
+use crate::validation::repeatability;
 
 /// The session could not start or go on.
 #[derive(Debug, thiserror::Error)]
@@ -431,7 +432,7 @@ where
                     .map(|i| i.info().model)
                     .unwrap_or_default();
                 let deviation =
-                    deviation(&earlier, &reading, Repeatability::stated(&model, step.mode));
+                    deviation(&earlier, &reading, repeatability::stated(&model, step.mode));
                 let elapsed = start.elapsed();
                 progress.step(&StepProgress {
                     done: done + 1,

@@ -99,7 +99,8 @@ pub struct Model {
     /// Options of its simulation beyond `time_scale`, `seed` and `noise`.
     pub sim_options: &'static [&'static str],
     /// Simulated units whose capabilities describe the model (`metamer devices --describe`):
-    /// what each stands for and its simulation options (`rev=e&diffuser=on`).
+    /// what kind of unit each stands for (`i1Pro 2 (Rev E) with the diffuser`) and its
+    /// simulation options (`rev=e&diffuser=on`).
     pub described_by: &'static [(&'static str, &'static str)],
     /// The modes its readings can be taken in. A model whose only mode is emissive reads
     /// nothing but emitted light, so a reading it took is emissive whatever a file says.
@@ -192,9 +193,8 @@ const CS100A_EMISSIVE: Repeatability = Repeatability {
     y_digits: Some(4),
     xy: Some(XyNoise::Fixed(crate::cs100a::emulator::SIGMA_XY)),
     xy_decimals: Some(4),
-    source: "±0.2 % in Y and ±0.001 in x, y as 2σ, general knowledge of the CS-100A not yet \
-             confirmed by Konica Minolta's sheet (protocols/cs100a/README.md); the last digit it \
-             sends (four significant digits of Y, four decimals of x, y)",
+    source: "general knowledge of the CS-100A, not yet confirmed by Konica Minolta's sheet \
+             (protocols/cs100a/README.md)",
 };
 
 /// The i1Pro's emissive figure: the emulator's curve, checked against the simulated unit
@@ -255,7 +255,7 @@ pub const MODELS: &[Model] = &[
         replay: Some(crate::cs100a::open::replay),
         sim: Some(crate::cs100a::open::sim),
         sim_options: &[],
-        described_by: &[("the CS-100A", "")],
+        described_by: &[("CS-100A", "")],
         modes: &[MeasureMode::Emissive],
         repeatability: &[(MeasureMode::Emissive, CS100A_EMISSIVE)],
         reading_time: None,
@@ -280,8 +280,8 @@ pub const MODELS: &[Model] = &[
         sim: Some(crate::i1pro::open::sim),
         sim_options: &["rev", "diffuser"],
         described_by: &[
-            ("an i1Pro (Rev A–D) with the diffuser", "rev=d&diffuser=on"),
-            ("an i1Pro 2 (Rev E) with the diffuser", "rev=e&diffuser=on"),
+            ("i1Pro (Rev A–D) with the diffuser", "rev=d&diffuser=on"),
+            ("i1Pro 2 (Rev E) with the diffuser", "rev=e&diffuser=on"),
         ],
         modes: &[
             MeasureMode::Emissive,
