@@ -22,6 +22,37 @@ pub enum ColorJobError {
     Color(#[from] ColorError),
     #[error(transparent)]
     Csv(#[from] CsvError),
+    /// The caller's handling of a column failed (e.g. its output closed).
+    #[error(transparent)]
+    Event(#[from] std::io::Error),
+    /// One row is a single wavelength: a sum over Δλ (CIE 15:2018 §7.1) needs at least
+    /// two, and reading one sample as a 1 nm line or as a flat spectrum would be a guess.
+    #[error(
+        "{}:{line}: the spectrum has one row ({nm} nm): XYZ is a sum over wavelength steps \
+         (CIE 15:2018 §7.1), so give at least two rows; for a single line, give the samples \
+         either side of it as 0",
+        file.display()
+    )]
+    OneSample { file: PathBuf, line: usize, nm: f64 },
+    /// No sample lies where the colour-matching functions are summed, so the result would
+    /// be zero, or (a reflectance held at its end values) a flat spectrum nobody measured.
+    #[error(
+        "{}:{first_line}: column '{}': its samples ({first_nm}–{last_nm} nm) lie outside \
+         {start_nm}–{end_nm} nm, the wavelengths the colour-matching functions are summed \
+         over{}",
+        file.display(), text::echo(column),
+        if *method == Integration::Linear { " with --method linear" } else { "" }
+    )]
+    OutsideSummation {
+        file: PathBuf,
+        first_line: usize,
+        column: String,
+        first_nm: f64,
+        last_nm: f64,
+        start_nm: i32,
+        end_nm: i32,
+        method: Integration,
+    },
     /// A column's result overflowed.
     #[error(
         "{}: column '{}': the result is not a finite number (XYZ {xyz:?}): the values are too \
@@ -105,7 +136,11 @@ pub struct ColumnColor {
 ///     method: Integration::Cie15,
 /// };
 /// let mut columns = Vec::new();
-/// spectra_xyz(&request, &mut |c| columns.push(c)).unwrap();
+/// spectra_xyz(&request, &mut |c| {
+///     columns.push(c);
+///     Ok(())
+/// })
+/// .unwrap();
 /// // A white paper under D65: Y near 100, and a CIELAB against D65's white.
 /// let d = &columns[0].description;
 /// assert!(d.xyz.y > 50.0 && d.xyz.y <= 110.0);
@@ -113,7 +148,7 @@ pub struct ColumnColor {
 /// ```
 pub fn spectra_xyz(
     request: &XyzRequest,
-    each: &mut dyn FnMut(ColumnColor),
+    each: &mut dyn FnMut(ColumnColor) -> std::io::Result<()>,
 ) -> Result<(), ColorJobError> {
     let table = SpectralTable::read(&request.spectrum)?;
     let illuminant = load_illuminant(&request.illuminant)?;
@@ -130,6 +165,13 @@ pub fn spectra_xyz(
             .zip(table.all(Outside::Zero))
             .collect(),
     };
+    if let ([nm], [line]) = (&table.wavelengths_nm[..], &table.lines[..]) {
+        return Err(ColorJobError::OneSample {
+            file: request.spectrum.clone(),
+            line: *line,
+            nm: *nm,
+        });
+    }
     let white = request.white;
     let named = columns.len() > 1 || request.column.is_some();
     for (name, spectrum) in columns {
@@ -137,6 +179,20 @@ pub fn spectra_xyz(
             Integration::Cie15 => spectrum.with_outside(outside).as_measured(),
             Integration::Linear => spectrum.with_outside(outside),
         };
+        let range = summation_range(&spectrum);
+        let (first_nm, last_nm) = spectrum.range_nm();
+        if last_nm < f64::from(*range.start()) || first_nm > f64::from(*range.end()) {
+            return Err(ColorJobError::OutsideSummation {
+                file: request.spectrum.clone(),
+                first_line: table.lines[0],
+                column: name,
+                first_nm,
+                last_nm,
+                start_nm: *range.start(),
+                end_nm: *range.end(),
+                method: request.method,
+            });
+        }
         let d = describe(
             &spectrum,
             request.quantity,
@@ -158,7 +214,7 @@ pub fn spectra_xyz(
             name,
             named,
             description: d,
-        });
+        })?;
     }
     Ok(())
 }

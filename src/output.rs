@@ -36,6 +36,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
+pub mod console;
+
 /// Why an output was not written.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {

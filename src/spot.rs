@@ -19,7 +19,7 @@ use metamer_drivers::{
 };
 
 use crate::output::{OutputError, OutputPolicy};
-use crate::session::{attendance, Answer, NobodyAtTheRig, Operator, OperatorError};
+use crate::session::{attendance, Answer, Heartbeat, NobodyAtTheRig, Operator, OperatorError};
 
 /// A spot reading that could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -86,7 +86,12 @@ pub fn calibrate(
         if let Some(h) = hands {
             h.place(&condition);
         }
+        let beat = Heartbeat::start(format!(
+            "the {} calibrates for {mode} readings",
+            instrument.info().model
+        ));
         let outcome = instrument.calibrate(mode, &condition);
+        drop(beat);
         if let Some(h) = hands {
             h.back();
         }
@@ -109,7 +114,10 @@ pub fn read(
     let request = Request { mode };
     for _ in 0..MAX_ROUNDS {
         calibrate(instrument, mode, operator, hands)?;
-        match instrument.measure(&request) {
+        let beat = Heartbeat::start(format!("the {} measures", instrument.info().model));
+        let measured = instrument.measure(&request);
+        drop(beat);
+        match measured {
             Err(DriverError::NeedsCalibration { .. }) => continue,
             r => return Ok(r?),
         }
@@ -161,7 +169,7 @@ pub fn spectra_csv(readings: &[Reading]) -> Option<String> {
 #[derive(Clone, Debug)]
 pub struct SpotRequest {
     /// The instrument's spec (`cs100a:PORT`, `i1pro`, `replay:FILE`, `sim:…`).
-    pub instrument: String,
+    pub instrument: Spec,
     pub mode: MeasureMode,
     /// Response speed, for instruments that have one; `None` keeps the instrument's.
     pub speed: Option<Speed>,
@@ -211,6 +219,9 @@ impl SpotRunError {
 /// What [`run`] reports while it works.
 #[derive(Debug)]
 pub enum SpotEvent<'a> {
+    /// Something to say before the instrument opens: a simulation that keeps a real
+    /// instrument's pace (its calibration alone may take seconds).
+    Note(String),
     /// The instrument is open and set up.
     Opened(&'a InstrumentInfo),
     /// Reading number `n` (from 1) arrived; later ones may still fail.
@@ -267,7 +278,7 @@ pub fn run(
             path.display()
         ));
     }
-    let spec = Spec::new(request.instrument.as_str());
+    let spec = &request.instrument;
     let mut policy = OutputPolicy::new(request.force);
     policy.inputs(
         spec.replay_file()
@@ -279,12 +290,15 @@ pub fn run(
         policy.check(path)?;
     }
     // Before the instrument is opened: a real one with nobody to place it is refused.
-    let attended = attendance(&[&request.instrument], request.unattended)?;
+    let attended = attendance(&[spec], request.unattended)?;
     let hands = spec
         .is_simulated()
         .then(|| simulated_target(request.mode))
         .transpose()?;
-    let mut instrument = open(request, &spec, hands.as_ref())?;
+    if let Some(pace) = crate::session::pace_note(&[spec]) {
+        events(SpotEvent::Note(pace))?;
+    }
+    let mut instrument = open(request, spec, hands.as_ref())?;
     let info = instrument.info();
     events(SpotEvent::Opened(&info))?;
     let mut operator = attended.operator();

@@ -5,7 +5,11 @@
 //!
 //! ```sh
 //! cargo run --release -p metamer-drivers --example record_i1pro_transcripts
+//! cargo run --release -p metamer-drivers --example record_i1pro_transcripts -- dark_patches
 //! ```
+//!
+//! The second form records only the transcript it names (of those recorded by a function
+//! of their own: `dark_patches`), leaving the others as they are.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -143,9 +147,40 @@ fn quiet(revision: Revision) -> EmulatorConfig {
     }
 }
 
+/// A display's darkest patches on a noisy Rev D: a CRT's black (0.05 cd/m²), too dim for
+/// one reading at 2 s, is read six times; a dimmer light, read six times, still does not
+/// stand out of the noise; no light at all is too dark at once (no longer reading could
+/// lift it); an LCD's black (0.22 cd/m²) is one reading.
+fn dark_patches(dir: &Path) {
+    let path = dir.join("dark_patches.jsonl");
+    let noisy = EmulatorConfig {
+        seed: 5,
+        ..EmulatorConfig::default()
+    };
+    let mut r = Run::open(&path, noisy, View::WhiteTile);
+    r.calibrate(MeasureMode::Emissive);
+    for cd in [0.05, 0.025, 0.0, 0.22] {
+        let view = if cd > 0.0 {
+            View::radiance(default_light().scaled(cd / 100.0)).unwrap()
+        } else {
+            View::Capped
+        };
+        r.measure(MeasureMode::Emissive, view, None);
+    }
+    r.finish(&path, "Rev D with its noise (seed 5): a display's darkest patches. 0.05 cd/m² of LED-RGB1 (the ideal-crt preset's black) does not stand 5σ above the sensor's noise in one reading of 2 s, so five more readings of 2 s join it and the six are a reading; 0.025 cd/m², read six times, still does not (too dark, averaged over 6 readings); a capped sensor is too dark after one reading, since no longer reading could lift it; 0.22 cd/m² (the ips-lcd black) is one reading of 2 s. Recorded from sim:i1pro with noise on.");
+}
+
 fn main() {
     let dir = PathBuf::from("protocols/i1pro/transcripts");
     std::fs::create_dir_all(&dir).unwrap();
+    if let Some(name) = std::env::args().nth(1) {
+        match name.as_str() {
+            "dark_patches" => dark_patches(&dir),
+            other => panic!("no transcript '{other}' is recorded on its own (known: dark_patches)"),
+        }
+        return;
+    }
+    dark_patches(&dir);
     let p = |name: &str| dir.join(format!("{name}.jsonl"));
     let emissive = MeasureMode::Emissive;
     let reflective = MeasureMode::Reflective;

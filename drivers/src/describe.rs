@@ -13,7 +13,7 @@ use crate::DriverError;
 
 /// Everything metamer knows about one model.
 #[derive(Clone, Debug, Serialize)]
-pub struct Description {
+pub struct ModelDescription {
     /// Its stable name (`i1pro`).
     pub name: &'static str,
     pub title: &'static str,
@@ -34,9 +34,9 @@ pub struct Description {
     pub units: Vec<Unit>,
     /// Its stated repeatability per mode.
     pub repeatability: Vec<Figure>,
-    /// Whether its driver states how long a reading takes
-    /// ([`Model::reading_time`](registry::Model::reading_time)).
-    pub reading_time_stated: bool,
+    /// Whether its driver states how long its readings and calibrations take
+    /// ([`crate::time_budget`]).
+    pub time_budget_stated: bool,
 }
 
 /// A simulated unit's capabilities, standing for a kind of real unit.
@@ -68,7 +68,7 @@ pub struct Figure {
 /// assert_eq!(d.units[0].capabilities.modes[0].mode.name(), "emissive");
 /// # Ok::<(), metamer_drivers::DriverError>(())
 /// ```
-pub fn describe(name: &str) -> Result<Description, DriverError> {
+pub fn describe(name: &str) -> Result<ModelDescription, DriverError> {
     let model = spec::model_named(name).ok_or_else(|| DriverError::UnknownModel {
         name: name.to_string(),
         known: registry::MODELS
@@ -77,7 +77,7 @@ pub fn describe(name: &str) -> Result<Description, DriverError> {
             .collect::<Vec<_>>()
             .join(", "),
     })?;
-    Ok(Description {
+    Ok(ModelDescription {
         name: model.name,
         title: model.title,
         real: model.real_spec(),
@@ -105,7 +105,7 @@ pub fn describe(name: &str) -> Result<Description, DriverError> {
                 source: r.source,
             })
             .collect(),
-        reading_time_stated: model.reading_time.is_some(),
+        time_budget_stated: model.time_budget.is_some(),
     })
 }
 

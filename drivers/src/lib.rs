@@ -6,6 +6,7 @@
 //! one [`Instrument`] trait. Devices are chosen by one string, read by [`Spec`];
 //! the models and how each is opened are rows of the [`registry`].
 
+pub mod budget;
 pub mod cs100a;
 pub mod describe;
 pub mod devices;
@@ -23,6 +24,7 @@ pub mod simulated;
 pub mod spec;
 pub mod world;
 
+pub use budget::{TimeBudget, TimeQuery};
 pub use cs100a::Cs100aError;
 pub use cs100a::Speed;
 pub use error::DriverError;
@@ -33,6 +35,7 @@ pub use instrument::{
 };
 pub use open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
 pub use permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};
+pub use registry::time_budget;
 pub use spec::{
     check_spec, is_physical, open_instrument, open_instrument_with, Spec, MAX_TIME_SCALE,
 };

@@ -38,7 +38,7 @@ pub const CELLS: usize = 128;
 pub const SHIELDED_CELLS: usize = 6;
 
 /// A spectrum on the instrument's fixed grid (index `i` is `380 + 10·i` nm).
-pub type Spectrum = [f64; BANDS];
+pub type GridSpectrum = [f64; BANDS];
 
 /// Hardware generation: the two speak different dialects of the same protocol.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

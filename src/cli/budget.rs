@@ -61,13 +61,18 @@ pub fn run(args: Args) -> CliResult {
         Error::UnknownName(text) => CliError::Usage(text),
         e => CliError::from(e),
     })?;
-    println!("preset            model                   patches  mean ΔE00  p95 ΔE00  max ΔE00");
+    outln!("preset            model                   patches  mean ΔE00  p95 ΔE00  max ΔE00")?;
     for p in &points {
-        println!(
+        outln!(
             "{:<17} {:<23} {:>7}  {:>9.3}  {:>8.3}  {:>8.3}",
-            p.preset, p.model, p.patches, p.mean_de00, p.p95_de00, p.max_de00
-        );
+            p.preset,
+            p.model,
+            p.patches,
+            p.mean_de00,
+            p.p95_de00,
+            p.max_de00
+        )?;
     }
-    println!("wrote {}", request.out.display());
+    outln!("wrote {}", request.out.display())?;
     Ok(())
 }

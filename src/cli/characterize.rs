@@ -1,14 +1,13 @@
 //! `metamer characterize`: show and measure patches on a display, fit and verify a profile.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::ValueEnum;
 use metamer::display::characterize::finish::Summary;
 use metamer::display::characterize::{
-    self, default_grid_steps, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions,
-    Request, SimulatedMeter, DEFAULT_RAMP_STEPS,
+    self, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions, Request,
+    SimulatedMeter, DEFAULT_RAMP_STEPS,
 };
 use metamer::display::ModelKind;
 use metamer::rig::ScreenSpec;
@@ -86,11 +85,7 @@ pub fn run(args: Args) -> CliResult {
             SpeedArg::Fast => Speed::Fast,
             SpeedArg::Slow => Speed::Slow,
         }),
-        plan: PlanOptions {
-            ramp_steps: args.ramp_steps,
-            repeats: args.repeats,
-            grid_steps: (args.grid_steps).unwrap_or(default_grid_steps(model, args.ramp_steps)),
-        },
+        plan: PlanOptions::for_model(model, args.ramp_steps, args.repeats, args.grid_steps),
         model,
         settle: args.settle_ms.map(Duration::from_millis),
         resume: args.resume,
@@ -109,7 +104,7 @@ pub fn run(args: Args) -> CliResult {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
         (_, text) => {
-            println!("{}", text.unwrap_or_default());
+            outln!("{}", text.unwrap_or_default())?;
             Ok(())
         }
     }
@@ -120,10 +115,10 @@ struct Printer(Option<BarProgress>);
 
 impl Listener for Printer {
     fn note(&mut self, text: &str) {
-        eprintln!("note: {text}");
+        super::console::reported_at_exit(errln!("note: {text}"));
     }
     fn warning(&mut self, text: &str) {
-        eprintln!("warning: {text}");
+        super::console::reported_at_exit(errln!("warning: {text}"));
     }
     fn progress(&mut self, attended: bool) -> &mut dyn ProgressSink {
         self.0.insert(BarProgress::new("patch").attended(attended))
@@ -157,35 +152,36 @@ fn plan_usage(e: &PlanError) -> String {
 }
 
 fn print_summary(s: &Summary) -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
     let v = &s.verification;
-    writeln!(
-        out,
+    outln!(
         "measured {} readings of {} with {} ({})",
-        s.readings, s.display, s.instrument_info.model, s.instrument
+        s.readings,
+        s.display,
+        s.instrument_info.model,
+        s.instrument
     )?;
-    writeln!(
-        out,
+    outln!(
         "white {:.2} cd/m², black {:.3} cd/m²",
-        s.white_xyz[1], s.black_xyz[1]
+        s.white_xyz[1],
+        s.black_xyz[1]
     )?;
-    writeln!(
-        out,
+    outln!(
         "model {}: fit on {} patches, ΔE00 mean {:.2}, max {:.2}",
-        s.model, s.fit_patches, s.fit_residuals.mean_de00, s.fit_residuals.max_de00
+        s.model,
+        s.fit_patches,
+        s.fit_residuals.mean_de00,
+        s.fit_residuals.max_de00
     )?;
-    writeln!(
-        out,
+    outln!(
         "verification on {} held-out patches: ΔE00 mean {:.2}, p95 {:.2}, max {:.2}",
         v.patches.len(),
-        v.mean,
-        v.p95,
-        v.max
+        v.de00.mean,
+        v.de00.p95,
+        v.de00.max
     )?;
     // The verdict already names every failed assumption.
-    writeln!(out, "verdict: {}", s.verdict)?;
-    writeln!(
-        out,
+    outln!("verdict: {}", s.verdict)?;
+    outln!(
         "wrote {}, {}, {}, {} (log {})",
         s.files.profile.display(),
         s.files.ti3.display(),

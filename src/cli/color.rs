@@ -97,11 +97,13 @@ pub fn run(args: Args) -> CliResult {
 fn color_error(e: ColorJobError) -> CliError {
     match e {
         ColorJobError::UnknownIlluminant(_) => CliError::Usage(e.to_string()),
-        ColorJobError::NotFinite { .. } | ColorJobError::PairNotFinite { .. } => {
-            CliError::Failed(e.to_string().into())
-        }
+        ColorJobError::NotFinite { .. }
+        | ColorJobError::PairNotFinite { .. }
+        | ColorJobError::OneSample { .. }
+        | ColorJobError::OutsideSummation { .. } => CliError::Failed(e.to_string().into()),
         ColorJobError::Color(e) => CliError::from(e),
         ColorJobError::Csv(e) => CliError::from(e),
+        ColorJobError::Event(e) => CliError::from(e),
     }
 }
 
@@ -134,17 +136,24 @@ fn xyz(a: XyzArgs) -> CliResult {
             if c.named {
                 obj["column"] = serde_json::json!(c.name);
             }
-            println!("{obj}");
+            outln!("{obj}")?;
         } else {
             let lab = d
                 .lab
                 .map(|l| format!("  L*a*b* {:8.3} {:8.3} {:8.3}", l.l, l.a, l.b))
                 .unwrap_or_default();
-            println!(
+            outln!(
                 "{:<24} XYZ {:10.4} {:10.4} {:10.4}  xyY {:.5} {:.5} {:10.4}{lab}",
-                c.name, d.xyz.x, d.xyz.y, d.xyz.z, d.xyy.x, d.xyy.y, d.xyy.luminance
-            );
+                c.name,
+                d.xyz.x,
+                d.xyz.y,
+                d.xyz.z,
+                d.xyy.x,
+                d.xyy.y,
+                d.xyy.luminance
+            )?;
         }
+        Ok(())
     })
     .map_err(color_error)
 }
@@ -156,11 +165,11 @@ fn delta_e(a: DeltaEArgs) -> CliResult {
             .iter()
             .map(|(d76, d00)| serde_json::json!({"de76": d76, "de00": d00}))
             .collect();
-        println!("{}", serde_json::Value::Array(arr));
+        outln!("{}", serde_json::Value::Array(arr))?;
     } else {
-        println!("{:>5} {:>10} {:>10}", "row", "dE76", "dE00");
+        outln!("{:>5} {:>10} {:>10}", "row", "dE76", "dE00")?;
         for (i, (d76, d00)) in results.iter().enumerate() {
-            println!("{:>5} {d76:>10.4} {d00:>10.4}", i + 1);
+            outln!("{:>5} {d76:>10.4} {d00:>10.4}", i + 1)?;
         }
     }
     Ok(())

@@ -1,9 +1,7 @@
 //! `metamer devices`: serial ports and known USB/HID instruments on this machine, with the
 //! fix for any the user may not open; with `--describe MODEL`, what a model can do.
 
-use std::io::Write;
-
-use metamer_drivers::describe::{describe, Description};
+use metamer_drivers::describe::{describe, ModelDescription};
 use metamer_drivers::devices::{list_devices, Access, DeviceList};
 use metamer_drivers::{registry, CalibrationNeed, OptionValues};
 
@@ -22,7 +20,6 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let mut out = std::io::stdout().lock();
     if let Some(model) = &args.describe {
         let d = describe(model).map_err(|e| match e {
             e @ metamer_drivers::DriverError::UnknownModel { .. } => {
@@ -31,17 +28,17 @@ pub fn run(args: Args) -> CliResult {
             e => CliError::from(e),
         })?;
         if args.json {
-            writeln!(out, "{}", serde_json::to_string_pretty(&d)?)?;
+            outln!("{}", serde_json::to_string_pretty(&d)?)?;
         } else {
-            write!(out, "{}", described(&d))?;
+            out!("{}", described(&d))?;
         }
         return Ok(());
     }
     let list = list_devices();
     if args.json {
-        writeln!(out, "{}", serde_json::to_string_pretty(&list)?)?;
+        outln!("{}", serde_json::to_string_pretty(&list)?)?;
     } else {
-        write!(out, "{}", human(&list))?;
+        out!("{}", human(&list))?;
     }
     Ok(())
 }
@@ -65,7 +62,7 @@ fn calibration(c: &CalibrationNeed) -> String {
     format!("{} ({}; {valid})", c.name, c.condition.prompt())
 }
 
-fn described(d: &Description) -> String {
+fn described(d: &ModelDescription) -> String {
     let mut s = format!("{} ({})\n", d.title, d.name);
     if let Some(why) = d.unsupported {
         s.push_str(&format!("  not supported: {why}\n"));
@@ -140,8 +137,8 @@ fn described(d: &Description) -> String {
             s.push_str(&format!("    {}: {} [{}]\n", f.mode, f.stated, f.source));
         }
     }
-    if d.unsupported.is_none() && !d.reading_time_stated {
-        s.push_str("  reading time: not stated by its driver yet\n");
+    if d.unsupported.is_none() && !d.time_budget_stated {
+        s.push_str("  time budget: not stated by its driver yet\n");
     }
     s
 }

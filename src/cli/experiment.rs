@@ -5,11 +5,13 @@ use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
+use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
 use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
-use metamer::experiment::simulation::{ImageSpec, SimulationOptions};
+use metamer::experiment::simulation::SimulationOptions;
 use metamer::experiment::{BoxRequest, Progress, Request, RequestError, Stage, StageOutcome};
+use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 use metamer_drivers::Spec;
 
@@ -23,7 +25,7 @@ pub struct Args {
     /// The spectral instrument that measures the box's light tiles and materials (the box
     /// stage is the `measure-box` session; sim:i1pro measures the simulated box).
     #[arg(long, value_name = "SPEC", required_unless_present = "box_scene")]
-    spectral: Option<String>,
+    spectral: Option<Spec>,
     /// The box measurement plan (see `metamer measure-box --help`); default: the paper's.
     #[arg(long, value_name = "PLAN.json")]
     plan: Option<PathBuf>,
@@ -45,16 +47,16 @@ pub struct Args {
     box_spots: Option<PathBuf>,
     /// The monitor that shows the simulation: window:N (a real monitor) or virtual:PRESET.
     #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
-    display: String,
+    display: ScreenSpec,
     /// The spot meter that reads the box (fall-off, spots) and the display.
     #[arg(long, default_value = metamer::experiment::DEFAULT_SPOT, value_name = "SPEC")]
-    spot: String,
+    spot: Spec,
     /// Display model (see `metamer fit --help`).
     #[arg(long, default_value = "lut", value_name = "MODEL")]
-    model: String,
+    model: ModelKind,
     /// Out-of-gamut colours: nearest-lab or clip.
     #[arg(long, default_value = "nearest-lab", value_name = "MAPPING")]
-    gamut: String,
+    gamut: GamutMapping,
     /// The simulation's accuracy: every patch's ΔE*ab uncertainty below this.
     #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
     target_de: f64,
@@ -80,7 +82,7 @@ pub struct Args {
     /// display-white (the ips-lcd display's white, as the paper's box was lit by an LCD)
     /// or led-rgb1 (CIE LED-RGB1, whose saturated colours no virtual display can show).
     #[arg(long, value_name = "LIGHT", conflicts_with = "box_scene")]
-    scenario: Option<String>,
+    scenario: Option<Scenario>,
     /// Spot readings averaged per patch on the display.
     #[arg(long, default_value_t = 3, value_name = "K")]
     repeats: usize,
@@ -89,7 +91,7 @@ pub struct Args {
     /// Run only this stage (again): box, simulation, display, reproduction, display-spots,
     /// validation.
     #[arg(long, value_name = "STAGE")]
-    stage: Option<String>,
+    stage: Option<Stage>,
     /// Continue an interrupted measuring stage from its journal.
     #[arg(long)]
     resume: bool,
@@ -108,30 +110,25 @@ pub fn run_cli(args: Args) -> CliResult {
     let outcome = request.run(&|p| shown.show(p));
     shown.finish();
     let outcome = outcome.map_err(refusal)?;
-    print_outcomes(&outcome.stages, outcome.given_box.as_deref());
+    print_outcomes(&outcome.stages, outcome.given_box.as_deref())?;
     for line in outcome.comparison_lines() {
-        println!("{line}");
+        outln!("{line}")?;
     }
     if let Some(report) = &outcome.report {
-        println!("report: {}", report.display());
+        outln!("report: {}", report.display())?;
     }
     Ok(())
 }
 
 /// The flags as the library's request; the library checks and completes it.
 fn request(args: Args) -> Result<Request, CliError> {
-    let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
-    let stage: Option<Stage> = match &args.stage {
-        Some(s) => Some(s.parse().map_err(CliError::Usage)?),
-        None => None,
-    };
-    let spot = Spec::new(args.spot.as_str());
+    let spot = args.spot;
     Ok(Request {
         dir: args.out.clone(),
         box_source: match (args.box_scene, args.box_spots, args.spectral) {
             (Some(scene), Some(spots), _) => BoxRequest::Given { scene, spots },
             (_, _, Some(spectral)) => BoxRequest::Measure {
-                spectral: Spec::new(spectral),
+                spectral,
                 spot: spot.clone(),
                 plan: args.plan,
                 repeats: args.box_repeats,
@@ -144,27 +141,24 @@ fn request(args: Args) -> Result<Request, CliError> {
                 ))
             }
         },
-        simulation: SimulationOptions {
-            target_de: args.target_de,
-            seed: args.seed,
-            max_seconds: 600.0,
-            image: (args.image_size > 0).then_some(ImageSpec {
-                size: args.image_size,
-                spp: args.image_spp,
-            }),
-            external_image: args.simulation_image,
-        },
+        simulation: SimulationOptions::new(
+            args.target_de,
+            args.seed,
+            args.image_size,
+            args.image_spp,
+            args.simulation_image,
+        ),
         display: DisplayOptions {
             screen: args.display,
             spot,
-            model,
+            model: args.model,
         },
         reproduction: ReproductionOptions {
             gamut: args.gamut,
             mirror: !args.no_mirror,
         },
         repeats: args.repeats,
-        stage,
+        stage: args.stage,
         rerun_all: false,
         resume: args.resume,
         unattended: args.unattended,
@@ -180,6 +174,9 @@ fn request(args: Args) -> Result<Request, CliError> {
 pub(super) fn refusal(e: RequestError) -> CliError {
     match e {
         RequestError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
+        RequestError::BoxLight(e) => {
+            super::rig::box_light_refusal(e, Some(metamer::experiment::DEFAULT_SPOT))
+        }
         e if e.is_usage() => CliError::Usage(e.to_string()),
         e => CliError::from(e),
     }
@@ -197,9 +194,9 @@ impl StageProgress {
             Progress::Stage { stage, reused } => {
                 self.finish();
                 if reused {
-                    eprintln!("{stage}: unchanged inputs, re-used");
+                    super::console::reported_at_exit(errln!("{stage}: unchanged inputs, re-used"));
                 } else {
-                    eprintln!("{stage}: running");
+                    super::console::reported_at_exit(errln!("{stage}: running"));
                 }
             }
             Progress::Readings { done, total } => {
@@ -217,7 +214,7 @@ impl StageProgress {
             }
             Progress::Note(text) => match self.bar.borrow().as_ref() {
                 Some(b) => b.println(format!("  {text}")),
-                None => eprintln!("  {text}"),
+                None => super::console::reported_at_exit(errln!("  {text}")),
             },
         }
     }
@@ -231,18 +228,19 @@ impl StageProgress {
 
 /// One line per stage: ran, re-used or (a box measured earlier or elsewhere) given, how
 /// long, where.
-pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>) {
+pub(super) fn print_outcomes(outcomes: &[StageOutcome], given_box: Option<&Path>) -> CliResult {
     for o in outcomes {
         let (how, dir) = match given_box {
             Some(spots) if o.stage == Stage::Box => ("given", spots),
             _ => (if o.reused { "re-used" } else { "ran" }, o.dir.as_path()),
         };
-        println!(
+        outln!(
             "{:<14} {:<8} {:>8.1} s  {}",
             o.stage.name(),
             how,
             o.seconds,
             dir.display()
-        );
+        )?;
     }
+    Ok(())
 }

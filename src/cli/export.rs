@@ -53,8 +53,8 @@ pub fn run(args: Args) -> CliResult {
         e => e.into(),
     })?;
     for f in &report.files {
-        println!("wrote {}", f.display());
+        outln!("wrote {}", f.display())?;
     }
-    println!("{}", report.summary);
+    outln!("{}", report.summary)?;
     Ok(())
 }

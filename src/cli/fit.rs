@@ -83,9 +83,12 @@ pub fn run(args: Args) -> CliResult {
         icc_version: args.icc_version,
         chart: args.chart.clone(),
     };
-    let report = fit::run(&request, &mut print_event).map_err(|e| refusal(e, &args))?;
+    let report = fit::run(&request, &mut |e| {
+        super::console::reported_at_exit(print_event(e))
+    })
+    .map_err(|e| refusal(e, &args))?;
     if let Some(icc) = &report.icc {
-        println!(
+        outln!(
             "ICC {} profile ({}) written to {}; read back, it follows the model to ΔE00 mean \
              {:.4}, max {:.4} over the {} patches",
             icc.summary.version,
@@ -94,48 +97,56 @@ pub fn run(args: Args) -> CliResult {
             icc.forward.mean_de00,
             icc.forward.max_de00,
             icc.forward.points
-        );
+        )?;
         if let Some(inverse) = &icc.inverse {
-            println!(
+            outln!(
                 "its B2A0 inverts the model to ΔE00 mean {:.4}, max {:.4} over the same patches",
-                inverse.mean_de00, inverse.max_de00
-            );
+                inverse.mean_de00,
+                inverse.max_de00
+            )?;
         }
         let clipped = icc.summary.clipped_black;
         if clipped.iter().any(|&v| v > 0.0) {
-            println!(
+            outln!(
                 "note: the black lies outside the primaries' cone; the ICC curves clip it by \
                  Y {:.2e} {:.2e} {:.2e} of the white (R, G, B)",
-                clipped[0], clipped[1], clipped[2]
-            );
+                clipped[0],
+                clipped[1],
+                clipped[2]
+            )?;
         }
     }
     Ok(())
 }
 
-fn print_event(event: Event<'_>) {
+fn print_event(event: Event<'_>) -> Result<(), super::console::ConsoleError> {
     match event {
-        Event::Warning(text) => eprintln!("warning: {text}"),
-        Event::Selected(selection) => println!("{selection}"),
-        Event::ChartWritten(path) => println!("selection chart written to {}", path.display()),
+        Event::Warning(text) => errln!("warning: {text}"),
+        Event::Selected(selection) => outln!("{selection}"),
+        Event::ChartWritten(path) => outln!("selection chart written to {}", path.display()),
         Event::Fitted {
             patches,
             measurements,
             profile,
         } => {
-            println!(
+            outln!(
                 "{patches} patches from {}; model {}",
                 measurements.display(),
                 profile.model
-            );
+            )?;
             let (w, k) = (profile.white_xyz, profile.black_xyz);
-            println!(
+            outln!(
                 "white XYZ {:.3} {:.3} {:.3} cd/m², black XYZ {:.4} {:.4} {:.4} cd/m²",
-                w[0], w[1], w[2], k[0], k[1], k[2]
-            );
-            println!("{}", profile.diagnostics());
+                w[0],
+                w[1],
+                w[2],
+                k[0],
+                k[1],
+                k[2]
+            )?;
+            outln!("{}", profile.diagnostics())
         }
-        Event::ProfileWritten(path) => println!("profile written to {}", path.display()),
+        Event::ProfileWritten(path) => outln!("profile written to {}", path.display()),
     }
 }
 

@@ -2,7 +2,10 @@
 
 use std::path::PathBuf;
 
+use metamer::display::gamut::GamutMapping;
+use metamer::display::ModelKind;
 use metamer::experiment::lab::{run_lab, LabError, LabOptions, LabSummary, LAB_FILE};
+use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::experiment::{print_outcomes, refusal, StageProgress};
@@ -18,17 +21,18 @@ pub struct Args {
     /// lit by an LCD) or led-rgb1 (CIE LED-RGB1, a warm light whose saturated colours no
     /// virtual display can show).
     #[arg(long, default_value = "display-white", value_name = "LIGHT")]
-    scenario: String,
-    /// The simulated monitor: ideal-crt, ips-lcd or wide-gamut-ccfl.
-    #[arg(long, default_value = "ips-lcd", value_name = "PRESET")]
-    display: String,
+    scenario: Scenario,
+    /// The simulated monitor, named as `experiment --display` names it: virtual:ideal-crt,
+    /// virtual:ips-lcd or virtual:wide-gamut-ccfl (the preset's name alone is taken too).
+    #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
+    display: ScreenSpec,
     /// Display model: lut (3D LUT, for displays where PLCC's assumptions fail, as the
     /// simulated LCDs'), plcc (paper Eq. 9), plcc-gamma, gog, gogo, matrix-lsq.
     #[arg(long, default_value = "lut", value_name = "MODEL")]
-    model: String,
+    model: ModelKind,
     /// Out-of-gamut colours: nearest-lab (least ΔE*ab the display can show) or clip.
     #[arg(long, default_value = "nearest-lab", value_name = "MAPPING")]
-    gamut: String,
+    gamut: GamutMapping,
     /// The simulation's accuracy: 95 % half-width of every patch's ΔE*ab.
     #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
     target_de: f64,
@@ -58,11 +62,17 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
+    let ScreenSpec::Virtual(display) = args.display else {
+        return Err(CliError::Usage(format!(
+            "--display {}: the lab's monitor is simulated; name it virtual:PRESET",
+            args.display
+        )));
+    };
     let options = LabOptions {
-        scenario: args.scenario.parse().map_err(CliError::Usage)?,
-        display: args.display.parse().map_err(CliError::Usage)?,
-        model: args.model.parse().map_err(CliError::Usage)?,
-        gamut: args.gamut.parse().map_err(CliError::Usage)?,
+        scenario: args.scenario,
+        display,
+        model: args.model,
+        gamut: args.gamut,
         target_de: args.target_de,
         repeats: args.repeats,
         box_repeats: args.box_repeats,
@@ -83,18 +93,18 @@ pub fn run(args: Args) -> CliResult {
         LabError::Request(e) => refusal(e),
         e => CliError::from(e),
     })?;
-    print_outcomes(&outcomes, None);
-    print_summary(&summary);
-    println!(
+    print_outcomes(&outcomes, None)?;
+    print_summary(&summary)?;
+    outln!(
         "report: {}; summary: {}",
         args.out.join(&summary.report).display(),
         args.out.join(LAB_FILE).display()
-    );
+    )?;
     Ok(())
 }
 
-fn print_summary(s: &LabSummary) {
-    println!(
+fn print_summary(s: &LabSummary) -> CliResult {
+    outln!(
         "box lit by {}; display virtual:{}, model {}; {} of 24 simulated colours out of its gamut{}",
         s.options.scenario,
         s.options.display.name(),
@@ -113,13 +123,14 @@ fn print_summary(s: &LabSummary) {
                 s.options.gamut
             )
         }
-    );
+    )?;
     for c in [
         &s.display_vs_box,
         &s.simulation_vs_box,
         &s.display_vs_simulation,
     ] {
-        println!("{}", c.summary);
+        outln!("{}", c.summary)?;
     }
-    println!("total {:.1} s", s.seconds);
+    outln!("total {:.1} s", s.seconds)?;
+    Ok(())
 }

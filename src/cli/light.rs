@@ -107,7 +107,7 @@ fn run_fit(a: FitArgs) -> CliResult {
         force: a.force,
     };
     job::fit(&request, &|event| match event {
-        FitEvent::Fitted(fit) => print_fit(&request.falloff, fit),
+        FitEvent::Fitted(fit) => super::console::reported_at_exit(print_fit(&request.falloff, fit)),
         FitEvent::Written(file, path) => {
             let what = match file {
                 LightFile::Fit => "fit",
@@ -115,37 +115,55 @@ fn run_fit(a: FitArgs) -> CliResult {
                 LightFile::Ies => "IES",
                 LightFile::Ldt => "EULUMDAT",
             };
-            println!("{what} written to {}", path.display());
+            super::console::reported_at_exit(outln!("{what} written to {}", path.display()));
         }
-        FitEvent::Panel { panel, flux_lm } => println!(
-            "panel {} m × {} m at {} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
-            panel.width_m,
-            panel.height_m,
-            panel.normal_luminance_cd_m2,
-            panel.normal_intensity_cd(),
-            flux_lm
-        ),
+        FitEvent::Panel {
+            panel,
+            flux_lm,
+            extrapolated,
+        } => {
+            super::console::reported_at_exit(outln!(
+                "panel {} m × {} m at {} cd/m²: I₀ = {:.4} cd, flux {:.4} lm",
+                panel.width_m,
+                panel.height_m,
+                panel.normal_luminance_cd_m2,
+                panel.normal_intensity_cd(),
+                flux_lm
+            ));
+            if let Some(e) = extrapolated {
+                super::console::reported_at_exit(outln!(
+                    "  of which {:.4} lm ({:.1} %) above γ = {}°, where the table is extrapolated",
+                    e.flux_lm,
+                    100.0 * e.flux_lm / flux_lm,
+                    e.beyond_deg
+                ));
+            }
+        }
     })
     .map_err(light_error)?;
     Ok(())
 }
 
-fn print_fit(source: &std::path::Path, fit: &LdcFit) {
-    println!(
+fn print_fit(source: &std::path::Path, fit: &LdcFit) -> Result<(), super::console::ConsoleError> {
+    outln!(
         "{}: normal luminance {} (horizontal {}, vertical {} at 0°)",
         source.display(),
         num(fit.normal_luminance),
         num(fit.normal_readings[0]),
         num(fit.normal_readings[1])
-    );
-    println!(
+    )?;
+    outln!(
         "  {:<11} {:>5} {:>9} {:>9} {:>9}  parameters per half-plane",
-        "model", "par.", "rms", "LOO rms", "LOO max"
-    );
+        "model",
+        "par.",
+        "rms",
+        "LOO rms",
+        "LOO max"
+    )?;
     let score = |v: Option<f64>| v.map_or("-".to_string(), num);
     for c in &fit.candidates {
         let mark = if c.model == fit.model { "*" } else { " " };
-        println!(
+        outln!(
             "{mark} {:<11} {:>5} {:>9} {:>9} {:>9}  {}",
             c.model.name(),
             c.parameters,
@@ -153,15 +171,18 @@ fn print_fit(source: &std::path::Path, fit: &LdcFit) {
             score(c.cv_rms),
             score(c.cv_max),
             c.note.as_deref().unwrap_or("")
-        );
+        )?;
         if c.parameters > 0 {
             for h in &c.halves {
-                println!("      {:<20} {}", h.half.to_string(), h.params.describe());
+                outln!("      {:<20} {}", h.half.to_string(), h.params.describe())?;
             }
         }
     }
-    println!("chose {}", fit.why);
-    println!("residuals (reading/normal − fitted):");
+    outln!("chose {}", fit.why)?;
+    if let Some(e) = fit.extrapolation() {
+        outln!("note: {}", e.sentence())?;
+    }
+    outln!("residuals (reading/normal − fitted):")?;
     for plane in [Plane::Horizontal, Plane::Vertical] {
         let cells: Vec<String> = fit
             .residuals
@@ -169,8 +190,9 @@ fn print_fit(source: &std::path::Path, fit: &LdcFit) {
             .filter(|r| r.plane == plane)
             .map(|r| format!("{:+}°:{:+.4}", r.angle_deg, r.residual))
             .collect();
-        println!("  {plane:<10} {}", cells.join(" "));
+        outln!("  {plane:<10} {}", cells.join(" "))?;
     }
+    Ok(())
 }
 
 /// A number for a table: 5 significant digits in at most 9 characters, in exponent form
@@ -191,60 +213,60 @@ fn num(v: f64) -> String {
 
 fn run_show(a: ShowArgs) -> CliResult {
     let (table, p) = job::show(&a.file).map_err(light_error)?;
-    print_photometry(&a.file, &table, &p);
-    Ok(())
+    print_photometry(&a.file, &table, &p)
 }
 
-fn print_photometry(file: &std::path::Path, table: &CGammaTable, p: &Photometry) {
-    println!("{}: {}", file.display(), p.format);
+fn print_photometry(file: &std::path::Path, table: &CGammaTable, p: &Photometry) -> CliResult {
+    outln!("{}: {}", file.display(), p.format)?;
     if let Some(enc) = &p.text_encoding {
-        println!("  text lines read as {enc} (not UTF-8)");
+        outln!("  text lines read as {enc} (not UTF-8)")?;
     }
     for (key, text) in &p.labels {
-        println!("  {key:<11} {text}");
+        outln!("  {key:<11} {text}")?;
     }
-    println!(
+    outln!(
         "  C-planes: {} stored, symmetry {}; {} after expansion; γ 0…90° in {} steps",
         p.stored_planes,
         p.symmetry,
         table.c_deg().len(),
         table.gamma_deg().len() - 1
-    );
-    println!(
+    )?;
+    outln!(
         "  candela: {} … {} cd (normal {} cd)",
         num(p.min_intensity_cd),
         num(p.max_intensity_cd),
         num(p.normal_intensity_cd)
-    );
+    )?;
     match p.normal_luminance_cd_m2() {
-        Some(l) => println!(
+        Some(l) => outln!(
             "  luminous opening {} m × {} m ({} m²): normal luminance {} cd/m²",
             num(p.width_m),
             num(p.height_m),
             num(p.area_m2),
             num(l)
         ),
-        None => println!("  no luminous opening given: luminance unknown"),
-    }
-    println!("  flux {} lm (front hemisphere)", num(p.flux_lm));
+        None => outln!("  no luminous opening given: luminance unknown"),
+    }?;
+    outln!("  flux {} lm (front hemisphere)", num(p.flux_lm))?;
     if p.max_backward_cd > 0.0 {
-        println!(
+        outln!(
             "  up to {} cd behind the panel (γ > 90°), left out of the distribution",
             num(p.max_backward_cd)
-        );
+        )?;
     }
-    println!("  relative luminance f(C, γ):");
+    outln!("  relative luminance f(C, γ):")?;
     let gammas = [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0];
     let head: String = gammas
         .iter()
         .map(|g| format!(" {:>9}", format!("{g}°")))
         .collect();
-    println!("    {:<6}{head}", "C \\ γ");
+    outln!("    {:<6}{head}", "C \\ γ")?;
     for h in HalfPlane::ALL {
         let cells: String = gammas
             .iter()
             .map(|&g| format!(" {:>9}", num(table.at(h.c_deg(), g))))
             .collect();
-        println!("    {:<6}{cells}", format!("C{}", h.c_deg()));
+        outln!("    {:<6}{cells}", format!("C{}", h.c_deg()))?;
     }
+    Ok(())
 }

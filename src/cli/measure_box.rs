@@ -1,11 +1,12 @@
 //! `metamer measure-box`: the guided, resumable measurement of the validation box.
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
-use metamer::measure_box::{Outcome, PlanError, Summary};
+use metamer::measure_box::{BoxPlanError, Outcome, Summary};
+use metamer::rig::Scenario;
 use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
+use metamer_drivers::Spec;
 
 use super::rig::{box_light_refusal, nobody_at_the_rig};
 use super::{CliError, CliResult};
@@ -18,10 +19,10 @@ pub struct Args {
     out: PathBuf,
     /// The spectral instrument: i1pro, i1pro:SERIAL, replay:FILE.jsonl or sim:i1pro.
     #[arg(long, value_name = "SPEC")]
-    spectral: String,
+    spectral: Spec,
     /// The spot meter: cs100a:PORT, replay:FILE.jsonl or sim:cs100a.
     #[arg(long, value_name = "SPEC")]
-    spot: String,
+    spot: Spec,
     /// A plan file (JSON) changing counts, angles and geometry; default the paper's plan.
     #[arg(long, value_name = "FILE.json")]
     plan: Option<PathBuf>,
@@ -42,7 +43,7 @@ pub struct Args {
     /// ips-lcd display's white, as the paper's box was lit by an LCD) or led-rgb1 (CIE
     /// LED-RGB1, a warm light whose saturated colours no virtual display can show).
     #[arg(long, value_name = "LIGHT")]
-    scenario: Option<String>,
+    scenario: Option<Scenario>,
     /// Replace an existing scene.json, light.json/.svg/.ies/.ldt or summary.json in DIR.
     #[arg(long)]
     force: bool,
@@ -80,9 +81,11 @@ pub fn run(args: Args) -> CliResult {
         attendance: None,
         spot_readings: false,
     };
-    let outcome = job::measure(&request, &|n| eprintln!("{n}…"), &mut |shown| {
-        Box::new(BarProgress::new("reading").attended(shown))
-    })
+    let outcome = job::measure(
+        &request,
+        &|n| super::console::reported_at_exit(errln!("{n}…")),
+        &mut |shown| Box::new(BarProgress::new("reading").attended(shown)),
+    )
     .map_err(refusal)?;
     report(outcome)
 }
@@ -90,11 +93,11 @@ pub fn run(args: Args) -> CliResult {
 /// A failure in the command's words: its flags named where the request was wrong.
 fn refusal(e: MeasureBoxJobError) -> CliError {
     match e {
-        MeasureBoxJobError::Plan(e @ PlanError::Io { .. }) => CliError::from(e),
+        MeasureBoxJobError::Plan(e @ BoxPlanError::Io { .. }) => CliError::from(e),
         MeasureBoxJobError::Repeats(message) => usage(format!("--repeats {message}")),
         MeasureBoxJobError::Plan(e) => usage(e),
         MeasureBoxJobError::UnknownStage(message) => usage(message),
-        MeasureBoxJobError::BoxLight(e) => box_light_refusal(e),
+        MeasureBoxJobError::BoxLight(e) => box_light_refusal(e, None),
         MeasureBoxJobError::Nobody(e) => nobody_at_the_rig(e),
         MeasureBoxJobError::Rig(e) if e.is_request() => usage(e),
         MeasureBoxJobError::Rig(e) => CliError::from(e),
@@ -113,17 +116,15 @@ fn report(outcome: Outcome) -> CliResult {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
         (_, text) => {
-            println!("{}", text.unwrap_or_default());
+            outln!("{}", text.unwrap_or_default())?;
             Ok(())
         }
     }
 }
 
 fn print_summary(s: &Summary) -> CliResult {
-    let mut out = std::io::stdout().lock();
     let c = &s.render.comparison;
-    writeln!(
-        out,
+    outln!(
         "tiles: {} · fall-off: {} angles, {} LDC (rms {}) · materials: {} · spots: {}",
         s.tiles.len(),
         s.falloff.len(),
@@ -137,14 +138,10 @@ fn print_summary(s: &Summary) -> CliResult {
     )?;
     let flagged = &s.provenance.outliers;
     if flagged.is_empty() {
-        writeln!(
-            out,
-            "no outliers; every group's spread within the instruments' noise"
-        )?;
+        outln!("no outliers; every group's spread within the instruments' noise")?;
     }
     for f in flagged {
-        writeln!(
-            out,
+        outln!(
             "flagged: {} {}: outlier repeats {:?}{}",
             f.stage,
             f.what,
@@ -156,9 +153,7 @@ fn print_summary(s: &Summary) -> CliResult {
             }
         )?;
     }
-    writeln!(
-        out,
-        "measured scene rendered vs box spots: ΔE*ab mean {:.2}, max {:.2}; ΔE00 mean {:.2}, max {:.2}; {} of {} below the JND by point estimate",
+    outln!("measured scene rendered vs box spots: ΔE*ab mean {:.2}, max {:.2}; ΔE00 mean {:.2}, max {:.2}; {} of {} below the JND by point estimate",
         c.mean_de76,
         c.max_de76,
         c.mean_de00,
@@ -167,8 +162,7 @@ fn print_summary(s: &Summary) -> CliResult {
         c.patches.len()
     )?;
     let f = &s.files;
-    writeln!(
-        out,
+    outln!(
         "wrote {}, {}, {}, {}, {}, {}",
         f.scene.display(),
         f.light.display(),

@@ -4,6 +4,25 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use metamer::output::console;
+
+/// A line on standard output: `Err` (never a panic) when it cannot be written, as behind a
+/// full disk. Every command prints through these macros (see `metamer::output::console`).
+macro_rules! outln {
+    () => { metamer::output::console::out_fmt(format_args!("")) };
+    ($($arg:tt)*) => { metamer::output::console::out_fmt(format_args!($($arg)*)) };
+}
+
+/// Text on standard output without a newline.
+macro_rules! out {
+    ($($arg:tt)*) => { metamer::output::console::out_part(format_args!($($arg)*)) };
+}
+
+/// A line on standard error, as `outln!`.
+macro_rules! errln {
+    () => { metamer::output::console::err_fmt(format_args!("")) };
+    ($($arg:tt)*) => { metamer::output::console::err_fmt(format_args!($($arg)*)) };
+}
 
 mod budget;
 mod characterize;
@@ -83,7 +102,10 @@ impl<E: std::error::Error + Send + Sync + 'static> From<E> for CliError {
 pub type CliResult = Result<(), CliError>;
 
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
     let result = match cli.command {
         Command::Color(args) => color::run(args),
         Command::Devices(args) => devices::run(args),
@@ -102,16 +124,33 @@ pub fn main() -> ExitCode {
         Command::Validate(args) => validate::run(args),
         Command::Export(args) => export::run(args),
     };
+    // A write that failed inside a callback is remembered rather than returned; an
+    // unflushed last line fails only here.
+    let result = match (result, console::flush()) {
+        (Ok(()), Err(e)) => Err(CliError::from(e)),
+        (Ok(()), Ok(())) => match console::failure() {
+            Some(e) => Err(CliError::from(e)),
+            None => Ok(()),
+        },
+        (result, _) => result,
+    };
+    report(result)
+}
+
+/// The exit code of a command's result, with its error on standard error: one line, then
+/// the hint `--force` lifts and causes that the line does not already say. If standard
+/// error itself cannot be written there is nobody to tell; the exit code still says it.
+fn report(result: CliResult) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(CliError::Usage(message)) => {
-            eprintln!("error: {message}");
+            let _ = errln!("error: {message}");
             ExitCode::from(2)
         }
         Err(CliError::Failed(error)) => {
-            eprintln!("error: {error}");
+            let _ = errln!("error: {error}");
             if needs_force(&*error) {
-                eprintln!("  add --force to replace it");
+                let _ = errln!("  add --force to replace it");
             }
             let mut shown = error.to_string();
             let mut source = error.source();
@@ -119,13 +158,35 @@ pub fn main() -> ExitCode {
                 let text = cause.to_string();
                 // thiserror messages often quote their source already; say each thing once.
                 if !shown.contains(&text) {
-                    eprintln!("  caused by: {text}");
+                    let _ = errln!("  caused by: {text}");
                     shown.push_str(&text);
                 }
                 source = cause.source();
             }
             ExitCode::from(1)
         }
+    }
+}
+
+/// clap's help, version or usage error. clap prints help and version on standard output and
+/// exits 0 even when that write fails, so the write's failure is reported here instead.
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let code = e.exit_code();
+    let stream = if e.use_stderr() {
+        console::Stream::Stderr
+    } else {
+        console::Stream::Stdout
+    };
+    let written = e.print().and_then(|()| match stream {
+        console::Stream::Stdout => std::io::Write::flush(&mut std::io::stdout()),
+        console::Stream::Stderr => Ok(()),
+    });
+    match written {
+        Ok(()) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
+        Err(source) => report(Err(CliError::from(console::ConsoleError {
+            stream,
+            source,
+        }))),
     }
 }
 

@@ -204,14 +204,14 @@ fn convergence(a: ConvergenceArgs) -> CliResult {
         force: a.force,
     };
     job::convergence::run(&request, &|e| match e {
-        RenderEvent::Log(m) => eprintln!("{m}"),
+        RenderEvent::Log(m) => super::console::reported_at_exit(errln!("{m}")),
         other => print_event(other),
     })
     .map_err(cli_error)?;
-    eprintln!(
+    errln!(
         "wrote {}/convergence.csv and convergence.svg",
         request.output.display()
-    );
+    )?;
     Ok(())
 }
 
@@ -226,8 +226,8 @@ fn cli_error(e: RenderError) -> CliError {
 
 /// The events every command shows the same way.
 fn print_event(e: RenderEvent) {
-    if let RenderEvent::SceneWarning(w) = e {
-        eprintln!("warning: {w}");
+    if let RenderEvent::SceneWarning(w) | RenderEvent::Warning(w) = e {
+        super::console::reported_at_exit(errln!("warning: {w}"));
     }
 }
 
@@ -257,16 +257,19 @@ fn spots(a: SpotsArgs) -> CliResult {
     let report = job::spots::run(&request, &|e| match e {
         RenderEvent::Method(m) => {
             if let Some(why) = m.fallback() {
-                eprintln!("using the path tracer: {why}");
+                super::console::reported_at_exit(errln!("using the path tracer: {why}"));
             }
             if m.method == Solver::PathTracer {
                 bar.set_message("(reference white)");
             }
         }
-        RenderEvent::Level(l) => eprintln!(
+        RenderEvent::Level(l) => super::console::reported_at_exit(errln!(
             "level {}: {} elements, {} sweeps, {:.2} s",
-            l.level, l.elements, l.sweeps, l.seconds
-        ),
+            l.level,
+            l.elements,
+            l.sweeps,
+            l.seconds
+        )),
         RenderEvent::Spots(p) => {
             bar.set_position(p.converged as u64);
             bar.set_message(format!("worst ΔE95 {:.3}", p.worst_de));
@@ -276,28 +279,54 @@ fn spots(a: SpotsArgs) -> CliResult {
     .map_err(cli_error)?;
     bar.finish_and_clear();
     if a.json {
-        println!("{}", report.to_json()?);
+        outln!("{}", report.to_json()?)?;
         return Ok(());
     }
-    print_provenance(&report.scene);
-    print_spots(&report.readings);
+    print_spots(&report.readings)?;
+    print_provenance(&report.scene)
+}
+
+/// The scene's provenance in one short line after the readings (the answer comes first):
+/// its plain values in full, a nested object or list by its size; `--json` carries it all.
+fn print_provenance(scene: &Scene) -> CliResult {
+    if let Some(p) = &scene.provenance {
+        outln!(
+            "provenance (in full with --json): {}",
+            provenance_summary(p)
+        )?;
+    }
     Ok(())
 }
 
-/// The scene's provenance, one line, ahead of the readings.
-fn print_provenance(scene: &Scene) {
-    if let Some(p) = &scene.provenance {
-        println!("provenance: {}", serde_json::Value::Object(p.clone()));
-    }
+fn provenance_summary(p: &serde_json::Map<String, serde_json::Value>) -> String {
+    use serde_json::Value;
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    let shown = |v: &Value| match v {
+        Value::String(s) if s.chars().count() <= 60 => s.clone(),
+        Value::String(s) => format!("{}…", s.chars().take(60).collect::<String>()),
+        Value::Object(o)
+            if o.values().all(|v| !v.is_object() && !v.is_array()) && v.to_string().len() <= 80 =>
+        {
+            v.to_string()
+        }
+        Value::Object(o) => format!("{{{} field{}}}", o.len(), plural(o.len())),
+        Value::Array(a) if a.is_empty() => "none".into(),
+        Value::Array(a) => format!("[{} item{}]", a.len(), plural(a.len())),
+        other => other.to_string(),
+    };
+    p.iter()
+        .map(|(k, v)| format!("{k} {}", shown(v)))
+        .collect::<Vec<_>>()
+        .join(" · ")
 }
 
 /// The run's white and time, then one row per patch with its uncertainty as its solver
 /// states it (the path tracer's 95 % half-width and samples, the radiosity bound).
-fn print_spots(readings: &Readings) {
+fn print_spots(readings: &Readings) -> CliResult {
     let w = readings.white();
     match readings {
         Readings::PathTracer(r) => {
-            println!(
+            outln!(
                 "white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s{}",
                 w[0],
                 w[1],
@@ -308,14 +337,22 @@ fn print_spots(readings: &Readings) {
                 } else {
                     "  (time limit: not converged)"
                 }
-            );
-            println!(
+            )?;
+            outln!(
                 "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>10}",
-                "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "samples"
-            );
+                "patch",
+                "X",
+                "Y",
+                "Z",
+                "L*",
+                "a*",
+                "b*",
+                "ΔE95",
+                "samples"
+            )?;
         }
         Readings::Radiosity { result: r, .. } => {
-            println!(
+            outln!(
                 "radiosity: white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.2} s, {} levels{}",
                 w[0],
                 w[1],
@@ -327,11 +364,18 @@ fn print_spots(readings: &Readings) {
                 } else {
                     "  (level or time limit reached: bound above the target)"
                 }
-            );
-            println!(
+            )?;
+            outln!(
                 "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>9}",
-                "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE bound"
-            );
+                "patch",
+                "X",
+                "Y",
+                "Z",
+                "L*",
+                "a*",
+                "b*",
+                "ΔE bound"
+            )?;
         }
     }
     for p in readings.patches() {
@@ -343,11 +387,12 @@ fn print_spots(readings: &Readings) {
         match p.uncertainty {
             Uncertainty::HalfWidth95 { de, sampling } => {
                 let samples = sampling.map(|s| s.samples.to_string());
-                println!("{row} {de:>8.4} {:>10}", samples.unwrap_or_default());
+                outln!("{row} {de:>8.4} {:>10}", samples.unwrap_or_default())
             }
-            Uncertainty::Bound { de, .. } => println!("{row} {de:>9.5}"),
-        }
+            Uncertainty::Bound { de, .. } => outln!("{row} {de:>9.5}"),
+        }?;
     }
+    Ok(())
 }
 
 fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
@@ -360,12 +405,11 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
     };
     let report = job::spots_from_image::run(&request, &print_event).map_err(cli_error)?;
     if a.json {
-        println!("{}", report.to_json()?);
+        outln!("{}", report.to_json()?)?;
         return Ok(());
     }
-    print_provenance(&report.scene);
     let w = report.white;
-    println!(
+    outln!(
         "{} ({}×{}, sha256 {}): white X Y Z = {:.4} {:.4} {:.4} cd/m²   {:.1} s",
         report.image.display(),
         report.pixels.width,
@@ -375,22 +419,31 @@ fn spots_from_image(a: SpotsFromImageArgs) -> CliResult {
         w[1],
         w[2],
         report.seconds
-    );
-    println!(
+    )?;
+    outln!(
         "{:>5} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>7} {:>9}",
-        "patch", "X", "Y", "Z", "L*", "a*", "b*", "ΔE95", "pixels", "effective"
-    );
+        "patch",
+        "X",
+        "Y",
+        "Z",
+        "L*",
+        "a*",
+        "b*",
+        "ΔE95",
+        "pixels",
+        "effective"
+    )?;
     for (p, c) in report.patches.iter().zip(&report.cones) {
         let ([x, y, z], [l, a, b]) = (p.xyz.to_array(), p.lab);
-        println!(
+        outln!(
             "{:>5} {x:>10.4} {y:>10.4} {z:>10.4} {l:>8.3} {a:>8.3} {b:>8.3} {:>8.4} {:>7} {:>9.1}",
             p.patch,
             p.uncertainty.de_ab(),
             c.pixels,
             c.effective
-        );
+        )?;
     }
-    Ok(())
+    print_provenance(&report.scene)
 }
 
 fn image(a: ImageArgs) -> CliResult {
@@ -413,7 +466,7 @@ fn image(a: ImageArgs) -> CliResult {
         RenderEvent::Rows(n) => bar.inc(n as u64),
         RenderEvent::ImageWritten(r) => {
             bar.finish_and_clear();
-            eprintln!(
+            super::console::reported_at_exit(errln!(
                 "{}×{} at {} spp by {} in {:.1} s ({:.0} samples/s), wrote {}",
                 r.width,
                 r.height,
@@ -425,9 +478,11 @@ fn image(a: ImageArgs) -> CliResult {
                 r.seconds,
                 (r.width * r.height) as f64 * r.spp as f64 / r.seconds,
                 r.output.display()
-            );
+            ));
         }
-        RenderEvent::PreviewWritten(p) => eprintln!("preview {}", p.display()),
+        RenderEvent::PreviewWritten(p) => {
+            super::console::reported_at_exit(errln!("preview {}", p.display()))
+        }
         other => print_event(other),
     })
     .map_err(cli_error)?;
@@ -462,10 +517,10 @@ fn probes(a: ProbesArgs) -> CliResult {
     bar.finish_and_clear();
     let r = &report.result;
     if let Some(why) = &r.method_reason {
-        eprintln!("using the path tracer: {why}");
+        errln!("using the path tracer: {why}")?;
     }
     if !r.converged {
-        eprintln!(
+        errln!(
             "warning: not converged: {}; the largest bound is {:.3e} of its total{}",
             r.stopped.as_deref().unwrap_or("stopped early"),
             report.worst_relative_bound(),
@@ -474,26 +529,54 @@ fn probes(a: ProbesArgs) -> CliResult {
             } else {
                 String::new()
             }
-        );
+        )?;
     }
     if a.json {
-        println!("{}", report.to_json()?);
+        outln!("{}", report.to_json()?)?;
     } else {
-        print_probes(&report);
+        print_probes(&report)?;
     }
     Ok(())
 }
 
-fn print_probes(report: &ProbesReport) {
+fn print_probes(report: &ProbesReport) -> CliResult {
     let r = &report.result;
-    eprintln!("{}: {:.2} s", r.method, r.seconds);
-    println!("x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux,bound_lux");
+    errln!("{}: {:.2} s", r.method, r.seconds)?;
+    outln!("x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux,bound_lux")?;
     for (p, e) in report.probes.iter().zip(&r.probes) {
         let [x, y, z] = p.position.to_array();
         let [a, b, c] = p.normal.to_array();
-        println!(
+        outln!(
             "{x},{y},{z},{a},{b},{c},{:.6},{:.6},{:.6},{:.6}",
-            e.direct_lux, e.indirect_lux, e.total_lux, e.bound_lux
+            e.direct_lux,
+            e.indirect_lux,
+            e.total_lux,
+            e.bound_lux
+        )?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::provenance_summary;
+
+    #[test]
+    fn the_provenance_line_shows_plain_values_and_sizes_the_rest() {
+        let p: serde_json::Value = serde_json::json!({
+            "date": "2026-12-07T17:11:19Z",
+            "clamped_values": 0,
+            "instrument_specs": {"spot": "sim:cs100a"},
+            "instruments": {"spot": {"model": "cs100a"}},
+            "journals": [{"file": "a"}, {"file": "b"}],
+            "outliers": [],
+        });
+        // serde_json's map keeps its keys sorted.
+        assert_eq!(
+            provenance_summary(p.as_object().unwrap()),
+            "clamped_values 0 · date 2026-12-07T17:11:19Z · instrument_specs \
+             {\"spot\":\"sim:cs100a\"} · instruments {1 field} · journals [2 items] · \
+             outliers none"
         );
     }
 }

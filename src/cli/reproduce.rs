@@ -66,7 +66,7 @@ pub fn run(args: Args) -> CliResult {
         Report::Targets {
             count,
             out_of_gamut: out,
-        } => eprintln!(
+        } => errln!(
             "{count} targets, {out} out of gamut ({}); written to {output}",
             if out > 0 && request.gamut == GamutMapping::Clip {
                 "clipped"
@@ -82,12 +82,12 @@ pub fn run(args: Args) -> CliResult {
             elapsed,
             out_of_gamut,
             bits,
-        } => eprintln!(
+        } => errln!(
             "{width}×{height} pixels converted in {:.1} ms; {out_of_gamut} out of gamut ({:.3} \
              %); {bits}-bit PNG written to {output}",
             elapsed.as_secs_f64() * 1e3,
             100.0 * out_of_gamut as f64 / (width * height).max(1) as f64,
         ),
-    }
+    }?;
     Ok(())
 }

@@ -1,8 +1,6 @@
 //! `metamer simulate cs100a --pty`: serves the simulated CS-100A on a pseudo-terminal for
 //! other programs, until Ctrl-C or SIGTERM.
 
-use std::io::Write;
-
 use clap::{Subcommand, ValueEnum};
 use metamer::color::Xyz;
 use metamer::rig::sim_meter::{PtyMeter, PtyMeterError, PtyMeterOptions};
@@ -74,16 +72,14 @@ fn cs100a(args: Cs100aArgs) -> CliResult {
         PtyMeterError::BadTimeScale(_) => CliError::Usage(format!("--time-scale: {e}")),
         e => CliError::from(e),
     })?;
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "{}", meter.path())?;
-    out.flush()?;
-    drop(out);
-    eprintln!(
+    outln!("{}", meter.path())?;
+    super::console::flush()?;
+    errln!(
         "serving a simulated CS-100A on {} (4800 baud, 7E2); Ctrl-C stops",
         meter.path()
-    );
+    )?;
     let signal = wait_for(&signals)?;
-    eprintln!("stopped by signal {signal}");
+    errln!("stopped by signal {signal}")?;
     drop(meter);
     Ok(())
 }

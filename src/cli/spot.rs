@@ -1,13 +1,12 @@
 //! `metamer spot`: spot readings from an instrument (real, replayed or simulated), with the
 //! instrument's calibrations negotiated at the terminal.
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use clap::ValueEnum;
 use metamer::spot::{self, SpotEvent, SpotRequest, SpotRunError};
 use metamer::validation::readings::spot_line;
-use metamer_drivers::{MeasureMode, Reading, Speed};
+use metamer_drivers::{MeasureMode, Reading, Spec, Speed};
 
 use super::{CliError, CliResult};
 
@@ -74,7 +73,7 @@ pub fn run(args: Args) -> CliResult {
         ModeArg::Ambient => MeasureMode::Ambient,
     };
     let request = SpotRequest {
-        instrument: args.instrument,
+        instrument: Spec::new(args.instrument),
         mode,
         speed: args.speed.map(|s| match s {
             SpeedArg::Fast => Speed::Fast,
@@ -88,21 +87,24 @@ pub fn run(args: Args) -> CliResult {
         unattended: args.unattended,
     };
     let json = args.json;
-    let mut out = std::io::stdout().lock();
     spot::run(&request, &mut |event| match event {
-        SpotEvent::Opened(info) if !json => writeln!(out, "{} on {}", info.model, info.connection),
+        SpotEvent::Opened(info) if !json => Ok(outln!("{} on {}", info.model, info.connection)?),
         SpotEvent::Opened(_) => Ok(()),
         SpotEvent::Reading { n, reading } => {
             if json {
-                writeln!(out, "{}", spot_line(reading))?;
+                outln!("{}", spot_line(reading))?;
             } else {
-                writeln!(out, "{}", human_line(n, mode, reading))?;
+                outln!("{}", human_line(n, mode, reading))?;
             }
             // Each reading is shown as it arrives: a later failure must not hide earlier ones.
-            out.flush()
+            Ok(super::console::flush()?)
+        }
+        SpotEvent::Note(text) => {
+            errln!("note: {text}")?;
+            Ok(())
         }
         SpotEvent::Stopped { done, of } => {
-            eprintln!("stopped at your request after {done} of {of} readings");
+            errln!("stopped at your request after {done} of {of} readings")?;
             Ok(())
         }
     })

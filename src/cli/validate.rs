@@ -118,8 +118,7 @@ pub fn run(args: Args) -> CliResult {
         force: args.force,
     })
     .map_err(refusal)?;
-    print(&outcome, args.json);
-    Ok(())
+    print(&outcome, args.json)
 }
 
 /// The numbers the library takes as given, checked as this command's options.
@@ -163,42 +162,60 @@ fn refusal(e: ValidationError) -> CliError {
     }
 }
 
-fn print(outcome: &Outcome, json: bool) {
+fn print(outcome: &Outcome, json: bool) -> CliResult {
     let input = &outcome.report;
     if json {
-        println!("{}", to_json(input));
-        return;
+        outln!("{}", to_json(input))?;
+        return Ok(());
     }
     for note in &input.notes {
-        eprintln!("note: {note}");
+        errln!("note: {note}")?;
     }
     let white = outcome.white;
-    println!(
+    outln!(
         "white X Y Z = {:.4} {:.4} {:.4} ({})",
-        white.x, white.y, white.z, input.white_source
-    );
+        white.x,
+        white.y,
+        white.z,
+        input.white_source
+    )?;
     for (_, a) in comparisons(input) {
-        print_table(a);
+        print_table(a)?;
     }
     for f in &outcome.files {
-        println!("wrote {}", f.display());
+        outln!("wrote {}", f.display())?;
     }
+    Ok(())
 }
 
-fn print_table(a: &Assessment) {
-    println!();
-    println!(
+fn print_table(a: &Assessment) -> CliResult {
+    outln!()?;
+    outln!(
         "{} vs {} (CIELAB of {} first, then of {})",
-        a.test, a.reference, a.reference, a.test
-    );
-    println!(
+        a.test,
+        a.reference,
+        a.reference,
+        a.test
+    )?;
+    outln!(
         "{:>3} {:<14} {:>7} {:>7} {:>7}  {:>7} {:>7} {:>7}  {:>7} {:>15}  {:>7} {:>15}  JND",
-        "#", "patch", "L*", "a*", "b*", "L*", "a*", "b*", "ΔE*ab", "95 %", "ΔE00", "95 %"
-    );
+        "#",
+        "patch",
+        "L*",
+        "a*",
+        "b*",
+        "L*",
+        "a*",
+        "b*",
+        "ΔE*ab",
+        "95 %",
+        "ΔE00",
+        "95 %"
+    )?;
     for p in &a.patches {
         let [rl, ra, rb] = p.reference.lab;
         let [tl, ta, tb] = p.test.lab;
-        println!(
+        outln!(
             "{:>3} {:<14} {rl:>7.2} {ra:>7.2} {rb:>7.2}  {tl:>7.2} {ta:>7.2} {tb:>7.2}  {:>7.2} {:>15}  {:>7.2} {:>15}  {}{}",
             p.patch,
             p.name,
@@ -208,7 +225,8 @@ fn print_table(a: &Assessment) {
             format!("[{:.2}, {:.2}]", p.de00_interval.lo, p.de00_interval.hi),
             p.jnd.name(),
             if p.out_of_gamut { "  (out of gamut)" } else { "" }
-        );
+        )?;
     }
-    println!("{}", a.summary());
+    outln!("{}", a.summary())?;
+    Ok(())
 }

@@ -23,21 +23,23 @@ pub fn run(args: Args) -> CliResult {
         profile: args.profile,
         measurements: args.measurements,
     };
-    let report = verify::run(&request, &mut |text| eprintln!("warning: {text}"))?;
+    let report = verify::run(&request, &mut |text| {
+        super::console::reported_at_exit(errln!("warning: {text}"))
+    })?;
     let v = &report.verification;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string(v).expect("a verification always serialises")
-        );
+        )?;
     } else {
-        println!(
+        outln!(
             "{} ({}) against {}",
             request.profile.display(),
             report.profile.model,
             request.measurements.display()
-        );
-        println!("{v}");
+        )?;
+        outln!("{v}")?;
     }
     Ok(())
 }

@@ -382,8 +382,15 @@ pub fn write_budget(
 ) -> Result<(), BudgetError> {
     out.dir(dir)?;
     let csv = dir.join("budget.csv");
-    let mut presets: Vec<&str> = points.iter().map(|p| p.preset.as_str()).collect();
-    presets.dedup();
+    // Each preset once, in the order of its first point: the study lists the mixture
+    // points after every preset's own, so a preset's points are not adjacent, and writing
+    // its chart twice would refuse the file the run itself had just written.
+    let mut presets: Vec<&str> = Vec::new();
+    for p in points {
+        if !presets.contains(&p.preset.as_str()) {
+            presets.push(&p.preset);
+        }
+    }
     out.check(&csv)?;
     for preset in &presets {
         out.check(&dir.join(format!("budget-{preset}.svg")))?;
@@ -411,7 +418,6 @@ pub fn write_budget(
             .filter(|p| p.preset == preset)
             .map(|p| p.model.as_str())
             .collect();
-        models.dedup();
         models.sort();
         models.dedup();
         let series: Vec<Series> = models
@@ -484,6 +490,48 @@ mod tests {
         assert_eq!(a, random_patches(200, 7));
         let mean: f64 = a.iter().map(|c| f64::from(c[0])).sum::<f64>() / 200.0;
         assert!((mean - 127.5).abs() < 15.0, "{mean}");
+    }
+
+    /// The study lists each preset's ramp and scattered points, then the mixture points of
+    /// every preset: points of one preset that are not adjacent still make one chart, and
+    /// nothing is written twice (a second chart of a preset was refused as an existing
+    /// file, after minutes of study).
+    #[test]
+    fn interleaved_presets_make_one_chart_each() {
+        let dir = std::env::temp_dir().join(format!("metamer-budget-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let pt = |preset: &str, model: &str, patches: usize, mean: f64| BudgetPoint {
+            preset: preset.into(),
+            model: model.into(),
+            patches,
+            ramp_steps: 3,
+            cube: 0,
+            mean_de00: mean,
+            p95_de00: mean,
+            max_de00: mean,
+            fit_ms: 1.0,
+        };
+        let points = [
+            pt("ideal-crt", "plcc", 9, 0.1),
+            pt("ips-lcd", "plcc", 9, 1.0),
+            pt("ideal-crt", "lut ramps+grid", 50, 0.2),
+            pt("ips-lcd", "lut ramps+grid", 50, 0.5),
+        ];
+        write_budget(&dir, &points, &OutputPolicy::new(false)).unwrap();
+        let mut files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        files.sort();
+        assert_eq!(
+            files,
+            ["budget-ideal-crt.svg", "budget-ips-lcd.svg", "budget.csv"]
+        );
+        let crt = std::fs::read_to_string(dir.join("budget-ideal-crt.svg")).unwrap();
+        assert!(crt.contains("lut ramps+grid") && crt.contains("plcc"));
+        let csv = std::fs::read_to_string(dir.join("budget.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + points.len());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// On the display that satisfies PLCC, PLCC reproduces colours within the error the

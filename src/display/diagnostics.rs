@@ -401,6 +401,14 @@ impl Diagnostics {
                 "No PLCC assumption fails within ΔE00 {tol} among those checked; not checked: {}.",
                 unchecked.join("; ")
             )
+        } else if self.model == ModelKind::Lut {
+            // The fitted model is the answer to these failures, so the verdict says that
+            // first rather than opening on assumptions the model does not make.
+            format!(
+                "The lut assumes neither constant chromaticity nor additivity, so it holds \
+                 where PLCC's assumptions fail, as they do here: {}.",
+                failures.join("; ")
+            )
         } else {
             format!(
                 "PLCC's assumptions fail: {}. Models that do not assume them: lut (needs a full \

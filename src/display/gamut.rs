@@ -11,8 +11,10 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::color::{Lab, Xyz};
 
-/// How out-of-gamut targets are brought onto the display.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// How out-of-gamut targets are brought onto the display; written by the name the
+/// command line takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum GamutMapping {
     /// Clip each drive value of the inverse model's solution to 0–1.
     Clip,

@@ -39,4 +39,4 @@ pub use measurements::{
 pub use model::{DisplayModel, FitError, Inverse, ModelKind, Sample};
 pub use profile::{Profile, ProfileError};
 pub use select::{select_model, Selection};
-pub use verify::{verify_profile, ProfileVerification};
+pub use verify::{verify_profile, Verification};

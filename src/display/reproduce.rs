@@ -55,7 +55,9 @@ pub fn reproduce_targets(profile: &Profile, targets: &[Xyz], mapping: GamutMappi
         .collect()
 }
 
-/// A drive-value image, rows top to bottom.
+/// An image of drive values 0–1 before quantisation (32-bit floats), rows top to bottom,
+/// with the count of pixels whose colour was out of gamut. Quantised and written, it reads
+/// back as an [`crate::image::Drive8Image`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct DriveImage {
     pub width: usize,

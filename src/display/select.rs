@@ -171,6 +171,44 @@ pub fn select_model(
 ) -> Result<Selection, FitError> {
     check_samples(patches)?;
     let folds = folds.max(2);
+    let rotating = rotating_patches(patches, folds)?;
+    let fold = |i: usize| fold_of(i) % folds;
+    let full = SortedSamples::new(patches);
+    let mixtures = mixture_evidence(patches, &full, options);
+    let candidates: Vec<Candidate> = ModelKind::ALL
+        .into_iter()
+        .map(|kind| {
+            if mixtures.few && kind == ModelKind::Lut {
+                return Candidate {
+                    model: kind,
+                    cv_mean_de00: Err("not a candidate on a set with few mixed patches: its \
+                                       colours between the ramps would be its smoothness \
+                                       prior, not a measurement"
+                        .into()),
+                    held_out_de00: Vec::new(),
+                    white_de00: None,
+                    set_aside: None,
+                };
+            }
+            let scores = cross_validate(kind, patches, &rotating, folds, &fold, options);
+            score(kind, scores, &full, patches, options, &mixtures)
+        })
+        .collect();
+    let (chosen, best, white_decides) = choose(&candidates, &mixtures)?;
+    Ok(Selection {
+        model: chosen,
+        lowest: (chosen != best).then_some(best),
+        white_decided: white_decides && chosen != best,
+        folds,
+        held_out: rotating.len(),
+        mixtures,
+        candidates,
+    })
+}
+
+/// The patches that take turns in being held out: all but the cube's corners, which every
+/// fit keeps. At least one per fold.
+fn rotating_patches(patches: &[Sample], folds: usize) -> Result<Vec<usize>, FitError> {
     let corner = |p: &Sample| {
         p.rgb
             .iter()
@@ -189,17 +227,25 @@ pub fn select_model(
             ),
         });
     }
-    let fold = |i: usize| fold_of(i) % folds;
+    Ok(rotating)
+}
+
+/// What the set says about mixtures: how many it has, how well the measured white is the
+/// sum of the channels, with what noise, and the white's allowance that follows.
+fn mixture_evidence(
+    patches: &[Sample],
+    full: &SortedSamples,
+    options: &FitOptions,
+) -> MixtureEvidence {
     let n_mixed = mixed_patches(patches);
-    let full = SortedSamples::new(patches);
     let white = full.white;
     let sigma = options
         .noise_de00
         .or_else(|| white.and_then(|w| repeat_noise(patches, w).map(|n| n.de00)));
-    let reading_noise = repeat_reading_noise(patches).or_else(|| ramp_noise(&full));
+    let reading_noise = repeat_reading_noise(patches).or_else(|| ramp_noise(full));
     let additivity_noise_de00 = white
         .zip(reading_noise)
-        .and_then(|(w, n)| check_noise_de00(&full, n, w).map(|e| (e, n.source)));
+        .and_then(|(w, n)| check_noise_de00(full, n, w).map(|e| (e, n.source)));
     // Two white readings differ by σ√2, and the white and the sum of four readings by what
     // the ramps' noise propagates to; beyond twice the larger the model, not the meter, is
     // to blame.
@@ -208,53 +254,56 @@ pub fn select_model(
         .into_iter()
         .chain(additivity_noise_de00.map(|n| n.0))
         .fold(0.0, f64::max);
-    let mixtures = MixtureEvidence {
+    MixtureEvidence {
         mixed: n_mixed,
         few: n_mixed < MIN_MIXED,
-        additivity_de00: white.and_then(|w| Additivity::check(&full, w).map(|a| a.de00)),
+        additivity_de00: white.and_then(|w| Additivity::check(full, w).map(|a| a.de00)),
         additivity_noise_de00,
         allowance_de00: TOLERANCE_DE00 + 2.0 * spread,
-    };
-    let mut candidates = Vec::new();
-    for kind in ModelKind::ALL {
-        if mixtures.few && kind == ModelKind::Lut {
-            candidates.push(Candidate {
-                model: kind,
-                cv_mean_de00: Err("not a candidate on a set with few mixed patches: its \
-                                   colours between the ramps would be its smoothness prior, \
-                                   not a measurement"
-                    .into()),
-                held_out_de00: Vec::new(),
-                white_de00: None,
-                set_aside: None,
-            });
-            continue;
-        }
-        let scores = cross_validate(kind, patches, &rotating, folds, &fold, options);
-        let white_de00 = match (&scores, white, mixtures.few) {
-            (Ok(_), Some(w), true) => fit_params(kind, &full, patches, options)
-                .ok()
-                .map(|p| de(p.model().forward([1.0; 3]), w, w))
-                .filter(|e| e.is_finite()),
-            _ => None,
-        };
-        let set_aside = white_de00
-            .filter(|&e| e > mixtures.allowance_de00)
-            .map(|e| {
-                format!(
-                    "its fit misses the measured white by ΔE00 {e:.2}, more than {:.2}: its \
-                     mixtures are not held by the measurements",
-                    mixtures.allowance_de00
-                )
-            });
-        candidates.push(Candidate {
-            model: kind,
-            cv_mean_de00: scores.as_ref().map(|s| s.0).map_err(Clone::clone),
-            held_out_de00: scores.map(|s| s.1).unwrap_or_default(),
-            white_de00,
-            set_aside,
-        });
     }
+}
+
+/// A candidate of its cross-validation `scores` (mean and per-patch ΔE00): on a set with
+/// few mixtures, also how far its fit misses the measured white, and whether that sets it
+/// aside.
+fn score(
+    kind: ModelKind,
+    scores: Result<(f64, Vec<f64>), String>,
+    full: &SortedSamples,
+    patches: &[Sample],
+    options: &FitOptions,
+    mixtures: &MixtureEvidence,
+) -> Candidate {
+    let white_de00 = match (&scores, full.white, mixtures.few) {
+        (Ok(_), Some(w), true) => fit_params(kind, full, patches, options)
+            .ok()
+            .map(|p| de(p.model().forward([1.0; 3]), w, w))
+            .filter(|e| e.is_finite()),
+        _ => None,
+    };
+    let set_aside = white_de00
+        .filter(|&e| e > mixtures.allowance_de00)
+        .map(|e| {
+            format!(
+                "its fit misses the measured white by ΔE00 {e:.2}, more than {:.2}: its \
+                 mixtures are not held by the measurements",
+                mixtures.allowance_de00
+            )
+        });
+    Candidate {
+        model: kind,
+        cv_mean_de00: scores.as_ref().map(|s| s.0).map_err(Clone::clone),
+        held_out_de00: scores.map(|s| s.1).unwrap_or_default(),
+        white_de00,
+        set_aside,
+    }
+}
+
+/// The model chosen, the one of lowest held-out error, and whether the white decided.
+fn choose(
+    candidates: &[Candidate],
+    mixtures: &MixtureEvidence,
+) -> Result<(ModelKind, ModelKind, bool), FitError> {
     // Those the white sets aside compete only if it sets aside every candidate.
     let competing: Vec<Candidate> = if candidates
         .iter()
@@ -266,7 +315,7 @@ pub fn select_model(
             .cloned()
             .collect()
     } else {
-        candidates.clone()
+        candidates.to_vec()
     };
     let best = competing
         .iter()
@@ -297,15 +346,7 @@ pub fn select_model(
         Some(noise) => holding_white_within_one_se(&competing, best.0, noise),
         None => simplest_within_one_se(&competing, best.0),
     };
-    Ok(Selection {
-        model: chosen,
-        lowest: (chosen != best.0).then_some(best.0),
-        white_decided: white_decides.is_some() && chosen != best.0,
-        folds,
-        held_out: rotating.len(),
-        mixtures,
-        candidates,
-    })
+    Ok((chosen, best.0, white_decides.is_some()))
 }
 
 /// ΔE00 between two XYZ, CIELAB relative to `white`.

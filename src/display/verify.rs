@@ -1,11 +1,12 @@
-//! Checking a profile against measured patches, typically ones it was not fitted to: the
-//! profile's forward prediction of each patch against its measured XYZ, in CIELAB relative
-//! to the profile's white ([`ProfileVerification`], `metamer verify`'s result). The
-//! characterization's own check of its fitted model on its held-out patches is another
-//! job with its own result (`characterize::verify::HeldOutVerification`); both refuse a
-//! prediction that is no colour the same way ([`check_prediction`]).
+//! Checking a model against measured patches it was not fitted to: its forward prediction
+//! of each patch against the measured XYZ, in CIELAB relative to a white
+//! ([`Verification`]). `metamer verify` checks a profile against a measurement file
+//! ([`verify_profile`], relative to the profile's white); a characterization checks the
+//! model it fitted on the patches it held out (`characterize::verify::verify_held_out`,
+//! relative to the white it measured). Both go through [`verify`], which refuses a patch or
+//! a prediction that is no colour.
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
 use super::diagnostics::percentile;
 use super::model::Sample;
@@ -24,38 +25,147 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// Of a set that is not empty; the mean sums the values smallest first.
     fn of(values: &[f64]) -> Stats {
         let mut sorted = values.to_vec();
         sorted.sort_by(f64::total_cmp);
         Stats {
-            mean: values.iter().sum::<f64>() / values.len() as f64,
+            mean: sorted.iter().sum::<f64>() / sorted.len() as f64,
             p95: percentile(&sorted, 0.95),
             max: *sorted.last().expect("verified sets are not empty"),
         }
     }
 }
 
-/// One patch's prediction error.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct PatchError {
-    /// Index of the patch in the file, from 1.
+/// One patch's prediction: measured, predicted and their differences in CIELAB.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VerifiedPatch {
+    /// The patch's number from 1: its place in the measurement file, or in the
+    /// characterization's plan.
     pub index: usize,
+    /// The plan's name of the patch; a measurement file's patches have none.
+    pub label: Option<String>,
+    /// Drive values 0–1.
     pub rgb: [f64; 3],
     pub measured_xyz: Xyz,
     pub predicted_xyz: Xyz,
+    /// CIEDE2000 between measured and predicted.
     pub de00: f64,
+    /// CIE 1976 ΔE*ab between measured and predicted.
     pub de76: f64,
 }
 
-/// A profile's prediction errors on a set of patches: what `metamer verify` prints (its
-/// `--json` is this, serialized).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ProfileVerification {
-    pub patches: usize,
+/// A model's prediction errors on a set of patches, in CIELAB relative to a white: what
+/// `metamer verify` prints for a profile against a measurement file, and the
+/// characterization's own check of its fitted model on the patches it held out of the fit
+/// (the summary's `verification`). Both are made by [`verify`], which refuses a patch or a
+/// prediction that is no colour. It serializes as `metamer verify --json` writes it; the
+/// characterization's summary writes it with [`serialize_held_out`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verification {
+    /// The white CIELAB is taken relative to, cd/m²: the profile's, or the measured one.
+    pub white_xyz: Xyz,
+    /// Every patch verified, in the order given.
+    pub patches: Vec<VerifiedPatch>,
     pub de00: Stats,
     pub de76: Stats,
-    /// The [`WORST_SHOWN`] largest ΔE00, largest first.
-    pub worst: Vec<PatchError>,
+}
+
+impl VerifiedPatch {
+    /// The drives as the nearest 8-bit codes: exact for a characterization's patches,
+    /// whose drives are codes over 255.
+    pub fn rgb8(&self) -> [u8; 3] {
+        self.rgb.map(|c| (c * 255.0).round() as u8)
+    }
+}
+
+impl Verification {
+    /// The [`WORST_SHOWN`] patches of largest ΔE00, largest first.
+    pub fn worst(&self) -> Vec<&VerifiedPatch> {
+        let mut worst: Vec<&VerifiedPatch> = self.patches.iter().collect();
+        worst.sort_by(|a, b| b.de00.total_cmp(&a.de00));
+        worst.truncate(WORST_SHOWN);
+        worst
+    }
+}
+
+/// `metamer verify --json`: the patch count, the statistics and the worst patches.
+impl Serialize for Verification {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Worst {
+            index: usize,
+            rgb: [f64; 3],
+            measured_xyz: Xyz,
+            predicted_xyz: Xyz,
+            de00: f64,
+            de76: f64,
+        }
+        #[derive(Serialize)]
+        struct Form<'a> {
+            patches: usize,
+            de00: &'a Stats,
+            de76: &'a Stats,
+            worst: Vec<Worst>,
+        }
+        Form {
+            patches: self.patches.len(),
+            de00: &self.de00,
+            de76: &self.de76,
+            worst: self
+                .worst()
+                .into_iter()
+                .map(|p| Worst {
+                    index: p.index,
+                    rgb: p.rgb,
+                    measured_xyz: p.measured_xyz,
+                    predicted_xyz: p.predicted_xyz,
+                    de00: p.de00,
+                    de76: p.de76,
+                })
+                .collect(),
+        }
+        .serialize(s)
+    }
+}
+
+/// The characterization summary's `verification`: the white, every patch by label and
+/// 8-bit drive with its ΔE00, and the ΔE00 statistics (`serialize_with` of its field).
+pub fn serialize_held_out<S: Serializer>(v: &Verification, s: S) -> Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    struct Patch<'a> {
+        label: &'a str,
+        rgb8: [u8; 3],
+        measured_xyz: Xyz,
+        predicted_xyz: Xyz,
+        delta_e00: f64,
+    }
+    #[derive(Serialize)]
+    struct Form<'a> {
+        white_xyz: Xyz,
+        patches: Vec<Patch<'a>>,
+        mean: f64,
+        p95: f64,
+        max: f64,
+    }
+    Form {
+        white_xyz: v.white_xyz,
+        patches: v
+            .patches
+            .iter()
+            .map(|p| Patch {
+                label: p.label.as_deref().unwrap_or_default(),
+                rgb8: p.rgb8(),
+                measured_xyz: p.measured_xyz,
+                predicted_xyz: p.predicted_xyz,
+                delta_e00: p.de00,
+            })
+            .collect(),
+        mean: v.de00.mean,
+        p95: v.de00.p95,
+        max: v.de00.max,
+    }
+    .serialize(s)
 }
 
 /// Why patches cannot be verified.
@@ -96,39 +206,48 @@ pub fn check_prediction(index: usize, rgb: [f64; 3], predicted: Xyz) -> Result<(
     }
 }
 
-/// Predicts every patch with `profile` and compares with what was measured.
-pub fn verify_profile(
-    profile: &Profile,
-    patches: &[Sample],
-) -> Result<ProfileVerification, VerifyError> {
-    if patches.is_empty() {
-        return Err(VerifyError::NoSamples);
-    }
-    let white = profile.white_xyz;
-    let mut errors = Vec::with_capacity(patches.len());
-    for (i, p) in patches.iter().enumerate() {
+/// Predicts every patch with `profile` and compares with what was measured, relative to the
+/// profile's white; the patches are numbered in their order from 1.
+pub fn verify_profile(profile: &Profile, patches: &[Sample]) -> Result<Verification, VerifyError> {
+    let numbered = patches.iter().enumerate().map(|(i, p)| (i + 1, None, *p));
+    verify(numbered, profile.white_xyz, &|rgb| profile.forward(rgb))
+}
+
+/// Predicts each patch (its number from 1, its label if it has one, and its sample) with
+/// `predict`, the model's forward direction (drive 0–1 → XYZ), and compares with what was
+/// measured in CIELAB relative to `white_xyz`. A patch that is no measurement (a drive
+/// outside 0–1, an XYZ that is not finite) or a prediction that is no colour is an error
+/// naming the patch: its ΔE would be NaN or infinite, and a mean over it NaN while the
+/// maximum hides it.
+pub fn verify(
+    patches: impl IntoIterator<Item = (usize, Option<String>, Sample)>,
+    white_xyz: Xyz,
+    predict: &dyn Fn([f64; 3]) -> Xyz,
+) -> Result<Verification, VerifyError> {
+    let white = white_xyz;
+    let mut verified = Vec::new();
+    for (index, label, p) in patches {
         let ok =
             p.rgb.iter().all(|d| (0.0..=1.0).contains(d)) && p.xyz.iter().all(|v| v.is_finite());
         if !ok {
-            return Err(VerifyError::BadSample {
-                index: i + 1,
-                rgb: p.rgb,
-            });
+            return Err(VerifyError::BadSample { index, rgb: p.rgb });
         }
-        let predicted = profile.forward(p.rgb);
-        check_prediction(i + 1, p.rgb, predicted)?;
-        let (a, b) = (predicted.to_lab(white), p.xyz.to_lab(white));
-        let (de00, de76) = (delta_e2000(a, b), delta_e76(a, b));
+        let predicted = predict(p.rgb);
+        check_prediction(index, p.rgb, predicted)?;
+        let (measured_lab, predicted_lab) = (p.xyz.to_lab(white), predicted.to_lab(white));
+        let de00 = delta_e2000(measured_lab, predicted_lab);
+        let de76 = delta_e76(measured_lab, predicted_lab);
         if !(de00.is_finite() && de76.is_finite()) {
             return Err(VerifyError::BadPrediction {
-                index: i + 1,
+                index,
                 rgb: p.rgb,
                 predicted: predicted.to_array(),
                 why: format!("its ΔE00 is {de00}, its ΔE*ab {de76}"),
             });
         }
-        errors.push(PatchError {
-            index: i + 1,
+        verified.push(VerifiedPatch {
+            index,
+            label,
             rgb: p.rgb,
             measured_xyz: p.xyz,
             predicted_xyz: predicted,
@@ -136,21 +255,22 @@ pub fn verify_profile(
             de76,
         });
     }
-    let de00: Vec<f64> = errors.iter().map(|e| e.de00).collect();
-    let de76: Vec<f64> = errors.iter().map(|e| e.de76).collect();
-    errors.sort_by(|a, b| b.de00.total_cmp(&a.de00));
-    errors.truncate(WORST_SHOWN);
-    Ok(ProfileVerification {
-        patches: patches.len(),
+    if verified.is_empty() {
+        return Err(VerifyError::NoSamples);
+    }
+    let de00: Vec<f64> = verified.iter().map(|e| e.de00).collect();
+    let de76: Vec<f64> = verified.iter().map(|e| e.de76).collect();
+    Ok(Verification {
+        white_xyz,
         de00: Stats::of(&de00),
         de76: Stats::of(&de76),
-        worst: errors,
+        patches: verified,
     })
 }
 
-impl std::fmt::Display for ProfileVerification {
+impl std::fmt::Display for Verification {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(f, "{} patches", self.patches)?;
+        writeln!(f, "{} patches", self.patches.len())?;
         for (name, s) in [("ΔE00 ", &self.de00), ("ΔE*ab", &self.de76)] {
             writeln!(
                 f,
@@ -159,7 +279,7 @@ impl std::fmt::Display for ProfileVerification {
             )?;
         }
         write!(f, "worst patches (r,g,b 0–1: ΔE00):")?;
-        for e in &self.worst {
+        for e in self.worst() {
             write!(
                 f,
                 "\n  #{} {:.4},{:.4},{:.4}: {:.3}",

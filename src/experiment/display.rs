@@ -13,16 +13,16 @@ use serde::{Deserialize, Serialize};
 use super::error::ExperimentError;
 use super::progress::Progress;
 use crate::color::Xyz;
-use crate::display::characterize::{self, default_grid_steps, CharacterizeError, PlanOptions};
+use crate::display::characterize::{self, CharacterizeError, PlanOptions};
 use crate::display::{ModelKind, Profile};
-use crate::rig::{Screen, ScreenSpec, VirtualPanel};
+use crate::rig::{OpenError, Screen, ScreenSpec, VirtualPanel};
 use crate::session::{ProgressSink, RunOptions, StepProgress};
 
 /// The monitor and how it is characterized.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DisplayOptions {
-    /// `window:N` or `virtual:PRESET`.
-    pub screen: String,
+    /// `window:N` or `virtual:PRESET` (written as that text).
+    pub screen: ScreenSpec,
     /// The spot meter, as named on the command line.
     pub spot: Spec,
     pub model: ModelKind,
@@ -32,7 +32,7 @@ pub struct DisplayOptions {
 /// simulated one exactly, and the luminance check.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DisplaySetting {
-    pub screen: String,
+    pub screen: ScreenSpec,
     /// A simulated monitor's full-white luminance, set for the rendering (cd/m²).
     pub virtual_white_cd_m2: Option<f64>,
     /// The measured white, cd/m².
@@ -49,13 +49,22 @@ pub const SUMMARY_FILE: &str = "summary.json";
 
 /// The screen of `spec`, set for `setting` when it is simulated.
 pub fn open_screen(
-    spec: &str,
+    spec: &ScreenSpec,
     virtual_white_cd_m2: Option<f64>,
 ) -> Result<Box<dyn Screen>, ExperimentError> {
-    Ok(characterize::open_screen(
-        &ScreenSpec::parse(spec)?,
-        virtual_white_cd_m2,
-    )?)
+    Ok(characterize::open_screen(spec, virtual_white_cd_m2)?)
+}
+
+/// The display stage's checks (and the display-spots stage's, which opens the same screen
+/// and meter) before the experiment's first reading: the meter can see the screen, and a
+/// real monitor's X display can be reached (without it the box was measured and the scene
+/// rendered before the display stage failed).
+pub(super) fn preflight(opts: &DisplayOptions) -> Result<(), ExperimentError> {
+    characterize::meter_sees(&opts.spot, &opts.screen)?;
+    if let ScreenSpec::Window { .. } = opts.screen {
+        crate::rig::window::list_monitors(None).map_err(OpenError::Window)?;
+    }
+    Ok(())
 }
 
 /// Headroom above the brightest in-gamut target, so no channel sits at its very end.
@@ -92,17 +101,14 @@ pub fn white_luminance_for(panel: &VirtualPanel, targets: &[Xyz]) -> f64 {
     }
 }
 
-/// The spot meter aimed at `screen` (a simulated meter sees a simulated screen).
+/// The spot meter aimed at the screen `named` as `screen` (a simulated meter sees only a
+/// simulated screen).
 pub fn open_meter(
     spec: &Spec,
+    named: &ScreenSpec,
     screen: &dyn Screen,
 ) -> Result<Box<dyn Instrument>, ExperimentError> {
-    if spec.is_simulated() && screen.stimulus().is_none() {
-        return Err(ExperimentError::SimulatedMeterOnRealScreen {
-            meter: spec.to_string(),
-            screen: screen.spec(),
-        });
-    }
+    characterize::meter_sees(spec, named)?;
     Ok(spec.open(screen.stimulus())?)
 }
 
@@ -175,7 +181,7 @@ pub fn characterize_display(
     run: &RunOptions,
     progress: &dyn Fn(Progress),
 ) -> Result<(DisplaySetting, Vec<&'static str>), ExperimentError> {
-    let screen = ScreenSpec::parse(&opts.screen)?;
+    let screen = opts.screen.clone();
     let virtual_white_cd_m2 = match &screen {
         ScreenSpec::Virtual(p) => Some(white_luminance_for(&VirtualPanel::preset(*p), targets)),
         ScreenSpec::Window { .. } => None,
@@ -187,10 +193,7 @@ pub fn characterize_display(
         virtual_white_cd_m2,
         instrument: opts.spot.clone(),
         speed: None,
-        plan: PlanOptions {
-            grid_steps: default_grid_steps(opts.model, defaults.ramp_steps),
-            ..defaults
-        },
+        plan: PlanOptions::for_model(opts.model, defaults.ramp_steps, defaults.repeats, None),
         model: opts.model,
         settle: None,
         resume,
@@ -211,9 +214,7 @@ pub fn characterize_display(
     let outcome = characterize::characterize(&request, &mut listener).map_err(|e| match e {
         CharacterizeError::OpenScreen(e) => ExperimentError::OpenScreen(e),
         CharacterizeError::Instrument(e) => ExperimentError::Instrument(e),
-        CharacterizeError::SimulatedMeterOnRealScreen { meter, screen } => {
-            ExperimentError::SimulatedMeterOnRealScreen { meter, screen }
-        }
+        CharacterizeError::SimulatedMeterOnRealScreen(e) => e.into(),
         e => ExperimentError::Characterize(e),
     })?;
     let summary = match outcome {

@@ -21,11 +21,12 @@ use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::{write_readings, PatchReading};
 use super::reproduction::{PatchDrive, PatchRegion};
-use crate::image::{RgbImage, ScreenSpot};
+use crate::image::{Drive8Image, ScreenSpot};
 use crate::rig::{MeterAim, Placement};
 use crate::session::{
-    Answer, InstrumentRecord, Operator, OperatorError, Prepare, Readings, Recheck, Rig, RunEnd,
-    RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, TerminalOperator,
+    Answer, InstrumentRecord, Operator, OperatorError, PlacementReadings, Prepare, Recheck, Rig,
+    RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress,
+    TerminalOperator,
 };
 
 /// A display-spot step's own data in the journal.
@@ -135,7 +136,11 @@ impl Operator for Aiming<'_> {
 
     // The operator's own placement prompt (with its reading count) and re-aim question,
     // not the plain defaults a wrapper would otherwise fall back to.
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         if let (Some(meter), Some(spot)) = (&self.meter, self.aims.get(what)) {
             meter.set(Some(*spot));
         }
@@ -214,7 +219,7 @@ pub fn measure(
         ..
     } = *s;
     let mut screen = open_screen(&setting.screen, setting.virtual_white_cd_m2)?;
-    let mut meter = open_meter(spot_spec, screen.as_ref())?;
+    let mut meter = open_meter(spot_spec, &setting.screen, screen.as_ref())?;
     // A real monitor takes a moment to settle after a change; a simulated one does not.
     let settle = if setting.virtual_white_cd_m2.is_some() {
         std::time::Duration::ZERO
@@ -223,10 +228,11 @@ pub fn measure(
     };
     let (mut plan, record) = match &s.image {
         Some(shown) => {
-            let image = RgbImage::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
-                file: shown.file.to_path_buf(),
-                message: e.to_string(),
-            })?;
+            let image =
+                Drive8Image::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
+                    file: shown.file.to_path_buf(),
+                    message: e.to_string(),
+                })?;
             let placement = screen.show_image(&image)?;
             let aims = aims_on(&placement, shown.regions);
             let plan = image_plan(&aims, repeats.max(1));
@@ -257,7 +263,7 @@ pub fn measure(
         &journal,
         plan,
         SpotHeader {
-            screen: setting.screen.clone(),
+            screen: setting.screen.canonical(),
             virtual_white_cd_m2: setting.virtual_white_cd_m2,
         },
         instruments,
@@ -303,7 +309,7 @@ pub fn measure(
         }
     }
     let mut rig = Rig {
-        screen: s.image.is_none().then_some(screen.as_show()),
+        screen: s.image.is_none().then_some(screen.as_mut()),
         instruments: vec![("spot".to_string(), meter.as_mut())],
         operator: &mut operator,
     };
@@ -377,7 +383,7 @@ mod tests {
             meter: None,
             inner: &mut scripted,
         };
-        let readings = Readings { first: 1, of: 5 };
+        let readings = PlacementReadings { first: 1, of: 5 };
         aiming.ask_placement("aim at patch 3", readings).unwrap();
         assert_eq!(scripted.prompts, vec!["aim at patch 3 — 5 readings"]);
 

@@ -6,7 +6,7 @@ use metamer_drivers::DriverError;
 
 use super::cache::CacheError;
 use super::readings::ReadingsError;
-use crate::display::characterize::CharacterizeError;
+use crate::display::characterize::{CharacterizeError, SimulatedMeterOnRealScreen};
 use crate::display::ProfileError;
 use crate::image::ImageError;
 use crate::render::image::ImageRenderError;
@@ -69,8 +69,21 @@ pub enum ExperimentError {
         total: usize,
         journal: PathBuf,
     },
-    #[error("the simulated meter {meter} cannot see the real screen {screen}; use a real meter, or a virtual display")]
-    SimulatedMeterOnRealScreen { meter: String, screen: String },
+    #[error(transparent)]
+    SimulatedMeterOnRealScreen(#[from] SimulatedMeterOnRealScreen),
+    /// Ctrl-C while a stage that takes no readings ran: its work was cut short and not
+    /// recorded, so the next run does it again.
+    #[error("interrupted in the {stage} stage, which was stopped and not recorded; run the experiment again to redo it (the stages before it are kept)")]
+    Interrupted { stage: &'static str },
+    /// Ctrl-C between stages: the finished ones are kept.
+    #[error("interrupted before the {stage} stage began; the stages before it are finished and kept: run the experiment again to continue")]
+    InterruptedBefore { stage: &'static str },
+    /// Another renderer's image does not fit the scene's camera.
+    #[error(transparent)]
+    ReadBack(#[from] crate::render::spot::cone::ReadBackError),
+    /// `--simulation-image` lies where the simulation stage writes its own copy.
+    #[error("--simulation-image {}: lies in the simulation stage's directory {}, which the experiment replaces: copy it elsewhere and give that copy", file.display(), dir.display())]
+    ImageInStage { file: PathBuf, dir: PathBuf },
     #[error("the display's white is {white_cd_m2:.1} cd/m², but the rendering needs at least {needed_cd_m2:.1} cd/m² to be shown without tone mapping: raise the monitor's brightness (backlight) until full white reads at least that, then move {} aside and run the display stage again", dir.display())]
     DisplayTooDim {
         white_cd_m2: f64,

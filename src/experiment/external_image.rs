@@ -14,12 +14,12 @@ use super::error::ExperimentError;
 use super::progress::Progress;
 use super::readings::write_readings;
 use super::simulation::{
-    as_readings, from_render, patches_in_image, ExternalSource, SimulationOptions,
-    SimulationSummary, IMAGE_FILE, SPOTS_FILE, SUMMARY_FILE,
+    as_readings, from_render, patches_in_image, ExternalSource, SimulationMethod,
+    SimulationOptions, SimulationSummary, IMAGE_FILE, SPOTS_FILE, SUMMARY_FILE,
 };
 use crate::image::write_xyz_image;
 use crate::output::OutputPolicy;
-use crate::render::job::spots_from_image::{self, Request, METHOD};
+use crate::render::job::spots_from_image::{self, Request};
 
 /// What the summary and report call the source.
 pub const RENDERER: &str = "external renderer";
@@ -54,7 +54,7 @@ pub fn read_back(
     let image_patches = patches_in_image(&report.scene, img, &report.patches, report.white)?;
     write_xyz_image(&dir.join(IMAGE_FILE), img, &OutputPolicy::new(true))?;
     let summary = SimulationSummary {
-        method: METHOD.into(),
+        method: SimulationMethod::ExternalImage,
         white: report.white,
         converged: true,
         seconds: start.elapsed().as_secs_f64(),

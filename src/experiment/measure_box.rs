@@ -12,7 +12,7 @@ use super::error::ExperimentError;
 use super::progress::Progress;
 use crate::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
 use crate::measure_box::setup::RigError;
-use crate::measure_box::{Outcome, PlanError};
+use crate::measure_box::{BoxPlanError, Outcome};
 use crate::rig::Scenario;
 use crate::session::{Attendance, RunOptions, StepProgress};
 
@@ -56,14 +56,14 @@ impl MeasureBox {
     ) -> MeasureBoxRequest {
         MeasureBoxRequest {
             out: dir.to_path_buf(),
-            spectral: self.spectral.to_string(),
-            spot: self.spot.to_string(),
+            spectral: self.spectral.clone(),
+            spot: self.spot.clone(),
             plan: self.plan.clone(),
             repeats: self.repeats,
             resume,
             stage: None,
             seed: self.seed,
-            scenario: self.light.map(|l| l.name().to_string()),
+            scenario: self.light,
             force: true,
             unattended,
             run: run.clone(),
@@ -124,7 +124,7 @@ fn stage_error(e: MeasureBoxJobError) -> ExperimentError {
         MeasureBoxJobError::SpotReadings(e) => e.into(),
         // Told apart from a bad plan file for the command's `--repeats`; the stage says it
         // as the plan's check does.
-        MeasureBoxJobError::Repeats(message) => bad(PlanError::Invalid {
+        MeasureBoxJobError::Repeats(message) => bad(BoxPlanError::Invalid {
             field: "repeats".into(),
             message,
         }),
@@ -153,8 +153,8 @@ mod tests {
         assert_eq!(r.stage, None);
         assert!(r.force && r.spot_readings);
         assert_eq!(r.attendance, Some(Attendance::Terminal));
-        assert_eq!(r.scenario.as_deref(), Some(Scenario::default().name()));
-        assert_eq!((r.spectral.as_str(), r.seed), ("sim:i1pro?time_scale=0", 3));
+        assert_eq!(r.scenario, Some(Scenario::default()));
+        assert_eq!((&r.spectral, r.seed), (&m.spectral, 3));
         let r = m.request(dir, true, true, &RunOptions::default());
         assert_eq!(r.attendance, Some(Attendance::Unattended));
         assert!(r.resume);

@@ -1,6 +1,9 @@
 //! What an experiment can know before its first reading or rendering, checked first: a
-//! plan the fall-off fit or the validation cannot use, and a user's files that a stage
-//! would replace, fail now with the reason instead of after hours of measuring.
+//! plan the fall-off fit or the validation cannot use, a user's files that a stage would
+//! replace, another renderer's image the simulation cannot read back, a screen that cannot
+//! be reached or a meter that cannot see it, fail now with the reason instead of after
+//! hours of measuring. Each stage states its own checks; this calls them all, in the
+//! order of the stages.
 
 use std::path::Path;
 
@@ -14,16 +17,25 @@ use crate::render::Scene;
 
 /// Every check, in the order a user would fix them.
 pub fn check(opts: &ExperimentOptions) -> Result<(), ExperimentError> {
-    // An option the reproduction stage reads, which would otherwise fail only after the
-    // box, the simulation and the display have been measured.
-    opts.reproduction.mapping()?;
     given_files_outside_stages(opts)?;
-    match &opts.box_source {
-        BoxSource::Measure(m) => measured_box(m),
-        BoxSource::Existing { scene, spots } => {
-            given_box(scene, spots, opts.given_readings.as_ref())
+    let camera = match &opts.box_source {
+        BoxSource::Measure(m) => {
+            measured_box(m)?;
+            Some(crate::measure_box::scene::CAMERA_PIXELS)
         }
+        BoxSource::Existing { scene, spots } => {
+            given_box(scene, spots, opts.given_readings.as_ref())?
+        }
+    };
+    let runs = |stage: Stage| opts.stage.is_none_or(|s| s == stage);
+    if runs(Stage::Simulation) {
+        let dir = opts.dir.join(Stage::Simulation.name());
+        super::simulation::preflight(&opts.simulation, camera, &dir)?;
     }
+    if runs(Stage::Display) || runs(Stage::DisplaySpots) {
+        super::display::preflight(&opts.display)?;
+    }
+    Ok(())
 }
 
 /// A given box's files may not lie in a stage directory the run writes or moves aside:
@@ -86,14 +98,15 @@ fn shown(plan: Option<&Path>) -> String {
 
 /// A given box's readings (`given`: as the request's checks read them, else read here, by
 /// the validation's reader either way) must hold the patches its scene has, which are
-/// those the simulation renders and the validation compares. Whatever else the validation
+/// those the simulation renders and the validation compares. Returns the size of the
+/// scene's camera image, if it has a camera. Whatever else the validation
 /// stage needs of the file its reader checks: patches 1–24 (or `white`), finite and
 /// plausible values; a repeated row is a repeat of its patch.
 fn given_box(
     scene: &Path,
     spots: &Path,
     given: Option<&ReadingSet>,
-) -> Result<(), ExperimentError> {
+) -> Result<Option<[usize; 2]>, ExperimentError> {
     let s = Scene::load(scene)?;
     let in_scene: Vec<usize> = (1..=24).filter(|&k| s.patch_surface(k).is_some()).collect();
     let read_here;
@@ -113,7 +126,7 @@ fn given_box(
             in_scene,
         });
     }
-    Ok(())
+    Ok(s.camera.map(|c| [c.width, c.height]))
 }
 
 #[cfg(test)]

@@ -23,21 +23,9 @@ use crate::rig::virtual_display::quantize;
 /// How targets are reproduced.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ReproductionOptions {
-    /// `clip` or `nearest-lab`.
-    pub gamut: String,
+    /// Written as `clip` or `nearest-lab`.
+    pub gamut: GamutMapping,
     pub mirror: bool,
-}
-
-impl ReproductionOptions {
-    /// The gamut mapping `gamut` names.
-    pub fn mapping(&self) -> Result<GamutMapping, ExperimentError> {
-        self.gamut
-            .parse()
-            .map_err(|e: String| ExperimentError::Option {
-                what: "gamut mapping",
-                message: e,
-            })
-    }
 }
 
 /// One patch's drive values.
@@ -93,7 +81,7 @@ pub fn reproduce(
     image: Option<(&Path, &[ImagePatch])>,
     opts: &ReproductionOptions,
 ) -> Result<(Reproduction, Vec<&'static str>), ExperimentError> {
-    let mapping = opts.mapping()?;
+    let mapping = opts.gamut;
     let targets: Vec<Xyz> = spots.iter().map(|s| s.xyz).collect();
     let drives = reproduce_targets(profile, &targets, mapping);
     let patches: Vec<PatchDrive> = spots

@@ -17,7 +17,7 @@ use super::run::{run, StageOutcome};
 use super::simulation::SimulationOptions;
 use super::stage::Stage;
 use super::validate::{ValidationResult, FILE as COMPARISONS_FILE};
-use crate::measure_box::setup::{is_simulated, mixed_rig};
+use crate::measure_box::setup::{box_light, BoxLightError};
 use crate::render::{Scene, SceneError};
 use crate::rig::Scenario;
 use crate::session::{NobodyAtTheRig, RunOptions};
@@ -44,10 +44,9 @@ pub enum BoxRequest {
         repeats: Option<usize>,
         /// The simulated box's seed (and its instruments').
         seed: u64,
-        /// The simulated box's light by name (`display-white`, `led-rgb1`), as given: it is
-        /// read after the instruments' specs are checked and refused with real instruments,
-        /// whose box has its own light. None on a simulated rig: the default light.
-        light: Option<String>,
+        /// The simulated box's light, refused with real instruments, whose box has its own
+        /// light ([`box_light`]). None on a simulated rig: the default light.
+        light: Option<Scenario>,
     },
     /// The box measured earlier or elsewhere: its measured scene and spot readings.
     Given { scene: PathBuf, spots: PathBuf },
@@ -163,6 +162,7 @@ impl Request {
     /// The box stage alone on the simulated rig, one reading per target:
     ///
     /// ```
+    /// use metamer::display::gamut::GamutMapping;
     /// use metamer::display::ModelKind;
     /// use metamer::experiment::display::DisplayOptions;
     /// use metamer::experiment::reproduction::ReproductionOptions;
@@ -183,9 +183,9 @@ impl Request {
     ///         seed: 1,
     ///         light: None,
     ///     },
-    ///     simulation: SimulationOptions { target_de: 0.1, seed: 1, max_seconds: 600.0, image: None, external_image: None },
-    ///     display: DisplayOptions { screen: "virtual:ips-lcd".into(), spot: meter, model: ModelKind::Lut },
-    ///     reproduction: ReproductionOptions { gamut: "nearest-lab".into(), mirror: true },
+    ///     simulation: SimulationOptions::new(0.1, 1, 0, 16, None),
+    ///     display: DisplayOptions { screen: "virtual:ips-lcd".parse()?, spot: meter, model: ModelKind::Lut },
+    ///     reproduction: ReproductionOptions { gamut: GamutMapping::NearestLab, mirror: true },
     ///     repeats: 3,
     ///     stage: Some(Stage::Box),
     ///     rerun_all: false,
@@ -197,7 +197,7 @@ impl Request {
     /// assert_eq!(outcome.stages.len(), 1);
     /// assert!(dir.join("box/scene.json").exists());
     /// # std::fs::remove_dir_all(&dir).ok();
-    /// # Ok::<(), metamer::experiment::RequestError>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn run(&self, progress: &dyn Fn(Progress)) -> Result<Outcome, RequestError> {
         let options = self.options()?;
@@ -257,35 +257,17 @@ impl Request {
                 seed,
                 light,
             } => BoxSource::Measure(MeasureBox {
-                spectral: {
-                    if is_simulated(spectral, spot).is_err() {
-                        let default = spot.as_str() == DEFAULT_SPOT;
-                        return Err(RequestError::MixedRig(mixed_rig(
-                            spectral,
-                            spot,
-                            if default {
-                                " (the default when --spot is not given)"
-                            } else {
-                                ""
-                            },
-                        )));
-                    }
-                    spectral.clone()
-                },
+                spectral: spectral.clone(),
                 spot: spot.clone(),
                 plan: plan.clone(),
                 repeats: *repeats,
                 seed: *seed,
-                light: box_light(light.as_deref(), spectral, spot)?,
+                light: box_light(spectral, spot, *light)?,
             }),
         };
-        let specs: Vec<&str> = match &box_source {
-            BoxSource::Measure(m) => vec![
-                m.spectral.as_str(),
-                m.spot.as_str(),
-                self.display.spot.as_str(),
-            ],
-            BoxSource::Existing { .. } => vec![self.display.spot.as_str()],
+        let specs: Vec<&Spec> = match &box_source {
+            BoxSource::Measure(m) => vec![&m.spectral, &m.spot, &self.display.spot],
+            BoxSource::Existing { .. } => vec![&self.display.spot],
         };
         crate::session::attendance(&specs, self.unattended)?;
         Ok(ExperimentOptions {
@@ -327,23 +309,6 @@ impl Request {
     }
 }
 
-/// The simulated box's light: the named one or the default when both instruments are
-/// simulated (recorded in the box stage's options either way); none for a real box, whose
-/// light is its own.
-fn box_light(
-    name: Option<&str>,
-    spectral: &Spec,
-    spot: &Spec,
-) -> Result<Option<Scenario>, RequestError> {
-    let simulated = spectral.is_simulated() && spot.is_simulated();
-    match (name, simulated) {
-        (None, false) => Ok(None),
-        (None, true) => Ok(Some(Scenario::default())),
-        (Some(n), true) => n.parse().map(Some).map_err(RequestError::UnknownLight),
-        (Some(_), false) => Err(RequestError::LightOnRealBox),
-    }
-}
-
 /// Why an experiment was refused before its first stage, or stopped in one. The refusals
 /// of the request's own values name the command's flags (see [`RequestError::is_usage`]).
 #[derive(Debug, thiserror::Error)]
@@ -362,17 +327,9 @@ pub enum RequestError {
     ImageSpp,
     #[error("-o {}: exists and is not a directory", .0.display())]
     OutNotDir(PathBuf),
-    /// One of the box's instruments is simulated and the other not (the message names
-    /// both, and a spot meter left at [`DEFAULT_SPOT`] as the default, since the user never
-    /// wrote it).
-    #[error("{0}")]
-    MixedRig(String),
-    /// A simulated box's light was named for a real rig.
-    #[error("--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light")]
-    LightOnRealBox,
-    /// The named light is none of the simulated box's (the message lists them).
-    #[error("{0}")]
-    UnknownLight(String),
+    /// The instruments and the box's light make no rig.
+    #[error(transparent)]
+    BoxLight(#[from] BoxLightError),
     /// A real instrument with nobody to place, aim or calibrate it.
     #[error(transparent)]
     NobodyAtTheRig(#[from] NobodyAtTheRig),
@@ -399,9 +356,7 @@ impl RequestError {
                 | RequestError::ImageSize
                 | RequestError::ImageSpp
                 | RequestError::OutNotDir(_)
-                | RequestError::MixedRig(_)
-                | RequestError::LightOnRealBox
-                | RequestError::UnknownLight(_)
+                | RequestError::BoxLight(_)
                 | RequestError::NobodyAtTheRig(_)
         )
     }

@@ -17,6 +17,8 @@ use super::stage::Stage;
 use super::{display, display_spots, reproduction, simulation, validate};
 use crate::color::Xyz;
 use crate::display::Profile;
+use crate::render::deadline::cancellable;
+use crate::rig::ScreenSpec;
 use crate::validation::job::ReadingFiles;
 
 /// How one stage went.
@@ -153,11 +155,16 @@ pub fn run(
             });
             continue;
         }
+        if interrupted(opts) {
+            return Err(ExperimentError::InterruptedBefore {
+                stage: stage.name(),
+            });
+        }
         progress(Progress::Stage {
             stage,
             reused: false,
         });
-        if matches!(stage, Stage::Box | Stage::Display | Stage::DisplaySpots) {
+        if stage.measures() {
             if let Some(aside) = set_aside_stale(&sd)? {
                 progress(Progress::Note(format!(
                     "the {stage} stage's inputs changed: its earlier measurements are kept in {}",
@@ -167,7 +174,17 @@ pub fn run(
         } else {
             sd.invalidate()?;
         }
-        let files = run_stage(stage, opts, &sd, progress)?;
+        let files = run_stage(stage, opts, &sd, progress);
+        // A stage that takes no readings is cut short by Ctrl-C (the render stops at its
+        // next check, with a result or with "no result in time"): what it wrote is not
+        // this stage's result, so it is not recorded. A measuring stage says itself where
+        // its journal stopped.
+        if interrupted(opts) && !stage.measures() {
+            return Err(ExperimentError::Interrupted {
+                stage: stage.name(),
+            });
+        }
+        let files = files?;
         let seconds = start.elapsed().as_secs_f64();
         sd.finish(&inputs, &files, seconds)?;
         outcomes.push(StageOutcome {
@@ -179,6 +196,13 @@ pub fn run(
         });
     }
     Ok(outcomes)
+}
+
+fn interrupted(opts: &ExperimentOptions) -> bool {
+    opts.run
+        .interrupt
+        .as_ref()
+        .is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst))
 }
 
 fn stage_path(opts: &ExperimentOptions, stage: Stage, file: &str) -> PathBuf {
@@ -212,7 +236,7 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
         Stage::Display => {
             let i = Inputs::new().value("options", &opts.display);
             // A simulated monitor's white is set for the rendering; a real one is not.
-            if opts.display.screen.starts_with("virtual") {
+            if matches!(opts.display.screen, ScreenSpec::Virtual(_)) {
                 i.file("spots", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
             } else {
                 i
@@ -286,16 +310,18 @@ fn run_stage(
         },
         Stage::Simulation => {
             let (scene, _) = box_files(opts);
-            let (_, files) = match &opts.simulation.external_image {
-                Some(image) => super::external_image::read_back(
-                    &scene,
-                    image,
-                    &opts.simulation,
-                    &sd.dir,
-                    progress,
-                )?,
-                None => simulate(&scene, &opts.simulation, &sd.dir, progress)?,
-            };
+            let (_, files) = cancellable(opts.run.interrupt.as_ref(), || {
+                match &opts.simulation.external_image {
+                    Some(image) => super::external_image::read_back(
+                        &scene,
+                        image,
+                        &opts.simulation,
+                        &sd.dir,
+                        progress,
+                    ),
+                    None => simulate(&scene, &opts.simulation, &sd.dir, progress),
+                }
+            })?;
             Ok(owned(files))
         }
         Stage::Display => {
@@ -392,12 +418,12 @@ mod tests {
                 image: None,
             },
             display: DisplayOptions {
-                screen: "virtual:ips-lcd".into(),
+                screen: ScreenSpec::Virtual(crate::rig::Preset::IpsLcd),
                 spot: "sim:cs100a?time_scale=0".into(),
                 model: ModelKind::MatrixLsq,
             },
             reproduction: ReproductionOptions {
-                gamut: "clip".into(),
+                gamut: crate::display::gamut::GamutMapping::Clip,
                 mirror: true,
             },
             repeats: 1,

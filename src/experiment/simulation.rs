@@ -45,6 +45,106 @@ pub struct SimulationOptions {
     pub external_image: Option<PathBuf>,
 }
 
+/// The simulation's time limit in the experiment (s): no refinement starts after it.
+pub const MAX_RENDER_SECONDS: f64 = 600.0;
+
+impl SimulationOptions {
+    /// The stage's options as `metamer experiment` and the lab ask for them: no refinement
+    /// after [`MAX_RENDER_SECONDS`], and a camera image of `image_size` pixels a side at
+    /// `image_spp` samples per pixel, none when `image_size` is 0.
+    pub fn new(
+        target_de: f64,
+        seed: u64,
+        image_size: usize,
+        image_spp: u64,
+        external_image: Option<PathBuf>,
+    ) -> SimulationOptions {
+        SimulationOptions {
+            target_de,
+            seed,
+            max_seconds: MAX_RENDER_SECONDS,
+            image: (image_size > 0).then_some(ImageSpec {
+                size: image_size,
+                spp: image_spp,
+            }),
+            external_image,
+        }
+    }
+}
+
+/// The simulation stage's checks before the experiment's first reading: another renderer's
+/// image (`external_image`) must be an image metamer reads, of the aspect ratio of the
+/// scene's camera (`camera`: width and height in pixels) and outside the stage's
+/// directory `stage_dir`, where the stage writes its own copy over it. A scene without a
+/// camera (None) is refused by the read-back itself.
+pub(super) fn preflight(
+    opts: &SimulationOptions,
+    camera: Option<[usize; 2]>,
+    stage_dir: &Path,
+) -> Result<(), ExperimentError> {
+    let Some(file) = &opts.external_image else {
+        return Ok(());
+    };
+    if let (Ok(dir), Ok(f)) = (
+        std::fs::canonicalize(stage_dir),
+        std::fs::canonicalize(file),
+    ) {
+        if f.starts_with(dir) {
+            return Err(ExperimentError::ImageInStage {
+                file: file.clone(),
+                dir: stage_dir.to_path_buf(),
+            });
+        }
+    }
+    let image = crate::image::read_xyz_image(file)?;
+    let Some([camera_width, camera_height]) = camera else {
+        return Ok(());
+    };
+    if image.width * camera_height != image.height * camera_width {
+        return Err(crate::render::spot::cone::ReadBackError::Aspect {
+            file: file.clone(),
+            width: image.width,
+            height: image.height,
+            camera_width,
+            camera_height,
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Where the simulation's readings came from, as `simulation.json` names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SimulationMethod {
+    /// The deterministic radiosity solver: each reading's uncertainty is a bound.
+    #[serde(rename = "radiosity")]
+    Radiosity,
+    /// The spectral path tracer: a 95 % half-width.
+    #[serde(rename = "path tracer")]
+    PathTracer,
+    /// Another renderer's image read back (`--simulation-image`): a 95 % half-width from
+    /// the pixels' spread.
+    #[serde(rename = "external image")]
+    ExternalImage,
+}
+
+impl SimulationMethod {
+    /// The name `simulation.json` and the report give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SimulationMethod::Radiosity => "radiosity",
+            SimulationMethod::PathTracer => "path tracer",
+            SimulationMethod::ExternalImage => crate::render::job::spots_from_image::METHOD,
+        }
+    }
+}
+
+impl std::fmt::Display for SimulationMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ImageSpec {
     pub size: usize,
@@ -76,7 +176,7 @@ pub struct ImagePatch {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(into = "SummaryFile", from = "SummaryFile")]
 pub struct SimulationSummary {
-    pub method: String,
+    pub method: SimulationMethod,
     /// The scene's reference white (a perfect diffuser in place of patch 19), cd/m².
     pub white: Xyz,
     pub converged: bool,
@@ -113,7 +213,7 @@ pub struct ExternalSource {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(rename = "SimulationSummary")]
 struct SummaryFile {
-    method: String,
+    method: SimulationMethod,
     white: Xyz,
     converged: bool,
     seconds: f64,
@@ -160,9 +260,11 @@ impl From<SimulationSummary> for SummaryFile {
 
 impl From<SummaryFile> for SimulationSummary {
     fn from(f: SummaryFile) -> Self {
-        let uncertainty = |de| match f.method.as_str() {
-            "radiosity" => Uncertainty::Bound { de, regular: None },
-            _ => Uncertainty::HalfWidth95 { de, sampling: None },
+        let uncertainty = |de| match f.method {
+            SimulationMethod::Radiosity => Uncertainty::Bound { de, regular: None },
+            SimulationMethod::PathTracer | SimulationMethod::ExternalImage => {
+                Uncertainty::HalfWidth95 { de, sampling: None }
+            }
         };
         let spots = f
             .spots
@@ -219,8 +321,8 @@ pub fn simulate(
     .map_err(from_render)?;
     let scene = &report.scene;
     let method = match report.readings {
-        Readings::Radiosity { .. } => "radiosity",
-        Readings::PathTracer(_) => "path tracer",
+        Readings::Radiosity { .. } => SimulationMethod::Radiosity,
+        Readings::PathTracer(_) => SimulationMethod::PathTracer,
     };
     let (white, converged) = (report.readings.white(), report.readings.converged());
     let spots = report.readings.patches().to_vec();
@@ -247,7 +349,7 @@ pub fn simulate(
     let image = match opts.image {
         Some(spec) => {
             progress(Progress::Note(match method {
-                "radiosity" => format!(
+                SimulationMethod::Radiosity => format!(
                     "rendering the {0}×{0} image from the radiosity solution",
                     spec.size
                 ),
@@ -270,12 +372,12 @@ pub fn simulate(
         }
     };
     let summary = SimulationSummary {
-        method: method.into(),
+        method,
         white,
         converged,
         seconds: start.elapsed().as_secs_f64(),
         spots,
-        image_method: image.as_ref().map(|_| method.to_string()),
+        image_method: image.as_ref().map(|_| method.name().to_string()),
         image,
         image_patches,
         source: None,

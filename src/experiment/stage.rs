@@ -34,6 +34,12 @@ impl Stage {
             Stage::Validation => "validation",
         }
     }
+
+    /// Whether the stage takes readings in a journalled session: whose directory is moved
+    /// aside, never cleared, when its inputs change, and which resumes after Ctrl-C.
+    pub fn measures(self) -> bool {
+        matches!(self, Stage::Box | Stage::Display | Stage::DisplaySpots)
+    }
 }
 
 impl std::fmt::Display for Stage {

@@ -41,6 +41,45 @@ pub(crate) fn num(x: f64) -> String {
     }
 }
 
+/// A name as the text of a one-line comment: every control character (the line ends `\n`
+/// and `\r` among them), Unicode's line and paragraph separators, the noncharacters
+/// U+FFFE and U+FFFF and the backslash are written as Rust escapes (`\r`, `\u{2028}`,
+/// `\\`), so a name can neither end the comment's line nor show as something it is not,
+/// and the escape is read back unambiguously.
+pub(crate) fn one_line(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if c.is_control()
+            || c == '\\'
+            || matches!(c, '\u{2028}' | '\u{2029}' | '\u{fffe}' | '\u{ffff}')
+        {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A name as text inside an XML comment (`<!-- … -->`): on one line ([`one_line`]), which
+/// also leaves only characters XML 1.0 allows (its `Char` production excludes the C0
+/// controls but tab and the line ends, and U+FFFE, U+FFFF), and with a space between any
+/// two hyphens and after a last one, since a comment may not hold `--` nor end with `-`
+/// (XML 1.0 §2.5): `-->` in a name cannot close the comment.
+pub(crate) fn xml_comment(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in one_line(s).chars() {
+        if c == '-' && out.ends_with('-') {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    if out.ends_with('-') {
+        out.push(' ');
+    }
+    out
+}
+
 /// The wavelength of bin `i` of the scene's 1 nm grid.
 pub(crate) fn grid_nm(i: usize) -> f64 {
     (metamer_color::START_NM as usize + i) as f64
@@ -94,4 +133,20 @@ pub(crate) fn luminance(scene: &Scene, radiance: &[f64]) -> f64 {
             .zip(&scene.cmf[1])
             .map(|(l, y)| l * y)
             .sum::<f64>()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_cannot_end_a_comment_line_or_an_xml_comment() {
+        assert_eq!(one_line("a\rWorldEnd\nb\\r"), "a\\rWorldEnd\\nb\\\\r");
+        assert_eq!(one_line("x\u{2028}y\u{1b}"), "x\\u{2028}y\\u{1b}");
+        assert_eq!(one_line("<&\"é>"), "<&\"é>");
+        assert_eq!(xml_comment("a-->b"), "a- ->b");
+        assert_eq!(xml_comment("---"), "- - - ");
+        assert_eq!(xml_comment("-a-"), "-a- ");
+        assert!(!xml_comment("x\r\n--\u{ffff}-").contains("--"));
+    }
 }

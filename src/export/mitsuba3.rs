@@ -29,7 +29,7 @@ use std::fmt::Write;
 use std::path::PathBuf;
 
 use super::approximation::Approximation;
-use super::common::{grid_nm, num, tiles, File};
+use super::common::{grid_nm, num, tiles, xml_comment, File};
 use crate::render::scene::{Camera, Scene};
 
 /// The scene file's name in the export.
@@ -113,7 +113,7 @@ pub(super) fn files(
         x,
         "<!-- {}: written by metamer export for Mitsuba 3 (a spectral variant, e.g. \
          scalar_spectral). The image is XYZ in cd/m2, not mirrored; see README.md. -->",
-        scene.name.replace("--", "- -")
+        xml_comment(&scene.name)
     );
     let _ = writeln!(x, r#"<scene version="3.0.0">"#);
     for (k, v) in [

@@ -58,7 +58,7 @@ pub struct ExportRequest {
     pub scene: Option<PathBuf>,
     pub to: Renderer,
     /// The output directory: created if missing; refused when it holds anything, unless
-    /// `force`.
+    /// `force`. Even forced, no file the scene reads, nor the scene file, is replaced.
     pub output: PathBuf,
     pub force: bool,
     /// Samples per pixel written as the scene's default (both files let a user override it).
@@ -93,11 +93,12 @@ pub struct ExportReport {
     pub summary: String,
 }
 
-/// The scene as `render spots` would load it, with the name errors use.
-fn load(scene: Option<&Path>) -> Result<(Scene, String), ExportError> {
+/// The scene as `render spots` would load it, with the name errors use and the files it
+/// read (none for a built-in scene).
+fn load(scene: Option<&Path>) -> Result<(Scene, String, Vec<PathBuf>), ExportError> {
     let builtin = |name: &str| {
         Scene::builtin(name)
-            .map(|s| (s, format!("built-in scene {name}")))
+            .map(|s| (s, format!("built-in scene {name}"), Vec::new()))
             .map_err(|source| ExportError::Builtin {
                 name: name.to_string(),
                 source,
@@ -107,7 +108,10 @@ fn load(scene: Option<&Path>) -> Result<(Scene, String), ExportError> {
         None => builtin(crate::render::scene::builtin::NAMES[0]),
         Some(p) => match Scene::builtin_named(p) {
             Some(name) => builtin(name),
-            None => Ok((Scene::load(p)?, p.display().to_string())),
+            None => {
+                let (scene, inputs) = Scene::load_with_inputs(p)?;
+                Ok((scene, p.display().to_string(), inputs))
+            }
         },
     }
 }
@@ -136,7 +140,7 @@ pub fn run(request: &ExportRequest) -> Result<ExportReport, ExportError> {
     if request.spp == 0 {
         return Err(ExportError::BadSpp);
     }
-    let (scene, name) = load(request.scene.as_deref())?;
+    let (scene, name, inputs) = load(request.scene.as_deref())?;
     let Some(camera) = scene.camera else {
         return Err(ExportError::NoCamera { scene: name });
     };
@@ -155,13 +159,21 @@ pub fn run(request: &ExportRequest) -> Result<ExportReport, ExportError> {
         rel: PathBuf::from("README.md"),
         text: readme::text(request.to, &name, &camera, &approximation, &summary),
     };
+    // Even forced, no file the scene reads (nor the scene itself) is replaced: every
+    // output is checked against them before the first is written, so a refusal leaves the
+    // directory as it was.
     let mut policy = OutputPolicy::new(request.force);
-    if let Some(p) = request.scene.as_deref().filter(|p| p.exists()) {
-        policy.input(p);
+    policy.inputs(inputs.iter().map(PathBuf::as_path));
+    let all: Vec<&File> = files.iter().chain(std::iter::once(&readme)).collect();
+    for f in &all {
+        let path = request.output.join(&f.rel);
+        if path.parent().is_some_and(|d| d.is_dir()) {
+            policy.check(&path)?;
+        }
     }
     policy.dir(&request.output)?;
     let mut written = Vec::new();
-    for f in files.iter().chain(std::iter::once(&readme)) {
+    for f in all {
         let path = request.output.join(&f.rel);
         if let Some(parent) = path.parent() {
             policy.dir(parent)?;

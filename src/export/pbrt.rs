@@ -34,7 +34,7 @@ use std::fmt::Write;
 use std::path::PathBuf;
 
 use super::approximation::Approximation;
-use super::common::{grid_nm, luminance, num, tiles, File};
+use super::common::{grid_nm, luminance, num, one_line, tiles, File};
 use crate::render::scene::{Camera, Scene};
 
 /// The scene file's name in the export.
@@ -118,7 +118,7 @@ pub(super) fn files(
         x,
         "# {}: written by metamer export for pbrt-v4. The image is RGB in ACES2065-1 \
          whose XYZ is in cd/m2, not mirrored; see README.md.",
-        scene.name.replace('\n', " ")
+        one_line(&scene.name)
     );
     let _ = writeln!(
         x,
@@ -160,7 +160,7 @@ pub(super) fn files(
     );
     let _ = writeln!(x, "\nWorldBegin\n");
     for s in &scene.surfaces {
-        let _ = writeln!(x, "# surface {}", s.name.replace('\n', " "));
+        let _ = writeln!(x, "# surface {}", one_line(&s.name));
         let _ = writeln!(x, "AttributeBegin");
         let _ = writeln!(
             x,

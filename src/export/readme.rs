@@ -219,10 +219,11 @@ pub(super) fn text(
     summary: &str,
 ) -> String {
     let mut s = format!(
-        "# {scene_name} for {}\n\n\
+        "# {} for {}\n\n\
          Written by `metamer export --to {}`. Geometry in metres; every surface a Lambertian \
          reflector with the scene's spectral reflectance; every emitter tile an area light \
          of its absolute spectral radiance.\n\n**In short:** {summary}.\n\n",
+        super::common::one_line(scene_name),
         match to {
             Renderer::Mitsuba3 => "Mitsuba 3",
             Renderer::PbrtV4 => "pbrt-v4",
@@ -238,9 +239,10 @@ pub(super) fn text(
         "\n## Reading the image back\n\n`metamer render spots-from-image IMAGE --scene {} --json > \
          readings.json` reads the image back as the 24 meter readings, each with its \
          uncertainty from the pixels' spread; `metamer validate --reference SPOTS \
-         --simulation readings.json` compares them with the box, and `metamer experiment \
-         --simulation-image IMAGE` runs the whole chain with this renderer's image as the \
-         simulation.\n",
+         --test readings.json -o DIR` compares them with the box's spot readings (SPOTS: \
+         the box's `spots.jsonl`, or an experiment's `box/spots.csv`), and `metamer \
+         experiment -o DIR --box-scene SCENE --box-spots SPOTS --simulation-image IMAGE` \
+         runs the whole chain with this renderer's image as the simulation.\n",
         scene_name
             .strip_prefix("built-in scene ")
             .unwrap_or(scene_name)

@@ -15,16 +15,23 @@ pub struct ScreenSpot {
     pub radius: f64,
 }
 
-/// Rows top to bottom, each pixel's drive values.
+/// An image of 8-bit drive values (what a screen shows and the reproduction's PNG holds),
+/// rows top to bottom. The reproduction's drive values before quantisation are
+/// `display::reproduce::DriveImage` (0–1, 32-bit floats); absolute colour is
+/// [`super::XyzImage`].
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct RgbImage {
+pub struct Drive8Image {
     pub width: usize,
     pub height: usize,
     pub pixels: Vec<[u8; 3]>,
 }
 
-impl RgbImage {
-    pub fn new(width: usize, height: usize, pixels: Vec<[u8; 3]>) -> Result<RgbImage, ImageError> {
+impl Drive8Image {
+    pub fn new(
+        width: usize,
+        height: usize,
+        pixels: Vec<[u8; 3]>,
+    ) -> Result<Drive8Image, ImageError> {
         if width == 0 || height == 0 || pixels.len() != width * height {
             return Err(ImageError::Size {
                 width,
@@ -33,7 +40,7 @@ impl RgbImage {
                 got: pixels.len(),
             });
         }
-        Ok(RgbImage {
+        Ok(Drive8Image {
             width,
             height,
             pixels,
@@ -41,7 +48,7 @@ impl RgbImage {
     }
 
     /// An 8-bit RGB PNG (the reproduction's drive values).
-    pub fn read_png(path: &Path) -> Result<RgbImage, ImageError> {
+    pub fn read_png(path: &Path) -> Result<Drive8Image, ImageError> {
         let bad = |message: String| ImageError::NotShowablePng {
             file: path.to_path_buf(),
             message,
@@ -72,7 +79,7 @@ impl RgbImage {
             .chunks_exact(3)
             .map(|p| [p[0], p[1], p[2]])
             .collect();
-        RgbImage::new(w, h, pixels)
+        Drive8Image::new(w, h, pixels)
     }
 
     pub fn at(&self, x: usize, y: usize) -> [u8; 3] {

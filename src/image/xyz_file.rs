@@ -9,10 +9,12 @@
 //! cd/m² and (1,1,1) has Y = 1. A reader that honours the attributes converts to its display
 //! correctly; without them it would take XYZ for Rec. 709 RGB.
 //!
-//! Read back are: R, G, B with these chromaticities or none (metamer wrote none before);
-//! R, G, B with another space's chromaticities, converted by the matrix they define (pbrt-v4
-//! can only write its film's RGB space and names it there); and channels named X, Y, Z
-//! (Mitsuba 3's XYZ films).
+//! Read back are: R, G, B with these chromaticities; R, G, B with another space's
+//! chromaticities, converted by the matrix they define (pbrt-v4 can only write its film's
+//! RGB space and names it there), or with none, which OpenEXR defines as BT.709 with D65;
+//! and channels named X, Y, Z (Mitsuba 3's XYZ films). The header's whiteLuminance scales
+//! the values to cd/m², and only the display window is returned; `exr_header` interprets
+//! every attribute that changes what a pixel means, for every caller.
 //!
 //! Every reader refuses what would make the rest of the chain lie or stall: sizes whose
 //! pixel count overflows or exceeds [`MAX_PIXELS`], an OpenEXR file whose header, offset
@@ -22,8 +24,9 @@
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
-use super::chromaticities::{self, Chromaticities, XYZ_CHROMATICITIES};
+use super::chromaticities;
 use super::error::ImageError;
+use super::exr_header::{self, ExrChannels, Frame};
 use super::exr_layout;
 use super::xyz::{XyzImage, MAX_PIXELS};
 use crate::color::{srgb_encode, xyz_to_linear_srgb};
@@ -186,15 +189,15 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
     exr_layout::check(&bytes).map_err(bad)?;
     let meta = MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
         .map_err(|e| exr_error(path, e))?;
-    let mut layout = None;
+    let mut meaning = None;
     for header in meta.headers.iter() {
         let size = header.layer_size;
         pixel_count(path, size.width(), size.height())?;
-        if layout.is_none() {
-            layout = Some(exr_channels(header).map_err(bad)?);
+        if meaning.is_none() {
+            meaning = Some(exr_header::meaning(header).map_err(bad)?);
         }
     }
-    let layout = layout.ok_or_else(|| bad("holds no image".into()))?;
+    let meaning = meaning.ok_or_else(|| bad("holds no image".into()))?;
     fn create(res: exr::math::Vec2<usize>) -> XyzImage {
         XyzImage {
             width: res.width(),
@@ -206,7 +209,7 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
         let w = img.width;
         img.pixels[pos.y() * w + pos.x()] = v;
     }
-    let mut img = match layout {
+    let stored = match meaning.channels {
         ExrChannels::Xyz => {
             read()
                 .no_deep_data()
@@ -246,84 +249,43 @@ fn read_exr(path: &Path) -> Result<XyzImage, ImageError> {
                 .pixels
         }
     };
-    if let ExrChannels::Rgb(Some(m)) = layout {
+    let mut img = in_frame(stored, meaning.frame).ok_or_else(|| {
+        bad("its first image part is not the one its first header describes".into())
+    })?;
+    if let ExrChannels::Rgb(Some(m)) = meaning.channels {
         for p in &mut img.pixels {
             *p = chromaticities::apply(&m, *p);
+        }
+    }
+    if meaning.scale != 1.0 {
+        for p in &mut img.pixels {
+            *p = p.map(|v| (f64::from(v) * meaning.scale) as f32);
         }
     }
     check_finite(path, &img)?;
     Ok(img)
 }
 
-/// Which channels of an OpenEXR part hold the XYZ, and how.
-#[derive(Clone, Copy, Debug)]
-enum ExrChannels {
-    /// Channels named X, Y, Z (Mitsuba 3's `specfilm` with those names, its `hdrfilm`'s
-    /// `xyz` format).
-    Xyz,
-    /// R, G, B: XYZ itself (XYZ's chromaticities, or none), or RGB to convert by the matrix
-    /// its `chromaticities` attribute defines.
-    Rgb(Option<[[f64; 3]; 3]>),
-}
-
-/// The layout of the first part, or why it cannot be read as XYZ.
-fn exr_channels(header: &exr::meta::header::Header) -> Result<ExrChannels, String> {
-    let has = |name: &str| header.channels.list.iter().any(|c| c.name.eq(name));
-    let stated = header
-        .shared_attributes
-        .chromaticities
-        .map(|c| Chromaticities {
-            red: [f64::from(c.red.0), f64::from(c.red.1)],
-            green: [f64::from(c.green.0), f64::from(c.green.1)],
-            blue: [f64::from(c.blue.0), f64::from(c.blue.1)],
-            white: [f64::from(c.white.0), f64::from(c.white.1)],
-        });
-    let is_xyz = |c: &Chromaticities| {
-        let near =
-            |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
-        let x = XYZ_CHROMATICITIES;
-        near(c.red, x.red)
-            && near(c.green, x.green)
-            && near(c.blue, x.blue)
-            && near(c.white, x.white)
-    };
-    if has("X") && has("Y") && has("Z") {
-        return match stated {
-            Some(c) if !is_xyz(&c) => Err(format!(
-                "names its channels X, Y, Z but its chromaticities say RGB with primaries R \
-                 {:?}, G {:?}, B {:?} (white {:?})",
-                c.red, c.green, c.blue, c.white
-            )),
-            _ => Ok(ExrChannels::Xyz),
-        };
+/// The display window's pixels out of the data window's; None if the frame is not inside
+/// them.
+fn in_frame(stored: XyzImage, frame: Frame) -> Option<XyzImage> {
+    if (frame.x, frame.y, frame.width, frame.height) == (0, 0, stored.width, stored.height) {
+        return Some(stored);
     }
-    if !(has("R") && has("G") && has("B")) {
-        let names: Vec<String> = header
-            .channels
-            .list
-            .iter()
-            .map(|c| metamer_color::text::echo(&c.name.to_string()))
-            .collect();
-        return Err(format!(
-            "has the channels {} — an XYZ image needs X, Y, Z, or R, G, B with the \
-             chromaticities they hold",
-            names.join(", ")
-        ));
+    if frame.x + frame.width > stored.width || frame.y + frame.height > stored.height {
+        return None;
     }
-    match stated {
-        None => Ok(ExrChannels::Rgb(None)),
-        Some(c) if is_xyz(&c) => Ok(ExrChannels::Rgb(None)),
-        Some(c) => c
-            .rgb_to_xyz()
-            .map(|m| ExrChannels::Rgb(Some(m)))
-            .ok_or_else(|| {
-                format!(
-                "holds RGB whose chromaticities (R {:?}, G {:?}, B {:?}, white {:?}) define no \
-                 conversion to XYZ",
-                c.red, c.green, c.blue, c.white
-            )
-            }),
-    }
+    let pixels = (frame.y..frame.y + frame.height)
+        .flat_map(|y| {
+            let row = y * stored.width + frame.x;
+            stored.pixels[row..row + frame.width].iter().copied()
+        })
+        .collect();
+    Some(XyzImage {
+        width: frame.width,
+        height: frame.height,
+        pixels,
+    })
 }
 
 fn pfm_bytes(img: &XyzImage) -> Vec<u8> {

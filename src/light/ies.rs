@@ -18,12 +18,19 @@
 //! plane, 0…360° none. We write the opening's width along the 90–270° axis (our panel's
 //! `height_m`, along `edge_v`) and its length along 0–180° (`width_m`, along `edge_u`); the
 //! reader uses only their product, the area.
+//!
+//! A fitted table past the last reading is the model's extrapolation, and the candela
+//! values cannot say so: a written file says it in the keyword block, in `[OTHER]` (the
+//! keyword LM-63 keeps for information no other keyword holds) and in a user keyword,
+//! `[_MEASURED_GAMMA]` (LM-63 lets a file define its own keywords, each beginning with an
+//! underscore), both as described in the LM-63-2002 text the module's sources name.
 
 use std::path::Path;
 
 use metamer_color::text::{echo, strip_bom};
 
 use super::cgamma::CGammaTable;
+use super::fit::Extrapolation;
 use super::numbers::{tokens, Numbers};
 use super::photometry::{
     candela_grid, decode_text, finish, format_sig, mirror_planes, Opening, Panel, Photometry,
@@ -41,6 +48,9 @@ pub struct IesInfo {
     pub luminaire: String,
     /// `[FILEGENINFO]`: how the file was made.
     pub generation: String,
+    /// Where the table is extrapolated past the readings: said in an `[OTHER]` line and
+    /// in the user keyword `[_MEASURED_GAMMA]` (last angle read per half-plane).
+    pub extrapolation: Option<Extrapolation>,
 }
 
 /// File generation type of LM-63-2019 for a computer-generated (simulated) distribution.
@@ -73,6 +83,17 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &IesInfo) -> String {
         &mut out,
         &format!("[FILEGENINFO] {}", one_line(&info.generation)),
     );
+    if let Some(e) = &info.extrapolation {
+        line(&mut out, &format!("[OTHER] {}", e.sentence()));
+        let m = e.measured_to_deg;
+        line(
+            &mut out,
+            &format!(
+                "[_MEASURED_GAMMA] C0 0-{} C90 0-{} C180 0-{} C270 0-{}",
+                m[0], m[1], m[2], m[3]
+            ),
+        );
+    }
     line(&mut out, "TILT=NONE");
     let gammas = table.gamma_deg();
     // A full circle is closed with 360° (= the 0° plane), as the format expects.

@@ -13,7 +13,7 @@ use super::chart::ldc_chart_svg;
 use super::fit::{fit as fit_falloff, Falloff, LdcError, LdcFit, ModelChoice};
 use super::ies::{self, IesInfo};
 use super::ldt::{self, LdtInfo};
-use super::photometry::{flux_lm, Panel, Photometry, PhotometryError};
+use super::photometry::{flux_beyond_lm, flux_lm, Panel, Photometry, PhotometryError};
 use crate::output::{OutputError, OutputPolicy};
 
 /// Why a light job did not finish.
@@ -85,8 +85,21 @@ pub enum FitEvent<'a> {
     Fitted(&'a LdcFit),
     /// A file is written.
     Written(LightFile, &'a Path),
-    /// The panel the light files describe, before they are written.
-    Panel { panel: &'a Panel, flux_lm: f64 },
+    /// The panel the light files describe, before they are written, with its flux and the
+    /// part of it the model extrapolates past the readings (see [`LdcFit::extrapolation`]).
+    Panel {
+        panel: &'a Panel,
+        flux_lm: f64,
+        extrapolated: Option<ExtrapolatedFlux>,
+    },
+}
+
+/// The flux emitted where the table is extrapolated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExtrapolatedFlux {
+    /// γ above which at least one half-plane is extrapolated.
+    pub beyond_deg: f64,
+    pub flux_lm: f64,
 }
 
 /// Fits the light distribution curve to `request.falloff` and writes the files asked for.
@@ -140,9 +153,14 @@ pub fn fit(request: &FitRequest, events: &dyn Fn(FitEvent)) -> Result<LdcFit, Li
     }
     if let Some(panel) = panel {
         let flux_lm = flux_lm(&fit.table, &panel);
+        let extrapolated = fit.extrapolation().map(|e| ExtrapolatedFlux {
+            beyond_deg: e.beyond_deg,
+            flux_lm: flux_beyond_lm(&fit.table, &panel, e.beyond_deg),
+        });
         events(FitEvent::Panel {
             panel: &panel,
             flux_lm,
+            extrapolated,
         });
         write_light_files(request, &policy, &fit, &panel, events)?;
     }
@@ -234,6 +252,7 @@ fn write_light_files(
             issue_date: date.clone(),
             luminaire: luminaire.clone(),
             generation: format!("metamer light fit, model {}", fit.model),
+            extrapolation: fit.extrapolation(),
         };
         let text = ies::to_string(&fit.table, panel, &info);
         policy.write(path, text.as_bytes())?;
@@ -247,6 +266,7 @@ fn write_light_files(
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
             date_user: format!("{date} metamer"),
+            extrapolation: fit.extrapolation(),
         };
         let text = ldt::to_string(&fit.table, panel, &info);
         policy.write(path, text.as_bytes())?;

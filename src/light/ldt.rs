@@ -25,6 +25,7 @@ use std::path::Path;
 use metamer_color::text::{echo, strip_bom};
 
 use super::cgamma::CGammaTable;
+use super::fit::Extrapolation;
 use super::numbers::{tokens, Numbers};
 use super::photometry::{
     candela_grid, decode_text, finish, flux_lm, format_sig, mirror_planes, Opening, Panel,
@@ -39,6 +40,9 @@ pub struct LdtInfo {
     pub file_name: String,
     /// Line 12, date and user.
     pub date_user: String,
+    /// Where the table is extrapolated past the readings: said in line 8, the measurement
+    /// report, the one line about how the data were obtained.
+    pub extrapolation: Option<Extrapolation>,
 }
 
 /// The EULUMDAT text of `table` for `panel`.
@@ -72,7 +76,7 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &LdtInfo) -> String {
         format_sig(dc, 8),
         g.len().to_string(),
         format_sig(dg, 8),
-        "fitted light distribution".into(),
+        text(&report_line(info.extrapolation.as_ref())),
         text(&info.luminaire),
         "-".into(),
         text(&info.file_name),
@@ -107,6 +111,18 @@ pub fn to_string(table: &CGammaTable, panel: &Panel, info: &LdtInfo) -> String {
     let mut out = lines.join("\r\n");
     out.push_str("\r\n");
     out
+}
+
+/// Line 8, the measurement report: a fit, and where it is extrapolated (at most 78
+/// characters whatever the model's name: the longest is 10).
+fn report_line(e: Option<&Extrapolation>) -> String {
+    match e {
+        None => "fitted light distribution".into(),
+        Some(e) => format!(
+            "fit of readings to gamma {} deg; above, extrapolated by the {} model",
+            e.beyond_deg, e.model
+        ),
+    }
 }
 
 /// Reads an EULUMDAT file: the distribution as a C-γ table and its photometry.

@@ -104,12 +104,23 @@ pub fn flux_lm(table: &CGammaTable, panel: &Panel) -> f64 {
     panel.normal_intensity_cd() * projected_solid_angle(table)
 }
 
+/// The part of [`flux_lm`] emitted at γ above `gamma_deg` (lm), with the same exact
+/// quadrature: what an extrapolation past the last reading contributes.
+pub fn flux_beyond_lm(table: &CGammaTable, panel: &Panel, gamma_deg: f64) -> f64 {
+    panel.normal_intensity_cd() * projected_solid_angle_from(table, gamma_deg)
+}
+
 /// ∫ f(C, γ)·cos γ dΩ over the hemisphere, in sr (π for a Lambertian table).
 ///
 /// The quadrature is exact for the table as it is evaluated: f is linear in γ between the
 /// table's angles, so each γ interval is integrated against cos γ·sin γ in closed form, and
 /// linear in C between planes (periodically), so the planes get trapezoid weights.
 pub fn projected_solid_angle(table: &CGammaTable) -> f64 {
+    projected_solid_angle_from(table, 0.0)
+}
+
+/// [`projected_solid_angle`] over γ ≥ `from_deg` only.
+fn projected_solid_angle_from(table: &CGammaTable, from_deg: f64) -> f64 {
     let planes = table.c_deg();
     let weights: Vec<f64> = if planes.len() == 1 {
         vec![2.0 * PI]
@@ -127,22 +138,26 @@ pub fn projected_solid_angle(table: &CGammaTable) -> f64 {
     weights
         .iter()
         .zip(table.values())
-        .map(|(w, row)| w * profile_integral(&g, row))
+        .map(|(w, row)| w * profile_integral(&g, row, from_deg.to_radians()))
         .sum()
 }
 
-/// ∫₀^{π/2} f(γ)·cos γ·sin γ dγ for f linear between (g[k], row[k]).
-fn profile_integral(g: &[f64], row: &[f64]) -> f64 {
+/// ∫ f(γ)·cos γ·sin γ dγ over γ ≥ `from` (radians) for f linear between (g[k], row[k]).
+fn profile_integral(g: &[f64], row: &[f64], from: f64) -> f64 {
     // With w = sin 2γ / 2: ∫w = −cos 2γ / 4 and ∫γ·w = −γ·cos 2γ / 4 + sin 2γ / 8.
     let w0 = |x: f64| -(2.0 * x).cos() / 4.0;
     let w1 = |x: f64| -x * (2.0 * x).cos() / 4.0 + (2.0 * x).sin() / 8.0;
     let mut total = 0.0;
     for k in 1..g.len() {
         let (a, b) = (g[k - 1], g[k]);
+        if b <= from {
+            continue;
+        }
         let (fa, fb) = (row[k - 1], row[k]);
         let slope = (fb - fa) / (b - a);
-        // f = fa + slope·(γ − a)
-        total += (fa - slope * a) * (w0(b) - w0(a)) + slope * (w1(b) - w1(a));
+        // f = fa + slope·(γ − a), integrated from where the range starts.
+        let start = a.max(from);
+        total += (fa - slope * a) * (w0(b) - w0(start)) + slope * (w1(b) - w1(start));
     }
     total
 }

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
-use super::plan::{BoxPlan, BoxStep, Geometry, Plane, Stage, Target};
+use super::plan::{BoxPlan, BoxStage, BoxStep, Geometry, Plane, Target};
 use super::scene::{scene_json, BoxContents};
 use super::stats::{group, mean_spectrum, GroupStats, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum, Xyz};
@@ -35,13 +35,13 @@ pub struct BoxDetails {
 
 /// Every stage's journal path and entries, complete.
 pub struct StageEntries {
-    pub stages: BTreeMap<Stage, (PathBuf, Vec<Entry<BoxStep>>)>,
+    pub stages: BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)>,
 }
 
 /// A group of readings flagged.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Flagged {
-    pub stage: Stage,
+    pub stage: BoxStage,
     /// `tile 2,3`, `spot 7`.
     pub what: String,
     /// Repeats (1-based) left out of the mean as outliers.
@@ -62,7 +62,7 @@ pub struct Reduced {
 /// A journal and its digest.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JournalDigest {
-    pub stage: Stage,
+    pub stage: BoxStage,
     pub file: PathBuf,
     pub sha256: String,
 }
@@ -138,7 +138,7 @@ pub enum AssembleError {
     #[error(transparent)]
     LightFiles(#[from] LightFilesError),
     #[error("the {0} stage's readings are missing")]
-    Missing(Stage),
+    Missing(BoxStage),
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -187,7 +187,7 @@ struct StageReduced {
 }
 
 fn reduce(
-    stage: Stage,
+    stage: BoxStage,
     entries: &[Entry<BoxStep>],
     spectral: bool,
     flags: &mut Vec<Flagged>,
@@ -355,7 +355,7 @@ struct Stages {
 
 /// Every stage's groups reduced, and the groups flagged for outliers or spread.
 fn reduce_stages(entries: &StageEntries) -> Result<(Stages, Vec<Flagged>), AssembleError> {
-    let get = |stage: Stage| {
+    let get = |stage: BoxStage| {
         entries
             .stages
             .get(&stage)
@@ -363,10 +363,20 @@ fn reduce_stages(entries: &StageEntries) -> Result<(Stages, Vec<Flagged>), Assem
             .ok_or(AssembleError::Missing(stage))
     };
     let mut flags = Vec::new();
-    let tiles = reduce(Stage::Tiles, get(Stage::Tiles)?, true, &mut flags)?;
-    let falloff = reduce(Stage::Falloff, get(Stage::Falloff)?, false, &mut flags)?;
-    let materials = reduce(Stage::Materials, get(Stage::Materials)?, true, &mut flags)?;
-    let spots = reduce(Stage::Spots, get(Stage::Spots)?, false, &mut flags)?;
+    let tiles = reduce(BoxStage::Tiles, get(BoxStage::Tiles)?, true, &mut flags)?;
+    let falloff = reduce(
+        BoxStage::Falloff,
+        get(BoxStage::Falloff)?,
+        false,
+        &mut flags,
+    )?;
+    let materials = reduce(
+        BoxStage::Materials,
+        get(BoxStage::Materials)?,
+        true,
+        &mut flags,
+    )?;
+    let spots = reduce(BoxStage::Spots, get(BoxStage::Spots)?, false, &mut flags)?;
     let stages = Stages {
         tiles,
         falloff,
@@ -420,7 +430,7 @@ fn measured_materials(
     let tile_spectra: Vec<Spectrum> = tile_spectra
         .into_iter()
         .collect::<Option<_>>()
-        .ok_or(AssembleError::Missing(Stage::Tiles))?;
+        .ok_or(AssembleError::Missing(BoxStage::Tiles))?;
     let nominal = colorchecker(ColorCheckerSet::BabelColorAverage);
     let mut patches: Vec<Option<Spectrum>> = vec![None; 24];
     let mut wall = None;
@@ -434,7 +444,7 @@ fn measured_materials(
             _ => {}
         }
     }
-    let wall = wall.ok_or(AssembleError::Missing(Stage::Materials))?;
+    let wall = wall.ok_or(AssembleError::Missing(BoxStage::Materials))?;
     let nominal_patches: Vec<usize> = (1..=24).filter(|k| patches[k - 1].is_none()).collect();
     let patches: Vec<Spectrum> = patches
         .into_iter()

@@ -67,11 +67,13 @@ pub fn light_files(
         issue_date: date.into(),
         luminaire: luminaire.clone(),
         generation: format!("metamer measure-box, model {}", fit.model),
+        extrapolation: fit.extrapolation(),
     };
     let ldt_info = LdtInfo {
         luminaire,
         file_name: "light.ldt".into(),
         date_user: format!("{date} metamer measure-box"),
+        extrapolation: fit.extrapolation(),
     };
     Ok([
         ("light.svg", ldc_chart_svg(fit)?),

@@ -15,11 +15,12 @@ use std::path::PathBuf;
 
 use metamer_drivers::Spec;
 
-use super::plan::{BoxPlan, PlanError, Stage};
-use super::run::{run, Instruments, MeasureBoxError, Options, Outcome};
+use super::plan::{BoxPlan, BoxPlanError, BoxStage};
+use super::run::{run, BoxOptions, Instruments, MeasureBoxError, Outcome};
 use super::setup::{self, BoxLightError, RigError, RigRequest};
 use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
+use crate::rig::Scenario;
 use crate::session::{attendance, Attendance, NobodyAtTheRig, ProgressSink, RunOptions};
 use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
 use crate::validation::repeatability;
@@ -29,14 +30,14 @@ use crate::validation::repeatability;
 pub const SPOTS_FILE: &str = "spots.csv";
 
 /// What `measure-box` is asked to do.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct MeasureBoxRequest {
     /// Output directory: the stage journals, scene, light files and summary.
     pub out: PathBuf,
-    /// The spectral instrument's spec.
-    pub spectral: String,
-    /// The spot meter's spec.
-    pub spot: String,
+    /// The spectral instrument.
+    pub spectral: Spec,
+    /// The spot meter.
+    pub spot: Spec,
     /// A plan file; `None`: the paper's plan.
     pub plan: Option<PathBuf>,
     /// Readings of each tile and each spot; `None`: the plan's.
@@ -44,13 +45,14 @@ pub struct MeasureBoxRequest {
     /// Continue the journals in `out`.
     pub resume: bool,
     /// Only this stage, by name (tiles, falloff, materials, spots). A name, not a
-    /// [`Stage`], because it is checked after the plan, as the command always did. The
+    /// [`BoxStage`], because it is checked after the plan, as the command always did. The
     /// experiment's box stage measures them all (None).
     pub stage: Option<String>,
     /// Seed of the simulated box and its instruments' noise.
     pub seed: u64,
-    /// The simulated box's light, by name; checked once the rig is known to be simulated.
-    pub scenario: Option<String>,
+    /// The simulated box's light (None: the default); refused on a real rig
+    /// ([`setup::box_light`]).
+    pub scenario: Option<Scenario>,
     /// Replace an existing scene, light files or summary in `out`: the command's
     /// `--force`; the experiment's box stage always, as its directory is its own.
     pub force: bool,
@@ -79,13 +81,14 @@ pub struct MeasureBoxRequest {
 pub enum MeasureBoxJobError {
     /// The plan file cannot be read or is not a valid plan.
     #[error(transparent)]
-    Plan(#[from] PlanError),
+    Plan(#[from] BoxPlanError),
     /// The repeat count asked for ([`MeasureBoxRequest::repeats`]) is out of range.
     #[error("repeats {0}")]
     Repeats(String),
     /// No stage has this name.
     #[error("{0}")]
     UnknownStage(String),
+    /// The instruments and the light make no rig ([`setup::box_light`]).
     #[error(transparent)]
     BoxLight(#[from] BoxLightError),
     #[error(transparent)]
@@ -111,17 +114,24 @@ pub enum MeasureBoxJobError {
 /// ```
 /// use metamer::measure_box::job::{measure, MeasureBoxRequest};
 /// use metamer::measure_box::Outcome;
-/// use metamer::session::NoProgress;
+/// use metamer::session::{NoProgress, RunOptions};
 ///
 /// let out = std::env::temp_dir().join(format!("metamer-doc-box-{}", std::process::id()));
 /// let request = MeasureBoxRequest {
 ///     out: out.clone(),
 ///     spectral: "sim:i1pro?time_scale=0".into(),
 ///     spot: "sim:cs100a?time_scale=0".into(),
+///     plan: None,
 ///     repeats: Some(1),
+///     resume: false,
 ///     stage: Some("tiles".into()),
 ///     seed: 1,
-///     ..MeasureBoxRequest::default()
+///     scenario: None,
+///     force: false,
+///     unattended: false,
+///     run: RunOptions::default(),
+///     attendance: None,
+///     spot_readings: false,
 /// };
 /// let outcome = measure(&request, &|_| {}, &mut |_| Box::new(NoProgress)).unwrap();
 /// // The other stages are still to measure before the scene can be assembled.
@@ -135,40 +145,40 @@ pub fn measure<'p>(
     progress: &mut dyn FnMut(bool) -> Box<dyn ProgressSink + 'p>,
 ) -> Result<Outcome, MeasureBoxJobError> {
     let plan = plan(request)?;
-    let stage: Option<Stage> = request
+    let stage: Option<BoxStage> = request
         .stage
         .as_deref()
         .map(str::parse)
         .transpose()
         .map_err(MeasureBoxJobError::UnknownStage)?;
-    let (spectral, spot) = (
-        Spec::new(request.spectral.as_str()),
-        Spec::new(request.spot.as_str()),
-    );
-    // As written, before a simulated box is made and its seed appended to the specs.
-    for spec in [&spectral, &spot] {
+    let (spectral, spot) = (&request.spectral, &request.spot);
+    // As written, before a simulated box is made and its seed appended to the specs: a
+    // misnamed instrument is refused as such, not as half of a mixed rig.
+    for spec in [spectral, spot] {
         spec.check().map_err(RigError::Open)?;
     }
-    let simulated = setup::is_simulated(&spectral, &spot)?;
-    let light = setup::box_light(request.scenario.as_deref(), simulated)?;
+    let light = setup::box_light(spectral, spot, request.scenario)?;
     // Before anything is opened: a real rig with nobody to ask is refused.
     let attended = match request.attendance {
         Some(a) => a,
-        None => attendance(&[&request.spectral, &request.spot], request.unattended)?,
+        None => attendance(&[spectral, spot], request.unattended)?,
     };
     let rig_request = RigRequest {
         plan: &plan,
-        spectral: &spectral,
-        spot: &spot,
+        spectral,
+        spot,
         seed: request.seed,
         light,
     };
+    if let Some(pace) = crate::session::pace_note(&[spectral, spot]) {
+        note(pace);
+    }
     let mut rig = setup::open(&rig_request, || attended.operator(), note)?;
     let mut output = OutputPolicy::new(request.force);
     if let Some(p) = &request.plan {
         output.input(p);
     }
-    let options = Options {
+    let options = BoxOptions {
         output,
         dir: request.out.clone(),
         plan,
@@ -176,8 +186,8 @@ pub fn measure<'p>(
         resume: request.resume,
         rig_options: std::mem::take(&mut rig.rig_options),
         details: BoxDetails {
-            spectral: request.spectral.clone(),
-            spot: request.spot.clone(),
+            spectral: request.spectral.to_string(),
+            spot: request.spot.to_string(),
         },
         run: request.run.clone(),
     };
@@ -234,7 +244,7 @@ fn plan(request: &MeasureBoxRequest) -> Result<BoxPlan, MeasureBoxJobError> {
         plan.repeats = n;
     }
     plan.validate().map_err(|e| match e {
-        PlanError::Invalid { field, message } if field == "repeats" => {
+        BoxPlanError::Invalid { field, message } if field == "repeats" => {
             MeasureBoxJobError::Repeats(message)
         }
         e => e.into(),

@@ -21,5 +21,5 @@ pub mod simulated_box;
 pub mod stats;
 
 pub use assemble::{BoxDetails, Summary};
-pub use plan::{BoxPlan, BoxStep, Geometry, PlanError, Plane, Stage, Target};
-pub use run::{run, Instruments, MeasureBoxError, Options, Outcome};
+pub use plan::{BoxPlan, BoxPlanError, BoxStage, BoxStep, Geometry, Plane, Target};
+pub use run::{run, BoxOptions, Instruments, MeasureBoxError, Outcome};

@@ -33,22 +33,27 @@ pub const SPOT: &str = "spot";
 /// The four stages, in the order a full session takes them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Stage {
+pub enum BoxStage {
     Tiles,
     Falloff,
     Materials,
     Spots,
 }
 
-impl Stage {
-    pub const ALL: [Stage; 4] = [Stage::Tiles, Stage::Falloff, Stage::Materials, Stage::Spots];
+impl BoxStage {
+    pub const ALL: [BoxStage; 4] = [
+        BoxStage::Tiles,
+        BoxStage::Falloff,
+        BoxStage::Materials,
+        BoxStage::Spots,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
-            Stage::Tiles => "tiles",
-            Stage::Falloff => "falloff",
-            Stage::Materials => "materials",
-            Stage::Spots => "spots",
+            BoxStage::Tiles => "tiles",
+            BoxStage::Falloff => "falloff",
+            BoxStage::Materials => "materials",
+            BoxStage::Spots => "spots",
         }
     }
 
@@ -58,16 +63,16 @@ impl Stage {
     }
 }
 
-impl std::fmt::Display for Stage {
+impl std::fmt::Display for BoxStage {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
 }
 
-impl std::str::FromStr for Stage {
+impl std::str::FromStr for BoxStage {
     type Err = String;
-    fn from_str(s: &str) -> Result<Stage, String> {
-        Stage::ALL
+    fn from_str(s: &str) -> Result<BoxStage, String> {
+        BoxStage::ALL
             .into_iter()
             .find(|st| st.name() == s)
             .ok_or_else(|| format!("unknown stage '{s}' (known: tiles, falloff, materials, spots)"))
@@ -93,7 +98,7 @@ pub enum Target {
 /// One step's data in the journal.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BoxStep {
-    pub stage: Stage,
+    pub stage: BoxStage,
     #[serde(flatten)]
     pub target: Target,
     /// 0-based.
@@ -168,7 +173,7 @@ impl Default for BoxPlan {
 
 /// A plan that cannot be measured; each names the field.
 #[derive(Debug, thiserror::Error)]
-pub enum PlanError {
+pub enum BoxPlanError {
     #[error("cannot read the plan {}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -183,8 +188,8 @@ pub enum PlanError {
     Invalid { field: String, message: String },
 }
 
-fn invalid(field: &str, message: impl Into<String>) -> PlanError {
-    PlanError::Invalid {
+fn invalid(field: &str, message: impl Into<String>) -> BoxPlanError {
+    BoxPlanError::Invalid {
         field: field.into(),
         message: message.into(),
     }
@@ -198,12 +203,12 @@ pub const MAX_REPEATS: usize = 100;
 
 impl BoxPlan {
     /// Reads and validates a plan file.
-    pub fn load(path: &Path) -> Result<BoxPlan, PlanError> {
-        let text = metamer_color::text::read_text(path).map_err(|source| PlanError::Io {
+    pub fn load(path: &Path) -> Result<BoxPlan, BoxPlanError> {
+        let text = metamer_color::text::read_text(path).map_err(|source| BoxPlanError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let json = |source| PlanError::Json {
+        let json = |source| BoxPlanError::Json {
             path: path.to_path_buf(),
             source,
         };
@@ -233,7 +238,7 @@ impl BoxPlan {
     }
 
     /// The steps of one stage.
-    pub fn steps(&self, stage: Stage) -> Vec<Step<BoxStep>> {
+    pub fn steps(&self, stage: BoxStage) -> Vec<Step<BoxStep>> {
         let step = |target: Target, repeat: usize, role: &str, mode, prompt: String| Step {
             label: label(&target, repeat),
             role: role.to_string(),
@@ -248,7 +253,7 @@ impl BoxPlan {
         };
         let mut steps = Vec::new();
         match stage {
-            Stage::Tiles => {
+            BoxStage::Tiles => {
                 for row in 0..self.geometry.rows {
                     for col in 0..self.geometry.cols {
                         for r in 0..self.repeats {
@@ -259,7 +264,7 @@ impl BoxPlan {
                     }
                 }
             }
-            Stage::Falloff => {
+            BoxStage::Falloff => {
                 for plane in [Plane::Horizontal, Plane::Vertical] {
                     for &angle_deg in &self.falloff_angles_deg {
                         for r in 0..self.falloff_repeats {
@@ -270,7 +275,7 @@ impl BoxPlan {
                     }
                 }
             }
-            Stage::Materials => {
+            BoxStage::Materials => {
                 let targets = std::iter::once(Target::Wall)
                     .chain(self.patches.iter().map(|&patch| Target::Patch { patch }));
                 for t in targets {
@@ -280,7 +285,7 @@ impl BoxPlan {
                     }
                 }
             }
-            Stage::Spots => {
+            BoxStage::Spots => {
                 for &patch in &self.patches {
                     for r in 0..self.repeats {
                         let t = Target::Spot { patch };
@@ -368,7 +373,7 @@ impl BoxPlan {
     /// is refused naming what differs.
     pub fn session_plan(
         &self,
-        stage: Stage,
+        stage: BoxStage,
         extra: &BTreeMap<String, String>,
     ) -> SessionPlan<BoxStep> {
         let mut options = extra.clone();
@@ -445,9 +450,9 @@ mod tests {
         let p = BoxPlan::default();
         p.validate().unwrap();
         // 25 tiles × 5, 2 planes × 9 angles, wall + 24 patches, 24 spots × 5.
-        let counts: Vec<usize> = Stage::ALL.iter().map(|&s| p.steps(s).len()).collect();
+        let counts: Vec<usize> = BoxStage::ALL.iter().map(|&s| p.steps(s).len()).collect();
         assert_eq!(counts, [125, 18, 25, 120]);
-        let tiles = p.steps(Stage::Tiles);
+        let tiles = p.steps(BoxStage::Tiles);
         assert_eq!(
             tiles[5 * 13].prepare,
             Prepare::Operator {

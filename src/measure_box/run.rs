@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::Instrument;
 
 use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary};
-use super::plan::{BoxPlan, BoxStep, Stage, SPECTRAL, SPOT};
+use super::plan::{BoxPlan, BoxStage, BoxStep, SPECTRAL, SPOT};
 use crate::output::OutputPolicy;
 use crate::session::{
     placements, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig, RunEnd,
@@ -18,11 +18,11 @@ use crate::session::{
 
 /// What to measure and how.
 #[derive(Clone, Debug)]
-pub struct Options {
+pub struct BoxOptions {
     pub dir: PathBuf,
     pub plan: BoxPlan,
     /// Only this stage (measured again from the start unless resuming); None: every stage.
-    pub stage: Option<Stage>,
+    pub stage: Option<BoxStage>,
     /// Continue the journals in `dir` instead of refusing them.
     pub resume: bool,
     /// Options of the rig that change what is measured (a simulated box's seed); recorded
@@ -49,14 +49,14 @@ pub enum Outcome {
     Finished(Box<Summary>),
     /// A stage stopped before its end; its journal holds what was measured.
     Incomplete {
-        stage: Stage,
+        stage: BoxStage,
         end: RunEnd,
         done: usize,
         total: usize,
         log: PathBuf,
     },
     /// The stages run are complete, these others have no complete journal yet.
-    StagesMissing(Vec<Stage>),
+    StagesMissing(Vec<BoxStage>),
 }
 
 /// A box measurement failed.
@@ -64,13 +64,13 @@ pub enum Outcome {
 pub enum MeasureBoxError {
     #[error("stage {stage}: {source}")]
     Session {
-        stage: Stage,
+        stage: BoxStage,
         #[source]
         source: SessionError,
     },
     #[error("setting aside the earlier {stage} journal {}: {source}", path.display())]
     SetAside {
-        stage: Stage,
+        stage: BoxStage,
         path: PathBuf,
         source: std::io::Error,
     },
@@ -162,7 +162,7 @@ impl Outcome {
 
 /// Moves an earlier journal of a stage to be measured again out of the way, to
 /// `NAME.replaced-K.jsonl` (nothing measured is deleted).
-fn set_aside(stage: Stage, path: &Path) -> Result<(), MeasureBoxError> {
+fn set_aside(stage: BoxStage, path: &Path) -> Result<(), MeasureBoxError> {
     if !path.exists() {
         return Ok(());
     }
@@ -182,8 +182,8 @@ fn set_aside(stage: Stage, path: &Path) -> Result<(), MeasureBoxError> {
 }
 
 fn open_stage(
-    options: &Options,
-    stage: Stage,
+    options: &BoxOptions,
+    stage: BoxStage,
     instruments: &BTreeMap<String, InstrumentRecord>,
     resume: bool,
 ) -> Result<Session<BoxDetails, BoxStep>, MeasureBoxError> {
@@ -200,7 +200,7 @@ fn open_stage(
 /// Measures what the journals in `options.dir` lack (every stage, or `options.stage`),
 /// then, when all four stages are complete, writes the measured scene and its files.
 pub fn run(
-    options: &Options,
+    options: &BoxOptions,
     instruments: Instruments<'_>,
     operator: &mut dyn Operator,
     progress: &mut dyn ProgressSink,
@@ -213,9 +213,9 @@ pub fn run(
         (SPOT.to_string(), InstrumentRecord::of(&*instruments.spot)),
     ]
     .into();
-    let stages: Vec<Stage> = match options.stage {
+    let stages: Vec<BoxStage> = match options.stage {
         Some(s) => vec![s],
-        None => Stage::ALL.to_vec(),
+        None => BoxStage::ALL.to_vec(),
     };
     let mut rig = Rig {
         screen: None,
@@ -239,8 +239,8 @@ pub fn run(
             }
             continue;
         }
-        let number = Stage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;
-        let of = Stage::ALL.len();
+        let number = BoxStage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;
+        let of = BoxStage::ALL.len();
         progress.stage(&StageOf {
             number,
             of,
@@ -274,27 +274,10 @@ pub fn run(
             });
         }
     }
-    // Every stage's readings, from the journals (earlier runs' included).
-    let mut missing = Vec::new();
-    let mut loaded: BTreeMap<Stage, (PathBuf, Vec<Entry<BoxStep>>)> = BTreeMap::new();
-    for stage in Stage::ALL {
-        let path = stage.journal(&options.dir);
-        if !path.exists() {
-            missing.push(stage);
-            continue;
-        }
-        let session = open_stage(options, stage, &records, true)?;
-        match session.complete_entries() {
-            Some(entries) => {
-                loaded.insert(stage, (path, entries.into_iter().cloned().collect()));
-            }
-            None => missing.push(stage),
-        }
-    }
-    if !missing.is_empty() {
-        return Ok(Outcome::StagesMissing(missing));
-    }
-    let entries = StageEntries { stages: loaded };
+    let entries = match completed_stages(options, &records)? {
+        Ok(entries) => entries,
+        Err(missing) => return Ok(Outcome::StagesMissing(missing)),
+    };
     let owned = options.output.force() || options.resume || options.stage.is_some();
     let policy = options.output.with_force(owned);
     let summary = assemble(
@@ -306,4 +289,32 @@ pub fn run(
         &options.details,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+/// Every stage's readings, from the journals (earlier runs' included), or the stages that
+/// have no complete journal yet.
+fn completed_stages(
+    options: &BoxOptions,
+    records: &BTreeMap<String, InstrumentRecord>,
+) -> Result<Result<StageEntries, Vec<BoxStage>>, MeasureBoxError> {
+    let mut missing = Vec::new();
+    let mut loaded: BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)> = BTreeMap::new();
+    for stage in BoxStage::ALL {
+        let path = stage.journal(&options.dir);
+        if !path.exists() {
+            missing.push(stage);
+            continue;
+        }
+        let session = open_stage(options, stage, records, true)?;
+        match session.complete_entries() {
+            Some(entries) => {
+                loaded.insert(stage, (path, entries.into_iter().cloned().collect()));
+            }
+            None => missing.push(stage),
+        }
+    }
+    if !missing.is_empty() {
+        return Ok(Err(missing));
+    }
+    Ok(Ok(StageEntries { stages: loaded }))
 }

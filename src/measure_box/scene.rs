@@ -58,6 +58,9 @@ pub fn chart_centre(g: &Geometry) -> [f64; 3] {
     [g.size_m - FRAME_OFF_M, g.size_m / 2.0, g.size_m / 2.0]
 }
 
+/// The measured scene's camera image, width and height in pixels: the paper's 1014².
+pub const CAMERA_PIXELS: [usize; 2] = [1014, 1014];
+
 /// The scene file of the box.
 pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) -> Value {
     let mut surfaces = walls(g, &inline(&c.wall));
@@ -73,8 +76,8 @@ pub fn scene_json(name: &str, description: &str, g: &Geometry, c: &BoxContents) 
             "look_at": centre,
             "up": [0.0, 1.0, 0.0],
             "vfov_deg": 15.71,
-            "width": 1014,
-            "height": 1014,
+            "width": CAMERA_PIXELS[0],
+            "height": CAMERA_PIXELS[1],
         },
         "meter": {"acceptance_deg": g.acceptance_deg},
     });

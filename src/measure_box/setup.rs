@@ -16,12 +16,9 @@ use crate::session::Operator;
 /// The rig could not be opened.
 #[derive(Debug, thiserror::Error)]
 pub enum RigError {
-    /// One instrument is simulated and the other is not ([`mixed_rig`] names both).
-    #[error("{0}")]
-    Mixed(String),
-    /// A simulated box's light was asked of a real rig.
-    #[error("the light '{0}' is the simulated box's; real instruments measure the real box, lit by its own light")]
-    LightOnRealBox(Scenario),
+    /// The instruments and the light asked for make no rig ([`box_light`]).
+    #[error(transparent)]
+    Light(#[from] BoxLightError),
     /// The simulated box could not be made.
     #[error(transparent)]
     Truth(#[from] SimulatedBoxError),
@@ -34,66 +31,78 @@ impl RigError {
     /// Whether the request itself is wrong (a misnamed instrument or a mixed or mislit
     /// rig), as opposed to something that failed while opening what was asked for.
     pub fn is_request(&self) -> bool {
-        matches!(self, RigError::Mixed(_) | RigError::LightOnRealBox(_))
-            || matches!(self, RigError::Open(e) if e.is_spec())
+        matches!(self, RigError::Light(_)) || matches!(self, RigError::Open(e) if e.is_spec())
     }
 }
 
-/// Why `spectral` and `spot` make no rig: one is simulated and the other is not. `spot_is`
-/// says more of the spot meter's spec where the user did not write it (a default). When
-/// only the spot meter is simulated, says how its model is named on real hardware.
-pub fn mixed_rig(spectral: &Spec, spot: &Spec, spot_is: &str) -> String {
-    let kind = |s: &Spec| {
-        if s.is_simulated() {
-            "simulated"
-        } else if s.replay_file().is_some() {
-            "a replayed transcript"
-        } else {
-            "real"
-        }
-    };
+/// What a spec names, in a word for a message.
+fn kind(s: &Spec) -> &'static str {
+    if s.is_simulated() {
+        "simulated"
+    } else if s.replay_file().is_some() {
+        "a replayed transcript"
+    } else {
+        "real"
+    }
+}
+
+/// Why `spectral` and `spot` make no rig (one is simulated and the other is not), naming
+/// them as the caller does: `names` are what it calls the two (`the spot meter`, or a
+/// command's flags), `spot_note` says more of the spot meter's spec where the user did not
+/// write it (a default). When only the spot meter is simulated, says how its model is
+/// named on real hardware.
+pub fn mixed_rig(names: [&str; 2], spectral: &Spec, spot: &Spec, spot_note: &str) -> String {
+    let [spectral_is, spot_is] = names;
     let mut s = format!(
-        "--spectral {spectral} is {} and --spot {spot}{spot_is} is {}: both must be simulated \
-         (sim:…) or neither, as a simulated instrument sees only the simulated box",
+        "{spectral_is} {spectral} is {} and {spot_is} {spot}{spot_note} is {}: both must be \
+         simulated (sim:…) or neither, as a simulated instrument sees only the simulated box",
         kind(spectral),
         kind(spot)
     );
-    if let (true, Some(real)) = (
-        spot.is_simulated(),
-        spot.model().and_then(|m| m.real_spec()),
-    ) {
-        s.push_str(&format!("; name the real spot meter with --spot {real}"));
+    if let (true, Some(model)) = (spot.is_simulated(), spot.model()) {
+        if let Some(real) = model.real_spec() {
+            s.push_str(&format!("; a real {} is named {real}", model.title));
+        }
     }
     s
 }
 
-/// A light asked of the box that it cannot have.
+/// The two instruments of a rig, one simulated and the other not.
+#[derive(Debug)]
+pub struct MixedRig {
+    pub spectral: Spec,
+    pub spot: Spec,
+}
+
+/// Instruments and a light that make no box rig.
 #[derive(Debug, thiserror::Error)]
 pub enum BoxLightError {
-    /// No simulated box light has this name.
-    #[error("{0}")]
-    Unknown(String),
+    /// One instrument is simulated and the other is not.
+    #[error("{}", mixed_rig(["the spectral instrument", "the spot meter"], &.0.spectral, &.0.spot, ""))]
+    Mixed(Box<MixedRig>),
     /// The simulated box's light was asked of a real rig.
     #[error("a real rig measures the real box under its own light; only the simulated box's light can be chosen")]
     RealRig,
 }
 
-/// The simulated box's light named `name`, checked against the rig: a real rig is lit
-/// by whatever light it has. Checked before anything is opened.
-pub fn box_light(name: Option<&str>, simulated: bool) -> Result<Option<Scenario>, BoxLightError> {
-    match (name, simulated) {
-        (None, _) => Ok(None),
-        (Some(n), true) => n.parse().map(Some).map_err(BoxLightError::Unknown),
-        (Some(_), false) => Err(BoxLightError::RealRig),
-    }
-}
-
-/// Whether the rig is the simulated box: a simulated instrument sees only that box, and
-/// a real one only the real box, so the two must agree.
-pub fn is_simulated(spectral: &Spec, spot: &Spec) -> Result<bool, RigError> {
-    match (spectral.is_simulated(), spot.is_simulated()) {
-        (a, b) if a == b => Ok(a),
-        _ => Err(RigError::Mixed(mixed_rig(spectral, spot, ""))),
+/// The box the instruments measure, and its light: the simulated box (both instruments
+/// simulated: a simulated instrument sees only that box) under `light` or the default
+/// light, or the real box (both real), which has its own light, so none may be asked of
+/// it. `measure-box`, the experiment's checks and [`open`] decide it here, before anything
+/// is opened; None is the real box.
+pub fn box_light(
+    spectral: &Spec,
+    spot: &Spec,
+    light: Option<Scenario>,
+) -> Result<Option<Scenario>, BoxLightError> {
+    match (spectral.is_simulated(), spot.is_simulated(), light) {
+        (true, true, light) => Ok(Some(light.unwrap_or_default())),
+        (false, false, None) => Ok(None),
+        (false, false, Some(_)) => Err(BoxLightError::RealRig),
+        _ => Err(BoxLightError::Mixed(Box::new(MixedRig {
+            spectral: spectral.clone(),
+            spot: spot.clone(),
+        }))),
     }
 }
 
@@ -117,7 +126,7 @@ pub struct RigRequest<'a> {
     /// Seeds the simulated box; its spectral instrument draws noise from this seed and its
     /// spot meter from the next, unless their specs name their own.
     pub seed: u64,
-    /// The simulated box's light (None: the default); refused on a real rig.
+    /// The simulated box's light (None: the default); refused on a real rig ([`box_light`]).
     pub light: Option<Scenario>,
 }
 
@@ -129,21 +138,17 @@ pub fn open(
     operator: impl FnOnce() -> Box<dyn Operator>,
     note: &dyn Fn(String),
 ) -> Result<BoxRig, RigError> {
-    let simulated = is_simulated(request.spectral, request.spot)?;
     let mut rig_options = BTreeMap::new();
-    if !simulated {
-        if let Some(light) = request.light {
-            return Err(RigError::LightOnRealBox(light));
-        }
+    let Some(light) = box_light(request.spectral, request.spot, request.light)? else {
         return Ok(BoxRig {
             spectral: request.spectral.open(None)?,
             spot: request.spot.open(None)?,
             operator: operator(),
             rig_options,
-            simulated,
+            simulated: false,
         });
-    }
-    let (seed, light) = (request.seed, request.light.unwrap_or_default());
+    };
+    let seed = request.seed;
     rig_options.insert("seed".to_string(), seed.to_string());
     rig_options.insert("light".to_string(), light.name().to_string());
     note(format!("simulating the box (seed {seed}, lit by {light})"));
@@ -162,7 +167,7 @@ pub fn open(
         spot,
         operator: Box::new(BoxOperator::new(truth, world)),
         rig_options,
-        simulated,
+        simulated: true,
     })
 }
 
@@ -171,24 +176,36 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_rig_is_simulated_only_as_a_whole() {
+    fn a_rig_is_simulated_only_as_a_whole_and_only_the_simulated_box_takes_a_light() {
         let sim = Spec::new("sim:cs100a");
         let real = Spec::new("cs100a:/dev/ttyUSB0");
         let replayed = Spec::new("replay:spots.jsonl");
-        assert!(is_simulated(&sim, &sim).unwrap());
-        assert!(!is_simulated(&real, &replayed).unwrap());
+        let led = Some(Scenario::LedRgb1);
         assert_eq!(
-            is_simulated(&sim, &real).unwrap_err().to_string(),
-            "--spectral sim:cs100a is simulated and --spot cs100a:/dev/ttyUSB0 is real: both \
-             must be simulated (sim:…) or neither, as a simulated instrument sees only the \
-             simulated box"
+            box_light(&sim, &sim, None).unwrap(),
+            Some(Scenario::default())
         );
-        assert_eq!(
-            is_simulated(&replayed, &sim).unwrap_err().to_string(),
-            "--spectral replay:spots.jsonl is a replayed transcript and --spot sim:cs100a is \
-             simulated: both must be simulated (sim:…) or neither, as a simulated instrument \
-             sees only the simulated box; name the real spot meter with --spot cs100a:PORT"
-        );
+        assert_eq!(box_light(&sim, &sim, led).unwrap(), led);
+        assert_eq!(box_light(&real, &replayed, None).unwrap(), None);
+        assert!(matches!(
+            box_light(&real, &replayed, led),
+            Err(BoxLightError::RealRig)
+        ));
+        for light in [None, led] {
+            assert_eq!(
+                box_light(&sim, &real, light).unwrap_err().to_string(),
+                "the spectral instrument sim:cs100a is simulated and the spot meter \
+                 cs100a:/dev/ttyUSB0 is real: both must be simulated (sim:…) or neither, as a \
+                 simulated instrument sees only the simulated box"
+            );
+            assert_eq!(
+                box_light(&replayed, &sim, light).unwrap_err().to_string(),
+                "the spectral instrument replay:spots.jsonl is a replayed transcript and the \
+                 spot meter sim:cs100a is simulated: both must be simulated (sim:…) or \
+                 neither, as a simulated instrument sees only the simulated box; a real \
+                 Konica Minolta CS-100A is named cs100a:PORT"
+            );
+        }
     }
 
     #[test]
@@ -238,7 +255,7 @@ mod tests {
             light: Some(Scenario::default()),
         };
         let e = open(&request, || unreachable!(), &|_| {}).err().unwrap();
-        assert!(matches!(e, RigError::LightOnRealBox(_)), "{e}");
+        assert!(matches!(e, RigError::Light(BoxLightError::RealRig)), "{e}");
         assert!(e.is_request());
         let e = open(
             &RigRequest {

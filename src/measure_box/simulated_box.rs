@@ -37,7 +37,7 @@ use std::sync::{Arc, OnceLock};
 use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 
 use super::compare::{render_scene, CompareError};
-use super::plan::{BoxPlan, Stage, Target};
+use super::plan::{BoxPlan, BoxStage, Target};
 use super::scene::{scene_json, BoxContents};
 use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::{CGammaError, CGammaTable};
@@ -245,7 +245,7 @@ impl BoxOperator {
     /// The operator of the truth box's plan, moving what `world` shows.
     pub fn new(truth: SimulatedBox, world: Arc<SharedWorld>) -> BoxOperator {
         let mut targets = HashMap::new();
-        for stage in Stage::ALL {
+        for stage in BoxStage::ALL {
             for step in truth.plan.steps(stage) {
                 targets
                     .entry(truth.plan.prompt(&step.data.target))

@@ -3,13 +3,12 @@
 //! monitor); display mathematics (models, fitting, reproduction) stays in `display`.
 
 pub mod scenario;
-pub mod screen;
 pub mod sim_meter;
 pub mod spec;
 pub mod virtual_display;
 pub mod window;
 
+pub use crate::session::screen::{MeterAim, Placement, Screen, ScreenError};
 pub use scenario::Scenario;
-pub use screen::{MeterAim, Placement, Screen, ScreenError};
 pub use spec::{OpenError, ScreenSpec};
 pub use virtual_display::{Preset, VirtualDisplay, VirtualPanel};

@@ -1,9 +1,10 @@
 //! Opening a screen by the name the command line and the logs use: `window[:N]` (a
-//! full-screen window on monitor N) or `virtual[:PRESET]` (a simulated monitor).
+//! full-screen window on monitor N) or `virtual[:PRESET]` (a simulated monitor; a preset's
+//! name alone, `ips-lcd`, names it too, as `metamer lab --display` takes it).
 
-use super::screen::Screen;
 use super::virtual_display::{Preset, VirtualDisplay};
 use super::window::{WindowDisplay, WindowError};
+use super::Screen;
 
 /// A screen could not be named or opened.
 #[derive(Debug, thiserror::Error)]
@@ -26,7 +27,8 @@ pub enum ScreenSpec {
 }
 
 impl ScreenSpec {
-    /// Parses `window`, `window:N`, `virtual`, `virtual:PRESET` (`virtual` is `ips-lcd`).
+    /// Parses `window`, `window:N`, `virtual`, `virtual:PRESET` (`virtual` is `ips-lcd`), and
+    /// a preset's name alone (`ips-lcd` is `virtual:ips-lcd`: no other screen has it).
     pub fn parse(spec: &str) -> Result<ScreenSpec, OpenError> {
         let unknown = || OpenError::UnknownSpec {
             spec: spec.to_string(),
@@ -48,6 +50,7 @@ impl ScreenSpec {
                 .map_err(|_| unknown()),
             ("virtual", None) => Ok(ScreenSpec::Virtual(Preset::IpsLcd)),
             ("virtual", Some(p)) => p.parse().map(ScreenSpec::Virtual).map_err(|_| unknown()),
+            (p, None) => p.parse().map(ScreenSpec::Virtual).map_err(|_| unknown()),
             _ => Err(unknown()),
         }
     }
@@ -66,6 +69,34 @@ impl ScreenSpec {
             ScreenSpec::Window { monitor } => Box::new(WindowDisplay::open(None, *monitor)?),
             ScreenSpec::Virtual(p) => Box::new(VirtualDisplay::preset(*p)),
         })
+    }
+}
+
+impl std::str::FromStr for ScreenSpec {
+    type Err = OpenError;
+    fn from_str(text: &str) -> Result<ScreenSpec, OpenError> {
+        ScreenSpec::parse(text)
+    }
+}
+
+impl std::fmt::Display for ScreenSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.canonical())
+    }
+}
+
+/// Written as its canonical text (`virtual:ips-lcd`, `window:0`), the form the stages'
+/// files and option hashes have always held.
+impl serde::Serialize for ScreenSpec {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.canonical())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for ScreenSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<ScreenSpec, D::Error> {
+        let text = String::deserialize(d)?;
+        ScreenSpec::parse(&text).map_err(serde::de::Error::custom)
     }
 }
 
@@ -91,7 +122,19 @@ mod tests {
             let spec = format!("virtual:{}", p.name());
             assert_eq!(ScreenSpec::parse(&spec).unwrap().canonical(), spec);
         }
-        for bad in ["", "window:", "window:x", "virtual:oled", "screen:1"] {
+        // A preset's name alone is unambiguous: no other screen has it.
+        assert_eq!(
+            ScreenSpec::parse("wide-gamut-ccfl").unwrap(),
+            ScreenSpec::Virtual(Preset::WideGamutCcfl)
+        );
+        for bad in [
+            "",
+            "window:",
+            "window:x",
+            "virtual:oled",
+            "screen:1",
+            "oled",
+        ] {
             let e = ScreenSpec::parse(bad).unwrap_err().to_string();
             assert!(
                 e.contains("expected window, window:N") && e.contains("wide-gamut-ccfl"),

@@ -2,10 +2,11 @@
 //! validation box): a plan of steps ([`plan`]), a durable resumable journal ([`journal`]) of
 //! what was measured ([`record`]), and a runner that takes each step the journal lacks
 //! ([`runner`]; calibrate, prepare, settle, measure: [`step`]),
-//! with the operator ([`operator`]), the readings a placement should repeat ([`repeats`]),
+//! with the operator ([`operator`]) and who answers for it ([`attendance`]), the readings a placement should repeat ([`repeats`]),
 //! the screen ([`screen`]), progress ([`progress`]) and
 //! Ctrl-C ([`interrupt`]) as small parts a caller supplies or picks.
 
+pub mod attendance;
 pub mod interrupt;
 pub mod journal;
 pub mod operator;
@@ -17,18 +18,21 @@ pub mod runner;
 pub mod screen;
 pub mod step;
 
+pub use attendance::{attendance, Attendance, NobodyAtTheRig};
 pub use interrupt::on_ctrl_c;
 pub use journal::{
     duplicates_path, reading_problem, refuse_existing, torn_path, CalibrationRecord, Header,
     Journal, JournalEntry, JournalError,
 };
 pub use operator::{
-    attendance, Answer, Attendance, NobodyAtTheRig, Operator, OperatorError, Readings, Recheck,
-    ScriptedOperator, TerminalOperator, Unattended,
+    Answer, Operator, OperatorError, PlacementReadings, Recheck, ScriptedOperator,
+    TerminalOperator, Unattended,
 };
 pub use plan::{placements, Prepare, SessionPlan, Step};
-pub use progress::{BarProgress, NoProgress, ProgressSink, StageOf, StepProgress};
+pub use progress::{
+    pace_note, BarProgress, Heartbeat, NoProgress, ProgressSink, StageOf, StepProgress,
+};
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers};
-pub use screen::{Screen, ScreenError};
-pub use step::{Rig, StepFailure};
+pub use screen::{MeterAim, Placement, Screen, ScreenError};
+pub use step::{Rig, StepFailure, AIM_AT_SCREEN_AGAIN};

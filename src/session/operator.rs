@@ -2,7 +2,9 @@
 //! aim the meter) and to confirm when done, or to abort the session; and whether anybody
 //! is there to ask at all.
 
-use std::io::{BufRead, IsTerminal, Write};
+use std::io::{BufRead, IsTerminal};
+
+use crate::output::console;
 
 /// The operator's answer to a request.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,7 +29,7 @@ pub enum Recheck {
 
 /// The readings one placement is for, so a request can say how many are coming.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Readings {
+pub struct PlacementReadings {
     /// The first reading this request is for, 1-based (above 1 when a placement is asked
     /// again: after a calibration, or when a resumed session continues mid-placement).
     pub first: usize,
@@ -35,7 +37,7 @@ pub struct Readings {
     pub of: usize,
 }
 
-impl std::fmt::Display for Readings {
+impl std::fmt::Display for PlacementReadings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match (self.first, self.of) {
             (_, 1) => f.write_str("1 reading"),
@@ -47,7 +49,7 @@ impl std::fmt::Display for Readings {
 }
 
 /// A placement request as the terminal shows it: `{what} — 5 readings`.
-pub fn placement_prompt(what: &str, readings: Readings) -> String {
+pub fn placement_prompt(what: &str, readings: PlacementReadings) -> String {
     format!("{what} — {readings}")
 }
 
@@ -64,7 +66,11 @@ pub trait Operator {
     /// Asks for the placement `what` (the plan's words, the same for each of its readings)
     /// before `readings` of it are taken. By default [`Operator::ask`] with `what` alone:
     /// a simulated rig acts on the plan's words.
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         let _ = readings;
         self.ask(what)
     }
@@ -90,12 +96,11 @@ fn read_answer(prompt: &str) -> Result<Option<String>, OperatorError> {
     if !stdin.is_terminal() {
         return Ok(None);
     }
-    eprint!("{prompt} ");
-    std::io::stderr().flush()?;
+    console::err_part(format_args!("{prompt} ")).map_err(std::io::Error::from)?;
     let mut line = String::new();
     if stdin.lock().read_line(&mut line)? == 0 {
         // End of input (Ctrl-D) stops, as `q` does; end the prompt's line.
-        eprintln!();
+        console::err_fmt(format_args!("")).map_err(std::io::Error::from)?;
         return Ok(Some("q".into()));
     }
     Ok(Some(line.trim().to_lowercase()))
@@ -115,7 +120,11 @@ impl Operator for TerminalOperator {
         )
     }
 
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         self.ask(&placement_prompt(what, readings))
     }
 
@@ -139,61 +148,6 @@ pub struct Unattended;
 impl Operator for Unattended {
     fn ask(&mut self, _: &str) -> Result<Answer, OperatorError> {
         Ok(Answer::Confirmed)
-    }
-}
-
-/// Who answers a session's requests.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Attendance {
-    /// Somebody at the terminal: ask them ([`TerminalOperator`]).
-    Terminal,
-    /// Nobody: the user said so, or no terminal and nothing physical measured (simulated
-    /// or replayed instruments), so every request counts as done.
-    Unattended,
-}
-
-impl Attendance {
-    /// The operator that answers for this attendance.
-    pub fn operator(self) -> Box<dyn Operator> {
-        match self {
-            Attendance::Terminal => Box::new(TerminalOperator),
-            Attendance::Unattended => Box::new(Unattended),
-        }
-    }
-}
-
-/// A physical instrument would be driven with nobody to place, aim or calibrate it.
-#[derive(Debug, thiserror::Error)]
-#[error("{spec} is a real instrument and stdin is not a terminal: nobody can be asked to place, aim or calibrate it, and it would measure wherever it points")]
-pub struct NobodyAtTheRig {
-    /// The first physical instrument's spec.
-    pub spec: String,
-}
-
-/// Who answers the requests of a session with the instruments `specs` (as the user named
-/// them): refused when one is physical, stdin is no terminal and the user did not say
-/// `unattended`; nothing is opened, so the refusal comes before any reading.
-pub fn attendance(specs: &[&str], unattended: bool) -> Result<Attendance, NobodyAtTheRig> {
-    attendance_with(specs, unattended, std::io::stdin().is_terminal())
-}
-
-/// [`attendance`] with the terminal's presence given (for tests).
-pub fn attendance_with(
-    specs: &[&str],
-    unattended: bool,
-    terminal: bool,
-) -> Result<Attendance, NobodyAtTheRig> {
-    if unattended {
-        return Ok(Attendance::Unattended);
-    }
-    if terminal {
-        return Ok(Attendance::Terminal);
-    }
-    match specs.iter().find(|s| metamer_drivers::is_physical(s)) {
-        Some(spec) => Err(NobodyAtTheRig {
-            spec: spec.to_string(),
-        }),
-        None => Ok(Attendance::Unattended),
     }
 }
 
@@ -229,7 +183,11 @@ impl Operator for ScriptedOperator {
         Ok(self.answers.pop_front().unwrap_or(Answer::Confirmed))
     }
 
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         self.ask(&placement_prompt(what, readings))
     }
 }
@@ -240,40 +198,10 @@ mod tests {
 
     #[test]
     fn a_placement_says_how_many_readings_it_is_for() {
-        let p = |first, of| placement_prompt("aim at patch 1", Readings { first, of });
+        let p = |first, of| placement_prompt("aim at patch 1", PlacementReadings { first, of });
         assert_eq!(p(1, 1), "aim at patch 1 — 1 reading");
         assert_eq!(p(1, 5), "aim at patch 1 — 5 readings");
         assert_eq!(p(3, 5), "aim at patch 1 — readings 3–5 of 5");
         assert_eq!(p(5, 5), "aim at patch 1 — reading 5 of 5");
-    }
-
-    #[test]
-    fn a_real_instrument_needs_a_terminal_or_unattended() {
-        let real = ["sim:i1pro", "cs100a:/dev/ttyUSB0"];
-        let e = attendance_with(&real, false, false).unwrap_err();
-        assert_eq!(e.spec, "cs100a:/dev/ttyUSB0");
-        assert_eq!(
-            attendance_with(&real, true, false).unwrap(),
-            Attendance::Unattended
-        );
-        assert_eq!(
-            attendance_with(&real, false, true).unwrap(),
-            Attendance::Terminal
-        );
-        // Said unattended at a terminal: nobody is asked.
-        assert_eq!(
-            attendance_with(&real, true, true).unwrap(),
-            Attendance::Unattended
-        );
-        // Simulated and replayed instruments measure nothing real.
-        let played = ["sim:cs100a", "replay:a.jsonl"];
-        assert_eq!(
-            attendance_with(&played, false, false).unwrap(),
-            Attendance::Unattended
-        );
-        assert_eq!(
-            attendance_with(&played, false, true).unwrap(),
-            Attendance::Terminal
-        );
     }
 }

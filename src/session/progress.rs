@@ -1,8 +1,12 @@
 //! Where a session reports how far it is: a sink trait, a terminal progress bar for the
 //! command line, and closures for callers that only count.
 
-use std::time::Duration;
+use std::io::IsTerminal;
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
+use metamer_drivers::spec::Spec;
 use metamer_drivers::{MeasureMode, Reading};
 
 use super::repeats::Deviation;
@@ -118,6 +122,78 @@ pub fn reading_line(p: &StepProgress<'_>, stage: Option<&StageOf>, noun: &str) -
     line
 }
 
+/// How often a wait shows it is alive: a real i1Pro's dark calibration alone takes about
+/// 20 s, and a line every few seconds tells a log reader the command has not hung.
+pub const HEARTBEAT: Duration = Duration::from_secs(5);
+
+/// While an instrument works on one slow request (a calibration, a reading), a line on
+/// stderr every [`HEARTBEAT`] saying what it waits for and since when. Nothing is printed
+/// for a wait shorter than that (a simulation at `time_scale=0` never prints). The line
+/// stops when the value is dropped.
+pub struct Heartbeat {
+    stop: Option<mpsc::Sender<()>>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Heartbeat {
+    /// Starts the lines for `what` ("the spectral instrument (i1pro) calibrates").
+    pub fn start(what: String) -> Heartbeat {
+        Heartbeat::every(what, HEARTBEAT)
+    }
+
+    pub fn every(what: String, period: Duration) -> Heartbeat {
+        let (stop, stopped) = mpsc::channel::<()>();
+        let start = Instant::now();
+        let thread = std::thread::spawn(move || {
+            while let Err(mpsc::RecvTimeoutError::Timeout) = stopped.recv_timeout(period) {
+                crate::output::console::reported_at_exit(crate::output::console::err_fmt(
+                    format_args!("  … {what}: {} s so far", start.elapsed().as_secs()),
+                ));
+            }
+        });
+        Heartbeat {
+            stop: Some(stop),
+            thread: Some(thread),
+        }
+    }
+}
+
+impl Drop for Heartbeat {
+    fn drop(&mut self) {
+        drop(self.stop.take());
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// The first thing a command with simulated instruments should say when they keep a real
+/// instrument's pace (their default): that the wait is on purpose, and how to skip it.
+/// None when every simulation among `specs` answers at once.
+pub fn pace_note(specs: &[&Spec]) -> Option<String> {
+    let paced: Vec<(String, f64)> = specs
+        .iter()
+        .filter_map(|s| Some((s.as_str().to_string(), s.sim_time_scale()?)))
+        .filter(|(_, scale)| *scale > 0.0)
+        .collect();
+    let (_, scale) = paced.first()?;
+    let names: Vec<&str> = paced.iter().map(|(n, _)| n.as_str()).collect();
+    let same = paced.iter().all(|(_, s)| s == scale);
+    let pace = if same && *scale == 1.0 {
+        "at their real pace, as long as real ones take".to_string()
+    } else if same {
+        format!("at {scale} times their real pace")
+    } else {
+        let scales: Vec<String> = paced.iter().map(|(_, s)| format!("{s}")).collect();
+        format!("at {} times their real pace", scales.join(", "))
+    };
+    Some(format!(
+        "the simulated instruments ({}) run {pace}; `?time_scale=0` in a spec (or \
+         METAMER_SIM_TIME_SCALE=0) makes them answer at once",
+        names.join(", ")
+    ))
+}
+
 /// A progress bar on stderr, for the command line; notes are printed above it. Attended,
 /// every reading of a placement also gets a line of its own above the bar, so the
 /// operator sees each value (the bar is cleared whenever a request waits for them).
@@ -127,6 +203,9 @@ pub struct BarProgress {
     noun: &'static str,
     stage: Option<StageOf>,
     lines: bool,
+    /// Where stderr is no terminal (a log, a pipe), the bar is not drawn: a line then says
+    /// how far the session is, at most once per [`HEARTBEAT`]; when the last one was.
+    logged: Option<Instant>,
 }
 
 impl BarProgress {
@@ -136,6 +215,7 @@ impl BarProgress {
             noun,
             stage: None,
             lines: false,
+            logged: None,
         }
     }
 
@@ -158,6 +238,12 @@ impl ProgressSink for BarProgress {
         }
         self.bar.set_position(done as u64);
         self.bar.reset_eta();
+        if std::io::stderr().is_terminal() {
+            // Elapsed time and the estimate move while an instrument works.
+            self.bar.enable_steady_tick(Duration::from_secs(1));
+        } else {
+            self.logged = Some(Instant::now());
+        }
     }
 
     fn stage(&mut self, stage: &StageOf) {
@@ -175,11 +261,28 @@ impl ProgressSink for BarProgress {
             reading_summary(p.mode, p.reading)
         ));
         self.bar.set_position(p.done as u64);
+        if self
+            .logged
+            .is_some_and(|t| t.elapsed() >= HEARTBEAT || p.done == p.total)
+        {
+            crate::output::console::reported_at_exit(crate::output::console::err_fmt(
+                format_args!(
+                    "{line} · {} s elapsed, about {} s left",
+                    p.elapsed.as_secs(),
+                    p.remaining.as_secs()
+                ),
+            ));
+            self.logged = Some(Instant::now());
+        }
     }
 
     fn note(&mut self, text: &str) {
         if self.bar.is_hidden() {
-            eprintln!("{text}");
+            // A note cannot fail the reading it comes with; a failed write is remembered
+            // and the command reports it when it ends.
+            crate::output::console::reported_at_exit(crate::output::console::err_fmt(
+                format_args!("{text}"),
+            ));
         } else {
             self.bar.println(text);
         }
@@ -233,5 +336,25 @@ mod tests {
             reading_summary(MeasureMode::Emissive, &dark),
             "Y 0.01230 cd/m² · xy —"
         );
+    }
+
+    #[test]
+    fn a_paced_simulation_is_named_and_an_instant_or_real_one_is_not() {
+        let instant = Spec::new("sim:cs100a?time_scale=0");
+        let real = Spec::new("cs100a:/dev/ttyUSB0");
+        let paced = Spec::new("sim:i1pro?time_scale=1");
+        let slow = Spec::new("sim:cs100a?time_scale=2");
+        assert_eq!(pace_note(&[&instant, &real]), None);
+        assert_eq!(
+            pace_note(&[&paced, &instant]).as_deref(),
+            Some(
+                "the simulated instruments (sim:i1pro?time_scale=1) run at their real pace, as \
+                 long as real ones take; `?time_scale=0` in a spec (or METAMER_SIM_TIME_SCALE=0) \
+                 makes them answer at once"
+            )
+        );
+        assert!(pace_note(&[&paced, &slow])
+            .unwrap()
+            .contains("(sim:i1pro?time_scale=1, sim:cs100a?time_scale=2) run at 1, 2 times"));
     }
 }

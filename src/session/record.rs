@@ -8,6 +8,7 @@ use metamer_drivers::{Instrument, InstrumentInfo, MeasureMode, Reading};
 use serde::{Deserialize, Serialize};
 
 use super::journal::{reading_problem, Journal, JournalEntry};
+use super::plan::Step;
 
 /// One measured step as journalled.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -19,6 +20,20 @@ pub struct Entry<D> {
     pub mode: MeasureMode,
     pub data: D,
     pub reading: Reading,
+}
+
+impl<D: Clone> Entry<D> {
+    /// The entry of step `index` of a plan, measured as `reading`.
+    pub fn of_step(index: usize, step: &Step<D>, reading: Reading) -> Entry<D> {
+        Entry {
+            index,
+            label: step.label.clone(),
+            role: step.role.clone(),
+            mode: step.mode,
+            data: step.data.clone(),
+            reading,
+        }
+    }
 }
 
 /// Entries of a session journal: the step is the plan index, and the reading must be one

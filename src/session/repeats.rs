@@ -3,7 +3,7 @@
 //! Found while the operator is still there to re-aim, not later in the statistics.
 //!
 //! The repeatability is each model's stated one (1σ of one reading), data in its driver
-//! registry row and read through [`crate::validation::repeatability`], the one figure the
+//! registry row ([`metamer_drivers::registry::stated_repeatability`]), the one figure the
 //! session's flags, the box's outlier and spread tests and a single reading's covariance in
 //! the validation all use (the figures and their sources: `metamer devices --describe
 //! MODEL`).
@@ -14,10 +14,8 @@
 //! flag is worth the operator's attention; a misaimed spot meter (a few per cent) always
 //! trips it.
 
-use metamer_drivers::registry::{XyNoise, DARK_CD_M2};
+use metamer_drivers::registry::{Repeatability, XyNoise, DARK_CD_M2};
 use metamer_drivers::Reading;
-
-use crate::validation::repeatability::Repeatability;
 
 /// How far from the earlier readings' mean, in σ of the difference, a reading is flagged.
 /// The same distance as the box assembly's outlier test, so what is flagged here is what
@@ -130,7 +128,7 @@ pub fn deviation(earlier: &[&Reading], this: &Reading, r: Repeatability) -> Opti
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::validation::repeatability::stated;
+    use metamer_drivers::registry::stated_repeatability as stated;
     use metamer_drivers::MeasureMode;
 
     fn reading(x: f64, y: f64, lum: f64) -> Reading {

@@ -10,7 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use metamer_drivers::Reading;
+use metamer_drivers::registry::Repeatability;
+use metamer_drivers::{MeasureMode, Reading};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
@@ -23,7 +24,6 @@ use super::progress::{reading_summary, ProgressSink, StepProgress};
 use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 use super::repeats::deviation;
 use super::step::{Rig, StepFailure, StepTaker};
-use crate::validation::repeatability;
 
 /// The session could not start or go on.
 #[derive(Debug, thiserror::Error)]
@@ -127,6 +127,24 @@ pub enum RunEnd {
     Aborted { missing: usize },
 }
 
+impl RunOptions {
+    /// How a run ends before its next step, with `missing` steps missing, when it has taken
+    /// `new` steps: interrupted, or stopped after as many as asked; None to go on.
+    fn end_before_step(&self, new: usize, missing: usize) -> Option<RunEnd> {
+        if self
+            .interrupt
+            .as_ref()
+            .is_some_and(|i| i.load(Ordering::SeqCst))
+        {
+            return Some(RunEnd::Interrupted { missing });
+        }
+        if self.stop_after.is_some_and(|n| new >= n) {
+            return Some(RunEnd::Stopped { missing });
+        }
+        None
+    }
+}
+
 impl RunEnd {
     /// Whether the run was interrupted (Ctrl-C, a signal): a failure to the caller, though
     /// every reading taken is safe.
@@ -152,6 +170,114 @@ pub struct Session<H, D> {
     /// What resuming repaired that the operator should know (readings of a second session
     /// set aside); [`Session::run`] reports them first.
     pub notes: Vec<String>,
+}
+
+/// Puts each journalled entry of `recovered` (with its line) at its step in `entries`,
+/// refusing one the plan does not have or planned otherwise.
+fn place_entries<D: Serialize + PartialEq>(
+    path: &Path,
+    plan: &SessionPlan<D>,
+    recovered: Vec<(usize, Entry<D>)>,
+    entries: &mut [Option<Entry<D>>],
+) -> Result<(), SessionError> {
+    let bad = |line: usize, message: String| SessionError::Entry {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    for (line, entry) in recovered {
+        let step = plan.steps.get(entry.index).ok_or_else(|| {
+            bad(
+                line,
+                format!(
+                    "step index {} is beyond the plan's {}",
+                    entry.index,
+                    plan.steps.len()
+                ),
+            )
+        })?;
+        if step.label != entry.label || step.data != entry.data {
+            return Err(bad(
+                line,
+                format!(
+                    "step {} was planned as '{}' ({}) but journalled as '{}' ({})",
+                    entry.index,
+                    step.label,
+                    serde_json::to_string(&step.data).unwrap_or_default(),
+                    entry.label,
+                    serde_json::to_string(&entry.data).unwrap_or_default(),
+                ),
+            ));
+        }
+        // The journal has refused readings no instrument gave and set aside a step's
+        // later entries (see JournalEntry), so each step is here once.
+        let i = entry.index;
+        entries[i] = Some(entry);
+    }
+    Ok(())
+}
+
+/// The repeatability stated for the instrument in `role` in `mode` (its model's, or a
+/// default when the rig has none in that role).
+fn stated_repeatability(rig: &mut Rig<'_>, role: &str, mode: MeasureMode) -> Repeatability {
+    let model = rig
+        .instrument(role)
+        .map(|i| i.info().model)
+        .unwrap_or_default();
+    metamer_drivers::registry::stated_repeatability(&model, mode)
+}
+
+/// What the operator is asked about when step `index` (`label`) differs from the readings
+/// before it in its placement.
+fn what_differs(placement: &Option<std::ops::Range<usize>>, index: usize, label: &str) -> String {
+    match placement {
+        Some(r) => format!(
+            "reading {}/{} ({}) differs",
+            index - r.start + 1,
+            r.len(),
+            label
+        ),
+        None => format!("{label} differs"),
+    }
+}
+
+/// How far `reading` of step `index` lies from the readings before it in its placement
+/// (earlier runs' included), beyond the instrument's `repeatability`; None within it or
+/// for the first reading.
+fn deviation_from_earlier<D>(
+    entries: &[Option<Entry<D>>],
+    placement: &Option<std::ops::Range<usize>>,
+    index: usize,
+    reading: &Reading,
+    repeatability: Repeatability,
+) -> Option<super::repeats::Deviation> {
+    let earlier: Vec<&Reading> = placement
+        .clone()
+        .map(|r| r.start..index)
+        .into_iter()
+        .flatten()
+        .filter_map(|i| entries[i].as_ref().map(|e| &e.reading))
+        .collect();
+    deviation(&earlier, reading, repeatability)
+}
+
+/// What the operator should know of the readings of steps already journalled (`(line,
+/// step)`) that resuming moved aside, if any.
+fn duplicates_note(path: &Path, duplicates: &[(usize, usize)]) -> Option<String> {
+    if duplicates.is_empty() {
+        return None;
+    }
+    let lines: Vec<String> = duplicates
+        .iter()
+        .map(|(line, step)| format!("line {line} (step {step})"))
+        .collect();
+    Some(format!(
+        "{} held {} reading(s) of steps it already had, written by a second session at the same time: the first of each is kept, the others were moved to {} ({})",
+        path.display(),
+        lines.len(),
+        super::journal::duplicates_path(path).display(),
+        lines.join(", ")
+    ))
 }
 
 impl<H, D> Session<H, D>
@@ -220,56 +346,11 @@ where
                 same_instrument(path, role, logged, now)?;
             }
         }
-        let bad = |line: usize, message: String| SessionError::Entry {
-            path: path.to_path_buf(),
-            line,
-            message,
-        };
         let n = recovered.entries.len();
-        for (line, entry) in recovered.entries {
-            let step = plan.steps.get(entry.index).ok_or_else(|| {
-                bad(
-                    line,
-                    format!(
-                        "step index {} is beyond the plan's {}",
-                        entry.index,
-                        plan.steps.len()
-                    ),
-                )
-            })?;
-            if step.label != entry.label || step.data != entry.data {
-                return Err(bad(
-                    line,
-                    format!(
-                        "step {} was planned as '{}' ({}) but journalled as '{}' ({})",
-                        entry.index,
-                        step.label,
-                        serde_json::to_string(&step.data).unwrap_or_default(),
-                        entry.label,
-                        serde_json::to_string(&entry.data).unwrap_or_default(),
-                    ),
-                ));
-            }
-            // The journal has refused readings no instrument gave and set aside a step's
-            // later entries (see JournalEntry), so each step is here once.
-            let i = entry.index;
-            entries[i] = Some(entry);
-        }
-        let mut notes = Vec::new();
-        if !recovered.duplicates.is_empty() {
-            let lines: Vec<String> = recovered
-                .duplicates
-                .iter()
-                .map(|(line, step)| format!("line {line} (step {step})"))
-                .collect();
-            notes.push(format!(
-                "{} held {} reading(s) of steps it already had, written by a second session at the same time: the first of each is kept, the others were moved to {} ({})",
-                path.display(),
-                lines.len(),
-                super::journal::duplicates_path(path).display(),
-                lines.join(", ")
-            ));
-        }
+        place_entries(path, &plan, recovered.entries, &mut entries)?;
+        let notes = duplicates_note(path, &recovered.duplicates)
+            .into_iter()
+            .collect();
         Ok(Session {
             plan,
             journal,
@@ -368,26 +449,18 @@ where
         progress: &mut dyn ProgressSink,
     ) -> Result<RunEnd, SessionError> {
         let total = self.plan.steps.len();
-        let placements = placements(&self.plan.steps);
         let mut placed = None;
         let mut done = self.done();
         let mut new = 0usize;
         let start = Instant::now();
         let journal_path = self.journal.path().to_path_buf();
-        for (index, placement) in placements.into_iter().enumerate() {
+        for (index, placement) in placements(&self.plan.steps).into_iter().enumerate() {
             if self.entries[index].is_some() {
                 continue;
             }
             let missing = total - done;
-            if options
-                .interrupt
-                .as_ref()
-                .is_some_and(|i| i.load(Ordering::SeqCst))
-            {
-                return Ok(RunEnd::Interrupted { missing });
-            }
-            if options.stop_after.is_some_and(|n| new >= n) {
-                return Ok(RunEnd::Stopped { missing });
+            if let Some(end) = options.end_before_step(new, missing) {
+                return Ok(end);
             }
             let step = &self.plan.steps[index];
             let fail = |source: StepFailure| SessionError::Step {
@@ -415,24 +488,17 @@ where
                     placement: placement.clone(),
                     placed: &mut placed,
                 };
-                let reading = match taker.take().map_err(fail)? {
-                    Some(r) => r,
-                    None => return Ok(RunEnd::Aborted { missing }),
+                let Some(reading) = taker.take().map_err(fail)? else {
+                    return Ok(RunEnd::Aborted { missing });
                 };
-                // The placement's readings before this one, earlier runs' included.
-                let earlier: Vec<&Reading> = placement
-                    .clone()
-                    .map(|r| r.start..index)
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|i| self.entries[i].as_ref().map(|e| &e.reading))
-                    .collect();
-                let model = rig
-                    .instrument(&step.role)
-                    .map(|i| i.info().model)
-                    .unwrap_or_default();
-                let deviation =
-                    deviation(&earlier, &reading, repeatability::stated(&model, step.mode));
+                let repeatability = stated_repeatability(rig, &step.role, step.mode);
+                let deviation = deviation_from_earlier(
+                    &self.entries,
+                    &placement,
+                    index,
+                    &reading,
+                    repeatability,
+                );
                 let elapsed = start.elapsed();
                 progress.step(&StepProgress {
                     done: done + 1,
@@ -449,15 +515,7 @@ where
                 if deviation.is_none() {
                     break reading;
                 }
-                let why = match &placement {
-                    Some(r) => format!(
-                        "reading {}/{} ({}) differs",
-                        index - r.start + 1,
-                        r.len(),
-                        step.label
-                    ),
-                    None => format!("{} differs", step.label),
-                };
+                let why = what_differs(&placement, index, &step.label);
                 let operator = &mut *rig.operator;
                 let mut answer = Ok(Recheck::Keep);
                 progress.suspend(&mut || answer = operator.recheck(&why));
@@ -474,14 +532,7 @@ where
                     }
                 }
             };
-            let entry = Entry {
-                index,
-                label: step.label.clone(),
-                role: step.role.clone(),
-                mode: step.mode,
-                data: step.data.clone(),
-                reading,
-            };
+            let entry = Entry::of_step(index, step, reading);
             self.journal
                 .append(&entry)
                 .map_err(|e| fail(StepFailure::Journal(e)))?;

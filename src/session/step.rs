@@ -12,9 +12,9 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use super::journal::{CalibrationRecord, JournalError};
-use super::operator::{Answer, Operator, OperatorError, Readings};
+use super::operator::{Answer, Operator, OperatorError, PlacementReadings};
 use super::plan::{Prepare, Step};
-use super::progress::ProgressSink;
+use super::progress::{Heartbeat, ProgressSink};
 use super::record::SessionJournal;
 use super::screen::Screen;
 
@@ -72,6 +72,11 @@ pub enum StepFailure {
     Journal(#[from] JournalError),
 }
 
+/// What the operator is asked after a calibration moved the instrument (onto its tile, under
+/// a cap) before a step that shows a colour: the screen step has no placement prompt of its
+/// own, so without it the instrument would read its tile or its cap.
+pub const AIM_AT_SCREEN_AGAIN: &str = "aim the instrument at the screen again";
+
 /// Noise streams with this bit set are calibrations' (see [`StepTaker::calibrate`]); plan
 /// indices never reach it.
 const CALIBRATION_NOISE: u64 = 1 << 63;
@@ -112,7 +117,14 @@ where
                 return Ok(None);
             }
             std::thread::sleep(self.step.settle);
-            match self.instrument()?.measure(&request) {
+            let model = self.instrument()?.info().model;
+            let beat = Heartbeat::start(format!(
+                "the {} instrument ({model}) measures {}",
+                self.step.role, self.step.label
+            ));
+            let measured = self.instrument()?.measure(&request);
+            drop(beat);
+            match measured {
                 Ok(reading) => return Ok(Some(reading)),
                 Err(DriverError::NeedsCalibration { condition, .. })
                     if expired < REMEASURE_ATTEMPTS =>
@@ -186,7 +198,9 @@ where
         noise_step: usize,
     ) -> Result<bool, StepFailure> {
         let (role, mode) = (self.step.role.clone(), self.step.mode);
+        let mut moved = false;
         for _ in 0..CALIBRATION_ATTEMPTS {
+            moved |= condition != CalibrationCondition::OnTarget;
             let model = self.instrument()?.info().model;
             let prompt = format!(
                 "{role} instrument ({model}), {mode} calibration: {}",
@@ -195,7 +209,12 @@ where
             if self.ask(&prompt)? == Answer::Abort {
                 return Ok(false);
             }
-            let outcome = self.instrument()?.calibrate(mode, &condition)?;
+            let beat = Heartbeat::start(format!(
+                "the {role} instrument ({model}) calibrates for {mode} readings"
+            ));
+            let outcome = self.instrument()?.calibrate(mode, &condition);
+            drop(beat);
+            let outcome = outcome?;
             let record = CalibrationRecord {
                 role: role.clone(),
                 instrument: model.clone(),
@@ -215,6 +234,10 @@ where
                     self.progress.note(&format!(
                         "calibrated the {role} instrument ({model}) for {mode} readings {how}"
                     ));
+                    if moved && matches!(self.step.prepare, Prepare::Show { .. }) {
+                        let prompt = format!("{role} instrument ({model}): {AIM_AT_SCREEN_AGAIN}");
+                        return Ok(self.ask(&prompt)? == Answer::Confirmed);
+                    }
                     return Ok(true);
                 }
                 CalibrationOutcome::Needs(next) => {
@@ -258,7 +281,7 @@ where
                 if *self.placed == Some(range.start) {
                     return Ok(true);
                 }
-                let readings = Readings {
+                let readings = PlacementReadings {
                     first: self.index - range.start + 1,
                     of: range.len(),
                 };

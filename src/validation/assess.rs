@@ -11,7 +11,7 @@ use crate::color::{delta_e2000, delta_e76, Xyz, COLORCHECKER_NAMES};
 
 use super::covariance::{self, Cov3};
 use super::error::ValidationError;
-use super::montecarlo::{summary_interval, Metric, PatchDraws, Summary};
+use super::montecarlo::{summary_interval, Metric, PatchDraws, Statistic};
 use super::propagate::{propagate, Interval, Propagated, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
 
@@ -297,7 +297,7 @@ pub(super) fn compare_pairs(
         Propagation::MonteCarlo { seed, .. } => seed,
         Propagation::Linear => 0,
     };
-    let stat = |(metric, summary): (Metric, Summary)| {
+    let stat = |(metric, summary): (Metric, Statistic)| {
         let values: Vec<f64> = patches
             .iter()
             .map(|p| match metric {
@@ -323,10 +323,10 @@ pub(super) fn compare_pairs(
         }
     };
     let stats: Vec<Stat> = [
-        (Metric::De76, Summary::Mean),
-        (Metric::De76, Summary::Max),
-        (Metric::De00, Summary::Mean),
-        (Metric::De00, Summary::Max),
+        (Metric::De76, Statistic::Mean),
+        (Metric::De76, Statistic::Max),
+        (Metric::De00, Statistic::Mean),
+        (Metric::De00, Statistic::Max),
     ]
     .into_par_iter()
     .map(stat)

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::covariance::{self, Cov3};
 use super::montecarlo::{
-    lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Summary,
+    lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Statistic,
 };
 use super::propagate::{Interval, Uncertain};
 use super::repeatability;
@@ -27,28 +27,28 @@ const DRAWS: usize = 2000;
 const SUMMARY_DRAWS: usize = 500;
 
 /// The display's white in the default lab, cd/m².
-const WHITE: Xyz = Xyz::new(15.573, 16.34, 18.356);
+pub(super) const WHITE: Xyz = Xyz::new(15.573, 16.34, 18.356);
 
 /// One patch's truth: the box's and the display's XYZ and one reading's covariance of
 /// each, with the repeats each mean is of.
 #[derive(Clone)]
-struct Truth {
-    reference: Xyz,
-    test: Xyz,
-    cov_reference: Cov3,
-    cov_test: Cov3,
+pub(super) struct Truth {
+    pub(super) reference: Xyz,
+    pub(super) test: Xyz,
+    pub(super) cov_reference: Cov3,
+    pub(super) cov_test: Cov3,
     k_reference: usize,
     k_test: usize,
 }
 
 impl Truth {
-    fn de76(&self) -> f64 {
+    pub(super) fn de76(&self) -> f64 {
         delta_e76(self.reference.to_lab(WHITE), self.test.to_lab(WHITE))
     }
 }
 
 /// `k` readings about `mean` with one reading's covariance `cov`.
-fn readings(mean: Xyz, cov: &Cov3, k: usize, rng: &mut SplitMix64) -> Vec<Xyz> {
+pub(super) fn readings(mean: Xyz, cov: &Cov3, k: usize, rng: &mut SplitMix64) -> Vec<Xyz> {
     let f = covariance::factors(cov);
     (0..k)
         .map(|_| {
@@ -136,7 +136,7 @@ fn coverage(truth: &Truth, how: Stated, seed: u64) -> (f64, f64) {
 }
 
 /// A colour `de` ΔE*ab from `from` along the unit CIELAB direction `dir`.
-fn moved(from: Xyz, dir: [f64; 3], de: f64) -> Xyz {
+pub(super) fn moved(from: Xyz, dir: [f64; 3], de: f64) -> Xyz {
     let l = from.to_lab(WHITE);
     let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
     Lab::new(
@@ -149,7 +149,7 @@ fn moved(from: Xyz, dir: [f64; 3], de: f64) -> Xyz {
 
 /// ColorChecker 16 (yellow) as the default lab's box shows it, and the CS-100A's stated
 /// repeatability of one reading of it, scaled by `noise`.
-fn yellow(de: f64, noise: f64, k_reference: usize, k_test: usize) -> Truth {
+pub(super) fn yellow(de: f64, noise: f64, k_reference: usize, k_test: usize) -> Truth {
     let reference = Xyz::new(9.0356, 9.9766, 1.2852);
     let one = repeatability::covariance(&repeatability::emissive_of("cs100a").unwrap(), reference)
         .unwrap();
@@ -246,7 +246,7 @@ fn six_patches(noise: f64) -> Vec<Truth> {
         .collect()
 }
 
-fn summary_coverage(patches: &[Truth], summary: Summary, how: Stated, seed: u64) -> f64 {
+fn summary_coverage(patches: &[Truth], summary: Statistic, how: Stated, seed: u64) -> f64 {
     let values: Vec<f64> = patches.iter().map(Truth::de76).collect();
     let truth = summary.of(&values);
     let hits: u64 = (0..SUMMARY_TRIALS)
@@ -281,7 +281,7 @@ fn check_summary(name: &str, got: f64) {
 
 #[test]
 fn the_mean_and_max_over_patches_are_covered() {
-    for (summary, seed) in [(Summary::Mean, 7), (Summary::Max, 8)] {
+    for (summary, seed) in [(Statistic::Mean, 7), (Statistic::Max, 8)] {
         let got = summary_coverage(&six_patches(1.0), summary, Stated::Known, seed);
         check_summary(&format!("the {summary:?} ΔE*ab of 6 patches"), got);
     }
@@ -291,7 +291,7 @@ fn the_mean_and_max_over_patches_are_covered() {
 /// mean's interval nearly the normal one; the max holds its patches' t intervals.
 #[test]
 fn the_mean_and_max_with_estimated_covariances_are_covered() {
-    for (summary, seed) in [(Summary::Mean, 9), (Summary::Max, 12)] {
+    for (summary, seed) in [(Statistic::Mean, 9), (Statistic::Max, 12)] {
         let got = summary_coverage(&six_patches(1.0), summary, Stated::Estimated, seed);
         check_summary(
             &format!("the {summary:?} ΔE*ab of 6 patches, covariances from repeats"),
@@ -303,7 +303,7 @@ fn the_mean_and_max_with_estimated_covariances_are_covered() {
 /// Where noise swamps most patches.
 #[test]
 fn the_mean_and_max_of_patches_lost_in_noise_are_covered() {
-    for (summary, seed) in [(Summary::Mean, 10), (Summary::Max, 11)] {
+    for (summary, seed) in [(Statistic::Mean, 10), (Statistic::Max, 11)] {
         let got = summary_coverage(&six_patches(4.0), summary, Stated::Known, seed);
         check_summary(
             &format!("the {summary:?} ΔE*ab of 6 patches lost in noise"),

@@ -31,7 +31,7 @@ pub enum ValidationError {
     #[error(transparent)]
     Readings(#[from] super::readings::ReadingsError),
     #[error(transparent)]
-    Implausible(#[from] super::plausible::Implausible),
+    Incomparable(#[from] super::plausible::Incomparable),
     /// The white the caller gave is no white for these readings (the command line words
     /// it as a refusal of its option).
     #[error("{0}")]

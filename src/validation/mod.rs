@@ -31,6 +31,7 @@ pub mod readings;
 pub mod repeatability;
 pub mod report;
 mod report_data;
+pub mod sequential;
 pub mod uncertain;
 pub mod verdict;
 

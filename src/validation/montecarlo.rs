@@ -61,16 +61,16 @@ impl Metric {
 
 /// A statistic over patches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Summary {
+pub enum Statistic {
     Mean,
     Max,
 }
 
-impl Summary {
+impl Statistic {
     pub fn of(self, v: &[f64]) -> f64 {
         match self {
-            Summary::Mean => v.iter().sum::<f64>() / v.len() as f64,
-            Summary::Max => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Statistic::Mean => v.iter().sum::<f64>() / v.len() as f64,
+            Statistic::Max => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         }
     }
 }
@@ -324,7 +324,7 @@ pub fn patch_interval(r: Lab, t: Lab, noise: &LabNoise, metric: Metric, seed: u6
 pub fn summary_interval(
     patches: &[PatchDraws<'_>],
     metric: Metric,
-    summary: Summary,
+    summary: Statistic,
     seed: u64,
 ) -> Option<Interval> {
     let n = patches
@@ -348,53 +348,9 @@ pub fn summary_interval(
         .iter()
         .map(|p| (p[0].0 + p[1].0).max(f64::MIN_POSITIVE))
         .collect();
-    // A mean pools the patches' degrees of freedom (Welch–Satterthwaite over all of them:
-    // nearly normal for many patches). A max turns on one patch or two, whose own
-    // intervals carry their t: its draws take the covariances as known, and its bounds
-    // then hold every patch's own (the max is at least each patch's difference).
-    let nu = match summary {
-        Summary::Mean => effective_dof(
-            &parts
-                .iter()
-                .flat_map(|p| [(1.0, p[0]), (1.0, p[1])])
-                .collect::<Vec<_>>(),
-        ),
-        Summary::Max => None,
-    };
-    let scale = t_scales(nu, n, seed);
-    let top = lengths.iter().copied().fold(0.0, f64::max);
+    let scale = t_scales(summary_dof(summary, &parts), n, seed);
     // The patches' true lengths at c (c = 1: the observed ones).
-    let family = |c: f64| -> Vec<f64> {
-        if top == 0.0 {
-            // No difference anywhere: every patch an L* step of c.
-            return vec![c; patches.len()];
-        }
-        match summary {
-            Summary::Mean => {
-                let most = lengths
-                    .iter()
-                    .zip(&sigma2)
-                    .map(|(l, s)| l / s)
-                    .fold(0.0, f64::max);
-                let lambda = most * (1.0 - c);
-                lengths
-                    .iter()
-                    .zip(&sigma2)
-                    .map(|(l, s)| (l - lambda * s).max(0.0))
-                    .collect()
-            }
-            Summary::Max => {
-                let cap = c * top;
-                let mut v: Vec<f64> = lengths.iter().map(|l| l.min(cap)).collect();
-                if c > 1.0 {
-                    if let Some(k) = lengths.iter().position(|l| *l == top) {
-                        v[k] = cap;
-                    }
-                }
-                v
-            }
-        }
-    };
+    let family = |c: f64| true_lengths(summary, &lengths, &sigma2, c);
     let families: Vec<Family> = patches
         .iter()
         .zip(&units)
@@ -447,13 +403,65 @@ pub fn summary_interval(
         |c| value(&truths(c), None),
         SUMMARY_TOLERANCE,
     );
-    if summary == Summary::Max {
+    if summary == Statistic::Max {
         for i in patches.iter().filter_map(|p| p.interval) {
             interval.lo = interval.lo.max(i.lo);
             interval.hi = interval.hi.max(i.hi);
         }
     }
     Some(interval)
+}
+
+/// The degrees of freedom of `summary`'s draws. A mean pools the patches' (Welch–
+/// Satterthwaite over all of them: nearly normal for many patches). A max turns on one
+/// patch or two, whose own intervals carry their t: its draws take the covariances as
+/// known (None), and its bounds then hold every patch's own (the max is at least each
+/// patch's difference).
+fn summary_dof(summary: Statistic, parts: &[[Part; 2]]) -> Option<f64> {
+    match summary {
+        Statistic::Mean => effective_dof(
+            &parts
+                .iter()
+                .flat_map(|p| [(1.0, p[0]), (1.0, p[1])])
+                .collect::<Vec<_>>(),
+        ),
+        Statistic::Max => None,
+    }
+}
+
+/// The patches' true lengths at `c` of the profile family of `summary` (c = 1: the
+/// observed `lengths`; `sigma2` each patch's variance along its difference).
+fn true_lengths(summary: Statistic, lengths: &[f64], sigma2: &[f64], c: f64) -> Vec<f64> {
+    let top = lengths.iter().copied().fold(0.0, f64::max);
+    if top == 0.0 {
+        // No difference anywhere: every patch an L* step of c.
+        return vec![c; lengths.len()];
+    }
+    match summary {
+        Statistic::Mean => {
+            let most = lengths
+                .iter()
+                .zip(sigma2)
+                .map(|(l, s)| l / s)
+                .fold(0.0, f64::max);
+            let lambda = most * (1.0 - c);
+            lengths
+                .iter()
+                .zip(sigma2)
+                .map(|(l, s)| (l - lambda * s).max(0.0))
+                .collect()
+        }
+        Statistic::Max => {
+            let cap = c * top;
+            let mut v: Vec<f64> = lengths.iter().map(|l| l.min(cap)).collect();
+            if c > 1.0 {
+                if let Some(k) = lengths.iter().position(|l| *l == top) {
+                    v[k] = cap;
+                }
+            }
+            v
+        }
+    }
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@ pub const SCALE_NOTE_RATIO: f64 = 3.0;
 
 /// Why readings or a white cannot be compared.
 #[derive(Debug, thiserror::Error)]
-pub enum Implausible {
+pub enum Incomparable {
     #[error("{}: its readings were taken {how}: they are not luminances of the scene (cd/m²), which is what validate compares; measure the box and the display as light (emissive mode)", file.display())]
     NotLuminance {
         file: std::path::PathBuf,
@@ -45,9 +45,9 @@ pub enum Implausible {
 }
 
 /// Refuses a set whose file says its readings are not luminances.
-pub fn check_luminance(set: &ReadingSet) -> Result<(), Implausible> {
+pub fn check_luminance(set: &ReadingSet) -> Result<(), Incomparable> {
     match &set.measured_as {
-        Some(how) => Err(Implausible::NotLuminance {
+        Some(how) => Err(Incomparable::NotLuminance {
             file: set.file.clone(),
             how: how.clone(),
         }),
@@ -58,9 +58,9 @@ pub fn check_luminance(set: &ReadingSet) -> Result<(), Implausible> {
 /// Checks a white given by the user: every component above 0, and a chromaticity a white
 /// light has (near the Planckian locus: CIE 015 puts it between x = 0.24, y = 0.23 at
 /// infinite temperature and x = 0.65, y = 0.34 at 1000 K, y at most 0.42).
-pub fn check_given_white(white: Xyz) -> Result<(), Implausible> {
+pub fn check_given_white(white: Xyz) -> Result<(), Incomparable> {
     let xyz = white.to_array();
-    let not = |why: String| Implausible::NotAWhite { xyz, why };
+    let not = |why: String| Incomparable::NotAWhite { xyz, why };
     if !xyz.iter().all(|v| v.is_finite() && *v > 0.0) {
         return Err(not("each of X, Y and Z must be above 0".into()));
     }
@@ -87,7 +87,7 @@ fn lstar(ratio: f64) -> f64 {
 
 /// Checks that `white` is in the units of every set: each set's brightest reading lies
 /// between L* [`MIN_LSTAR`] and [`MAX_LSTAR`] against it.
-pub fn check_white_against(white: Xyz, sets: &[&ReadingSet]) -> Result<(), Implausible> {
+pub fn check_white_against(white: Xyz, sets: &[&ReadingSet]) -> Result<(), Incomparable> {
     let white_y = white.y;
     for set in sets {
         let Some((&patch, p)) = set
@@ -99,7 +99,7 @@ pub fn check_white_against(white: Xyz, sets: &[&ReadingSet]) -> Result<(), Impla
         };
         let y = p.xyz[1];
         let l = lstar(y / white_y);
-        let scale = |which, hint| Implausible::Scale {
+        let scale = |which, hint| Incomparable::Scale {
             white_y,
             which,
             file: set.file.clone(),

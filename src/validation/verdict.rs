@@ -189,13 +189,23 @@ fn verdict_with(
         s.push_str(" Every patch is reproduced within the JND.");
         return s;
     }
-    let named = |v: &[&PatchAssessment]| {
-        v.iter()
-            .map(|p| format!("{} {}", p.patch, esc(&p.name)))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    // Each patch in the group of the first cause that explains it.
+    s.push_str(&causes(&failing));
+    s.push_str(&origins(&failing));
+    s.push_str(&intervals(&failing));
+    s
+}
+
+/// Patch numbers and names, comma-separated.
+fn named(v: &[&PatchAssessment]) -> String {
+    v.iter()
+        .map(|p| format!("{} {}", p.patch, esc(&p.name)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The patches not shown below the JND by cause, each in the group of the first cause that
+/// explains it.
+fn causes(failing: &[(&PatchAssessment, Why)]) -> String {
     let mut groups: [(Vec<&PatchAssessment>, &str); 4] = [
         (Vec::new(), "outside the display's gamut"),
         (Vec::new(), "dark, where the meter's noise dominates"),
@@ -205,7 +215,7 @@ fn verdict_with(
             "in gamut and clear of noise: the display model's error",
         ),
     ];
-    for (p, why) in &failing {
+    for (p, why) in failing {
         let g = if why.out_of_gamut {
             0
         } else if why.dark.is_some() {
@@ -222,13 +232,16 @@ fn verdict_with(
         .filter(|(v, _)| !v.is_empty())
         .map(|(v, what)| format!("{} {what} ({})", v.len(), named(v)))
         .collect();
-    let _ = write!(
-        s,
+    format!(
         " Of the {} not shown to be below the JND: {}.",
         failing.len(),
         parts.join("; ")
-    );
-    // Where the errors arise, when the simulation tells.
+    )
+}
+
+/// Where the errors arise, when the simulation tells.
+fn origins(failing: &[(&PatchAssessment, Why)]) -> String {
+    let mut s = String::new();
     let by = |o: Origin| -> Vec<&PatchAssessment> {
         failing
             .iter()
@@ -265,6 +278,11 @@ fn verdict_with(
             }
         }
     }
+    s
+}
+
+/// Each failing patch's ΔE*ab with its 95 % interval and what explains it.
+fn intervals(failing: &[(&PatchAssessment, Why)]) -> String {
     let list: Vec<String> = failing
         .iter()
         .map(|(p, why)| {
@@ -282,8 +300,7 @@ fn verdict_with(
             )
         })
         .collect();
-    let _ = write!(s, " ΔE*ab with 95 % interval: {}.", list.join("; "));
-    s
+    format!(" ΔE*ab with 95 % interval: {}.", list.join("; "))
 }
 
 #[cfg(test)]

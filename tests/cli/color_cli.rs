@@ -7,6 +7,7 @@ use std::process::Command;
 use metamer::color::{delta_e2000, delta_e76, Lab};
 use metamer::numeric_csv::NumericCsv;
 
+use crate::support::oracle::COLOUR_SCIENCE;
 use crate::support::{fresh_dir, metamer_in_root, stderr, test_data};
 
 fn sharma_pairs() -> Vec<Vec<f64>> {
@@ -190,7 +191,7 @@ fn i1pro_readings_csv(dir: &Path) -> PathBuf {
 
 /// colour-science's XYZ of each column of a spectral CSV: `sd_to_XYZ` with k = 683 and an
 /// equal-energy illuminant by `method`, ×100 (it divides absolute values by 100). None
-/// where colour-science is not installed (outside CI).
+/// (the test skipped with the reason) where colour-science is missing.
 fn colour_science(csv: &Path, method: &str) -> Option<Vec<[f64; 3]>> {
     let script = r##"
 import json, sys, warnings
@@ -206,26 +207,19 @@ for c in range(1, len(rows[0])):
     out.append([100.0 * v for v in colour.sd_to_XYZ(sd, cmfs, ones, k=683, method=sys.argv[2])])
 print(json.dumps(out))
 "##;
-    let o = Command::new("python3")
+    let python = COLOUR_SCIENCE.find()?;
+    let o = Command::new(python)
         .args(["-c", script])
         .arg(csv)
         .arg(method)
-        .output();
-    match o {
-        Ok(o) if o.status.success() => Some(serde_json::from_slice(&o.stdout).unwrap()),
-        other => {
-            let why = match other {
-                Ok(o) => stderr(&o),
-                Err(e) => e.to_string(),
-            };
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "CI is set but colour-science does not run (.ci/run installs it): {why}"
-            );
-            eprintln!("skipped: colour-science is not installed (pip install colour-science)");
-            None
-        }
-    }
+        .output()
+        .expect("python3 runs");
+    assert!(
+        o.status.success(),
+        "colour-science's script failed: {}",
+        stderr(&o)
+    );
+    Some(serde_json::from_slice(&o.stdout).unwrap())
 }
 
 #[test]
@@ -274,6 +268,51 @@ fn run_bad(name: &str, content: &str) -> (i32, String) {
     std::fs::write(&file, content).unwrap();
     let o = metamer_in_root(&["color", "xyz", file.to_str().unwrap()]);
     (o.status.code().unwrap(), stderr(&o))
+}
+
+/// Spectra nothing can be integrated from, refused with the file and line: no wavelength
+/// is zero or less; one row has no wavelength step to sum over (CIE 15:2018 §7.1); and
+/// samples that all lie outside the range summed would give zero (radiance) or a flat
+/// spectrum held from a far end value (reflectance). The CIE tables span 360–830 nm (CIE
+/// 15:2018 Table 1), the default method sums a 10 nm spectrum over all of it and a 1 nm
+/// one, or any with `--method linear`, over 380–780 nm (paper Eq. 8).
+#[test]
+fn spectra_with_nothing_to_integrate_are_refused_with_their_line() {
+    let (code, e) = run_bad("negative", "# c\nnm,v\n-400,1\n410,2\n");
+    assert_eq!(code, 1, "{e}");
+    assert!(
+        e.contains("negative.csv:3: wavelength -400 nm: wavelengths are positive"),
+        "{e}"
+    );
+    let (code, e) = run_bad("one_row", "nm,v\n\n555,0.01\n");
+    assert_eq!(code, 1, "{e}");
+    assert!(
+        e.contains("one_row.csv:3: the spectrum has one row (555 nm)"),
+        "{e}"
+    );
+    let infrared: String = (0..8).map(|i| format!("{},1\n", 900 + 10 * i)).collect();
+    let (code, e) = run_bad("infrared", &format!("# far\nnm,v\n{infrared}"));
+    assert_eq!(code, 1, "{e}");
+    assert!(
+        e.contains("infrared.csv:3: column 'v': its samples (900–970 nm) lie outside 360–830 nm"),
+        "{e}"
+    );
+    // 790–800 nm lies inside the CIE tables but outside paper Eq. 8's 380–780 nm.
+    let dir = fresh_dir("linear");
+    let file = dir.join("near.csv");
+    std::fs::write(&file, "nm,v\n790,1\n800,1\n").unwrap();
+    let o = metamer_in_root(&["color", "xyz", file.to_str().unwrap(), "--method", "linear"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("near.csv:2: column 'v': its samples (790–800 nm) lie outside 380–780 nm")
+            && e.contains("with --method linear"),
+        "{e}"
+    );
+    // One sample inside is enough: 770–800 nm at 10 nm is summed as given.
+    std::fs::write(&file, "nm,v\n770,1\n780,1\n790,1\n800,1\n").unwrap();
+    let o = metamer_in_root(&["color", "xyz", file.to_str().unwrap(), "--method", "linear"]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]

@@ -7,26 +7,9 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/pyserial_client.py");
+use crate::support::oracle::PYSERIAL;
 
-/// A Python that can `import serial`. Debian's python3-serial installs into the system
-/// Python, which need not be the first `python3` on PATH (pyenv, virtual environments).
-fn python_with_pyserial() -> String {
-    for python in ["python3", "/usr/bin/python3"] {
-        let ok = Command::new(python)
-            .args(["-c", "import serial"])
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-        if ok {
-            return python.to_string();
-        }
-    }
-    panic!(
-        "pyserial is missing: neither python3 on PATH nor /usr/bin/python3 can import serial; \
-         install it with `apt-get install -y python3-serial` (.ci/run does)"
-    );
-}
+const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/pyserial_client.py");
 
 /// Starts the command and returns it with the device path from its first line.
 fn start(args: &[&str]) -> (Child, String) {
@@ -75,7 +58,7 @@ fn stop(mut child: Child, signal: i32) -> Option<i32> {
     }
 }
 
-fn client(python: &str, path: &str, xyz: [f64; 3], tolerances: &[&str]) -> String {
+fn client(python: &Path, path: &str, xyz: [f64; 3], tolerances: &[&str]) -> String {
     let out = Command::new(python)
         .arg(SCRIPT)
         .arg(path)
@@ -96,7 +79,9 @@ fn client(python: &str, path: &str, xyz: [f64; 3], tolerances: &[&str]) -> Strin
 /// the client gets exactly those numbers; SIGTERM ends the command with exit 0.
 #[test]
 fn pyserial_reads_the_light_given_and_sigterm_stops_cleanly() {
-    let python = python_with_pyserial();
+    let Some(python) = PYSERIAL.find() else {
+        return;
+    };
     let (x, y, lum) = (0.15, 0.06, 7.22);
     let xyz = [x / y * lum, lum, (1.0 - x - y) / y * lum];
     let arg = format!("{},{},{}", xyz[0], xyz[1], xyz[2]);
@@ -112,7 +97,9 @@ fn pyserial_reads_the_light_given_and_sigterm_stops_cleanly() {
 /// 0.0005 in x and y); Ctrl-C (SIGINT) ends the command with exit 0.
 #[test]
 fn noisy_readings_stay_within_the_repeatability_and_sigint_stops_cleanly() {
-    let python = python_with_pyserial();
+    let Some(python) = PYSERIAL.find() else {
+        return;
+    };
     let xyz = [41.2, 35.0, 5.5];
     let arg = "41.2,35,5.5";
     let (child, path) = start(&["--seed", "7", "--time-scale", "0", "--xyz", arg]);

@@ -342,3 +342,37 @@ fn a_meter_on_a_serial_port() {
         assert_eq!(v["xyY"], serde_json::json!([0.15, 0.06, 7.22]), "{v}");
     }
 }
+
+/// A simulated i1Pro that keeps (a part of) the real one's pace says so first, and its
+/// dark calibration (20 s at the real pace, 6 s here) shows it is alive every 5 s while
+/// stderr is no terminal.
+#[test]
+fn a_paced_simulation_says_so_first_and_a_long_wait_shows_progress() {
+    let o = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args([
+            "spot",
+            "--instrument",
+            "sim:i1pro?time_scale=0.3",
+            "--count",
+            "1",
+        ])
+        .env_remove("METAMER_SIM_TIME_SCALE")
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(
+        err.lines().next(),
+        Some(
+            "note: the simulated instruments (sim:i1pro?time_scale=0.3) run at 0.3 times their \
+             real pace; `?time_scale=0` in a spec (or METAMER_SIM_TIME_SCALE=0) makes them \
+             answer at once"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.lines()
+            .any(|l| l == "  … the i1pro calibrates for emissive readings: 5 s so far"),
+        "{err}"
+    );
+}

@@ -215,6 +215,18 @@ fn violated_assumptions_are_named() {
     let blue = &diag.channels[2];
     let at = blue.drift_at_drive.unwrap();
     assert!((0.4..=0.8).contains(&at), "{at}");
+    // The same failures under the lut, which does not assume what fails: the verdict
+    // leads with the model, then names the same failed assumptions.
+    let lut = fit_profile(ModelKind::Lut, &d.patches(16), None).unwrap();
+    let v = &lut.diagnostics().verdict;
+    assert!(
+        v.starts_with(
+            "The lut assumes neither constant chromaticity nor additivity, so it holds where \
+             PLCC's assumptions fail, as they do here: "
+        ) && v.contains("blue channel's chromaticity drifts")
+            && !v.contains("Models that do not assume them"),
+        "{v}"
+    );
 }
 
 #[test]

@@ -7,7 +7,9 @@ use metamer::display::reproduce::{reproduce_image, reproduce_targets, write_driv
 use metamer::display::{fit_profile, read_measurements, ModelKind, Profile};
 use metamer::image::XyzImage;
 
-use crate::support::{dispread_analytic, fresh_dir, metamer};
+use crate::support::{
+    dispread_analytic, fresh_dir, metamer, srgb_from_xyz, write_rgb_exr, XYZ_CHROMATICITIES,
+};
 
 /// The fixture's analytic display (see tests/display/display_fit.rs): black + Σ col·d^γ.
 fn analytic(rgb: [f64; 3]) -> [f64; 3] {
@@ -297,5 +299,137 @@ fn reproduce_an_exr_image_from_the_command_line() {
             }
         }
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Runs `reproduce --image` at 16 bits; the drive values read back from the PNG, or the
+/// refusal.
+fn reproduce_exr(
+    profile: &std::path::Path,
+    exr: &std::path::Path,
+) -> Result<Vec<[f64; 3]>, String> {
+    let png_path = exr.with_extension("png");
+    let out = metamer(&[
+        "reproduce",
+        "--profile",
+        profile.to_str().unwrap(),
+        "--image",
+        exr.to_str().unwrap(),
+        "-o",
+        png_path.to_str().unwrap(),
+        "--bits",
+        "16",
+        "--force",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    if !out.status.success() {
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        return Err(stderr);
+    }
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&png_path).unwrap(),
+    ));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    reader.next_frame(&mut buf).unwrap();
+    Ok(buf
+        .chunks_exact(6)
+        .map(|p| {
+            std::array::from_fn(|c| {
+                f64::from(u16::from_be_bytes([p[2 * c], p[2 * c + 1]])) / 65535.0
+            })
+        })
+        .collect())
+}
+
+/// What an OpenEXR header says of its pixels is what `reproduce` shows: whiteLuminance
+/// scales the values to cd/m², R, G, B without chromaticities are BT.709 with D65, only
+/// the display window is shown, and a crop of it is refused naming both windows. Each file
+/// holds, by construction, the analytic display's XYZ of known drive values.
+#[test]
+fn reproduce_reads_an_exr_header_as_openexr_defines_it() {
+    let dir = fresh_dir("repro-exr-header");
+    let profile_path = dir.join("p.json");
+    profile()
+        .save(&profile_path, &metamer::output::OutputPolicy::new(true))
+        .unwrap();
+    let (w, h) = (4usize, 3usize);
+    let drive = |x: usize, y: usize| [0.2 + x as f64 / 5.0, 0.25 + y as f64 / 4.0, 0.5];
+    let check = |name: &str, got: Vec<[f64; 3]>| {
+        assert_eq!(got.len(), w * h, "{name}");
+        for (i, d) in got.iter().enumerate() {
+            let want = drive(i % w, i / w);
+            for c in 0..3 {
+                assert!(
+                    (d[c] - want[c]).abs() < 2e-3,
+                    "{name}: pixel {i} channel {c}: {} vs {}",
+                    d[c],
+                    want[c]
+                );
+            }
+        }
+    };
+
+    // whiteLuminance 2: a value of 1 is 2 cd/m².
+    let p = dir.join("half.exr");
+    write_rgb_exr(
+        &p,
+        (w, h),
+        (0, 0),
+        (w, h),
+        Some(XYZ_CHROMATICITIES),
+        Some(2.0),
+        |x, y| analytic(drive(x, y)).map(|v| (v / 2.0) as f32),
+    );
+    check(
+        "whiteLuminance 2",
+        reproduce_exr(&profile_path, &p).unwrap(),
+    );
+
+    // No chromaticities: linear BT.709 RGB.
+    let p = dir.join("rec709.exr");
+    write_rgb_exr(&p, (w, h), (0, 0), (w, h), None, None, |x, y| {
+        srgb_from_xyz(analytic(drive(x, y)))
+    });
+    check(
+        "no chromaticities",
+        reproduce_exr(&profile_path, &p).unwrap(),
+    );
+
+    // Overscan: two more pixels on each side, far out of gamut, outside the display window.
+    let p = dir.join("overscan.exr");
+    write_rgb_exr(
+        &p,
+        (w + 4, h + 4),
+        (-2, -2),
+        (w, h),
+        Some(XYZ_CHROMATICITIES),
+        None,
+        |x, y| {
+            if (2..w + 2).contains(&x) && (2..h + 2).contains(&y) {
+                analytic(drive(x - 2, y - 2)).map(|v| v as f32)
+            } else {
+                [1e4; 3]
+            }
+        },
+    );
+    check("overscan", reproduce_exr(&profile_path, &p).unwrap());
+
+    // A crop: the file holds 4×3 pixels of an 8×6 frame.
+    let p = dir.join("crop.exr");
+    write_rgb_exr(
+        &p,
+        (w, h),
+        (2, 1),
+        (8, 6),
+        Some(XYZ_CHROMATICITIES),
+        None,
+        |x, y| analytic(drive(x, y)).map(|v| v as f32),
+    );
+    let e = reproduce_exr(&profile_path, &p).unwrap_err();
+    assert!(
+        e.contains("crop.exr: its data window (2, 1)–(5, 3) does not cover its display window (0, 0)–(7, 5)"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

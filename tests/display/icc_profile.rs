@@ -22,6 +22,7 @@ use metamer::display::icc::{
 use metamer::display::{fit_profile, read_measurement_file, ModelKind, Profile};
 use moxcms::{ColorProfile, DataColorSpace, ProfileClass, ProfileVersion};
 
+use crate::support::oracle::{ICCDUMP, XICCLU};
 use crate::support::unused_dir;
 
 /// A .ti3 as dispread writes it after dispcal: the measured patches, then the `CAL` table
@@ -204,21 +205,11 @@ fn a_black_outside_the_primaries_cone_is_clipped_and_reported() {
     assert!(a.max_de00 > 0.1, "the clipped black shows: {a:?}");
 }
 
-/// An Argyll tool. Required, not skipped: a check that quietly passes where its oracle is
-/// missing would say nothing in CI (`.ci/run` installs the package).
-fn argyll(tool: &str) -> Command {
-    let found = std::env::var_os("PATH")
-        .map(|p| std::env::split_paths(&p).any(|d| d.join(tool).is_file()))
-        .unwrap_or(false);
-    assert!(
-        found,
-        "ArgyllCMS `{tool}` is not installed: this test reads metamer's profiles with it (Debian: apt-get install argyll)"
-    );
-    Command::new(tool)
-}
-
 #[test]
 fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
+    let (Some(iccdump), Some(xicclu)) = (ICCDUMP.find(), XICCLU.find()) else {
+        return;
+    };
     let dir = unused_dir("argyll");
     std::fs::create_dir_all(&dir).unwrap();
     let devices = [
@@ -236,7 +227,7 @@ fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
         let icc = encode_icc(&profile, IccVersion::V2_4, "test display").unwrap();
         let path = dir.join(format!("{kind}.icc"));
         std::fs::write(&path, &icc.bytes).unwrap();
-        let dump = argyll("iccdump")
+        let dump = Command::new(&iccdump)
             .args(["-v", "3"])
             .arg(&path)
             .output()
@@ -249,7 +240,7 @@ fn argyll_reads_the_version_2_profiles_and_agrees_on_xyz() {
         );
         assert!(text.contains(tag) && text.contains("'lumi'") && text.contains("'chad'"));
         // -ff: float device values 0–1 in, -ir: relative colorimetric, -pX: PCS XYZ ×100.
-        let mut child = argyll("xicclu")
+        let mut child = Command::new(&xicclu)
             .args(["-v0", "-ff", "-ir", "-pX"])
             .arg(&path)
             .stdin(std::process::Stdio::piped())
@@ -327,4 +318,75 @@ fn fit_writes_the_icc_profile_it_is_asked_for() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--icc-version needs --icc"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The plcc profile of the test file with every XYZ it predicts multiplied so that its
+/// white's largest component is `top` cd/m².
+fn plcc_with_white_up_to(top: f64) -> Profile {
+    let (mut profile, _) = fitted(ModelKind::Plcc);
+    let w = icc_white(&profile);
+    let s = top / w.x.max(w.y).max(w.z);
+    let metamer::display::model::ModelParams::MatrixTrc(m) = &mut profile.parameters else {
+        panic!("plcc is a matrix model");
+    };
+    m.black = m.black.map(|v| v * s);
+    m.matrix = m.matrix.map(|row| row.map(|v| v * s));
+    m.prepare(ModelKind::Plcc).unwrap();
+    profile
+}
+
+/// `lumi` is an XYZType of s15Fixed16Numbers, whose largest value is 32767 + 65535/65536:
+/// a white up to that is stored to 1/65536 cd/m², a brighter one is refused, not clamped.
+#[test]
+fn the_luminance_tag_holds_its_white_or_the_profile_is_refused() {
+    let bright = plcc_with_white_up_to(32000.0);
+    let icc = encode_icc(&bright, IccVersion::V4, "bright").unwrap();
+    let lumi = tags(&icc.bytes)
+        .unwrap()
+        .into_iter()
+        .find(|(sig, _)| sig == b"lumi")
+        .expect("a lumi tag")
+        .1;
+    assert_eq!(&lumi[..4], b"XYZ ");
+    let s15 = |at: usize| f64::from(i32::from_be_bytes(lumi[at..at + 4].try_into().unwrap()));
+    let white = icc_white(&bright);
+    for (k, at) in [8, 12, 16].into_iter().enumerate() {
+        assert!(
+            (s15(at) / 65536.0 - white[k]).abs() <= 0.5 / 65536.0,
+            "lumi {k}: {} for {}",
+            s15(at) / 65536.0,
+            white[k]
+        );
+    }
+    let too_bright = plcc_with_white_up_to(32768.0);
+    for version in [IccVersion::V4, IccVersion::V2_4] {
+        let e = encode_icc(&too_bright, version, "too bright")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("luminance tag") && e.contains("32767.99998"),
+            "{e}"
+        );
+    }
+}
+
+/// A version 4 LUT profile carries its tables as lutAtoBType / lutBtoAType (ICC.1:2010
+/// 10.10, 10.11; signatures 'mAB ' and 'mBA '), which LittleCMS saves again after reading
+/// (icc_resave); version 2.4 has only lut16Type ('mft2').
+#[test]
+fn lut_profiles_use_the_tag_types_of_their_version() {
+    let (profile, _) = fitted(ModelKind::Lut);
+    for (version, a2b, b2a) in [
+        (IccVersion::V4, b"mAB ", b"mBA "),
+        (IccVersion::V2_4, b"mft2", b"mft2"),
+    ] {
+        let icc = encode_icc(&profile, version, "types").unwrap();
+        let t = tags(&icc.bytes).unwrap();
+        let kind = |want: &[u8; 4]| {
+            let data = &t.iter().find(|(s, _)| s == want).expect("tag").1;
+            <[u8; 4]>::try_from(&data[..4]).unwrap()
+        };
+        assert_eq!(&kind(b"A2B0"), a2b, "{version} A2B0");
+        assert_eq!(&kind(b"B2A0"), b2a, "{version} B2A0");
+    }
 }

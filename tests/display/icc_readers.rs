@@ -35,26 +35,16 @@ use metamer::display::{
 use metamer::rig::{Preset, VirtualPanel};
 
 use crate::support::fresh_dir;
+use crate::support::oracle::TRANSICC;
 
-fn transicc_installed() -> bool {
-    let found = std::env::var_os("PATH")
-        .map(|p| std::env::split_paths(&p).any(|d| d.join("transicc").is_file()))
-        .unwrap_or(false);
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but transicc is not installed (.ci/run installs liblcms2-utils)"
-        );
-        eprintln!(
-            "skipped: LittleCMS `transicc` is not installed (apt-get install liblcms2-utils)"
-        );
-    }
-    found
+/// LittleCMS's `transicc`, or None (the test skipped with the reason) where it is missing.
+pub(crate) fn transicc_installed() -> bool {
+    TRANSICC.find().is_some()
 }
 
 /// Runs `transicc -n -c0 -t1 ARGS` on one triple per line; its triples back.
-fn transicc(args: &[&str], input: &[[f64; 3]]) -> Vec<[f64; 3]> {
-    let mut child = Command::new("transicc")
+pub(crate) fn transicc(args: &[&str], input: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let mut child = Command::new(TRANSICC.find().expect("probed by the test"))
         .args(["-n", "-c0", "-t1"])
         .args(args)
         .stdin(Stdio::piped())

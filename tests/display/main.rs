@@ -9,6 +9,7 @@ mod display_fit;
 mod display_reproduce;
 mod icc_profile;
 mod icc_readers;
+mod icc_resave;
 mod ramp_fit;
 mod rig_display_white;
 mod scattered_fit;

@@ -2,6 +2,7 @@
 //! primary, no mixtures): which model `--model auto` picks, judged as a rendering uses the
 //! profile, by the inverse round trip through the true display on mixed colours.
 
+use crate::support::oracle::{COLPROF, XICCLU};
 use metamer::color::{delta_e2000, Xyz};
 use metamer::display::characterize::plan::{colorchecker_srgb, random_patches};
 use metamer::display::characterize::plan::{RANDOM_VERIFICATION, VERIFICATION_SEED};
@@ -95,10 +96,11 @@ fn ramp_set(preset: Preset, noise_seed: Option<u64>) -> (VirtualPanel, Vec<Sampl
 }
 
 /// ArgyllCMS `colprof -qm -as` on the same set and its inverse (`xicclu -fb -iA -pX`), run as
-/// an external program when it is installed; None otherwise.
+/// an external program when it is installed; None (with the reason printed) otherwise.
 fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path) -> Option<f64> {
     use std::process::Command;
-    Command::new("colprof").arg("-?").output().ok()?;
+    let colprof = COLPROF.find()?;
+    let xicclu = XICCLU.find()?;
     std::fs::create_dir_all(dir).unwrap();
     write_ti3(
         &dir.join("ramps.ti3"),
@@ -107,7 +109,7 @@ fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path
         &metamer::output::OutputPolicy::new(true),
     )
     .unwrap();
-    let status = Command::new("colprof")
+    let status = Command::new(colprof)
         .args(["-qm", "-as", "-D", "ramps", "ramps"])
         .current_dir(dir)
         .output()
@@ -118,7 +120,7 @@ fn colprof_error(panel: &VirtualPanel, patches: &[Sample], dir: &std::path::Path
         .iter()
         .map(|t| format!("{:.8} {:.8} {:.8}\n", t[0], t[1], t[2]))
         .collect();
-    let mut child = Command::new("xicclu")
+    let mut child = Command::new(xicclu)
         .args(["-v0", "-fb", "-iA", "-pX", "ramps.icc"])
         .current_dir(dir)
         .stdin(std::process::Stdio::piped())

@@ -222,3 +222,76 @@ fn ctrl_c_in_the_display_stage_stops_that_stage() {
     assert!(line_count(&stage_dir) >= 4);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Ctrl-C while the simulation renders stops the render at its next check, names the
+/// simulation stage, and leaves the stage unrecorded so the next run renders it again
+/// (the flag used to wait for the render's end and then stop the display stage, which was
+/// blamed).
+#[test]
+fn ctrl_c_during_the_render_stops_it_and_names_the_simulation_stage() {
+    let out = unused_dir("ctrl-c-render");
+    let given = crate::support::test_data("report/experiment/box");
+    // A target no render reaches within its 600 s limit.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(["experiment", "-o"])
+        .arg(&out)
+        .arg("--box-scene")
+        .arg(crate::support::scenes_dir().join("validation-box.json"))
+        .arg("--box-spots")
+        .arg(given.join("spots.csv"))
+        .args(["--target-de", "0.00001", "--image-size", "0"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (tx, lines) = mpsc::channel();
+    let err = BufReader::new(child.stderr.take().unwrap());
+    std::thread::spawn(move || {
+        for line in err.lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let start = Instant::now();
+    let mut seen = Vec::new();
+    while !seen
+        .iter()
+        .any(|l: &String| l.contains("simulation: running"))
+    {
+        let line = lines
+            .recv_timeout(Duration::from_secs(60))
+            .unwrap_or_else(|_| panic!("the simulation never started: {seen:?}"));
+        seen.push(line);
+    }
+    // Well into the render.
+    std::thread::sleep(Duration::from_secs(2));
+    let sent = Instant::now();
+    // SAFETY: kill with a child's pid and a signal number.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGINT) }, 0);
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(
+            sent.elapsed() < Duration::from_secs(30),
+            "still rendering 30 s after Ctrl-C"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let stopped_in = sent.elapsed();
+    seen.extend(lines.try_iter());
+    let err = seen.join("\n");
+    assert_eq!(status.code(), Some(1), "{err}");
+    assert!(err.contains("interrupted in the simulation stage"), "{err}");
+    assert!(!err.contains("display"), "{err}");
+    assert!(!out.join("simulation/stage.json").exists());
+    assert!(!out.join("display").exists());
+    eprintln!(
+        "stopped {:.2} s after Ctrl-C ({:.1} s in all)",
+        stopped_in.as_secs_f64(),
+        start.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(&out).ok();
+}

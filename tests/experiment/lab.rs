@@ -309,7 +309,8 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
 fn bad_options_are_usage_errors() {
     let never = "/nonexistent/never-written";
     for (args, needle) in [
-        (&["--display", "oled"][..], "unknown virtual display preset"),
+        (&["--display", "oled"][..], "unknown display 'oled'"),
+        (&["--display", "window:0"][..], "name it virtual:PRESET"),
         (&["--model", "magic"][..], "magic"),
         (&["--gamut", "hue"][..], "unknown gamut mapping"),
         (&["--target-de", "0"][..], "--target-de"),

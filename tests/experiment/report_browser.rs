@@ -19,8 +19,9 @@ use serde_json::Value;
 
 mod chromium;
 
-use chromium::{browser, fresh, headless, load, on_path};
+use chromium::{browser, fresh, headless, load};
 
+use crate::support::oracle::{PDFINFO, PDFTOPPM, PDFTOTEXT};
 use crate::support::validate_data;
 
 /// Runs in the page's copy once it has loaded; measures in CSS pixels of the page.
@@ -482,19 +483,6 @@ fn fig5_shows_each_displacement_in_a_screenshot() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A poppler tool, or `None` (and the test skipped) where poppler is not installed.
-fn poppler(name: &str) -> Option<PathBuf> {
-    let found = on_path(name);
-    if found.is_none() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but {name} is not installed (.ci/run installs poppler-utils)"
-        );
-        eprintln!("skipped: no {name} on PATH (apt-get install poppler-utils)");
-    }
-    found
-}
-
 fn squash(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
@@ -506,11 +494,9 @@ fn report_prints_to_pdf_without_splitting_a_figure() {
     let Some(browser) = browser() else {
         return;
     };
-    let (Some(pdftotext), Some(pdfinfo), Some(pdftoppm)) = (
-        poppler("pdftotext"),
-        poppler("pdfinfo"),
-        poppler("pdftoppm"),
-    ) else {
+    let (Some(pdftotext), Some(pdfinfo), Some(pdftoppm)) =
+        (PDFTOTEXT.find(), PDFINFO.find(), PDFTOPPM.find())
+    else {
         return;
     };
     let dir = fresh("report-print");

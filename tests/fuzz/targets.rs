@@ -243,11 +243,13 @@ fn seed_photometric() -> (Vec<Vec<u8>>, Vec<Vec<u8>>) {
         issue_date: "2026-12-01".into(),
         luminaire: "panel".into(),
         generation: "metamer".into(),
+        extrapolation: None,
     };
     let ldt_info = LdtInfo {
         luminaire: "panel".into(),
         file_name: "seed.ldt".into(),
         date_user: "2026-12-01 fuzz".into(),
+        extrapolation: None,
     };
     let tables = [symmetric, asymmetric];
     (

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use metamer::experiment::cache::{Inputs, Product, StageDir};
 use metamer::light::{fit, Falloff, ModelChoice};
-use metamer::measure_box::{BoxPlan, Stage};
+use metamer::measure_box::{BoxPlan, BoxStage};
 use metamer::session::{reading_problem, Entry, Header, Journal, JournalEntry};
 use metamer::validation::readings::parse_readings;
 use serde::de::DeserializeOwned;
@@ -37,7 +37,7 @@ fn box_plan(bytes: &[u8], dir: &Path) -> Check {
         return Err(format!("a plan with a box of {} m accepted", g.size_m));
     }
     let mut steps = 0;
-    for stage in Stage::ALL {
+    for stage in BoxStage::ALL {
         steps += plan.steps(stage).len();
         if steps > MAX_PLAN_STEPS {
             return Err(format!(
@@ -45,7 +45,7 @@ fn box_plan(bytes: &[u8], dir: &Path) -> Check {
             ));
         }
     }
-    for target in plan.steps(Stage::Tiles).iter().take(3) {
+    for target in plan.steps(BoxStage::Tiles).iter().take(3) {
         let _ = plan.prompt(&target.data.target);
     }
     Ok(())

@@ -31,11 +31,13 @@ fn photometric_files() -> (String, String) {
         issue_date: "2026-12-02".into(),
         luminaire: "panel".into(),
         generation: "metamer".into(),
+        extrapolation: None,
     };
     let ldt_info = LdtInfo {
         luminaire: "panel".into(),
         file_name: "panel.ldt".into(),
         date_user: "2026-12-02".into(),
+        extrapolation: None,
     };
     (
         ies::to_string(&table, &panel, &ies_info),

@@ -5,6 +5,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod experiment_preflight;
 mod hardening;
 mod hardening_commands;
 mod hardening_inputs;

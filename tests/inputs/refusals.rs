@@ -51,8 +51,8 @@ fn budget_with_no_trials_is_refused() {
     assert!(!d.join("b").exists(), "nothing is created");
 }
 
-/// The reproduction stage's gamut mapping is checked before the box is measured, not
-/// after the box, the simulation and the display have run.
+/// The reproduction stage's gamut mapping is read with the command line, before the box is
+/// measured, not after the box, the simulation and the display have run.
 #[test]
 fn experiment_with_an_unknown_gamut_mapping_is_refused_before_any_stage() {
     let d = fresh_dir("gamut");
@@ -66,9 +66,10 @@ fn experiment_with_an_unknown_gamut_mapping_is_refused_before_any_stage() {
         "--gamut",
         "nearest",
     ]);
-    assert_eq!(code, Some(1));
+    assert_eq!(code, Some(2));
     assert!(
-        err.contains("gamut mapping: unknown gamut mapping 'nearest' (known: nearest-lab, clip)"),
+        err.contains("--gamut")
+            && err.contains("unknown gamut mapping 'nearest' (known: nearest-lab, clip)"),
         "{err}"
     );
     assert!(!d.join("ex").exists(), "nothing is created");
@@ -341,7 +342,7 @@ fn a_real_instrument_with_nobody_at_it_is_refused_before_any_reading() {
             "-o",
             &out,
             "--spectral",
-            "replay:x.jsonl",
+            "i1pro",
             "--spot",
             &meter,
         ],
@@ -403,8 +404,8 @@ fn a_real_spectral_instrument_with_the_default_spot_meter_is_refused_naming_the_
         err,
         "error: --spectral i1pro is real and --spot sim:cs100a?time_scale=0 (the default when \
          --spot is not given) is simulated: both must be simulated (sim:…) or neither, as a \
-         simulated instrument sees only the simulated box; name the real spot meter with --spot \
-         cs100a:PORT\n"
+         simulated instrument sees only the simulated box; a real Konica Minolta CS-100A is \
+         named cs100a:PORT\n"
     );
     // A spot meter given by hand is not called a default.
     let (code, _, err) = refused(&[

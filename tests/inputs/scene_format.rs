@@ -257,11 +257,13 @@ fn ies_and_ldt_files_are_emitter_distributions() {
         issue_date: "2026-12-01".into(),
         luminaire: "test panel".into(),
         generation: "metamer test".into(),
+        extrapolation: None,
     };
     let ldt_info = LdtInfo {
         luminaire: "test panel".into(),
         file_name: "light.ldt".into(),
         date_user: "2026-12-01 metamer".into(),
+        extrapolation: None,
     };
     std::fs::write(
         dir.join("light.ies"),

@@ -4,8 +4,9 @@
 //! two renderers' noise. Mitsuba is an independent renderer (BSD-3), so this checks the
 //! geometry, spectra, emitter units, camera and film of the export at once.
 //!
-//! Without Mitsuba the test prints "skipped" and passes, unless `METAMER_ORACLES=required`
-//! (CI sets it after installing the wheel), when it fails.
+//! Without Mitsuba (or the numpy its script reads the pixels with) the test prints
+//! "skipped" with the reason and passes, unless `METAMER_ORACLES=required` (CI sets it after
+//! installing the wheel), when it fails (`support::oracle`).
 
 use std::path::Path;
 use std::process::Command;
@@ -17,6 +18,7 @@ use metamer::render::job::image::ImageRequest;
 use metamer::render::method::Method;
 use metamer::render::Scene;
 
+use crate::support::oracle::{MITSUBA, MITSUBA_NUMPY};
 use crate::support::{fresh_dir, scenes_dir};
 
 const SIZE: usize = 80;
@@ -38,33 +40,20 @@ img = np.array(mi.render(scene, seed=7), dtype="<f4")
 assert img.shape == (int(sys.argv[3]), int(sys.argv[3]), 3), img.shape
 img.tofile(sys.argv[4])
 "#;
-    let out = Command::new("python3")
+    let python = MITSUBA_NUMPY.find()?;
+    let out = Command::new(python)
         .args(["-c", script])
         .arg(xml)
         .arg(SPP.to_string())
         .arg(SIZE.to_string())
         .arg(raw)
-        .output();
-    let required = std::env::var("METAMER_ORACLES").as_deref() == Ok("required");
-    match out {
-        Ok(o) if o.status.success() => {}
-        Ok(o) => {
-            let err = String::from_utf8_lossy(&o.stderr).to_string();
-            let missing = err.contains("No module named 'mitsuba'");
-            assert!(
-                missing && !required,
-                "Mitsuba 3 did not render the export (METAMER_ORACLES={}): {err}",
-                std::env::var("METAMER_ORACLES").unwrap_or_default()
-            );
-            eprintln!("skipped: Mitsuba 3 is not installed (pip install mitsuba==3.9.1)");
-            return None;
-        }
-        Err(e) => {
-            assert!(!required, "python3 does not run: {e}");
-            eprintln!("skipped: python3 does not run: {e}");
-            return None;
-        }
-    }
+        .output()
+        .expect("python3 runs");
+    assert!(
+        out.status.success(),
+        "Mitsuba 3 did not render the export: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let bytes = std::fs::read(raw).unwrap();
     assert_eq!(bytes.len(), SIZE * SIZE * 12);
     let f: Vec<f32> = bytes
@@ -198,19 +187,13 @@ mi.set_variant("scalar_spectral")
 scene = mi.load_file(sys.argv[1], spp=1, width=8, height=8)
 mi.render(scene)
 "#;
-    let o = Command::new("python3")
+    let Some(python) = MITSUBA.find() else {
+        return;
+    };
+    let o = Command::new(python)
         .args(["-c", script])
         .arg(out.join("scene.xml"))
         .output()
         .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("No module named 'mitsuba'") {
-        assert!(
-            std::env::var("METAMER_ORACLES").as_deref() != Ok("required"),
-            "METAMER_ORACLES=required but mitsuba is not installed"
-        );
-        eprintln!("skipped: Mitsuba 3 is not installed (pip install mitsuba==3.9.1)");
-        return;
-    }
-    assert!(o.status.success(), "{err}");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }

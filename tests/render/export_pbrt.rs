@@ -3,7 +3,7 @@
 //! cannot be built in CI (no network but package registries, and no package of it):
 //!
 //! - tokens (`src/pbrt/parser.cpp`, `Tokenizer::Next`): whitespace separates; `#` starts a
-//!   comment to the end of the line; `"…"` is a string with `\b \f \n \r \t \\ \' \"`
+//!   comment up to the next `\n` or `\r`; `"…"` is a string with `\b \f \n \r \t \\ \' \"`
 //!   escapes; `[` and `]` are tokens of their own; anything else runs to whitespace, a
 //!   quote or a bracket;
 //! - directives (`parse` in the same file) and their fixed arguments (`LookAt` 9 numbers,
@@ -26,21 +26,22 @@ use metamer::render::Scene;
 use crate::support::{fresh_dir, root, scenes_dir};
 
 #[derive(Clone, Debug, PartialEq)]
-enum Token {
+pub(crate) enum Token {
     Str(String),
     Open,
     Close,
     Word(String),
 }
 
-fn tokenize(text: &str) -> Vec<Token> {
+pub(crate) fn tokenize(text: &str) -> Vec<Token> {
     let mut out = Vec::new();
     let mut chars = text.chars().peekable();
     while let Some(&c) = chars.peek() {
         if c.is_whitespace() {
             chars.next();
         } else if c == '#' {
-            while chars.next().is_some_and(|c| c != '\n') {}
+            // pbrt-v4 ends a comment at either line end (`Tokenizer::Next`).
+            while chars.next().is_some_and(|c| c != '\n' && c != '\r') {}
         } else if c == '[' || c == ']' {
             chars.next();
             out.push(if c == '[' { Token::Open } else { Token::Close });

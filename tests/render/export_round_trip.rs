@@ -6,14 +6,16 @@
 //! uncertainty, on the Lambertian box and, within the stated difference of its emitter's
 //! Lambertian form, on a box measured by `measure-box`.
 //!
-//! Without Mitsuba the tests print "skipped" and pass, unless `METAMER_ORACLES=required`
-//! (CI sets it after installing the wheel), when they fail.
+//! Without Mitsuba the tests print "skipped" with the reason and pass, unless
+//! `METAMER_ORACLES=required` (CI sets it after installing the wheel), when they fail
+//! (`support::oracle`).
 
 use std::path::Path;
 use std::process::Command;
 
 use serde_json::Value;
 
+use crate::support::oracle::MITSUBA;
 use crate::support::{fresh_dir, metamer, metamer_unscaled, scenes_dir, stderr, text};
 
 /// 256² at 64 spp: about 240 pixels in each meter cone, a ΔE*ab half-width near 1, in a
@@ -37,31 +39,23 @@ scene = mi.load_file(sys.argv[1], spp=int(sys.argv[2]), width=size, height=size)
 mi.render(scene, seed=11)
 scene.sensors()[0].film().bitmap().write(sys.argv[4])
 "#;
-    let required = std::env::var("METAMER_ORACLES").as_deref() == Ok("required");
-    let out = Command::new("python3")
+    let Some(python) = MITSUBA.find() else {
+        return false;
+    };
+    let out = Command::new(python)
         .args(["-c", script])
         .arg(xml)
         .arg(SPP.to_string())
         .arg(SIZE.to_string())
         .arg(exr)
-        .output();
-    match out {
-        Ok(o) if o.status.success() => true,
-        Ok(o) => {
-            let err = text(&o.stderr);
-            assert!(
-                err.contains("No module named 'mitsuba'") && !required,
-                "Mitsuba 3 did not render the export: {err}"
-            );
-            eprintln!("skipped: Mitsuba 3 is not installed (pip install mitsuba==3.9.1)");
-            false
-        }
-        Err(e) => {
-            assert!(!required, "python3 does not run: {e}");
-            eprintln!("skipped: python3 does not run: {e}");
-            false
-        }
-    }
+        .output()
+        .expect("python3 runs");
+    assert!(
+        out.status.success(),
+        "Mitsuba 3 did not render the export: {}",
+        text(&out.stderr)
+    );
+    true
 }
 
 fn run_json(args: &[&str]) -> Value {

@@ -7,6 +7,7 @@ use std::path::Path;
 use metamer::light::fit::Params;
 use metamer::light::ies::{self, IesInfo};
 use metamer::light::ldt::{self, LdtInfo};
+use metamer::light::photometry::flux_beyond_lm;
 use metamer::light::{fit, flux_lm, CGammaTable, Falloff, LdcModel, ModelChoice, Panel, PlaneData};
 
 fn ies_info() -> IesInfo {
@@ -15,6 +16,7 @@ fn ies_info() -> IesInfo {
         issue_date: "2026-12-01".into(),
         luminaire: "test panel".into(),
         generation: "test".into(),
+        extrapolation: None,
     }
 }
 
@@ -23,6 +25,7 @@ fn ldt_info() -> LdtInfo {
         luminaire: "test panel".into(),
         file_name: "t.ldt".into(),
         date_user: "2026-12-01 test".into(),
+        extrapolation: None,
     }
 }
 
@@ -212,4 +215,161 @@ fn an_ldt_with_a_non_finite_opening_or_overflowing_intensities_is_refused() {
         e.contains("too large to use") || e.contains("must be finite"),
         "{e}"
     );
+}
+
+/// ∫ over γ ≥ γ₀ of a Lambertian panel's intensity I₀·cos γ: 2π·I₀·∫cos γ sin γ dγ =
+/// π·I₀·cos²γ₀, so a quarter of the flux above 60° and all of it above 0°.
+#[test]
+fn flux_beyond_an_angle_is_pi_i0_cos2() {
+    let t = cos_power_table(0.0);
+    let panel = Panel::new(0.3, 0.3, 1000.0).unwrap();
+    let i0 = 90.0;
+    for g in [0.0f64, 37.5, 60.0, 89.0] {
+        let want = PI * i0 * g.to_radians().cos().powi(2);
+        let got = flux_beyond_lm(&t, &panel, g);
+        assert!((got - want).abs() < 1e-9 * i0, "{g}°: {got} vs {want}");
+    }
+    assert!((flux_beyond_lm(&t, &panel, 0.0) - flux_lm(&t, &panel)).abs() < 1e-9);
+}
+
+/// Readings of 0.5 + 0.5·cos γ at every `step`° to `h_max` in the horizontal and `v_max` in
+/// the vertical plane.
+fn half_cos_falloff(h_max: i32, v_max: i32, step: i32) -> Falloff {
+    let plane = |max: i32| {
+        let angles: Vec<f64> = (-max / step..=max / step)
+            .map(|k| f64::from(k * step))
+            .collect();
+        PlaneData {
+            luminance: angles
+                .iter()
+                .map(|a| 0.5 + 0.5 * a.to_radians().cos())
+                .collect(),
+            angles_deg: angles,
+        }
+    };
+    Falloff {
+        horizontal: plane(h_max),
+        vertical: plane(v_max),
+    }
+}
+
+/// Readings to 85° in one plane and 60° in the other leave 60–90° to the model in two
+/// half-planes (no reading reaches 90°: the light is seen from the front): the fit says how
+/// far each half-plane was read, and the IES file says it in `[OTHER]` and
+/// `[_MEASURED_GAMMA]`, the EULUMDAT file in its report line (8), both read back.
+#[test]
+fn written_files_say_where_the_table_is_extrapolated() {
+    let f = fit(&half_cos_falloff(85, 60, 5), ModelChoice::Auto).unwrap();
+    assert_eq!(f.measured_to_deg, Some([85.0, 60.0, 85.0, 60.0]));
+    let e = f.extrapolation().unwrap();
+    assert_eq!(e.beyond_deg, 60.0);
+    assert!(
+        e.sentence().contains("gamma above 60 deg")
+            && e.sentence()
+                .contains("C0 85 deg, C90 60 deg, C180 85 deg, C270 60 deg"),
+        "{}",
+        e.sentence()
+    );
+    let panel = Panel::new(0.3, 0.3, 1000.0).unwrap();
+    let info = IesInfo {
+        extrapolation: Some(e.clone()),
+        ..ies_info()
+    };
+    let text = ies::to_string(&f.table, &panel, &info);
+    assert!(
+        text.contains("\r\n[_MEASURED_GAMMA] C0 0-85 C90 0-60 C180 0-85 C270 0-60\r\n"),
+        "{text}"
+    );
+    let (_, p) = ies::parse(&text, Path::new("x.ies")).unwrap();
+    let other = p.labels.iter().find(|(k, _)| k == "OTHER").unwrap();
+    assert!(other
+        .1
+        .starts_with("gamma above 60 deg up to 90 deg is not measured"));
+    let ldt_text = ldt::to_string(
+        &f.table,
+        &panel,
+        &LdtInfo {
+            extrapolation: Some(e),
+            ..ldt_info()
+        },
+    );
+    let line8 = ldt_text.lines().nth(7).unwrap();
+    assert_eq!(
+        line8,
+        format!(
+            "fit of readings to gamma 60 deg; above, extrapolated by the {} model",
+            f.model
+        )
+    );
+    assert!(line8.chars().count() <= 78);
+    let (_, p) = ldt::parse(&ldt_text, Path::new("x.ldt")).unwrap();
+    assert!(p.labels.iter().any(|(k, v)| k == "report" && v == line8));
+
+    let far = fit(&half_cos_falloff(85, 85, 5), ModelChoice::Auto).unwrap();
+    assert_eq!(far.extrapolation().unwrap().beyond_deg, 85.0);
+}
+
+/// `light fit` as the guide gives it, with a Lambertian model named so that the figures
+/// are known by hand: the readings reach 60°, so the output says that 60–90° is not
+/// measured, and that π·I₀·cos²60° = 70.6858 lm of the π·I₀ = 282.7433 lm (I₀ = 90 cd),
+/// 25.0 %, come from there.
+#[test]
+fn light_fit_says_what_it_extrapolates() {
+    let dir = crate::support::unused_dir("extrapolated");
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = crate::support::root().join("data/light_falloff_9_angles.csv");
+    let arg = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let out = crate::support::metamer(&[
+        "light",
+        "fit",
+        "--falloff",
+        csv.to_str().unwrap(),
+        "--model",
+        "lambertian",
+        "-o",
+        &arg("LIGHT.json"),
+        "--ies",
+        &arg("light.ies"),
+        "--ldt",
+        &arg("light.ldt"),
+        "--width-m",
+        "0.3",
+        "--height-m",
+        "0.3",
+        "--luminance",
+        "1000",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains(
+            "note: gamma above 60 deg up to 90 deg is not measured: there the table is the \
+             lambertian model's extrapolation (readings reach 60 deg in C0, C90, C180 and \
+             C270)"
+        ),
+        "{stdout}"
+    );
+    assert!(stdout.contains("flux 282.7433 lm"), "{stdout}");
+    assert!(
+        stdout.contains(
+            "of which 70.6858 lm (25.0 %) above γ = 60°, where the table is extrapolated"
+        ),
+        "{stdout}"
+    );
+    let ies_text = std::fs::read_to_string(dir.join("light.ies")).unwrap();
+    assert!(
+        ies_text.contains("[OTHER] gamma above 60 deg"),
+        "{ies_text}"
+    );
+    let show = crate::support::metamer(&["light", "show", &arg("light.ldt")]);
+    let shown = String::from_utf8_lossy(&show.stdout);
+    assert!(
+        shown.contains("fit of readings to gamma 60 deg; above, extrapolated by the lambertian"),
+        "{shown}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

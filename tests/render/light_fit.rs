@@ -414,6 +414,7 @@ fn ies_held_out_error(f: &metamer::light::LdcFit, d: &Skewed) -> f64 {
         issue_date: "2026-12-02".into(),
         luminaire: d.name.into(),
         generation: "test".into(),
+        extrapolation: None,
     };
     let text = ies::to_string(&f.table, &panel, &info);
     let (table, p) = ies::parse(&text, Path::new("skewed.ies")).unwrap();

@@ -7,6 +7,7 @@ mod support;
 
 mod cie171;
 mod export_mitsuba;
+mod export_names;
 mod export_pbrt;
 mod export_round_trip;
 mod light_files;

@@ -9,7 +9,9 @@ use metamer::image::{write_xyz_image, XyzImage};
 use metamer::output::OutputPolicy;
 use serde_json::Value;
 
-use crate::support::{fresh_dir, metamer, scenes_dir, stderr, text};
+use crate::support::{
+    fresh_dir, metamer, scenes_dir, srgb_from_xyz, stderr, text, write_rgb_exr, XYZ_CHROMATICITIES,
+};
 
 /// The white `render spots` found for the built-in box by radiosity (cd/m²); given to the
 /// read-back so the refusals do not trace one first.
@@ -232,18 +234,42 @@ fn an_image_that_does_not_fit_the_scene_is_refused_naming_what_differs() {
         assert!(e.contains("outside 0.1–10"), "{e}");
     }
 
-    // OpenEXR's own statement of the unit.
-    let p = dir.join("nits.exr");
+    // A crop of the camera's frame: where its pixels sit is in the header, not the size.
+    let p = dir.join("crop.exr");
+    write_rgb_exr(
+        &p,
+        (64, 64),
+        (32, 32),
+        (128, 128),
+        Some(XYZ_CHROMATICITIES),
+        None,
+        |_, _| [17.0; 3],
+    );
+    let e = refusal(&p, None);
+    assert!(
+        e.contains(
+            "crop.exr: its data window (32, 32)–(95, 95) does not cover its display window \
+             (0, 0)–(127, 127)"
+        ),
+        "{e}"
+    );
+
+    // whiteLuminance is defined for RGB; on channels named X, Y, Z its meaning is a guess.
+    let p = dir.join("xyz-nits.exr");
     {
         use exr::prelude::*;
-        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (17.0f32, 17.0f32, 17.0f32));
+        let channels = SpecificChannels::build()
+            .with_channel("X")
+            .with_channel("Y")
+            .with_channel("Z")
+            .with_pixel_fn(|_: Vec2<usize>| (8.5f32, 8.5f32, 8.5f32));
         let mut image = Image::from_channels((128, 128), channels);
         image.layer_data.attributes.white_luminance = Some(2.0);
         image.write().to_file(&p).unwrap();
     }
     let e = refusal(&p, None);
     assert!(
-        e.contains("nits.exr: the OpenEXR attribute whiteLuminance is 2"),
+        e.contains("xyz-nits.exr: its whiteLuminance is 2, which OpenEXR defines for RGB"),
         "{e}"
     );
 
@@ -274,5 +300,152 @@ fn an_image_that_does_not_fit_the_scene_is_refused_naming_what_differs() {
     );
     let e = refusal(&good, Some(&scene_without(&dir, "camera")));
     assert!(e.contains("no-camera.json: the scene has no camera"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The 24 readings' XYZ of `image` read back against the built-in box with the given
+/// white.
+fn read_back(image: &Path) -> Vec<[f64; 3]> {
+    let v = run_json(&[
+        "render",
+        "spots-from-image",
+        image.to_str().unwrap(),
+        "--white",
+        WHITE,
+        "--json",
+    ]);
+    v["patches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| std::array::from_fn(|i| p["XYZ"][i].as_f64().unwrap()))
+        .collect()
+}
+
+/// What an OpenEXR header says of its pixels is what the read-back reads, each file's XYZ
+/// known by construction: whiteLuminance scales to cd/m², R, G, B without chromaticities
+/// are BT.709 with D65, and overscan around the display window is cut off.
+#[test]
+fn an_exr_header_is_read_as_openexr_defines_it() {
+    let dir = fresh_dir("exr-header");
+    // A uniform image reads, in every cone, its one XYZ.
+    let xyz = [16.0f64, 17.0, 18.5];
+    let uniform = |name: &str, got: Vec<[f64; 3]>, tolerance: f64| {
+        assert_eq!(got.len(), 24);
+        for (k, g) in got.iter().enumerate() {
+            for c in 0..3 {
+                assert!(
+                    (g[c] - xyz[c]).abs() <= tolerance * xyz[c],
+                    "{name}: patch {}: XYZ {g:?} against {xyz:?}",
+                    k + 1
+                );
+            }
+        }
+    };
+    let p = dir.join("nits.exr");
+    write_rgb_exr(
+        &p,
+        (128, 128),
+        (0, 0),
+        (128, 128),
+        Some(XYZ_CHROMATICITIES),
+        Some(2.0),
+        |_, _| xyz.map(|v| (v / 2.0) as f32),
+    );
+    // Halving and doubling are exact in binary; the cone's weighted mean rounds.
+    uniform("whiteLuminance 2", read_back(&p), 1e-6);
+    let p = dir.join("rec709.exr");
+    write_rgb_exr(&p, (128, 128), (0, 0), (128, 128), None, None, |_, _| {
+        srgb_from_xyz(xyz)
+    });
+    // The standard's four-decimal matrix is its exact inverse to a few parts in 10⁴.
+    uniform("no chromaticities", read_back(&p), 1e-3);
+
+    // A pattern, so a frame read from the wrong place reads other values.
+    let pattern = |x: usize, y: usize| {
+        let f = 1.0 + 0.3 * ((x as f64 / 7.0).sin() * (y as f64 / 5.0).cos());
+        xyz.map(|v| (v * f) as f32)
+    };
+    let plain = dir.join("plain.exr");
+    let img = XyzImage {
+        width: 128,
+        height: 128,
+        pixels: (0..128 * 128).map(|i| pattern(i % 128, i / 128)).collect(),
+    };
+    write_xyz_image(&plain, &img, &OutputPolicy::new(true)).unwrap();
+    let p = dir.join("overscan.exr");
+    write_rgb_exr(
+        &p,
+        (140, 136),
+        (-8, -4),
+        (128, 128),
+        Some(XYZ_CHROMATICITIES),
+        None,
+        |x, y| {
+            if (8..136).contains(&x) && (4..132).contains(&y) {
+                pattern(x - 8, y - 4)
+            } else {
+                [1e4; 3]
+            }
+        },
+    );
+    assert_eq!(read_back(&p), read_back(&plain));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A white traced for the read-back that stops at its time limit short of its target is
+/// used with a stated warning: on stderr, and in the JSON's `warnings` and `white_trace`.
+/// One that reaches its target says so and warns of nothing.
+#[test]
+fn a_white_cut_short_by_the_time_limit_is_a_stated_warning() {
+    let dir = fresh_dir("short-white");
+    let p = dir.join("box.pfm");
+    write(&p, 128, 128, [17.0; 3]);
+    let image = p.to_str().unwrap();
+    // A third of 0.0003 ΔE*ab takes the path tracer hours; it gets a second.
+    let o = metamer(&[
+        "render",
+        "spots-from-image",
+        image,
+        "--target-de",
+        "0.0003",
+        "--max-seconds",
+        "1",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("warning: the reference white stopped at the time limit (1 s)"),
+        "{e}"
+    );
+    let v: Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+    let trace = &v["white_trace"];
+    assert_eq!(trace["reached"], false, "{v}");
+    assert!(
+        (trace["target_de"].as_f64().unwrap() - 0.0001).abs() < 1e-12,
+        "{trace}"
+    );
+    assert!(trace["de_ci95"].as_f64().unwrap() > 0.0001, "{trace}");
+    assert!(trace["samples"].as_u64().unwrap() >= 2, "{trace}");
+    assert_eq!(trace["XYZ"], v["white"]);
+    let warnings = v["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1);
+    assert!(e.contains(warnings[0].as_str().unwrap()), "{e}");
+
+    let o = metamer(&[
+        "render",
+        "spots-from-image",
+        image,
+        "--target-de",
+        "6",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+    assert_eq!(v["white_trace"]["reached"], true, "{v}");
+    assert!(v["white_trace"]["de_ci95"].as_f64().unwrap() < 2.0);
+    assert_eq!(v["warnings"], Value::Array(vec![]));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use metamer::measure_box::simulated_box::{BoxOperator, SimulatedBox};
-use metamer::measure_box::{self, BoxDetails, BoxPlan, Instruments, Options, Outcome, Stage};
+use metamer::measure_box::{self, BoxDetails, BoxOptions, BoxPlan, BoxStage, Instruments, Outcome};
 use metamer::output::OutputPolicy;
 use metamer::rig::scenario::Scenario;
 use metamer::session::{NoProgress, RunEnd, RunOptions};
@@ -41,10 +41,10 @@ fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
         .open(Some(world.clone()))
         .unwrap();
     let mut operator = BoxOperator::new(truth, world);
-    let options = Options {
+    let options = BoxOptions {
         dir: dir.to_path_buf(),
         plan,
-        stage: Some(Stage::Tiles),
+        stage: Some(BoxStage::Tiles),
         resume,
         rig_options: BTreeMap::from([("seed".to_string(), SEED.to_string())]),
         details: BoxDetails {
@@ -71,7 +71,7 @@ fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
 
 /// The journal's entries without their wall-clock times, and its calibration records.
 fn journal(dir: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
-    let text = std::fs::read_to_string(Stage::Tiles.journal(dir)).unwrap();
+    let text = std::fs::read_to_string(BoxStage::Tiles.journal(dir)).unwrap();
     let (mut entries, mut calibrations) = (Vec::new(), Vec::new());
     for line in text.lines() {
         let mut v: serde_json::Value = serde_json::from_str(line).unwrap();

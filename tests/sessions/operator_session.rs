@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 
 use metamer::session::operator::placement_prompt;
 use metamer::session::{
-    Answer, InstrumentRecord, Operator, OperatorError, Prepare, Readings, Recheck, Rig, RunEnd,
-    RunOptions, Session, SessionPlan, Step, StepProgress,
+    Answer, InstrumentRecord, Operator, OperatorError, PlacementReadings, Prepare, Recheck, Rig,
+    RunEnd, RunOptions, Session, SessionPlan, Step, StepProgress,
 };
 use metamer_drivers::{
     CalibrationCondition, CalibrationOutcome, Capabilities, DriverError, Instrument,
@@ -104,7 +104,11 @@ impl Operator for Hands {
         self.prompts.push(prompt.into());
         Ok(Answer::Confirmed)
     }
-    fn ask_placement(&mut self, what: &str, readings: Readings) -> Result<Answer, OperatorError> {
+    fn ask_placement(
+        &mut self,
+        what: &str,
+        readings: PlacementReadings,
+    ) -> Result<Answer, OperatorError> {
         self.ask(&placement_prompt(what, readings))
     }
     fn recheck(&mut self, why: &str) -> Result<Recheck, OperatorError> {

@@ -1,18 +1,18 @@
 //! The full-screen patch window on a real X server (Xvfb): a screenshot of the monitor
 //! must show exactly the requested 8-bit RGB, every pixel. Each test starts its own Xvfb,
 //! which picks a free display number itself (`-displayfd`), so tests and parallel runs do
-//! not collide. Without Xvfb the tests are skipped with a reason, except in CI (`CI` set),
-//! where `.ci/run` installs it and a missing Xvfb is a failure.
+//! not collide. Without Xvfb the tests are skipped with a reason, unless
+//! `METAMER_ORACLES=required` (`.ci/run` installs it), when a missing Xvfb is a failure.
 
 use std::io::BufRead;
 use std::os::fd::FromRawFd;
 use std::process::{Child, Command, Stdio};
 
-use metamer::image::RgbImage;
+use metamer::image::Drive8Image;
 use metamer::rig::window::{list_monitors, WindowDisplay, WindowError};
 use metamer::rig::{Placement, Screen};
-use metamer::session::Screen as _;
 
+use crate::support::oracle::XVFB;
 use crate::support::unused_dir;
 
 struct Xvfb {
@@ -27,28 +27,15 @@ impl Drop for Xvfb {
     }
 }
 
-/// Starts `Xvfb -screen 0 WxHx24`, or None (with the reason printed) when Xvfb is not
-/// installed outside CI.
+/// Starts `Xvfb -screen 0 WxHx24`, or None (with the reason printed) when Xvfb is
+/// missing and not required (`support::oracle`).
 fn xvfb(width: u32, height: u32) -> Option<Xvfb> {
-    let installed = Command::new("Xvfb")
-        .arg("-help")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok();
-    if !installed {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "Xvfb is not installed but CI is set: .ci/run installs it (apt-get install xvfb)"
-        );
-        eprintln!("skipped: Xvfb is not installed (apt-get install xvfb); CI runs this test");
-        return None;
-    }
+    let xvfb = XVFB.find()?;
     let mut fds = [0; 2];
     // SAFETY: pipe writes two new descriptors into the array; without O_CLOEXEC the write
     // end is inherited by Xvfb, which reports its display number on it when ready.
     assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
-    let child = Command::new("Xvfb")
+    let child = Command::new(xvfb)
         .args(["-displayfd", &fds[1].to_string()])
         .args(["-screen", "0", &format!("{width}x{height}x24")])
         .args(["-nolisten", "tcp"])
@@ -121,7 +108,7 @@ fn an_image_is_shown_whole_scaled_to_fit() {
     let Some(x) = xvfb(640, 480) else { return };
     let mut window = WindowDisplay::open(Some(&x.display), 0).unwrap();
     let (a, b, c, d) = ([255, 0, 0], [0, 255, 0], [0, 0, 255], [10, 20, 30]);
-    let image = RgbImage::new(2, 2, vec![a, b, c, d]).unwrap();
+    let image = Drive8Image::new(2, 2, vec![a, b, c, d]).unwrap();
     let placement = window.show_image(&image).unwrap();
     assert_eq!(
         placement,

@@ -12,6 +12,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde_json::Value;
 
+pub mod oracle;
+
 /// The repository's root (the root package's manifest directory).
 pub fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -119,4 +121,50 @@ pub fn fresh_dir(tag: &str) -> PathBuf {
     let dir = unused_dir(tag);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// An OpenEXR file of R, G, B channels: `pixel(x, y)` over the data window at `data_at`
+/// (of `size`), inside a display window of `frame` at the origin, with the given
+/// `chromaticities` (none if None) and `whiteLuminance`.
+pub fn write_rgb_exr(
+    path: &std::path::Path,
+    size: (usize, usize),
+    data_at: (i32, i32),
+    frame: (usize, usize),
+    chromaticities: Option<[f32; 8]>,
+    white_luminance: Option<f32>,
+    pixel: impl Fn(usize, usize) -> [f32; 3] + Sync,
+) {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let v = pixel(p.x(), p.y());
+        (v[0], v[1], v[2])
+    });
+    let mut image = Image::from_channels(size, channels);
+    image.attributes.display_window = IntegerBounds::new(Vec2(0, 0), frame);
+    image.layer_data.attributes.layer_position = Vec2(data_at.0, data_at.1);
+    image.attributes.chromaticities =
+        chromaticities.map(|c| exr::meta::attribute::Chromaticities {
+            red: Vec2(c[0], c[1]),
+            green: Vec2(c[2], c[3]),
+            blue: Vec2(c[4], c[5]),
+            white: Vec2(c[6], c[7]),
+        });
+    image.layer_data.attributes.white_luminance = white_luminance;
+    image.write().to_file(path).unwrap();
+}
+
+/// XYZ's own chromaticities: R, G, B hold X, Y, Z.
+pub const XYZ_CHROMATICITIES: [f32; 8] = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0 / 3.0, 1.0 / 3.0];
+
+/// IEC 61966-2-1:1999 §5.2 (sRGB): linear R, G, B from XYZ (white Y = 1), as published to
+/// four decimals; BT.709's primaries and D65, which OpenEXR assumes for an RGB file
+/// without chromaticities.
+pub fn srgb_from_xyz(xyz: [f64; 3]) -> [f32; 3] {
+    let m = [
+        [3.2406, -1.5372, -0.4986],
+        [-0.9689, 1.8758, 0.0415],
+        [0.0557, -0.2040, 1.0570],
+    ];
+    std::array::from_fn(|r| (0..3).map(|c| m[r][c] * xyz[c]).sum::<f64>() as f32)
 }

@@ -6,6 +6,7 @@
 //! requested speed differs from the one last set, then `MES` per reading. Every exchange
 //! discards stale input first (PP and VCC do the same, [C2]).
 
+pub mod budget;
 pub mod emulator;
 pub mod error;
 pub mod open;
@@ -216,7 +217,12 @@ impl<L: SerialLink> Cs100a<L> {
                 "{error}; asking again (attempt {} of {ATTEMPTS})",
                 attempt + 1
             );
-            eprintln!("warning: {warning}");
+            // eprintln! would panic on a full stderr; the warning is kept in `rejected` for
+            // the session's record either way.
+            let _ = std::io::Write::write_fmt(
+                &mut std::io::stderr(),
+                format_args!("warning: {warning}\n"),
+            );
             self.rejected.push(warning);
         }
     }

@@ -24,14 +24,14 @@ use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Exposure};
 use metamer_protocols::i1pro::replies::MeasChar;
 use metamer_protocols::i1pro::{
     commands::{Setup, Transfer},
-    readings, Calibration, Gain, RawReading, Request, Revision, Spectrum as Bands, BANDS, CELLS,
+    readings, Calibration, Gain, GridSpectrum, RawReading, Request, Revision, BANDS, CELLS,
     SHIELDED_CELLS, START_NM, STEP_NM,
 };
 use metamer_protocols::transcript::TransferKind;
 
 use super::synthetic;
 use crate::link::usb::ControlSetup;
-use crate::link::usb_pair::{Answer, UsbDevice};
+use crate::link::usb_pair::{TransferAnswer, UsbDevice};
 use crate::world::{Light, View, World};
 
 /// Read noise of the simulated sensor, counts (1σ).
@@ -162,10 +162,13 @@ pub struct I1ProEmulator {
     noise: crate::noise::NoiseCursor,
     /// In low power; after the power-up reset, the GetMisc answers still to come in it.
     low_power: Option<(bool, u32)>,
+    /// The instrument's own time at the real unit's pace, whatever the time scale: every
+    /// measurement's integration (and lamp warm-up) adds to it.
+    real_pace: super::ManualClock,
 }
 
 /// The light a world gives as the instrument's 36 bands, mW·m⁻²·sr⁻¹·nm⁻¹.
-fn light_bands(light: &Light) -> Bands {
+fn light_bands(light: &Light) -> GridSpectrum {
     let s = match light {
         Light::Radiance(s) => s.clone(),
         Light::Xyz(xyz) => metamer_for(*xyz),
@@ -249,7 +252,14 @@ impl I1ProEmulator {
             mode: 1,
             pending: None,
             measurements: 0,
+            real_pace: super::ManualClock::new(),
         })
+    }
+
+    /// The clock the simulated unit's measurements advance at the real unit's pace (a
+    /// session's instrument time, also when it runs at `time_scale` 0).
+    pub fn real_pace_clock(&self) -> super::ManualClock {
+        self.real_pace.clone()
     }
 
     /// The handle a session moves the noise stream with (see
@@ -311,7 +321,7 @@ impl I1ProEmulator {
     }
 
     /// The resampled, uncalibrated values the instrument sees now.
-    fn seen(&self, lamp_on: bool) -> Result<Bands, String> {
+    fn seen(&self, lamp_on: bool) -> Result<GridSpectrum, String> {
         let cal = &self.cal;
         let err = |e: pipeline::PipelineError| e.to_string();
         let zero = [0.0; BANDS];
@@ -379,7 +389,7 @@ impl I1ProEmulator {
         readings::encode(&out, revision, synthetic::MAX_POSITIVE).map_err(|e| e.to_string())
     }
 
-    fn start(&mut self, t: f64, n: u64, lamp_on: bool) -> Answer<()> {
+    fn start(&mut self, t: f64, n: u64, lamp_on: bool) -> TransferAnswer<()> {
         match self.readings(t, n, lamp_on) {
             Ok(bytes) => {
                 let t = t * n as f64
@@ -388,12 +398,13 @@ impl I1ProEmulator {
                     } else {
                         0.0
                     };
+                self.real_pace.advance(t);
                 let delay = crate::link::duration_s(t * self.config.time_scale);
                 self.measurements += 1;
                 self.pending = Some((delay, bytes));
-                Answer::Done(())
+                TransferAnswer::Done(())
             }
-            Err(_) => Answer::Stall,
+            Err(_) => TransferAnswer::Stall,
         }
     }
 }
@@ -411,7 +422,7 @@ fn transfer_in(setup: ControlSetup, len: usize) -> Transfer {
 }
 
 impl UsbDevice for I1ProEmulator {
-    fn control_in(&mut self, setup: ControlSetup, len: usize) -> Answer<Vec<u8>> {
+    fn control_in(&mut self, setup: ControlSetup, len: usize) -> TransferAnswer<Vec<u8>> {
         let revision = self.config.revision;
         match Request::decode(&transfer_in(setup, len), revision) {
             Ok(Request::GetMisc) => {
@@ -423,21 +434,21 @@ impl UsbDevice for I1ProEmulator {
                         self.low_power = left.checked_sub(1).filter(|n| *n > 0).map(|n| (true, n));
                     }
                 }
-                Answer::Done(misc.encode().to_vec())
+                TransferAnswer::Done(misc.encode().to_vec())
             }
             Ok(Request::GetClockMode) if self.config.has_clock_modes() => {
-                Answer::Done(self.clock_mode().encode().to_vec())
+                TransferAnswer::Done(self.clock_mode().encode().to_vec())
             }
-            Ok(Request::GetMeasChar) => Answer::Done(MeasChar::KNOWN.encode().to_vec()),
+            Ok(Request::GetMeasChar) => TransferAnswer::Done(MeasChar::KNOWN.encode().to_vec()),
             Ok(Request::GetEepromSize) => {
-                Answer::Done((self.image.len() as u32).to_be_bytes().to_vec())
+                TransferAnswer::Done((self.image.len() as u32).to_be_bytes().to_vec())
             }
-            Ok(Request::GetChipId) => Answer::Done(vec![0; 8]),
-            _ => Answer::Stall,
+            Ok(Request::GetChipId) => TransferAnswer::Done(vec![0; 8]),
+            _ => TransferAnswer::Stall,
         }
     }
 
-    fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> Answer<()> {
+    fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> TransferAnswer<()> {
         let transfer = Transfer::Out {
             setup: Setup {
                 request_type: setup.request_type,
@@ -453,25 +464,25 @@ impl UsbDevice for I1ProEmulator {
                 if mask == metamer_protocols::i1pro::commands::RESET_POWER {
                     self.low_power = self.low_power.map(|(_, n)| (true, n));
                 }
-                Answer::Done(())
+                TransferAnswer::Done(())
             }
             Ok(Request::ReadEeprom { address, length }) => {
                 let (a, l) = (address as usize, usize::from(length));
                 match self.image.get(a..a + l) {
                     Some(bytes) => {
                         self.pending = Some((Duration::ZERO, bytes.to_vec()));
-                        Answer::Done(())
+                        TransferAnswer::Done(())
                     }
-                    None => Answer::Stall,
+                    None => TransferAnswer::Stall,
                 }
             }
             Ok(Request::SetClockMode(m))
                 if self.config.has_clock_modes() && (1..=self.config.clock_modes).contains(&m) =>
             {
                 self.mode = m;
-                Answer::Done(())
+                TransferAnswer::Done(())
             }
-            Ok(Request::SetClockMode(_)) => Answer::Stall,
+            Ok(Request::SetClockMode(_)) => TransferAnswer::Stall,
             Ok(Request::SetMeasParams(p)) => match self.integration(u64::from(p.int_clocks)) {
                 Some(t) => {
                     self.params = (
@@ -479,16 +490,16 @@ impl UsbDevice for I1ProEmulator {
                         u64::from(p.readings),
                         p.flags & metamer_protocols::i1pro::commands::flags::LAMP_OFF == 0,
                     );
-                    Answer::Done(())
+                    TransferAnswer::Done(())
                 }
-                None => Answer::Stall,
+                None => TransferAnswer::Stall,
             },
             Ok(Request::Trigger)
                 if self.config.fault == Some(Fault::StallTrigger(self.measurements + 1)) =>
             {
-                Answer::Stall
+                TransferAnswer::Stall
             }
-            Ok(Request::Trigger) if self.params.1 == 0 => Answer::Stall,
+            Ok(Request::Trigger) if self.params.1 == 0 => TransferAnswer::Stall,
             Ok(Request::Trigger) => {
                 let (t, n, lamp_on) = self.params;
                 self.start(t, n, lamp_on)
@@ -498,19 +509,19 @@ impl UsbDevice for I1ProEmulator {
                     let lamp_on = p.flags & metamer_protocols::i1pro::commands::flags_e::LAMP != 0;
                     self.start(t, u64::from(p.readings), lamp_on)
                 }
-                None => Answer::Stall,
+                None => TransferAnswer::Stall,
             },
-            Ok(_) => Answer::Done(()),
-            Err(_) => Answer::Stall,
+            Ok(_) => TransferAnswer::Done(()),
+            Err(_) => TransferAnswer::Stall,
         }
     }
 
-    fn read(&mut self, kind: TransferKind, endpoint: u8, len: usize) -> Answer<Vec<u8>> {
+    fn read(&mut self, kind: TransferKind, endpoint: u8, len: usize) -> TransferAnswer<Vec<u8>> {
         if kind != TransferKind::Bulk || endpoint != EP_DATA_IN {
-            return Answer::Silent;
+            return TransferAnswer::Silent;
         }
         let Some((delay, mut bytes)) = self.pending.take() else {
-            return Answer::Silent;
+            return TransferAnswer::Silent;
         };
         let scaled = |d: Duration| d;
         match self.config.fault {
@@ -518,16 +529,16 @@ impl UsbDevice for I1ProEmulator {
                 bytes.truncate(bytes.len() / 2);
             }
             Some(Fault::DisconnectMidRead(n)) if n == self.measurements => {
-                return Answer::Disconnect
+                return TransferAnswer::Disconnect
             }
-            Some(Fault::SilentRead(n)) if n == self.measurements => return Answer::Silent,
+            Some(Fault::SilentRead(n)) if n == self.measurements => return TransferAnswer::Silent,
             _ => {}
         }
         bytes.truncate(len);
-        Answer::After(scaled(delay), bytes)
+        TransferAnswer::After(scaled(delay), bytes)
     }
 
-    fn write(&mut self, _kind: TransferKind, _endpoint: u8, _data: &[u8]) -> Answer<()> {
-        Answer::Stall
+    fn write(&mut self, _kind: TransferKind, _endpoint: u8, _data: &[u8]) -> TransferAnswer<()> {
+        TransferAnswer::Stall
     }
 }

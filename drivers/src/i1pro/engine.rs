@@ -3,7 +3,7 @@
 //! the order the instrument needs them).
 
 use metamer_protocols::i1pro::pipeline::{self, AbsRaw, Averaged, Exposure};
-use metamer_protocols::i1pro::{Calibration, Gain, RawReading, Revision, Spectrum, CELLS};
+use metamer_protocols::i1pro::{Calibration, Gain, GridSpectrum, RawReading, Revision, CELLS};
 
 use super::error::I1ProError;
 use super::wire::{Shot, Wire};
@@ -36,6 +36,16 @@ pub const MAX_READINGS: usize = 16;
 /// A light is too dark when its counts summed over the cells stay within this many
 /// standard deviations of the sensor's noise at the longest time.
 pub const TOO_DARK_SIGMAS: f64 = 5.0;
+/// A light too dim for one reading at the longest time is read this many times at it in
+/// all (12 s), so that a display's black and near-black patches are readings with their
+/// larger uncertainty rather than errors: the floor falls to √(1/6 + 1/9) / √(1 + 1/9) =
+/// 0.53 of one reading's, which puts the ideal-crt preset's black (0.05 cd/m², 4.3σ of one
+/// reading) 3.4σ above it; four readings would leave it 2.5σ above, and fail one black in
+/// 160. ArgyllCMS reads a dim patch longer too (its
+/// adaptive emissive mode integrates past 2 s up to the unit's maximum when the light is
+/// far below the sensor target [C2 `i1pro_optimise_sensor`]); more readings at 2 s need no
+/// other dark than the calibration's, whose noise then limits what further readings gain.
+pub const DARK_PATCH_READINGS: usize = 6;
 /// No reading is more precise than its rounding to whole counts: 1/√12 count.
 const QUANTISATION_COUNTS: f64 = 0.288_675_134_594_812_9;
 
@@ -97,7 +107,9 @@ impl DarkPair {
 
 /// A finished emissive or reflective shot: the resampled spectrum and what averaging saw.
 pub struct Processed {
-    pub spectrum: Spectrum,
+    /// The raw readings, so that more readings of the same exposure can join them.
+    pub raw: Vec<RawReading>,
+    pub spectrum: GridSpectrum,
     pub averaged: Averaged,
     pub integration_s: f64,
     pub readings: usize,
@@ -223,6 +235,17 @@ pub fn process<L: UsbLink>(
         readings,
         lamp,
     })?;
+    processed(cal, raw, t, dark)
+}
+
+/// Steps 1–5 of the pipeline on the readings of one exposure at `t`.
+fn processed(
+    cal: &Calibration,
+    raw: Vec<RawReading>,
+    t: f64,
+    dark: &AbsRaw,
+) -> Result<Processed, DriverError> {
+    let readings = raw.len();
     let e = exposure(t);
     let (spectrum, averaged) = pipeline::measure(cal, &raw, dark, &e).map_err(I1ProError::from)?;
     let signal_counts = averaged.mean.cells[used_cells(cal.revision())]
@@ -230,6 +253,7 @@ pub fn process<L: UsbLink>(
         .sum::<f64>()
         * t;
     Ok(Processed {
+        raw,
         spectrum,
         peak_counts: averaged.highest * t,
         signal_counts,
@@ -297,20 +321,60 @@ pub fn emissive_shot<L: UsbLink>(
         return Err(too_bright().into());
     }
     if t >= max * 0.999 {
-        let noise = darks.noise(t, p.readings);
-        let cells = used_cells(cal.revision()).len() as f64;
-        let floor =
-            TOO_DARK_SIGMAS * (noise.floor.powi(2) + noise.dark.powi(2)).sqrt() * cells.sqrt();
-        if p.signal_counts < floor {
-            return Err(I1ProError::TooDark {
-                max_s: max,
-                signal: p.signal_counts,
-                floor,
-            }
-            .into());
-        }
+        return check(dim(wire, cal, darks, p, max)?);
     }
     check(p)
+}
+
+/// The light's noise floor at `t` over `readings`: [`TOO_DARK_SIGMAS`] standard deviations
+/// of the sum over the cells of the readings' mean, the subtracted dark's noise included.
+fn too_dark_floor(darks: &DarkPair, cal: &Calibration, t: f64, readings: usize) -> f64 {
+    let noise = darks.noise(t, readings);
+    let cells = used_cells(cal.revision()).len() as f64;
+    TOO_DARK_SIGMAS * (noise.floor.powi(2) + noise.dark.powi(2)).sqrt() * cells.sqrt()
+}
+
+/// A reading at the longest time `t`: kept when its light stands above the noise floor;
+/// otherwise, when more readings could lift it above theirs, read [`DARK_PATCH_READINGS`]
+/// times in all (a display's black); "too dark" when it still does not stand out. Where
+/// even a first reading one standard deviation higher could not reach the lower floor of
+/// the longer measurement, nothing is gained by it (a capped sensor, a meter facing away).
+fn dim<L: UsbLink>(
+    wire: &mut Wire<L>,
+    cal: &Calibration,
+    darks: &DarkPair,
+    p: Processed,
+    t: f64,
+) -> Result<Processed, DriverError> {
+    let floor = too_dark_floor(darks, cal, t, p.readings);
+    if p.signal_counts >= floor {
+        return Ok(p);
+    }
+    let sigma = floor / TOO_DARK_SIGMAS;
+    let longer = too_dark_floor(darks, cal, t, DARK_PATCH_READINGS.max(p.readings));
+    let p = if p.readings < DARK_PATCH_READINGS && p.signal_counts + sigma >= longer {
+        let more = wire.shot(Shot {
+            integration_s: t,
+            readings: DARK_PATCH_READINGS - p.readings,
+            lamp: false,
+        })?;
+        let mut raw = p.raw;
+        raw.extend(more);
+        processed(cal, raw, t, &darks.at(t)?)?
+    } else {
+        p
+    };
+    let floor = too_dark_floor(darks, cal, t, p.readings);
+    if p.signal_counts < floor {
+        return Err(I1ProError::TooDark {
+            max_s: t,
+            readings: p.readings,
+            signal: p.signal_counts,
+            floor,
+        }
+        .into());
+    }
+    Ok(p)
 }
 
 fn check(p: Processed) -> Result<Processed, DriverError> {
@@ -325,7 +389,7 @@ pub fn white<L: UsbLink>(
     wire: &mut Wire<L>,
     cal: &Calibration,
     dark: &AbsRaw,
-) -> Result<Spectrum, DriverError> {
+) -> Result<GridSpectrum, DriverError> {
     let t = quantize(wire, REFLECTIVE_S)?;
     let p = process(wire, cal, t, REFLECTIVE_READINGS, true, dark)?;
     if p.averaged.saturated {
@@ -350,8 +414,8 @@ pub fn reflective<L: UsbLink>(
     wire: &mut Wire<L>,
     cal: &Calibration,
     dark: &AbsRaw,
-    factors: &Spectrum,
-) -> Result<(Spectrum, Processed), DriverError> {
+    factors: &GridSpectrum,
+) -> Result<(GridSpectrum, Processed), DriverError> {
     let t = quantize(wire, REFLECTIVE_S)?;
     let p = check(process(wire, cal, t, REFLECTIVE_READINGS, true, dark)?)?;
     Ok((pipeline::reflective(&p.spectrum, factors), p))

@@ -59,8 +59,14 @@ pub enum I1ProError {
     #[error("the i1Pro's sensor saturated at the fixed integration time of {integration_s} s; set a shorter integration time or let the instrument choose it (auto)")]
     SaturatedAtFixedTime { integration_s: f64 },
     /// No light distinguishable from the sensor's noise even at the longest integration time.
-    #[error("too dark for the i1Pro: even at its longest integration time of {max_s:.3} s the light gives {:.0} counts over all cells, within the sensor's noise ({floor:.0} counts, 5σ); check that the instrument faces the light source and nothing covers it", whole(.signal))]
-    TooDark { max_s: f64, signal: f64, floor: f64 },
+    #[error("too dark for the i1Pro: even at its longest integration time of {max_s:.3} s{} the light gives {:.0} counts over all cells, within the sensor's noise ({floor:.0} counts, 5σ); check that the instrument faces the light source and nothing covers it", over(*.readings), whole(.signal))]
+    TooDark {
+        max_s: f64,
+        /// Readings averaged at it (more than one for a dim light worth reading longer).
+        readings: usize,
+        signal: f64,
+        floor: f64,
+    },
     /// A dark calibration saw light.
     #[error("the dark calibration saw light (mean {mean:.0} counts/s, limit {limit:.0}): place the instrument on its white tile, which covers the sensor, and calibrate again")]
     DarkNotDark { mean: f64, limit: f64 },
@@ -84,6 +90,15 @@ pub enum I1ProError {
 /// Rounded counts as they print, without a "-0" for a sum that is a hair below zero.
 fn whole(c: &f64) -> f64 {
     c.round() + 0.0
+}
+
+/// How many readings a "too dark" verdict averaged, where more than one.
+fn over(readings: usize) -> String {
+    if readings > 1 {
+        format!(", averaged over {readings} readings,")
+    } else {
+        String::new()
+    }
 }
 
 fn ms(s: &f64) -> f64 {

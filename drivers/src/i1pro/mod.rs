@@ -8,6 +8,7 @@
 //! Not done: the Rev E wavelength re-calibration with its LED (the factory mapping from the
 //! EEPROM is used as it is), high gain, scans, and restoring calibrations from the EEPROM.
 
+pub mod budget;
 pub mod clock;
 pub mod emulator;
 mod engine;
@@ -26,8 +27,8 @@ use metamer_protocols::i1pro::pipeline::{self, AbsRaw};
 use metamer_protocols::i1pro::replies::{MeasChar, Misc};
 use metamer_protocols::i1pro::timing::ClockUnit;
 use metamer_protocols::i1pro::{
-    commands, eeprom, replies, wavelength, Calibration, Eeprom, Model, Request, Revision,
-    Spectrum as Bands, BANDS, START_NM, STEP_NM,
+    commands, eeprom, replies, wavelength, Calibration, Eeprom, GridSpectrum, Model, Request,
+    Revision, BANDS, START_NM, STEP_NM,
 };
 
 pub use clock::{Clock, ManualClock, ScaledClock, SystemClock};
@@ -38,7 +39,6 @@ use self::wire::Wire;
 use crate::instrument::{
     now_s, CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag,
     Instrument, InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading,
-    Request as MeasureRequest,
 };
 use crate::link::usb::UsbLink;
 use crate::DriverError;
@@ -66,7 +66,7 @@ pub struct I1Pro<L: UsbLink> {
     /// has no ambient mode.
     ambient_table: AmbientTable,
     /// Reflective calibration factors per band, and when they were made.
-    white: Option<(Bands, f64)>,
+    white: Option<(GridSpectrum, f64)>,
 }
 
 fn revision_name(r: Revision) -> &'static str {
@@ -399,7 +399,7 @@ impl<L: UsbLink> Instrument for I1Pro<L> {
         Ok(CalibrationOutcome::Done)
     }
 
-    fn measure(&mut self, request: &MeasureRequest) -> Result<Reading, DriverError> {
+    fn measure(&mut self, request: &crate::instrument::Request) -> Result<Reading, DriverError> {
         let mode = request.mode;
         if !self.supports(mode) {
             return Err(self.unsupported(mode));

@@ -17,7 +17,7 @@ use super::wire::Shot;
 use super::{I1Pro, ManualClock};
 use crate::instrument::{CalibrationCondition, Instrument, MeasureMode};
 use crate::link::usb::{ControlSetup, UsbLink};
-use crate::link::usb_pair::{usb_pair, Answer, UsbDevice, UsbPairHost};
+use crate::link::usb_pair::{usb_pair, TransferAnswer, UsbDevice, UsbPairHost};
 use crate::world::{SharedWorld, View, World};
 use crate::{DriverError, Request as MeasureRequest};
 
@@ -68,7 +68,7 @@ fn setup(request_type: u8, request: u8) -> ControlSetup {
 }
 
 /// Sends an OUT request straight to the emulator, as a host that ignored the rules would.
-fn send(device: &mut I1ProEmulator, r: Request, revision: Revision) -> Answer<()> {
+fn send(device: &mut I1ProEmulator, r: Request, revision: Revision) -> TransferAnswer<()> {
     match r.encode(revision).unwrap() {
         Transfer::Out { setup: s, data } => device.control_out(
             ControlSetup {
@@ -92,8 +92,8 @@ fn params(int_clocks: u16) -> Request {
     })
 }
 
-fn done(a: Answer<()>) -> bool {
-    matches!(a, Answer::Done(()))
+fn done(a: TransferAnswer<()>) -> bool {
+    matches!(a, TransferAnswer::Done(()))
 }
 
 #[test]
@@ -127,7 +127,7 @@ fn the_emulator_refuses_integrations_below_one_sub_clock_of_the_mode_in_force() 
     assert!(!done(send(&mut dev, Request::SetClockMode(1), d)));
     assert!(matches!(
         dev.control_in(setup(0xC0, 0xD1), 6),
-        Answer::Stall
+        TransferAnswer::Stall
     ));
     // Rev E: 36 µs × 136; 135 clocks refused.
     let e = Revision::E;

@@ -50,7 +50,7 @@ pub struct Wire<L> {
     pub max_positive: u16,
     /// The unit's usable clock modes, mode 1 first: one on Rev E and on firmware before
     /// 301, as many as GetClockMode reports (less those in "subtract mode") after.
-    pub modes: Vec<Mode>,
+    pub modes: Vec<ClockChoice>,
     /// Index in `modes` of the mode in force.
     current: usize,
     /// Firmware revision, for the timeout rule of firmware 200–399.
@@ -64,7 +64,7 @@ pub struct Wire<L> {
 
 /// One clock mode the driver may select.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Mode {
+pub struct ClockChoice {
     /// The number SetClockMode selects it by; None where the clock cannot be changed.
     pub number: Option<u8>,
     pub unit: ClockUnit,
@@ -72,7 +72,7 @@ pub struct Mode {
 
 /// An integration time as the instrument will run it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plan {
+pub struct IntegrationPlan {
     /// Index in [`Wire::modes`].
     pub mode: usize,
     pub clocks: u64,
@@ -96,7 +96,7 @@ impl<L: UsbLink> Wire<L> {
             link,
             revision,
             max_positive: u16::MAX,
-            modes: vec![Mode {
+            modes: vec![ClockChoice {
                 number: None,
                 unit: CLOCK_BEFORE_301,
             }],
@@ -142,7 +142,7 @@ impl<L: UsbLink> Wire<L> {
 
     /// A unit whose clock cannot be changed (Rev E, and firmware before 301).
     pub fn fixed_clock(&mut self, unit: ClockUnit) {
-        self.modes = vec![Mode { number: None, unit }];
+        self.modes = vec![ClockChoice { number: None, unit }];
         self.current = 0;
     }
 
@@ -163,14 +163,14 @@ impl<L: UsbLink> Wire<L> {
     /// The clock mode and clock count that integrate `t`: the first mode in which `t` is at
     /// least one sub-clock (see [`timing::pick_mode`]). A time no mode can run is an error
     /// before anything is sent, never a request the unit would have to refuse.
-    pub fn plan(&self, t: f64) -> Result<Plan, I1ProError> {
+    pub fn plan(&self, t: f64) -> Result<IntegrationPlan, I1ProError> {
         let units: Vec<ClockUnit> = self.modes.iter().map(|m| m.unit).collect();
         let (mode, clocks) =
             timing::pick_mode(&units, t, self.max_clocks()).ok_or(I1ProError::IntegrationTime {
                 seconds: t,
                 shortest_s: self.shortest_s(),
             })?;
-        Ok(Plan {
+        Ok(IntegrationPlan {
             mode,
             clocks,
             integration_s: clocks as f64 * units[mode].clock_s,
@@ -192,10 +192,10 @@ impl<L: UsbLink> Wire<L> {
                 found.push((number, self.set_clock_mode(number)?));
             }
         }
-        let modes: Vec<Mode> = found
+        let modes: Vec<ClockChoice> = found
             .iter()
             .filter(|(_, c)| !c.subtract_mode())
-            .map(|(number, c)| Mode {
+            .map(|(number, c)| ClockChoice {
                 number: (first.max > 1).then_some(*number),
                 unit: ClockUnit {
                     clock_s: c.clock_s(),

@@ -2,7 +2,7 @@
 //! emulated device on its own thread, so a USB instrument's emulator sits behind the real
 //! driver as the CS-100A emulator does behind its serial pair.
 //!
-//! The device answers each transfer with an [`Answer`]: data (after a delay it chooses, as
+//! The device answers each transfer with a [`TransferAnswer`]: data (after a delay it chooses, as
 //! an instrument that is integrating), a stall, silence, or a disconnect. The host end
 //! waits no longer than each transfer's timeout, as libusb does; a transfer the device
 //! answers too late fails with [`LinkError::Timeout`] and its late answer is dropped, never
@@ -20,7 +20,7 @@ use super::LinkError;
 
 /// How an emulated device answers one transfer.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Answer<T> {
+pub enum TransferAnswer<T> {
     /// Completes at once with this result.
     Done(T),
     /// Completes with this result after the device has worked this long.
@@ -34,14 +34,14 @@ pub enum Answer<T> {
     Disconnect,
 }
 
-impl<T> Answer<T> {
-    fn map<U>(self, f: impl FnOnce(T) -> U) -> Answer<U> {
+impl<T> TransferAnswer<T> {
+    fn map<U>(self, f: impl FnOnce(T) -> U) -> TransferAnswer<U> {
         match self {
-            Answer::Done(t) => Answer::Done(f(t)),
-            Answer::After(d, t) => Answer::After(d, f(t)),
-            Answer::Stall => Answer::Stall,
-            Answer::Silent => Answer::Silent,
-            Answer::Disconnect => Answer::Disconnect,
+            TransferAnswer::Done(t) => TransferAnswer::Done(f(t)),
+            TransferAnswer::After(d, t) => TransferAnswer::After(d, f(t)),
+            TransferAnswer::Stall => TransferAnswer::Stall,
+            TransferAnswer::Silent => TransferAnswer::Silent,
+            TransferAnswer::Disconnect => TransferAnswer::Disconnect,
         }
     }
 }
@@ -51,13 +51,13 @@ impl<T> Answer<T> {
 pub trait UsbDevice: Send + 'static {
     /// A control transfer device → host asking for at most `len` bytes (more are cut, as
     /// the host's wLength limits what a device may send).
-    fn control_in(&mut self, setup: ControlSetup, len: usize) -> Answer<Vec<u8>>;
+    fn control_in(&mut self, setup: ControlSetup, len: usize) -> TransferAnswer<Vec<u8>>;
     /// A control transfer host → device.
-    fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> Answer<()>;
+    fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> TransferAnswer<()>;
     /// A bulk or interrupt read of at most `len` bytes from IN endpoint `endpoint`.
-    fn read(&mut self, kind: TransferKind, endpoint: u8, len: usize) -> Answer<Vec<u8>>;
+    fn read(&mut self, kind: TransferKind, endpoint: u8, len: usize) -> TransferAnswer<Vec<u8>>;
     /// A bulk or interrupt write to OUT endpoint `endpoint`.
-    fn write(&mut self, kind: TransferKind, endpoint: u8, data: &[u8]) -> Answer<()>;
+    fn write(&mut self, kind: TransferKind, endpoint: u8, data: &[u8]) -> TransferAnswer<()>;
 }
 
 /// One transfer on its way to the device.
@@ -132,19 +132,19 @@ fn serve<D: UsbDevice>(mut device: D, rx: Receiver<Request>) -> D {
             }
         };
         let outcome = match answer {
-            Answer::Done(data) => Outcome::Data(data),
-            Answer::After(delay, data) => {
+            TransferAnswer::Done(data) => Outcome::Data(data),
+            TransferAnswer::After(delay, data) => {
                 std::thread::sleep(delay);
                 Outcome::Data(data)
             }
-            Answer::Stall => Outcome::Stall,
-            Answer::Silent => {
+            TransferAnswer::Stall => Outcome::Stall,
+            TransferAnswer::Silent => {
                 unanswered = Some(reply);
                 continue;
             }
             // Leaving drops both channels: this transfer and all later ones see a
             // disconnect.
-            Answer::Disconnect => break,
+            TransferAnswer::Disconnect => break,
         };
         // The host may have given up already (timeout); the answer is then dropped here.
         let _ = reply.send(outcome);
@@ -283,42 +283,52 @@ mod tests {
     }
 
     impl UsbDevice for Toy {
-        fn control_in(&mut self, setup: ControlSetup, _len: usize) -> Answer<Vec<u8>> {
+        fn control_in(&mut self, setup: ControlSetup, _len: usize) -> TransferAnswer<Vec<u8>> {
             self.transfers += 1;
             match setup.request {
-                ECHO_FETCH => Answer::Done(self.stored.clone()),
-                _ => Answer::Stall,
+                ECHO_FETCH => TransferAnswer::Done(self.stored.clone()),
+                _ => TransferAnswer::Stall,
             }
         }
 
-        fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> Answer<()> {
+        fn control_out(&mut self, setup: ControlSetup, data: &[u8]) -> TransferAnswer<()> {
             self.transfers += 1;
             match setup.request {
                 ECHO_STORE => {
                     self.stored = data.to_vec();
-                    Answer::Done(())
+                    TransferAnswer::Done(())
                 }
                 TRIGGER => {
                     self.triggered = true;
-                    Answer::Done(())
+                    TransferAnswer::Done(())
                 }
-                UNPLUG => Answer::Disconnect,
-                _ => Answer::Stall,
+                UNPLUG => TransferAnswer::Disconnect,
+                _ => TransferAnswer::Stall,
             }
         }
 
-        fn read(&mut self, _kind: TransferKind, endpoint: u8, _len: usize) -> Answer<Vec<u8>> {
+        fn read(
+            &mut self,
+            _kind: TransferKind,
+            endpoint: u8,
+            _len: usize,
+        ) -> TransferAnswer<Vec<u8>> {
             self.transfers += 1;
             if endpoint != DATA_IN || !self.triggered {
-                return Answer::Silent;
+                return TransferAnswer::Silent;
             }
             self.triggered = false;
-            Answer::After(WORK, vec![1, 2, 3, 4])
+            TransferAnswer::After(WORK, vec![1, 2, 3, 4])
         }
 
-        fn write(&mut self, _kind: TransferKind, _endpoint: u8, _data: &[u8]) -> Answer<()> {
+        fn write(
+            &mut self,
+            _kind: TransferKind,
+            _endpoint: u8,
+            _data: &[u8],
+        ) -> TransferAnswer<()> {
             self.transfers += 1;
-            Answer::Stall
+            TransferAnswer::Stall
         }
     }
 

@@ -62,11 +62,6 @@ pub struct Real {
     pub open: OpenReal,
 }
 
-/// Seconds one reading in a mode takes on a target of a luminance (cd/m²; white = 100 in
-/// reflective mode) at the model's default options, from its driver's protocol facts; None
-/// where the model does not measure in that mode.
-pub type ReadingTime = fn(MeasureMode, f64) -> Option<f64>;
-
 /// A word people use for a model that is not one of its spec prefixes (`i1pro2`): a spec
 /// using it is refused with how to name the model instead.
 #[derive(Clone, Copy, Debug)]
@@ -107,8 +102,9 @@ pub struct Model {
     pub modes: &'static [MeasureMode],
     /// Its stated repeatability in each mode it states one for (1σ of one reading).
     pub repeatability: &'static [(MeasureMode, Repeatability)],
-    /// How long one reading takes; None until its driver states it.
-    pub reading_time: Option<ReadingTime>,
+    /// How long its readings and calibrations take, from its protocol facts
+    /// ([`crate::budget`]); None while metamer has no driver for it.
+    pub time_budget: Option<crate::budget::TimeBudgetFn>,
     /// Words for it that are not spec prefixes, refused with how to name it.
     pub other_names: &'static [OtherName],
     /// Why metamer does not drive it; None where it does.
@@ -258,7 +254,7 @@ pub const MODELS: &[Model] = &[
         described_by: &[("CS-100A", "")],
         modes: &[MeasureMode::Emissive],
         repeatability: &[(MeasureMode::Emissive, CS100A_EMISSIVE)],
-        reading_time: None,
+        time_budget: Some(crate::cs100a::budget::time_budget),
         other_names: &[],
         unsupported: None,
     },
@@ -293,7 +289,7 @@ pub const MODELS: &[Model] = &[
             (MeasureMode::Reflective, I1PRO_REFLECTIVE),
             (MeasureMode::Ambient, I1PRO_AMBIENT),
         ],
-        reading_time: None,
+        time_budget: Some(crate::i1pro::budget::time_budget),
         // The i1Pro 2 is the Rev E unit on the same USB ID; the driver reads both
         // (protocols/i1pro/README.md, "Models").
         other_names: &[OtherName {
@@ -319,7 +315,7 @@ pub const MODELS: &[Model] = &[
         described_by: &[],
         modes: &[],
         repeatability: &[],
-        reading_time: None,
+        time_budget: None,
         other_names: &[],
         unsupported: Some(
             "it speaks a USB protocol of its own (ArgyllCMS drives it with a separate driver, \
@@ -343,7 +339,7 @@ pub const MODELS: &[Model] = &[
         described_by: &[],
         modes: &[],
         repeatability: &[],
-        reading_time: None,
+        time_budget: None,
         other_names: &[],
         unsupported: Some("metamer has no codec for its protocol"),
     },
@@ -363,7 +359,7 @@ pub const MODELS: &[Model] = &[
         described_by: &[],
         modes: &[],
         repeatability: &[],
-        reading_time: None,
+        time_budget: None,
         other_names: &[],
         unsupported: Some("metamer has no codec for its HID protocol"),
     },
@@ -435,6 +431,30 @@ pub fn spec_forms() -> String {
     }
 }
 
+/// The time budget of model `name` (a registry name: `i1pro`, `cs100a`).
+pub fn time_budget(
+    name: &str,
+    query: &crate::budget::TimeQuery,
+) -> Result<crate::budget::TimeBudget, DriverError> {
+    let model = by_name(name).ok_or_else(|| DriverError::UnknownSpec {
+        spec: name.to_string(),
+        expected: spec_forms(),
+    })?;
+    let budget = model.time_budget.ok_or_else(|| DriverError::Unsupported {
+        instrument: name.to_string(),
+        what: "a time budget (metamer has no driver for it)".into(),
+    })?;
+    if !query.luminance_cd_m2.is_finite() || query.luminance_cd_m2 < 0.0 {
+        return Err(DriverError::BadOption {
+            instrument: name.to_string(),
+            option: "expected luminance".into(),
+            value: query.luminance_cd_m2.to_string(),
+            message: "expected a luminance of 0 or more".into(),
+        });
+    }
+    budget(query)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -462,9 +482,11 @@ mod tests {
         for m in MODELS.iter().filter(|m| m.real.is_some()) {
             assert!(!m.spec_prefixes.is_empty(), "{}", m.name);
         }
-        // A model metamer does not drive says why; one it drives does not.
+        // A model metamer does not drive says why; one it drives does not, and states how
+        // long its readings take.
         for m in MODELS {
             assert_eq!(m.real.is_none(), m.unsupported.is_some(), "{}", m.name);
+            assert_eq!(m.real.is_some(), m.time_budget.is_some(), "{}", m.name);
         }
         // Another word for a model is nobody's name or prefix.
         for word in MODELS.iter().flat_map(|m| m.other_names).map(|o| o.word) {

@@ -42,12 +42,12 @@ use words::{REPLAY_PREFIX, SIM_PREFIX};
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Spec {
     text: String,
-    kind: Kind,
+    kind: SpecForm,
 }
 
 /// The form of a spec, read from its words alone (the registry is not asked).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub enum Kind {
+pub enum SpecForm {
     /// `sim:MODEL[?OPTIONS]`: an emulator.
     Simulated {
         /// The model's name.
@@ -79,19 +79,19 @@ impl Spec {
         let kind = match text.split_once(':') {
             Some((SIM_PREFIX, rest)) => {
                 let (model, options) = rest.split_once('?').unwrap_or((rest, ""));
-                Kind::Simulated {
+                SpecForm::Simulated {
                     model: model.to_string(),
                     options: options.to_string(),
                 }
             }
-            Some((REPLAY_PREFIX, rest)) => Kind::Replay {
+            Some((REPLAY_PREFIX, rest)) => SpecForm::Replay {
                 file: rest.to_string(),
             },
-            Some((prefix, address)) => Kind::Device {
+            Some((prefix, address)) => SpecForm::Device {
                 prefix: prefix.to_string(),
                 address: address.to_string(),
             },
-            None => Kind::Device {
+            None => SpecForm::Device {
                 prefix: text.clone(),
                 address: String::new(),
             },
@@ -133,20 +133,20 @@ impl Spec {
     }
 
     /// The form of the spec.
-    pub fn kind(&self) -> &Kind {
+    pub fn kind(&self) -> &SpecForm {
         &self.kind
     }
 
     /// Whether an emulator answers (`sim:…`): it sees only the world it is given, never a
     /// real screen or box.
     pub fn is_simulated(&self) -> bool {
-        matches!(self.kind, Kind::Simulated { .. })
+        matches!(self.kind, SpecForm::Simulated { .. })
     }
 
     /// The transcript a replayed instrument reads, when one is named.
     pub fn replay_file(&self) -> Option<&Path> {
         match &self.kind {
-            Kind::Replay { file } if !file.is_empty() => Some(Path::new(file)),
+            SpecForm::Replay { file } if !file.is_empty() => Some(Path::new(file)),
             _ => None,
         }
     }
@@ -164,6 +164,21 @@ impl Spec {
     /// instrument's port and a transcript's content are only looked at when opened.
     pub fn check(&self) -> Result<(), DriverError> {
         self.check_in(registry::MODELS)
+    }
+
+    /// A simulation's pace: its `time_scale` option, else `METAMER_SIM_TIME_SCALE`, else 1
+    /// (the real instrument's). None for a real or replayed instrument, or a simulation
+    /// whose spec does not check.
+    pub fn sim_time_scale(&self) -> Option<f64> {
+        let SpecForm::Simulated { model, options } = &self.kind else {
+            return None;
+        };
+        let row = registry::MODELS
+            .iter()
+            .find(|m| m.name == model && m.sim.is_some())?;
+        sim_settings(&self.text, options, row.sim_options)
+            .ok()
+            .map(|s| s.time_scale)
     }
 
     /// Opens the instrument; `stimulus` is what a simulated one sees.
@@ -191,11 +206,11 @@ impl Spec {
 
     fn model_in<'m>(&self, models: &'m [Model]) -> Option<&'m Model> {
         match &self.kind {
-            Kind::Simulated { model, .. } => models.iter().find(|m| m.name == model),
-            Kind::Device { prefix, .. } => models
+            SpecForm::Simulated { model, .. } => models.iter().find(|m| m.name == model),
+            SpecForm::Device { prefix, .. } => models
                 .iter()
                 .find(|m| m.spec_prefixes.contains(&prefix.as_str())),
-            Kind::Replay { .. } => None,
+            SpecForm::Replay { .. } => None,
         }
     }
 
@@ -204,9 +219,9 @@ impl Spec {
     /// form the registry offers.
     fn unknown_in(&self, models: &[Model]) -> DriverError {
         let word = match &self.kind {
-            Kind::Simulated { model, .. } => model.as_str(),
-            Kind::Device { prefix, .. } => prefix.as_str(),
-            Kind::Replay { .. } => "",
+            SpecForm::Simulated { model, .. } => model.as_str(),
+            SpecForm::Device { prefix, .. } => prefix.as_str(),
+            SpecForm::Replay { .. } => "",
         };
         let spec = self.text.clone();
         for m in models {
@@ -235,7 +250,7 @@ impl Spec {
 
     fn is_physical_in(&self, models: &[Model]) -> bool {
         match &self.kind {
-            Kind::Device { prefix, .. } => models
+            SpecForm::Device { prefix, .. } => models
                 .iter()
                 .any(|m| m.spec_prefixes.contains(&prefix.as_str()) && m.real.is_some()),
             _ => false,
@@ -244,8 +259,8 @@ impl Spec {
 
     fn check_in(&self, models: &[Model]) -> Result<(), DriverError> {
         match &self.kind {
-            Kind::Replay { file } if !file.is_empty() => Ok(()),
-            Kind::Simulated { model, options } => {
+            SpecForm::Replay { file } if !file.is_empty() => Ok(()),
+            SpecForm::Simulated { model, options } => {
                 let row = models
                     .iter()
                     .find(|m| m.name == model && m.sim.is_some())
@@ -260,7 +275,7 @@ impl Spec {
     fn real_in<'m>(&self, models: &'m [Model]) -> Result<(&'m registry::Real, &str), DriverError> {
         // A bare prefix (`i1pro`) names a model whose address may be left out; `replay:`
         // with no file, or a prefix no row has, names nothing.
-        let Kind::Device { prefix, address } = &self.kind else {
+        let SpecForm::Device { prefix, address } = &self.kind else {
             return Err(self.unknown_in(models));
         };
         match models
@@ -281,7 +296,7 @@ impl Spec {
     ) -> Result<Box<dyn Instrument>, DriverError> {
         let by_name = |name: &str| models.iter().find(|m| m.name == name);
         match &self.kind {
-            Kind::Replay { file } if !file.is_empty() => {
+            SpecForm::Replay { file } if !file.is_empty() => {
                 let transcript = Transcript::load(Path::new(file))?;
                 let instrument = transcript.header.instrument.clone();
                 let open = by_name(&instrument).and_then(|m| m.replay).ok_or_else(|| {
@@ -297,7 +312,7 @@ impl Spec {
                 })?;
                 open(transcript, options)
             }
-            Kind::Simulated {
+            SpecForm::Simulated {
                 model,
                 options: query,
             } => {

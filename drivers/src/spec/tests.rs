@@ -219,7 +219,7 @@ const FAKE: &[Model] = &[Model {
     described_by: &[],
     modes: &[],
     repeatability: &[],
-    reading_time: None,
+    time_budget: None,
     other_names: &[],
     unsupported: None,
 }];
@@ -254,7 +254,7 @@ fn a_spec_keeps_its_text_and_reads_its_form() {
     assert_eq!(back, s);
     assert_eq!(
         s.kind(),
-        &Kind::Simulated {
+        &SpecForm::Simulated {
             model: "cs100a".into(),
             options: String::new()
         }
@@ -268,7 +268,7 @@ fn a_spec_keeps_its_text_and_reads_its_form() {
     }
     assert_eq!(
         Spec::new("cs100a:COM3").kind(),
-        &Kind::Device {
+        &SpecForm::Device {
             prefix: "cs100a".into(),
             address: "COM3".into()
         }

@@ -42,6 +42,9 @@ pub enum ColorError {
         expected: usize,
         found: usize,
     },
+    /// A wavelength of zero or less.
+    #[error("{file}:{line}: wavelength {nm} nm: wavelengths are positive numbers of nanometres")]
+    NotPositive { file: PathBuf, line: usize, nm: f64 },
     /// Wavelengths must rise strictly from row to row.
     #[error("{file}:{line}: wavelengths must increase: {nm} nm follows {previous} nm")]
     NotIncreasing {

@@ -19,6 +19,9 @@ pub struct SpectralTable {
     pub wavelengths_nm: Vec<f64>,
     /// `data[c][i]` is column `c` at `wavelengths_nm[i]`.
     pub data: Vec<Vec<f64>>,
+    /// `lines[i]` is the line of the file (1-based) that holds row `i`, for errors about
+    /// a row found after parsing.
+    pub lines: Vec<usize>,
 }
 
 impl SpectralTable {
@@ -38,6 +41,7 @@ impl SpectralTable {
         let mut header: Option<Vec<String>> = None;
         let mut wavelengths_nm = Vec::new();
         let mut data: Vec<Vec<f64>> = Vec::new();
+        let mut lines = Vec::new();
         for (index, raw) in crate::text::strip_bom(text).lines().enumerate() {
             let line = index + 1;
             let trimmed = raw.trim();
@@ -90,6 +94,14 @@ impl SpectralTable {
                     }
                 }
             }
+            // No light has a wavelength of zero or less: such a row is a wrong column or unit.
+            if row[0] <= 0.0 {
+                return Err(ColorError::NotPositive {
+                    file,
+                    line,
+                    nm: row[0],
+                });
+            }
             if let Some(&previous) = wavelengths_nm.last() {
                 if row[0] <= previous {
                     return Err(ColorError::NotIncreasing {
@@ -101,6 +113,7 @@ impl SpectralTable {
                 }
             }
             wavelengths_nm.push(row[0]);
+            lines.push(line);
             for (c, v) in row[1..].iter().enumerate() {
                 data[c].push(*v);
             }
@@ -117,6 +130,7 @@ impl SpectralTable {
             columns,
             wavelengths_nm,
             data,
+            lines,
         })
     }
 
@@ -169,6 +183,24 @@ mod tests {
         assert_eq!(t.columns, vec!["a", "b"]);
         assert_eq!(t.wavelengths_nm, vec![400.0, 410.0]);
         assert_eq!(t.column("b").unwrap().values(), &[2.0, 4.0]);
+    }
+
+    #[test]
+    fn rows_keep_their_lines_and_wavelengths_are_positive() {
+        let t = SpectralTable::parse("# c\nnm,a\n\n400,1\n# mid\n410,2\n", "t.csv").unwrap();
+        assert_eq!(t.lines, vec![4, 6]);
+        for (text, line, nm) in [
+            ("nm,a\n-5,1\n400,1\n", 2, "-5"),
+            ("nm,a\n400,1\n# x\n0,1\n", 4, "0"),
+        ] {
+            let e = SpectralTable::parse(text, "w.csv").unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!(
+                    "w.csv:{line}: wavelength {nm} nm: wavelengths are positive numbers of nanometres"
+                )
+            );
+        }
     }
 
     #[test]

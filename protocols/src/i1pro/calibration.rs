@@ -3,7 +3,7 @@
 //! so a simulated instrument serves exactly the calibration it was built from.
 
 use super::eeprom::{key_name, Eeprom, EepromError, Value};
-use super::{Model, Revision, Spectrum, BANDS, CELLS};
+use super::{GridSpectrum, Model, Revision, BANDS, CELLS};
 
 pub mod key;
 
@@ -111,7 +111,7 @@ impl Filter {
     }
 
     /// `S[w] = Σ_k c_w[k] · cells[start_w + k]`.
-    pub fn apply(&self, cells: &[f64; CELLS]) -> Spectrum {
+    pub fn apply(&self, cells: &[f64; CELLS]) -> GridSpectrum {
         let mut s = [0.0; BANDS];
         for (w, out) in s.iter_mut().enumerate() {
             let (start, c) = self.band(w);
@@ -179,11 +179,11 @@ pub struct Calibration {
     pub max_integration_s: f64,
     pub filter: Filter,
     /// Reflectance of the white tile (absent on the i1Monitor).
-    pub white_reference: Option<Spectrum>,
+    pub white_reference: Option<GridSpectrum>,
     /// Multiplies a resampled spectrum into radiance.
-    pub emissive: Spectrum,
+    pub emissive: GridSpectrum,
     /// Multiplies the emissive factors for an ambient (diffuser) reading.
-    pub ambient: Option<Spectrum>,
+    pub ambient: Option<GridSpectrum>,
     /// Counts the integration time is optimised for.
     pub sensor_target: i32,
     /// Dark threshold in counts (before the integration-time term).
@@ -519,14 +519,14 @@ impl Reader<'_> {
         Ok(self.floats(key, Some(1))?[0])
     }
 
-    fn spectrum(&self, key: u16) -> Result<Spectrum, CalibrationError> {
+    fn spectrum(&self, key: u16) -> Result<GridSpectrum, CalibrationError> {
         let v = self.floats(key, Some(BANDS))?;
         let mut s = [0.0; BANDS];
         s.copy_from_slice(&v);
         Ok(s)
     }
 
-    fn optional_spectrum(&self, key: u16) -> Result<Option<Spectrum>, CalibrationError> {
+    fn optional_spectrum(&self, key: u16) -> Result<Option<GridSpectrum>, CalibrationError> {
         match self.e.get(key) {
             None => Ok(None),
             Some(_) => self.spectrum(key).map(Some),

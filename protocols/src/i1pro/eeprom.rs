@@ -22,96 +22,120 @@ const MARKER_LIMIT: u16 = 0x100;
 
 /// Element type of an item, fixed by its key.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
+pub enum ItemKind {
     Int,
     Float,
     Short,
     Bytes,
 }
 
-impl Kind {
+impl ItemKind {
     fn width(self) -> usize {
         match self {
-            Kind::Int | Kind::Float => 4,
-            Kind::Short => 2,
-            Kind::Bytes => 1,
+            ItemKind::Int | ItemKind::Float => 4,
+            ItemKind::Short => 2,
+            ItemKind::Bytes => 1,
         }
     }
 }
 
 /// The known keys: name and element type. Keys not listed are kept as raw bytes.
-const KEYS: &[(u16, &str, Kind)] = &[
-    (0x03E8, "normal-gain linearisation", Kind::Float),
-    (0x03E9, "high-gain linearisation", Kind::Float),
-    (0x03EA, "resampling filter start cells", Kind::Int),
-    (0x03EB, "resampling filter coefficient counts", Kind::Int),
-    (0x03EC, "resampling filter coefficients", Kind::Float),
-    (0x044C, "white tile reflectance", Kind::Float),
-    (0x044D, "emissive calibration factors", Kind::Float),
-    (0x044E, "ambient calibration factors", Kind::Float),
-    (0x04B4, "sensor target", Kind::Int),
-    (0x04B5, "sensor dark threshold", Kind::Int),
-    (0x04B7, "normal-gain saturation", Kind::Int),
-    (0x04B8, "high-gain saturation", Kind::Int),
-    (0x04BB, "serial number", Kind::Int),
-    (0x04BC, "manufacture date", Kind::Int),
-    (0x04BD, "high-gain factor", Kind::Float),
-    (0x04C5, "minimum integration time", Kind::Float),
-    (0x04C6, "maximum integration time", Kind::Float),
-    (0x0BB9, "unknown 0x0BB9", Kind::Int),
-    (0x0BBA, "unknown 0x0BBA", Kind::Int),
-    (0x0BBF, "unknown 0x0BBF", Kind::Int),
-    (0x0BC0, "CPLD revision", Kind::Int),
-    (0x0BC1, "unknown 0x0BC1", Kind::Int),
-    (0x0BC2, "capabilities", Kind::Int),
-    (0x0BC3, "unknown 0x0BC3", Kind::Int),
-    (0x0BC4, "physical filter", Kind::Int),
-    (0x0BC5, "unknown 0x0BC5", Kind::Int),
-    (0x0BC6, "unknown 0x0BC6", Kind::Float),
-    (0x0FA0, "unknown 0x0FA0", Kind::Int),
-    (0x2710, "log checksum", Kind::Int),
-    (0x2711, "log last reflective integration time", Kind::Float),
-    (0x2712, "log reflective spot count", Kind::Int),
-    (0x2713, "log reflective scan count", Kind::Int),
-    (0x2714, "log lamp age", Kind::Float),
-    (0x2715, "log measurement count", Kind::Int),
-    (0x271A, "log reflective dark reading", Kind::Int),
-    (0x271B, "log reflective white reading", Kind::Int),
-    (0x271C, "log reflective gain mode", Kind::Int),
-    (0x271D, "log reflective integration time", Kind::Float),
-    (0x2724, "log calibration date", Kind::Int),
-    (0x2725, "log calibration count", Kind::Int),
-    (0x2EE1, "chip id", Kind::Bytes),
-    (0x2EE2, "Rev E capabilities", Kind::Int),
-    (0x2EEB, "Rev E sensor target", Kind::Int),
-    (0x2EEC, "Rev E saturation", Kind::Int),
-    (0x2EF9, "UV calibration integration time", Kind::Float),
+const KEYS: &[(u16, &str, ItemKind)] = &[
+    (0x03E8, "normal-gain linearisation", ItemKind::Float),
+    (0x03E9, "high-gain linearisation", ItemKind::Float),
+    (0x03EA, "resampling filter start cells", ItemKind::Int),
+    (
+        0x03EB,
+        "resampling filter coefficient counts",
+        ItemKind::Int,
+    ),
+    (0x03EC, "resampling filter coefficients", ItemKind::Float),
+    (0x044C, "white tile reflectance", ItemKind::Float),
+    (0x044D, "emissive calibration factors", ItemKind::Float),
+    (0x044E, "ambient calibration factors", ItemKind::Float),
+    (0x04B4, "sensor target", ItemKind::Int),
+    (0x04B5, "sensor dark threshold", ItemKind::Int),
+    (0x04B7, "normal-gain saturation", ItemKind::Int),
+    (0x04B8, "high-gain saturation", ItemKind::Int),
+    (0x04BB, "serial number", ItemKind::Int),
+    (0x04BC, "manufacture date", ItemKind::Int),
+    (0x04BD, "high-gain factor", ItemKind::Float),
+    (0x04C5, "minimum integration time", ItemKind::Float),
+    (0x04C6, "maximum integration time", ItemKind::Float),
+    (0x0BB9, "unknown 0x0BB9", ItemKind::Int),
+    (0x0BBA, "unknown 0x0BBA", ItemKind::Int),
+    (0x0BBF, "unknown 0x0BBF", ItemKind::Int),
+    (0x0BC0, "CPLD revision", ItemKind::Int),
+    (0x0BC1, "unknown 0x0BC1", ItemKind::Int),
+    (0x0BC2, "capabilities", ItemKind::Int),
+    (0x0BC3, "unknown 0x0BC3", ItemKind::Int),
+    (0x0BC4, "physical filter", ItemKind::Int),
+    (0x0BC5, "unknown 0x0BC5", ItemKind::Int),
+    (0x0BC6, "unknown 0x0BC6", ItemKind::Float),
+    (0x0FA0, "unknown 0x0FA0", ItemKind::Int),
+    (0x2710, "log checksum", ItemKind::Int),
+    (
+        0x2711,
+        "log last reflective integration time",
+        ItemKind::Float,
+    ),
+    (0x2712, "log reflective spot count", ItemKind::Int),
+    (0x2713, "log reflective scan count", ItemKind::Int),
+    (0x2714, "log lamp age", ItemKind::Float),
+    (0x2715, "log measurement count", ItemKind::Int),
+    (0x271A, "log reflective dark reading", ItemKind::Int),
+    (0x271B, "log reflective white reading", ItemKind::Int),
+    (0x271C, "log reflective gain mode", ItemKind::Int),
+    (0x271D, "log reflective integration time", ItemKind::Float),
+    (0x2724, "log calibration date", ItemKind::Int),
+    (0x2725, "log calibration count", ItemKind::Int),
+    (0x2EE1, "chip id", ItemKind::Bytes),
+    (0x2EE2, "Rev E capabilities", ItemKind::Int),
+    (0x2EEB, "Rev E sensor target", ItemKind::Int),
+    (0x2EEC, "Rev E saturation", ItemKind::Int),
+    (0x2EF9, "UV calibration integration time", ItemKind::Float),
     (
         0x2EFA,
         "wavelength calibration integration time",
-        Kind::Float,
+        ItemKind::Float,
     ),
-    (0x2EFE, "wavelength calibration minimum level", Kind::Int),
+    (
+        0x2EFE,
+        "wavelength calibration minimum level",
+        ItemKind::Int,
+    ),
     (
         0x2F44,
         "wavelength calibration reference spectrum",
-        Kind::Float,
+        ItemKind::Float,
     ),
-    (0x2F45, "wavelength calibration reference offset", Kind::Int),
-    (0x2F46, "wavelength calibration maximum error", Kind::Float),
-    (0x2F4E, "wavelength calibration FWHM", Kind::Float),
-    (0x2F4F, "wavelength calibration FWHM tolerance", Kind::Float),
-    (0x2F58, "stray-light matrix", Kind::Short),
-    (0x2F59, "stray-light scale", Kind::Float),
+    (
+        0x2F45,
+        "wavelength calibration reference offset",
+        ItemKind::Int,
+    ),
+    (
+        0x2F46,
+        "wavelength calibration maximum error",
+        ItemKind::Float,
+    ),
+    (0x2F4E, "wavelength calibration FWHM", ItemKind::Float),
+    (
+        0x2F4F,
+        "wavelength calibration FWHM tolerance",
+        ItemKind::Float,
+    ),
+    (0x2F58, "stray-light matrix", ItemKind::Short),
+    (0x2F59, "stray-light scale", ItemKind::Float),
     (
         0x2F62,
         "reflective cell-to-wavelength polynomial",
-        Kind::Float,
+        ItemKind::Float,
     ),
     (
         0x2F63,
         "emissive cell-to-wavelength polynomial",
-        Kind::Float,
+        ItemKind::Float,
     ),
 ];
 
@@ -121,7 +145,7 @@ const LOG_COPY: u16 = 1000;
 /// Keys Rev E keeps in its second table.
 const TABLE_2_KEYS: std::ops::RangeInclusive<u16> = 0x2EE0..=0x2FFF;
 
-fn lookup(key: u16) -> Option<(&'static str, Kind)> {
+fn lookup(key: u16) -> Option<(&'static str, ItemKind)> {
     let base = if (LOG_KEYS.start() + LOG_COPY..=LOG_KEYS.end() + LOG_COPY).contains(&key) {
         key - LOG_COPY
     } else {
@@ -133,8 +157,8 @@ fn lookup(key: u16) -> Option<(&'static str, Kind)> {
 }
 
 /// The element type of a key's item (raw bytes for keys this codec does not know).
-pub fn kind_of(key: u16) -> Kind {
-    lookup(key).map_or(Kind::Bytes, |(_, kind)| kind)
+pub fn kind_of(key: u16) -> ItemKind {
+    lookup(key).map_or(ItemKind::Bytes, |(_, kind)| kind)
 }
 
 /// A readable name of a key for messages.
@@ -152,33 +176,33 @@ pub enum Value {
 }
 
 impl Value {
-    fn kind(&self) -> Kind {
+    fn kind(&self) -> ItemKind {
         match self {
-            Value::Ints(_) => Kind::Int,
-            Value::Floats(_) => Kind::Float,
-            Value::Shorts(_) => Kind::Short,
-            Value::Bytes(_) => Kind::Bytes,
+            Value::Ints(_) => ItemKind::Int,
+            Value::Floats(_) => ItemKind::Float,
+            Value::Shorts(_) => ItemKind::Short,
+            Value::Bytes(_) => ItemKind::Bytes,
         }
     }
 
-    fn decode(kind: Kind, b: &[u8]) -> Value {
+    fn decode(kind: ItemKind, b: &[u8]) -> Value {
         match kind {
-            Kind::Int => Value::Ints(
+            ItemKind::Int => Value::Ints(
                 b.chunks_exact(4)
                     .map(|c| i32::from_be_bytes([c[0], c[1], c[2], c[3]]))
                     .collect(),
             ),
-            Kind::Float => Value::Floats(
+            ItemKind::Float => Value::Floats(
                 b.chunks_exact(4)
                     .map(|c| f32::from_be_bytes([c[0], c[1], c[2], c[3]]))
                     .collect(),
             ),
-            Kind::Short => Value::Shorts(
+            ItemKind::Short => Value::Shorts(
                 b.chunks_exact(2)
                     .map(|c| i16::from_be_bytes([c[0], c[1]]))
                     .collect(),
             ),
-            Kind::Bytes => Value::Bytes(b.to_vec()),
+            ItemKind::Bytes => Value::Bytes(b.to_vec()),
         }
     }
 
@@ -237,8 +261,8 @@ pub enum EepromError {
     WrongKind {
         key: u16,
         name: &'static str,
-        expected: Kind,
-        found: Kind,
+        expected: ItemKind,
+        found: ItemKind,
     },
     #[error("EEPROM key {key:#06x} is a section marker and cannot hold an item")]
     MarkerKey { key: u16 },

@@ -12,9 +12,13 @@ use super::calibration::Calibration;
 use super::linalg::solve;
 use super::pipeline::{drift_corrected_dark, scale, AbsRaw, Exposure, PipelineError};
 use super::readings::{value_range, RawReading};
-use super::{Revision, Spectrum, BANDS, CELLS, SHIELDED_CELLS, START_NM, STEP_NM};
+use super::{GridSpectrum, Revision, BANDS, CELLS, SHIELDED_CELLS, START_NM, STEP_NM};
 
-fn divide(s: &Spectrum, f: &Spectrum, what: &'static str) -> Result<Spectrum, PipelineError> {
+fn divide(
+    s: &GridSpectrum,
+    f: &GridSpectrum,
+    what: &'static str,
+) -> Result<GridSpectrum, PipelineError> {
     let mut out = [0.0; BANDS];
     for (band, ((o, a), b)) in out.iter_mut().zip(s).zip(f).enumerate() {
         if *b == 0.0 {
@@ -32,16 +36,16 @@ fn divide(s: &Spectrum, f: &Spectrum, what: &'static str) -> Result<Spectrum, Pi
 /// Spectral radiance → the resampled spectrum the emissive factors turn into it.
 pub fn uncalibrate_emissive(
     cal: &Calibration,
-    radiance: &Spectrum,
-) -> Result<Spectrum, PipelineError> {
+    radiance: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     divide(radiance, &cal.emissive, "the emissive calibration factor")
 }
 
 /// Ambient irradiance → the resampled spectrum.
 pub fn uncalibrate_ambient(
     cal: &Calibration,
-    ambient: &Spectrum,
-) -> Result<Spectrum, PipelineError> {
+    ambient: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     let a = cal.ambient.as_ref().ok_or(PipelineError::NoAmbient)?;
     let s = divide(ambient, a, "the ambient calibration factor")?;
     uncalibrate_emissive(cal, &s)
@@ -49,16 +53,16 @@ pub fn uncalibrate_ambient(
 
 /// Reflectance → the resampled spectrum, given the factors of a white calibration.
 pub fn uncalibrate_reflective(
-    reflectance: &Spectrum,
-    factors: &Spectrum,
-) -> Result<Spectrum, PipelineError> {
+    reflectance: &GridSpectrum,
+    factors: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     divide(reflectance, factors, "the reflective calibration factor")
 }
 
 /// Dark-subtracted cell values (absraw) whose resampling — and stray-light correction on
 /// Rev E — gives `s`. On Rev A–D the junk cells 0 and 127 are copies of cells 1 and 126 by
 /// the time the filter sees them, so they are solved for as one with their neighbours.
-pub fn cells_for(cal: &Calibration, s: &Spectrum) -> Result<[f64; CELLS], PipelineError> {
+pub fn cells_for(cal: &Calibration, s: &GridSpectrum) -> Result<[f64; CELLS], PipelineError> {
     let target: Vec<f64> = match &cal.rev_e {
         Some(e) => {
             let m = e.stray_light_matrix();
@@ -174,7 +178,7 @@ pub fn counts_for(
 pub fn emissive_reading(
     cal: &Calibration,
     e: &Exposure,
-    radiance: &Spectrum,
+    radiance: &GridSpectrum,
     dark: &AbsRaw,
     shielded: Option<[u16; SHIELDED_CELLS]>,
     max_positive: u16,

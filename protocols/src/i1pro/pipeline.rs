@@ -13,7 +13,7 @@
 
 use super::calibration::{Calibration, Gain, RevECalibration};
 use super::readings::RawReading;
-use super::{Revision, Spectrum, BANDS, CELLS};
+use super::{GridSpectrum, Revision, BANDS, CELLS};
 
 /// How a reading was taken.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -303,7 +303,7 @@ pub fn thresholds(
 }
 
 /// Step 5: `S' = M·S` with Rev E's stray-light matrix.
-pub fn stray_light(e: &RevECalibration, s: &Spectrum) -> Spectrum {
+pub fn stray_light(e: &RevECalibration, s: &GridSpectrum) -> GridSpectrum {
     let m = e.stray_light_matrix();
     let mut out = [0.0; BANDS];
     for (o, row) in out.iter_mut().zip(&m) {
@@ -313,7 +313,7 @@ pub fn stray_light(e: &RevECalibration, s: &Spectrum) -> Spectrum {
 }
 
 /// Steps 4 and 5: resampling, then stray light on Rev E.
-pub fn resample(cal: &Calibration, cells: &[f64; CELLS]) -> Spectrum {
+pub fn resample(cal: &Calibration, cells: &[f64; CELLS]) -> GridSpectrum {
     let s = cal.filter.apply(cells);
     match &cal.rev_e {
         Some(e) => stray_light(e, &s),
@@ -321,7 +321,7 @@ pub fn resample(cal: &Calibration, cells: &[f64; CELLS]) -> Spectrum {
     }
 }
 
-fn times(s: &Spectrum, f: &Spectrum) -> Spectrum {
+fn times(s: &GridSpectrum, f: &GridSpectrum) -> GridSpectrum {
     let mut out = [0.0; BANDS];
     for ((o, a), b) in out.iter_mut().zip(s).zip(f) {
         *o = a * b;
@@ -330,12 +330,12 @@ fn times(s: &Spectrum, f: &Spectrum) -> Spectrum {
 }
 
 /// Step 6, emissive: spectral radiance in mW·m⁻²·sr⁻¹·nm⁻¹, `S · emissive factor`.
-pub fn emissive(cal: &Calibration, s: &Spectrum) -> Spectrum {
+pub fn emissive(cal: &Calibration, s: &GridSpectrum) -> GridSpectrum {
     times(s, &cal.emissive)
 }
 
 /// Step 6, ambient (diffuser): `S · emissive factor · ambient factor`.
-pub fn ambient(cal: &Calibration, s: &Spectrum) -> Result<Spectrum, PipelineError> {
+pub fn ambient(cal: &Calibration, s: &GridSpectrum) -> Result<GridSpectrum, PipelineError> {
     let a = cal.ambient.as_ref().ok_or(PipelineError::NoAmbient)?;
     Ok(times(&times(s, &cal.emissive), a))
 }
@@ -345,7 +345,10 @@ pub const MIN_WHITE_READING: f64 = 1000.0;
 
 /// Reflective calibration factors from a white-tile reading: `white reference / white
 /// reading`, the reading clamped to at least [`MIN_WHITE_READING`].
-pub fn reflective_factors(cal: &Calibration, white: &Spectrum) -> Result<Spectrum, PipelineError> {
+pub fn reflective_factors(
+    cal: &Calibration,
+    white: &GridSpectrum,
+) -> Result<GridSpectrum, PipelineError> {
     let r = cal
         .white_reference
         .as_ref()
@@ -359,7 +362,7 @@ pub fn reflective_factors(cal: &Calibration, white: &Spectrum) -> Result<Spectru
 
 /// Transmissive calibration factors from an open-aperture reading: `1 / reading`, the reading
 /// clamped to at least 0.4 % of its mean.
-pub fn transmissive_factors(white: &Spectrum) -> Spectrum {
+pub fn transmissive_factors(white: &GridSpectrum) -> GridSpectrum {
     let floor = 0.004 * white.iter().sum::<f64>() / BANDS as f64;
     let mut f = [0.0; BANDS];
     for (f, w) in f.iter_mut().zip(white) {
@@ -369,12 +372,12 @@ pub fn transmissive_factors(white: &Spectrum) -> Spectrum {
 }
 
 /// Step 6, reflective or transmissive: `S · factors`.
-pub fn reflective(s: &Spectrum, factors: &Spectrum) -> Spectrum {
+pub fn reflective(s: &GridSpectrum, factors: &GridSpectrum) -> GridSpectrum {
     times(s, factors)
 }
 
 /// Alias of [`reflective`] for transmissive factors.
-pub fn transmissive(s: &Spectrum, factors: &Spectrum) -> Spectrum {
+pub fn transmissive(s: &GridSpectrum, factors: &GridSpectrum) -> GridSpectrum {
     times(s, factors)
 }
 
@@ -385,7 +388,7 @@ pub fn measure(
     readings: &[RawReading],
     dark: &AbsRaw,
     e: &Exposure,
-) -> Result<(Spectrum, Averaged), PipelineError> {
+) -> Result<(GridSpectrum, Averaged), PipelineError> {
     let mut abs = readings
         .iter()
         .map(|r| to_absraw(cal, r, e))

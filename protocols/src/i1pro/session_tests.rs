@@ -9,14 +9,14 @@ use super::pipeline::{self, Exposure};
 use super::readings::{self, RawReading};
 use super::replies::Misc;
 use super::timing::clocks;
-use super::{fixture, inverse, Calibration, Model, Revision, Spectrum, BANDS, CELLS};
+use super::{fixture, inverse, Calibration, GridSpectrum, Model, Revision, BANDS, CELLS};
 
 /// The simulated instrument: answers each transfer from its EEPROM image and the light.
 struct Device {
     rev: Revision,
     cal: Calibration,
     image: Vec<u8>,
-    light: Spectrum,
+    light: GridSpectrum,
     dark_counts: i32,
     shielded: [u16; 6],
     pending: Option<(u32, u32)>,

@@ -150,7 +150,7 @@ mod tests {
              run the same command with --resume"
         );
         let box_error = crate::measure_box::MeasureBoxError::Session {
-            stage: crate::measure_box::Stage::Spots,
+            stage: crate::measure_box::BoxStage::Spots,
             source: failed_step(),
         };
         assert_eq!(

@@ -9,9 +9,10 @@ use serde::Serialize;
 
 use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
-use super::verify::{average, usable, verify, HeldOutVerification};
+use super::verify::{average, usable, verify_held_out};
 use crate::color::Xyz;
 use crate::display::model::{FitError, Sample};
+use crate::display::verify::Verification;
 use crate::display::{fit_profile, write_ti3, ModelKind, ProfileError, Residuals};
 use crate::output::{OutputError, OutputPolicy};
 
@@ -49,7 +50,7 @@ pub enum FinishError {
 }
 
 /// Who measured what, for the files' descriptions.
-pub struct Provenance<'a> {
+pub struct MeasuredBy<'a> {
     pub display: &'a str,
     pub display_description: &'a str,
     pub instrument: &'a str,
@@ -74,7 +75,8 @@ pub struct Summary {
     /// The model against the patches it was fitted to.
     pub fit_residuals: Residuals,
     /// The model against the held-out patches (ΔE00 relative to the measured white).
-    pub verification: HeldOutVerification,
+    #[serde(serialize_with = "crate::display::verify::serialize_held_out")]
+    pub verification: Verification,
     pub files: Files,
 }
 
@@ -113,7 +115,7 @@ pub fn finish(
     log: &Path,
     readings: &[(&DriveStep, &Reading)],
     model: ModelKind,
-    who: &Provenance,
+    who: &MeasuredBy,
     out: &OutputPolicy,
 ) -> Result<Summary, FinishError> {
     let files = files(dir, log);
@@ -136,24 +138,19 @@ pub fn finish(
     let training: Vec<Sample> = readings
         .iter()
         .filter(|(p, r)| p.purpose == Purpose::Fit && usable(r))
-        .map(|(p, r)| Sample {
-            rgb: p.rgb.map(|c| f64::from(c) / 255.0),
-            xyz: r.xyz,
-        })
+        .map(|(p, r)| Sample::from_rgb8(p.rgb, r.xyz))
         .collect();
     let profile = fit_profile(model, &training, Some(log))
         .map_err(|source| FinishError::Fit { model, source })?;
     let forward = |rgb: [f64; 3]| profile.forward(rgb);
-    let verification = verify(&averaged, white, &forward)?.ok_or(FinishError::NoVerification)?;
+    let verification =
+        verify_held_out(&averaged, white, &forward)?.ok_or(FinishError::NoVerification)?;
 
     profile.save(&files.profile, out)?;
     let raw: Vec<Sample> = readings
         .iter()
         .filter(|(_, r)| usable(r))
-        .map(|(p, r)| Sample {
-            rgb: p.rgb.map(|c| f64::from(c) / 255.0),
-            xyz: r.xyz,
-        })
+        .map(|(p, r)| Sample::from_rgb8(p.rgb, r.xyz))
         .collect();
     let description = format!(
         "metamer characterize: {} measured with {} ({})",

@@ -5,12 +5,15 @@
 
 mod advice;
 pub mod finish;
+mod hands;
+pub mod meter;
 pub mod plan;
 pub mod report;
 pub mod request;
 pub mod run;
 pub mod verify;
 
+pub use meter::{meter_sees, SimulatedMeterOnRealScreen};
 pub use plan::{
     default_grid_steps, plan_advice, DriveStep, Plan, PlanError, PlanOptions, Purpose,
     DEFAULT_RAMP_STEPS,
@@ -18,4 +21,4 @@ pub use plan::{
 pub use report::{write_report, Report, ReportError};
 pub use request::{characterize, open_screen, Attend, Listener, Request, SimulatedMeter};
 pub use run::{log_path, run, CharacterizeError, LogDetails, Options, Outcome, LOG_FILE};
-pub use verify::{average, verify, AveragedPatch, HeldOutVerification};
+pub use verify::{average, verify_held_out, AveragedPatch};

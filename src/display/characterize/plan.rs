@@ -111,6 +111,24 @@ pub struct PlanOptions {
     pub grid_steps: usize,
 }
 
+impl PlanOptions {
+    /// The plan for `model`: `ramp_steps` and `repeats` as given, and the fit grid asked
+    /// for or, when None, the model's default ([`default_grid_steps`]). `characterize` and
+    /// the experiment's display stage both make their plan here.
+    pub fn for_model(
+        model: ModelKind,
+        ramp_steps: usize,
+        repeats: usize,
+        grid_steps: Option<usize>,
+    ) -> PlanOptions {
+        PlanOptions {
+            ramp_steps,
+            repeats,
+            grid_steps: grid_steps.unwrap_or(default_grid_steps(model, ramp_steps)),
+        }
+    }
+}
+
 impl Default for PlanOptions {
     fn default() -> Self {
         PlanOptions {

@@ -12,7 +12,8 @@ use plotters::prelude::*;
 use crate::color::Xyz;
 use crate::output::{OutputError, OutputPolicy};
 
-use super::verify::{AveragedPatch, HeldOutVerification};
+use super::verify::AveragedPatch;
+use crate::display::verify::Verification;
 
 /// The report could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
@@ -29,7 +30,7 @@ pub struct Report<'a> {
     pub patches: &'a [AveragedPatch],
     /// The fitted model, drive 0–1 → XYZ, drawn over the measured TRCs.
     pub forward: Option<&'a dyn Fn([f64; 3]) -> Xyz>,
-    pub verification: Option<&'a HeldOutVerification>,
+    pub verification: Option<&'a Verification>,
 }
 
 /// The ramps: red, green, blue and grey, each with the drive mask it varies.
@@ -197,14 +198,14 @@ fn draw_chromaticity(
     Ok(())
 }
 
-fn draw_delta_e(area: &DrawingArea<SVGBackend, Shift>, v: &HeldOutVerification) -> DrawResult {
+fn draw_delta_e(area: &DrawingArea<SVGBackend, Shift>, v: &Verification) -> DrawResult {
     let n = v.patches.len();
-    let top = v.patches.iter().map(|p| p.delta_e00).fold(1.0, f64::max) * 1.15;
+    let top = v.patches.iter().map(|p| p.de00).fold(1.0, f64::max) * 1.15;
     let mut chart = ChartBuilder::on(area)
         .caption(
             format!(
                 "ΔE00 of the {n} verification patches: mean {:.2}, p95 {:.2}, max {:.2} (bars in the patch's drive colour)",
-                v.mean, v.p95, v.max
+                v.de00.mean, v.de00.p95, v.de00.max
             ),
             ("sans-serif", 16),
         )
@@ -222,20 +223,17 @@ fn draw_delta_e(area: &DrawingArea<SVGBackend, Shift>, v: &HeldOutVerification) 
         .draw()?;
     chart.draw_series(v.patches.iter().enumerate().map(|(i, p)| {
         let x = i as f64 + 1.0;
-        let [r, g, b] = p.rgb8;
+        let [r, g, b] = p.rgb8();
         Rectangle::new(
-            [(x - 0.35, 0.0), (x + 0.35, p.delta_e00)],
+            [(x - 0.35, 0.0), (x + 0.35, p.de00)],
             RGBColor(r, g, b).filled(),
         )
     }))?;
     chart.draw_series(v.patches.iter().enumerate().map(|(i, p)| {
         let x = i as f64 + 1.0;
-        Rectangle::new(
-            [(x - 0.35, 0.0), (x + 0.35, p.delta_e00)],
-            BLACK.stroke_width(1),
-        )
+        Rectangle::new([(x - 0.35, 0.0), (x + 0.35, p.de00)], BLACK.stroke_width(1))
     }))?;
-    for (value, label, colour) in [(v.mean, "mean", BLUE), (v.p95, "p95", RED)] {
+    for (value, label, colour) in [(v.de00.mean, "mean", BLUE), (v.de00.p95, "p95", RED)] {
         chart
             .draw_series(LineSeries::new(
                 [(0.5, value), (n as f64 + 0.5, value)],
@@ -292,7 +290,7 @@ mod tests {
     #[test]
     fn a_report_of_a_simulated_panel_draws_every_panel() {
         use crate::display::characterize::plan::{Plan, PlanOptions};
-        use crate::display::characterize::verify::verify;
+        use crate::display::characterize::verify::verify_held_out;
         use crate::rig::virtual_display::{Preset, VirtualPanel};
         let panel = VirtualPanel::preset(Preset::IpsLcd);
         let plan = Plan::new(PlanOptions::default()).unwrap();
@@ -310,10 +308,10 @@ mod tests {
             .collect();
         // The panel predicting itself: every ΔE00 is 0.
         let forward = |rgb: [f64; 3]| panel.xyz_of_drive(rgb);
-        let v = verify(&patches, panel.xyz([255; 3]), &forward)
+        let v = verify_held_out(&patches, panel.xyz([255; 3]), &forward)
             .unwrap()
             .unwrap();
-        assert_eq!((v.patches.len(), v.max), (48, 0.0));
+        assert_eq!((v.patches.len(), v.de00.max), (48, 0.0));
         let file = std::env::temp_dir().join(format!("metamer-report-{}.svg", std::process::id()));
         write_report(
             &Report {

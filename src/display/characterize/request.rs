@@ -5,11 +5,14 @@
 //! so that it is visible in one place rather than in two copies of the same steps.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
-use metamer_drivers::{Instrument, Spec, Speed};
+use metamer_drivers::{Instrument, Spec, Speed, World};
 
 use super::finish::files;
+use super::hands::{Hands, HandsOperator};
+use super::meter::meter_sees;
 use super::plan::{plan_advice, Plan, PlanOptions};
 use super::run::{log_path, run, CharacterizeError, Options, Outcome};
 use crate::display::ModelKind;
@@ -129,7 +132,7 @@ pub trait Listener {
 ///     panic!("nothing stops a simulated session");
 /// };
 /// assert!(summary.files.profile.is_file());
-/// assert!(summary.verification.mean < 1.0, "ΔE00 {}", summary.verification.mean);
+/// assert!(summary.verification.de00.mean < 1.0, "ΔE00 {}", summary.verification.de00.mean);
 /// # std::fs::remove_dir_all(&out)?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -139,12 +142,9 @@ pub fn characterize(
 ) -> Result<Outcome, CharacterizeError> {
     let out = request.out.as_path();
     let plan = Plan::new(request.plan)?;
-    if let Some(advice) = plan_advice(&plan) {
-        listener.note(&advice);
-    }
     let attended = match request.attend {
         Attend::Terminal { unattended } => {
-            attendance(&[request.instrument.as_str()], unattended)? == Attendance::Terminal
+            attendance(&[&request.instrument], unattended)? == Attendance::Terminal
         }
         Attend::Stage { unattended } => {
             !unattended && !matches!(request.screen, ScreenSpec::Virtual(_))
@@ -161,17 +161,28 @@ pub fn characterize(
             }
         }
     }
+    if let Some(pace) = crate::session::pace_note(&[&request.instrument]) {
+        listener.note(&pace);
+    }
+    // After every refusal: a note on what the plan can judge is no answer to a command
+    // that will not run.
+    if let Some(advice) = plan_advice(&plan) {
+        listener.note(&advice);
+    }
     let mut display = open_screen(&request.screen, request.virtual_white_cd_m2)
         .map_err(CharacterizeError::OpenScreen)?;
     for warning in display.warnings() {
         listener.warning(&warning);
     }
-    let mut instrument = open_meter(request, display.as_ref(), listener)?;
+    // A simulated monitor's meter is moved onto its tile for calibrations and back.
+    let hands = display.stimulus().map(Hands::new);
+    let seen = hands.clone().map(|h| h as Arc<dyn World>);
+    let mut instrument = open_meter(request, seen, listener)?;
     let options = Options {
         dir: out.to_path_buf(),
         plan: request.plan,
         model: request.model,
-        instrument: request.instrument.to_string(),
+        instrument: request.instrument.clone(),
         settle: request.settle,
         resume: request.resume,
         force: request.force,
@@ -183,11 +194,22 @@ pub fn characterize(
         (Attend::Stage { .. }, true) => Box::new(TerminalOperator),
         (Attend::Stage { .. }, false) => Box::new(ScriptedOperator::confirming()),
     };
+    let mut moved;
+    let operator: &mut dyn Operator = match hands {
+        Some(hands) => {
+            moved = HandsOperator {
+                hands,
+                inner: operator.as_mut(),
+            };
+            &mut moved
+        }
+        None => operator.as_mut(),
+    };
     run(
         &options,
         display.as_mut(),
         instrument.as_mut(),
-        operator.as_mut(),
+        operator,
         listener.progress(attended),
     )
 }
@@ -205,22 +227,22 @@ pub fn open_screen(
     })
 }
 
-/// The request's meter, aimed at `display`, at the requested speed.
+/// The request's meter, aimed at `display` (a simulated meter sees `seen`), at the
+/// requested speed.
 fn open_meter(
     request: &Request,
-    display: &dyn Screen,
+    seen: Option<Arc<dyn World>>,
     listener: &mut dyn Listener,
 ) -> Result<Box<dyn Instrument>, CharacterizeError> {
-    let blind = request.instrument.is_simulated() && display.stimulus().is_none();
-    if blind && request.simulated_meter == SimulatedMeter::Refuse {
-        return Err(CharacterizeError::SimulatedMeterOnRealScreen {
-            meter: request.instrument.to_string(),
-            screen: display.spec(),
-        });
-    }
+    let blind = match meter_sees(&request.instrument, &request.screen) {
+        Err(e) if request.simulated_meter == SimulatedMeter::Refuse => {
+            return Err(CharacterizeError::SimulatedMeterOnRealScreen(e))
+        }
+        seen => seen.is_err(),
+    };
     let mut instrument = request
         .instrument
-        .open(display.stimulus())
+        .open(seen)
         .map_err(CharacterizeError::Instrument)?;
     if blind {
         listener.warning(

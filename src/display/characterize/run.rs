@@ -6,10 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use metamer_drivers::Instrument;
+use metamer_drivers::{Instrument, Spec};
 use serde::{Deserialize, Serialize};
 
-use super::finish::{files, finish, FinishError, Provenance, Summary};
+use super::finish::{files, finish, FinishError, MeasuredBy, Summary};
 use super::plan::{DriveStep, Plan, PlanError, PlanOptions, METER};
 use crate::display::ModelKind;
 use crate::output::{OutputError, OutputPolicy};
@@ -40,7 +40,7 @@ pub struct Options {
     pub plan: PlanOptions,
     pub model: ModelKind,
     /// The instrument as named by the user, for the files' provenance.
-    pub instrument: String,
+    pub instrument: Spec,
     /// Wait between showing a colour and measuring it; None: the display's default.
     pub settle: Option<Duration>,
     /// Continue the journal in `dir` instead of refusing it.
@@ -91,8 +91,8 @@ pub enum CharacterizeError {
     /// The meter refused the requested response speed.
     #[error(transparent)]
     Speed(metamer_drivers::DriverError),
-    #[error("the simulated meter {meter} cannot see the real screen {screen}; use a real meter, or a virtual display")]
-    SimulatedMeterOnRealScreen { meter: String, screen: String },
+    #[error(transparent)]
+    SimulatedMeterOnRealScreen(super::meter::SimulatedMeterOnRealScreen),
 }
 
 /// The journal of a characterization in `dir`.
@@ -117,7 +117,7 @@ pub fn run(
     let details = LogDetails {
         display: display_name.clone(),
         display_description: display.describe(),
-        instrument: options.instrument.clone(),
+        instrument: options.instrument.to_string(),
     };
     let instruments = [(METER.to_string(), InstrumentRecord::of(instrument))].into();
     let mut session: Session<LogDetails, DriveStep> = Session::open(
@@ -141,21 +141,8 @@ pub fn run(
     for f in files(&options.dir, session.journal_path()).outputs() {
         out.check(f)?;
     }
-    if session.recovered > 0 || session.torn_bytes > 0 {
-        let torn = if session.torn_bytes > 0 {
-            format!(
-                " ({} bytes of a reading cut off by the interruption were set aside in {})",
-                session.torn_bytes,
-                crate::session::torn_path(session.journal_path()).display()
-            )
-        } else {
-            String::new()
-        };
-        progress.note(&format!(
-            "resuming: {} of {total} readings in {}{torn}",
-            session.recovered,
-            session.journal_path().display()
-        ));
+    if let Some(note) = resuming_note(&session) {
+        progress.note(&note);
     }
     let incomplete = |session: &Session<LogDetails, DriveStep>, end| Outcome::Incomplete {
         end,
@@ -176,7 +163,7 @@ pub fn run(
     }
     let end = {
         let mut rig = Rig {
-            screen: Some(display.as_show()),
+            screen: Some(display),
             instruments: vec![(METER.to_string(), &mut *instrument)],
             operator: &mut *operator,
         };
@@ -196,7 +183,7 @@ pub fn run(
         session.journal_path(),
         &readings,
         options.model,
-        &Provenance {
+        &MeasuredBy {
             display: &details.display,
             display_description: &details.display_description,
             instrument: &details.instrument,
@@ -205,6 +192,29 @@ pub fn run(
         &out,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+/// What resuming `session` found in its journal (readings, a torn last line set aside),
+/// if it resumed one.
+fn resuming_note(session: &Session<LogDetails, DriveStep>) -> Option<String> {
+    if session.recovered == 0 && session.torn_bytes == 0 {
+        return None;
+    }
+    let torn = if session.torn_bytes > 0 {
+        format!(
+            " ({} bytes of a reading cut off by the interruption were set aside in {})",
+            session.torn_bytes,
+            crate::session::torn_path(session.journal_path()).display()
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "resuming: {} of {} readings in {}{torn}",
+        session.recovered,
+        session.plan().steps.len(),
+        session.journal_path().display()
+    ))
 }
 
 #[cfg(test)]
@@ -284,8 +294,8 @@ mod tests {
         };
         // Noise is off: the same readings, so the same fit and verification.
         assert_eq!(a.readings, b.readings);
-        assert_eq!(a.verification.mean, b.verification.mean);
-        assert_eq!(a.verification.max, b.verification.max);
+        assert_eq!(a.verification.de00.mean, b.verification.de00.mean);
+        assert_eq!(a.verification.de00.max, b.verification.de00.max);
         std::fs::remove_dir_all(&straight.dir).unwrap();
         std::fs::remove_dir_all(&first.dir).unwrap();
     }

@@ -1,16 +1,15 @@
 //! From readings to what the fit and the verification use: repeats averaged per planned
 //! patch, and the fitted model's forward prediction of each held-out verification patch
-//! compared with its measurement in CIEDE2000, CIELAB relative to the measured white (the
-//! paper's validation uses the display white as reference white).
+//! compared with its measurement (`display::verify`), CIELAB relative to the measured white
+//! (the paper's validation uses the display white as reference white).
 
 use metamer_drivers::{Flag, Reading};
 use serde::Serialize;
 
 use super::plan::{DriveStep, Purpose};
-use crate::color::{delta_e2000, Xyz};
-use crate::display::diagnostics::percentile;
+use crate::color::Xyz;
 use crate::display::model::Sample;
-use crate::display::verify::{check_prediction, VerifyError};
+use crate::display::verify::{verify, Verification, VerifyError};
 
 /// A planned patch with its readings averaged.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -28,11 +27,8 @@ pub struct AveragedPatch {
 
 impl AveragedPatch {
     /// As the display models take it: drive 0–1 and XYZ.
-    pub fn to_patch(&self) -> Sample {
-        Sample {
-            rgb: self.rgb8.map(|c| f64::from(c) / 255.0),
-            xyz: self.xyz,
-        }
+    pub fn to_sample(&self) -> Sample {
+        Sample::from_rgb8(self.rgb8, self.xyz)
     }
 }
 
@@ -86,71 +82,26 @@ pub fn average(readings: &[(&DriveStep, &Reading)]) -> Result<Vec<AveragedPatch>
     }
 }
 
-/// One verification patch: measured, predicted and their CIEDE2000.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct VerifiedPatch {
-    pub label: String,
-    pub rgb8: [u8; 3],
-    pub measured_xyz: Xyz,
-    pub predicted_xyz: Xyz,
-    pub delta_e00: f64,
-}
-
-/// The characterization's own check: ΔE00 of the model it fitted over the patches it held
-/// out of the fit, relative to the white it measured (the summary's `verification`). A
-/// profile checked against readings afterwards is `metamer verify`'s job
-/// ([`crate::display::verify::ProfileVerification`]).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct HeldOutVerification {
-    /// The measured white CIELAB is taken relative to, cd/m².
-    pub white_xyz: Xyz,
-    pub patches: Vec<VerifiedPatch>,
-    pub mean: f64,
-    /// 95th percentile, linear between order statistics (rank 0.95·(n − 1)).
-    pub p95: f64,
-    pub max: f64,
-}
-
-/// Compares `predict` (the model's forward direction, drive 0–1 → XYZ) with the measured
-/// verification patches of `patches`. None if there are none; an error if the model
-/// predicts a patch as no colour (the same check as `metamer verify`'s), which would
-/// otherwise make the mean NaN and the summary's statistics `null`.
-pub fn verify(
+/// The characterization's own check: the model it fitted (`predict`, its forward
+/// direction, drive 0–1 → XYZ) against the measured verification patches of `patches`, the
+/// ones held out of the fit, relative to the white it measured (the summary's
+/// `verification`). None if the plan held none out; an error if the model predicts a
+/// patch as no colour (the same check as `metamer verify`'s), which would otherwise make
+/// the mean NaN and the summary's statistics `null`.
+pub fn verify_held_out(
     patches: &[AveragedPatch],
     white_xyz: Xyz,
     predict: &dyn Fn([f64; 3]) -> Xyz,
-) -> Result<Option<HeldOutVerification>, VerifyError> {
-    let white = white_xyz;
-    let verified: Vec<VerifiedPatch> = patches
+) -> Result<Option<Verification>, VerifyError> {
+    let held_out: Vec<_> = patches
         .iter()
         .filter(|p| p.purpose == Purpose::Verify)
-        .map(|p| {
-            let rgb = p.to_patch().rgb;
-            let predicted = predict(rgb);
-            check_prediction(p.patch + 1, rgb, predicted)?;
-            let de = delta_e2000(p.xyz.to_lab(white), predicted.to_lab(white));
-            Ok(VerifiedPatch {
-                label: p.label.clone(),
-                rgb8: p.rgb8,
-                measured_xyz: p.xyz,
-                predicted_xyz: predicted,
-                delta_e00: de,
-            })
-        })
-        .collect::<Result<_, VerifyError>>()?;
-    if verified.is_empty() {
+        .map(|p| (p.patch + 1, Some(p.label.clone()), p.to_sample()))
+        .collect();
+    if held_out.is_empty() {
         return Ok(None);
     }
-    let mut sorted: Vec<f64> = verified.iter().map(|v| v.delta_e00).collect();
-    sorted.sort_by(f64::total_cmp);
-    let mean = sorted.iter().sum::<f64>() / sorted.len() as f64;
-    Ok(Some(HeldOutVerification {
-        white_xyz,
-        mean,
-        p95: percentile(&sorted, 0.95),
-        max: *sorted.last().expect("not empty"),
-        patches: verified,
-    }))
+    verify(held_out, white_xyz, predict).map(Some)
 }
 
 #[cfg(test)]
@@ -183,7 +134,7 @@ mod tests {
         assert_eq!(avg[0].readings, 2);
         assert!((avg[0].xyz[1] - 2.0).abs() < 1e-15);
         assert_eq!(avg[1].readings, 1, "low light is still a value");
-        assert_eq!(avg[1].to_patch().rgb, [9.0 / 255.0; 3]);
+        assert_eq!(avg[1].to_sample().rgb, [9.0 / 255.0; 3]);
         let e = average(&[(&a, &over)]).unwrap_err();
         assert_eq!(e, vec!["p0 (RGB [0, 0, 0])".to_string()]);
     }
@@ -216,27 +167,23 @@ mod tests {
             let y = ((l + 16.0) / 116.0).powi(3) * 100.0;
             white.map(|w| w * y / 100.0)
         };
-        let v = verify(&patches, white, &predict).unwrap().unwrap();
+        let v = verify_held_out(&patches, white, &predict).unwrap().unwrap();
         assert_eq!(v.patches.len(), 20);
         for (k, p) in v.patches.iter().enumerate() {
             let dl = (k + 1) as f64 / 10.0;
             let lbar: f64 = 50.0 + dl / 2.0;
             let sl = 1.0 + 0.015 * (lbar - 50.0).powi(2) / (20.0 + (lbar - 50.0).powi(2)).sqrt();
-            assert!(
-                (p.delta_e00 - dl / sl).abs() < 1e-9,
-                "{}: {}",
-                p.label,
-                p.delta_e00
-            );
+            assert!((p.de00 - dl / sl).abs() < 1e-9, "{:?}: {}", p.label, p.de00);
         }
-        assert!((v.max - v.patches[19].delta_e00).abs() < 1e-15);
+        assert!((v.de00.max - v.patches[19].de00).abs() < 1e-15);
         // Rank 0.95·19 = 18.05: between the 19th and 20th values.
-        let p95 =
-            v.patches[18].delta_e00 + 0.05 * (v.patches[19].delta_e00 - v.patches[18].delta_e00);
-        assert!((v.p95 - p95).abs() < 1e-12);
-        let mean = v.patches.iter().map(|p| p.delta_e00).sum::<f64>() / 20.0;
-        assert!((v.mean - mean).abs() < 1e-12);
-        assert!(verify(&patches[..1], white, &predict).unwrap().is_none());
+        let p95 = v.patches[18].de00 + 0.05 * (v.patches[19].de00 - v.patches[18].de00);
+        assert!((v.de00.p95 - p95).abs() < 1e-12);
+        let mean = v.patches.iter().map(|p| p.de00).sum::<f64>() / 20.0;
+        assert!((v.de00.mean - mean).abs() < 1e-12);
+        assert!(verify_held_out(&patches[..1], white, &predict)
+            .unwrap()
+            .is_none());
         // A model that predicts one patch as no colour is an error naming that patch, not
         // a NaN mean.
         let broken = |rgb: [f64; 3]| {
@@ -246,7 +193,9 @@ mod tests {
                 predict(rgb)
             }
         };
-        let e = verify(&patches, white, &broken).unwrap_err().to_string();
+        let e = verify_held_out(&patches, white, &broken)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("for patch 8 (r,g,b = "), "{e}");
     }
 }

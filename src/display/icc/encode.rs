@@ -19,9 +19,20 @@ pub enum IccError {
         "the model's matrix cannot be inverted, so its black offset cannot be put into the curves"
     )]
     Singular,
+    /// A white brighter than the luminance tag can hold.
+    #[error(
+        "the display white's XYZ has a component of {value} cd/m², more than the \
+         {MAX_S15_FIXED16} cd/m² the ICC luminance tag can hold (an s15Fixed16Number): \
+         the profile would state a dimmer display than the one measured"
+    )]
+    Luminance { value: f64 },
     #[error("the ICC encoder refused the profile: {0}")]
     Encode(String),
 }
+
+/// The largest s15Fixed16Number, 32767 + 65535/65536 (ICC.1:2010 basic number types):
+/// the ceiling of every XYZNumber, `lumi`'s among them.
+pub const MAX_S15_FIXED16: f64 = 32767.0 + 65535.0 / 65536.0;
 
 /// 0–1 as a 16-bit fraction (curveType, lut16 tables and device values).
 pub(super) fn unit_u16(v: f64) -> u16 {

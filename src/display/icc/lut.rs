@@ -1,4 +1,9 @@
-//! A LUT model as `lut16Type` A2B0 (device → PCS) and B2A0 (PCS → device) tags.
+//! A LUT model as A2B0 (device → PCS) and B2A0 (PCS → device) tags: `lut16Type` in a
+//! version 2.4 profile, `lutAtoBType` / `lutBtoAType` (ICC.1:2010 10.10, 10.11) in a version
+//! 4 profile. The tables are the same; only their container differs. LittleCMS reads a
+//! version 4 profile's lut16 B2A0 but cannot write it back (its version 4 writer takes a
+//! lutBtoA, whose B curves must come before the matrix), so a program that re-embeds such a
+//! profile through LittleCMS fails; the lutAtoB/lutBtoA form it saves as it read it.
 //!
 //! The model interpolates its grid tetrahedrally in the space of its shapers, so between
 //! two of its levels it is linear in the shaped coordinate. A2B0 puts a CLUT node on every
@@ -19,7 +24,10 @@
 //! unclipped inverse (within a margin), so colours inside the gamut next to its surface
 //! interpolate between true solutions instead of clipped ones; the output tables clip.
 
-use moxcms::{LutDataType, LutStore, LutType, LutWarehouse, Matrix3d};
+use moxcms::{
+    LutDataType, LutMultidimensionalType, LutStore, LutType, LutWarehouse, Matrix3d, ToneReprCurve,
+    Vector3d,
+};
 
 use super::encode::{unit_u16, xyz_u16, IccError, CURVE_ENTRIES};
 use super::pcs::{self, Mat3, Pcs};
@@ -163,25 +171,86 @@ fn a2b_nodes(axes: &[Axis; 3], target: usize) -> [Vec<f64>; 3] {
     })
 }
 
-fn lut16(
+/// One tag's tables in the order of `lut16Type`: a matrix on PCS XYZ input (identity for
+/// device input), three input tables, the CLUT (`points` per axis, 16-bit), three output
+/// tables, all as 16-bit fractions of 0–1.
+pub(super) struct Tables {
     matrix: Mat3,
     input: Vec<u16>,
     points: usize,
     clut: Vec<u16>,
     output: Vec<u16>,
-) -> LutWarehouse {
-    LutWarehouse::Lut(LutDataType {
-        num_input_channels: 3,
-        num_output_channels: 3,
-        num_clut_grid_points: points as u8,
-        matrix: Matrix3d { v: matrix },
-        num_input_table_entries: (input.len() / 3) as u16,
-        num_output_table_entries: (output.len() / 3) as u16,
-        input_table: LutStore::Store16(input),
-        clut_table: LutStore::Store16(clut),
-        output_table: LutStore::Store16(output),
-        lut_type: LutType::Lut16,
-    })
+}
+
+/// A flat run of three equal tables as three curves (`curveType`).
+fn curves(flat: Vec<u16>) -> Vec<ToneReprCurve> {
+    let n = flat.len() / 3;
+    flat.chunks(n)
+        .map(|c| ToneReprCurve::Lut(c.to_vec()))
+        .collect()
+}
+
+/// Three identity curves: two entries, 0 and full scale.
+fn identity_curves() -> Vec<ToneReprCurve> {
+    vec![ToneReprCurve::Lut(vec![0, 65535]); 3]
+}
+
+impl Tables {
+    /// `lut16Type` (ICC.1:2001-04 6.5.7, ICC.1:2010 10.9).
+    pub(super) fn lut16(self) -> LutWarehouse {
+        LutWarehouse::Lut(LutDataType {
+            num_input_channels: 3,
+            num_output_channels: 3,
+            num_clut_grid_points: self.points as u8,
+            matrix: Matrix3d { v: self.matrix },
+            num_input_table_entries: (self.input.len() / 3) as u16,
+            num_output_table_entries: (self.output.len() / 3) as u16,
+            input_table: LutStore::Store16(self.input),
+            clut_table: LutStore::Store16(self.clut),
+            output_table: LutStore::Store16(self.output),
+            lut_type: LutType::Lut16,
+        })
+    }
+
+    fn grid(&self) -> [u8; 16] {
+        let mut g = [0u8; 16];
+        g[..3].fill(self.points as u8);
+        g
+    }
+
+    /// `lutAtoBType` for device → PCS tables: A curves (the input tables), CLUT, B curves
+    /// (the output tables); no matrix, which a device input does not take.
+    pub(super) fn a_to_b(self) -> LutWarehouse {
+        debug_assert!(self.matrix == IDENTITY, "device input takes no matrix");
+        LutWarehouse::Multidimensional(LutMultidimensionalType {
+            num_input_channels: 3,
+            num_output_channels: 3,
+            grid_points: self.grid(),
+            a_curves: curves(self.input),
+            clut: Some(LutStore::Store16(self.clut)),
+            m_curves: Vec::new(),
+            matrix: Matrix3d { v: IDENTITY },
+            bias: Vector3d { v: [0.0; 3] },
+            b_curves: curves(self.output),
+        })
+    }
+
+    /// `lutBtoAType` for PCS → device tables: identity B curves, the matrix (no offset),
+    /// M curves (the input tables), CLUT, A curves (the output tables): lut16's order with
+    /// the curves lutBtoA requires first.
+    pub(super) fn b_to_a(self) -> LutWarehouse {
+        LutWarehouse::Multidimensional(LutMultidimensionalType {
+            num_input_channels: 3,
+            num_output_channels: 3,
+            grid_points: self.grid(),
+            b_curves: identity_curves(),
+            matrix: Matrix3d { v: self.matrix },
+            bias: Vector3d { v: [0.0; 3] },
+            m_curves: curves(self.input),
+            clut: Some(LutStore::Store16(self.clut)),
+            a_curves: curves(self.output),
+        })
+    }
 }
 
 const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -191,7 +260,7 @@ fn unit(i: usize, n: usize) -> f64 {
 }
 
 /// A2B0: drive → PCS XYZ with nodes on the model's levels.
-pub(super) fn a2b(lut: &Lut3d, pcs: &Pcs) -> LutWarehouse {
+pub(super) fn a2b(lut: &Lut3d, pcs: &Pcs) -> Tables {
     let axes: [Axis; 3] = std::array::from_fn(|c| Axis::new(lut, c));
     let nodes = a2b_nodes(&axes, TARGET_POINTS);
     let n = nodes[0].len();
@@ -224,11 +293,17 @@ pub(super) fn a2b(lut: &Lut3d, pcs: &Pcs) -> LutWarehouse {
             }
         }
     }
-    lut16(IDENTITY, input, n, clut, [0, 65535].repeat(3))
+    Tables {
+        matrix: IDENTITY,
+        input,
+        points: n,
+        clut,
+        output: [0, 65535].repeat(3),
+    }
 }
 
 /// B2A0: PCS XYZ → drive through the lut16 matrix, input tables, CLUT and output tables.
-pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<LutWarehouse, IccError> {
+pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<Tables, IccError> {
     let axes: [Axis; 3] = std::array::from_fn(|c| Axis::new(lut, c));
     let at = |rgb: [f64; 3]| pcs.to_pcs(lut.forward(rgb));
     let black = at([0.0; 3]);
@@ -336,7 +411,13 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<LutWarehouse, IccError> {
             unit_u16(axis.drive(s))
         }));
     }
-    Ok(lut16(matrix, input, n, clut, output))
+    Ok(Tables {
+        matrix,
+        input,
+        points: n,
+        clut,
+        output,
+    })
 }
 
 /// Drive values on the cube's six faces, `SURFACE_SAMPLES` per edge.

@@ -17,9 +17,15 @@
 //! exactly; each curve is then scaled to end at 1 and its column of M by the same factor.
 //! A black outside the primaries' cone (a component of k below 0) cannot be stored in a
 //! curve that must stay in 0–1: that component is clipped, and [`IccSummary`] says by how
-//! much the profile then departs from the model. The LUT models become `lut16Type` A2B0 and
-//! B2A0 tags ([`lut`]), which both ICC versions accept, plus matrix/TRC tags that
-//! approximate the model for readers that use nothing else.
+//! much the profile then departs from the model. The LUT models become A2B0 and B2A0 tags
+//! ([`lut`]) — `lutAtoBType` / `lutBtoAType` in version 4, which LittleCMS can save again
+//! after reading, `lut16Type` in version 2.4, which has nothing else — plus matrix/TRC tags
+//! that approximate the model for readers that use nothing else.
+//!
+//! `lumi` holds the white's luminance as an s15Fixed16Number (ICC.1:2010 luminanceTag, an
+//! XYZType), whose largest value is 32767 + 65535/65536: a brighter white is refused
+//! ([`IccError::Luminance`]) rather than clamped, since a reader would take the clamped
+//! value for the display's.
 
 mod encode;
 pub mod layout;
@@ -36,8 +42,8 @@ use moxcms::{
 use super::model::ModelParams;
 use super::profile::Profile;
 use crate::color::Xyz;
-pub use encode::IccError;
 use encode::{unit_u16, CURVE_ENTRIES};
+pub use encode::{IccError, MAX_S15_FIXED16};
 pub use pcs::Pcs;
 pub use readback::{agreement, inverse_agreement, Agreement, IccForward, IccInverse, IccReadError};
 
@@ -77,7 +83,8 @@ impl std::fmt::Display for IccVersion {
 #[derive(Clone, Debug)]
 pub struct IccSummary {
     pub version: IccVersion,
-    /// "matrix/TRC" or "lut16 A2B0/B2A0 + matrix/TRC".
+    /// "matrix/TRC", "lutAtoB A2B0, lutBtoA B2A0 + matrix/TRC" (version 4) or "lut16
+    /// A2B0/B2A0 + matrix/TRC" (version 2.4).
     pub form: &'static str,
     /// The curves' black components that had to be clipped at 0 (R, G, B; PCS Y units),
     /// zero when the black lies inside the primaries' cone.
@@ -110,6 +117,9 @@ pub fn encode_icc(
 ) -> Result<IccProfile, IccError> {
     let pcs = profile_pcs(profile)?;
     let white = icc_white(profile);
+    if let Some(&v) = white.to_array().iter().find(|&&v| v > MAX_S15_FIXED16) {
+        return Err(IccError::Luminance { value: v });
+    }
     let mut icc = ColorProfile::default();
     icc.profile_class = ProfileClass::DisplayDevice;
     icc.color_space = DataColorSpace::Rgb;
@@ -135,11 +145,22 @@ pub fn encode_icc(
             ("matrix/TRC", clipped)
         }
         ModelParams::Lut(l) => {
-            icc.lut_a_to_b_perceptual = Some(lut::a2b(l, &pcs));
-            icc.lut_b_to_a_perceptual = Some(lut::b2a(l, &pcs)?);
+            let (a2b, b2a) = (lut::a2b(l, &pcs), lut::b2a(l, &pcs)?);
+            let form = match version {
+                IccVersion::V4 => {
+                    icc.lut_a_to_b_perceptual = Some(a2b.a_to_b());
+                    icc.lut_b_to_a_perceptual = Some(b2a.b_to_a());
+                    "lutAtoB A2B0, lutBtoA B2A0 + matrix/TRC"
+                }
+                IccVersion::V2_4 => {
+                    icc.lut_a_to_b_perceptual = Some(a2b.lut16());
+                    icc.lut_b_to_a_perceptual = Some(b2a.lut16());
+                    "lut16 A2B0/B2A0 + matrix/TRC"
+                }
+            };
             let (matrix, black, curves) = lut::matrix_approximation(l);
             matrix_trc(&mut icc, &matrix, black, curves, &pcs)?;
-            ("lut16 A2B0/B2A0 + matrix/TRC", [0.0; 3])
+            (form, [0.0; 3])
         }
     };
     let bytes = icc.encode().map_err(|e| IccError::Encode(e.to_string()))?;

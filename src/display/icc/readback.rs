@@ -1,20 +1,26 @@
 //! An ICC display profile read back by moxcms and evaluated from its tags: matrix/TRC
-//! through moxcms's own curve evaluators, lut16 A2B0 and B2A0 by the lut16Type definition
+//! through moxcms's own curve evaluators, A2B0 and B2A0 by the lut16Type definition
 //! (ICC.1:2010 10.9: matrix for XYZ input, input tables, CLUT, output tables) with
-//! tetrahedral interpolation in the CLUT, as LittleCMS interpolates three inputs. It tells
+//! tetrahedral interpolation in the CLUT, as LittleCMS interpolates three inputs. The
+//! lutAtoB / lutBtoA tags of a version 4 profile are read as the same stages in their own
+//! order (10.10: A curves, CLUT, B curves; 10.11: B curves, matrix, M curves, CLUT, A
+//! curves), in the forms this program writes (identity where lut16 has no stage). It tells
 //! whether a written profile says what the model says.
 
 use crate::color::Xyz;
-use moxcms::{ColorProfile, LutDataType, LutStore, LutWarehouse, ToneCurveEvaluator};
+use moxcms::{
+    ColorProfile, LutDataType, LutMultidimensionalType, LutStore, LutWarehouse, ToneCurveEvaluator,
+    ToneReprCurve,
+};
 
 /// Why a profile could not be read back.
 #[derive(Debug, thiserror::Error)]
 pub enum IccReadError {
     #[error("moxcms cannot parse the profile: {0}")]
     Parse(String),
-    #[error("the profile has neither rXYZ/gXYZ/bXYZ with rTRC/gTRC/bTRC nor a lut16 A2B0 tag")]
+    #[error("the profile has neither rXYZ/gXYZ/bXYZ with rTRC/gTRC/bTRC nor an A2B0 tag")]
     NoForward,
-    #[error("the profile has no lut16 B2A0 tag")]
+    #[error("the profile has no B2A0 tag")]
     NoInverse,
     #[error("the profile's {0} is malformed")]
     Malformed(&'static str),
@@ -36,6 +42,32 @@ fn table(
         .collect())
 }
 
+/// Three `curveType` curves as tables over 0–1 (an empty curve is the identity).
+fn curve_tables(
+    curves: &[ToneReprCurve],
+    what: &'static str,
+) -> Result<[Vec<f64>; 3], IccReadError> {
+    let table = |c: &ToneReprCurve| match c {
+        ToneReprCurve::Lut(v) if v.is_empty() => Ok(vec![0.0, 1.0]),
+        ToneReprCurve::Lut(v) if v.len() >= 2 => {
+            Ok(v.iter().map(|&x| x as f64 / 65535.0).collect())
+        }
+        _ => Err(IccReadError::Malformed(what)),
+    };
+    match curves {
+        [a, b, c] => Ok([table(a)?, table(b)?, table(c)?]),
+        _ => Err(IccReadError::Malformed(what)),
+    }
+}
+
+/// Whether three curves are the identity.
+fn identity(curves: &[ToneReprCurve]) -> bool {
+    curves.iter().all(|c| match c {
+        ToneReprCurve::Lut(v) => v.is_empty() || v.as_slice() == [0, 65535],
+        ToneReprCurve::Parametric(p) => p.as_slice() == [1.0],
+    })
+}
+
 /// Linear interpolation in a table over 0–1.
 fn interpolate(t: &[f64], x: f64) -> f64 {
     let p = x.clamp(0.0, 1.0) * (t.len() - 1) as f64;
@@ -44,8 +76,8 @@ fn interpolate(t: &[f64], x: f64) -> f64 {
     t[i] * (1.0 - f) + t[i + 1] * f
 }
 
-/// One lut16Type tag: matrix (XYZ input only), input tables, CLUT, output tables, all as
-/// normalised 0–1 values.
+/// One lut16Type tag, or a lutAtoB/lutBtoA tag of the same stages: matrix (XYZ input
+/// only), input tables, CLUT, output tables, all as normalised 0–1 values.
 pub struct Lut16 {
     matrix: [[f64; 3]; 3],
     input: [Vec<f64>; 3],
@@ -75,6 +107,60 @@ impl Lut16 {
             points,
             clut,
             output: [o0, o1, o2],
+        })
+    }
+
+    /// A lutAtoB (`a_to_b`) or lutBtoA tag whose stages are lut16's: for lutAtoB, A curves,
+    /// CLUT and B curves with no matrix or M curves; for lutBtoA, identity B curves, a
+    /// matrix without offset, M curves, CLUT and A curves.
+    fn read_mab(
+        lut: &LutMultidimensionalType,
+        a_to_b: bool,
+        what: &'static str,
+    ) -> Result<Lut16, IccReadError> {
+        let points = lut.grid_points[0] as usize;
+        let Some(LutStore::Store16(flat)) = &lut.clut else {
+            return Err(IccReadError::Malformed(what));
+        };
+        if lut.num_input_channels != 3
+            || lut.num_output_channels != 3
+            || points < 2
+            || lut.grid_points[..3].iter().any(|&p| p as usize != points)
+            || flat.len() != 3 * points.pow(3)
+            || lut.bias.v != [0.0; 3]
+        {
+            return Err(IccReadError::Malformed(what));
+        }
+        let (matrix, input, output) = if a_to_b {
+            if !lut.m_curves.is_empty() && !identity(&lut.m_curves) {
+                return Err(IccReadError::Malformed(what));
+            }
+            let identity3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            (
+                identity3,
+                curve_tables(&lut.a_curves, what)?,
+                curve_tables(&lut.b_curves, what)?,
+            )
+        } else {
+            if !identity(&lut.b_curves) {
+                return Err(IccReadError::Malformed(what));
+            }
+            (
+                lut.matrix.v,
+                curve_tables(&lut.m_curves, what)?,
+                curve_tables(&lut.a_curves, what)?,
+            )
+        };
+        let clut = flat
+            .chunks(3)
+            .map(|n| std::array::from_fn(|c| n[c] as f64 / 65535.0))
+            .collect();
+        Ok(Lut16 {
+            matrix,
+            input,
+            points,
+            clut,
+            output,
         })
     }
 
@@ -126,8 +212,18 @@ impl IccForward {
     pub fn parse(bytes: &[u8]) -> Result<IccForward, IccReadError> {
         let p =
             ColorProfile::new_from_slice(bytes).map_err(|e| IccReadError::Parse(e.to_string()))?;
-        if let Some(LutWarehouse::Lut(lut)) = &p.lut_a_to_b_perceptual {
-            return Ok(IccForward::Lut16(Lut16::read(lut, "A2B0 lut16")?));
+        match &p.lut_a_to_b_perceptual {
+            Some(LutWarehouse::Lut(lut)) => {
+                return Ok(IccForward::Lut16(Lut16::read(lut, "A2B0 lut16")?))
+            }
+            Some(LutWarehouse::Multidimensional(lut)) => {
+                return Ok(IccForward::Lut16(Lut16::read_mab(
+                    lut,
+                    true,
+                    "A2B0 lutAtoB",
+                )?))
+            }
+            None => {}
         }
         Self::matrix(&p)
     }
@@ -173,7 +269,7 @@ impl IccForward {
     }
 }
 
-/// PCS XYZ → device RGB through a profile's lut16 B2A0.
+/// PCS XYZ → device RGB through a profile's B2A0.
 pub struct IccInverse(Lut16);
 
 impl IccInverse {
@@ -182,6 +278,9 @@ impl IccInverse {
             ColorProfile::new_from_slice(bytes).map_err(|e| IccReadError::Parse(e.to_string()))?;
         match &p.lut_b_to_a_perceptual {
             Some(LutWarehouse::Lut(lut)) => Ok(IccInverse(Lut16::read(lut, "B2A0 lut16")?)),
+            Some(LutWarehouse::Multidimensional(lut)) => {
+                Ok(IccInverse(Lut16::read_mab(lut, false, "B2A0 lutBtoA")?))
+            }
             _ => Err(IccReadError::NoInverse),
         }
     }

@@ -1,6 +1,8 @@
 //! `metamer reproduce` as one call: XYZ targets (CSV) or an absolute XYZ image through a
 //! display profile's inverse model to drive values, written as CSV or PNG, with the
-//! out-of-gamut values counted.
+//! out-of-gamut values counted. The image is read as [`crate::image`] interprets every
+//! reader's header: an OpenEXR `whiteLuminance` scales its values to cd/m², as it does for
+//! the read-back, so both see the same XYZ in one file.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

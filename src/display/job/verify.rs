@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::display::verify::{ProfileVerification, VerifyError};
+use crate::display::verify::{Verification, VerifyError};
 use crate::display::{
     read_measurement_file, verify_profile, MeasurementsError, Profile, ProfileError,
 };
@@ -21,7 +21,7 @@ pub struct Request {
 #[derive(Clone, Debug)]
 pub struct Report {
     pub profile: Profile,
-    pub verification: ProfileVerification,
+    pub verification: Verification,
 }
 
 /// A check failed.

@@ -10,13 +10,13 @@ use super::samples::{SortedSamples, CHANNEL_NAMES};
 use super::trc::fit_power_gamma;
 use super::{MatrixTrc, ModelKind, Trc};
 
-/// Residuals of a parameter vector.
-pub type Residuals = dyn Fn(&[f64]) -> Vec<f64> + Send + Sync;
+/// The residuals of a parameter vector.
+pub type ResidualFn = dyn Fn(&[f64]) -> Vec<f64> + Send + Sync;
 
 /// One channel's GOG (`flare` false) or GOGO curve fit as a least-squares problem: the
 /// residual, the start and the box bounds of its parameters (see [`gog_curve`]).
 pub struct GogProblem {
-    pub residual: Box<Residuals>,
+    pub residual: Box<ResidualFn>,
     pub start: Vec<f64>,
     pub lower: Vec<f64>,
     pub upper: Vec<f64>,

@@ -50,6 +50,9 @@ pub(super) struct Unfolded {
     pub held_edges: usize,
 }
 
+/// The sign combinations of the two other channels in "own ≥ Σ|others| + margin".
+const SIGNS: [[f64; 2]; 4] = [[1.0, 1.0], [1.0, -1.0], [-1.0, 1.0], [-1.0, -1.0]];
+
 /// Refits `correction` (on an n³ grid over `base`) until the table `base + correction`
 /// folds nowhere, calling `solve(held, ρ, start)` for each refit. `steps[c][i]` is the
 /// share of channel c's full light between its grid levels i and i + 1 (the normalised
@@ -96,7 +99,6 @@ pub(super) fn unfold(
     let mut held: BTreeMap<(usize, usize), usize> = BTreeMap::new();
     // The constraints (edge, signs) the penalty pulls up to their margin.
     let mut binding: BTreeSet<(usize, usize, usize)> = BTreeSet::new();
-    let signs = [[1.0, 1.0], [1.0, -1.0], [-1.0, 1.0], [-1.0, -1.0]];
     // "own ≥ Σ|others| + margin" is the four linear constraints own ± a ± b ≥ margin.
     let constraint = |from: usize, to: usize, axis: usize, combo: usize| {
         let base_step = at(base, to) - at(base, from);
@@ -104,21 +106,14 @@ pub(super) fn unfold(
         let margin = MARGIN * steps[axis][level];
         let mut u = to_primaries.row(axis).transpose();
         let others = (0..3).filter(|&o| o != axis);
-        for (o, sign) in others.zip(signs[combo]) {
+        for (o, sign) in others.zip(SIGNS[combo]) {
             u += sign * to_primaries.row(o).transpose();
         }
         (u, margin, base_step)
     };
     let mut rho = 100.0 * stiffness;
     for round in 0..ROUNDS {
-        for path in &folded {
-            for step in 0..3 {
-                let axis = (0..3)
-                    .find(|&a| path[step + 1][a] != path[step][a])
-                    .expect("each step of a path moves along one axis");
-                held.insert((index(path[step]), index(path[step + 1])), axis);
-            }
-        }
+        hold_edges(&mut held, &folded, &index);
         let nodes = table(&current);
         let before = binding.len();
         // A hinge: a constraint short of its margin is pulled up to it, one past it is let
@@ -126,18 +121,8 @@ pub(super) fn unfold(
         // released constraint pulled back by the readings): after HINGE_ROUNDS the set only
         // grows, which ends the rounds at the price of pinning some edges at the margin.
         let sticky = round >= HINGE_ROUNDS;
-        let mut released = 0;
-        for (&(from, to), &axis) in &held {
-            let step = at(&nodes, to) - at(&nodes, from);
-            for combo in 0..signs.len() {
-                let (u, margin, _) = constraint(from, to, axis, combo);
-                if u.dot(&step) < margin {
-                    binding.insert((from, to, combo));
-                } else if !sticky && binding.remove(&(from, to, combo)) {
-                    released += 1;
-                }
-            }
-        }
+        let step = |from: usize, to: usize| at(&nodes, to) - at(&nodes, from);
+        let released = hinge(&mut binding, &held, &step, &constraint, sticky);
         let before = before - released;
         if binding.len() == before {
             rho *= 10.0;
@@ -167,4 +152,46 @@ pub(super) fn unfold(
         correction: best.1,
         held_edges: held.len(),
     }
+}
+
+/// Holds every edge of the `folded` paths (node triples, `index` to a node's number) with
+/// the channel it steps along.
+fn hold_edges(
+    held: &mut BTreeMap<(usize, usize), usize>,
+    folded: &[[[usize; 3]; 4]],
+    index: &dyn Fn([usize; 3]) -> usize,
+) {
+    for path in folded {
+        for step in 0..3 {
+            let axis = (0..3)
+                .find(|&a| path[step + 1][a] != path[step][a])
+                .expect("each step of a path moves along one axis");
+            held.insert((index(path[step]), index(path[step + 1])), axis);
+        }
+    }
+}
+
+/// One round of the hinge over the `held` edges' constraints: one short of its margin
+/// (`constraint` of edge, channel and sign combination; `step` the edge's step now) joins
+/// `binding`, one past it leaves unless `sticky`. Returns how many left.
+fn hinge(
+    binding: &mut BTreeSet<(usize, usize, usize)>,
+    held: &BTreeMap<(usize, usize), usize>,
+    step: &dyn Fn(usize, usize) -> Vector3<f64>,
+    constraint: &dyn Fn(usize, usize, usize, usize) -> (Vector3<f64>, f64, Vector3<f64>),
+    sticky: bool,
+) -> usize {
+    let mut released = 0;
+    for (&(from, to), &axis) in held {
+        let step = step(from, to);
+        for combo in 0..SIGNS.len() {
+            let (u, margin, _) = constraint(from, to, axis, combo);
+            if u.dot(&step) < margin {
+                binding.insert((from, to, combo));
+            } else if !sticky && binding.remove(&(from, to, combo)) {
+                released += 1;
+            }
+        }
+    }
+    released
 }

@@ -13,6 +13,17 @@ pub struct Sample {
     pub xyz: Xyz,
 }
 
+impl Sample {
+    /// A sample of 8-bit drive values (each code c is the drive c/255) and the XYZ read
+    /// with them shown: how every reading of a characterization becomes a sample.
+    pub fn from_rgb8(rgb8: [u8; 3], xyz: Xyz) -> Sample {
+        Sample {
+            rgb: rgb8.map(|c| f64::from(c) / 255.0),
+            xyz,
+        }
+    }
+}
+
 /// Drive values closer than this count as equal (finer than a 16-bit step).
 pub const SAME_DRIVE: f64 = 1e-6;
 

@@ -71,148 +71,24 @@ fn fit_stages(
 ) -> Result<(MatrixTrc, MatrixTrc, Option<MatrixTrc>), FitError> {
     let kind = ModelKind::ShaperMatrix;
     let knots = knots.max(1);
-    if patches.len() < 8 {
-        return Err(FitError::Missing {
-            model: kind,
-            what: format!(
-                "at least 8 patches to fit 15 parameters in 3 equations each (found {})",
-                patches.len()
-            ),
-        });
-    }
-    let gamma0 = [2.2; 3];
-    let (black0, m0) =
-        linear_matrix(patches, &gamma0, set.white.map(|w| w[1])).ok_or_else(|| {
-            FitError::Failed {
-                model: kind,
-                message: "the patches do not span the three channels: the matrix is undetermined \
-                      (measure colours that vary each of red, green and blue)"
-                    .into(),
-            }
-        })?;
-    // The CIELAB reference stays fixed during the fit: the measured white if there is one,
-    // otherwise the start model's white.
-    let white = set.white.unwrap_or_else(|| {
-        Xyz::from(std::array::from_fn(|r| {
-            black0[r] + m0[r].iter().sum::<f64>()
-        }))
-    });
-    let yw = white[1];
-    if !(yw.is_finite() && yw > 0.0) {
-        return Err(FitError::Failed {
-            model: kind,
-            message: format!("the white has no positive luminance (Y = {yw})"),
-        });
-    }
-    let w = white;
-    let measured: Vec<Lab> = patches.iter().map(|p| p.xyz.to_lab(w)).collect();
-    let lab_residual = |predict: &dyn Fn([f64; 3]) -> [f64; 3]| -> Vec<f64> {
-        let mut r = Vec::with_capacity(3 * patches.len());
-        for (p, m) in patches.iter().zip(&measured) {
-            let lab = Xyz::from_array(predict(p.rgb)).to_lab(w);
-            r.extend([lab.l - m.l, lab.a - m.a, lab.b - m.b]);
-        }
-        r
-    };
-    let floor = NOISE_FLOOR * yw;
-    let noise_residual = |predict: &dyn Fn([f64; 3]) -> [f64; 3]| -> Vec<f64> {
-        let mut r = Vec::with_capacity(3 * patches.len());
-        for p in patches {
-            let q = predict(p.rgb);
-            r.extend(reading_residual(q, p.xyz.into(), floor));
-        }
-        r
-    };
-    // Parameters shared by both stages: matrix (row-major) and black, in units of white Y.
-    let mut shared: Vec<f64> = m0.iter().flatten().map(|v| v / yw).collect();
-    shared.extend(black0.iter().map(|v| v / yw));
-    let unpack = |p: &[f64]| -> ([[f64; 3]; 3], [f64; 3]) {
-        (
-            std::array::from_fn(|r| std::array::from_fn(|c| p[r * 3 + c] * yw)),
-            std::array::from_fn(|r| p[9 + r] * yw),
-        )
-    };
-    let apply = |m: &[[f64; 3]; 3], b: &[f64; 3], lin: [f64; 3]| -> [f64; 3] {
-        std::array::from_fn(|r| b[r] + m[r][0] * lin[0] + m[r][1] * lin[1] + m[r][2] * lin[2])
-    };
+    let (problem, shared) = Problem::new(set, patches)?;
     let (mut lower, mut upper) = (vec![-10.0; 12], vec![10.0; 12]);
     for i in 9..12 {
         lower[i] = -0.5;
         upper[i] = 0.5;
     }
-
-    // Stage 1: power laws.
-    let mut start: Vec<f64> = gamma0.to_vec();
-    start.extend(&shared);
-    let mut lo1 = vec![0.3; 3];
-    lo1.extend(&lower);
-    let mut hi1 = vec![5.0; 3];
-    hi1.extend(&upper);
-    let stage1 = |p: &[f64]| -> Vec<f64> {
-        let (m, b) = unpack(&p[3..]);
-        lab_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
-    };
-    let p1 = levenberg_marquardt(&stage1, &start, &lo1, &hi1);
-    let stage1_noise = |p: &[f64]| -> Vec<f64> {
-        let (m, b) = unpack(&p[3..]);
-        noise_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c]))))
-    };
-    // Kept only where the power laws hold within the noise: a reduced χ² (in units of the
-    // assumed noise) beyond MAX_REDUCED_CHI2 says the misses are the form's, not the
-    // meter's, and then CIELAB's weighting by what is seen is the better one.
-    let p1_noise = noise_units
-        .then(|| levenberg_marquardt(&stage1_noise, &p1, &lo1, &hi1))
-        .filter(|p| {
-            let dof = (3 * patches.len()).saturating_sub(p.len()).max(1);
-            let chi2: f64 = stage1_noise(p).iter().map(|r| r * r).sum();
-            chi2 / dof as f64 <= MAX_REDUCED_CHI2
-        });
+    let (p1, p1_noise) = problem.power_laws(&shared, (&lower, &upper), noise_units);
     let gamma = [p1[0], p1[1], p1[2]];
-
-    // Stage 2: monotone knot tables in each power law's root domain.
-    let free = knots - 1;
     let drive: Vec<f64> = (0..=knots).map(|k| k as f64 / knots as f64).collect();
-    let tables = |t: &[f64]| -> [Trc; 3] {
-        std::array::from_fn(|c| {
-            let mut inc = vec![1.0];
-            inc.extend(t[c * free..(c + 1) * free].iter().map(|v| v.exp()));
-            let total: f64 = inc.iter().sum();
-            let mut u = vec![0.0];
-            let mut acc = 0.0;
-            for v in &inc {
-                acc += v;
-                u.push(acc / total);
-            }
-            Trc::Table {
-                drive: drive.clone(),
-                value: u.iter().map(|v| v.powf(gamma[c])).collect(),
-                exponent: gamma[c],
-            }
-        })
-    };
-    let mut start2 = vec![0.0; 3 * free];
-    start2.extend(&p1[3..]);
-    let mut lo2 = vec![-8.0; 3 * free];
-    lo2.extend(&lower);
-    let mut hi2 = vec![8.0; 3 * free];
-    hi2.extend(&upper);
-    let stage2 = |p: &[f64]| -> Vec<f64> {
-        let trc = tables(p);
-        let (m, b) = unpack(&p[3 * free..]);
-        lab_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| trc[c].eval(rgb[c]))))
-    };
-    let p2 = if free > 0 {
-        levenberg_marquardt(&stage2, &start2, &lo2, &hi2)
-    } else {
-        start2.clone()
-    };
+    let free = knots - 1;
+    let (start2, p2) = problem.knot_tables(&p1, gamma, &drive, free, (&lower, &upper));
     let model = |p: &[f64]| {
-        let (m, b) = unpack(&p[3 * free..]);
-        MatrixTrc::new(kind, b.into(), m, tables(p)).map_err(singular)
+        let (m, b) = problem.unpack(&p[3 * free..]);
+        MatrixTrc::new(kind, b.into(), m, tables(p, free, &drive, gamma)).map_err(singular)
     };
     let noise = match p1_noise {
         Some(p) => {
-            let (m, b) = unpack(&p[3..]);
+            let (m, b) = problem.unpack(&p[3..]);
             let trc = std::array::from_fn(|c| Trc::Table {
                 drive: drive.clone(),
                 value: drive.iter().map(|d| d.powf(p[c])).collect(),
@@ -223,6 +99,192 @@ fn fit_stages(
         None => None,
     };
     Ok((model(&start2)?, model(&p2)?, noise))
+}
+
+/// What both stages fit: the patches, their CIELAB relative to a white that stays fixed
+/// during the fit, and the white's luminance that the matrix and black are scaled by.
+struct Problem<'a> {
+    patches: &'a [Sample],
+    measured: Vec<Lab>,
+    white: Xyz,
+    yw: f64,
+}
+
+impl<'a> Problem<'a> {
+    /// The problem, and the parameters both stages share at their start: the linear
+    /// matrix (row-major) and black of power laws of 2.2, in units of white Y.
+    fn new(
+        set: &SortedSamples,
+        patches: &'a [Sample],
+    ) -> Result<(Problem<'a>, Vec<f64>), FitError> {
+        let kind = ModelKind::ShaperMatrix;
+        if patches.len() < 8 {
+            return Err(FitError::Missing {
+                model: kind,
+                what: format!(
+                    "at least 8 patches to fit 15 parameters in 3 equations each (found {})",
+                    patches.len()
+                ),
+            });
+        }
+        let (black0, m0) =
+            linear_matrix(patches, &[2.2; 3], set.white.map(|w| w[1])).ok_or_else(|| {
+                FitError::Failed {
+                    model: kind,
+                    message:
+                        "the patches do not span the three channels: the matrix is undetermined \
+                      (measure colours that vary each of red, green and blue)"
+                            .into(),
+                }
+            })?;
+        // The CIELAB reference stays fixed during the fit: the measured white if there is
+        // one, otherwise the start model's white.
+        let white = set.white.unwrap_or_else(|| {
+            Xyz::from(std::array::from_fn(|r| {
+                black0[r] + m0[r].iter().sum::<f64>()
+            }))
+        });
+        let yw = white[1];
+        if !(yw.is_finite() && yw > 0.0) {
+            return Err(FitError::Failed {
+                model: kind,
+                message: format!("the white has no positive luminance (Y = {yw})"),
+            });
+        }
+        let mut shared: Vec<f64> = m0.iter().flatten().map(|v| v / yw).collect();
+        shared.extend(black0.iter().map(|v| v / yw));
+        let problem = Problem {
+            patches,
+            measured: patches.iter().map(|p| p.xyz.to_lab(white)).collect(),
+            white,
+            yw,
+        };
+        Ok((problem, shared))
+    }
+
+    /// The CIELAB misses of `predict` on every patch.
+    fn lab_residual(&self, predict: &dyn Fn([f64; 3]) -> [f64; 3]) -> Vec<f64> {
+        let mut r = Vec::with_capacity(3 * self.patches.len());
+        for (p, m) in self.patches.iter().zip(&self.measured) {
+            let lab = Xyz::from_array(predict(p.rgb)).to_lab(self.white);
+            r.extend([lab.l - m.l, lab.a - m.a, lab.b - m.b]);
+        }
+        r
+    }
+
+    /// The misses of `predict` on every patch in units of a reading's noise.
+    fn noise_residual(&self, predict: &dyn Fn([f64; 3]) -> [f64; 3]) -> Vec<f64> {
+        let floor = NOISE_FLOOR * self.yw;
+        let mut r = Vec::with_capacity(3 * self.patches.len());
+        for p in self.patches {
+            let q = predict(p.rgb);
+            r.extend(reading_residual(q, p.xyz.into(), floor));
+        }
+        r
+    }
+
+    /// The matrix and black of the 12 shared parameters.
+    fn unpack(&self, p: &[f64]) -> ([[f64; 3]; 3], [f64; 3]) {
+        (
+            std::array::from_fn(|r| std::array::from_fn(|c| p[r * 3 + c] * self.yw)),
+            std::array::from_fn(|r| p[9 + r] * self.yw),
+        )
+    }
+
+    /// Stage 1: power laws, fitted in CIELAB, and with `noise_units` refitted in units of
+    /// a reading's noise where that fits within it.
+    fn power_laws(
+        &self,
+        shared: &[f64],
+        (lower, upper): (&[f64], &[f64]),
+        noise_units: bool,
+    ) -> (Vec<f64>, Option<Vec<f64>>) {
+        let mut start: Vec<f64> = vec![2.2; 3];
+        start.extend(shared);
+        let mut lo1 = vec![0.3; 3];
+        lo1.extend(lower);
+        let mut hi1 = vec![5.0; 3];
+        hi1.extend(upper);
+        let stage1 = |p: &[f64]| -> Vec<f64> {
+            let (m, b) = self.unpack(&p[3..]);
+            self.lab_residual(&|rgb| {
+                apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c])))
+            })
+        };
+        let p1 = levenberg_marquardt(&stage1, &start, &lo1, &hi1);
+        let stage1_noise = |p: &[f64]| -> Vec<f64> {
+            let (m, b) = self.unpack(&p[3..]);
+            self.noise_residual(&|rgb| {
+                apply(&m, &b, std::array::from_fn(|c| rgb[c].max(0.0).powf(p[c])))
+            })
+        };
+        // Kept only where the power laws hold within the noise: a reduced χ² (in units of
+        // the assumed noise) beyond MAX_REDUCED_CHI2 says the misses are the form's, not the
+        // meter's, and then CIELAB's weighting by what is seen is the better one.
+        let p1_noise = noise_units
+            .then(|| levenberg_marquardt(&stage1_noise, &p1, &lo1, &hi1))
+            .filter(|p| {
+                let dof = (3 * self.patches.len()).saturating_sub(p.len()).max(1);
+                let chi2: f64 = stage1_noise(p).iter().map(|r| r * r).sum();
+                chi2 / dof as f64 <= MAX_REDUCED_CHI2
+            });
+        (p1, p1_noise)
+    }
+
+    /// Stage 2: monotone knot tables (`free` free increments per channel) in each power
+    /// law's root domain, started from stage 1's `p1`; its start and its fit.
+    fn knot_tables(
+        &self,
+        p1: &[f64],
+        gamma: [f64; 3],
+        drive: &[f64],
+        free: usize,
+        (lower, upper): (&[f64], &[f64]),
+    ) -> (Vec<f64>, Vec<f64>) {
+        let mut start2 = vec![0.0; 3 * free];
+        start2.extend(&p1[3..]);
+        let mut lo2 = vec![-8.0; 3 * free];
+        lo2.extend(lower);
+        let mut hi2 = vec![8.0; 3 * free];
+        hi2.extend(upper);
+        let stage2 = |p: &[f64]| -> Vec<f64> {
+            let trc = tables(p, free, drive, gamma);
+            let (m, b) = self.unpack(&p[3 * free..]);
+            self.lab_residual(&|rgb| apply(&m, &b, std::array::from_fn(|c| trc[c].eval(rgb[c]))))
+        };
+        let p2 = if free > 0 {
+            levenberg_marquardt(&stage2, &start2, &lo2, &hi2)
+        } else {
+            start2.clone()
+        };
+        (start2, p2)
+    }
+}
+
+/// XYZ of linear drives `lin` through matrix `m` over black `b`.
+fn apply(m: &[[f64; 3]; 3], b: &[f64; 3], lin: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|r| b[r] + m[r][0] * lin[0] + m[r][1] * lin[1] + m[r][2] * lin[2])
+}
+
+/// Stage 2's tone curves of parameters `t`: per channel, `free` log increments after a
+/// first of 1, accumulated and normalised, raised to the channel's power law `gamma`.
+fn tables(t: &[f64], free: usize, drive: &[f64], gamma: [f64; 3]) -> [Trc; 3] {
+    std::array::from_fn(|c| {
+        let mut inc = vec![1.0];
+        inc.extend(t[c * free..(c + 1) * free].iter().map(|v| v.exp()));
+        let total: f64 = inc.iter().sum();
+        let mut u = vec![0.0];
+        let mut acc = 0.0;
+        for v in &inc {
+            acc += v;
+            u.push(acc / total);
+        }
+        Trc::Table {
+            drive: drive.to_vec(),
+            value: u.iter().map(|v| v.powf(gamma[c])).collect(),
+            exponent: gamma[c],
+        }
+    })
 }
 
 /// Below this fraction of the white's luminance a reading's noise is taken as constant,

@@ -21,12 +21,12 @@ use crate::display::ModelKind;
 use crate::experiment::display::DisplayOptions;
 use crate::experiment::reproduction::ReproductionOptions;
 use crate::experiment::request::{check_dir, check_image_size, check_repeats, check_target_de};
-use crate::experiment::simulation::{ImageSpec, SimulationOptions};
+use crate::experiment::simulation::SimulationOptions;
 use crate::experiment::validate::{ValidationResult, FILE as COMPARISONS_FILE};
 use crate::experiment::{BoxRequest, Progress, Request, RequestError, Stage, StageOutcome};
 use crate::measure_box::BoxPlan;
 use crate::output::OutputPolicy;
-use crate::rig::{Preset, Scenario};
+use crate::rig::{Preset, Scenario, ScreenSpec};
 use crate::session::RunOptions;
 use crate::validation::assess::{Assessment, JndCount, JndVerdict, Stat};
 use crate::validation::export::HTML_FILE;
@@ -41,7 +41,6 @@ pub struct LabOptions {
     #[serde(serialize_with = "preset_name")]
     pub display: Preset,
     pub model: ModelKind,
-    #[serde(serialize_with = "display_string")]
     pub gamut: GamutMapping,
     /// The simulation's target: 95 % half-width of every patch's ΔE*ab.
     pub target_de: f64,
@@ -66,18 +65,8 @@ fn preset_name<S: serde::Serializer>(p: &Preset, s: S) -> Result<S::Ok, S::Error
     s.serialize_str(p.name())
 }
 
-fn display_string<S: serde::Serializer, T: std::fmt::Display>(
-    v: &T,
-    s: S,
-) -> Result<S::Ok, S::Error> {
-    s.collect_str(v)
-}
-
 /// The summary of a lab run, [`LAB_FILE`] in its directory.
 pub const LAB_FILE: &str = "lab.json";
-
-/// The simulation's time limit, as the experiment's command gives it.
-const MAX_RENDER_SECONDS: f64 = 600.0;
 
 impl LabOptions {
     /// The simulated instrument `model` at this run's pace, with `seed` when given.
@@ -118,25 +107,22 @@ impl LabOptions {
                 plan: None,
                 repeats: self.box_repeats,
                 seed: self.seed,
-                light: Some(self.scenario.name().to_string()),
+                light: Some(self.scenario),
             },
-            simulation: SimulationOptions {
-                target_de: self.target_de,
-                seed: self.seed,
-                max_seconds: MAX_RENDER_SECONDS,
-                image: (self.image_size > 0).then_some(ImageSpec {
-                    size: self.image_size,
-                    spp: IMAGE_SPP,
-                }),
-                external_image: None,
-            },
+            simulation: SimulationOptions::new(
+                self.target_de,
+                self.seed,
+                self.image_size,
+                IMAGE_SPP,
+                None,
+            ),
             display: DisplayOptions {
-                screen: format!("virtual:{}", self.display.name()),
+                screen: ScreenSpec::Virtual(self.display),
                 spot: self.instrument("cs100a", Some(self.seed.wrapping_add(2))),
                 model: self.model,
             },
             reproduction: ReproductionOptions {
-                gamut: self.gamut.to_string(),
+                gamut: self.gamut,
                 mirror: true,
             },
             repeats: self.repeats,

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::files::{read_json, unusable};
-use crate::experiment::simulation::{SimulationSummary, SUMMARY_FILE};
+use crate::experiment::simulation::{SimulationMethod, SimulationSummary, SUMMARY_FILE};
 use crate::validation::propagate::render_lab_sigma;
 use crate::validation::report::RenderConfidenceSection;
 pub use crate::validation::report::RenderUncertainty;
@@ -18,7 +18,7 @@ pub fn section(dir: &Path) -> Result<(RenderConfidenceSection, RenderUncertainty
     let v = read_json(&file).map_err(|why| unusable(WHAT, &file, why))?;
     let s: SimulationSummary = serde_json::from_value(v)
         .map_err(|e| unusable(WHAT, &file, format!("is not a render summary: {e}")))?;
-    let bound = s.method == "radiosity";
+    let bound = s.method == SimulationMethod::Radiosity;
     let (measure, method) = if bound {
         (
             "ΔE*ab error bound (the mesh levels' extrapolation against its alternatives)",

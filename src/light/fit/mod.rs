@@ -105,7 +105,45 @@ pub struct LdcFit {
     pub normal_luminance: f64,
     /// Each plane's reading at 0° (horizontal, vertical).
     pub normal_readings: [f64; 2],
+    /// The largest angle read in each half-plane, C0, C90, C180, C270 (degrees): beyond it
+    /// the table is the model's extrapolation (None in a fit written before this was kept).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_to_deg: Option<[f64; 4]>,
     pub table: CGammaTable,
+}
+
+/// Where a fitted table is not measured: the angles past the last reading, up to 90°,
+/// which the model extrapolates. Said wherever the table goes (the command's output, the
+/// IES and EULUMDAT files), since a reader of those files cannot tell a measured candela
+/// value from an extrapolated one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Extrapolation {
+    /// The smallest of the half-planes' last angles: past it at least one half-plane is
+    /// extrapolated.
+    pub beyond_deg: f64,
+    /// The last angle read in C0, C90, C180, C270.
+    pub measured_to_deg: [f64; 4],
+    pub model: LdcModel,
+}
+
+impl Extrapolation {
+    /// One line in ASCII (for the files): what is measured and what extrapolated.
+    pub fn sentence(&self) -> String {
+        let m = self.measured_to_deg;
+        let reach = if m.iter().all(|&x| x == m[0]) {
+            format!("readings reach {} deg in C0, C90, C180 and C270", m[0])
+        } else {
+            format!(
+                "readings reach C0 {} deg, C90 {} deg, C180 {} deg, C270 {} deg",
+                m[0], m[1], m[2], m[3]
+            )
+        };
+        format!(
+            "gamma above {} deg up to 90 deg is not measured: there the table is the {} \
+             model's extrapolation ({reach})",
+            self.beyond_deg, self.model
+        )
+    }
 }
 
 /// C-plane step of the table written, degrees.
@@ -169,6 +207,7 @@ pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
         }
     }
     let table = build_table(&chosen_halves)?;
+    let measured_to_deg = std::array::from_fn(|k| halves[k].0.iter().copied().fold(0.0, f64::max));
     let fit = LdcFit {
         model,
         halves: chosen_halves,
@@ -177,6 +216,7 @@ pub fn fit(falloff: &Falloff, choice: ModelChoice) -> Result<LdcFit, LdcError> {
         why,
         normal_luminance: l0,
         normal_readings,
+        measured_to_deg: Some(measured_to_deg),
         table,
     };
     fit.check_finite()?;
@@ -192,6 +232,19 @@ impl LdcFit {
     /// The chosen model's candidate entry (its RMS and CV scores).
     pub fn chosen(&self) -> Option<&Candidate> {
         self.candidates.iter().find(|c| c.model == self.model)
+    }
+
+    /// Where the table is the model's extrapolation. Readings stop short of 90° (the light
+    /// is seen from the front), so every fit has one; None only for a fit written before
+    /// it kept how far it was read.
+    pub fn extrapolation(&self) -> Option<Extrapolation> {
+        let measured_to_deg = self.measured_to_deg?;
+        let beyond_deg = measured_to_deg.iter().copied().fold(90.0, f64::min);
+        (beyond_deg < 90.0).then_some(Extrapolation {
+            beyond_deg,
+            measured_to_deg,
+            model: self.model,
+        })
     }
 
     /// Every number of the fit is finite: JSON has no infinity (serde writes `null`), and

@@ -2,11 +2,11 @@
 //! repeat counts, the fall-off angles, the patches, the tile grid, the box's geometry.
 //! The first bad field is named.
 
-use super::{invalid, BoxPlan, Geometry, PlanError, MAX_REPEATS, MAX_TILES_PER_SIDE};
+use super::{invalid, BoxPlan, BoxPlanError, Geometry, MAX_REPEATS, MAX_TILES_PER_SIDE};
 
 impl BoxPlan {
     /// Checks every field; the first bad one is named.
-    pub fn validate(&self) -> Result<(), PlanError> {
+    pub fn validate(&self) -> Result<(), BoxPlanError> {
         self.check_repeats()?;
         check_falloff_angles(&self.falloff_angles_deg)?;
         check_patches(&self.patches)?;
@@ -14,7 +14,7 @@ impl BoxPlan {
         self.geometry.check_walls()
     }
 
-    fn check_repeats(&self) -> Result<(), PlanError> {
+    fn check_repeats(&self) -> Result<(), BoxPlanError> {
         for (field, n) in [
             ("repeats", self.repeats),
             ("material_repeats", self.material_repeats),
@@ -32,7 +32,7 @@ impl BoxPlan {
 }
 
 /// Angles off the normal, increasing, with the normal and one on each side of it.
-fn check_falloff_angles(a: &[f64]) -> Result<(), PlanError> {
+fn check_falloff_angles(a: &[f64]) -> Result<(), BoxPlanError> {
     if a.is_empty() {
         return Err(invalid("falloff_angles_deg", "needs at least one angle"));
     }
@@ -76,7 +76,7 @@ fn check_falloff_angles(a: &[f64]) -> Result<(), PlanError> {
 }
 
 /// ColorChecker patch numbers, each once.
-fn check_patches(patches: &[usize]) -> Result<(), PlanError> {
+fn check_patches(patches: &[usize]) -> Result<(), BoxPlanError> {
     if patches.is_empty() {
         return Err(invalid("patches", "needs at least one patch"));
     }
@@ -95,7 +95,7 @@ fn check_patches(patches: &[usize]) -> Result<(), PlanError> {
 }
 
 /// The light's tile grid, and the fall-off tile on it.
-fn check_grid(g: &Geometry, falloff_tile: Option<[usize; 2]>) -> Result<(), PlanError> {
+fn check_grid(g: &Geometry, falloff_tile: Option<[usize; 2]>) -> Result<(), BoxPlanError> {
     for (field, n) in [("geometry.rows", g.rows), ("geometry.cols", g.cols)] {
         if !(1..=MAX_TILES_PER_SIDE).contains(&n) {
             return Err(invalid(
@@ -121,7 +121,7 @@ fn check_grid(g: &Geometry, falloff_tile: Option<[usize; 2]>) -> Result<(), Plan
 impl Geometry {
     /// The box's size, the light on its back wall, the viewpoint in front of it and the
     /// spot meter's acceptance.
-    fn check_walls(&self) -> Result<(), PlanError> {
+    fn check_walls(&self) -> Result<(), BoxPlanError> {
         let g = self;
         // The chart (204 mm × 291 mm) must fit on the right wall.
         if !(g.size_m.is_finite() && (0.3..=5.0).contains(&g.size_m)) {

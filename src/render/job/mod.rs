@@ -102,6 +102,9 @@ pub enum RenderEvent<'a> {
     PreviewWritten(&'a Path),
     /// A line of a long run's log (the convergence chart's strategies and levels).
     Log(&'a str),
+    /// Something about the result the caller must show the user (the report carries it
+    /// too): a reference white cut short by the time limit.
+    Warning(&'a str),
 }
 
 /// A written image (of [`image::run`]).

@@ -17,11 +17,19 @@
 //! all sides (the display's or the box's), so this white changes no comparison: it serves
 //! the printed Lab and the check of the image's units.
 //!
-//! Units: an image in another unit than cd/m² (W/(sr·m²) is 683 times smaller) cannot be
-//! told in general from a renderer that is wrong. What is checked: an OpenEXR
-//! `whiteLuminance` attribute, when present, must be 1 (values are cd/m²); no cone may be
-//! all zero; and patch 19, the chart's white, must read between a tenth and ten times the
-//! white diffuser. A smaller factor is left to the validation to find.
+//! A white traced to the time limit before its target is still used, with a warning (a
+//! [`RenderEvent::Warning`], and in the report's `warnings` and `white_trace` in the JSON):
+//! the readings' XYZ and their standard errors do not depend on it, so refusing would
+//! throw away a read-back for a figure the comparison does not use, but the printed CIELAB
+//! and each reading's ΔE95 do, and an operator must not take them for the target's.
+//!
+//! Units: the image is read as [`crate::image`] interprets its header (an OpenEXR
+//! `whiteLuminance` scales the values to cd/m², an RGB file without chromaticities is
+//! BT.709, a crop of the camera's frame is refused). An image in another unit than cd/m²
+//! (W/(sr·m²) is 683 times smaller) cannot be told in general from a renderer that is
+//! wrong. What is checked: no cone may be all zero, and patch 19, the chart's white, must
+//! read between a tenth and ten times the white diffuser. A smaller factor is left to the
+//! validation to find.
 //!
 //! ```
 //! use metamer::render::job::spots_from_image::{run, Request};
@@ -61,7 +69,8 @@ use crate::render::scene::Scene;
 use crate::render::spot::cone::{cone_mean, cone_pixels, ConeMean};
 pub use crate::render::spot::cone::{ReadBackError, MIN_EFFECTIVE_PIXELS};
 use crate::render::spot::{
-    de_ci95_of, patch_aim, reference_white, RenderedReading, Sampling, SpotOptions, Uncertainty,
+    de_ci95_of, patch_aim, reference_white_traced, RenderedReading, Sampling, SpotOptions,
+    TracedWhite, Uncertainty,
 };
 
 /// What the readings' JSON names as their method: `validate` shows it as the
@@ -111,6 +120,11 @@ pub struct Report {
     pub pixels: XyzImage,
     /// The white the readings' CIELAB is against.
     pub white: Xyz,
+    /// How the white was traced (None: it was given).
+    pub white_trace: Option<TracedWhite>,
+    /// What the operator must know about these readings (a white cut short by the time
+    /// limit); also sent as [`RenderEvent::Warning`] as it happens.
+    pub warnings: Vec<String>,
     pub seconds: f64,
     /// Each with its 95 % half-width, its standard errors and the pixels in its cone as
     /// its samples.
@@ -137,8 +151,19 @@ struct Json<'a> {
     provenance: Option<&'a serde_json::Map<String, serde_json::Value>>,
     image: Source<'a>,
     white: Xyz,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    white_trace: Option<WhiteTrace<'a>>,
+    warnings: &'a [String],
     seconds: f64,
     patches: &'a [RenderedReading],
+}
+
+/// A traced white as the JSON states it, with whether it reached its target.
+#[derive(serde::Serialize)]
+struct WhiteTrace<'a> {
+    #[serde(flatten)]
+    traced: &'a TracedWhite,
+    reached: bool,
 }
 
 impl Report {
@@ -157,6 +182,11 @@ impl Report {
                 renderer: "external",
             },
             white: self.white,
+            white_trace: self.white_trace.as_ref().map(|t| WhiteTrace {
+                traced: t,
+                reached: t.reached(),
+            }),
+            warnings: &self.warnings,
             seconds: self.seconds,
             patches: &self.patches,
         })
@@ -181,7 +211,6 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
     }
     let file = request.image.clone();
     let image = read_xyz_image(&file)?;
-    check_white_luminance(&file)?;
     if image.width * camera.height != image.height * camera.width {
         return Err(ReadBackError::Aspect {
             file,
@@ -193,18 +222,27 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
         .into());
     }
     let cones = read_cones(&scene, &image, &file)?;
-    let white = match request.white {
-        Some(w) => w,
-        None => reference_white(
-            &scene,
-            &SpotOptions {
-                target_de: request.target_de,
-                max_seconds: request.max_seconds,
-                seed: request.seed,
-                ..SpotOptions::default()
-            },
-        )?,
+    let (white, traced) = match request.white {
+        Some(w) => (w, None),
+        None => {
+            let t = reference_white_traced(
+                &scene,
+                &SpotOptions {
+                    target_de: request.target_de,
+                    max_seconds: request.max_seconds,
+                    seed: request.seed,
+                    ..SpotOptions::default()
+                },
+            )?;
+            (t.xyz, Some(t))
+        }
     };
+    let mut warnings = Vec::new();
+    if let Some(t) = traced.filter(|t| !t.reached()) {
+        let w = short_white_warning(&t);
+        events(RenderEvent::Warning(&w));
+        warnings.push(w);
+    }
     let (patch, ratio) = (cones[18].xyz[1], cones[18].xyz[1] / white[1]);
     if !(0.1..=10.0).contains(&ratio) {
         return Err(ReadBackError::Units {
@@ -241,10 +279,21 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
         image: file,
         sha256,
         white,
+        white_trace: traced,
+        warnings,
         seconds: start.elapsed().as_secs_f64(),
         patches,
         cones,
     })
+}
+
+/// What a white cut short by the time limit means for the readings, in words for the
+/// operator.
+fn short_white_warning(t: &TracedWhite) -> String {
+    format!(
+        "the reference white stopped at the time limit ({} s) with a ΔE*ab 95 % half-width of          {:.3}, above its target of {:.3} (a third of --target-de): the readings' XYZ are as          read, but their CIELAB and ΔE95 carry the white's extra noise; give --white, or more          --max-seconds or a larger --target-de",
+        t.max_seconds, t.de_ci95, t.target_de
+    )
 }
 
 /// The 24 cones' means, patch 1 first.
@@ -282,36 +331,6 @@ fn read_cones(scene: &Scene, image: &XyzImage, file: &Path) -> Result<Vec<ConeMe
         out.push(mean);
     }
     Ok(out)
-}
-
-/// An OpenEXR file's `whiteLuminance`, when it has one, must say its values are cd/m².
-/// The file has been read whole by then, so its header is known to be sound.
-fn check_white_luminance(file: &Path) -> Result<(), RenderError> {
-    let is_exr = file
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if !is_exr {
-        return Ok(());
-    }
-    let meta = exr::meta::MetaData::read_from_file(file, false).map_err(|e| {
-        crate::image::ImageError::Exr {
-            file: file.to_path_buf(),
-            message: e.to_string(),
-        }
-    })?;
-    for header in meta.headers.iter() {
-        if let Some(value) = header.own_attributes.white_luminance {
-            if (value - 1.0).abs() > 1e-6 {
-                return Err(ReadBackError::WhiteLuminance {
-                    file: file.to_path_buf(),
-                    value,
-                }
-                .into());
-            }
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

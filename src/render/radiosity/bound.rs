@@ -12,9 +12,18 @@
 //! beyond the observed one's side, as long as the effective order keeps rising towards p);
 //! where they converge as fast or faster, the classical bound stands. With a fourth level
 //! the previous estimate is a further alternative: the bound is at least the step between
-//! them. Levels that do not converge monotonically are not yet in the asymptotic range
-//! (a point closer to an edge than the elements are small): the estimate is then marked
-//! irregular, and its bound is only a rough figure.
+//! them.
+//!
+//! Levels that do not converge monotonically are either not yet in the asymptotic range (a
+//! point closer to an edge than the elements are small) or already converged below what
+//! the sums can resolve: their changes are then the Gauss–Seidel iteration's remainder and
+//! rounding, whose sign means nothing. Such an estimate is marked irregular unless its
+//! changes are at that floor; its bound is then at least what the slowest convergence
+//! trusted (order [`MIN_ORDER`]) could still add to the last change ([`turning_gain`] times
+//! it), so a turn whose changes are small against the tolerance (at most 1/gain of it, a
+//! tenth at level 3, a twentieth at level 6) is converged whatever its sign, and a turn by
+//! a large change is not. A sequence that converges monotonically but more slowly than
+//! [`MIN_ORDER`] stays irregular: its bound cannot be trusted however small it is.
 
 use crate::color::{delta_e76, Xyz};
 
@@ -68,6 +77,11 @@ pub fn observed_order(v: [f64; 3], h: [f64; 3]) -> Option<f64> {
     Some(0.5 * (lo + hi))
 }
 
+/// The relative rounding floor of a reading: every reading is a sum over at most
+/// [`MAX_ELEMENTS`](super::mesh::MAX_ELEMENTS) elements' terms (5,000 × 2.2e-16 ≈ 1.1e-12
+/// of the sum), so changes between levels this small say nothing about convergence.
+pub const ROUNDING_FLOOR: f64 = 1e-12;
+
 /// One quantity's estimate from its last levels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Estimate {
@@ -76,8 +90,13 @@ pub struct Estimate {
     pub alt: f64,
     /// The previous levels' estimate, when there were four levels.
     pub previous: Option<f64>,
-    /// The last three levels converge monotonically at an order of at least [`MIN_ORDER`].
+    /// The last three levels converge monotonically at an order of at least [`MIN_ORDER`],
+    /// or change by no more than rounding.
     pub regular: bool,
+    /// The last three levels turn back (the two changes have opposite signs, or one is 0).
+    pub turning: bool,
+    /// The larger of the last two changes between levels (absolute).
+    pub step: f64,
 }
 
 impl Estimate {
@@ -100,9 +119,9 @@ pub fn estimate(v: &[f64], h: &[f64], p: f64) -> Estimate {
         );
         let fine = richardson(v3[1], h3[1], v3[2], h3[2], p);
         let coarse = richardson(v3[0], h3[0], v3[1], h3[1], p);
+        let step = (v3[2] - v3[1]).abs().max((v3[1] - v3[0]).abs());
         // Readings equal to rounding need no order.
-        let settled = (v3[2] - v3[1]).abs().max((v3[1] - v3[0]).abs())
-            <= 1e-12 * v3[2].abs().max(f64::MIN_POSITIVE);
+        let settled = step <= ROUNDING_FLOOR * v3[2].abs().max(f64::MIN_POSITIVE);
         match observed_order(v3, h3) {
             Some(q) if q < p => {
                 let q_used = q.max(MIN_ORDER);
@@ -110,7 +129,9 @@ pub fn estimate(v: &[f64], h: &[f64], p: f64) -> Estimate {
                     value: richardson(v3[1], h3[1], v3[2], h3[2], q_used),
                     alt: fine,
                     previous: None,
-                    regular: q >= MIN_ORDER,
+                    regular: q >= MIN_ORDER || settled,
+                    turning: false,
+                    step,
                 }
             }
             Some(_) => Estimate {
@@ -118,12 +139,16 @@ pub fn estimate(v: &[f64], h: &[f64], p: f64) -> Estimate {
                 alt: coarse,
                 previous: None,
                 regular: true,
+                turning: false,
+                step,
             },
             None => Estimate {
                 value: fine,
                 alt: coarse,
                 previous: None,
                 regular: settled,
+                turning: true,
+                step,
             },
         }
     };
@@ -134,16 +159,62 @@ pub fn estimate(v: &[f64], h: &[f64], p: f64) -> Estimate {
     e
 }
 
-/// A scalar's estimate and bound from its levels (see [`estimate`]); `abs_err` is an
-/// absolute error each level's reading may carry besides the discretization (the stopped
-/// iteration), which the extrapolation can amplify.
-pub fn extrapolated_with_bound(v: &[f64], h: &[f64], p: f64, abs_err: f64) -> (f64, f64, bool) {
-    let e = estimate(v, h, p);
-    // The extrapolation's weights sum in magnitude to (a + b)/(a − b) ≤ 1 + 2/((h₁/h₂)ᵖ − 1).
+/// The factor by which the last levels' changes may grow into the error of their estimate
+/// when the convergence is no faster than order min(`p`, [`MIN_ORDER`]): an extrapolation's
+/// weights sum in magnitude to (a + b)/(a − b) ≤ 1 + 2/((h₁/h₂)^q − 1), and a monotone
+/// sequence of that order whose last change is d has at most d/((h₁/h₂)^q − 1) left to go.
+/// `h` holds the element sizes, coarsest first (at least two).
+pub fn turning_gain(h: &[f64], p: f64) -> f64 {
     let n = h.len();
     let r = (h[n - 2] / h[n - 1]).powf(MIN_ORDER.min(p));
-    let gain = 1.0 + 2.0 / (r - 1.0);
-    (e.value, e.bound() + gain * abs_err, e.regular)
+    1.0 + 2.0 / (r - 1.0)
+}
+
+/// A scalar's estimate from its levels, with its bound (see [`extrapolated_with_bound`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scalar {
+    pub value: f64,
+    pub bound: f64,
+    /// See [`Estimate::regular`]; also true when the last changes are within what the
+    /// stopped iteration leaves.
+    pub regular: bool,
+    /// The last levels turn back by changes that are not at the floor (see the module's
+    /// documentation): the bound is then at least [`turning_gain`] times the last change.
+    pub turning: bool,
+}
+
+impl Scalar {
+    /// Whether the estimate is converged to an absolute tolerance `tol`: its bound is within
+    /// it, and it converges regularly or turns back by changes so small against `tol` that
+    /// their sign does not matter (the bound of a turning estimate covers them). A slow
+    /// monotone sequence is not converged, however small its bound.
+    pub fn converged(&self, tol: f64) -> bool {
+        self.bound <= tol && (self.regular || self.turning)
+    }
+}
+
+/// A scalar's estimate and bound from its levels (see [`estimate`]); `abs_err` is an
+/// absolute error each level's reading may carry besides the discretization (the stopped
+/// iteration), which the extrapolation can amplify. Levels whose changes are within twice
+/// `abs_err` (each of two levels may carry it) and rounding are regular whatever their
+/// signs; levels that turn back by more get a bound of at least [`turning_gain`] times their
+/// larger change.
+pub fn extrapolated_with_bound(v: &[f64], h: &[f64], p: f64, abs_err: f64) -> Scalar {
+    let e = estimate(v, h, p);
+    let gain = turning_gain(h, p);
+    let floor = 2.0 * abs_err + ROUNDING_FLOOR * e.value.abs();
+    let at_floor = e.step <= floor;
+    let mut bound = e.bound();
+    let turning = e.turning && !at_floor;
+    if turning {
+        bound = bound.max(gain * e.step);
+    }
+    Scalar {
+        value: e.value,
+        bound: bound + gain * abs_err,
+        regular: e.regular || at_floor,
+        turning,
+    }
 }
 
 /// One patch's estimate from its levels (coarsest first) of the patch and the white.
@@ -179,6 +250,8 @@ pub fn extrapolate(
             alt: x,
             previous: Some(x),
             regular: true,
+            turning: false,
+            step: 0.0,
         }),
         None => comps(white),
     };
@@ -264,12 +337,13 @@ mod tests {
                     "level {m}: the classical bound held"
                 );
             }
-            let (value, bound, regular) = extrapolated_with_bound(vs, hs, 2.0, 0.0);
-            assert!(regular);
+            let s = extrapolated_with_bound(vs, hs, 2.0, 0.0);
+            assert!(s.regular && !s.turning);
             assert!(
-                (value - 1.0).abs() <= bound,
-                "level {m}: error {} vs bound {bound}",
-                (value - 1.0).abs()
+                (s.value - 1.0).abs() <= s.bound,
+                "level {m}: error {} vs bound {}",
+                (s.value - 1.0).abs(),
+                s.bound
             );
         }
     }
@@ -279,8 +353,83 @@ mod tests {
     fn a_turning_sequence_is_irregular() {
         let h = [1.0, 0.5, 1.0 / 3.0];
         let e = estimate(&[1.0, 1.2, 1.1], &h, 2.0);
-        assert!(!e.regular);
+        assert!(!e.regular && e.turning);
         let e = estimate(&[1.0, 1.0, 1.0], &h, 2.0);
         assert!(e.regular && e.bound() == 0.0);
+    }
+
+    /// Levels 1–3 (h ratio 3/2 last): at order 1/2 the gain is 1 + 2/(√1.5 − 1) = 9.899.
+    #[test]
+    fn the_turning_gain_is_that_of_order_one_half() {
+        let h = [1.0, 0.5, 1.0 / 3.0];
+        assert!((turning_gain(&h, 2.0) - (1.0 + 2.0 / (1.5f64.sqrt() - 1.0))).abs() < 1e-12);
+        assert!((turning_gain(&h, 2.0) - 9.899).abs() < 1e-3);
+    }
+
+    /// Changes within what the stopped iteration leaves (here 1e-9 per level) are converged
+    /// whatever their signs: regular, and bounded by the iteration's own term.
+    #[test]
+    fn a_turn_at_the_iteration_floor_is_converged() {
+        let h = [1.0, 0.5, 1.0 / 3.0];
+        let v = [600.0 + 1e-9, 600.0 - 1e-9, 600.0 + 0.5e-9];
+        let s = extrapolated_with_bound(&v, &h, 2.0, 1e-9);
+        assert!(s.regular && !s.turning, "{s:?}");
+        assert!(s.bound < 1e-7 && s.converged(1e-6), "{s:?}");
+        // Without the iteration's error the same turn is not at the floor: it turns, and
+        // its bound is the gain times its larger change (2e-9, to the rounding of 600).
+        let s = extrapolated_with_bound(&v, &h, 2.0, 0.0);
+        assert!(!s.regular && s.turning, "{s:?}");
+        assert!(s.bound >= turning_gain(&h, 2.0) * 1.999e-9, "{s:?}");
+    }
+
+    /// A turn by 0.002 in 100: converged to 0.1 (the bound, 9.899 × 0.002 ≈ 0.0198, is
+    /// within it), not to 0.01, and a turn by 0.2 is never taken for convergence at a
+    /// tolerance below 1.979.
+    #[test]
+    fn a_turn_is_converged_only_when_small_against_the_tolerance() {
+        let h = [1.0, 0.5, 1.0 / 3.0];
+        let s = extrapolated_with_bound(&[100.001, 99.999, 100.0005], &h, 2.0, 0.0);
+        assert!(s.turning && !s.regular);
+        assert!((s.bound - 9.899 * 0.002).abs() < 1e-4, "{s:?}");
+        assert!(s.converged(0.1));
+        assert!(!s.converged(0.01));
+        let s = extrapolated_with_bound(&[1.0, 1.2, 1.1], &h, 2.0, 0.0);
+        assert!(s.bound >= 1.979 && !s.converged(1.97), "{s:?}");
+    }
+
+    /// A sequence that converges monotonically at order 0.3, slower than trusted, is not
+    /// converged however small its bound against the tolerance.
+    #[test]
+    fn a_slow_monotone_sequence_is_not_converged() {
+        let h = [1.0, 0.5, 1.0 / 3.0];
+        let v = h.map(|x: f64| 5.0 - 1e-6 * x.powf(0.3));
+        let s = extrapolated_with_bound(&v, &h, 2.0, 0.0);
+        assert!(!s.regular && !s.turning && s.bound < 1.0, "{s:?}");
+        assert!(!s.converged(1.0));
+    }
+
+    /// A converged reading R∞ = 1 with a small h² term under an iteration error of ±1e-9
+    /// alternating from level to level, on levels 1–12: the estimate is within its bound at
+    /// every level, turning or not.
+    #[test]
+    fn a_noisy_converged_sequence_is_within_its_bound() {
+        let eta = 1e-9;
+        for c in [0.0, 1e-9, 1e-8, 1e-6] {
+            let hs: Vec<f64> = (1..=12).map(|k| 0.5 / k as f64).collect();
+            let v: Vec<f64> = hs
+                .iter()
+                .enumerate()
+                .map(|(k, h)| 1.0 + c * h * h + if k % 2 == 0 { eta } else { -eta })
+                .collect();
+            for m in 3..=hs.len() {
+                let first = m.saturating_sub(4);
+                let s = extrapolated_with_bound(&v[first..m], &hs[first..m], 2.0, eta);
+                assert!(
+                    (s.value - 1.0).abs() <= s.bound,
+                    "c {c}, level {m}: error {:e}, {s:?}",
+                    (s.value - 1.0).abs()
+                );
+            }
+        }
     }
 }

@@ -3,7 +3,7 @@
 //! for checks of the whole field (flux balance).
 
 use super::super::geometry::Vec3;
-use super::bound::extrapolated_with_bound;
+use super::bound::{extrapolated_with_bound, MIN_ORDER};
 use super::direct::irradiance_factor;
 use super::lights::Lights;
 use super::polygon::point_to_rect;
@@ -277,18 +277,26 @@ pub fn probe_illuminance(
         let hs: Vec<f64> = (first + 1..=m).map(|k| base / k as f64).collect();
         // What the stopped iteration may leave, in lux, at the finest level.
         let algebraic = levels_alg.iter().skip(first).fold(0.0f64, |a, &b| a.max(b));
-        let mut irregular = 0;
+        // Probes whose estimate is not converged although within the tolerance: their last
+        // levels converge more slowly than the slowest order trusted.
+        let mut slow = 0;
+        let mut done = true;
         let out: Vec<Illuminance> = (0..probes.len())
             .map(|i| {
                 let v: Vec<f64> = raw[first..].iter().map(|r| r[i]).collect();
                 let abs_err = algebraic * (v[v.len() - 1].abs() + direct[i].abs());
-                let (fine, bound, regular) = extrapolated_with_bound(&v, &hs, opts.order, abs_err);
-                irregular += usize::from(!regular);
+                let e = extrapolated_with_bound(&v, &hs, opts.order, abs_err);
+                let total = direct[i] + e.value;
+                let tol = rel_tolerance * total.abs();
+                if !e.converged(tol) {
+                    done = false;
+                    slow += usize::from(e.bound <= tol);
+                }
                 Illuminance {
                     direct_lux: direct[i],
-                    indirect_lux: fine,
-                    total_lux: direct[i] + fine,
-                    bound_lux: bound,
+                    indirect_lux: e.value,
+                    total_lux: total,
+                    bound_lux: e.bound,
                 }
             })
             .collect();
@@ -303,10 +311,6 @@ pub fn probe_illuminance(
         if let Some(l) = levels.last_mut() {
             l.worst_relative_bound = Some(worst);
         }
-        let done = irregular == 0
-            && out
-                .iter()
-                .all(|r| r.bound_lux <= rel_tolerance * r.total_lux.abs());
         if done {
             return Ok(ProbeRun {
                 probes: out,
@@ -320,12 +324,12 @@ pub fn probe_illuminance(
                 probes: out,
                 levels,
                 converged: false,
-                stopped: Some(if irregular > 0 {
+                stopped: Some(if slow > 0 {
                     format!(
-                        "level {level} is the finest the solver tries, and at {irregular} \
-                         probe(s) the last levels still do not converge monotonically (a point \
-                         nearer an edge than the elements are small): their bound is a rough \
-                         figure"
+                        "level {level} is the finest the solver tries, and at {slow} probe(s) \
+                         the last levels still converge more slowly than order {MIN_ORDER} (a \
+                         point nearer an edge than the elements are small): their bound is a \
+                         rough figure"
                     )
                 } else {
                     format!("level {level} is the finest the solver tries")

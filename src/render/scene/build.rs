@@ -6,7 +6,7 @@ use std::sync::Arc;
 use super::super::geometry::{Rect, Vec3, VecOps};
 use super::super::spectral::{cmf_bins, constant_bins};
 use super::file::{CameraFile, DistributionFile, EmitterFile, SceneFile};
-use super::loader::{err, Files, Loader, R};
+use super::loader::{err, Loader, SpectrumFiles, R};
 use super::model::{
     Camera, Distribution, Emitter, Scene, Surface, MAX_EMITTERS, MAX_LUMINANCE_CD_M2, MAX_SURFACES,
     MAX_TILES, MAX_TILES_PER_SIDE, MAX_TILE_SPECTRA,
@@ -16,7 +16,7 @@ use crate::color::{ObserverKind, K_M};
 
 /// The whole scene: its sizes first, then the surfaces, the emitters, the camera and the
 /// meter, then what only the whole can show (emitters hidden in a surface, no light).
-pub fn scene(file: &SceneFile, files: Files) -> R<Scene> {
+pub fn scene(file: &SceneFile, files: SpectrumFiles) -> R<Scene> {
     check_sizes(file)?;
     let mut loader = Loader::new(files);
     let mut warnings = Vec::new();
@@ -445,7 +445,7 @@ fn distribution(dp: &str, d: &DistributionFile, loader: &Loader) -> R<Distributi
         }
         DistributionFile::CGamma { table } => Distribution::Table(Arc::new(table.clone())),
         DistributionFile::Ies { file } | DistributionFile::Ldt { file } => {
-            let Files::Dir(dir) = loader.files else {
+            let SpectrumFiles::Dir(dir) = loader.files else {
                 return err(
                     format!("{dp}.file"),
                     "built-in scenes name no photometric file",
@@ -508,5 +508,5 @@ fn check_table_peak(
 /// A built-in scene from its text.
 pub fn builtin_scene(text: &str) -> R<Scene> {
     let file = SceneFile::from_json(text)?;
-    scene(&file, Files::Builtin)
+    scene(&file, SpectrumFiles::Builtin)
 }

@@ -152,6 +152,40 @@ pub enum WriteError {
 }
 
 impl SceneFile {
+    /// Every file the scene names (spectral tables, photometric files), as written in it:
+    /// relative to the scene file's directory. A program that writes beside a scene
+    /// registers them as its inputs, so nothing it writes replaces what the scene reads.
+    pub fn named_files(&self) -> Vec<&str> {
+        fn spectrum(s: &SpectrumRef) -> Option<&str> {
+            match s {
+                SpectrumRef::File { file, .. } => Some(file.as_str()),
+                _ => None,
+            }
+        }
+        let mut out: Vec<&str> = Vec::new();
+        out.extend(
+            self.surfaces
+                .iter()
+                .filter_map(|s| spectrum(&s.reflectance)),
+        );
+        for e in &self.emitters {
+            out.extend(
+                e.tiles
+                    .iter()
+                    .filter_map(|t| t.spectrum.as_ref().and_then(spectrum)),
+            );
+            out.extend(e.spectrum.as_ref().and_then(spectrum));
+            out.extend(e.reflectance.as_ref().and_then(spectrum));
+            if let DistributionFile::Ies { file } | DistributionFile::Ldt { file } = &e.distribution
+            {
+                out.push(file);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// Pretty JSON of the file.
     pub fn to_json(&self) -> Result<String, serde_json::Error> {
         serde_json::to_string_pretty(self)

@@ -24,7 +24,7 @@ pub(super) fn err<T>(path: impl Into<String>, message: impl Into<String>) -> R<T
 
 /// Where the spectral CSV files a scene names are found.
 #[derive(Clone, Copy)]
-pub enum Files<'a> {
+pub enum SpectrumFiles<'a> {
     /// Relative to the scene file's directory.
     Dir(&'a Path),
     /// The data files compiled into the binary (the built-in scenes).
@@ -33,12 +33,12 @@ pub enum Files<'a> {
 
 /// Spectra read so far: a file named by a thousand tiles is read once.
 pub(super) struct Loader<'a> {
-    pub(super) files: Files<'a>,
+    pub(super) files: SpectrumFiles<'a>,
     tables: HashMap<String, SpectralTable>,
 }
 
 impl<'a> Loader<'a> {
-    pub(super) fn new(files: Files<'a>) -> Loader<'a> {
+    pub(super) fn new(files: SpectrumFiles<'a>) -> Loader<'a> {
         Loader {
             files,
             tables: HashMap::new(),
@@ -48,8 +48,8 @@ impl<'a> Loader<'a> {
     fn table(&mut self, p: &str, file: &str) -> R<&SpectralTable> {
         if !self.tables.contains_key(file) {
             let t = match self.files {
-                Files::Dir(dir) => SpectralTable::read(&dir.join(file)),
-                Files::Builtin => match builtin::data_file(file) {
+                SpectrumFiles::Dir(dir) => SpectralTable::read(&dir.join(file)),
+                SpectrumFiles::Builtin => match builtin::data_file(file) {
                     Some(text) => SpectralTable::parse(text, file),
                     None => {
                         return err(

@@ -70,6 +70,12 @@ pub enum SceneError {
 impl Scene {
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Scene::load_with_inputs(path).map(|(scene, _)| scene)
+    }
+
+    /// [`Scene::load`], with every file the scene read: the scene file first, then the
+    /// files it names, resolved against its directory.
+    pub fn load_with_inputs(path: &Path) -> Result<(Scene, Vec<PathBuf>), SceneError> {
         let io = |source| SceneError::Io {
             file: path.to_path_buf(),
             source,
@@ -92,12 +98,16 @@ impl Scene {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        Scene::build(&file, dir).map_err(invalid)
+        let scene = Scene::build(&file, dir).map_err(invalid)?;
+        let inputs = std::iter::once(path.to_path_buf())
+            .chain(file.named_files().into_iter().map(|f| dir.join(f)))
+            .collect();
+        Ok((scene, inputs))
     }
 
     /// Validates a parsed scene; files are resolved against `dir`.
     pub fn build(file: &SceneFile, dir: &Path) -> Result<Scene, PathError> {
-        build::scene(file, loader::Files::Dir(dir))
+        build::scene(file, loader::SpectrumFiles::Dir(dir))
     }
 
     /// A box built into the program by name (`validation-box`, lit by the `ips-lcd`

@@ -112,12 +112,6 @@ pub enum ReadBackError {
     )]
     Dark { file: PathBuf, patch: usize },
     #[error(
-        "{}: the OpenEXR attribute whiteLuminance is {value}, so a value of 1 is not 1 cd/m²; \
-         the readings need absolute XYZ in cd/m² (whiteLuminance 1 or none)",
-        file.display()
-    )]
-    WhiteLuminance { file: PathBuf, value: f32 },
-    #[error(
         "{}: patch 19 (the chart's white) reads Y = {patch:.4} against the white diffuser's \
          {white:.4} cd/m², {ratio:.3} times it: outside 0.1–10, so the image is not in cd/m² \
          of this scene (W/(sr·m²) would be 683 times too small) or not of this scene",

@@ -273,6 +273,34 @@ pub struct SpotProgress {
 /// refined to a third of `opts.target_de`. Its error shifts every patch alike and is not in
 /// the patches' half-widths, so it has to be well below theirs.
 pub fn reference_white(scene: &Scene, opts: &SpotOptions) -> Result<Xyz, SpotError> {
+    reference_white_traced(scene, opts).map(|w| w.xyz)
+}
+
+/// A reference white as traced: its XYZ and how close it came to its target before the
+/// time limit.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct TracedWhite {
+    #[serde(rename = "XYZ")]
+    pub xyz: Xyz,
+    /// Its own ΔE*ab 95 % half-width (against itself).
+    pub de_ci95: f64,
+    /// What it was traced to: a third of the readings' target.
+    pub target_de: f64,
+    pub samples: u64,
+    /// The time limit (s) it was traced under.
+    pub max_seconds: f64,
+}
+
+impl TracedWhite {
+    /// Whether the white reached its target; one that did not was cut short by the time
+    /// limit.
+    pub fn reached(&self) -> bool {
+        self.de_ci95 < self.target_de
+    }
+}
+
+/// [`reference_white`] with how far it got.
+pub fn reference_white_traced(scene: &Scene, opts: &SpotOptions) -> Result<TracedWhite, SpotError> {
     check_options(opts)?;
     reference_white_until(scene, opts, Deadline::after(opts.max_seconds))
 }
@@ -291,7 +319,7 @@ fn reference_white_until(
     scene: &Scene,
     opts: &SpotOptions,
     deadline: Deadline,
-) -> Result<Xyz, SpotError> {
+) -> Result<TracedWhite, SpotError> {
     let ws = white_scene(scene)?;
     let wt = Tracer::new(&ws, opts.strategy);
     let aim = patch_aim(&ws, 19)?;
@@ -320,7 +348,13 @@ fn reference_white_until(
     if !(white[1] > 0.0 && white.is_finite()) {
         return Err(SpotError::DarkWhite(white[1]));
     }
-    Ok(white)
+    Ok(TracedWhite {
+        xyz: white,
+        de_ci95: st.de_ci95(white),
+        target_de: opts.target_de / 3.0,
+        samples: st.n,
+        max_seconds: opts.max_seconds,
+    })
 }
 
 /// The 24 readings, refined until every ΔE*ab 95 % half-width is below the target.
@@ -348,7 +382,7 @@ pub fn render_spots_with_progress(
             }
             w
         }
-        None => reference_white_until(scene, opts, deadline)?,
+        None => reference_white_until(scene, opts, deadline)?.xyz,
     };
     let mut stats = vec![XyzStats::default(); 24];
     let mut batch = [opts.first_batch; 24];
@@ -410,7 +444,19 @@ pub fn render_spots_with_progress(
             RenderedReading::new(k + 1, st.mean(), white, uncertainty)
         })
         .collect::<Vec<RenderedReading>>();
-    if let Some((p, _)) = patches.iter().zip(&stats).find(|(p, st)| {
+    check_finite(&patches, &stats)?;
+    Ok(SpotResult {
+        white,
+        seconds: start.elapsed().as_secs_f64(),
+        patches,
+        converged,
+    })
+}
+
+/// Refuses a reading that is no number (its XYZ, CIELAB, standard errors or uncertainty),
+/// naming its patch.
+fn check_finite(patches: &[RenderedReading], stats: &[XyzStats]) -> Result<(), SpotError> {
+    if let Some((p, _)) = patches.iter().zip(stats).find(|(p, st)| {
         !(p.xyz.is_finite()
             && p.lab
                 .iter()
@@ -423,10 +469,5 @@ pub fn render_spots_with_progress(
             xyz: p.xyz.to_array(),
         });
     }
-    Ok(SpotResult {
-        white,
-        seconds: start.elapsed().as_secs_f64(),
-        patches,
-        converged,
-    })
+    Ok(())
 }

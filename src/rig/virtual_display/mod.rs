@@ -40,15 +40,14 @@ use metamer_drivers::{Light, View, World};
 pub use panel::{quantize, VirtualPanel};
 pub use presets::{PanelParams, PanelTrc, Preset};
 
-use super::screen::{MeterAim, Placement, Screen, ScreenError};
-use crate::image::{RgbImage, ScreenSpot};
-use crate::session;
+use super::{MeterAim, Placement, Screen, ScreenError};
+use crate::image::{Drive8Image, ScreenSpot};
 
 /// What the panel shows: one colour everywhere, or an image filling the screen.
 #[derive(Clone)]
 enum Shown {
     Colour([u8; 3]),
-    Image(Arc<RgbImage>),
+    Image(Arc<Drive8Image>),
 }
 
 /// The panel plus what it shows now and where the meter looks; this is what a simulated
@@ -130,6 +129,11 @@ impl VirtualDisplay {
 }
 
 impl Screen for VirtualDisplay {
+    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Colour(rgb);
+        Ok(())
+    }
+
     fn spec(&self) -> String {
         format!("virtual:{}", self.lit.panel.name())
     }
@@ -146,7 +150,7 @@ impl Screen for VirtualDisplay {
         )
     }
 
-    fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {
+    fn show_image(&mut self, image: &Drive8Image) -> Result<Placement, ScreenError> {
         *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) =
             Shown::Image(Arc::new(image.clone()));
         Ok(Placement::WHOLE)
@@ -163,15 +167,5 @@ impl Screen for VirtualDisplay {
 
     fn meter_aim(&self) -> Option<MeterAim> {
         Some(self.lit.aim.clone())
-    }
-    fn as_show(&mut self) -> &mut dyn session::Screen {
-        self
-    }
-}
-
-impl session::Screen for VirtualDisplay {
-    fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
-        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Colour(rgb);
-        Ok(())
     }
 }

@@ -30,7 +30,7 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use super::spectral::{Band, ChannelShape, Filter, PanelSpectra};
+use super::spectral::{Band, ChannelShape, ColourFilter, PanelSpectra};
 
 /// The named simulated monitors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -118,7 +118,7 @@ impl Preset {
 fn p22_phosphors() -> PanelSpectra {
     let phosphor = |source: Vec<Band>| ChannelShape {
         source,
-        filter: Filter::None,
+        filter: ColourFilter::None,
     };
     PanelSpectra {
         primaries: [
@@ -147,17 +147,17 @@ fn white_led_lcd() -> PanelSpectra {
     };
     PanelSpectra {
         primaries: [
-            through(Filter::LongPass {
+            through(ColourFilter::LongPass {
                 edge_nm: 620.39,
                 width_nm: 12.0,
                 floor: 0.00258,
             }),
-            through(Filter::BandPass {
+            through(ColourFilter::BandPass {
                 centre_nm: 542.12,
                 fwhm_nm: 62.0,
                 floor: 0.04069,
             }),
-            through(Filter::ShortPass {
+            through(ColourFilter::ShortPass {
                 edge_nm: 500.47,
                 width_nm: 12.0,
                 floor: 0.00916,
@@ -185,17 +185,17 @@ fn wide_gamut_ccfl() -> PanelSpectra {
     };
     PanelSpectra {
         primaries: [
-            through(Filter::LongPass {
+            through(ColourFilter::LongPass {
                 edge_nm: 616.91,
                 width_nm: 10.0,
                 floor: 0.000834,
             }),
-            through(Filter::BandPass {
+            through(ColourFilter::BandPass {
                 centre_nm: 550.50,
                 fwhm_nm: 46.06,
                 floor: 0.01,
             }),
-            through(Filter::ShortPass {
+            through(ColourFilter::ShortPass {
                 edge_nm: 489.99,
                 width_nm: 11.30,
                 floor: 0.002,

@@ -54,7 +54,7 @@ impl Band {
 
 /// A colour filter's transmittance: `floor + (1 − floor)·shape(λ)`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub enum Filter {
+pub enum ColourFilter {
     /// No filter (a CRT's phosphor is its own channel).
     None,
     /// Passes long wavelengths: the logistic `1/(1 + e^(−(λ − edge)/width))`.
@@ -77,22 +77,22 @@ pub enum Filter {
     },
 }
 
-impl Filter {
+impl ColourFilter {
     pub fn transmittance(&self, nm: f64) -> f64 {
         let logistic = |t: f64| 1.0 / (1.0 + (-t).exp());
         match *self {
-            Filter::None => 1.0,
-            Filter::LongPass {
+            ColourFilter::None => 1.0,
+            ColourFilter::LongPass {
                 edge_nm,
                 width_nm,
                 floor,
             } => floor + (1.0 - floor) * logistic((nm - edge_nm) / width_nm),
-            Filter::ShortPass {
+            ColourFilter::ShortPass {
                 edge_nm,
                 width_nm,
                 floor,
             } => floor + (1.0 - floor) * logistic((edge_nm - nm) / width_nm),
-            Filter::BandPass {
+            ColourFilter::BandPass {
                 centre_nm,
                 fwhm_nm,
                 floor,
@@ -105,7 +105,7 @@ impl Filter {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ChannelShape {
     pub source: Vec<Band>,
-    pub filter: Filter,
+    pub filter: ColourFilter,
 }
 
 impl ChannelShape {
@@ -165,7 +165,7 @@ mod tests {
         assert_eq!(b.eval(550.0), 2.0);
         // Half maximum at centre ± FWHM/2.
         assert!((b.eval(570.0) - 1.0).abs() < 1e-12 && (b.eval(530.0) - 1.0).abs() < 1e-12);
-        let long = Filter::LongPass {
+        let long = ColourFilter::LongPass {
             edge_nm: 600.0,
             width_nm: 10.0,
             floor: 0.02,
@@ -173,14 +173,14 @@ mod tests {
         // At the edge the logistic is ½: floor + (1 − floor)/2.
         assert!((long.transmittance(600.0) - 0.51).abs() < 1e-12);
         assert!(long.transmittance(400.0) < 0.0201 && long.transmittance(780.0) > 0.9999);
-        let short = Filter::ShortPass {
+        let short = ColourFilter::ShortPass {
             edge_nm: 500.0,
             width_nm: 10.0,
             floor: 0.0,
         };
         assert!((short.transmittance(500.0) - 0.5).abs() < 1e-12);
         assert!((short.transmittance(490.0) - 1.0 / (1.0 + (-1.0f64).exp())).abs() < 1e-12);
-        let band = Filter::BandPass {
+        let band = ColourFilter::BandPass {
             centre_nm: 530.0,
             fwhm_nm: 60.0,
             floor: 0.1,
@@ -193,7 +193,7 @@ mod tests {
         // A single 1 nm-wide spike at 555 nm (ȳ = 1): 1/683 W·sr⁻¹·m⁻²·nm⁻¹ gives 1 cd/m².
         let spike = ChannelShape {
             source: vec![Band::new(555.0, 0.01, 1.0)],
-            filter: Filter::None,
+            filter: ColourFilter::None,
         };
         let s = spike.unit_radiance();
         assert!((s.value_at(555.0) - 1.0 / 683.0).abs() < 1e-12);

@@ -2,7 +2,6 @@
 
 use super::*;
 use crate::color::Xyz;
-use crate::session::Screen as _;
 
 fn sub(a: impl Into<[f64; 3]>, b: impl Into<[f64; 3]>) -> [f64; 3] {
     let (a, b) = (a.into(), b.into());
@@ -380,7 +379,7 @@ fn an_aimed_meter_sees_the_mean_emission_under_its_spot() {
     let (red, blue) = ([255, 0, 0], [0, 0, 255]);
     // 4×2: the left two columns red, the right two blue.
     let pixels = (0..8).map(|i| if i % 4 < 2 { red } else { blue }).collect();
-    let image = RgbImage::new(4, 2, pixels).unwrap();
+    let image = Drive8Image::new(4, 2, pixels).unwrap();
     let mut display = VirtualDisplay::preset(Preset::IpsLcd);
     assert_eq!(display.show_image(&image).unwrap(), Placement::WHOLE);
     let world = display.stimulus().unwrap();

@@ -9,8 +9,8 @@ use x11rb::protocol::xproto::{
 };
 
 use super::{perr, WindowDisplay, WindowError};
-use crate::image::RgbImage;
-use crate::rig::screen::Placement;
+use crate::image::Drive8Image;
+use crate::rig::Placement;
 
 /// Where an image of `iw × ih` lands on a monitor of `mw × mh` when scaled to fit: left,
 /// top, width and height in monitor pixels.
@@ -22,7 +22,7 @@ pub fn fit(iw: usize, ih: usize, mw: usize, mh: usize) -> (usize, usize, usize, 
 }
 
 /// The monitor's pixels showing `image` fitted as [`fit`] says, black elsewhere.
-pub fn fitted(image: &RgbImage, mw: usize, mh: usize) -> Vec<[u8; 3]> {
+pub fn fitted(image: &Drive8Image, mw: usize, mh: usize) -> Vec<[u8; 3]> {
     let (left, top, w, h) = fit(image.width, image.height, mw, mh);
     let mut out = vec![[0u8; 3]; mw * mh];
     for y in 0..h {
@@ -37,7 +37,7 @@ pub fn fitted(image: &RgbImage, mw: usize, mh: usize) -> Vec<[u8; 3]> {
 
 impl WindowDisplay {
     /// Shows `image` scaled to fit and returns once the server has painted it.
-    pub fn show_scaled(&mut self, image: &RgbImage) -> Result<Placement, WindowError> {
+    pub fn show_scaled(&mut self, image: &Drive8Image) -> Result<Placement, WindowError> {
         let (mw, mh) = (
             usize::from(self.monitor.width),
             usize::from(self.monitor.height),
@@ -141,7 +141,7 @@ mod tests {
     fn images_fit_with_their_aspect_ratio() {
         assert_eq!(fit(1014, 1014, 1920, 1080), (420, 0, 1080, 1080));
         assert_eq!(fit(2, 1, 4, 4), (0, 1, 4, 2));
-        let img = RgbImage::new(2, 1, vec![[1, 1, 1], [2, 2, 2]]).unwrap();
+        let img = Drive8Image::new(2, 1, vec![[1, 1, 1], [2, 2, 2]]).unwrap();
         let px = fitted(&img, 4, 4);
         let row = |y: usize| px[y * 4..y * 4 + 4].to_vec();
         assert_eq!(row(0), vec![[0; 3]; 4]);

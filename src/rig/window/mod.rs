@@ -25,9 +25,8 @@ use x11rb::wrapper::ConnectionExt as _;
 
 pub use pixels::PixelFormat;
 
-use super::screen::{Placement, Screen, ScreenError};
-use crate::image::RgbImage;
-use crate::session;
+use super::{Placement, Screen, ScreenError};
+use crate::image::Drive8Image;
 
 /// The window backend could not open or draw.
 #[derive(Debug, thiserror::Error)]
@@ -124,37 +123,7 @@ impl WindowDisplay {
                     .join(", "),
             })?;
 
-        // An invisible pointer: a 1×1 cursor whose mask pixel is 0, so the pointer parked
-        // in the middle of the screen does not stand in front of the meter.
-        let pixmap = conn
-            .generate_id()
-            .map_err(perr(&display, "allocating an id"))?;
-        conn.create_pixmap(1, pixmap, screen.root, 1, 1)
-            .map_err(perr(&display, "CreatePixmap"))?;
-        let gc = conn
-            .generate_id()
-            .map_err(perr(&display, "allocating an id"))?;
-        conn.create_gc(gc, pixmap, &CreateGCAux::new().foreground(0))
-            .map_err(perr(&display, "CreateGC"))?;
-        conn.poly_fill_rectangle(
-            pixmap,
-            gc,
-            &[Rectangle {
-                x: 0,
-                y: 0,
-                width: 1,
-                height: 1,
-            }],
-        )
-        .map_err(perr(&display, "PolyFillRectangle"))?;
-        let cursor = conn
-            .generate_id()
-            .map_err(perr(&display, "allocating an id"))?;
-        conn.create_cursor(cursor, pixmap, pixmap, 0, 0, 0, 0, 0, 0, 0, 0)
-            .map_err(perr(&display, "CreateCursor"))?;
-        conn.free_gc(gc).map_err(perr(&display, "FreeGC"))?;
-        conn.free_pixmap(pixmap)
-            .map_err(perr(&display, "FreePixmap"))?;
+        let cursor = invisible_cursor(&conn, screen.root, &display)?;
 
         let window = conn
             .generate_id()
@@ -357,18 +326,12 @@ impl Drop for WindowDisplay {
     }
 }
 
-impl session::Screen for WindowDisplay {
+impl Screen for WindowDisplay {
     fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
         self.show_rgb(rgb).map_err(|e| ScreenError::Backend {
             screen: self.spec(),
             source: Box::new(e),
         })
-    }
-}
-
-impl Screen for WindowDisplay {
-    fn as_show(&mut self) -> &mut dyn session::Screen {
-        self
     }
 
     fn spec(&self) -> String {
@@ -382,7 +345,7 @@ impl Screen for WindowDisplay {
         )
     }
 
-    fn show_image(&mut self, image: &RgbImage) -> Result<Placement, ScreenError> {
+    fn show_image(&mut self, image: &Drive8Image) -> Result<Placement, ScreenError> {
         self.show_scaled(image).map_err(|e| ScreenError::Backend {
             screen: self.spec(),
             source: Box::new(e),
@@ -416,6 +379,41 @@ pub fn list_monitors(display: Option<&str>) -> Result<Vec<Monitor>, WindowError>
     let (conn, display, screen_num) = connect(display)?;
     let screen = conn.setup().roots[screen_num].clone();
     monitors_of(&conn, &screen, &display)
+}
+
+/// An invisible pointer: a 1×1 cursor whose mask pixel is 0, so the pointer parked in the
+/// middle of the screen does not stand in front of the meter.
+fn invisible_cursor(conn: &RustConnection, root: u32, display: &str) -> Result<u32, WindowError> {
+    let pixmap = conn
+        .generate_id()
+        .map_err(perr(display, "allocating an id"))?;
+    conn.create_pixmap(1, pixmap, root, 1, 1)
+        .map_err(perr(display, "CreatePixmap"))?;
+    let gc = conn
+        .generate_id()
+        .map_err(perr(display, "allocating an id"))?;
+    conn.create_gc(gc, pixmap, &CreateGCAux::new().foreground(0))
+        .map_err(perr(display, "CreateGC"))?;
+    conn.poly_fill_rectangle(
+        pixmap,
+        gc,
+        &[Rectangle {
+            x: 0,
+            y: 0,
+            width: 1,
+            height: 1,
+        }],
+    )
+    .map_err(perr(display, "PolyFillRectangle"))?;
+    let cursor = conn
+        .generate_id()
+        .map_err(perr(display, "allocating an id"))?;
+    conn.create_cursor(cursor, pixmap, pixmap, 0, 0, 0, 0, 0, 0, 0, 0)
+        .map_err(perr(display, "CreateCursor"))?;
+    conn.free_gc(gc).map_err(perr(display, "FreeGC"))?;
+    conn.free_pixmap(pixmap)
+        .map_err(perr(display, "FreePixmap"))?;
+    Ok(cursor)
 }
 
 fn connect(display: Option<&str>) -> Result<(RustConnection, String, usize), WindowError> {

@@ -158,7 +158,14 @@ pub fn delta_e_bars(a: &Assessment, id: &str, head: &str) -> String {
         w - right,
         top_y + ph / 2.0
     );
-    let legend_y = h - 30.0;
+    wide_legend(&mut s, a, left, h - 30.0);
+    s.push_str("</svg>");
+    s
+}
+
+/// The wide drawing's legend in one row at `legend_y` from `left`, and what its marks say
+/// below it.
+fn wide_legend(s: &mut String, a: &Assessment, left: f64, legend_y: f64) {
     let mut lx = left;
     for (label, colour) in keys() {
         let _ = write!(
@@ -176,8 +183,6 @@ pub fn delta_e_bars(a: &Assessment, id: &str, head: &str) -> String {
         esc(&a.reference),
         esc(&a.test)
     );
-    s.push_str("</svg>");
-    s
 }
 
 /// The narrow drawing: one row per patch (360 user units wide, text 11 or more, so 10 px
@@ -257,6 +262,14 @@ pub fn delta_e_rows(a: &Assessment, id: &str, head: &str) -> String {
         rows_end + 4.0,
         rows_end + 17.0
     );
+    narrow_legend(&mut s, a, legend_y);
+    s.push_str("</svg>");
+    s
+}
+
+/// The narrow drawing's legend from `legend_y`, three keys to a row, and what its marks say
+/// below it.
+fn narrow_legend(s: &mut String, a: &Assessment, legend_y: f64) {
     let mut lx = 4.0;
     let mut ly = legend_y;
     for (k, (label, colour)) in keys().into_iter().enumerate() {
@@ -289,6 +302,4 @@ pub fn delta_e_rows(a: &Assessment, id: &str, head: &str) -> String {
             ly + 15.0 * (k + 1) as f64
         );
     }
-    s.push_str("</svg>");
-    s
 }

@@ -6,16 +6,16 @@
 
 /// An axis-aligned box in SVG user units: left, top, right, bottom.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Rect {
+pub struct LabelBox {
     pub x0: f64,
     pub y0: f64,
     pub x1: f64,
     pub y1: f64,
 }
 
-impl Rect {
-    pub fn around(cx: f64, cy: f64, half_w: f64, half_h: f64) -> Rect {
-        Rect {
+impl LabelBox {
+    pub fn around(cx: f64, cy: f64, half_w: f64, half_h: f64) -> LabelBox {
+        LabelBox {
             x0: cx - half_w,
             y0: cy - half_h,
             x1: cx + half_w,
@@ -23,11 +23,11 @@ impl Rect {
         }
     }
 
-    pub fn overlaps(&self, o: &Rect) -> bool {
+    pub fn overlaps(&self, o: &LabelBox) -> bool {
         self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
     }
 
-    fn within(&self, frame: &Rect) -> bool {
+    fn within(&self, frame: &LabelBox) -> bool {
         self.x0 >= frame.x0 && self.x1 <= frame.x1 && self.y0 >= frame.y0 && self.y1 <= frame.y1
     }
 }
@@ -42,23 +42,23 @@ const PAD: f64 = 1.0;
 
 /// A disc of radius `r` at `c` as three boxes (a cross and a square between its arms), so
 /// a label may come nearer its diagonal than a square would let it.
-pub fn disc_boxes(c: (f64, f64), r: f64) -> [Rect; 3] {
+pub fn disc_boxes(c: (f64, f64), r: f64) -> [LabelBox; 3] {
     [
-        Rect::around(c.0, c.1, r, 0.45 * r),
-        Rect::around(c.0, c.1, 0.45 * r, r),
-        Rect::around(c.0, c.1, 0.7 * r, 0.7 * r),
+        LabelBox::around(c.0, c.1, r, 0.45 * r),
+        LabelBox::around(c.0, c.1, 0.45 * r, r),
+        LabelBox::around(c.0, c.1, 0.7 * r, 0.7 * r),
     ]
 }
 
 /// Small boxes along the segment from `a` to `b`, `half` wide either side of it: a line as
 /// obstacles.
-pub fn segment_boxes(a: (f64, f64), b: (f64, f64), half: f64) -> Vec<Rect> {
+pub fn segment_boxes(a: (f64, f64), b: (f64, f64), half: f64) -> Vec<LabelBox> {
     let len = (b.0 - a.0).hypot(b.1 - a.1);
     let n = (len / 2.0).ceil().max(1.0) as usize;
     (0..=n)
         .map(|k| {
             let t = k as f64 / n as f64;
-            Rect::around(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1), half, half)
+            LabelBox::around(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1), half, half)
         })
         .collect()
 }
@@ -70,7 +70,7 @@ pub struct Placed {
     pub x: f64,
     pub baseline: f64,
     /// The box the text occupies (without the padding).
-    pub rect: Rect,
+    pub rect: LabelBox,
     /// From the marker's edge to the label's box, when the label sits away from it.
     pub leader: Option<((f64, f64), (f64, f64))>,
 }
@@ -86,7 +86,7 @@ pub struct Label<'a> {
 /// and of each other. A label that finds no free place goes where it overlaps least:
 /// with its leader across other labels if it must, on a mark or a label only in a frame
 /// too small for them all.
-pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Vec<Placed> {
+pub fn place(labels: &[Label], font: f64, obstacles: &[LabelBox], frame: LabelBox) -> Vec<Placed> {
     let half_h = HEIGHT_EM * font / 2.0;
     let mut order: Vec<usize> = (0..labels.len()).collect();
     let crowd = |i: usize| {
@@ -97,24 +97,12 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
     };
     order.sort_by_key(|&i| (std::cmp::Reverse(crowd(i)), i));
     // What a label's box must keep clear of: the marks, then each placed label and leader.
-    let mut taken: Vec<Rect> = obstacles.to_vec();
+    let mut taken: Vec<LabelBox> = obstacles.to_vec();
     // What a leader must not cross: the placed labels (leaders may cross each other, as
     // those of one crowded cluster all start at it).
-    let mut label_boxes: Vec<Rect> = Vec::new();
+    let mut label_boxes: Vec<LabelBox> = Vec::new();
     let mut placed: Vec<Option<Placed>> = vec![None; labels.len()];
-    // 32 directions, upper right first, then those nearest it.
-    let angles: Vec<f64> = {
-        let mut a: Vec<f64> = (0..32)
-            .map(|k| k as f64 * std::f64::consts::TAU / 32.0)
-            .collect();
-        let pref = -std::f64::consts::FRAC_PI_4;
-        let dist = |x: f64| {
-            let d = (x - pref).rem_euclid(std::f64::consts::TAU);
-            d.min(std::f64::consts::TAU - d)
-        };
-        a.sort_by(|x, y| dist(*x).total_cmp(&dist(*y)));
-        a
-    };
+    let angles = directions();
     for i in order {
         let l = &labels[i];
         let half_w = DIGIT_EM * font * l.text.chars().count() as f64 / 2.0;
@@ -130,8 +118,8 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
                 // the marker.
                 let reach = l.radius + gap + half_w * c.abs() + half_h * s.abs();
                 let (cx, cy) = (l.at.0 + reach * c, l.at.1 + reach * s);
-                let rect = Rect::around(cx, cy, half_w, half_h);
-                let padded = Rect::around(cx, cy, half_w + PAD, half_h + PAD);
+                let rect = LabelBox::around(cx, cy, half_w, half_h);
+                let padded = LabelBox::around(cx, cy, half_w + PAD, half_h + PAD);
                 if !padded.within(&frame) {
                     continue;
                 }
@@ -169,10 +157,10 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
         let p = best.map(|(_, p)| p).unwrap_or_else(|| Placed {
             x: l.at.0,
             baseline: l.at.1 - half_h + ASCENT_EM * font,
-            rect: Rect::around(l.at.0, l.at.1, half_w, half_h),
+            rect: LabelBox::around(l.at.0, l.at.1, half_w, half_h),
             leader: None,
         });
-        let own = Rect::around(
+        let own = LabelBox::around(
             (p.rect.x0 + p.rect.x1) / 2.0,
             (p.rect.y0 + p.rect.y1) / 2.0,
             half_w + PAD,
@@ -191,8 +179,22 @@ pub fn place(labels: &[Label], font: f64, obstacles: &[Rect], frame: Rect) -> Ve
         .collect()
 }
 
+/// The directions a label is tried in: 32, upper right first, then those nearest it.
+fn directions() -> Vec<f64> {
+    let mut a: Vec<f64> = (0..32)
+        .map(|k| k as f64 * std::f64::consts::TAU / 32.0)
+        .collect();
+    let pref = -std::f64::consts::FRAC_PI_4;
+    let dist = |x: f64| {
+        let d = (x - pref).rem_euclid(std::f64::consts::TAU);
+        d.min(std::f64::consts::TAU - d)
+    };
+    a.sort_by(|x, y| dist(*x).total_cmp(&dist(*y)));
+    a
+}
+
 /// The point of `r` nearest to `p`.
-fn nearest_point(r: &Rect, p: (f64, f64)) -> (f64, f64) {
+fn nearest_point(r: &LabelBox, p: (f64, f64)) -> (f64, f64) {
     (p.0.clamp(r.x0, r.x1), p.1.clamp(r.y0, r.y1))
 }
 
@@ -221,8 +223,8 @@ mod tests {
                 radius: 5.0,
             })
             .collect();
-        let markers: Vec<Rect> = at.iter().flat_map(|&c| disc_boxes(c, 5.0)).collect();
-        let frame = Rect {
+        let markers: Vec<LabelBox> = at.iter().flat_map(|&c| disc_boxes(c, 5.0)).collect();
+        let frame = LabelBox {
             x0: 0.0,
             y0: 0.0,
             x1: 200.0,

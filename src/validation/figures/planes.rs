@@ -10,7 +10,7 @@
 
 use std::fmt::Write;
 
-use super::labels::{disc_boxes, place, segment_boxes, Label, Rect};
+use super::labels::{disc_boxes, place, segment_boxes, Label, LabelBox};
 use super::{esc, srgb_swatch, tick_step, ticks, trim};
 use crate::validation::assess::{Assessment, JND_DE76};
 
@@ -179,8 +179,34 @@ pub fn lab_planes(a: &Assessment, id: &str) -> Planes {
     }
 }
 
+/// Where a patch is drawn: its disc's centre, and its ring's at the magnified displacement.
+type Mark = ((f64, f64), (f64, f64));
+
+/// Where a plane's values land in its SVG: the plot's scale and ranges, and its bottom
+/// right corner.
+struct Frame {
+    scale: f64,
+    xmin: f64,
+    ymax: f64,
+    /// The plot's height and the SVG's.
+    ph: f64,
+    h: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Frame {
+    fn px(&self, v: f64) -> f64 {
+        LEFT + (v - self.xmin) * self.scale
+    }
+    fn py(&self, v: f64) -> f64 {
+        TOP + (self.ymax - v) * self.scale
+    }
+}
+
 /// One plane's SVG, the patches whose displacement is drawn shorter than [`MIN_DRAWN`], and
-/// those drawn at a magnification of their own (with it).
+/// those drawn at a magnification of their own (with it): the frame and axes, the discs,
+/// the displacements, the JND's scale bar and the labels, in the order they are drawn.
 #[allow(clippy::too_many_arguments)]
 fn plane(
     a: &Assessment,
@@ -193,17 +219,87 @@ fn plane(
     m: f64,
 ) -> (String, Vec<usize>, Vec<(usize, f64)>) {
     let ph = (ymax - ymin) * scale;
-    let h = TOP + ph + BOTTOM;
-    let px = |v: f64| LEFT + (v - xmin) * scale;
-    let py = |v: f64| TOP + (ymax - v) * scale;
-    let (x1, y1) = (LEFT + P, TOP + ph);
+    let f = Frame {
+        scale,
+        xmin,
+        ymax,
+        ph,
+        h: TOP + ph + BOTTOM,
+        x1: LEFT + P,
+        y1: TOP + ph,
+    };
+    let mut s = String::new();
+    frame_and_axes(&mut s, &f, id, ax, (xmin, xmax), (ymin, ymax), m);
+    // Each patch's magnification in this plane: the figure's, or its own where that would
+    // not show its displacement.
+    let factors: Vec<f64> = pairs
+        .iter()
+        .map(|(r, t)| {
+            let d = (t[ax.x] - r[ax.x]).hypot(t[ax.y] - r[ax.y]);
+            own_magnification(d, m, scale)
+        })
+        .collect();
+    // Where each patch is drawn: its disc, and its ring at the magnified displacement.
+    let marks: Vec<Mark> = pairs
+        .iter()
+        .zip(&factors)
+        .map(|((r, t), &k)| {
+            let at = (f.px(r[ax.x]), f.py(r[ax.y]));
+            let end = (
+                f.px(r[ax.x] + k * (t[ax.x] - r[ax.x])),
+                f.py(r[ax.y] + k * (t[ax.y] - r[ax.y])),
+            );
+            (at, end)
+        })
+        .collect();
+    let more: Vec<(usize, f64)> = a
+        .patches
+        .iter()
+        .zip(&factors)
+        .filter(|(_, &k)| k != m)
+        .map(|(p, &k)| (p.patch, k))
+        .collect();
+    // The JND at the same magnification, as a scale bar in the plot's lower right.
+    let jnd_len = JND_DE76 * m * scale;
+    let bar = (jnd_len < 0.45 * P).then(|| {
+        let (bx1, by) = (f.x1 - 10.0, f.y1 - 10.0);
+        (bx1 - jnd_len, bx1, by)
+    });
+    let obstacles = obstacles(bar, &marks);
+    discs(&mut s, a, &marks);
+    let short = displacements(&mut s, a, &marks, &factors, m);
+    if let Some((bx0, bx1, by)) = bar {
+        let _ = write!(
+            s,
+            r##"<path class="scale" d="M{bx0:.1},{:.1}V{by:.1}H{bx1:.1}V{:.1}" stroke="#000" stroke-width="1.4" fill="none"/><text x="{bx1:.1}" y="{:.1}" text-anchor="end" font-size="{FONT}" font-family="sans-serif">JND {JND_DE76} at ×{}</text>"##,
+            by - 4.0,
+            by - 4.0,
+            by - 7.0,
+            trim(m)
+        );
+    }
+    labels(&mut s, a, &marks, &obstacles, &f);
+    s.push_str("</svg>");
+    (s, short, more)
+}
+
+/// The SVG's opening, title, plot area, grid with tick labels, and axis names.
+fn frame_and_axes(
+    s: &mut String,
+    f: &Frame,
+    id: &str,
+    ax: &Axes,
+    (xmin, xmax): (f64, f64),
+    (ymin, ymax): (f64, f64),
+    m: f64,
+) {
+    let (h, ph, x1, y1) = (f.h, f.ph, f.x1, f.y1);
     let title = format!(
         "{} plane (CIELAB units), displacement ×{}",
         ax.name,
         trim(m)
     );
     let pid = format!("{id}-{}", if ax.y == 2 { "ab" } else { "la" });
-    let mut s = String::new();
     let _ = write!(
         s,
         r##"<svg xmlns="http://www.w3.org/2000/svg" id="{pid}" class="figure plane" viewBox="0 0 {W} {h:.1}" width="{W}" height="{h:.1}" role="img" aria-label="{t}"><title>{t}</title><rect x="0" y="0" width="{W}" height="{h:.1}" fill="#ffffff"/><text x="{:.1}" y="18" text-anchor="middle" font-size="14" font-family="sans-serif">{t}</text><rect x="{LEFT}" y="{TOP}" width="{P}" height="{ph:.1}" fill="#fafafa" stroke="#000"/>"##,
@@ -218,7 +314,7 @@ fn plane(
             if v == 0.0 { "#999" } else { "#e4e4e4" },
             y1 + 15.0,
             trim(v),
-            x = px(v)
+            x = f.px(v)
         );
     }
     let step = tick_step(ymax - ymin, 6.0);
@@ -232,9 +328,9 @@ fn plane(
                 "#e4e4e4"
             },
             LEFT - 4.0,
-            py(v) + 4.5,
+            f.py(v) + 4.5,
             trim(v),
-            y = py(v)
+            y = f.py(v)
         );
     }
     let _ = write!(
@@ -246,56 +342,30 @@ fn plane(
         TOP + ph / 2.0,
         ax.ylabel
     );
-    // Each patch's magnification in this plane: the figure's, or its own where that would
-    // not show its displacement.
-    let factors: Vec<f64> = pairs
-        .iter()
-        .map(|(r, t)| {
-            let d = (t[ax.x] - r[ax.x]).hypot(t[ax.y] - r[ax.y]);
-            own_magnification(d, m, scale)
-        })
-        .collect();
-    // Where each patch is drawn: its disc, and its ring at the magnified displacement.
-    let marks: Vec<((f64, f64), (f64, f64))> = pairs
-        .iter()
-        .zip(&factors)
-        .map(|((r, t), &f)| {
-            let at = (px(r[ax.x]), py(r[ax.y]));
-            let end = (
-                px(r[ax.x] + f * (t[ax.x] - r[ax.x])),
-                py(r[ax.y] + f * (t[ax.y] - r[ax.y])),
-            );
-            (at, end)
-        })
-        .collect();
-    let more: Vec<(usize, f64)> = a
-        .patches
-        .iter()
-        .zip(&factors)
-        .filter(|(_, &f)| f != m)
-        .map(|(p, &f)| (p.patch, f))
-        .collect();
-    // The JND at the same magnification, as a scale bar in the plot's lower right.
-    let jnd_len = JND_DE76 * m * scale;
-    let bar = (jnd_len < 0.45 * P).then(|| {
-        let (bx1, by) = (x1 - 10.0, y1 - 10.0);
-        (bx1 - jnd_len, bx1, by)
-    });
-    let mut obstacles: Vec<Rect> = Vec::new();
+}
+
+/// What a label must not cover: the scale bar, every disc and ring, every line.
+fn obstacles(bar: Option<(f64, f64, f64)>, marks: &[Mark]) -> Vec<LabelBox> {
+    let mut obstacles: Vec<LabelBox> = Vec::new();
     if let Some((bx0, bx1, by)) = bar {
-        obstacles.push(Rect {
+        obstacles.push(LabelBox {
             x0: bx0 - 2.0,
             y0: by - 20.0,
             x1: bx1 + 2.0,
             y1: by + 4.0,
         });
     }
-    for &(at, end) in &marks {
+    for &(at, end) in marks {
         obstacles.extend(disc_boxes(at, DISC));
         obstacles.extend(disc_boxes(end, RING + 0.7));
         obstacles.extend(segment_boxes(at, end, 1.0));
     }
-    for (p, &(at, _)) in a.patches.iter().zip(&marks) {
+    obstacles
+}
+
+/// Each patch's reference reading as a disc in its colour, its readings in its tooltip.
+fn discs(s: &mut String, a: &Assessment, marks: &[Mark]) {
+    for (p, &(at, _)) in a.patches.iter().zip(marks) {
         let c = srgb_swatch(p.reference.lab);
         let _ = write!(
             s,
@@ -324,13 +394,24 @@ fn plane(
             p.de76
         );
     }
+}
+
+/// Each displacement as a line from its disc to a ring; the patches drawn shorter than
+/// [`MIN_DRAWN`].
+fn displacements(
+    s: &mut String,
+    a: &Assessment,
+    marks: &[Mark],
+    factors: &[f64],
+    m: f64,
+) -> Vec<usize> {
     // White under every line and ring first, then the black marks over them, so a mark
     // shows on a dark disc and where it crosses another.
     let mut short = Vec::new();
     // The marks at a magnification of their own come last: they are short, and would
     // hide under the long lines of their neighbours.
     for pass in 0..3 {
-        for ((p, &(at, end)), &f) in a.patches.iter().zip(&marks).zip(&factors) {
+        for ((p, &(at, end)), &f) in a.patches.iter().zip(marks).zip(factors) {
             if (pass == 1 && f != m) || (pass == 2 && f == m) {
                 continue;
             }
@@ -366,33 +447,29 @@ fn plane(
             );
         }
     }
-    if let Some((bx0, bx1, by)) = bar {
-        let _ = write!(
-            s,
-            r##"<path class="scale" d="M{bx0:.1},{:.1}V{by:.1}H{bx1:.1}V{:.1}" stroke="#000" stroke-width="1.4" fill="none"/><text x="{bx1:.1}" y="{:.1}" text-anchor="end" font-size="{FONT}" font-family="sans-serif">JND {JND_DE76} at ×{}</text>"##,
-            by - 4.0,
-            by - 4.0,
-            by - 7.0,
-            trim(m)
-        );
-    }
+    short
+}
+
+/// The patch numbers, placed clear of `obstacles`, with a leader line where one had to
+/// move away from its disc.
+fn labels(s: &mut String, a: &Assessment, marks: &[Mark], obstacles: &[LabelBox], f: &Frame) {
     let names: Vec<String> = a.patches.iter().map(|p| p.patch.to_string()).collect();
     let labels: Vec<Label> = names
         .iter()
-        .zip(&marks)
+        .zip(marks)
         .map(|(text, &(at, _))| Label {
             text,
             at,
             radius: DISC,
         })
         .collect();
-    let frame = Rect {
+    let frame = LabelBox {
         x0: LEFT,
         y0: TOP,
-        x1,
-        y1,
+        x1: f.x1,
+        y1: f.y1,
     };
-    let placed = place(&labels, FONT, &obstacles, frame);
+    let placed = place(&labels, FONT, obstacles, frame);
     for l in &placed {
         if let Some((from, to)) = l.leader {
             let _ = write!(
@@ -409,8 +486,6 @@ fn plane(
             p.patch, l.x, l.baseline, p.patch
         );
     }
-    s.push_str("</svg>");
-    (s, short, more)
 }
 
 #[cfg(test)]

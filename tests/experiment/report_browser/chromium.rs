@@ -1,25 +1,13 @@
 //! Finding and driving headless Chromium for the report tests: the binary on PATH (its
-//! absence fails in CI), a run with logging on and a profile of the test's own, and a page
-//! loaded with its console checked and a screenshot that is not blank.
+//! absence fails under `METAMER_ORACLES=required`), a run with logging on and a profile of
+//! the test's own, and a page loaded with its console checked and a screenshot that is not
+//! blank.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::support::fresh_dir;
-
-pub fn on_path(name: &str) -> Option<PathBuf> {
-    std::env::var_os("PATH").and_then(|paths| {
-        std::env::split_paths(&paths)
-            .map(|p| p.join(name))
-            .find(|p| p.is_file())
-    })
-}
-
-fn chromium() -> Option<PathBuf> {
-    ["chromium", "chromium-browser", "google-chrome"]
-        .iter()
-        .find_map(|name| on_path(name))
-}
+use crate::support::oracle::CHROMIUM;
 
 /// Width and height from a PNG's IHDR chunk.
 fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
@@ -49,16 +37,9 @@ pub fn headless(browser: &Path, dir: &Path, extra: &[&str], page: &Path) -> std:
         .expect("chromium runs")
 }
 
+/// Headless Chromium, or None (the test skipped with the reason) where it is missing.
 pub fn browser() -> Option<PathBuf> {
-    let found = chromium();
-    if found.is_none() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but no chromium binary is installed (.ci/run installs Debian's chromium)"
-        );
-        eprintln!("skipped: no chromium binary on PATH (apt-get install chromium)");
-    }
-    found
+    CHROMIUM.find()
 }
 
 /// A fresh directory for one test.

@@ -3,8 +3,13 @@
 //! the spectrometer where the prompts say.
 
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
-use metamer::session::{Answer, Operator, OperatorError, Screen, ScreenError, ScriptedOperator};
+use metamer::image::Drive8Image;
+
+use metamer::session::{
+    Answer, Operator, OperatorError, Placement, Screen, ScreenError, ScriptedOperator,
+};
 use metamer_drivers::{
     CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, DriverError,
     Instrument, InstrumentInfo, MeasureMode, ModeInfo, Reading, Request,
@@ -28,6 +33,25 @@ impl Screen for FakeScreen {
     fn show(&mut self, rgb: [u8; 3]) -> Result<(), ScreenError> {
         self.0.lock().unwrap().rgb = rgb;
         Ok(())
+    }
+    fn spec(&self) -> String {
+        "fake".into()
+    }
+    fn describe(&self) -> String {
+        "the session engine test's made-up screen".into()
+    }
+    /// The engine shows colours only; an image has no place on this rig.
+    fn show_image(&mut self, _: &Drive8Image) -> Result<Placement, ScreenError> {
+        Err(ScreenError::Backend {
+            screen: self.spec(),
+            source: "the made-up screen shows colours only".into(),
+        })
+    }
+    fn default_settle(&self) -> Duration {
+        Duration::ZERO
+    }
+    fn stimulus(&self) -> Option<Arc<dyn metamer_drivers::World>> {
+        None
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::key;
 use crate::i1pro::eeprom::{Eeprom, Value};
-use crate::i1pro::{Spectrum, BANDS};
+use crate::i1pro::{GridSpectrum, BANDS};
 
 /// What an EEPROM's ambient table (key 0x044E) holds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,7 +20,7 @@ pub enum AmbientTable {
 
 impl AmbientTable {
     /// Judges a table (None: the key is missing).
-    pub fn of(table: Option<&Spectrum>) -> AmbientTable {
+    pub fn of(table: Option<&GridSpectrum>) -> AmbientTable {
         let Some(t) = table else {
             return AmbientTable::Missing;
         };

@@ -45,7 +45,7 @@ fn hand_made_image_parses_to_its_items() {
     assert_eq!(e.keys().count(), 4);
     assert_eq!(key_name(0x04BB), "serial number");
     assert_eq!(key_name(0x2715 + 1000), "log measurement count");
-    assert_eq!(kind_of(0x271D + 1000), Kind::Float);
+    assert_eq!(kind_of(0x271D + 1000), ItemKind::Float);
 }
 
 #[test]
@@ -177,8 +177,8 @@ fn building_refuses_what_does_not_fit() {
         EepromError::WrongKind {
             key: 0x04BB,
             name: "serial number",
-            expected: Kind::Int,
-            found: Kind::Float
+            expected: ItemKind::Int,
+            found: ItemKind::Float
         }
     );
     assert_eq!(

@@ -76,7 +76,11 @@ fn rounding_bound(cal: &Calibration, t: f64, band: usize) -> f64 {
     0.5 * 1.3 / t * cal.emissive[band] * 1.1
 }
 
-fn round_trip(cal: &Calibration, radiance: &Spectrum, t: f64) -> (Spectrum, pipeline::Averaged) {
+fn round_trip(
+    cal: &Calibration,
+    radiance: &GridSpectrum,
+    t: f64,
+) -> (GridSpectrum, pipeline::Averaged) {
     let e = exposure(t);
     let rev = cal.revision();
     let shielded = (rev == Revision::E).then_some([300u16, 310, 290, 305, 295, 300]);
