@@ -5,6 +5,7 @@
 
 use serde::Serialize;
 
+use crate::budget::TimeQuery;
 use crate::instrument::Capabilities;
 use crate::mode::MeasureMode;
 use crate::registry::{self, Model};
@@ -35,7 +36,7 @@ pub struct ModelDescription {
     /// Its stated repeatability per mode.
     pub repeatability: Vec<Figure>,
     /// Whether its driver states how long its readings and calibrations take
-    /// ([`crate::time_budget`]).
+    /// ([`crate::time_budget`]; each unit's [`Unit::times`]).
     pub time_budget_stated: bool,
 }
 
@@ -47,6 +48,23 @@ pub struct Unit {
     /// The spec it was opened with.
     pub spec: String,
     pub capabilities: Capabilities,
+    /// How long its readings and calibrations take in each of its modes, from its time
+    /// budget; empty where the model states none.
+    pub times: Vec<ModeTime>,
+}
+
+/// The light a described reading time is of: a display's white of 100 cd/m² (100 lx in
+/// ambient mode; reflective readings do not depend on it).
+pub const DESCRIBED_CD_M2: f64 = 100.0;
+
+/// A mode's instrument time ([`crate::budget::TimeBudget`]) on a unit.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModeTime {
+    pub mode: MeasureMode,
+    /// One reading of [`DESCRIBED_CD_M2`], seconds.
+    pub reading_s: f64,
+    /// The calibration the mode needs first, seconds (0: none).
+    pub calibration_s: f64,
 }
 
 /// A stated repeatability in one mode, in words (2σ) and with its source.
@@ -122,18 +140,44 @@ fn units(model: &Model) -> Result<Vec<Unit>, DriverError> {
             let mut spec = Spec::simulated(model.name)
                 .with_option("time_scale", 0)
                 .with_option("noise", "off");
-            for option in options.split('&').filter(|o| !o.is_empty()) {
-                let (key, value) = option.split_once('=').unwrap_or((option, ""));
+            for (key, value) in option_pairs(options) {
                 spec = spec.with_option(key, value);
             }
             let capabilities = spec.open(None)?.capabilities();
+            let times = match model.time_budget {
+                None => Vec::new(),
+                Some(budget) => capabilities
+                    .modes
+                    .iter()
+                    .map(|m| {
+                        let mut query = TimeQuery::new(m.mode, DESCRIBED_CD_M2);
+                        query.options = option_pairs(options)
+                            .map(|(k, v)| (k.to_string(), v.to_string()))
+                            .collect();
+                        budget(&query).map(|b| ModeTime {
+                            mode: m.mode,
+                            reading_s: b.reading_s,
+                            calibration_s: b.calibration_s,
+                        })
+                    })
+                    .collect::<Result<_, _>>()?,
+            };
             Ok(Unit {
                 stands_for,
                 spec: spec.as_str().to_string(),
                 capabilities,
+                times,
             })
         })
         .collect()
+}
+
+/// The `key=value` pairs of a row's simulation options (`rev=e&diffuser=on`).
+fn option_pairs(options: &str) -> impl Iterator<Item = (&str, &str)> {
+    options
+        .split('&')
+        .filter(|o| !o.is_empty())
+        .map(|o| o.split_once('=').unwrap_or((o, "")))
 }
 
 #[cfg(test)]
@@ -171,6 +215,31 @@ mod tests {
         let dark = |u: &Unit| u.capabilities.modes[0].calibrations[0].valid_for_s.unwrap();
         assert_eq!(dark(&d.units[0]), 1800.0);
         assert_eq!(dark(&d.units[1]), 3600.0);
+        // Its time budget on each unit, by hand from the facts (i1pro/budget.rs): the
+        // emissive dark is 212 readings of 4.716 ms (Rev A–D) or 204 of 4.896 ms (Rev E)
+        // and nine of 2 s; 100 cd/m² integrates 37 000 / (45 000 / 220 · 100) = 1.8089 s
+        // after the 0.1 s trial; a reflective reading is the lamp's 0.2 s and 8 × 0.02 s.
+        let emissive = |u: &Unit| {
+            let t = u.times.iter().find(|t| t.mode == MeasureMode::Emissive);
+            t.map(|t| (t.reading_s, t.calibration_s)).unwrap()
+        };
+        let reading = 0.1 + 37_000.0 * 220.0 / 4_500_000.0;
+        for (unit, dark) in [(0, 212.0 * 4.716e-3), (1, 204.0 * 4.896e-3)] {
+            let (r, c) = emissive(&d.units[unit]);
+            assert!((r - reading).abs() < 1e-9, "{r}");
+            assert!((c - (dark + 18.0)).abs() < 1e-9, "{c}");
+            let times = &d.units[unit].times;
+            let lit = times.iter().find(|t| t.mode == MeasureMode::Reflective);
+            let lit = lit.unwrap();
+            assert!((lit.reading_s - 0.36).abs() < 1e-12);
+        }
+        // The CS-100A at FAST: 0.1 s and 33 characters × 11 bits at 4800 baud.
+        let cs = describe("cs100a").unwrap();
+        assert_eq!(cs.units[0].times.len(), 1);
+        let fast = cs.units[0].times[0].reading_s;
+        // The character time is a whole number of nanoseconds.
+        assert!((fast - 0.175_625).abs() < 1e-6, "{fast}");
+        assert_eq!(cs.units[0].times[0].calibration_s, 0.0);
         let d = describe("i1pro3").unwrap();
         assert!(d.units.is_empty() && d.unsupported.is_some());
         let e = describe("spectro").unwrap_err().to_string();

@@ -1,7 +1,7 @@
 //! `metamer devices`: serial ports and known USB/HID instruments on this machine, with the
 //! fix for any the user may not open; with `--describe MODEL`, what a model can do.
 
-use metamer_drivers::describe::{describe, ModelDescription};
+use metamer_drivers::describe::{describe, ModelDescription, DESCRIBED_CD_M2};
 use metamer_drivers::devices::{list_devices, Access, DeviceList};
 use metamer_drivers::{registry, CalibrationNeed, OptionValues};
 
@@ -130,6 +130,22 @@ fn described(d: &ModelDescription) -> String {
             facts.push(format!("{low}–{high} cd/m²"));
         }
         s.push_str(&format!("    {}\n", facts.join(", ")));
+        if !unit.times.is_empty() {
+            let times: Vec<String> = unit
+                .times
+                .iter()
+                .map(|t| {
+                    format!(
+                        "{} {:.3} s (calibration {:.3} s)",
+                        t.mode, t.reading_s, t.calibration_s
+                    )
+                })
+                .collect();
+            s.push_str(&format!(
+                "    one reading of {DESCRIBED_CD_M2} cd/m² (lx in ambient): {}\n",
+                times.join(", ")
+            ));
+        }
     }
     if !d.repeatability.is_empty() {
         s.push_str("  stated repeatability (2σ of one reading):\n");

@@ -127,6 +127,14 @@ fn describe_tells_what_a_model_can_do() {
         "{cs}"
     );
     assert!(cs.contains("option speed: "), "{cs}");
+    // Its time budget at FAST: 0.1 s of measuring and 33 characters of 11 bits at 4800 baud
+    // on the wire, 0.175625 s; no calibration.
+    assert!(
+        cs.contains(
+            "\n    one reading of 100 cd/m² (lx in ambient): emissive 0.176 s (calibration 0.000 s)\n"
+        ),
+        "{cs}"
+    );
     let i1 = text(&["devices", "--describe", "i1pro"]);
     let dark = "dark (place the instrument on its white calibration tile; valid";
     let rev_d = i1.find("a simulated i1Pro (Rev A–D)").unwrap();
@@ -166,6 +174,11 @@ fn describe_tells_what_a_model_can_do() {
         "emissive"
     );
     assert_eq!(v["repeatability"][1]["mode"], "reflective");
+    // The Rev E unit's emissive dark: 204 readings of 4.896 ms and nine of 2 s.
+    let times = &v["units"][1]["times"][0];
+    assert_eq!(times["mode"], "emissive");
+    let dark = times["calibration_s"].as_f64().unwrap();
+    assert!((dark - (204.0 * 4.896e-3 + 18.0)).abs() < 1e-9, "{dark}");
     let o = run(&["devices", "--describe", "spectro"]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(
