@@ -46,12 +46,7 @@ LAYERS = [
 # Imports known to run up a layer, each in a file someone else is changing, as
 # "FILE -> MODULE" (every use of MODULE in FILE). Each entry is a debt: delete it once the
 # import is gone (the script says when one has become stale).
-KNOWN = {
-    # The simulated box lives with the rig but reads the box plan, scene and comparison.
-    "src/rig/simulated_box.rs -> measure_box",
-    # The repeatability's covariance is validation's type.
-    "src/session/repeats.rs -> validation",
-}
+KNOWN = set()
 
 
 def layer_of(layers):

@@ -51,7 +51,7 @@ ROLE_NAMES = {
 # script says when one has become stale).
 KNOWN = {
     # The i1Pro's product (protocol) and the drivers' registry row.
-    "Model": {"protocols/src/i1pro.rs", "drivers/src/registry.rs"},
+    "Model": {"protocols/src/i1pro.rs", "drivers/src/registry/mod.rs"},
     # The i1Pro's USB request's error and the experiment request's.
     "RequestError": {"protocols/src/i1pro/commands.rs", "src/experiment/request.rs"},
     # The export's approximation and the display-spots stage's readings.

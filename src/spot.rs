@@ -353,9 +353,7 @@ fn open(
         record: request.record.clone(),
     };
     let mut instrument = spec.open_with(&options).map_err(|e| match e {
-        DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. } => {
-            SpotRunError::BadRequest(e.to_string())
-        }
+        e if e.is_spec() => SpotRunError::BadRequest(e.to_string()),
         e => e.into(),
     })?;
     // Before measuring: a colorimeter's readings would be taken and then have no spectrum.

@@ -7,6 +7,7 @@ use serde::Serialize;
 use crate::permissions::SERIAL_PERMISSION_FIX;
 pub use crate::permissions::USB_PERMISSION_FIX;
 use crate::registry::{self, Bus};
+use crate::DriverError;
 
 /// Whether the current user may open a device.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -181,27 +182,6 @@ pub fn access_from_error(e: &std::io::Error, fix: &str) -> Access {
     }
 }
 
-/// Where Linux's libusb looks for USB devices.
-const USBFS: &str = "/dev/bus/usb";
-
-/// Why libusb could not start, in the machine's terms: libusb reports a missing device
-/// filesystem as its catch-all "Other error", which tells the user nothing.
-fn usb_unavailable_reason(e: &rusb::Error, usbfs: &std::path::Path) -> String {
-    if cfg!(target_os = "linux") && !usbfs.exists() {
-        return format!(
-            "{} does not exist (no USB controller, or a container or sandbox started without \
-             the host's USB devices; libusb said: {e})",
-            usbfs.display()
-        );
-    }
-    match e {
-        rusb::Error::Access => format!("no permission to read {} ({e})", usbfs.display()),
-        rusb::Error::NoMem => "libusb ran out of memory while starting".into(),
-        rusb::Error::NotSupported => "libusb does not support USB on this system".into(),
-        other => format!("libusb could not start ({other})"),
-    }
-}
-
 /// The title of the model with this ID on this bus, from the driver registry.
 fn known(vid: u16, pid: u16, bus: Bus) -> Option<&'static str> {
     registry::by_usb(vid, pid, bus).map(|m| m.title)
@@ -214,8 +194,8 @@ fn usb_instruments(list: &mut DeviceList) {
         Ok(c) => c,
         Err(e) => {
             list.notes.push(format!(
-                "USB not available on this machine: {}; no USB instruments listed",
-                usb_unavailable_reason(&e, std::path::Path::new(USBFS))
+                "{}; no USB instruments listed",
+                DriverError::usb_unavailable(&e)
             ));
             return;
         }
@@ -325,21 +305,6 @@ mod tests {
         // This machine (and CI) has no instruments and maybe no USB: no panic, no error.
         let list = list_devices();
         assert!(list.instruments.is_empty(), "{list:?}");
-    }
-
-    #[test]
-    fn libusbs_other_error_is_explained_by_the_missing_device_filesystem() {
-        let missing = std::path::Path::new("/nonexistent/bus/usb");
-        let why = usb_unavailable_reason(&rusb::Error::Other, missing);
-        if cfg!(target_os = "linux") {
-            assert!(
-                why.starts_with("/nonexistent/bus/usb does not exist (no USB controller"),
-                "{why}"
-            );
-        }
-        let present = std::env::temp_dir();
-        let why = usb_unavailable_reason(&rusb::Error::Access, &present);
-        assert!(why.starts_with("no permission to read"), "{why}");
     }
 
     #[test]

@@ -11,6 +11,16 @@ pub enum DriverError {
     #[error("unknown instrument '{spec}': expected {expected}")]
     UnknownSpec { spec: String, expected: String },
 
+    /// The spec names a model by a word it is not opened by (`i1pro2`), or one metamer
+    /// does not drive (`i1pro3`); `message` says how to name it, or why it is not
+    /// supported.
+    #[error("instrument '{spec}': {message}")]
+    NamedOtherwise { spec: String, message: String },
+
+    /// No model of the registry has this name.
+    #[error("no instrument model is named '{name}' (known: {known})")]
+    UnknownModel { name: String, known: String },
+
     /// An option of a spec (`sim:cs100a?time_scale=…`) is not understood.
     #[error("instrument '{spec}': {message}")]
     BadSpecOption { spec: String, message: String },
@@ -61,8 +71,9 @@ pub enum DriverError {
         #[source]
         source: std::io::Error,
     },
-    /// USB (or HID) cannot be used on this machine.
-    #[error("USB is not available: {message}")]
+    /// USB (or HID) cannot be used on this machine; `message` says why in the machine's
+    /// terms ([`DriverError::usb_unavailable`]).
+    #[error("USB is not available on this machine: {message}")]
     UsbUnavailable { message: String },
     /// No such USB/HID device is plugged in.
     #[error("no {device} is plugged in; `metamer devices` lists the instruments of this machine")]
@@ -100,4 +111,68 @@ pub enum DriverError {
     /// The simulated instrument could not be started.
     #[error("simulated instrument: {0}")]
     Simulation(String),
+}
+
+/// Where Linux's libusb looks for USB devices.
+const USBFS: &str = "/dev/bus/usb";
+
+impl DriverError {
+    /// libusb could not start: the one error every command gives (and `metamer devices`
+    /// notes) when USB is out of reach.
+    pub fn usb_unavailable(e: &rusb::Error) -> DriverError {
+        DriverError::UsbUnavailable {
+            message: usb_unavailable_reason(e, std::path::Path::new(USBFS)),
+        }
+    }
+
+    /// Whether the spec itself is wrong (an unknown form, a model named by another word or
+    /// not driven, a bad option), as opposed to something that failed while opening what it
+    /// names.
+    pub fn is_spec(&self) -> bool {
+        matches!(
+            self,
+            DriverError::UnknownSpec { .. }
+                | DriverError::NamedOtherwise { .. }
+                | DriverError::BadSpecOption { .. }
+        )
+    }
+}
+
+/// Why libusb could not start, in the machine's terms: libusb reports a missing device
+/// filesystem as its catch-all "Other error", which tells the user nothing.
+fn usb_unavailable_reason(e: &rusb::Error, usbfs: &std::path::Path) -> String {
+    if cfg!(target_os = "linux") && !usbfs.exists() {
+        return format!(
+            "{} does not exist (no USB controller, or a container or sandbox started without \
+             the host's USB devices; libusb said: {e})",
+            usbfs.display()
+        );
+    }
+    match e {
+        rusb::Error::Access => format!("no permission to read {} ({e})", usbfs.display()),
+        rusb::Error::NoMem => "libusb ran out of memory while starting".into(),
+        rusb::Error::NotSupported => "libusb does not support USB on this system".into(),
+        other => format!("libusb could not start ({other})"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn libusbs_other_error_is_explained_by_the_missing_device_filesystem() {
+        let missing = std::path::Path::new("/nonexistent/bus/usb");
+        let why = usb_unavailable_reason(&rusb::Error::Other, missing);
+        if cfg!(target_os = "linux") {
+            assert_eq!(
+                why,
+                "/nonexistent/bus/usb does not exist (no USB controller, or a container or \
+                 sandbox started without the host's USB devices; libusb said: Other error)"
+            );
+        }
+        let present = std::env::temp_dir();
+        let why = usb_unavailable_reason(&rusb::Error::Access, &present);
+        assert!(why.starts_with("no permission to read"), "{why}");
+    }
 }

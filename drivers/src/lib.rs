@@ -8,6 +8,7 @@
 
 pub mod budget;
 pub mod cs100a;
+pub mod describe;
 pub mod devices;
 pub mod i1pro;
 

@@ -12,7 +12,7 @@ use metamer::display::characterize::{
 use metamer::display::ModelKind;
 use metamer::rig::ScreenSpec;
 use metamer::session::{on_ctrl_c, BarProgress, ProgressSink, RunOptions};
-use metamer_drivers::{DriverError, Spec, Speed};
+use metamer_drivers::{Spec, Speed};
 
 use super::{CliError, CliResult};
 
@@ -130,9 +130,7 @@ fn refusal(e: CharacterizeError) -> CliError {
     match e {
         CharacterizeError::Plan(e) => CliError::Usage(plan_usage(&e)),
         CharacterizeError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
-        CharacterizeError::Instrument(
-            e @ (DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. }),
-        ) => CliError::Usage(e.to_string()),
+        CharacterizeError::Instrument(e) if e.is_spec() => CliError::Usage(e.to_string()),
         e => match e.advice() {
             Some(t) => CliError::Failed(t.into()),
             None => CliError::from(e),

@@ -49,7 +49,7 @@ pub struct Args {
     #[arg(long, default_value = "virtual:ips-lcd", value_name = "DISPLAY")]
     display: ScreenSpec,
     /// The spot meter that reads the box (fall-off, spots) and the display.
-    #[arg(long, default_value = "sim:cs100a?time_scale=0", value_name = "SPEC")]
+    #[arg(long, default_value = metamer::experiment::DEFAULT_SPOT, value_name = "SPEC")]
     spot: Spec,
     /// Display model (see `metamer fit --help`).
     #[arg(long, default_value = "lut", value_name = "MODEL")]
@@ -174,7 +174,9 @@ fn request(args: Args) -> Result<Request, CliError> {
 pub(super) fn refusal(e: RequestError) -> CliError {
     match e {
         RequestError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
-        RequestError::BoxLight(e) => super::rig::box_light_refusal(e),
+        RequestError::BoxLight(e) => {
+            super::rig::box_light_refusal(e, Some(metamer::experiment::DEFAULT_SPOT))
+        }
         e if e.is_usage() => CliError::Usage(e.to_string()),
         e => CliError::from(e),
     }

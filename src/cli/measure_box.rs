@@ -97,7 +97,7 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
         MeasureBoxJobError::Repeats(message) => usage(format!("--repeats {message}")),
         MeasureBoxJobError::Plan(e) => usage(e),
         MeasureBoxJobError::UnknownStage(message) => usage(message),
-        MeasureBoxJobError::BoxLight(e) => box_light_refusal(e),
+        MeasureBoxJobError::BoxLight(e) => box_light_refusal(e, None),
         MeasureBoxJobError::Nobody(e) => nobody_at_the_rig(e),
         MeasureBoxJobError::Rig(e) if e.is_request() => usage(e),
         MeasureBoxJobError::Rig(e) => CliError::from(e),

@@ -1,7 +1,7 @@
 //! The refusals shared by the commands that open a rig (`measure-box`, `experiment`,
 //! `spot`, `characterize`), said with their flags.
 
-use metamer::measure_box::setup::BoxLightError;
+use metamer::measure_box::setup::{mixed_rig, BoxLightError};
 use metamer::session::NobodyAtTheRig;
 
 use super::CliError;
@@ -11,11 +11,19 @@ fn usage(e: impl std::fmt::Display) -> CliError {
 }
 
 /// Instruments and a `--scenario` that make no box rig, in the words of the command line.
-pub(super) fn box_light_refusal(e: BoxLightError) -> CliError {
+/// `default_spot` is the spot meter the command takes when `--spot` is not given: a
+/// refusal of it says so, as the user never wrote it.
+pub(super) fn box_light_refusal(e: BoxLightError, default_spot: Option<&str>) -> CliError {
     match e {
-        BoxLightError::Mixed => usage(
-            "--spectral and --spot must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box",
-        ),
+        BoxLightError::Mixed(rig) => {
+            let (spectral, spot) = (&rig.spectral, &rig.spot);
+            let note = if default_spot == Some(spot.as_str()) {
+                " (the default when --spot is not given)"
+            } else {
+                ""
+            };
+            usage(mixed_rig(["--spectral", "--spot"], spectral, spot, note))
+        }
         BoxLightError::RealRig => usage(
             "--scenario sets the light of the simulated box; real instruments (--spectral/--spot not sim:…) measure the real box under its own light",
         ),

@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use metamer::color::Xyz;
 use metamer::spot::{self, SpotEvent, SpotRequest, SpotRunError};
+use metamer::validation::readings::spot_line;
 use metamer_drivers::{MeasureMode, Reading, Spec, Speed};
 
 use super::{CliError, CliResult};
@@ -92,7 +92,7 @@ pub fn run(args: Args) -> CliResult {
         SpotEvent::Opened(_) => Ok(()),
         SpotEvent::Reading { n, reading } => {
             if json {
-                outln!("{}", json_line(reading))?;
+                outln!("{}", spot_line(reading))?;
             } else {
                 outln!("{}", human_line(n, mode, reading))?;
             }
@@ -115,49 +115,6 @@ pub fn run(args: Args) -> CliResult {
         e => CliError::from(e),
     })?;
     Ok(())
-}
-
-/// `{"XYZ":[X,Y,Z],"xyY":[x,y,Y],"flags":[…],"instrument":"cs100a"}` and, from spectral
-/// instruments, `"spectrum":{"start_nm":380,"step_nm":10,"values":[…]}`; values the
-/// instrument did not measure are null.
-fn json_line(r: &Reading) -> String {
-    // A struct, not json!(), to keep the documented key order.
-    #[derive(serde::Serialize)]
-    struct Grid<'a> {
-        start_nm: f64,
-        step_nm: f64,
-        values: &'a [f64],
-    }
-    #[derive(serde::Serialize)]
-    struct Line<'a> {
-        #[serde(rename = "XYZ")]
-        xyz: Xyz,
-        #[serde(rename = "xyY")]
-        xyy: [f64; 3],
-        flags: Vec<&'static str>,
-        instrument: &'a str,
-        #[serde(skip_serializing_if = "Option::is_none")]
-        integration_s: Option<f64>,
-        #[serde(skip_serializing_if = "Option::is_none")]
-        spectrum: Option<Grid<'a>>,
-    }
-    let spectrum = r.spectrum.as_ref().and_then(|s| {
-        let (start_nm, step_nm) = s.grid()?;
-        Some(Grid {
-            start_nm,
-            step_nm,
-            values: s.values(),
-        })
-    });
-    let line = Line {
-        xyz: r.xyz,
-        xyy: r.xyy,
-        flags: r.flags.iter().map(|f| f.name()).collect(),
-        instrument: &r.instrument,
-        integration_s: r.spectrum.as_ref().and(r.integration_s),
-        spectrum,
-    };
-    serde_json::to_string(&line).expect("a reading serializes")
 }
 
 fn human_line(i: u32, mode: MeasureMode, r: &Reading) -> String {

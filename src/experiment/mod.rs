@@ -32,6 +32,6 @@ pub mod validate;
 pub use error::ExperimentError;
 pub use options::{BoxSource, ExperimentOptions};
 pub use progress::Progress;
-pub use request::{BoxRequest, Outcome, Request, RequestError, MAX_IMAGE_SIZE};
+pub use request::{BoxRequest, Outcome, Request, RequestError, DEFAULT_SPOT, MAX_IMAGE_SIZE};
 pub use run::{run, StageOutcome};
 pub use stage::Stage;

@@ -23,6 +23,10 @@ use crate::rig::Scenario;
 use crate::session::{NobodyAtTheRig, RunOptions};
 use crate::validation::export::HTML_FILE;
 
+/// The spot meter of `metamer experiment` when `--spot` is not given: the simulated CS-100A
+/// at once, so the experiment runs on the simulated rig with no flags.
+pub const DEFAULT_SPOT: &str = "sim:cs100a?time_scale=0";
+
 /// The largest camera image the experiment renders, a side in pixels.
 pub const MAX_IMAGE_SIZE: usize = 8192;
 

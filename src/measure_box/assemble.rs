@@ -17,12 +17,13 @@ use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
 use super::plan::{BoxPlan, BoxStage, BoxStep, Geometry, Plane, Target};
 use super::scene::{scene_json, BoxContents};
-use super::stats::{group, mean_spectrum, GroupStats, Repeatability, StatsError};
+use super::stats::{group, mean_spectrum, GroupStats, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
 use crate::render::scene::DistributionFile;
 use crate::session::{Entry, InstrumentRecord};
+use crate::validation::repeatability;
 
 /// What each stage journal's header says besides its plan.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -199,7 +200,7 @@ fn reduce(
     for (target, group_entries) in by_target(entries) {
         let w = what(&target);
         let readings: Vec<_> = group_entries.iter().map(|e| &e.reading).collect();
-        let noise = Repeatability::stated(&readings[0].instrument, group_entries[0].mode);
+        let noise = repeatability::stated(&readings[0].instrument, group_entries[0].mode);
         let err = |source| AssembleError::Stats {
             what: format!("{stage} {w}"),
             source,

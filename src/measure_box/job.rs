@@ -21,9 +21,9 @@ use super::setup::{self, BoxLightError, RigError, RigRequest};
 use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
 use crate::rig::Scenario;
-use crate::session::repeats::Repeatability;
 use crate::session::{attendance, Attendance, NobodyAtTheRig, ProgressSink, RunOptions};
 use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
+use crate::validation::repeatability;
 
 /// The spots' readings file in the output directory, with
 /// [`MeasureBoxRequest::spot_readings`].
@@ -152,6 +152,11 @@ pub fn measure<'p>(
         .transpose()
         .map_err(MeasureBoxJobError::UnknownStage)?;
     let (spectral, spot) = (&request.spectral, &request.spot);
+    // As written, before a simulated box is made and its seed appended to the specs: a
+    // misnamed instrument is refused as such, not as half of a mixed rig.
+    for spec in [spectral, spot] {
+        spec.check().map_err(RigError::Open)?;
+    }
     let light = setup::box_light(spectral, spot, request.scenario)?;
     // Before anything is opened: a real rig with nobody to ask is refused.
     let attended = match request.attendance {
@@ -212,14 +217,14 @@ pub fn measure<'p>(
 /// reduction kept, in the plan's order; a spot read once carries the stated repeatability
 /// of the `meter` (its model).
 fn spot_readings(summary: &Summary, meter: &str) -> Vec<(usize, PatchReading)> {
-    let stated = Repeatability::emissive_of(meter);
+    let stated = repeatability::emissive_of(meter);
     summary
         .spot_xyz
         .iter()
         .zip(summary.spots.iter())
         .map(|((patch, xyz), r)| {
             let n = r.stats.n - r.stats.outliers.len();
-            let cov = match (n, stated.and_then(|s| s.covariance(*xyz))) {
+            let cov = match (n, stated.and_then(|s| repeatability::covariance(&s, *xyz))) {
                 (1, Some(c)) => c,
                 _ => r.stats.cov,
             };
@@ -264,10 +269,10 @@ mod tests {
         );
         std::fs::copy(transcript, &file).unwrap();
         let spec = Spec::replay(&file);
-        assert!(Repeatability::emissive_of(spec.as_str()).is_none());
+        assert!(repeatability::emissive_of(spec.as_str()).is_none());
         let meter = spec.open(None).unwrap();
-        let stated = Repeatability::emissive_of(&meter.info().model).unwrap();
-        let cs100a = Repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
+        let stated = repeatability::emissive_of(&meter.info().model).unwrap();
+        let cs100a = repeatability::stated("cs100a", metamer_drivers::MeasureMode::Emissive);
         assert_eq!(stated, cs100a);
         std::fs::remove_dir_all(&dir).unwrap();
     }

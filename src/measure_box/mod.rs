@@ -6,7 +6,8 @@
 //! takes the stages, [`stats`] reduces repeats and flags outliers, [`falloff`] makes the
 //! light's distribution, [`scene`] writes the box as a scene file, [`assemble`] puts the
 //! measured scene and its provenance together, and [`compare`] renders it against the box's
-//! spot readings. [`setup`] opens the rig a session measures with.
+//! spot readings. [`setup`] opens the rig a session measures with: the real box, or the
+//! simulated truth box and its operator ([`simulated_box`]).
 
 pub mod assemble;
 pub mod compare;
@@ -16,6 +17,7 @@ pub mod plan;
 pub mod run;
 pub mod scene;
 pub mod setup;
+pub mod simulated_box;
 pub mod stats;
 
 pub use assemble::{BoxDetails, Summary};

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use metamer_drivers::{DriverError, Instrument, SharedWorld, Spec, View};
 
 use super::plan::BoxPlan;
-use crate::rig::simulated_box::{BoxOperator, SimulatedBox, SimulatedBoxError};
+use super::simulated_box::{BoxOperator, SimulatedBox, SimulatedBoxError};
 use crate::rig::Scenario;
 use crate::session::Operator;
 
@@ -31,22 +31,55 @@ impl RigError {
     /// Whether the request itself is wrong (a misnamed instrument or a mixed or mislit
     /// rig), as opposed to something that failed while opening what was asked for.
     pub fn is_request(&self) -> bool {
-        matches!(
-            self,
-            RigError::Light(_)
-                | RigError::Open(
-                    DriverError::UnknownSpec { .. } | DriverError::BadSpecOption { .. }
-                )
-        )
+        matches!(self, RigError::Light(_)) || matches!(self, RigError::Open(e) if e.is_spec())
     }
+}
+
+/// What a spec names, in a word for a message.
+fn kind(s: &Spec) -> &'static str {
+    if s.is_simulated() {
+        "simulated"
+    } else if s.replay_file().is_some() {
+        "a replayed transcript"
+    } else {
+        "real"
+    }
+}
+
+/// Why `spectral` and `spot` make no rig (one is simulated and the other is not), naming
+/// them as the caller does: `names` are what it calls the two (`the spot meter`, or a
+/// command's flags), `spot_note` says more of the spot meter's spec where the user did not
+/// write it (a default). When only the spot meter is simulated, says how its model is
+/// named on real hardware.
+pub fn mixed_rig(names: [&str; 2], spectral: &Spec, spot: &Spec, spot_note: &str) -> String {
+    let [spectral_is, spot_is] = names;
+    let mut s = format!(
+        "{spectral_is} {spectral} is {} and {spot_is} {spot}{spot_note} is {}: both must be \
+         simulated (sim:…) or neither, as a simulated instrument sees only the simulated box",
+        kind(spectral),
+        kind(spot)
+    );
+    if let (true, Some(model)) = (spot.is_simulated(), spot.model()) {
+        if let Some(real) = model.real_spec() {
+            s.push_str(&format!("; a real {} is named {real}", model.title));
+        }
+    }
+    s
+}
+
+/// The two instruments of a rig, one simulated and the other not.
+#[derive(Debug)]
+pub struct MixedRig {
+    pub spectral: Spec,
+    pub spot: Spec,
 }
 
 /// Instruments and a light that make no box rig.
 #[derive(Debug, thiserror::Error)]
 pub enum BoxLightError {
     /// One instrument is simulated and the other is not.
-    #[error("the spectral instrument and the spot meter must both be simulated (sim:…) or both real: a simulated instrument sees only the simulated box")]
-    Mixed,
+    #[error("{}", mixed_rig(["the spectral instrument", "the spot meter"], &.0.spectral, &.0.spot, ""))]
+    Mixed(Box<MixedRig>),
     /// The simulated box's light was asked of a real rig.
     #[error("a real rig measures the real box under its own light; only the simulated box's light can be chosen")]
     RealRig,
@@ -66,7 +99,10 @@ pub fn box_light(
         (true, true, light) => Ok(Some(light.unwrap_or_default())),
         (false, false, None) => Ok(None),
         (false, false, Some(_)) => Err(BoxLightError::RealRig),
-        _ => Err(BoxLightError::Mixed),
+        _ => Err(BoxLightError::Mixed(Box::new(MixedRig {
+            spectral: spectral.clone(),
+            spot: spot.clone(),
+        }))),
     }
 }
 
@@ -156,14 +192,19 @@ mod tests {
             Err(BoxLightError::RealRig)
         ));
         for light in [None, led] {
-            assert!(matches!(
-                box_light(&sim, &real, light),
-                Err(BoxLightError::Mixed)
-            ));
-            assert!(matches!(
-                box_light(&replayed, &sim, light),
-                Err(BoxLightError::Mixed)
-            ));
+            assert_eq!(
+                box_light(&sim, &real, light).unwrap_err().to_string(),
+                "the spectral instrument sim:cs100a is simulated and the spot meter \
+                 cs100a:/dev/ttyUSB0 is real: both must be simulated (sim:…) or neither, as a \
+                 simulated instrument sees only the simulated box"
+            );
+            assert_eq!(
+                box_light(&replayed, &sim, light).unwrap_err().to_string(),
+                "the spectral instrument replay:spots.jsonl is a replayed transcript and the \
+                 spot meter sim:cs100a is simulated: both must be simulated (sim:…) or \
+                 neither, as a simulated instrument sees only the simulated box; a real \
+                 Konica Minolta CS-100A is named cs100a:PORT"
+            );
         }
     }
 

@@ -18,8 +18,8 @@ use metamer_drivers::Reading;
 use serde::{Deserialize, Serialize};
 
 use crate::color::{Spectrum, Xyz};
-pub use crate::session::repeats::Repeatability;
 use crate::validation::covariance::{self, Cov3};
+pub use crate::validation::repeatability::Repeatability;
 
 /// Distance from the median, in noise σ, beyond which a reading is an outlier. At 5σ a
 /// normal reading is flagged about once in 1.7 million.
@@ -175,7 +175,7 @@ mod tests {
 
     #[test]
     fn a_reading_five_sigma_off_the_median_is_an_outlier_and_left_out_of_the_mean() {
-        let noise = Repeatability::stated("cs100a", MeasureMode::Emissive);
+        let noise = crate::validation::repeatability::stated("cs100a", MeasureMode::Emissive);
         // σ = 0.1 at Y = 100: 100.3 is 3σ off (kept), 101 is 10σ off (outlier).
         let ys = [100.0, 100.1, 99.9, 100.3, 101.0];
         let rs: Vec<Reading> = ys.iter().map(|&y| reading(y)).collect();
@@ -190,7 +190,7 @@ mod tests {
 
     #[test]
     fn a_spread_beyond_the_noise_is_flagged_and_two_readings_have_no_outlier() {
-        let noise = Repeatability::stated("i1pro", MeasureMode::Reflective);
+        let noise = crate::validation::repeatability::stated("i1pro", MeasureMode::Reflective);
         let rs: Vec<Reading> = [20.0, 21.0].iter().map(|&y| reading(y)).collect();
         let refs: Vec<&Reading> = rs.iter().collect();
         let g = group(&refs, noise).unwrap();
@@ -219,7 +219,7 @@ mod tests {
     /// χ²(4) ≈ 18.5, where a flat 0.1 % (σ 0.02) would give 100 and flag it.
     #[test]
     fn a_dim_i1pro_tile_is_allowed_the_scatter_of_its_level() {
-        let i1 = Repeatability::stated("i1pro", MeasureMode::Emissive);
+        let i1 = crate::validation::repeatability::stated("i1pro", MeasureMode::Emissive);
         // Mean 20, deviations −0.1, −0.1, 0, 0.1, 0.1: sd = √(0.04/4) = 0.1.
         let rs: Vec<Reading> = [19.9, 19.9, 20.0, 20.1, 20.1]
             .iter()

@@ -4,7 +4,6 @@
 
 pub mod scenario;
 pub mod sim_meter;
-pub mod simulated_box;
 pub mod spec;
 pub mod virtual_display;
 pub mod window;

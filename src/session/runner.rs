@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
+use metamer_drivers::registry::Repeatability;
 use metamer_drivers::{MeasureMode, Reading};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -21,7 +22,7 @@ use super::operator::Recheck;
 use super::plan::{placements, Prepare, SessionPlan};
 use super::progress::{reading_summary, ProgressSink, StepProgress};
 use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
-use super::repeats::{deviation, Repeatability};
+use super::repeats::deviation;
 use super::step::{Rig, StepFailure, StepTaker};
 
 /// The session could not start or go on.
@@ -218,12 +219,12 @@ fn place_entries<D: Serialize + PartialEq>(
 
 /// The repeatability stated for the instrument in `role` in `mode` (its model's, or a
 /// default when the rig has none in that role).
-fn repeatability(rig: &mut Rig<'_>, role: &str, mode: MeasureMode) -> Repeatability {
+fn stated_repeatability(rig: &mut Rig<'_>, role: &str, mode: MeasureMode) -> Repeatability {
     let model = rig
         .instrument(role)
         .map(|i| i.info().model)
         .unwrap_or_default();
-    Repeatability::stated(&model, mode)
+    metamer_drivers::registry::stated_repeatability(&model, mode)
 }
 
 /// What the operator is asked about when step `index` (`label`) differs from the readings
@@ -490,7 +491,7 @@ where
                 let Some(reading) = taker.take().map_err(fail)? else {
                     return Ok(RunEnd::Aborted { missing });
                 };
-                let repeatability = repeatability(rig, &step.role, step.mode);
+                let repeatability = stated_repeatability(rig, &step.role, step.mode);
                 let deviation = deviation_from_earlier(
                     &self.entries,
                     &placement,

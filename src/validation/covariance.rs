@@ -2,7 +2,7 @@
 //! readings (their X, Y and Z scatter together: a meter's repeats mostly move luminance
 //! and chromaticity, not one axis at a time), or, for a single reading, the instrument's
 //! stated repeatability in Y and in x, y carried to X, Y, Z to first order
-//! ([`crate::session::repeats::Repeatability::covariance`]).
+//! ([`super::repeatability::covariance`]).
 
 use nalgebra::{Matrix3, SymmetricEigen};
 

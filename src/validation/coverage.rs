@@ -16,8 +16,8 @@ use super::montecarlo::{
     lab_noise, patch_interval, summary_interval, LabNoise, Metric, PatchDraws, Statistic,
 };
 use super::propagate::{Interval, Uncertain};
+use super::repeatability;
 use crate::color::{delta_e76, Lab, Xyz};
-use crate::session::repeats::Repeatability;
 
 const TRIALS: u64 = 2000;
 /// Trials of a summary, whose band is wider.
@@ -151,9 +151,7 @@ pub(super) fn moved(from: Xyz, dir: [f64; 3], de: f64) -> Xyz {
 /// repeatability of one reading of it, scaled by `noise`.
 pub(super) fn yellow(de: f64, noise: f64, k_reference: usize, k_test: usize) -> Truth {
     let reference = Xyz::new(9.0356, 9.9766, 1.2852);
-    let one = Repeatability::emissive_of("cs100a")
-        .unwrap()
-        .covariance(reference)
+    let one = repeatability::covariance(&repeatability::emissive_of("cs100a").unwrap(), reference)
         .unwrap();
     let cov = covariance::scaled(&one, noise * noise);
     Truth {

@@ -28,6 +28,7 @@ pub mod montecarlo;
 pub mod plausible;
 pub mod propagate;
 pub mod readings;
+pub mod repeatability;
 pub mod report;
 mod report_data;
 pub mod sequential;

@@ -25,7 +25,6 @@ use super::uncertain::render_lab_sigma;
 pub use super::uncertain::CHI3_95;
 use crate::color::{Xyz, COLORCHECKER_NAMES};
 use crate::render::spot::Uncertainty;
-use crate::session::repeats::Repeatability;
 
 /// The number of patches of the chart.
 pub const PATCHES: usize = 24;
@@ -430,6 +429,7 @@ mod json;
 mod rows;
 pub mod write;
 
+pub use json::spot_line;
 pub use write::write_readings;
 
 #[cfg(test)]

@@ -216,7 +216,10 @@ fn bad_specs_and_arguments() {
     let o = metamer(&["spot", "--instrument", "sim:i1d3"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("unknown instrument 'sim:i1d3': expected cs100a:PORT"),
+        stderr(&o).starts_with(
+            "error: instrument 'sim:i1d3': the X-Rite i1Display Pro is not supported: metamer \
+             has no codec for its HID protocol; known: cs100a:PORT"
+        ),
         "{}",
         stderr(&o)
     );

@@ -231,7 +231,7 @@ fn the_lab_is_the_experiment_on_the_simulated_rig() {
 
     // Lit by the display's white, no measured colour lies clearly outside the display's
     // primaries: at most 1 % of its largest drive on the wrong side of an edge (the yellow
-    // sits on one, see src/rig/simulated_box.rs).
+    // sits on one, see src/measure_box/simulated_box.rs).
     let reach = least_linear_drive(&dir);
     assert_eq!(reach.len(), 24);
     assert!(outside(&reach, 0.01).is_empty(), "{reach:?}");

@@ -147,5 +147,5 @@ fn a_real_screen_that_cannot_be_used_is_refused_before_the_box_is_measured() {
     );
     // Half a simulated rig: the simulated spectrometer sees only the simulated box.
     let mixed = ["--spectral", "sim:i1pro", "--spot", meter];
-    refused_at_once(&out, &mixed, false, "must both be simulated", &[]);
+    refused_at_once(&out, &mixed, false, "both must be simulated", &[]);
 }

@@ -335,6 +335,8 @@ fn a_real_instrument_with_nobody_at_it_is_refused_before_any_reading() {
             &out,
         ],
         &["spot", "--instrument", &meter, "--count", "3"],
+        // Not simulated, as the meter is not: a simulated spectral instrument beside a real
+        // meter is refused as a mixed rig first.
         &[
             "experiment",
             "-o",
@@ -380,4 +382,47 @@ fn a_real_instrument_with_nobody_at_it_is_refused_before_any_reading() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(seen.0.load(Ordering::SeqCst), 2);
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Forgetting `--spot` on a real rig: the experiment's spot meter defaults to the simulated
+/// CS-100A, and the refusal names that default and how to name the real meter, before any
+/// stage.
+#[test]
+fn a_real_spectral_instrument_with_the_default_spot_meter_is_refused_naming_the_default() {
+    let dir = fresh_dir("mixed-rig");
+    let out = dir.join("out").display().to_string();
+    let (code, _, err) = refused(&[
+        "experiment",
+        "-o",
+        &out,
+        "--spectral",
+        "i1pro",
+        "--unattended",
+    ]);
+    assert_eq!(code, Some(2));
+    assert_eq!(
+        err,
+        "error: --spectral i1pro is real and --spot sim:cs100a?time_scale=0 (the default when \
+         --spot is not given) is simulated: both must be simulated (sim:…) or neither, as a \
+         simulated instrument sees only the simulated box; a real Konica Minolta CS-100A is \
+         named cs100a:PORT\n"
+    );
+    // A spot meter given by hand is not called a default.
+    let (code, _, err) = refused(&[
+        "experiment",
+        "-o",
+        &out,
+        "--spectral",
+        "i1pro",
+        "--spot",
+        "sim:cs100a",
+        "--unattended",
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.starts_with("error: --spectral i1pro is real and --spot sim:cs100a is simulated: "),
+        "{err}"
+    );
+    assert!(!dir.join("out").join("box").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

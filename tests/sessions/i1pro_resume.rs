@@ -7,10 +7,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use metamer::measure_box::simulated_box::{BoxOperator, SimulatedBox};
 use metamer::measure_box::{self, BoxDetails, BoxOptions, BoxPlan, BoxStage, Instruments, Outcome};
 use metamer::output::OutputPolicy;
 use metamer::rig::scenario::Scenario;
-use metamer::rig::simulated_box::{BoxOperator, SimulatedBox};
 use metamer::session::{NoProgress, RunEnd, RunOptions};
 use metamer_drivers::{SharedWorld, Spec, View};
 

@@ -12,10 +12,10 @@ use metamer::color::{luminance, Outside, Spectrum, Xyz};
 use metamer::light::CGammaTable;
 use metamer::measure_box::compare::{compare_readings, render_scene};
 use metamer::measure_box::scene::{scene_json, BoxContents};
+use metamer::measure_box::simulated_box::SimulatedBox;
 use metamer::measure_box::BoxPlan;
 use metamer::render::scene::DistributionFile;
 use metamer::render::spot::{RenderedReading, Uncertainty};
-use metamer::rig::simulated_box::SimulatedBox;
 use metamer::rig::Scenario;
 use serde_json::Value;
 
@@ -367,7 +367,14 @@ fn bad_flags_and_plans_are_usage_errors() {
     .output()
     .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("both be simulated"));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr),
+        format!(
+            "error: --spectral {SPECTRAL} is simulated and --spot cs100a:/dev/null is real: both \
+             must be simulated (sim:…) or neither, as a simulated instrument sees only the \
+             simulated box\n"
+        )
+    );
     let o = command(
         &dir,
         &["--spectral", SPECTRAL, "--spot", SPOT, "--repeats", "0"],

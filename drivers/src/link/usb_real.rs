@@ -27,12 +27,10 @@ impl RusbLink {
     ) -> Result<RusbLink, DriverError> {
         use rusb::UsbContext;
         let name = format!("usb:{vid:04x}:{pid:04x}");
-        let context = rusb::Context::new().map_err(|e| DriverError::UsbUnavailable {
-            message: e.to_string(),
-        })?;
-        let devices = context.devices().map_err(|e| DriverError::UsbUnavailable {
-            message: e.to_string(),
-        })?;
+        let context = rusb::Context::new().map_err(|e| DriverError::usb_unavailable(&e))?;
+        let devices = context
+            .devices()
+            .map_err(|e| DriverError::usb_unavailable(&e))?;
         let mut denied = false;
         for device in devices.iter() {
             let Ok(desc) = device.device_descriptor() else {

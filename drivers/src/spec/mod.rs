@@ -197,9 +197,53 @@ impl Spec {
         self.open_in(registry::MODELS, options)
     }
 
-    fn unknown(&self) -> DriverError {
+    /// The registry model this spec names by its stable name (`sim:MODEL`) or a prefix
+    /// (`PREFIX[:ADDRESS]`), whether or not it could be opened; None for a transcript, whose
+    /// model only its header says.
+    pub fn model(&self) -> Option<&'static Model> {
+        self.model_in(registry::MODELS)
+    }
+
+    fn model_in<'m>(&self, models: &'m [Model]) -> Option<&'m Model> {
+        match &self.kind {
+            SpecForm::Simulated { model, .. } => models.iter().find(|m| m.name == model),
+            SpecForm::Device { prefix, .. } => models
+                .iter()
+                .find(|m| m.spec_prefixes.contains(&prefix.as_str())),
+            SpecForm::Replay { .. } => None,
+        }
+    }
+
+    /// Why the spec opens nothing: a word for a model that is named otherwise (`i1pro2`),
+    /// a model metamer does not drive (`i1pro3`), or else an unknown form, with every
+    /// form the registry offers.
+    fn unknown_in(&self, models: &[Model]) -> DriverError {
+        let word = match &self.kind {
+            SpecForm::Simulated { model, .. } => model.as_str(),
+            SpecForm::Device { prefix, .. } => prefix.as_str(),
+            SpecForm::Replay { .. } => "",
+        };
+        let spec = self.text.clone();
+        for m in models {
+            if let Some(other) = m.other_names.iter().find(|o| o.word == word) {
+                return DriverError::NamedOtherwise {
+                    spec,
+                    message: m.named_instead(other),
+                };
+            }
+            if let (Some(why), true) = (m.unsupported, m.name == word) {
+                return DriverError::NamedOtherwise {
+                    spec,
+                    message: format!(
+                        "the {} is not supported: {why}; known: {}",
+                        m.title,
+                        registry::spec_forms()
+                    ),
+                };
+            }
+        }
         DriverError::UnknownSpec {
-            spec: self.text.clone(),
+            spec,
             expected: registry::spec_forms(),
         }
     }
@@ -220,7 +264,7 @@ impl Spec {
                 let row = models
                     .iter()
                     .find(|m| m.name == model && m.sim.is_some())
-                    .ok_or_else(|| self.unknown())?;
+                    .ok_or_else(|| self.unknown_in(models))?;
                 sim_settings(&self.text, options, row.sim_options).map(drop)
             }
             _ => self.real_in(models).map(drop),
@@ -232,7 +276,7 @@ impl Spec {
         // A bare prefix (`i1pro`) names a model whose address may be left out; `replay:`
         // with no file, or a prefix no row has, names nothing.
         let SpecForm::Device { prefix, address } = &self.kind else {
-            return Err(self.unknown());
+            return Err(self.unknown_in(models));
         };
         match models
             .iter()
@@ -240,7 +284,7 @@ impl Spec {
             .and_then(|m| m.real.as_ref())
         {
             Some(real) if !address.is_empty() || !real.address_required => Ok((real, address)),
-            _ => Err(self.unknown()),
+            _ => Err(self.unknown_in(models)),
         }
     }
 
@@ -274,8 +318,8 @@ impl Spec {
             } => {
                 let row = by_name(model)
                     .filter(|m| m.sim.is_some())
-                    .ok_or_else(|| self.unknown())?;
-                let open = row.sim.ok_or_else(|| self.unknown())?;
+                    .ok_or_else(|| self.unknown_in(models))?;
+                let open = row.sim.ok_or_else(|| self.unknown_in(models))?;
                 open(&sim_settings(&self.text, query, row.sim_options)?, options)
             }
             _ => {
@@ -349,6 +393,23 @@ pub fn open_instrument_with(
 /// [`Spec::check`] of the text `spec`.
 pub fn check_spec(spec: &str) -> Result<(), DriverError> {
     Spec::new(spec).check()
+}
+
+/// The model a name from a reading, a file or a command line stands for: a model's stable
+/// name (`cs100a`, `CS-100A`: case and hyphens aside), another word for it (`i1pro2`), or
+/// a spec naming it (`sim:i1pro?seed=2`, `cs100a:/dev/ttyUSB0`). None for anything else,
+/// a transcript among them (only its header says its model).
+pub fn model_named(name: &str) -> Option<&'static Model> {
+    let word: String = name
+        .trim()
+        .chars()
+        .filter(|c| *c != '-')
+        .flat_map(char::to_lowercase)
+        .collect();
+    registry::MODELS
+        .iter()
+        .find(|m| m.name == word || m.other_names.iter().any(|o| o.word == word))
+        .or_else(|| Spec::new(name.trim()).model())
 }
 
 /// [`Spec::is_physical`] of the text `spec`.

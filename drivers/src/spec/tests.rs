@@ -103,13 +103,22 @@ fn default_stimulus_and_bad_specs() {
     assert_eq!(r.xyy[2], 100.0);
     assert!((r.xyy[0] - 0.4558).abs() < 1e-9, "{:?}", r.xyy);
     assert!((r.xyy[1] - 0.4211).abs() < 1e-9, "{:?}", r.xyy);
-    for spec in ["nothing", "sim:i1d3", "cs100a:", "replay:"] {
+    for spec in ["nothing", "cs100a:", "replay:"] {
         let e = open_instrument(spec, None).err().unwrap();
         assert!(
             e.to_string().contains("expected cs100a:PORT"),
             "{spec}: {e}"
         );
     }
+    // A model the registry knows but does not drive says so.
+    let e = open_instrument("sim:i1d3", None).err().unwrap().to_string();
+    assert!(
+        e.starts_with(
+            "instrument 'sim:i1d3': the X-Rite i1Display Pro is not supported: metamer has no \
+             codec for its HID protocol; known: cs100a:PORT"
+        ),
+        "{e}"
+    );
     let e = open_instrument("sim:cs100a?speed=9", None).err().unwrap();
     assert!(e.to_string().contains("unknown option 'speed'"), "{e}");
     // A model's own options are known to it alone.
@@ -207,7 +216,12 @@ const FAKE: &[Model] = &[Model {
     replay: None,
     sim: None,
     sim_options: &[],
+    described_by: &[],
+    modes: &[],
+    repeatability: &[],
     time_budget: None,
+    other_names: &[],
+    unsupported: None,
 }];
 
 #[test]
@@ -295,4 +309,62 @@ fn options_and_seeds_are_appended_as_the_text_was_written_by_hand() {
         Spec::replay(std::path::Path::new("/tmp/x.jsonl")).as_str(),
         "replay:/tmp/x.jsonl"
     );
+}
+
+/// `i1pro2` is answered with how to name an i1Pro 2 (the i1Pro driver reads Rev E units,
+/// protocols/i1pro/README.md), `i1pro3` with "not supported" and why, in every form and by
+/// the check as by opening.
+#[test]
+fn the_i1pro_2_is_named_as_an_i1pro_and_the_i1pro_3_is_not_supported() {
+    let i1pro2 = "an i1Pro 2 (Rev E) is the X-Rite i1Pro / i1Pro 2: name it i1pro[:SERIAL], \
+                  and simulate one with sim:i1pro?rev=e";
+    for spec in ["i1pro2", "i1pro2:1234", "sim:i1pro2?time_scale=0"] {
+        let e = check_spec(spec).unwrap_err();
+        assert!(e.is_spec(), "{e}");
+        assert_eq!(e.to_string(), format!("instrument '{spec}': {i1pro2}"));
+        assert_eq!(
+            open_instrument(spec, None).err().unwrap().to_string(),
+            e.to_string()
+        );
+    }
+    for spec in ["i1pro3", "sim:i1pro3"] {
+        let e = check_spec(spec).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!(
+                "instrument '{spec}': the X-Rite i1Pro 3 is not supported: it speaks a USB \
+                 protocol of its own"
+            )),
+            "{e}"
+        );
+        assert!(
+            e.ends_with(
+                "; known: cs100a:PORT, i1pro[:SERIAL], replay:FILE.jsonl, sim:cs100a or sim:i1pro"
+            ),
+            "{e}"
+        );
+    }
+    // Any other word stays an unknown spec.
+    assert!(check_spec("i1pro4")
+        .unwrap_err()
+        .to_string()
+        .starts_with("unknown instrument 'i1pro4': expected cs100a:PORT"));
+}
+
+#[test]
+fn a_model_is_found_by_its_name_another_word_or_a_spec() {
+    let name = |n: &str| model_named(n).map(|m| m.name);
+    for (given, model) in [
+        ("cs100a", Some("cs100a")),
+        ("CS-100A", Some("cs100a")),
+        (" i1Pro ", Some("i1pro")),
+        ("i1pro2", Some("i1pro")),
+        ("sim:i1pro?seed=2", Some("i1pro")),
+        ("cs100a:/dev/ttyUSB0", Some("cs100a")),
+        ("i1d3", Some("i1d3")),
+        ("replay:cs100a.jsonl", None),
+        ("spectralon", None),
+        ("", None),
+    ] {
+        assert_eq!(name(given), model, "{given:?}");
+    }
 }

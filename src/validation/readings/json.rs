@@ -1,5 +1,8 @@
 //! The JSON forms of readings `validate` takes: a session journal, `metamer spot --json`
-//! lines and `metamer render spots --json`.
+//! lines (written here too, by [`spot_line`]) and `metamer render spots --json`.
+
+use metamer_drivers::spec::model_named;
+use metamer_drivers::Reading;
 
 use super::*;
 
@@ -108,11 +111,12 @@ impl Parsed {
                 })?),
             };
             let row = Row {
-                // A spot line does not say its mode: only a meter that reads emitted
-                // light alone (the CS-100A) is known to have taken an emissive reading.
+                // A spot line does not say its mode: only a model that reads emitted light
+                // alone (its registry row says so) is known to have taken an emissive
+                // reading.
                 instrument: v["instrument"]
                     .as_str()
-                    .filter(|m| m.to_ascii_lowercase().contains("cs100a"))
+                    .filter(|m| model_named(m).is_some_and(|row| row.reads_only_emitted_light()))
                     .map(String::from),
                 out_of_gamut: v["out_of_gamut"].as_bool().unwrap_or(false),
                 ..Row::reading(line, patch.unwrap_or(PatchId::Number(0)), xyz)
@@ -194,4 +198,49 @@ impl Parsed {
         }
         Ok(())
     }
+}
+
+/// One reading as a line of `metamer spot --json`, the form [`Parsed::spot_lines`] reads
+/// back: `{"XYZ":[X,Y,Z],"xyY":[x,y,Y],"flags":[…],"instrument":"cs100a"}` and, from
+/// spectral instruments, `"integration_s"` and `"spectrum":{"start_nm":380,"step_nm":10,
+/// "values":[…]}`; values the instrument did not measure are null.
+pub fn spot_line(r: &Reading) -> String {
+    // A struct, not json!(), to keep the documented key order.
+    #[derive(serde::Serialize)]
+    struct Grid<'a> {
+        start_nm: f64,
+        step_nm: f64,
+        values: &'a [f64],
+    }
+    #[derive(serde::Serialize)]
+    struct Line<'a> {
+        #[serde(rename = "XYZ")]
+        xyz: Xyz,
+        #[serde(rename = "xyY")]
+        xyy: [f64; 3],
+        flags: Vec<&'static str>,
+        instrument: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        integration_s: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        spectrum: Option<Grid<'a>>,
+    }
+    let spectrum = r.spectrum.as_ref().and_then(|s| {
+        let (start_nm, step_nm) = s.grid()?;
+        Some(Grid {
+            start_nm,
+            step_nm,
+            values: s.values(),
+        })
+    });
+    let line = Line {
+        xyz: r.xyz,
+        xyy: r.xyy,
+        flags: r.flags.iter().map(|f| f.name()).collect(),
+        instrument: &r.instrument,
+        integration_s: r.spectrum.as_ref().and(r.integration_s),
+        spectrum,
+    };
+    // Numbers (a non-finite one is written null) and strings: nothing here can fail.
+    serde_json::to_string(&line).expect("a reading serializes")
 }

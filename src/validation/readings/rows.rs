@@ -2,6 +2,7 @@
 //! every row passes, and each patch's mean with its uncertainty.
 
 use super::*;
+use crate::validation::repeatability;
 
 /// Largest 95 % ΔE*ab bound a renderer may state: CIELAB's whole gamut spans a few hundred.
 const MAX_DE95: f64 = 1000.0;
@@ -140,8 +141,8 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
 /// The covariance of one emissive reading of `row`'s instrument, from its stated
 /// repeatability, where the row names an instrument that has one.
 fn stated_covariance(row: &Row) -> Option<Cov3> {
-    let rep = Repeatability::emissive_of(row.instrument.as_deref()?)?;
-    rep.covariance(row.xyz.into())
+    let rep = repeatability::emissive_of(row.instrument.as_deref()?)?;
+    repeatability::covariance(&rep, row.xyz.into())
 }
 
 /// The uncertainty of the mean of `rows` (at `mean`) as factors, with its degrees of

@@ -107,3 +107,29 @@ fn render_json_carries_its_confidence() {
     assert_eq!(p.source, UncertaintySource::Render);
     assert!((p.u_lab - 0.01).abs() < 1e-6);
 }
+
+/// A `spot --json` line is written and read by this module: what [`spot_line`] writes
+/// reads back to the same XYZ, and a single reading gets its instrument's stated
+/// repeatability only where the model reads emitted light alone (the CS-100A), since the
+/// line does not say its mode.
+#[test]
+fn spot_lines_written_here_read_back() {
+    use metamer_drivers::Reading;
+    let cs = Reading::from_yxy(10.0, 0.25, 0.5, "cs100a");
+    let line = spot_line(&cs);
+    assert!(
+        line.starts_with("{\"XYZ\":[5.0,10.0,5.0],\"xyY\":[0.25,0.5,10.0],\"flags\":[],\"instrument\":\"cs100a\"}"),
+        "{line}"
+    );
+    let s = parse(&format!("{line}\n")).unwrap();
+    assert_eq!(s.format, Format::SpotJson);
+    let p = &s.patches[&1];
+    assert_eq!(p.xyz, cs.xyz);
+    assert_eq!(p.source, UncertaintySource::Instrument);
+    // σY of one CS-100A reading of 10 cd/m²: 0.1 % of 10 and the last of four digits
+    // (0.01, variance 0.01²/12): 0.01·√(1 + 1/12) = 0.010408.
+    assert!((p.reading_sd()[1] - 0.010_408_33).abs() < 1e-8, "{p:?}");
+    let i1 = Reading::from_yxy(10.0, 0.45, 0.5, "i1pro");
+    let s = parse(&format!("{}\n", spot_line(&i1))).unwrap();
+    assert_eq!(s.patches[&1].source, UncertaintySource::Unknown);
+}

@@ -13,6 +13,7 @@ use metamer_drivers::Reading;
 use super::rows::combine;
 use super::*;
 use crate::output::OutputPolicy;
+use crate::validation::repeatability;
 
 /// The header the stages write.
 pub const HEADER: &str = "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,cov_XY,cov_XZ,cov_YZ,u_lab";
@@ -69,8 +70,8 @@ impl PatchReading {
                 let xs: Vec<Xyz> = of_patch.iter().map(|r| r.xyz).collect();
                 let (xyz, mut cov) = covariance::sample(&xs);
                 if let [one] = of_patch.as_slice() {
-                    if let Some(c) = Repeatability::emissive_of(&one.instrument)
-                        .and_then(|r| r.covariance(one.xyz))
+                    if let Some(c) = repeatability::emissive_of(&one.instrument)
+                        .and_then(|r| repeatability::covariance(&r, one.xyz))
                     {
                         cov = c;
                     }
@@ -169,10 +170,9 @@ mod tests {
             (g[0].1.reading_sd()[1] - 0.010_408_33).abs() < 1e-8,
             "{g:?}"
         );
-        let stated = Repeatability::emissive_of("cs100a")
-            .unwrap()
-            .covariance(one.xyz)
-            .unwrap();
+        let stated =
+            repeatability::covariance(&repeatability::emissive_of("cs100a").unwrap(), one.xyz)
+                .unwrap();
         assert_eq!(g[0].1.reading_covariance(), stated);
         assert!(
             (g[1].1.reading_sd()[1] - 0.1 / 2f64.sqrt()).abs() < 1e-12,

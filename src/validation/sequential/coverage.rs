@@ -18,7 +18,7 @@ use crate::color::Lab;
 const SESSIONS: u64 = 2000;
 
 fn cs100a() -> Repeatability {
-    Repeatability::stated("cs100a", MeasureMode::Emissive)
+    repeatability::stated("cs100a", MeasureMode::Emissive)
 }
 
 fn rng(case: u64, session: u64) -> SplitMix64 {
@@ -159,7 +159,10 @@ fn pooled_session(targets: &[Xyz], scale: f64, session: u64) -> (Pool, Vec<bool>
     let mut taken: Vec<Vec<Xyz>> = Vec::new();
     let (half_width_jnd, most) = (0.3, 12);
     for &truth in targets {
-        let one = covariance::scaled(&stated.covariance(truth).unwrap(), scale * scale);
+        let one = covariance::scaled(
+            &repeatability::covariance(&stated, truth).unwrap(),
+            scale * scale,
+        );
         let all = readings(truth, &one, most, &mut rng);
         // The stopping figure: the pool's point estimate, taken as known.
         let so_far = RepeatNoise {
@@ -232,7 +235,10 @@ fn the_pooled_figure_is_honest_and_its_regions_are_covered() {
         .map(|(s, _)| {
             let mut rng = rng(3, s as u64);
             let truth = targets[0];
-            let one = covariance::scaled(&cs100a().covariance(truth).unwrap(), scale * scale);
+            let one = covariance::scaled(
+                &repeatability::covariance(&cs100a(), truth).unwrap(),
+                scale * scale,
+            );
             let all = readings(truth, &one, 3, &mut rng);
             u64::from(region_holds(&all, &RepeatNoise::stated(cs100a()), truth))
         })
@@ -308,7 +314,10 @@ fn the_verdict_rule_is_covered_at_the_jnd_and_beyond() {
     for (de, tight) in [(JND_DE76, true), (1.6, false), (3.2, false)] {
         let mut t = yellow(de, scale, 5, 1);
         t.test = moved(t.reference, [0.3, -0.4, -1.0], de);
-        t.cov_test = covariance::scaled(&stated.covariance(t.test).unwrap(), scale * scale);
+        t.cov_test = covariance::scaled(
+            &repeatability::covariance(&stated, t.test).unwrap(),
+            scale * scale,
+        );
         let results: Vec<(bool, usize, bool)> = (0..SESSIONS)
             .into_par_iter()
             .map(|s| verdict_session(&t, &noise, 0.0, most, s + 10_000 * de as u64))

@@ -10,7 +10,7 @@
 //! two readings and at most a stated count.
 //!
 //! **Noise.** One reading's XYZ covariance is the instrument's stated repeatability at the
-//! target's level ([`Repeatability::covariance`]) times a factor s²: 1 (the stated figure,
+//! target's level ([`repeatability::covariance`]) times a factor s²: 1 (the stated figure,
 //! known), or pooled across the targets the instrument read in the same mode, with its
 //! degrees of freedom ([`pool`]). CIELAB covariances are carried to first order through the
 //! Jacobian of XYZ → CIELAB at the mean (central differences).
@@ -71,9 +71,9 @@ pub use pool::Pool;
 
 use super::assess::{JndVerdict, JND_DE76};
 use super::covariance::{self, Cov3};
+use super::repeatability::{self, Repeatability};
 use super::uncertain::Interval;
 use crate::color::Xyz;
-use crate::session::repeats::Repeatability;
 
 /// The least number of readings of a target: one reading has no scatter of its own.
 pub const MIN_READINGS: usize = 2;
@@ -174,9 +174,7 @@ impl RepeatNoise {
 
     /// One reading's XYZ covariance at `xyz`; None without a chromaticity.
     pub fn covariance(&self, xyz: Xyz) -> Option<Cov3> {
-        self.stated
-            .covariance(xyz)
-            .map(|c| covariance::scaled(&c, self.scale2))
+        repeatability::covariance(&self.stated, xyz).map(|c| covariance::scaled(&c, self.scale2))
     }
 
     /// One reading's CIELAB covariance at `xyz` relative to `white`.
@@ -412,7 +410,7 @@ mod tests {
     fn the_width_rule_reads_until_the_half_width_is_reached() {
         let white = Xyz::new(95.047, 100.0, 108.883);
         let grey = Xyz::new(0.95047 * 20.0, 20.0, 1.08883 * 20.0);
-        let noise = RepeatNoise::stated(Repeatability::stated("cs100a", MeasureMode::Emissive));
+        let noise = RepeatNoise::stated(repeatability::stated("cs100a", MeasureMode::Emissive));
         let h1 = half_width(grey, &noise, white, 1).unwrap();
         // The half-width of n readings is h1/√n.
         let h4 = half_width(grey, &noise, white, 4).unwrap();

@@ -14,8 +14,8 @@
 
 use super::RepeatNoise;
 use crate::color::Xyz;
-use crate::session::repeats::Repeatability;
 use crate::validation::covariance;
+use crate::validation::repeatability::{self, Repeatability};
 
 /// The sum of the targets' whitened squared residuals and its degrees of freedom.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -32,7 +32,8 @@ impl Pool {
             return;
         }
         let (mean, _) = covariance::sample(readings);
-        let Some(inverse) = stated.covariance(mean).and_then(|c| inverse(&c)) else {
+        let Some(inverse) = repeatability::covariance(stated, mean).and_then(|c| inverse(&c))
+        else {
             return;
         };
         for x in readings {

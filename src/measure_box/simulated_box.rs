@@ -36,11 +36,11 @@ use std::sync::{Arc, OnceLock};
 
 use metamer_drivers::{CalibrationCondition, SharedWorld, View};
 
+use super::compare::{render_scene, CompareError};
+use super::plan::{BoxPlan, BoxStage, Target};
+use super::scene::{scene_json, BoxContents};
 use crate::color::{colorchecker, luminance, paper_white, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::{CGammaError, CGammaTable};
-use crate::measure_box::compare::{render_scene, CompareError};
-use crate::measure_box::plan::{BoxPlan, BoxStage, Target};
-use crate::measure_box::scene::{scene_json, BoxContents};
 use crate::render::scene::DistributionFile;
 use crate::rig::Scenario;
 use crate::session::{Answer, Operator, OperatorError};
