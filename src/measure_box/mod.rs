@@ -6,7 +6,8 @@
 //! takes the stages, [`stats`] reduces repeats and flags outliers, [`falloff`] makes the
 //! light's distribution, [`scene`] writes the box as a scene file, [`assemble`] puts the
 //! measured scene and its provenance together, and [`compare`] renders it against the box's
-//! spot readings. [`setup`] opens the rig a session measures with.
+//! spot readings. [`setup`] opens the rig a session measures with; [`spot_rule`] ends a
+//! spot's repeats by the plan's rule.
 
 pub mod assemble;
 pub mod compare;
@@ -16,6 +17,7 @@ pub mod plan;
 pub mod run;
 pub mod scene;
 pub mod setup;
+pub mod spot_rule;
 pub mod stats;
 
 pub use assemble::{BoxDetails, Summary};
