@@ -404,6 +404,17 @@ where
                 .is_some_and(|s| s.skip(index, &self.plan.steps, &self.entries))
     }
 
+    /// Whether step `index` needs no taking now: journalled, or skipped by the stopping
+    /// rule (then counted into `done`).
+    fn passed_over(&self, index: usize, done: &mut usize) -> bool {
+        if self.entries[index].is_some() {
+            return true;
+        }
+        let skipped = self.skipped(index);
+        *done += usize::from(skipped);
+        skipped
+    }
+
     /// Steps settled: in the journal, or skipped by the stopping rule.
     pub fn done(&self) -> usize {
         (0..self.entries.len())
@@ -503,11 +514,7 @@ where
         let start = Instant::now();
         let journal_path = self.journal.path().to_path_buf();
         for (index, placement) in placements(&self.plan.steps).into_iter().enumerate() {
-            if self.entries[index].is_some() {
-                continue;
-            }
-            if self.skipped(index) {
-                done += 1;
+            if self.passed_over(index, &mut done) {
                 continue;
             }
             let missing = total - done;
