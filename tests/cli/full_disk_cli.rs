@@ -293,13 +293,17 @@ fn every_command_ends_with_one_line_and_exit_1_when_its_output_cannot_be_written
 #[test]
 fn no_source_prints_around_the_console() {
     let mut found = Vec::new();
-    // A module compiled only for tests, declared under `#[cfg(test)]` elsewhere.
-    let test_only = [root().join("src/validation/coverage.rs")];
-    let mut stack = vec![
+    let roots = [
         root().join("src"),
         root().join("drivers/src"),
         root().join("protocols"),
     ];
+    let test_only = test_only_modules(&roots);
+    assert!(
+        test_only.contains(&root().join("src/validation/coverage.rs")),
+        "the test-only module list is read from the declarations: {test_only:?}"
+    );
+    let mut stack = roots.to_vec();
     while let Some(dir) = stack.pop() {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
@@ -332,6 +336,48 @@ fn no_source_prints_around_the_console() {
         "printing that panics on a full disk:\n{}",
         found.join("\n")
     );
+}
+
+/// The files of modules declared right after `#[cfg(test)]` (`mod name;`), which are
+/// compiled only for tests: `name.rs` beside the declaring file, or in the folder named
+/// after it when the declaring file is not a `mod.rs`/`lib.rs`.
+fn test_only_modules(roots: &[std::path::PathBuf]) -> Vec<std::path::PathBuf> {
+    let mut modules = Vec::new();
+    let mut stack = roots.to_vec();
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let source = std::fs::read_to_string(&path).unwrap();
+            let lines: Vec<&str> = source.lines().map(str::trim).collect();
+            for pair in lines.windows(2) {
+                if pair[0] != "#[cfg(test)]" {
+                    continue;
+                }
+                let decl = pair[1]
+                    .trim_start_matches("pub(crate) ")
+                    .trim_start_matches("pub ");
+                let Some(name) = decl.strip_prefix("mod ").and_then(|d| d.strip_suffix(';')) else {
+                    continue;
+                };
+                let stem = path.file_stem().unwrap().to_string_lossy();
+                let folder = if stem == "mod" || stem == "lib" || stem == "main" {
+                    path.parent().unwrap().to_path_buf()
+                } else {
+                    path.with_extension("")
+                };
+                modules.push(folder.join(format!("{name}.rs")));
+                modules.push(folder.join(name).join("mod.rs"));
+            }
+        }
+    }
+    modules
 }
 
 /// A result file written onto a disk that fills up: the write fails part way (here the
