@@ -211,7 +211,7 @@ fn invalid(field: &str, message: impl Into<String>) -> BoxPlanError {
 /// contact instrument's aperture (≈ 4 mm on a 300 mm panel).
 pub const MAX_TILES_PER_SIDE: usize = 64;
 /// The most readings of one thing.
-pub const MAX_REPEATS: usize = 100;
+pub const MAX_REPEATS: usize = crate::validation::sequential::MOST_LOOKS;
 
 impl BoxPlan {
     /// Reads and validates a plan file.

@@ -5,10 +5,41 @@
 //! session skips exactly what the first run skipped.
 
 use super::plan::{BoxStep, Target};
+use super::stats::GroupStats;
 use crate::color::Xyz;
 use crate::session::repeats::Repeatability;
 use crate::session::{Entry, Step, Stopping};
+use crate::validation::readings::PatchReading;
 use crate::validation::sequential::{width_decided, Pool, RepeatNoise, RepeatRule};
+
+/// Each spot's mean (in the plan's order, as `spot_xyz` and `spots` of the box's summary
+/// give them) with one reading's covariance the `stated` repeatability scaled by the
+/// figure pooled across every spot's kept readings, and its degrees of freedom: what the
+/// width rule's count rests on, so the validation's intervals take it too (Student's t
+/// with the pooled ν, not each spot's own k − 1). None where nothing pools (no spot read
+/// twice).
+pub fn pooled_readings(
+    spots: &[(usize, Xyz, GroupStats)],
+    stated: &Repeatability,
+) -> Option<Vec<(usize, PatchReading)>> {
+    let kept = |s: &GroupStats| s.n - s.outliers.len().min(s.n);
+    let mut pool = Pool::default();
+    for (_, xyz, s) in spots {
+        pool.add_sample(*xyz, &s.cov, kept(s), stated);
+    }
+    let noise = pool.noise(*stated);
+    let dof = pool.dof;
+    if dof == 0 {
+        return None;
+    }
+    spots
+        .iter()
+        .map(|(patch, xyz, s)| {
+            let cov = noise.covariance(*xyz)?;
+            Some((*patch, PatchReading::pooled(*xyz, cov, kept(s), dof, None)))
+        })
+        .collect()
+}
 
 /// The spots stage's stopping rule.
 pub struct SpotStopping {

@@ -3,6 +3,19 @@
 //!
 //! "Below the JND" is said of a patch only where its ΔE*ab interval's upper end is below
 //! 2.3, "above" only where the lower end is above it; otherwise it is undecided.
+//!
+//! **Which interval.** A patch's intervals come from the propagation
+//! ([`super::propagate`]): Student's t with each side's degrees of freedom, so a side read
+//! by the box's `width` rule, whose row states the repeatability pooled across the spots
+//! and its degrees of freedom (`dof`), gets t with the pooled ν. That rule's count is fixed
+//! by the level of the spot's first two readings and the spots read before it, not by the
+//! spot's mean, so the fixed-count interval holds at its count
+//! ([`super::sequential`]). A side whose repeats a `verdict` rule stopped on the ΔE*ab they
+//! showed (its row has `most`, the display's spots) gets instead the repeated interval of
+//! [`super::sequential::repeated_interval`] for ΔE*ab, which holds at whatever count the
+//! rule stopped: the JND verdict follows it. The ΔE00 interval and the summaries over
+//! patches stay the propagation's, with that side's pooled figure and its degrees of
+//! freedom.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -14,6 +27,7 @@ use super::error::ValidationError;
 use super::montecarlo::{summary_interval, Metric, PatchDraws, Statistic};
 use super::propagate::{propagate, Interval, Propagated, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
+use super::sequential::{repeated_interval, to_lab_covariance, Reference, Sequenced};
 
 /// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
 pub const JND_DE76: f64 = 2.3;
@@ -191,6 +205,7 @@ pub fn assess(
             reference: side(&reference.patches[&k], white, 0.0),
             test: side(&test.patches[&k], white, model_lab),
             out_of_gamut: reference.patches[&k].out_of_gamut || test.patches[&k].out_of_gamut,
+            sequential: sequenced(&reference.patches[&k], &test.patches[&k], white, model_lab),
         })
         .collect();
     Ok(compare_pairs(
@@ -199,6 +214,38 @@ pub fn assess(
         pairs,
         white,
         opts.propagation,
+    ))
+}
+
+/// Where one side's repeats were stopped by a verdict rule (its `most`), that side and the
+/// other as the repeated interval takes them; `extra_lab` is the test side's own CIELAB
+/// term (a display model's), fixed whatever the count, so it goes with the other side's.
+fn sequenced(
+    reference: &PatchReading,
+    test: &PatchReading,
+    white: Xyz,
+    extra_lab: f64,
+) -> Option<(Reference, Sequenced)> {
+    let (other, read, read_extra, other_extra) = match (reference.most, test.most) {
+        (_, Some(_)) => (reference, test, extra_lab, 0.0),
+        (Some(_), None) => (test, reference, 0.0, extra_lab),
+        (None, None) => return None,
+    };
+    let lab_var = other.u_lab.powi(2) + other_extra.powi(2) + read.u_lab.powi(2) + read_extra.powi(2);
+    Some((
+        Reference {
+            xyz: other.xyz,
+            cov_mean: covariance::of_factors(&other.u_factors),
+            dof: other.dof.map(|d| d as f64),
+            lab_var,
+        },
+        Sequenced {
+            mean: read.xyz,
+            n: read.n,
+            reading_lab: to_lab_covariance(&read.reading_covariance(), read.xyz, white),
+            dof: read.dof.map(|d| d as f64),
+            most: read.most?,
+        },
     ))
 }
 
@@ -219,6 +266,8 @@ pub(super) struct PatchPair {
     pub reference: (Side, Uncertain),
     pub test: (Side, Uncertain),
     pub out_of_gamut: bool,
+    /// Where a verdict rule stopped one side's repeats: the repeated interval's sides.
+    pub sequential: Option<(Reference, Sequenced)>,
 }
 
 /// A side known exactly (no uncertainty of its own): what [`super::compare`] compares.
@@ -268,7 +317,13 @@ pub(super) fn compare_pairs(
             let (r, ru) = pair.reference;
             let (t, tu) = pair.test;
             let k = pair.patch;
-            let p = propagate(&ru, &tu, white, propagation, k);
+            let mut p = propagate(&ru, &tu, white, propagation, k);
+            let repeated = pair.sequential.as_ref().and_then(|(r, t)| {
+                repeated_interval(r, t, white).map(|(_, interval, _)| interval)
+            });
+            if let Some(interval) = repeated {
+                p.de76 = interval;
+            }
             let (rl, tl) = (p.reference_lab, p.test_lab);
             let a = PatchAssessment {
                 patch: k,
