@@ -9,7 +9,6 @@ use metamer_drivers::{DriverError, Spec};
 use super::display::DisplayOptions;
 use super::error::ExperimentError;
 use super::measure_box::MeasureBox;
-use crate::validation::sequential::RepeatRule;
 use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
 use super::readings::{read_readings, ReadingSet, ReadingsError};
@@ -23,6 +22,7 @@ use crate::render::{Scene, SceneError};
 use crate::rig::Scenario;
 use crate::session::{NobodyAtTheRig, RunOptions};
 use crate::validation::export::HTML_FILE;
+use crate::validation::sequential::RepeatRule;
 
 /// The largest camera image the experiment renders, a side in pixels.
 pub const MAX_IMAGE_SIZE: usize = 8192;

@@ -231,7 +231,8 @@ fn sequenced(
         (Some(_), None) => (test, reference, 0.0, extra_lab),
         (None, None) => return None,
     };
-    let lab_var = other.u_lab.powi(2) + other_extra.powi(2) + read.u_lab.powi(2) + read_extra.powi(2);
+    let lab_var =
+        other.u_lab.powi(2) + other_extra.powi(2) + read.u_lab.powi(2) + read_extra.powi(2);
     Some((
         Reference {
             xyz: other.xyz,
@@ -318,9 +319,10 @@ pub(super) fn compare_pairs(
             let (t, tu) = pair.test;
             let k = pair.patch;
             let mut p = propagate(&ru, &tu, white, propagation, k);
-            let repeated = pair.sequential.as_ref().and_then(|(r, t)| {
-                repeated_interval(r, t, white).map(|(_, interval, _)| interval)
-            });
+            let repeated = pair
+                .sequential
+                .as_ref()
+                .and_then(|(r, t)| repeated_interval(r, t, white).map(|(_, interval, _)| interval));
             if let Some(interval) = repeated {
                 p.de76 = interval;
             }
@@ -497,6 +499,70 @@ mod tests {
         let m = a.mean_de76;
         let i = m.interval.unwrap();
         assert!(i.lo <= m.value + 0.5 && m.value - 0.5 <= i.hi, "{m:?}");
+    }
+
+    /// A display patch a verdict rule stopped (`most`) takes the repeated interval: with one
+    /// look (most 2) it is ΔE ± z₀.₉₇₅·σ along the difference, by hand for greys that differ
+    /// in L* alone (reference exact, the test's noise in Y only: σ_L = dL*/dY·sd_Y/√n, with
+    /// dL*/dY = (116/3)·(Y/Yₙ)^(−2/3)/Yₙ); more looks widen it (Pocock's constant for 2 to 5
+    /// readings). A pooled figure's degrees of freedom reach the side.
+    #[test]
+    fn a_patch_a_verdict_rule_stopped_takes_the_repeated_interval() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let g = |k: usize, y: f64| format!("{k},{},{y},{}", 0.950_47 * y, 1.088_83 * y);
+        let reference = set(&format!("patch,X,Y,Z\n{}\n", g(1, 18.418_652)));
+        let test = |tail: &str| {
+            set(&format!(
+                "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,cov_XY,cov_XZ,cov_YZ,u_lab,dof,most\n{},0,0.5,0,2,0,0,0,0,{tail}\n",
+                g(1, 19.703_227)
+            ))
+        };
+        let run = |t: &ReadingSet| {
+            assess(
+                "box",
+                &reference,
+                "display",
+                t,
+                white,
+                &AssessOptions::default(),
+            )
+            .unwrap()
+            .patches[0]
+                .clone()
+        };
+        let one_look = run(&test(",2"));
+        let y: f64 = 19.703_227;
+        let sigma = 116.0 / 3.0 * (y / 100.0).powf(-2.0 / 3.0) / 100.0 * 0.5 / 2f64.sqrt();
+        let half = 1.959_964 * sigma;
+        assert!((one_look.de76 - 1.5).abs() < 1e-4, "{}", one_look.de76);
+        let i = one_look.de76_interval;
+        assert!(
+            (i.lo - (one_look.de76 - half)).abs() < 1e-5,
+            "{i:?} against ±{half}"
+        );
+        assert!(
+            (i.hi - (one_look.de76 + half)).abs() < 1e-5,
+            "{i:?} against ±{half}"
+        );
+        let five = run(&test(",5")).de76_interval;
+        assert!(
+            five.hi - five.lo > 1.1 * (i.hi - i.lo),
+            "{five:?} against {i:?}"
+        );
+        // A pooled figure's 72 degrees of freedom, not the row's own 1.
+        let pooled = run(&test("72,"));
+        assert_eq!(pooled.test.dof, Some(72));
+        let own = run(&set(&format!(
+            "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n{},0,0.5,0,2\n",
+            g(1, 19.703_227)
+        )));
+        assert_eq!(own.test.dof, Some(1));
+        // Student's t with 72 degrees of freedom, not 1: a lower upper end (the lower ends
+        // are both 0, the noise across the difference being large).
+        assert!(
+            pooled.de76_interval.hi < own.de76_interval.hi,
+            "{pooled:?} {own:?}"
+        );
     }
 
     #[test]

@@ -166,7 +166,12 @@ impl Parsed {
         let u_lab = c.u_lab.map(num).transpose()?;
         let dof = match c.dof {
             Some(k) if cells[k].is_empty() => Some(None),
-            Some(k) => Some(Some(self.csv_whole(line, "dof", MAX_DOF, (num(k)?, cells[k]))?)),
+            Some(k) => Some(Some(self.csv_whole(
+                line,
+                "dof",
+                MAX_DOF,
+                (num(k)?, cells[k]),
+            )?)),
             None => None,
         };
         let most = match c.most {

@@ -52,6 +52,18 @@
 //! freedom, Welch–Satterthwaite over both sides) the nominal level of c is carried to
 //! Student's t.
 //!
+//! **In the validation.** The readings files carry what a rule used. The box's spots read
+//! by `width` state one reading's covariance as the pooled figure (s² on the stated shape,
+//! pooled over every spot's kept readings) with its ν (`dof` column): the width rule's count
+//! is not chosen on the spot's mean, so the validation's intervals are the fixed-count ones,
+//! Student's t with the pooled ν (Welch–Satterthwaite over both sides,
+//! [`super::montecarlo`]). The display's spots read by `verdict` state the same and `most`:
+//! their count was chosen on the ΔE*ab the readings showed, so the validation's ΔE*ab
+//! interval for them is [`repeated_interval`], the repeated interval at the count reached
+//! (valid whatever the stopping, for any comparison of that side: box or simulation), and
+//! the JND verdict follows it. The ΔE00 intervals and the summaries over patches stay the
+//! fixed-count ones with the pooled ν.
+//!
 //! Every choice follows from the readings given and the rule, so a resumed session and a
 //! re-run take the same count.
 

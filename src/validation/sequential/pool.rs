@@ -34,7 +34,13 @@ impl Pool {
 
     /// Adds one target's `k` readings given as their mean and sample covariance (divisor
     /// k − 1): Qⱼ = (k − 1)·tr(Σⱼ⁻¹ S), the same sum as the readings' own.
-    pub fn add_sample(&mut self, mean: Xyz, cov: &covariance::Cov3, k: usize, stated: &Repeatability) {
+    pub fn add_sample(
+        &mut self,
+        mean: Xyz,
+        cov: &covariance::Cov3,
+        k: usize,
+        stated: &Repeatability,
+    ) {
         if k < 2 {
             return;
         }
