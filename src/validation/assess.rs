@@ -28,38 +28,7 @@ use super::montecarlo::{summary_interval, Metric, PatchDraws, Statistic};
 use super::propagate::{propagate, Interval, Propagated, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
 use super::sequential::{repeated_interval, to_lab_covariance, Reference, Sequenced};
-
-/// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
-pub const JND_DE76: f64 = 2.3;
-
-/// What the interval of a patch's ΔE*ab says about the JND.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum JndVerdict {
-    Below,
-    Above,
-    Undecided,
-}
-
-impl JndVerdict {
-    pub fn of(interval: Interval) -> JndVerdict {
-        if interval.hi < JND_DE76 {
-            JndVerdict::Below
-        } else if interval.lo > JND_DE76 {
-            JndVerdict::Above
-        } else {
-            JndVerdict::Undecided
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            JndVerdict::Below => "below",
-            JndVerdict::Above => "above",
-            JndVerdict::Undecided => "undecided",
-        }
-    }
-}
+pub use super::uncertain::{JndVerdict, JND_DE76};
 
 /// One side's reading of a patch as the assessment keeps it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -81,9 +81,9 @@ use serde::{Deserialize, Serialize};
 
 pub use pool::Pool;
 
-use super::assess::{JndVerdict, JND_DE76};
 use super::covariance::{self, Cov3};
 use super::uncertain::Interval;
+use super::uncertain::{JndVerdict, JND_DE76};
 use crate::color::Xyz;
 use crate::session::repeats::Repeatability;
 
