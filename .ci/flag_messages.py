@@ -44,6 +44,7 @@ KNOWN = {
     "src/experiment/request.rs: --repeats",
     "src/experiment/request.rs: --target-de",
     "src/experiment/request.rs: --time-scale",
+    "src/experiment/request.rs: --until-decided",
     "src/export/error.rs: --force",
     "src/export/error.rs: --spp",
     "src/export/readme.rs: --json",

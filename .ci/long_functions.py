@@ -27,7 +27,7 @@ REASON = re.compile(r"^\s*//\s*Over 100 lines:\s*\S")
 KNOWN = {
     "src/display/diagnostics.rs:judge",
     "src/display/icc/lut.rs:b2a",
-    "src/experiment/display_spots.rs:measure",
+    "src/experiment/display_spots/mod.rs:measure",
     "src/experiment/report_input/display.rs:section",
     "src/experiment/report_input/light.rs:section",
     "src/experiment/run.rs:run",

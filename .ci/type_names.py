@@ -55,7 +55,7 @@ KNOWN = {
     # The i1Pro's USB request's error and the experiment request's.
     "RequestError": {"protocols/src/i1pro/commands.rs", "src/experiment/request.rs"},
     # The export's approximation and the display-spots stage's readings.
-    "Measured": {"src/export/approximation.rs", "src/experiment/display_spots.rs"},
+    "Measured": {"src/export/approximation.rs", "src/experiment/display_spots/mod.rs"},
     # The render command's clap copy of the method choice.
     "Method": {"src/render/method.rs", "src/cli/render.rs"},
 }

@@ -86,6 +86,11 @@ pub struct Args {
     /// Spot readings averaged per patch on the display.
     #[arg(long, default_value_t = 3, value_name = "K")]
     repeats: usize,
+    /// Read each patch on the display until its ΔE*ab against the box is decided at 95 %
+    /// with this margin beyond the JND (ΔE*ab 2.3), at least twice and at most --repeats
+    /// times (e.g. 0.1); without it every patch is read --repeats times.
+    #[arg(long, value_name = "ΔE")]
+    until_decided: Option<f64>,
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Run only this stage (again): box, simulation, display, reproduction, display-spots,
@@ -158,6 +163,7 @@ fn request(args: Args) -> Result<Request, CliError> {
             mirror: !args.no_mirror,
         },
         repeats: args.repeats,
+        until_decided: args.until_decided,
         stage: args.stage,
         rerun_all: false,
         resume: args.resume,

@@ -39,6 +39,15 @@ pub struct Args {
     /// Spot readings averaged per patch on the display.
     #[arg(long, default_value_t = 3, value_name = "K")]
     repeats: usize,
+    /// Read each patch on the display until its ΔE*ab against the box is decided at 95 %
+    /// with this margin beyond the JND (ΔE*ab 2.3), at least twice and at most --repeats
+    /// times (e.g. 0.1); without it every patch is read --repeats times.
+    #[arg(long, value_name = "ΔE")]
+    until_decided: Option<f64>,
+    /// The box measurement plan (see `metamer measure-box --help`), e.g. a spot rule;
+    /// default: the paper's.
+    #[arg(long, value_name = "PLAN.json")]
+    plan: Option<PathBuf>,
     /// Readings of each tile and spot in the box (default: the box plan's 5).
     #[arg(long, value_name = "N")]
     box_repeats: Option<usize>,
@@ -75,6 +84,8 @@ pub fn run(args: Args) -> CliResult {
         gamut: args.gamut,
         target_de: args.target_de,
         repeats: args.repeats,
+        until_decided: args.until_decided,
+        plan: args.plan,
         box_repeats: args.box_repeats,
         seed: args.seed,
         time_scale: args.time_scale,

@@ -35,8 +35,12 @@ pub struct ExperimentOptions {
     pub simulation: SimulationOptions,
     pub display: DisplayOptions,
     pub reproduction: ReproductionOptions,
-    /// Spot readings averaged per patch on the display.
+    /// Spot readings averaged per patch on the display: with `until_decided`, the most.
     pub repeats: usize,
+    /// Read each patch on the display until its ΔE*ab against the box is decided, this
+    /// margin (ΔE*ab) beyond the JND at 95 % (the verdict rule of
+    /// [`crate::validation::sequential`]); None: always `repeats` readings.
+    pub until_decided: Option<f64>,
     /// Run only this stage (again, even if its inputs are unchanged).
     pub stage: Option<Stage>,
     /// Continue an interrupted measuring stage's journal.

@@ -22,6 +22,7 @@ use crate::render::{Scene, SceneError};
 use crate::rig::Scenario;
 use crate::session::{NobodyAtTheRig, RunOptions};
 use crate::validation::export::HTML_FILE;
+use crate::validation::sequential::RepeatRule;
 
 /// The spot meter of `metamer experiment` when `--spot` is not given: the simulated CS-100A
 /// at once, so the experiment runs on the simulated rig with no flags.
@@ -65,8 +66,11 @@ pub struct Request {
     /// noise is independent of the box readings'.
     pub display: DisplayOptions,
     pub reproduction: ReproductionOptions,
-    /// Spot readings averaged per patch on the display.
+    /// Spot readings averaged per patch on the display: with `until_decided`, the most.
     pub repeats: usize,
+    /// Read each patch on the display until its ΔE*ab against the box is decided, this
+    /// margin beyond the JND; None: always `repeats` readings.
+    pub until_decided: Option<f64>,
     /// Run only this stage (again, even if its inputs are unchanged).
     pub stage: Option<Stage>,
     /// Every stage again, one at a time, even those whose inputs are unchanged (earlier
@@ -120,6 +124,20 @@ pub(super) fn check_target_de(target_de: f64) -> Result<(), RequestError> {
     } else {
         Err(RequestError::TargetDe)
     }
+}
+
+/// A verdict rule on the display's patches: its margin below the JND and at least two
+/// readings to stop at.
+pub(super) fn check_until_decided(margin: Option<f64>, repeats: usize) -> Result<(), RequestError> {
+    let Some(margin) = margin else {
+        return Ok(());
+    };
+    RepeatRule::Verdict {
+        margin,
+        most: repeats,
+    }
+    .check(crate::measure_box::plan::MAX_REPEATS)
+    .map_err(RequestError::UntilDecided)
 }
 
 /// Readings per patch on the display: as many as a box plan allows a reading of one thing
@@ -187,6 +205,7 @@ impl Request {
     ///     display: DisplayOptions { screen: "virtual:ips-lcd".parse()?, spot: meter, model: ModelKind::Lut },
     ///     reproduction: ReproductionOptions { gamut: GamutMapping::NearestLab, mirror: true },
     ///     repeats: 3,
+    ///     until_decided: None,
     ///     stage: Some(Stage::Box),
     ///     rerun_all: false,
     ///     resume: false,
@@ -243,6 +262,7 @@ impl Request {
             }
         }
         check_dir(&self.dir)?;
+        check_until_decided(self.until_decided, self.repeats)?;
         let given_readings = self.check_inputs()?;
         let box_source = match &self.box_source {
             BoxRequest::Given { scene, spots } => BoxSource::Existing {
@@ -278,6 +298,7 @@ impl Request {
             display: self.display.clone(),
             reproduction: self.reproduction.clone(),
             repeats: self.repeats,
+            until_decided: self.until_decided,
             stage: self.stage,
             resume: self.resume,
             unattended: self.unattended,
@@ -319,6 +340,10 @@ pub enum RequestError {
     Repeats { most: usize, got: usize },
     #[error("--box-repeats must be at least 1")]
     BoxRepeats,
+    /// The verdict rule on the display's patches cannot work: the margin, or `--repeats`
+    /// as its most readings.
+    #[error("--until-decided with --repeats: {0}")]
+    UntilDecided(String),
     #[error("--time-scale must be 0 or more")]
     TimeScale,
     #[error("--image-size must be at most {}", MAX_IMAGE_SIZE)]
@@ -352,6 +377,7 @@ impl RequestError {
             RequestError::TargetDe
                 | RequestError::Repeats { .. }
                 | RequestError::BoxRepeats
+                | RequestError::UntilDecided(_)
                 | RequestError::TimeScale
                 | RequestError::ImageSize
                 | RequestError::ImageSpp

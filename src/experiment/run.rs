@@ -262,6 +262,15 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
                 .file("display", &p(Stage::Display, display::SETTING_FILE)?)?
                 .value("spot", &opts.display.spot)
                 .value("repeats", &opts.repeats);
+            // A verdict rule decides against the box's readings relative to the profile's
+            // white: both are its inputs (a fixed count's hash stays as it was).
+            let i = match opts.until_decided {
+                Some(margin) => i
+                    .value("until_decided", &margin)
+                    .file("box", &need(stage, box_spots.clone())?)?
+                    .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?,
+                None => i,
+            };
             let image = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
             if image.exists() {
                 i.file("image", &image)?
@@ -359,6 +368,21 @@ fn run_stage(
             let setting: DisplaySetting =
                 read_json(&stage_path(opts, Stage::Display, display::SETTING_FILE))?;
             let png = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
+            let rule = match opts.until_decided {
+                Some(margin) => {
+                    let (_, box_spots) = box_files(opts);
+                    let profile =
+                        Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
+                    let box_readings = super::readings::read_readings(&box_spots)?;
+                    display_spots::DisplayRule::verdict(
+                        margin,
+                        opts.repeats,
+                        &box_readings,
+                        profile.white_xyz,
+                    )
+                }
+                None => display_spots::DisplayRule::Fixed(opts.repeats),
+            };
             let session = display_spots::SpotSession {
                 setting: &setting,
                 spot_spec: &opts.display.spot,
@@ -369,7 +393,7 @@ fn run_stage(
                         regions: &r.image_patches,
                     }
                 }),
-                repeats: opts.repeats,
+                rule: &rule,
                 resume: opts.resume,
                 unattended: opts.unattended,
                 run: &opts.run,
@@ -427,6 +451,7 @@ mod tests {
                 mirror: true,
             },
             repeats: 1,
+            until_decided: None,
             stage: None,
             resume: false,
             unattended: true,

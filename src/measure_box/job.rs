@@ -18,12 +18,14 @@ use metamer_drivers::Spec;
 use super::plan::{BoxPlan, BoxPlanError, BoxStage};
 use super::run::{run, BoxOptions, Instruments, MeasureBoxError, Outcome};
 use super::setup::{self, BoxLightError, RigError, RigRequest};
+use super::spot_rule;
 use super::{BoxDetails, Summary};
 use crate::output::OutputPolicy;
 use crate::rig::Scenario;
 use crate::session::{attendance, Attendance, NobodyAtTheRig, ProgressSink, RunOptions};
 use crate::validation::readings::{write_readings, PatchReading, ReadingsError};
 use crate::validation::repeatability;
+use crate::validation::sequential::RepeatRule;
 
 /// The spots' readings file in the output directory, with
 /// [`MeasureBoxRequest::spot_readings`].
@@ -194,6 +196,7 @@ pub fn measure<'p>(
     // The model the meter reports, not a guess from its spec: `replay:box-spots.jsonl`
     // names none. Asked only where the readings file is written, as the stage always did.
     let meter = request.spot_readings.then(|| rig.spot.info().model);
+    let by_rule = matches!(options.plan.spot_rule, Some(RepeatRule::Width { .. }));
     let mut sink = progress(!rig.simulated && attended == Attendance::Terminal);
     let outcome = run(
         &options,
@@ -207,7 +210,7 @@ pub fn measure<'p>(
     if let (Outcome::Finished(summary), Some(meter)) = (&outcome, meter) {
         write_readings(
             &request.out.join(SPOTS_FILE),
-            &spot_readings(summary, &meter),
+            &spot_readings(summary, &meter, by_rule),
         )?;
     }
     Ok(outcome)
@@ -215,9 +218,21 @@ pub fn measure<'p>(
 
 /// Each spot's mean with its scatter in X, Y and Z together, over the repeats the
 /// reduction kept, in the plan's order; a spot read once carries the stated repeatability
-/// of the `meter` (its model).
-fn spot_readings(summary: &Summary, meter: &str) -> Vec<(usize, PatchReading)> {
+/// of the `meter` (its model). Spots read `by_rule` (a width rule, whose counts rest on
+/// the figure pooled across the spots) carry that figure and its degrees of freedom.
+fn spot_readings(summary: &Summary, meter: &str, by_rule: bool) -> Vec<(usize, PatchReading)> {
     let stated = repeatability::emissive_of(meter);
+    if let Some(stated) = stated.filter(|_| by_rule) {
+        let spots: Vec<_> = summary
+            .spot_xyz
+            .iter()
+            .zip(summary.spots.iter())
+            .map(|((patch, xyz), r)| (*patch, *xyz, r.stats.clone()))
+            .collect();
+        if let Some(pooled) = spot_rule::pooled_readings(&spots, &stated) {
+            return pooled;
+        }
+    }
     summary
         .spot_xyz
         .iter()

@@ -7,7 +7,8 @@
 //! light's distribution, [`scene`] writes the box as a scene file, [`assemble`] puts the
 //! measured scene and its provenance together, and [`compare`] renders it against the box's
 //! spot readings. [`setup`] opens the rig a session measures with: the real box, or the
-//! simulated truth box and its operator ([`simulated_box`]).
+//! simulated truth box and its operator ([`simulated_box`]); [`spot_rule`] ends a spot's
+//! repeats by the plan's rule.
 
 pub mod assemble;
 pub mod compare;
@@ -18,6 +19,7 @@ pub mod run;
 pub mod scene;
 pub mod setup;
 pub mod simulated_box;
+pub mod spot_rule;
 pub mod stats;
 
 pub use assemble::{BoxDetails, Summary};

@@ -22,6 +22,7 @@ pub use crate::light::fit::Plane;
 
 use crate::color::COLORCHECKER_NAMES;
 use crate::session::{Prepare, SessionPlan, Step};
+use crate::validation::sequential::RepeatRule;
 
 /// The journal's session kind.
 pub const SESSION_KIND: &str = "measure-box";
@@ -155,6 +156,15 @@ pub struct BoxPlan {
     /// The ColorChecker patches to read (reflectance and spots), 1–24.
     pub patches: Vec<usize>,
     pub geometry: Geometry,
+    /// How many times each spot is read: None, `repeats` times (the paper's plan); a
+    /// `width` rule reads each spot until its 95 % half-width in CIELAB relative to
+    /// `spot_white` is reached ([`crate::validation::sequential`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spot_rule: Option<RepeatRule>,
+    /// The white (XYZ, cd/m²) the spots' CIELAB is relative to for a `width` rule: the
+    /// display's white, as in the validation.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spot_white: Option<[f64; 3]>,
 }
 
 impl Default for BoxPlan {
@@ -167,6 +177,8 @@ impl Default for BoxPlan {
             falloff_tile: None,
             patches: (1..=24).collect(),
             geometry: Geometry::default(),
+            spot_rule: None,
+            spot_white: None,
         }
     }
 }
@@ -179,7 +191,7 @@ pub enum BoxPlanError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}: not a valid plan: {source} (fields: repeats, material_repeats, falloff_repeats, falloff_angles_deg, falloff_tile, patches, geometry {{size_m, light_m, rows, cols, viewpoint_m, acceptance_deg}})", path.display())]
+    #[error("{}: not a valid plan: {source} (fields: repeats, material_repeats, falloff_repeats, falloff_angles_deg, falloff_tile, patches, geometry {{size_m, light_m, rows, cols, viewpoint_m, acceptance_deg}}, spot_rule, spot_white)", path.display())]
     Json {
         path: PathBuf,
         source: serde_json::Error,
@@ -199,7 +211,7 @@ fn invalid(field: &str, message: impl Into<String>) -> BoxPlanError {
 /// contact instrument's aperture (≈ 4 mm on a 300 mm panel).
 pub const MAX_TILES_PER_SIDE: usize = 64;
 /// The most readings of one thing.
-pub const MAX_REPEATS: usize = 100;
+pub const MAX_REPEATS: usize = crate::validation::sequential::MOST_LOOKS;
 
 impl BoxPlan {
     /// Reads and validates a plan file.
@@ -229,6 +241,13 @@ impl BoxPlan {
         let plan: BoxPlan = serde_json::from_value(value).map_err(json)?;
         plan.validate()?;
         Ok(plan)
+    }
+
+    /// The most readings of each spot: the rule's, or `repeats`.
+    pub fn spot_repeats(&self) -> usize {
+        self.spot_rule
+            .as_ref()
+            .map_or(self.repeats, RepeatRule::most)
     }
 
     /// The tile whose fall-off is measured.
@@ -287,7 +306,7 @@ impl BoxPlan {
             }
             BoxStage::Spots => {
                 for &patch in &self.patches {
-                    for r in 0..self.repeats {
+                    for r in 0..self.spot_repeats() {
                         let t = Target::Spot { patch };
                         let p = self.prompt(&t);
                         steps.push(step(t, r, SPOT, MeasureMode::Emissive, p));
@@ -530,6 +549,18 @@ mod tests {
         check(r#"{"geometry":{"viewpoint_m":[0,0,1]}}"#, "z < 0");
         check(r#"{"falloff_tile":[5,0]}"#, "outside the 5 × 5 grid");
         check(r#"{"repeat":3}"#, "unknown field `repeat`");
+        check(
+            r#"{"spot_rule":{"rule":"width","half_width_jnd":0.2,"most":10}}"#,
+            "plan: spot_white: a width rule needs the white",
+        );
+        check(
+            r#"{"spot_rule":{"rule":"verdict","margin":0.1,"most":10}}"#,
+            "plan: spot_rule: a verdict needs the display's reading",
+        );
+        check(
+            r#"{"spot_rule":{"rule":"width","half_width_jnd":0.2,"most":1},"spot_white":[1,1,1]}"#,
+            "plan: spot_rule: the most readings must be between 2 and 100, got 1",
+        );
         check(r#"{"repeats":"x"}"#, "not a valid plan");
     }
 }

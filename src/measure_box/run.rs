@@ -6,15 +6,18 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use metamer_drivers::Instrument;
+use metamer_drivers::{Instrument, MeasureMode};
 
 use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary};
 use super::plan::{BoxPlan, BoxStage, BoxStep, SPECTRAL, SPOT};
+use super::spot_rule::SpotStopping;
+use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::session::{
     placements, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig, RunEnd,
     RunOptions, Session, SessionError, StageOf,
 };
+use crate::validation::repeatability;
 
 /// What to measure and how.
 #[derive(Clone, Debug)]
@@ -187,14 +190,29 @@ fn open_stage(
     instruments: &BTreeMap<String, InstrumentRecord>,
     resume: bool,
 ) -> Result<Session<BoxDetails, BoxStep>, MeasureBoxError> {
-    Session::open(
+    let session = Session::open(
         &stage.journal(&options.dir),
         options.plan.session_plan(stage, &options.rig_options),
         options.details.clone(),
         instruments.clone(),
         resume,
     )
-    .map_err(|source| MeasureBoxError::Session { stage, source })
+    .map_err(|source| MeasureBoxError::Session { stage, source })?;
+    let plan = &options.plan;
+    Ok(match (&plan.spot_rule, plan.spot_white, stage) {
+        (Some(rule), Some(white), BoxStage::Spots) => {
+            let model = instruments
+                .get(SPOT)
+                .map(|r| r.info.model.clone())
+                .unwrap_or_default();
+            session.with_stopping(Box::new(SpotStopping {
+                rule: rule.clone(),
+                stated: repeatability::stated(&model, MeasureMode::Emissive),
+                white: Xyz::new(white[0], white[1], white[2]),
+            }))
+        }
+        _ => session,
+    })
 }
 
 /// Measures what the journals in `options.dir` lack (every stage, or `options.stage`),

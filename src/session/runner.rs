@@ -153,9 +153,25 @@ impl RunEnd {
     }
 }
 
+/// Which steps of a plan need not be taken, from the entries journalled so far: a rule
+/// that ends a target's repeats once they decide it. It must depend on nothing but the
+/// plan and the entries before the step, so a resumed session and a re-run skip what the
+/// first run skipped.
+pub trait Stopping<D>: Send {
+    /// Whether step `index` is skipped, given every step's entry so far (`None`: not
+    /// taken, or skipped).
+    fn skip(
+        &self,
+        index: usize,
+        steps: &[super::plan::Step<D>],
+        entries: &[Option<Entry<D>>],
+    ) -> bool;
+}
+
 /// A session bound to its journal.
 pub struct Session<H, D> {
     plan: SessionPlan<D>,
+    stopping: Option<Box<dyn Stopping<D>>>,
     journal: SessionJournal<H, D>,
     entries: Vec<Option<Entry<D>>>,
     calibrations: Vec<CalibrationRecord>,
@@ -330,6 +346,7 @@ where
             let journal = Journal::create(path, &header)?;
             return Ok(Session {
                 plan,
+                stopping: None,
                 journal,
                 entries,
                 calibrations: Vec::new(),
@@ -353,6 +370,7 @@ where
             .collect();
         Ok(Session {
             plan,
+            stopping: None,
             journal,
             entries,
             earlier_calibrations: recovered.calibrations.len(),
@@ -372,8 +390,41 @@ where
         self.journal.path()
     }
 
-    /// Steps in the journal.
+    /// Ends targets' repeats by `stopping`'s rule.
+    pub fn with_stopping(mut self, stopping: Box<dyn Stopping<D>>) -> Self {
+        self.stopping = Some(stopping);
+        self
+    }
+
+    /// Whether step `index` is skipped by the stopping rule.
+    fn skipped(&self, index: usize) -> bool {
+        self.entries[index].is_none()
+            && self
+                .stopping
+                .as_ref()
+                .is_some_and(|s| s.skip(index, &self.plan.steps, &self.entries))
+    }
+
+    /// Whether step `index` needs no taking now: journalled, or skipped by the stopping
+    /// rule (then counted into `done`).
+    fn passed_over(&self, index: usize, done: &mut usize) -> bool {
+        if self.entries[index].is_some() {
+            return true;
+        }
+        let skipped = self.skipped(index);
+        *done += usize::from(skipped);
+        skipped
+    }
+
+    /// Steps settled: in the journal, or skipped by the stopping rule.
     pub fn done(&self) -> usize {
+        (0..self.entries.len())
+            .filter(|&i| self.entries[i].is_some() || self.skipped(i))
+            .count()
+    }
+
+    /// Steps in the journal (readings taken).
+    pub fn taken(&self) -> usize {
         self.entries.iter().filter(|e| e.is_some()).count()
     }
 
@@ -382,9 +433,18 @@ where
         &self.calibrations
     }
 
-    /// Every entry in plan order; None until every step is measured.
+    /// Every entry in plan order; None until every step is measured or skipped by the
+    /// stopping rule.
     pub fn complete_entries(&self) -> Option<Vec<&Entry<D>>> {
-        self.entries.iter().map(Option::as_ref).collect()
+        let mut all = Vec::with_capacity(self.entries.len());
+        for (i, e) in self.entries.iter().enumerate() {
+            match e {
+                Some(e) => all.push(e),
+                None if self.skipped(i) => {}
+                None => return None,
+            }
+        }
+        Some(all)
     }
 
     /// Takes every step the journal lacks, in plan order.
@@ -450,12 +510,12 @@ where
     ) -> Result<RunEnd, SessionError> {
         let total = self.plan.steps.len();
         let mut placed = None;
-        let mut done = self.done();
+        let mut done = self.taken();
         let mut new = 0usize;
         let start = Instant::now();
         let journal_path = self.journal.path().to_path_buf();
         for (index, placement) in placements(&self.plan.steps).into_iter().enumerate() {
-            if self.entries[index].is_some() {
+            if self.passed_over(index, &mut done) {
                 continue;
             }
             let missing = total - done;

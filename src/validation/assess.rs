@@ -3,6 +3,19 @@
 //!
 //! "Below the JND" is said of a patch only where its ΔE*ab interval's upper end is below
 //! 2.3, "above" only where the lower end is above it; otherwise it is undecided.
+//!
+//! **Which interval.** A patch's intervals come from the propagation
+//! ([`super::propagate`]): Student's t with each side's degrees of freedom, so a side read
+//! by the box's `width` rule, whose row states the repeatability pooled across the spots
+//! and its degrees of freedom (`dof`), gets t with the pooled ν. That rule's count is fixed
+//! by the level of the spot's first two readings and the spots read before it, not by the
+//! spot's mean, so the fixed-count interval holds at its count
+//! ([`super::sequential`]). A side whose repeats a `verdict` rule stopped on the ΔE*ab they
+//! showed (its row has `most`, the display's spots) gets instead the repeated interval of
+//! [`super::sequential::repeated_interval`] for ΔE*ab, which holds at whatever count the
+//! rule stopped: the JND verdict follows it. The ΔE00 interval and the summaries over
+//! patches stay the propagation's, with that side's pooled figure and its degrees of
+//! freedom.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -14,38 +27,8 @@ use super::error::ValidationError;
 use super::montecarlo::{summary_interval, Metric, PatchDraws, Statistic};
 use super::propagate::{propagate, Interval, Propagated, Propagation, Uncertain};
 use super::readings::{PatchReading, ReadingSet, UncertaintySource};
-
-/// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
-pub const JND_DE76: f64 = 2.3;
-
-/// What the interval of a patch's ΔE*ab says about the JND.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum JndVerdict {
-    Below,
-    Above,
-    Undecided,
-}
-
-impl JndVerdict {
-    pub fn of(interval: Interval) -> JndVerdict {
-        if interval.hi < JND_DE76 {
-            JndVerdict::Below
-        } else if interval.lo > JND_DE76 {
-            JndVerdict::Above
-        } else {
-            JndVerdict::Undecided
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            JndVerdict::Below => "below",
-            JndVerdict::Above => "above",
-            JndVerdict::Undecided => "undecided",
-        }
-    }
-}
+use super::sequential::{repeated_interval, to_lab_covariance, Reference, Sequenced};
+pub use super::uncertain::{JndVerdict, JND_DE76};
 
 /// One side's reading of a patch as the assessment keeps it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -191,6 +174,7 @@ pub fn assess(
             reference: side(&reference.patches[&k], white, 0.0),
             test: side(&test.patches[&k], white, model_lab),
             out_of_gamut: reference.patches[&k].out_of_gamut || test.patches[&k].out_of_gamut,
+            sequential: sequenced(&reference.patches[&k], &test.patches[&k], white, model_lab),
         })
         .collect();
     Ok(compare_pairs(
@@ -199,6 +183,39 @@ pub fn assess(
         pairs,
         white,
         opts.propagation,
+    ))
+}
+
+/// Where one side's repeats were stopped by a verdict rule (its `most`), that side and the
+/// other as the repeated interval takes them; `extra_lab` is the test side's own CIELAB
+/// term (a display model's), fixed whatever the count, so it goes with the other side's.
+fn sequenced(
+    reference: &PatchReading,
+    test: &PatchReading,
+    white: Xyz,
+    extra_lab: f64,
+) -> Option<(Reference, Sequenced)> {
+    let (other, read, read_extra, other_extra) = match (reference.most, test.most) {
+        (_, Some(_)) => (reference, test, extra_lab, 0.0),
+        (Some(_), None) => (test, reference, 0.0, extra_lab),
+        (None, None) => return None,
+    };
+    let lab_var =
+        other.u_lab.powi(2) + other_extra.powi(2) + read.u_lab.powi(2) + read_extra.powi(2);
+    Some((
+        Reference {
+            xyz: other.xyz,
+            cov_mean: covariance::of_factors(&other.u_factors),
+            dof: other.dof.map(|d| d as f64),
+            lab_var,
+        },
+        Sequenced {
+            mean: read.xyz,
+            n: read.n,
+            reading_lab: to_lab_covariance(&read.reading_covariance(), read.xyz, white),
+            dof: read.dof.map(|d| d as f64),
+            most: read.most?,
+        },
     ))
 }
 
@@ -219,6 +236,8 @@ pub(super) struct PatchPair {
     pub reference: (Side, Uncertain),
     pub test: (Side, Uncertain),
     pub out_of_gamut: bool,
+    /// Where a verdict rule stopped one side's repeats: the repeated interval's sides.
+    pub sequential: Option<(Reference, Sequenced)>,
 }
 
 /// A side known exactly (no uncertainty of its own): what [`super::compare`] compares.
@@ -268,7 +287,14 @@ pub(super) fn compare_pairs(
             let (r, ru) = pair.reference;
             let (t, tu) = pair.test;
             let k = pair.patch;
-            let p = propagate(&ru, &tu, white, propagation, k);
+            let mut p = propagate(&ru, &tu, white, propagation, k);
+            let repeated = pair
+                .sequential
+                .as_ref()
+                .and_then(|(r, t)| repeated_interval(r, t, white).map(|(_, interval, _)| interval));
+            if let Some(interval) = repeated {
+                p.de76 = interval;
+            }
             let (rl, tl) = (p.reference_lab, p.test_lab);
             let a = PatchAssessment {
                 patch: k,
@@ -442,6 +468,70 @@ mod tests {
         let m = a.mean_de76;
         let i = m.interval.unwrap();
         assert!(i.lo <= m.value + 0.5 && m.value - 0.5 <= i.hi, "{m:?}");
+    }
+
+    /// A display patch a verdict rule stopped (`most`) takes the repeated interval: with one
+    /// look (most 2) it is ΔE ± z₀.₉₇₅·σ along the difference, by hand for greys that differ
+    /// in L* alone (reference exact, the test's noise in Y only: σ_L = dL*/dY·sd_Y/√n, with
+    /// dL*/dY = (116/3)·(Y/Yₙ)^(−2/3)/Yₙ); more looks widen it (Pocock's constant for 2 to 5
+    /// readings). A pooled figure's degrees of freedom reach the side.
+    #[test]
+    fn a_patch_a_verdict_rule_stopped_takes_the_repeated_interval() {
+        let white = Xyz::new(95.047, 100.0, 108.883);
+        let g = |k: usize, y: f64| format!("{k},{},{y},{}", 0.950_47 * y, 1.088_83 * y);
+        let reference = set(&format!("patch,X,Y,Z\n{}\n", g(1, 18.418_652)));
+        let test = |tail: &str| {
+            set(&format!(
+                "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,cov_XY,cov_XZ,cov_YZ,u_lab,dof,most\n{},0,0.5,0,2,0,0,0,0,{tail}\n",
+                g(1, 19.703_227)
+            ))
+        };
+        let run = |t: &ReadingSet| {
+            assess(
+                "box",
+                &reference,
+                "display",
+                t,
+                white,
+                &AssessOptions::default(),
+            )
+            .unwrap()
+            .patches[0]
+                .clone()
+        };
+        let one_look = run(&test(",2"));
+        let y: f64 = 19.703_227;
+        let sigma = 116.0 / 3.0 * (y / 100.0).powf(-2.0 / 3.0) / 100.0 * 0.5 / 2f64.sqrt();
+        let half = 1.959_964 * sigma;
+        assert!((one_look.de76 - 1.5).abs() < 1e-4, "{}", one_look.de76);
+        let i = one_look.de76_interval;
+        assert!(
+            (i.lo - (one_look.de76 - half)).abs() < 1e-5,
+            "{i:?} against ±{half}"
+        );
+        assert!(
+            (i.hi - (one_look.de76 + half)).abs() < 1e-5,
+            "{i:?} against ±{half}"
+        );
+        let five = run(&test(",5")).de76_interval;
+        assert!(
+            five.hi - five.lo > 1.1 * (i.hi - i.lo),
+            "{five:?} against {i:?}"
+        );
+        // A pooled figure's 72 degrees of freedom, not the row's own 1.
+        let pooled = run(&test("72,"));
+        assert_eq!(pooled.test.dof, Some(72));
+        let own = run(&set(&format!(
+            "patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n{},0,0.5,0,2\n",
+            g(1, 19.703_227)
+        )));
+        assert_eq!(own.test.dof, Some(1));
+        // Student's t with 72 degrees of freedom, not 1: a lower upper end (the lower ends
+        // are both 0, the noise across the difference being large).
+        assert!(
+            pooled.de76_interval.hi < own.de76_interval.hi,
+            "{pooled:?} {own:?}"
+        );
     }
 
     #[test]

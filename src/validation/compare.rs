@@ -86,6 +86,7 @@ pub(super) fn exact_pairs(
             reference: exact_side(*r, white),
             test: exact_side(*t, white),
             out_of_gamut: out_of_gamut.contains(&(i + 1)),
+            sequential: None,
         })
         .collect()
 }

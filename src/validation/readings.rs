@@ -105,6 +105,12 @@ pub struct PatchReading {
     /// say nothing per reading.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reading_cov: Option<Cov3>,
+    /// The most readings the rule that read this patch could have taken, where it stopped
+    /// on what the readings said (a verdict rule, [`super::sequential`]): the comparison's
+    /// ΔE*ab interval is then the repeated one, valid whatever the count. None for a fixed
+    /// count, or one fixed before the patch's mean was seen.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub most: Option<usize>,
 }
 
 /// All patches of one file.
@@ -223,6 +229,11 @@ struct Row {
     de95: Option<Uncertainty>,
     /// A renderer's per-axis CIELAB standard uncertainty.
     u_lab: Option<f64>,
+    /// The degrees of freedom of the row's sd and cov as the row states them (`dof`
+    /// column): None without the column, `Some(None)` for a cell that states them known.
+    dof: Option<Option<usize>>,
+    /// The `most` column: the readings the patch's rule could have taken.
+    most: Option<usize>,
     /// The instrument that took the reading, when the input names it.
     instrument: Option<String>,
     out_of_gamut: bool,
@@ -241,6 +252,8 @@ impl Row {
             stderr: None,
             de95: None,
             u_lab: None,
+            dof: None,
+            most: None,
             instrument: None,
             out_of_gamut: false,
         }

@@ -1,6 +1,7 @@
 //! One side of a comparison and its uncertainty, the 95 % interval, and how a renderer's
 //! statement of its own error becomes a CIELAB uncertainty: what the propagation, the
-//! Monte Carlo draws, the test inversion and the readings all speak of.
+//! Monte Carlo draws, the test inversion and the readings all speak of, and what an
+//! interval says about the JND.
 
 use serde::{Deserialize, Serialize};
 
@@ -24,6 +25,38 @@ pub struct Uncertain {
     pub dof: Option<usize>,
     /// Extra standard uncertainty of each CIELAB coordinate.
     pub u_lab: f64,
+}
+
+/// The just noticeable difference in ΔE*ab the paper uses (after Sharma 2003).
+pub const JND_DE76: f64 = 2.3;
+
+/// What the interval of a patch's ΔE*ab says about the JND.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum JndVerdict {
+    Below,
+    Above,
+    Undecided,
+}
+
+impl JndVerdict {
+    pub fn of(interval: Interval) -> JndVerdict {
+        if interval.hi < JND_DE76 {
+            JndVerdict::Below
+        } else if interval.lo > JND_DE76 {
+            JndVerdict::Above
+        } else {
+            JndVerdict::Undecided
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            JndVerdict::Below => "below",
+            JndVerdict::Above => "above",
+            JndVerdict::Undecided => "undecided",
+        }
+    }
 }
 
 /// A 95 % interval.

@@ -44,8 +44,15 @@ pub struct LabOptions {
     pub gamut: GamutMapping,
     /// The simulation's target: 95 % half-width of every patch's ΔE*ab.
     pub target_de: f64,
-    /// Spot readings averaged per patch on the display.
+    /// Spot readings averaged per patch on the display: with `until_decided`, the most.
     pub repeats: usize,
+    /// Read each display patch until its verdict against the box is decided, this margin
+    /// beyond the JND; None: always `repeats` readings.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub until_decided: Option<f64>,
+    /// The box plan file; None: the paper's plan.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plan: Option<PathBuf>,
     /// Readings of each tile and spot in the box; None: the box plan's (`lab.json` records
     /// the number used).
     pub box_repeats: Option<usize>,
@@ -104,7 +111,7 @@ impl LabOptions {
             box_source: BoxRequest::Measure {
                 spectral: self.instrument("i1pro", None),
                 spot: self.instrument("cs100a", None),
-                plan: None,
+                plan: self.plan.clone(),
                 repeats: self.box_repeats,
                 seed: self.seed,
                 light: Some(self.scenario),
@@ -126,6 +133,7 @@ impl LabOptions {
                 mirror: true,
             },
             repeats: self.repeats,
+            until_decided: self.until_decided,
             stage: None,
             rerun_all: force,
             resume,
@@ -250,6 +258,8 @@ pub struct LabSummary {
 ///     gamut: "nearest-lab".parse()?,
 ///     target_de: 0.1,
 ///     repeats: 3,
+///     until_decided: None,
+///     plan: None,
 ///     box_repeats: None,
 ///     seed: 1,
 ///     time_scale: 0.0,

@@ -3,11 +3,13 @@
 //! The first bad field is named.
 
 use super::{invalid, BoxPlan, BoxPlanError, Geometry, MAX_REPEATS, MAX_TILES_PER_SIDE};
+use crate::validation::sequential::RepeatRule;
 
 impl BoxPlan {
     /// Checks every field; the first bad one is named.
     pub fn validate(&self) -> Result<(), BoxPlanError> {
         self.check_repeats()?;
+        self.check_spot_rule()?;
         check_falloff_angles(&self.falloff_angles_deg)?;
         check_patches(&self.patches)?;
         check_grid(&self.geometry, self.falloff_tile)?;
@@ -28,6 +30,30 @@ impl BoxPlan {
             }
         }
         Ok(())
+    }
+}
+
+impl BoxPlan {
+    /// A spot rule the box can follow: a spot's verdict needs the display's reading,
+    /// measured later, so only a fixed count or a width, and a width with its white.
+    fn check_spot_rule(&self) -> Result<(), BoxPlanError> {
+        let Some(rule) = &self.spot_rule else {
+            return Ok(());
+        };
+        rule.check(MAX_REPEATS)
+            .map_err(|m| invalid("spot_rule", m))?;
+        match rule {
+            RepeatRule::Verdict { .. } => Err(invalid(
+                "spot_rule",
+                "a verdict needs the display's reading of the spot, measured after the box: use \"width\" or \"fixed\"",
+            )),
+            RepeatRule::Width { .. } => match self.spot_white {
+                Some(w) if w.iter().all(|v| v.is_finite()) && w[1] > 0.0 && w.iter().all(|&v| v >= 0.0) => Ok(()),
+                Some(w) => Err(invalid("spot_white", format!("must be a white's X, Y, Z with Y > 0, got {w:?}"))),
+                None => Err(invalid("spot_white", "a width rule needs the white its CIELAB is relative to (the display's X, Y, Z in cd/m²)")),
+            },
+            RepeatRule::Fixed { .. } => Ok(()),
+        }
     }
 }
 

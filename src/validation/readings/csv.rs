@@ -9,10 +9,23 @@
 //! - `n`: readings the row averages (default 1).
 //! - `u_lab`: a renderer's standard uncertainty per CIELAB axis.
 //! - `out_of_gamut`: 1 where the display cannot show the colour.
+//! - `dof`: the degrees of freedom of the sd and cov columns where they are not the row's
+//!   own sample's: a repeatability pooled across the patches one instrument read in one
+//!   mode ([`crate::validation::sequential::pool`]); an empty cell states them known.
+//!   Without the column they are n − 1 for n ≥ 2, known for n = 1.
+//! - `most`: the most readings the rule that read the patch could have taken, where it
+//!   stopped on what the readings said (a verdict rule); its comparisons then take the
+//!   repeated interval, valid at whatever count it stopped ([`crate::validation::assess`]).
 //!
-//! The experiment's stages write `patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,cov_XY,cov_XZ,cov_YZ,u_lab`.
+//! The experiment's stages write `patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,cov_XY,cov_XZ,cov_YZ,u_lab`,
+//! followed by `dof` and `most` where a stage's repeats were read by a rule.
 
 use super::*;
+use crate::validation::sequential::MOST_LOOKS;
+
+/// The most degrees of freedom a `dof` cell states: 3 per reading beyond each patch's
+/// first, for far more readings than any session takes.
+const MAX_DOF: usize = 1_000_000;
 
 /// Where each column of a CSV header is.
 struct Columns {
@@ -24,6 +37,8 @@ struct Columns {
     n: Option<usize>,
     out_of_gamut: Option<usize>,
     u_lab: Option<usize>,
+    dof: Option<usize>,
+    most: Option<usize>,
 }
 
 impl Parsed {
@@ -52,7 +67,7 @@ impl Parsed {
                 self.bad(
                     hline,
                     format!(
-                        "the header '{}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, cov_XY,cov_XZ,cov_YZ, n, u_lab, out_of_gamut)",
+                        "the header '{}' lacks the column '{name}' (expected patch,X,Y,Z with optional sd_X,sd_Y,sd_Z, cov_XY,cov_XZ,cov_YZ, n, u_lab, out_of_gamut, dof, most)",
                         echo(header)
                     ),
                 )
@@ -76,6 +91,13 @@ impl Parsed {
             _ => return Err(self.bad(hline, "give all three of cov_XY, cov_XZ, cov_YZ or none")),
         };
         let (n, out_of_gamut, u_lab) = (col("n"), col("out_of_gamut"), col("u_lab"));
+        let (dof, most) = (col("dof"), col("most"));
+        if dof.is_some() && sd.is_none() {
+            return Err(self.bad(
+                hline,
+                "dof needs the sd_X, sd_Y, sd_Z whose degrees of freedom it gives",
+            ));
+        }
         Ok(Columns {
             names,
             patch,
@@ -85,6 +107,8 @@ impl Parsed {
             n,
             out_of_gamut,
             u_lab,
+            dof,
+            most,
         })
     }
 
@@ -140,11 +164,28 @@ impl Parsed {
         };
         let cov = c.cov.map(three).transpose()?.unwrap_or([0.0; 3]);
         let u_lab = c.u_lab.map(num).transpose()?;
+        let dof = match c.dof {
+            Some(k) if cells[k].is_empty() => Some(None),
+            Some(k) => Some(Some(self.csv_whole(
+                line,
+                "dof",
+                MAX_DOF,
+                (num(k)?, cells[k]),
+            )?)),
+            None => None,
+        };
+        let most = match c.most {
+            Some(k) if cells[k].is_empty() => None,
+            Some(k) => Some(self.csv_whole(line, "most", MOST_LOOKS, (num(k)?, cells[k]))?),
+            None => None,
+        };
         Ok(Row {
             sd,
             cov,
             n,
             u_lab,
+            dof,
+            most,
             out_of_gamut,
             ..Row::reading(line, patch, three(c.xyz)?)
         })
@@ -156,6 +197,27 @@ impl Parsed {
             return Err(self.bad(
                 line,
                 format!("n: '{}' must be a whole number ≥ 1", echo(cell)),
+            ));
+        }
+        Ok(v as usize)
+    }
+
+    /// A `dof` or `most` cell: a whole number from 1 to `largest` (bounded before the
+    /// boundary of `most` looks is computed).
+    fn csv_whole(
+        &self,
+        line: usize,
+        name: &str,
+        largest: usize,
+        (v, cell): (f64, &str),
+    ) -> Result<usize, ReadingsError> {
+        if !(1.0..=largest as f64).contains(&v) || v.fract() != 0.0 {
+            return Err(self.bad(
+                line,
+                format!(
+                    "{name}: '{}' must be a whole number from 1 to {largest}",
+                    echo(cell)
+                ),
             ));
         }
         Ok(v as usize)

@@ -135,6 +135,7 @@ pub(super) fn combine(rows: &[&Row]) -> PatchReading {
         out_of_gamut: rows.iter().any(|r| r.out_of_gamut),
         line: rows[0].line,
         reading_cov,
+        most: rows.iter().filter_map(|r| r.most).max(),
     }
 }
 
@@ -174,8 +175,12 @@ fn uncertainty_of(
         for (r, g) in rows.iter().zip(&given) {
             c = covariance::sum(&c, &covariance::scaled(g, 1.0 / (r.n as f64 * k * k)));
         }
-        // A standard deviation of one reading is a stated one; of several, their sample's.
-        let dof = rows.iter().filter(|r| r.n > 1).map(|r| r.n - 1).min();
+        // A standard deviation of one reading is a stated one; of several, their sample's,
+        // unless the rows state its degrees of freedom (a figure pooled across patches).
+        let dof = match rows.iter().map(|r| r.dof).collect::<Option<Vec<_>>>() {
+            Some(stated) => stated.into_iter().flatten().min(),
+            None => rows.iter().filter(|r| r.n > 1).map(|r| r.n - 1).min(),
+        };
         (covariance::factors(&c), dof, UncertaintySource::Given)
     } else if rows.len() >= 2 {
         let scale = (k * (k - 1.0)).sqrt();

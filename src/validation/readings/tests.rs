@@ -133,3 +133,64 @@ fn spot_lines_written_here_read_back() {
     let s = parse(&format!("{}\n", spot_line(&i1))).unwrap();
     assert_eq!(s.patches[&1].source, UncertaintySource::Unknown);
 }
+
+/// A row whose sd and cov are a figure pooled across the patches states its degrees of
+/// freedom (`dof`) and, read by a verdict rule, its `most`; written and read back they are
+/// the same; a file without the columns reads as before (n − 1 for n ≥ 2), an empty `dof`
+/// cell states the figure known, and impossible cells are refused with their line.
+#[test]
+fn a_pooled_row_states_its_degrees_of_freedom_and_old_rows_read_as_before() {
+    let dir = std::env::temp_dir().join(format!("metamer-pooled-{}", std::process::id()));
+    let file = dir.join("spots.csv");
+    let cov = covariance::from_parts([0.01, 0.02, 0.03], [0.0001, 0.0, 0.0002]);
+    let pooled = PatchReading::pooled(Xyz::new(1.0, 2.0, 3.0), cov, 2, 72, Some(6));
+    let own = PatchReading::of(&[Xyz::new(4.0, 5.0, 6.0), Xyz::new(4.1, 5.0, 6.0)]);
+    write_readings(&file, &[(1, pooled.clone()), (2, own.clone())]).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(
+        text.starts_with(&format!("{}{}", write::HEADER, ",dof,most\n")),
+        "{text}"
+    );
+    let back = read_readings(&file).unwrap();
+    assert_eq!(
+        (back.patches[&1].dof, back.patches[&1].most),
+        (Some(72), Some(6))
+    );
+    assert_eq!(back.patches[&1].n, 2);
+    assert_eq!(
+        (back.patches[&2].dof, back.patches[&2].most),
+        (Some(1), None)
+    );
+    // The mean's covariance is one reading's over n: 0.02²/2 in Y.
+    assert!((back.patches[&1].u_xyz[1] - 0.02 / 2f64.sqrt()).abs() < 1e-12);
+    // Without a rule the stages' files are as they were.
+    write_readings(&file, &[(2, own)]).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert_eq!(text.lines().next(), Some(write::HEADER));
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let old = parse("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n\n3,1,2,3,0.1,0.2,0.3,5\n").unwrap();
+    assert_eq!((old.patches[&3].dof, old.patches[&3].most), (Some(4), None));
+    let known = parse("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,dof\n3,1,2,3,0.1,0.2,0.3,5,\n").unwrap();
+    assert_eq!(known.patches[&3].dof, None);
+    for (row, says) in [
+        ("3,1,2,3,0.1,0.2,0.3,5,0,", "dof: '0'"),
+        ("3,1,2,3,0.1,0.2,0.3,5,1.5,", "dof: '1.5'"),
+        (
+            "3,1,2,3,0.1,0.2,0.3,5,4,101",
+            "most: '101' must be a whole number from 1 to 100",
+        ),
+    ] {
+        let e = parse(&format!("patch,X,Y,Z,sd_X,sd_Y,sd_Z,n,dof,most\n{row}\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("r.csv:2:") && e.contains(says), "{row}: {e}");
+    }
+    let e = parse("patch,X,Y,Z,dof\n3,1,2,3,4\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("r.csv:1:") && e.contains("dof needs the sd_X"),
+        "{e}"
+    );
+}

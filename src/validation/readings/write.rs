@@ -39,6 +39,25 @@ impl PatchReading {
         }
     }
 
+    /// The mean `xyz` of `n` readings with one reading's covariance `cov` pooled across the
+    /// patches one instrument read in one mode, with its `dof` degrees of freedom
+    /// ([`crate::validation::sequential::pool`]); `most` where a rule stopped the patch's
+    /// repeats on what they said ([`PatchReading::most`]).
+    pub fn pooled(xyz: Xyz, cov: Cov3, n: usize, dof: usize, most: Option<usize>) -> PatchReading {
+        PatchReading {
+            dof: Some(dof),
+            most,
+            ..PatchReading::stated(xyz, cov, n, 0.0)
+        }
+    }
+
+    /// Whether the row of this patch needs the `dof` or `most` column: its degrees of
+    /// freedom are not those the reader takes without it.
+    fn needs_rule_columns(&self) -> bool {
+        let implied = (self.n > 1).then(|| self.n - 1);
+        self.most.is_some() || (self.dof != implied && self.source == UncertaintySource::Given)
+    }
+
     /// The mean and sample covariance of `readings` (at least one; one reading's
     /// covariance is 0: nothing is known of it).
     pub fn of(readings: &[Xyz]) -> PatchReading {
@@ -98,7 +117,13 @@ impl PatchReading {
 /// Writes `patches` (patch number and reading, in this order) to `path` in the stages'
 /// form, replacing the file: a stage's directory is its own.
 pub fn write_readings(path: &Path, patches: &[(usize, PatchReading)]) -> Result<(), ReadingsError> {
-    let mut s = format!("{HEADER}\n");
+    let rule_columns = patches.iter().any(|(_, p)| p.needs_rule_columns());
+    let mut s = if rule_columns {
+        format!("{HEADER},dof,most\n")
+    } else {
+        format!("{HEADER}\n")
+    };
+    let cell = |v: Option<usize>| v.map_or(String::new(), |v| v.to_string());
     for (patch, p) in patches {
         let cov = p.reading_covariance();
         let sd = covariance::sd(&cov);
@@ -118,6 +143,9 @@ pub fn write_readings(path: &Path, patches: &[(usize, PatchReading)]) -> Result<
             off[2],
             p.u_lab
         ));
+        if rule_columns {
+            s.insert_str(s.len() - 1, &format!(",{},{}", cell(p.dof), cell(p.most)));
+        }
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|source| ReadingsError::Write {

@@ -268,6 +268,7 @@ fn verdict_session(
         xyz: r,
         cov_mean: covariance::scaled(&t.cov_reference, 1.0 / 5.0),
         dof: None,
+        lab_var: 0.0,
     };
     let all = readings(t.test, &t.cov_test, most, &mut rng);
     let truth = t.de76();

@@ -52,6 +52,18 @@
 //! freedom, Welch–Satterthwaite over both sides) the nominal level of c is carried to
 //! Student's t.
 //!
+//! **In the validation.** The readings files carry what a rule used. The box's spots read
+//! by `width` state one reading's covariance as the pooled figure (s² on the stated shape,
+//! pooled over every spot's kept readings) with its ν (`dof` column): the width rule's count
+//! is not chosen on the spot's mean, so the validation's intervals are the fixed-count ones,
+//! Student's t with the pooled ν (Welch–Satterthwaite over both sides,
+//! [`super::montecarlo`]). The display's spots read by `verdict` state the same and `most`:
+//! their count was chosen on the ΔE*ab the readings showed, so the validation's ΔE*ab
+//! interval for them is [`repeated_interval`], the repeated interval at the count reached
+//! (valid whatever the stopping, for any comparison of that side: box or simulation), and
+//! the JND verdict follows it. The ΔE00 intervals and the summaries over patches stay the
+//! fixed-count ones with the pooled ν.
+//!
 //! Every choice follows from the readings given and the rule, so a resumed session and a
 //! re-run take the same count.
 
@@ -69,16 +81,18 @@ use serde::{Deserialize, Serialize};
 
 pub use pool::Pool;
 
-use super::assess::{JndVerdict, JND_DE76};
 use super::covariance::{self, Cov3};
 use super::repeatability::{self, Repeatability};
 use super::uncertain::Interval;
+use super::uncertain::{JndVerdict, JND_DE76};
 use crate::color::Xyz;
 
 /// The least number of readings of a target: one reading has no scatter of its own.
 pub const MIN_READINGS: usize = 2;
 /// The confidence of every interval here.
 pub const CONFIDENCE: f64 = 0.95;
+/// The most looks a rule may take at a target: the box plan's most readings of one thing.
+pub const MOST_LOOKS: usize = 100;
 
 /// How many times a target is read.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -253,12 +267,14 @@ pub fn width_decided(
 }
 
 /// The reference side of a verdict: its mean XYZ, the covariance of that mean and the
-/// degrees of freedom of that covariance (None: known).
+/// degrees of freedom of that covariance (None: known), and a variance per CIELAB axis it
+/// carries beyond it (a renderer's `u_lab`², 0 for a measurement).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reference {
     pub xyz: Xyz,
     pub cov_mean: Cov3,
     pub dof: Option<f64>,
+    pub lab_var: f64,
 }
 
 /// The verdict rule's look at a target.
@@ -321,11 +337,54 @@ pub fn verdict(
         return None;
     }
     let (mean, _) = covariance::sample(readings);
-    let (r, t) = (reference.xyz.to_lab(white), mean.to_lab(white));
+    let test = Sequenced {
+        mean,
+        n,
+        reading_lab: noise.lab_covariance(mean, white)?,
+        dof: noise.dof,
+        most,
+    };
+    let (de76, interval, constant) = repeated_interval(reference, &test, white)?;
+    let verdict = JndVerdict::of(interval);
+    let decided = n >= most || interval.hi <= JND_DE76 - margin || interval.lo >= JND_DE76 + margin;
+    Some(VerdictLook {
+        de76,
+        interval,
+        constant,
+        verdict,
+        decided,
+    })
+}
+
+/// The side a verdict rule read: the mean of its `n` readings, one reading's CIELAB
+/// covariance (with its degrees of freedom, None: known) and the most readings the rule
+/// could have taken.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sequenced {
+    pub mean: Xyz,
+    pub n: usize,
+    pub reading_lab: Cov3,
+    pub dof: Option<f64>,
+    pub most: usize,
+}
+
+/// ΔE*ab between `reference` and the sequenced side, the repeated 95 % interval at its
+/// count (see the module's docs: it holds whatever the rule that chose the count), and the
+/// boundary's constant. None where the test side has no noise along the difference.
+pub fn repeated_interval(
+    reference: &Reference,
+    test: &Sequenced,
+    white: Xyz,
+) -> Option<(f64, Interval, f64)> {
+    let n = test.n.max(1);
+    let (r, t) = (reference.xyz.to_lab(white), test.mean.to_lab(white));
     let d = [t.l - r.l, t.a - r.a, t.b - r.b];
     let de76 = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    let c_r = to_lab_covariance(&reference.cov_mean, reference.xyz, white);
-    let c_t = noise.lab_covariance(mean, white)?;
+    let mut c_r = to_lab_covariance(&reference.cov_mean, reference.xyz, white);
+    for (i, row) in c_r.iter_mut().enumerate() {
+        row[i] += reference.lab_var;
+    }
+    let c_t = test.reading_lab;
     let u = if de76 > 0.0 {
         d.map(|v| v / de76)
     } else {
@@ -344,11 +403,11 @@ pub fn verdict(
     if b <= 0.0 {
         return None;
     }
-    let mut constant = verdict_constant(most, a / b);
+    let mut constant = verdict_constant(test.most.clamp(MIN_READINGS, MOST_LOOKS), a / b);
     let v = a + b / n as f64;
     // Welch–Satterthwaite over the two sides, each known (infinite) or estimated.
     let part = |var: f64, dof: Option<f64>| dof.map_or(0.0, |nu| var * var / nu);
-    let denominator = part(a, reference.dof) + part(b / n as f64, noise.dof);
+    let denominator = part(a, reference.dof) + part(b / n as f64, test.dof);
     if denominator > 0.0 {
         let nu = v * v / denominator;
         let level = distributions::normal_cdf(constant);
@@ -359,15 +418,7 @@ pub fn verdict(
         lo: (de76 - half).max(0.0),
         hi: de76 + half,
     };
-    let verdict = JndVerdict::of(interval);
-    let decided = n >= most || interval.hi <= JND_DE76 - margin || interval.lo >= JND_DE76 + margin;
-    Some(VerdictLook {
-        de76,
-        interval,
-        constant,
-        verdict,
-        decided,
-    })
+    Some((de76, interval, constant))
 }
 
 #[cfg(test)]

@@ -28,21 +28,31 @@ impl Pool {
     /// Adds one target's readings; a target with one reading, or without a stated
     /// covariance at its level (no chromaticity), adds nothing.
     pub fn add(&mut self, readings: &[Xyz], stated: &Repeatability) {
-        if readings.len() < 2 {
+        let (mean, cov) = covariance::sample(readings);
+        self.add_sample(mean, &cov, readings.len(), stated);
+    }
+
+    /// Adds one target's `k` readings given as their mean and sample covariance (divisor
+    /// k − 1): Qⱼ = (k − 1)·tr(Σⱼ⁻¹ S), the same sum as the readings' own.
+    pub fn add_sample(
+        &mut self,
+        mean: Xyz,
+        cov: &covariance::Cov3,
+        k: usize,
+        stated: &Repeatability,
+    ) {
+        if k < 2 {
             return;
         }
-        let (mean, _) = covariance::sample(readings);
         let Some(inverse) = repeatability::covariance(stated, mean).and_then(|c| inverse(&c))
         else {
             return;
         };
-        for x in readings {
-            let d = [0, 1, 2].map(|i| x[i] - mean[i]);
-            self.sum += (0..3)
-                .map(|i| (0..3).map(|j| d[i] * inverse[i][j] * d[j]).sum::<f64>())
-                .sum::<f64>();
-        }
-        self.dof += 3 * (readings.len() - 1);
+        let trace: f64 = (0..3)
+            .map(|i| (0..3).map(|j| inverse[i][j] * cov[j][i]).sum::<f64>())
+            .sum();
+        self.sum += (k - 1) as f64 * trace;
+        self.dof += 3 * (k - 1);
     }
 
     /// The pooled factor on the stated covariance, with its degrees of freedom; the stated

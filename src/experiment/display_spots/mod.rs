@@ -9,25 +9,39 @@
 //! region is uniform where the 1° spot falls, so that puts the same light in front of the
 //! meter, but leaves out the display's dependence on the rest of the picture (power-supply
 //! loading, backlight dimming). `display-spots.json` records which was shown.
+//!
+//! **Until decided.** With a verdict rule ([`DisplayRule`]) each patch is read at least
+//! twice and at most `most` times, until the 95 % interval of its ΔE*ab against the box's
+//! reading of the patch (relative to the display profile's white, as the validation
+//! compares them) lies the margin or more beyond the JND
+//! ([`crate::validation::sequential::verdict`]), the meter's stated repeatability scaled by
+//! the figure pooled across the patches read before it. Each patch's row in `spots.csv`
+//! then carries the figure pooled across all patches, its degrees of freedom and `most`, so
+//! the validation takes the repeated interval, valid at whatever count the rule stopped.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use metamer_drivers::{MeasureMode, Spec};
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
 use super::progress::Progress;
-use super::readings::{write_readings, PatchReading};
+use super::readings::{write_readings, PatchReading, ReadingSet};
 use super::reproduction::{PatchDrive, PatchRegion};
+use crate::color::Xyz;
 use crate::image::{Drive8Image, ScreenSpot};
 use crate::rig::{MeterAim, Placement};
 use crate::session::{
-    Answer, InstrumentRecord, Operator, OperatorError, PlacementReadings, Prepare, Recheck, Rig,
-    RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress,
+    Answer, Entry, InstrumentRecord, Operator, OperatorError, PlacementReadings, Prepare, Recheck,
+    Rig, RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, Stopping,
     TerminalOperator,
 };
+use crate::validation::covariance;
+use crate::validation::repeatability::{self, Repeatability};
+use crate::validation::sequential::{verdict, Pool, Reference};
 
 /// A display-spot step's own data in the journal.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -81,6 +95,80 @@ pub fn aim_prompt(r: &PatchRegion, spot: ScreenSpot) -> String {
         100.0 * spot.x,
         100.0 * spot.y
     )
+}
+
+/// How many times each patch is read.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DisplayRule {
+    /// Always this many readings.
+    Fixed(usize),
+    /// Until the patch's ΔE*ab against the box is decided: the rule, the box's readings of
+    /// the patches and the white the comparison is relative to.
+    Verdict {
+        margin: f64,
+        most: usize,
+        references: BTreeMap<usize, Reference>,
+        white: Xyz,
+    },
+}
+
+impl DisplayRule {
+    /// The most readings of one patch.
+    pub fn most(&self) -> usize {
+        match self {
+            DisplayRule::Fixed(n) => (*n).max(1),
+            DisplayRule::Verdict { most, .. } => *most,
+        }
+    }
+
+    /// The verdict rule against the box's readings `reference` of the patches, relative to
+    /// `white`.
+    pub fn verdict(margin: f64, most: usize, reference: &ReadingSet, white: Xyz) -> DisplayRule {
+        let references = reference
+            .patches
+            .iter()
+            .map(|(k, p)| {
+                let r = Reference {
+                    xyz: p.xyz,
+                    cov_mean: covariance::of_factors(&p.u_factors),
+                    dof: p.dof.map(|d| d as f64),
+                    lab_var: p.u_lab * p.u_lab,
+                };
+                (*k, r)
+            })
+            .collect();
+        DisplayRule::Verdict {
+            margin,
+            most,
+            references,
+            white,
+        }
+    }
+
+    /// The plan's options: the count, and for a verdict rule the rule with what it decides
+    /// against (every value, so a journal is resumed only by the same decisions).
+    fn options(&self) -> BTreeMap<String, String> {
+        let mut options = BTreeMap::new();
+        options.insert("repeats".to_string(), self.most().to_string());
+        if let DisplayRule::Verdict {
+            margin,
+            references,
+            white,
+            ..
+        } = self
+        {
+            options.insert("rule".into(), format!("verdict, margin {margin}"));
+            let against: Vec<String> = references
+                .iter()
+                .map(|(k, r)| format!("{k}: {r:?}"))
+                .collect();
+            options.insert(
+                "against".into(),
+                crate::digest::hex(&Sha256::digest(format!("{white:?} {against:?}").as_bytes())),
+            );
+        }
+        options
+    }
 }
 
 /// The plan on the whole image: every patch, `repeats` times; the meter is aimed before
@@ -152,6 +240,111 @@ impl Operator for Aiming<'_> {
     }
 }
 
+/// The display spots' stopping rule: a patch's repeats end once its verdict against the
+/// box is decided; everything it decides follows from the journal's entries, so a resumed
+/// session skips exactly what the first run skipped.
+struct VerdictStopping {
+    margin: f64,
+    most: usize,
+    references: BTreeMap<usize, Reference>,
+    white: Xyz,
+    stated: Repeatability,
+}
+
+impl Stopping<SpotStep> for VerdictStopping {
+    fn skip(
+        &self,
+        index: usize,
+        steps: &[Step<SpotStep>],
+        entries: &[Option<Entry<SpotStep>>],
+    ) -> bool {
+        let Some(patch) = steps.get(index).map(|s| s.data.patch) else {
+            return false;
+        };
+        let Some(reference) = self.references.get(&patch) else {
+            return false;
+        };
+        let first = steps
+            .iter()
+            .position(|s| s.data.patch == patch)
+            .unwrap_or(index);
+        let this: Vec<Xyz> = entries[first..index]
+            .iter()
+            .flatten()
+            .map(|e| e.reading.xyz)
+            .collect();
+        let pool = pool_by_patch(entries[..first].iter().flatten(), &self.stated);
+        verdict(
+            self.margin,
+            self.most,
+            reference,
+            &this,
+            &pool.noise(self.stated),
+            self.white,
+        )
+        .is_some_and(|look| look.decided)
+    }
+}
+
+/// The stated repeatability pooled across `entries`, each patch its readings.
+fn pool_by_patch<'a>(
+    entries: impl Iterator<Item = &'a Entry<SpotStep>>,
+    stated: &Repeatability,
+) -> Pool {
+    let mut by_patch: BTreeMap<usize, Vec<Xyz>> = BTreeMap::new();
+    for e in entries {
+        by_patch
+            .entry(e.data.patch)
+            .or_default()
+            .push(e.reading.xyz);
+    }
+    let mut pool = Pool::default();
+    for readings in by_patch.values() {
+        pool.add(readings, stated);
+    }
+    pool
+}
+
+/// Each patch's readings reduced: by a verdict rule, its mean with the figure pooled
+/// across every patch, that figure's degrees of freedom and the rule's `most`; else its
+/// own scatter.
+fn reduce(
+    entries: &[&Entry<SpotStep>],
+    rule: &DisplayRule,
+    meter: &str,
+) -> Vec<(usize, PatchReading)> {
+    let stated = repeatability::stated(meter, MeasureMode::Emissive);
+    if let DisplayRule::Verdict { most, .. } = rule {
+        let pool = pool_by_patch(entries.iter().copied(), &stated);
+        let noise = pool.noise(stated);
+        let mut by_patch: BTreeMap<usize, Vec<Xyz>> = BTreeMap::new();
+        for e in entries {
+            by_patch
+                .entry(e.data.patch)
+                .or_default()
+                .push(e.reading.xyz);
+        }
+        let pooled: Option<Vec<(usize, PatchReading)>> = by_patch
+            .iter()
+            .map(|(k, xs)| {
+                let (mean, _) = covariance::sample(xs);
+                let cov = noise.covariance(mean)?;
+                let dof = (pool.dof > 0).then_some(pool.dof)?;
+                Some((
+                    *k,
+                    PatchReading::pooled(mean, cov, xs.len(), dof, Some(*most)),
+                ))
+            })
+            .collect();
+        if let Some(pooled) = pooled {
+            return pooled;
+        }
+    }
+    let readings: Vec<(usize, &metamer_drivers::Reading)> =
+        entries.iter().map(|e| (e.data.patch, &e.reading)).collect();
+    PatchReading::group(&readings)
+}
+
 /// The plan: every patch, `repeats` times, in patch order.
 pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
     let mut steps = Vec::new();
@@ -193,7 +386,7 @@ pub struct SpotSession<'a> {
     pub drives: &'a [PatchDrive],
     /// None: each patch's colour full-screen.
     pub image: Option<ShownImage<'a>>,
-    pub repeats: usize,
+    pub rule: &'a DisplayRule,
     pub resume: bool,
     /// Nobody at the rig: every request counts as done.
     pub unattended: bool,
@@ -213,11 +406,12 @@ pub fn measure(
         setting,
         spot_spec,
         drives,
-        repeats,
+        rule,
         resume,
         run,
         ..
     } = *s;
+    let repeats = rule.most();
     let mut screen = open_screen(&setting.screen, setting.virtual_white_cd_m2)?;
     let mut meter = open_meter(spot_spec, &setting.screen, screen.as_ref())?;
     // A real monitor takes a moment to settle after a change; a simulated one does not.
@@ -235,7 +429,8 @@ pub fn measure(
                 })?;
             let placement = screen.show_image(&image)?;
             let aims = aims_on(&placement, shown.regions);
-            let plan = image_plan(&aims, repeats.max(1));
+            let mut plan = image_plan(&aims, repeats);
+            plan.options.extend(rule.options());
             let record = SpotRecord {
                 shown: "image".into(),
                 note: None,
@@ -252,12 +447,15 @@ pub fn measure(
                 note: Some(note.into()),
                 aims: Vec::new(),
             };
-            (plan(drives, repeats.max(1)), record)
+            let mut plan = plan(drives, repeats);
+            plan.options.extend(rule.options());
+            (plan, record)
         }
     };
     plan.steps.iter_mut().for_each(|s| s.settle = settle);
     let mut instruments = BTreeMap::new();
     instruments.insert("spot".to_string(), InstrumentRecord::of(meter.as_ref()));
+    let model = meter.info().model;
     let journal: PathBuf = dir.join(JOURNAL_FILE);
     let mut session = Session::open(
         &journal,
@@ -269,6 +467,21 @@ pub fn measure(
         instruments,
         resume,
     )?;
+    if let DisplayRule::Verdict {
+        margin,
+        most,
+        references,
+        white,
+    } = rule
+    {
+        session = session.with_stopping(Box::new(VerdictStopping {
+            margin: *margin,
+            most: *most,
+            references: references.clone(),
+            white: *white,
+            stated: repeatability::stated(&model, MeasureMode::Emissive),
+        }));
+    }
     let mut scripted = ScriptedOperator::confirming();
     let mut terminal = TerminalOperator;
     let inner: &mut dyn Operator = if s.unattended || setting.virtual_white_cd_m2.is_some() {
@@ -329,9 +542,7 @@ pub fn measure(
         });
     }
     let entries = session.complete_entries().unwrap_or_default();
-    let readings: Vec<(usize, &metamer_drivers::Reading)> =
-        entries.iter().map(|e| (e.data.patch, &e.reading)).collect();
-    let stats = PatchReading::group(&readings);
+    let stats = reduce(&entries, rule, &model);
     write_readings(&dir.join(SPOTS_FILE), &stats)?;
     let text = serde_json::to_string_pretty(&record).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(RECORD_FILE), text.as_bytes())?;
@@ -360,39 +571,4 @@ pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> 
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A recheck that stops must reach the session: a wrapper that answered for the
-    /// operator would keep a reading the operator wanted gone.
-    struct Stopper;
-    impl Operator for Stopper {
-        fn ask(&mut self, _: &str) -> Result<Answer, OperatorError> {
-            Ok(Answer::Confirmed)
-        }
-        fn recheck(&mut self, _: &str) -> Result<Recheck, OperatorError> {
-            Ok(Recheck::Stop)
-        }
-    }
-
-    #[test]
-    fn the_aiming_wrapper_passes_on_the_reading_count_and_the_recheck() {
-        let mut scripted = ScriptedOperator::confirming();
-        let mut aiming = Aiming {
-            aims: BTreeMap::new(),
-            meter: None,
-            inner: &mut scripted,
-        };
-        let readings = PlacementReadings { first: 1, of: 5 };
-        aiming.ask_placement("aim at patch 3", readings).unwrap();
-        assert_eq!(scripted.prompts, vec!["aim at patch 3 — 5 readings"]);
-
-        let mut stopper = Stopper;
-        let mut aiming = Aiming {
-            aims: BTreeMap::new(),
-            meter: None,
-            inner: &mut stopper,
-        };
-        assert_eq!(aiming.recheck("Y differs").unwrap(), Recheck::Stop);
-    }
-}
+mod tests;
