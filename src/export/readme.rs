@@ -6,8 +6,8 @@ use std::fmt::Write;
 use super::approximation::{Approximation, Measured};
 use super::common::Renderer;
 use super::{blender, mitsuba3, pbrt};
-use crate::render::scene::Scene;
 use crate::render::scene::Camera;
+use crate::render::scene::Scene;
 
 /// A number for people: six significant digits (the files themselves hold every digit).
 fn shown(x: f64) -> String {
@@ -115,8 +115,7 @@ fn render_section(to: Renderer, camera: &Camera) -> String {
 fn spectra_section(to: Renderer, scene: &Scene, a: &Approximation) -> String {
     match to {
         Renderer::Blender => blender::colour_section(scene, a),
-        Renderer::Mitsuba3 => {
-            "## Spectra\n\n\
+        Renderer::Mitsuba3 => "## Spectra\n\n\
              Every spectrum is the scene's, on its 1 nm grid 380–780 nm, as an irregular \
              spectrum (`.spd`; a constant is a uniform `value`). Mitsuba interpolates linearly \
              and gives 0 outside the table (`include/mitsuba/core/distr_1d.h`), while sampling \
@@ -125,18 +124,15 @@ fn spectra_section(to: Renderer, scene: &Scene, a: &Approximation) -> String {
              reach a pixel: XYZ on 380–780 nm is what metamer integrates (it sums 1 nm bins; \
              Mitsuba integrates the linear interpolant, a difference far below the noise for \
              these smooth tables).\n"
-                .into()
-        }
-        Renderer::PbrtV4 => {
-            "## Spectra\n\n\
+            .into(),
+        Renderer::PbrtV4 => "## Spectra\n\n\
              Every spectrum is the scene's, on its 1 nm grid 380–780 nm, as an inline \
              `\"spectrum\"` of (λ, value) pairs: a `PiecewiseLinearSpectrum`, 0 outside \
              380–780 nm (`src/pbrt/util/spectrum.cpp`). pbrt samples wavelengths over 360–830 \
              nm; outside the table the lights emit nothing, so XYZ comes from 380–780 nm, as \
              metamer's does. pbrt's `diffuse` material clamps a reflectance to [0, 1]; a \
              measured reflectance the scene accepts up to 1.05 is clamped.\n"
-                .into()
-        }
+            .into(),
     }
 }
 

@@ -185,7 +185,10 @@ mod tests {
         let want = mul(&rgb_to_xyz(), emission_rgb(&scene, e.tile_spectrum(0)));
         let got = xyz(&form, form.emitters[0].tile_spectrum(0));
         for k in 0..3 {
-            assert!((got[k] - want[k]).abs() <= 1e-9 * want[1], "{got:?} {want:?}");
+            assert!(
+                (got[k] - want[k]).abs() <= 1e-9 * want[1],
+                "{got:?} {want:?}"
+            );
         }
     }
 }
