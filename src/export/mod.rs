@@ -158,7 +158,13 @@ pub fn run(request: &ExportRequest) -> Result<ExportReport, ExportError> {
         Renderer::PbrtV4 => pbrt::files(&scene, &camera, &approximation, request.spp),
         Renderer::Blender => blender::files(&scene, &camera, &approximation, request.spp),
     };
-    let summary = readme::summary(&approximation);
+    let mut summary = readme::summary(&approximation);
+    if request.to == Renderer::Blender {
+        summary.push_str(
+            "; Cycles renders in RGB, so every spectrum is entered as the linear Rec.709 \
+             colour the README states",
+        );
+    }
     let readme = File {
         rel: PathBuf::from("README.md"),
         text: readme::text(request.to, &scene, &name, &camera, &approximation, &summary),
