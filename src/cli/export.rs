@@ -1,4 +1,4 @@
-//! `metamer export`: the scene written for another renderer (Mitsuba 3 or pbrt-v4).
+//! `metamer export`: the scene written for another renderer (Mitsuba 3, pbrt-v4 or Blender).
 
 use std::path::PathBuf;
 
@@ -11,6 +11,7 @@ pub enum To {
     Mitsuba3,
     #[value(name = "pbrt-v4")]
     PbrtV4,
+    Blender,
 }
 
 #[derive(clap::Args)]
@@ -42,6 +43,7 @@ pub fn run(args: Args) -> CliResult {
         to: match args.to {
             To::Mitsuba3 => Renderer::Mitsuba3,
             To::PbrtV4 => Renderer::PbrtV4,
+            To::Blender => Renderer::Blender,
         },
         output: args.output,
         force: args.force,

@@ -13,6 +13,8 @@ pub enum Renderer {
     Mitsuba3,
     /// pbrt-v4 (spectral by construction).
     PbrtV4,
+    /// Blender 4.2's Cycles through `bpy` (an RGB renderer).
+    Blender,
 }
 
 impl Renderer {
@@ -21,6 +23,7 @@ impl Renderer {
         match self {
             Renderer::Mitsuba3 => "mitsuba3",
             Renderer::PbrtV4 => "pbrt-v4",
+            Renderer::Blender => "blender",
         }
     }
 }

@@ -1,5 +1,6 @@
 //! `metamer export`: the validated scene written for another renderer — Mitsuba 3 (XML and
-//! `.spd` spectrum files) or pbrt-v4 (one `.pbrt` file) — with a README beside it that says
+//! `.spd` spectrum files), pbrt-v4 (one `.pbrt` file) or Blender's Cycles (a `bpy` script
+//! with every spectrum as an RGB colour, [`rgb`]) — with a README beside it that says
 //! how to render it, what the image holds and where the other renderer cannot say what
 //! the scene says.
 //!
@@ -34,11 +35,13 @@
 //! ```
 
 pub mod approximation;
+mod blender;
 mod common;
 mod error;
 mod mitsuba3;
 mod pbrt;
 mod readme;
+pub mod rgb;
 
 use std::path::{Path, PathBuf};
 
@@ -153,11 +156,18 @@ pub fn run(request: &ExportRequest) -> Result<ExportReport, ExportError> {
     let files = match request.to {
         Renderer::Mitsuba3 => mitsuba3::files(&scene, &camera, &approximation, request.spp),
         Renderer::PbrtV4 => pbrt::files(&scene, &camera, &approximation, request.spp),
+        Renderer::Blender => blender::files(&scene, &camera, &approximation, request.spp),
     };
-    let summary = readme::summary(&approximation);
+    let mut summary = readme::summary(&approximation);
+    if request.to == Renderer::Blender {
+        summary.push_str(
+            "; Cycles renders in RGB, so every spectrum is entered as the linear Rec.709 \
+             colour the README states",
+        );
+    }
     let readme = File {
         rel: PathBuf::from("README.md"),
-        text: readme::text(request.to, &name, &camera, &approximation, &summary),
+        text: readme::text(request.to, &scene, &name, &camera, &approximation, &summary),
     };
     // Even forced, no file the scene reads (nor the scene itself) is replaced: every
     // output is checked against them before the first is written, so a refusal leaves the

@@ -5,8 +5,9 @@ use std::fmt::Write;
 
 use super::approximation::{Approximation, Measured};
 use super::common::Renderer;
-use super::{mitsuba3, pbrt};
+use super::{blender, mitsuba3, pbrt};
 use crate::render::scene::Camera;
+use crate::render::scene::Scene;
 
 /// A number for people: six significant digits (the files themselves hold every digit).
 fn shown(x: f64) -> String {
@@ -22,7 +23,7 @@ fn shown(x: f64) -> String {
 pub(super) fn summary(a: &Approximation) -> String {
     match &a.difference {
         Measured::NotNeeded => {
-            "exact: every emitter is Lambertian, as both renderers' area lights are".into()
+            "exact: every emitter is Lambertian, as the renderers' area lights are".into()
         }
         Measured::Done(d) => format!(
             "approximated: the emitter's angular distribution is written as Lambertian tiles \
@@ -107,13 +108,14 @@ fn render_section(to: Renderer, camera: &Camera) -> String {
             pfov = shown(pbrt::fov_deg(camera)),
             cs = pbrt::COLOR_SPACE,
         ),
+        Renderer::Blender => blender::render_section(camera),
     }
 }
 
-fn spectra_section(to: Renderer) -> &'static str {
+fn spectra_section(to: Renderer, scene: &Scene, a: &Approximation) -> String {
     match to {
-        Renderer::Mitsuba3 => {
-            "## Spectra\n\n\
+        Renderer::Blender => blender::colour_section(scene, a),
+        Renderer::Mitsuba3 => "## Spectra\n\n\
              Every spectrum is the scene's, on its 1 nm grid 380–780 nm, as an irregular \
              spectrum (`.spd`; a constant is a uniform `value`). Mitsuba interpolates linearly \
              and gives 0 outside the table (`include/mitsuba/core/distr_1d.h`), while sampling \
@@ -122,16 +124,15 @@ fn spectra_section(to: Renderer) -> &'static str {
              reach a pixel: XYZ on 380–780 nm is what metamer integrates (it sums 1 nm bins; \
              Mitsuba integrates the linear interpolant, a difference far below the noise for \
              these smooth tables).\n"
-        }
-        Renderer::PbrtV4 => {
-            "## Spectra\n\n\
+            .into(),
+        Renderer::PbrtV4 => "## Spectra\n\n\
              Every spectrum is the scene's, on its 1 nm grid 380–780 nm, as an inline \
              `\"spectrum\"` of (λ, value) pairs: a `PiecewiseLinearSpectrum`, 0 outside \
              380–780 nm (`src/pbrt/util/spectrum.cpp`). pbrt samples wavelengths over 360–830 \
              nm; outside the table the lights emit nothing, so XYZ comes from 380–780 nm, as \
              metamer's does. pbrt's `diffuse` material clamps a reflectance to [0, 1]; a \
              measured reflectance the scene accepts up to 1.05 is clamped.\n"
-        }
+            .into(),
     }
 }
 
@@ -139,8 +140,8 @@ fn emitter_section(a: &Approximation) -> String {
     let mut s = String::from("## The emitter\n\n");
     s.push_str(
         "Each tile of each emitter is an area light of the tile's absolute spectral radiance \
-         gain·S(λ). Both renderers' area lights (Mitsuba's `area`, pbrt-v4's `diffuse`) are \
-         Lambertian: they cannot give an area light an angular distribution (pbrt-v4's \
+         gain·S(λ). The renderers' area lights (Mitsuba's `area`, pbrt-v4's `diffuse`, Cycles' \
+         Emission shader on a mesh) are Lambertian: they cannot give an area light an angular distribution (pbrt-v4's \
          `goniometric` light is a point light, which is not the 25-tile emitter).\n\n",
     );
     if a.is_exact() {
@@ -213,6 +214,7 @@ fn emitter_section(a: &Approximation) -> String {
 /// The whole README.
 pub(super) fn text(
     to: Renderer,
+    scene: &Scene,
     scene_name: &str,
     camera: &Camera,
     a: &Approximation,
@@ -221,18 +223,29 @@ pub(super) fn text(
     let mut s = format!(
         "# {} for {}\n\n\
          Written by `metamer export --to {}`. Geometry in metres; every surface a Lambertian \
-         reflector with the scene's spectral reflectance; every emitter tile an area light \
-         of its absolute spectral radiance.\n\n**In short:** {summary}.\n\n",
+         reflector with {}; every emitter tile an area light of its absolute {}.\n\n\
+         **In short:** {summary}.\n\n",
         super::common::one_line(scene_name),
         match to {
             Renderer::Mitsuba3 => "Mitsuba 3",
             Renderer::PbrtV4 => "pbrt-v4",
+            Renderer::Blender => "Blender (Cycles)",
         },
         to.name(),
+        if to == Renderer::Blender {
+            "the scene's reflectance as an RGB colour (see Colours)"
+        } else {
+            "the scene's spectral reflectance"
+        },
+        if to == Renderer::Blender {
+            "radiance as an RGB colour and strength"
+        } else {
+            "spectral radiance"
+        },
     );
     s.push_str(&render_section(to, camera));
     s.push('\n');
-    s.push_str(spectra_section(to));
+    s.push_str(&spectra_section(to, scene, a));
     s.push('\n');
     s.push_str(&emitter_section(a));
     s.push_str(&format!(

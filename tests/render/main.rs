@@ -6,6 +6,7 @@
 mod support;
 
 mod cie171;
+mod export_blender;
 mod export_mitsuba;
 mod export_names;
 mod export_pbrt;

@@ -49,6 +49,17 @@ pub const MITSUBA_NUMPY: Oracle = Oracle {
     install: "python3 -m pip install mitsuba==3.9.1 numpy",
 };
 
+/// Blender 4.2 as a Python module, with Cycles (the export's script renders on the CPU).
+pub const BLENDER: Oracle = Oracle {
+    name: "Blender (bpy) with Cycles",
+    programs: &["python3"],
+    probe: &[
+        "-c",
+        "import bpy; assert 'cycles' in bpy.context.preferences.addons or bpy.ops.preferences.addon_enable(module='cycles')",
+    ],
+    install: "python3 -m pip install bpy==4.2.23",
+};
+
 /// colour-science, with the modules its comparison script imports.
 pub const COLOUR_SCIENCE: Oracle = Oracle {
     name: "colour-science",
