@@ -98,6 +98,10 @@ pub struct Args {
     /// Do not mirror the reproduced image (the paper views the display in a mirror).
     #[arg(long)]
     no_mirror: bool,
+    /// The operator's time per placement the budget printed before the first reading
+    /// assumes, seconds (default 30: a person's half minute to place, aim and confirm).
+    #[arg(long, value_name = "S", value_parser = super::parse_placement_seconds)]
+    placement_seconds: Option<f64>,
     /// Nobody is at the rig: take every reading without asking anyone to place, aim or
     /// calibrate the instruments. Real instruments without a terminal on stdin need it.
     #[arg(long)]
@@ -165,6 +169,7 @@ fn request(args: Args) -> Result<Request, CliError> {
         run: RunOptions {
             stop_after: None,
             interrupt: Some(on_ctrl_c()),
+            placement_s: args.placement_seconds,
         },
     })
 }

@@ -55,6 +55,10 @@ pub struct Args {
     /// Continue an interrupted measuring stage from its journal.
     #[arg(long)]
     resume: bool,
+    /// The operator's time per placement the budget printed before the first reading
+    /// assumes, seconds (default 30: a person's half minute to place, aim and confirm).
+    #[arg(long, value_name = "S", value_parser = super::parse_placement_seconds)]
+    placement_seconds: Option<f64>,
     /// Run every stage again, even those whose inputs are unchanged (earlier measurements
     /// are moved aside, never deleted).
     #[arg(long)]
@@ -83,6 +87,7 @@ pub fn run(args: Args) -> CliResult {
     let run = RunOptions {
         stop_after: None,
         interrupt: Some(on_ctrl_c()),
+        placement_s: args.placement_seconds,
     };
     let shown = StageProgress::default();
     let summary = run_lab(&args.out, &options, args.resume, args.force, run, &|p| {

@@ -23,10 +23,11 @@ use super::readings::{write_readings, PatchReading};
 use super::reproduction::{PatchDrive, PatchRegion};
 use crate::image::{Drive8Image, ScreenSpot};
 use crate::rig::{MeterAim, Placement};
+use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::{
-    Answer, InstrumentRecord, Operator, OperatorError, PlacementReadings, Prepare, Recheck, Rig,
-    RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress,
-    TerminalOperator,
+    Answer, CostReport, InstrumentRecord, Meter, Operator, OperatorError, PlacementReadings,
+    Prepare, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session, SessionPlan,
+    Step, StepProgress, TerminalOperator,
 };
 
 /// A display-spot step's own data in the journal.
@@ -68,6 +69,9 @@ pub struct SpotRecord {
     /// Why, when it is not the image.
     pub note: Option<String>,
     pub aims: Vec<PatchAim>,
+    /// The readings' budget before the first of this run and what the run took.
+    #[serde(default)]
+    pub cost: Option<CostReport>,
 }
 
 /// The operator's request for patch `r` at `spot` on the screen.
@@ -179,6 +183,32 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
     }
 }
 
+/// The light a display spot is budgeted at: its patch's drive values as the screen shows
+/// them (a simulated monitor), else on an sRGB display; and what that assumes.
+pub fn patch_light<'a>(
+    drives: &'a [PatchDrive],
+    screen: &'a dyn Screen,
+) -> (impl Fn(&Step<SpotStep>) -> f64 + 'a, String) {
+    let light = move |step: &Step<SpotStep>| {
+        let rgb = drives
+            .iter()
+            .find(|d| d.patch == step.data.patch)
+            .map_or([255; 3], |d| d.rgb8);
+        screen
+            .expected_cd_m2(rgb)
+            .unwrap_or_else(|| srgb_luminance(rgb, SRGB_WHITE_CD_M2))
+    };
+    let assumption = if screen.expected_cd_m2([255; 3]).is_some() {
+        format!(
+            "a spot's luminance from its patch's drive values as the simulated {} shows them",
+            screen.spec()
+        )
+    } else {
+        srgb_assumption(SRGB_WHITE_CD_M2)
+    };
+    (light, assumption)
+}
+
 /// The reproduced image and each patch's spot on it.
 pub struct ShownImage<'a> {
     pub file: &'a Path,
@@ -226,7 +256,7 @@ pub fn measure(
     } else {
         screen.default_settle()
     };
-    let (mut plan, record) = match &s.image {
+    let (mut plan, mut record) = match &s.image {
         Some(shown) => {
             let image =
                 Drive8Image::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
@@ -240,6 +270,7 @@ pub fn measure(
                 shown: "image".into(),
                 note: None,
                 aims,
+                cost: None,
             };
             (plan, record)
         }
@@ -251,6 +282,7 @@ pub fn measure(
                 shown: "patch colours".into(),
                 note: Some(note.into()),
                 aims: Vec::new(),
+                cost: None,
             };
             (plan(drives, repeats.max(1)), record)
         }
@@ -308,6 +340,14 @@ pub fn measure(
             }
         }
     }
+    let meters = [("spot".to_string(), Meter::of(meter.as_ref()))].into();
+    let estimate = {
+        let (light, assumption) = patch_light(drives, screen.as_ref());
+        session.estimate(&meters, &light, &assumption, run.placement_s())
+    };
+    if session.done() < session.plan().steps.len() {
+        progress(Progress::Note(estimate.before("the display's spots")));
+    }
     let mut rig = Rig {
         screen: s.image.is_none().then_some(screen.as_mut()),
         instruments: vec![("spot".to_string(), meter.as_mut())],
@@ -320,6 +360,14 @@ pub fn measure(
         })
     };
     let end = session.run(&mut rig, run, &mut sink)?;
+    let spent = session.spent().clone();
+    progress(Progress::Note(
+        spent.after("the display's spots", &estimate),
+    ));
+    record.cost = Some(CostReport {
+        estimate,
+        actual: Some(spent),
+    });
     if end != RunEnd::Complete {
         return Err(ExperimentError::Incomplete {
             stage: "display-spots",

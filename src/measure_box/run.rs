@@ -11,9 +11,10 @@ use metamer_drivers::Instrument;
 use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary};
 use super::plan::{BoxPlan, BoxStage, BoxStep, SPECTRAL, SPOT};
 use crate::output::OutputPolicy;
+use crate::session::budget::meters_of;
 use crate::session::{
-    placements, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig, RunEnd,
-    RunOptions, Session, SessionError, StageOf,
+    placements, CostReport, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig,
+    RunEnd, RunOptions, Session, SessionError, StageOf,
 };
 
 /// What to measure and how.
@@ -181,6 +182,14 @@ fn set_aside(stage: BoxStage, path: &Path) -> Result<(), MeasureBoxError> {
     })
 }
 
+/// The light every box target is budgeted at, cd/m²: a light tile's before its gain in the
+/// simulated box; a real box's light is not known before it is measured.
+pub const BOX_TARGET_CD_M2: f64 = crate::rig::simulated_box::TILE_CD_M2;
+
+/// What [`BOX_TARGET_CD_M2`] assumes, as the budget says it.
+pub const BOX_LIGHT_ASSUMPTION: &str =
+    "every box target read at a light tile's 100 cd/m² (the simulated box's tiles before their gain)";
+
 fn open_stage(
     options: &BoxOptions,
     stage: BoxStage,
@@ -225,6 +234,7 @@ pub fn run(
         ],
         operator,
     };
+    let mut cost = BTreeMap::new();
     for &stage in &stages {
         let path = stage.journal(&options.dir);
         if options.stage.is_some() && !options.resume {
@@ -261,9 +271,26 @@ pub fn run(
         } else {
             progress.note(&what);
         }
+        let estimate = session.estimate(
+            &meters_of(&rig.instruments),
+            &|_| BOX_TARGET_CD_M2,
+            BOX_LIGHT_ASSUMPTION,
+            options.run.placement_s(),
+        );
+        let named = format!("the box's {stage} stage");
+        progress.note(&estimate.before(&named));
         let end = session
             .run(&mut rig, &options.run, progress)
             .map_err(|source| MeasureBoxError::Session { stage, source })?;
+        let spent = session.spent().clone();
+        progress.note(&spent.after(&named, &estimate));
+        cost.insert(
+            stage.name().to_string(),
+            CostReport {
+                estimate,
+                actual: Some(spent),
+            },
+        );
         if end != RunEnd::Complete {
             return Ok(Outcome::Incomplete {
                 stage,
@@ -287,6 +314,7 @@ pub fn run(
         &entries,
         &records,
         &options.details,
+        &cost,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }

@@ -14,11 +14,12 @@ use metamer_drivers::{MeasureMode, Reading};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
+use super::budget::{estimate, Cost, Meter, PLACEMENT_S};
 use super::journal::{
     CalibrationRecord, Header, Journal, JournalError, JOURNAL_FORMAT, JOURNAL_VERSION,
 };
 use super::operator::Recheck;
-use super::plan::{placements, Prepare, SessionPlan};
+use super::plan::{placements, Prepare, SessionPlan, Step};
 use super::progress::{reading_summary, ProgressSink, StepProgress};
 use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 use super::repeats::{deviation, Repeatability};
@@ -111,6 +112,8 @@ pub struct RunOptions {
     pub stop_after: Option<usize>,
     /// Set from elsewhere (a Ctrl-C handler) to stop before the next step.
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// The operator's time per placement the budget assumes; None: [`PLACEMENT_S`].
+    pub placement_s: Option<f64>,
 }
 
 /// Where a run ended.
@@ -127,6 +130,11 @@ pub enum RunEnd {
 }
 
 impl RunOptions {
+    /// The operator's time per placement the budget assumes.
+    pub fn placement_s(&self) -> f64 {
+        self.placement_s.unwrap_or(PLACEMENT_S)
+    }
+
     /// How a run ends before its next step, with `missing` steps missing, when it has taken
     /// `new` steps: interrupted, or stopped after as many as asked; None to go on.
     fn end_before_step(&self, new: usize, missing: usize) -> Option<RunEnd> {
@@ -169,6 +177,8 @@ pub struct Session<H, D> {
     /// What resuming repaired that the operator should know (readings of a second session
     /// set aside); [`Session::run`] reports them first.
     pub notes: Vec<String>,
+    /// What this process's runs took.
+    spent: Cost,
 }
 
 /// Puts each journalled entry of `recovered` (with its line) at its step in `entries`,
@@ -337,6 +347,7 @@ where
                 torn_bytes: 0,
                 set_aside,
                 notes: Vec::new(),
+                spent: Cost::default(),
             });
         };
         let journal: SessionJournal<H, D> = journal;
@@ -360,6 +371,7 @@ where
             torn_bytes: recovered.torn_bytes,
             set_aside: None,
             notes,
+            spent: Cost::default(),
         })
     }
 
@@ -381,6 +393,35 @@ where
         &self.calibrations
     }
 
+    /// The cost of the steps the journal lacks ([`estimate`]), with the rig's instruments
+    /// as `meters`, each step's expected light from `light` (where it comes from said by
+    /// `light_assumption`) and `placement_s` seconds per placement.
+    pub fn estimate(
+        &self,
+        meters: &BTreeMap<String, Meter>,
+        light: &dyn Fn(&Step<D>) -> f64,
+        light_assumption: &str,
+        placement_s: f64,
+    ) -> Cost {
+        estimate(
+            &self.plan,
+            &|i| self.entries[i].is_some(),
+            meters,
+            light,
+            light_assumption,
+            placement_s,
+        )
+    }
+
+    /// What this process's runs of the session took: the readings journalled, the
+    /// placements the operator confirmed, the calibrations, the instruments' own time (a
+    /// simulation's at the real pace, whatever its time scale; a real instrument's by the
+    /// clock around its calls), the time requests waited for the operator, the settle
+    /// waits, and the wall time of the runs.
+    pub fn spent(&self) -> &Cost {
+        &self.spent
+    }
+
     /// Every entry in plan order; None until every step is measured.
     pub fn complete_entries(&self) -> Option<Vec<&Entry<D>>> {
         self.entries.iter().map(Option::as_ref).collect()
@@ -399,7 +440,23 @@ where
         }
         let total = self.plan.steps.len();
         progress.start(self.done(), total);
-        let result = self.run_steps(rig, options, progress);
+        let started = Instant::now();
+        let clocks: Vec<Option<f64>> = rig
+            .instruments
+            .iter()
+            .map(|(_, i)| i.instrument_time_s())
+            .collect();
+        let mut wall_in_calls = vec![0.0; clocks.len()];
+        let result = self.run_steps(rig, options, progress, &mut wall_in_calls);
+        // An instrument that counts its own time says it; another's is the clock's around
+        // its calls.
+        for (k, (_, instrument)) in rig.instruments.iter().enumerate() {
+            self.spent.instrument_s += match (clocks[k], instrument.instrument_time_s()) {
+                (Some(before), Some(after)) => after - before,
+                _ => wall_in_calls[k],
+            };
+        }
+        self.spent.wall_s += started.elapsed().as_secs_f64();
         progress.finish();
         result
     }
@@ -446,6 +503,7 @@ where
         rig: &mut Rig<'_>,
         options: &RunOptions,
         progress: &mut dyn ProgressSink,
+        wall_in_calls: &mut [f64],
     ) -> Result<RunEnd, SessionError> {
         let total = self.plan.steps.len();
         let mut placed = None;
@@ -486,6 +544,8 @@ where
                     progress,
                     placement: placement.clone(),
                     placed: &mut placed,
+                    spent: &mut self.spent,
+                    wall_in_calls: &mut *wall_in_calls,
                 };
                 let Some(reading) = taker.take().map_err(fail)? else {
                     return Ok(RunEnd::Aborted { missing });
@@ -517,11 +577,14 @@ where
                 let why = what_differs(&placement, index, &step.label);
                 let operator = &mut *rig.operator;
                 let mut answer = Ok(Recheck::Keep);
+                let asked = Instant::now();
                 progress.suspend(&mut || answer = operator.recheck(&why));
+                self.spent.operator_s += asked.elapsed().as_secs_f64();
                 match answer.map_err(|e| fail(StepFailure::Operator(e)))? {
                     Recheck::Keep => break reading,
                     Recheck::Stop => return Ok(RunEnd::Aborted { missing }),
                     Recheck::Again => {
+                        self.spent.placements += 1;
                         progress.note(&format!(
                             "  set aside: {}; reading it again",
                             reading_summary(step.mode, &reading)
@@ -537,6 +600,7 @@ where
                 .map_err(|e| fail(StepFailure::Journal(e)))?;
             done += 1;
             new += 1;
+            self.spent.readings += 1;
             self.entries[index] = Some(entry);
         }
         Ok(RunEnd::Complete)

@@ -14,9 +14,11 @@ use super::plan::{DriveStep, Plan, PlanError, PlanOptions, METER};
 use crate::display::ModelKind;
 use crate::output::{OutputError, OutputPolicy};
 use crate::rig::Screen;
+use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
+use crate::session::plan::{Prepare, Step};
 use crate::session::{
-    Answer, InstrumentRecord, Operator, OperatorError, ProgressSink, Rig, RunEnd, RunOptions,
-    Session, SessionError,
+    Answer, Cost, CostReport, InstrumentRecord, Meter, Operator, OperatorError, ProgressSink, Rig,
+    RunEnd, RunOptions, Session, SessionError,
 };
 
 /// The journal's file name inside the output directory.
@@ -161,6 +163,13 @@ pub fn run(
             return Ok(incomplete(&session, RunEnd::Aborted { missing }));
         }
     }
+    let mut cost = CostReport {
+        estimate: estimate(&session, display, &*instrument, options.run.placement_s()),
+        actual: None,
+    };
+    if session.done() < total {
+        progress.note(&cost.estimate.before("the display's patches"));
+    }
     let end = {
         let mut rig = Rig {
             screen: Some(display),
@@ -169,6 +178,9 @@ pub fn run(
         };
         session.run(&mut rig, &options.run, progress)?
     };
+    let spent = session.spent().clone();
+    progress.note(&spent.after("the display's patches", &cost.estimate));
+    cost.actual = Some(spent);
     if end != RunEnd::Complete {
         return Ok(incomplete(&session, end));
     }
@@ -188,10 +200,43 @@ pub fn run(
             display_description: &details.display_description,
             instrument: &details.instrument,
             instrument_info: info,
+            cost: &cost,
         },
         &out,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+/// The budget of the patches the journal of `session` lacks: each patch's luminance as the
+/// screen knows it (a simulated monitor), else as an sRGB display of the standard's 80 cd/m²
+/// white would give it.
+fn estimate(
+    session: &Session<LogDetails, DriveStep>,
+    display: &dyn Screen,
+    instrument: &dyn Instrument,
+    placement_s: f64,
+) -> Cost {
+    let meters = [(METER.to_string(), Meter::of(instrument))].into();
+    let known = display.expected_cd_m2([255; 3]).is_some();
+    let rgb = |step: &Step<DriveStep>| match step.prepare {
+        Prepare::Show { rgb } => rgb,
+        _ => step.data.rgb,
+    };
+    let light = |step: &Step<DriveStep>| {
+        let rgb = rgb(step);
+        display
+            .expected_cd_m2(rgb)
+            .unwrap_or_else(|| srgb_luminance(rgb, SRGB_WHITE_CD_M2))
+    };
+    let assumption = if known {
+        format!(
+            "a patch's luminance as the simulated {} shows it",
+            display.spec()
+        )
+    } else {
+        srgb_assumption(SRGB_WHITE_CD_M2)
+    };
+    session.estimate(&meters, &light, &assumption, placement_s)
 }
 
 /// What resuming `session` found in its journal (readings, a torn last line set aside),
