@@ -115,6 +115,7 @@ pub fn run_cli(args: Args) -> CliResult {
     shown.finish();
     let outcome = outcome.map_err(refusal)?;
     print_outcomes(&outcome.stages, outcome.given_box.as_deref())?;
+    print_cost(&metamer::experiment::budget::total(&outcome.budget))?;
     for line in outcome.comparison_lines() {
         outln!("{line}")?;
     }
@@ -172,6 +173,14 @@ fn request(args: Args) -> Result<Request, CliError> {
             placement_s: args.placement_seconds,
         },
     })
+}
+
+/// What the measuring stages cost against their budget, when every one of them says.
+pub(super) fn print_cost(total: &metamer::session::CostReport) -> CliResult {
+    if let Some(actual) = &total.actual {
+        outln!("{}", actual.after("the measuring stages", &total.estimate))?;
+    }
+    Ok(())
 }
 
 /// A refusal of the request in the words of the command line (exit 2), or what stopped

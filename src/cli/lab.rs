@@ -8,7 +8,7 @@ use metamer::experiment::lab::{run_lab, LabError, LabOptions, LabSummary, LAB_FI
 use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
-use super::experiment::{print_outcomes, refusal, StageProgress};
+use super::experiment::{print_cost, print_outcomes, refusal, StageProgress};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -99,6 +99,7 @@ pub fn run(args: Args) -> CliResult {
         e => CliError::from(e),
     })?;
     print_outcomes(&outcomes, None)?;
+    print_cost(&summary.budget_total)?;
     print_summary(&summary)?;
     outln!(
         "report: {}; summary: {}",

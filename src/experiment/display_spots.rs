@@ -345,9 +345,6 @@ pub fn measure(
         let (light, assumption) = patch_light(drives, screen.as_ref());
         session.estimate(&meters, &light, &assumption, run.placement_s())
     };
-    if session.done() < session.plan().steps.len() {
-        progress(Progress::Note(estimate.before("the display's spots")));
-    }
     let mut rig = Rig {
         screen: s.image.is_none().then_some(screen.as_mut()),
         instruments: vec![("spot".to_string(), meter.as_mut())],
@@ -361,9 +358,6 @@ pub fn measure(
     };
     let end = session.run(&mut rig, run, &mut sink)?;
     let spent = session.spent().clone();
-    progress(Progress::Note(
-        spent.after("the display's spots", &estimate),
-    ));
     record.cost = Some(CostReport {
         estimate,
         actual: Some(spent),
