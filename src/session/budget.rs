@@ -80,39 +80,61 @@ impl Cost {
         }
     }
 
-    /// One line for people: `554 readings in 92 placements, 2 calibrations: about 62.4
-    /// min (instrument 8.3 min, operator 46.0 min, settle 8.1 min)`; `about` is said of an
-    /// estimate.
-    pub fn summary(&self, about: &str) -> String {
+    /// The counts for people: `554 readings in 92 placements, 2 calibrations`.
+    pub fn counts(&self) -> String {
+        let calibrations = match self.calibrations {
+            1 => "1 calibration".to_string(),
+            n => format!("{n} calibrations"),
+        };
         format!(
-            "{} readings in {} placements, {} calibrations: {about}{:.1} min (instrument {:.1} min, operator {:.1} min, settle {:.1} min)",
-            self.readings,
-            self.placements,
-            self.calibrations,
-            self.wall_s / 60.0,
-            self.instrument_s / 60.0,
-            self.operator_s / 60.0,
-            self.settle_s / 60.0,
+            "{} readings in {} placements, {calibrations}",
+            self.readings, self.placements
         )
     }
 
-    /// What is said before the first reading of `what` (a stage, a command).
+    /// What is said before the first reading of `what` (a stage, a command): `budget of
+    /// the box's tiles stage: 125 readings in 25 placements, 1 calibration; about 16.8 min:
+    /// instrument 4.3 min, operator 12.5 min, settle 0 s (assumed: …)`.
     pub fn before(&self, what: &str) -> String {
-        let mut s = format!("budget of {what}: {}", self.summary("about "));
+        let mut s = format!(
+            "budget of {what}: {}; about {}: instrument {}, operator {}, settle {}",
+            self.counts(),
+            duration(self.wall_s),
+            duration(self.instrument_s),
+            duration(self.operator_s),
+            duration(self.settle_s),
+        );
         if !self.assumptions.is_empty() {
-            s.push_str(&format!("; assumed: {}", self.assumptions.join("; ")));
+            s.push_str(&format!(" (assumed: {})", self.assumptions.join("; ")));
         }
         s
     }
 
-    /// What is said when `what` has ended, with the estimate it was made with.
+    /// What is said when `what` has ended, against the `estimate` it was budgeted at:
+    /// `cost of …: 125 readings in 25 placements, 1 calibration; instrument 4.7 min
+    /// (budget 4.3 min), wall 0.2 s (budget 16.8 min)`.
     pub fn after(&self, what: &str, estimate: &Cost) -> String {
         format!(
-            "cost of {what}: {} (estimated {:.1} min, instrument {:.1} min)",
-            self.summary(""),
-            estimate.wall_s / 60.0,
-            estimate.instrument_s / 60.0,
+            "cost of {what}: {}; instrument {} (budget {}), wall {} (budget {})",
+            self.counts(),
+            duration(self.instrument_s),
+            duration(estimate.instrument_s),
+            duration(self.wall_s),
+            duration(estimate.wall_s),
         )
+    }
+}
+
+/// Seconds for people: `0.2 s`, `17 s`, `4.3 min`, `2.5 h`.
+pub fn duration(s: f64) -> String {
+    if s < 10.0 {
+        format!("{s:.1} s")
+    } else if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.1} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
     }
 }
 
@@ -326,4 +348,186 @@ pub fn srgb_assumption(white_cd_m2: f64) -> String {
     format!(
         "a patch's luminance from its drive values on an sRGB display of white {white_cd_m2} cd/m²"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+    use std::time::Duration;
+
+    use metamer_drivers::{SharedWorld, View, World};
+
+    use super::*;
+    use crate::session::{Answer, Operator, OperatorError, RunOptions, Session};
+
+    /// Puts the simulated i1Pro on its white tile to calibrate, and in front of 100 cd/m²
+    /// of LED light to read.
+    struct Placing(Arc<SharedWorld>);
+
+    impl Operator for Placing {
+        fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
+            if prompt.contains("calibration") {
+                self.0.set(View::WhiteTile);
+            } else {
+                let light = metamer_drivers::i1pro::emulator::default_light();
+                self.0.set(View::radiance(light).unwrap());
+            }
+            Ok(Answer::Confirmed)
+        }
+    }
+
+    fn step(role: &str, mode: MeasureMode, prepare: Prepare, settle_ms: u64) -> Step<u32> {
+        Step {
+            label: String::new(),
+            role: role.into(),
+            mode,
+            prepare,
+            settle: Duration::from_millis(settle_ms),
+            data: 0,
+        }
+    }
+
+    fn ask(p: &str) -> Prepare {
+        Prepare::Operator { prompt: p.into() }
+    }
+
+    /// A spot meter placed twice (three readings, then two) and a spectral instrument
+    /// reading two colours shown on a screen, 0.5 s settle each.
+    fn small_plan() -> SessionPlan<u32> {
+        use MeasureMode::Emissive;
+        let show = |v| Prepare::Show { rgb: [v; 3] };
+        SessionPlan {
+            kind: "test".into(),
+            options: BTreeMap::new(),
+            steps: vec![
+                step("spot", Emissive, ask("a"), 0),
+                step("spot", Emissive, ask("a"), 0),
+                step("spot", Emissive, Prepare::None, 0),
+                step("spot", Emissive, ask("b"), 0),
+                step("spot", Emissive, Prepare::None, 0),
+                step("spectral", Emissive, show(255), 500),
+                step("spectral", Emissive, show(128), 500),
+            ],
+        }
+    }
+
+    fn meters() -> BTreeMap<String, Meter> {
+        [
+            ("spot".to_string(), Meter::of_spec(&Spec::new("sim:cs100a"))),
+            (
+                "spectral".to_string(),
+                Meter::of_spec(&Spec::new("sim:i1pro?rev=d&time_scale=0")),
+            ),
+        ]
+        .into()
+    }
+
+    /// By hand from the drivers' stated facts: a CS-100A reading is its FAST 0.1 s plus
+    /// the 5-character command and 28-character reply at 11 bits a character, 4800 baud
+    /// (0.175625 s); an i1Pro Rev D reading of 100 cd/m² is the 0.1 s trial and an
+    /// integration of 37 000 / (45 000 / (2 s · 110 cd/m²) · 100 cd/m²) = 1.80889 s, and its
+    /// emissive dark 212 readings of 4.716 ms and nine of 2 s (18.99979 s), valid 30 min.
+    #[test]
+    fn the_budget_of_a_small_plan_is_the_hand_count() {
+        let plan = small_plan();
+        let cs100a = 0.1 + 33.0 * 11.0 / 4800.0;
+        let i1pro = 0.1 + 37_000.0 * 220.0 / 4_500_000.0;
+        let dark = 212.0 * 4.716e-3 + 18.0;
+        let light = |_: &Step<u32>| 100.0;
+        let all = estimate(&plan, &|_| false, &meters(), &light, "100 cd/m²", 20.0);
+        assert_eq!((all.readings, all.placements, all.calibrations), (7, 2, 1));
+        let instrument = 5.0 * cs100a + 2.0 * i1pro + dark;
+        // The wire time is whole nanoseconds a character, as the driver states it.
+        assert!((all.instrument_s - instrument).abs() < 1e-6, "{all:?}");
+        assert_eq!((all.operator_s, all.settle_s), (40.0, 1.0));
+        assert!((all.wall_s - (instrument + 41.0)).abs() < 1e-6);
+        assert_eq!(all.assumptions, vec!["100 cd/m²", "20 s per placement"]);
+
+        // Resumed after the first placement and one colour: what is left.
+        let left = estimate(&plan, &|i| i < 3 || i == 5, &meters(), &light, "", 20.0);
+        assert_eq!(
+            (left.readings, left.placements, left.calibrations),
+            (3, 1, 1)
+        );
+        assert!((left.instrument_s - (2.0 * cs100a + i1pro + dark)).abs() < 1e-6);
+        assert_eq!((left.operator_s, left.settle_s), (20.0, 0.5));
+
+        // A model that states no time counts at 0 s and says so.
+        let mut unknown = meters();
+        unknown.insert("spot".into(), Meter::of_spec(&Spec::new("replay:x.jsonl")));
+        let u = estimate(&plan, &|_| false, &unknown, &light, "", 20.0);
+        assert!((u.instrument_s - (2.0 * i1pro + dark)).abs() < 1e-6);
+        assert!(
+            u.assumptions[0].contains("not known before it opens"),
+            "{u:?}"
+        );
+    }
+
+    #[test]
+    fn a_placement_time_is_seconds_from_zero_to_a_day() {
+        assert_eq!(placement_s(" 12.5 "), Ok(12.5));
+        assert_eq!(placement_s("0"), Ok(0.0));
+        for bad in ["-1", "nan", "inf", "86401", "half a minute", ""] {
+            assert!(placement_s(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// The small plan's spot readings on the simulated CS-100A at its real pace, and its
+    /// i1Pro readings at no pace (its own clock counts the real unit's time), placed once:
+    /// its dark calibration and two readings of 100 cd/m². The budget within a fifth of what the session took, by the instruments'
+    /// clocks and, for the paced meter, by the wall clock.
+    #[test]
+    fn the_budget_comes_within_a_fifth_of_a_simulated_session_at_real_pace() {
+        let mut plan = small_plan();
+        for s in &mut plan.steps {
+            if matches!(s.prepare, Prepare::Show { .. }) {
+                s.prepare = ask("c");
+            }
+            s.settle = Duration::ZERO;
+        }
+        let dir = std::env::temp_dir().join(format!("metamer-budget-{}", std::process::id()));
+        let journal = dir.join("journal.jsonl");
+        let _ = std::fs::remove_file(&journal);
+        let mut spot = Spec::new("sim:cs100a?time_scale=1").open(None).unwrap();
+        let world = Arc::new(SharedWorld::new(View::WhiteTile));
+        let mut spectral = Spec::new("sim:i1pro?time_scale=0")
+            .open(Some(world.clone() as Arc<dyn World>))
+            .unwrap();
+        let light = |_: &Step<u32>| 100.0;
+        let mut session: Session<(), u32> =
+            Session::open(&journal, plan, (), BTreeMap::new(), false).unwrap();
+        let mut operator = Placing(world);
+        let mut rig = crate::session::Rig {
+            screen: None,
+            instruments: vec![
+                ("spot".to_string(), spot.as_mut()),
+                ("spectral".to_string(), spectral.as_mut()),
+            ],
+            operator: &mut operator,
+        };
+        let budget = session.estimate(&meters_of(&rig.instruments), &light, "", 0.0);
+        session
+            .run(
+                &mut rig,
+                &RunOptions::default(),
+                &mut crate::session::NoProgress,
+            )
+            .unwrap();
+        let spent = session.spent();
+        eprintln!("budget {budget:?}\nspent {spent:?}");
+        assert_eq!(
+            (spent.readings, spent.placements, spent.calibrations),
+            (budget.readings, budget.placements, budget.calibrations)
+        );
+        let near = |a: f64, b: f64| (a / b - 1.0).abs() < 0.2;
+        assert!(
+            near(budget.instrument_s, spent.instrument_s),
+            "{budget:?} {spent:?}"
+        );
+        // The paced meter's five readings by the wall clock: the session's whole run, the
+        // unpaced i1Pro's next to nothing.
+        let paced = 5.0 * (0.1 + 33.0 * 11.0 / 4800.0);
+        assert!(near(paced, spent.wall_s), "{paced} s budgeted, {spent:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -152,23 +152,37 @@ pub fn run(
         total,
         log: session.journal_path().to_path_buf(),
     };
-    if session.done() < total && display.stimulus().is_none() {
+    // A real screen: the operator aims the instrument at its white once, before the first
+    // patch; that is the session's one placement.
+    let aim = session.done() < total && display.stimulus().is_none();
+    let placement_s = options.run.placement_s();
+    let mut cost = CostReport {
+        estimate: estimate(&session, display, &*instrument, placement_s),
+        actual: None,
+    };
+    if aim {
+        cost.estimate.placements += 1;
+        cost.estimate.operator_s += placement_s;
+        cost.estimate.wall_s += placement_s;
+    }
+    if session.done() < total {
+        progress.note(&cost.estimate.before("the display's patches"));
+    }
+    let mut aimed = Cost::default();
+    if aim {
         display.show([255; 3]).map_err(CharacterizeError::Aim)?;
         let prompt = format!(
             "aim the instrument at the middle of the white {}",
             display.describe()
         );
+        let asked = std::time::Instant::now();
         if operator.ask(&prompt)? == Answer::Abort {
             let missing = total - session.done();
             return Ok(incomplete(&session, RunEnd::Aborted { missing }));
         }
-    }
-    let mut cost = CostReport {
-        estimate: estimate(&session, display, &*instrument, options.run.placement_s()),
-        actual: None,
-    };
-    if session.done() < total {
-        progress.note(&cost.estimate.before("the display's patches"));
+        aimed.placements = 1;
+        aimed.operator_s = asked.elapsed().as_secs_f64();
+        aimed.wall_s = aimed.operator_s;
     }
     let end = {
         let mut rig = Rig {
@@ -178,7 +192,8 @@ pub fn run(
         };
         session.run(&mut rig, &options.run, progress)?
     };
-    let spent = session.spent().clone();
+    let mut spent = session.spent().clone();
+    spent.add(&aimed);
     progress.note(&spent.after("the display's patches", &cost.estimate));
     cost.actual = Some(spent);
     if end != RunEnd::Complete {
