@@ -224,9 +224,10 @@ impl StageProgress {
                 b.set_length(total as u64);
                 b.set_position(done as u64);
             }
+            // A hidden bar (no terminal) prints nothing, not even its println.
             Progress::Note(text) => match self.bar.borrow().as_ref() {
-                Some(b) => b.println(format!("  {text}")),
-                None => super::console::reported_at_exit(errln!("  {text}")),
+                Some(b) if !b.is_hidden() => b.println(format!("  {text}")),
+                _ => super::console::reported_at_exit(errln!("  {text}")),
             },
         }
     }
