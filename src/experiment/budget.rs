@@ -127,10 +127,13 @@ fn box_cost(plan: &BoxPlan, m: &MeasureBox, placement_s: f64) -> Cost {
     cost
 }
 
+/// A patch's luminance (cd/m²) from its drive values.
+type PatchLight = Box<dyn Fn([u8; 3]) -> f64>;
+
 /// A patch's luminance on the stage's screen before the simulation sets a simulated
 /// monitor's white (its preset's), or on an sRGB display for a real one; and what that
 /// assumes.
-fn screen_light(screen: &ScreenSpec) -> (Box<dyn Fn([u8; 3]) -> f64>, String) {
+fn screen_light(screen: &ScreenSpec) -> (PatchLight, String) {
     match screen {
         ScreenSpec::Virtual(p) => {
             let panel = VirtualPanel::preset(*p);
