@@ -182,6 +182,34 @@ fn set_aside(stage: BoxStage, path: &Path) -> Result<(), MeasureBoxError> {
     })
 }
 
+/// Runs one stage's session, its budget said before its first reading and its cost after.
+fn run_costed(
+    session: &mut Session<BoxDetails, BoxStep>,
+    rig: &mut Rig<'_>,
+    options: &BoxOptions,
+    stage: BoxStage,
+    progress: &mut dyn ProgressSink,
+) -> Result<(RunEnd, CostReport), MeasureBoxError> {
+    let estimate = session.estimate(
+        &meters_of(&rig.instruments),
+        &|_| BOX_TARGET_CD_M2,
+        BOX_LIGHT_ASSUMPTION,
+        options.run.placement_s(),
+    );
+    let named = format!("the box's {stage} stage");
+    progress.note(&estimate.before(&named));
+    let end = session
+        .run(rig, &options.run, progress)
+        .map_err(|source| MeasureBoxError::Session { stage, source })?;
+    let spent = session.spent().clone();
+    progress.note(&spent.after(&named, &estimate));
+    let cost = CostReport {
+        estimate,
+        actual: Some(spent),
+    };
+    Ok((end, cost))
+}
+
 /// The light every box target is budgeted at, cd/m²: a light tile's before its gain in the
 /// simulated box; a real box's light is not known before it is measured.
 pub const BOX_TARGET_CD_M2: f64 = crate::rig::simulated_box::TILE_CD_M2;
@@ -271,26 +299,8 @@ pub fn run(
         } else {
             progress.note(&what);
         }
-        let estimate = session.estimate(
-            &meters_of(&rig.instruments),
-            &|_| BOX_TARGET_CD_M2,
-            BOX_LIGHT_ASSUMPTION,
-            options.run.placement_s(),
-        );
-        let named = format!("the box's {stage} stage");
-        progress.note(&estimate.before(&named));
-        let end = session
-            .run(&mut rig, &options.run, progress)
-            .map_err(|source| MeasureBoxError::Session { stage, source })?;
-        let spent = session.spent().clone();
-        progress.note(&spent.after(&named, &estimate));
-        cost.insert(
-            stage.name().to_string(),
-            CostReport {
-                estimate,
-                actual: Some(spent),
-            },
-        );
+        let (end, costs) = run_costed(&mut session, &mut rig, options, stage, progress)?;
+        cost.insert(stage.name().to_string(), costs);
         if end != RunEnd::Complete {
             return Ok(Outcome::Incomplete {
                 stage,

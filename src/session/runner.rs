@@ -575,20 +575,13 @@ where
                     break reading;
                 }
                 let why = what_differs(&placement, index, &step.label);
-                let operator = &mut *rig.operator;
-                let mut answer = Ok(Recheck::Keep);
-                let asked = Instant::now();
-                progress.suspend(&mut || answer = operator.recheck(&why));
-                self.spent.operator_s += asked.elapsed().as_secs_f64();
+                let answer = recheck(&mut *rig.operator, progress, &mut self.spent, &why);
                 match answer.map_err(|e| fail(StepFailure::Operator(e)))? {
                     Recheck::Keep => break reading,
                     Recheck::Stop => return Ok(RunEnd::Aborted { missing }),
                     Recheck::Again => {
-                        self.spent.placements += 1;
-                        progress.note(&format!(
-                            "  set aside: {}; reading it again",
-                            reading_summary(step.mode, &reading)
-                        ));
+                        let again = reading_summary(step.mode, &reading);
+                        progress.note(&format!("  set aside: {again}; reading it again"));
                         // The operator re-aimed and confirmed: the placement stands.
                         placed = placement.as_ref().map(|r| r.start);
                     }
@@ -605,6 +598,24 @@ where
         }
         Ok(RunEnd::Complete)
     }
+}
+
+/// Puts a reading that differs (`why`) to the operator with the progress display out of
+/// the way; the time it waits is the operator's, and reading again is a placement.
+fn recheck(
+    operator: &mut dyn super::operator::Operator,
+    progress: &mut dyn ProgressSink,
+    spent: &mut Cost,
+    why: &str,
+) -> Result<Recheck, super::operator::OperatorError> {
+    let mut answer = Ok(Recheck::Keep);
+    let asked = Instant::now();
+    progress.suspend(&mut || answer = operator.recheck(why));
+    spent.operator_s += asked.elapsed().as_secs_f64();
+    if matches!(answer, Ok(Recheck::Again)) {
+        spent.placements += 1;
+    }
+    answer
 }
 
 /// Whether readings of the instrument `now` are comparable with those of `logged`: the same

@@ -155,35 +155,17 @@ pub fn run(
     // A real screen: the operator aims the instrument at its white once, before the first
     // patch; that is the session's one placement.
     let aim = session.done() < total && display.stimulus().is_none();
-    let placement_s = options.run.placement_s();
     let mut cost = CostReport {
-        estimate: estimate(&session, display, &*instrument, placement_s),
+        estimate: estimate(&session, display, &*instrument, options, aim),
         actual: None,
     };
-    if aim {
-        cost.estimate.placements += 1;
-        cost.estimate.operator_s += placement_s;
-        cost.estimate.wall_s += placement_s;
-    }
     if session.done() < total {
         progress.note(&cost.estimate.before("the display's patches"));
     }
-    let mut aimed = Cost::default();
-    if aim {
-        display.show([255; 3]).map_err(CharacterizeError::Aim)?;
-        let prompt = format!(
-            "aim the instrument at the middle of the white {}",
-            display.describe()
-        );
-        let asked = std::time::Instant::now();
-        if operator.ask(&prompt)? == Answer::Abort {
-            let missing = total - session.done();
-            return Ok(incomplete(&session, RunEnd::Aborted { missing }));
-        }
-        aimed.placements = 1;
-        aimed.operator_s = asked.elapsed().as_secs_f64();
-        aimed.wall_s = aimed.operator_s;
-    }
+    let Some(aimed) = aim_at_white(aim, display, operator)? else {
+        let missing = total - session.done();
+        return Ok(incomplete(&session, RunEnd::Aborted { missing }));
+    };
     let end = {
         let mut rig = Rig {
             screen: Some(display),
@@ -222,15 +204,46 @@ pub fn run(
     Ok(Outcome::Finished(Box::new(summary)))
 }
 
+/// Has the operator aim the instrument at the white of a real screen (`aim`): the
+/// placement and the time it took (nothing without `aim`), or None when the operator
+/// declined.
+fn aim_at_white(
+    aim: bool,
+    display: &mut dyn Screen,
+    operator: &mut dyn Operator,
+) -> Result<Option<Cost>, CharacterizeError> {
+    if !aim {
+        return Ok(Some(Cost::default()));
+    }
+    display.show([255; 3]).map_err(CharacterizeError::Aim)?;
+    let prompt = format!(
+        "aim the instrument at the middle of the white {}",
+        display.describe()
+    );
+    let asked = std::time::Instant::now();
+    if operator.ask(&prompt)? == Answer::Abort {
+        return Ok(None);
+    }
+    let operator_s = asked.elapsed().as_secs_f64();
+    Ok(Some(Cost {
+        placements: 1,
+        operator_s,
+        wall_s: operator_s,
+        ..Cost::default()
+    }))
+}
+
 /// The budget of the patches the journal of `session` lacks: each patch's luminance as the
 /// screen knows it (a simulated monitor), else as an sRGB display of the standard's 80 cd/m²
-/// white would give it.
+/// white would give it; with the operator's aim at the white of a real screen (`aim`).
 fn estimate(
     session: &Session<LogDetails, DriveStep>,
     display: &dyn Screen,
     instrument: &dyn Instrument,
-    placement_s: f64,
+    options: &Options,
+    aim: bool,
 ) -> Cost {
+    let placement_s = options.run.placement_s();
     let meters = [(METER.to_string(), Meter::of(instrument))].into();
     let known = display.expected_cd_m2([255; 3]).is_some();
     let rgb = |step: &Step<DriveStep>| match step.prepare {
@@ -251,7 +264,13 @@ fn estimate(
     } else {
         srgb_assumption(SRGB_WHITE_CD_M2)
     };
-    session.estimate(&meters, &light, &assumption, placement_s)
+    let mut cost = session.estimate(&meters, &light, &assumption, placement_s);
+    if aim {
+        cost.placements += 1;
+        cost.operator_s += placement_s;
+        cost.wall_s += placement_s;
+    }
+    cost
 }
 
 /// What resuming `session` found in its journal (readings, a torn last line set aside),
