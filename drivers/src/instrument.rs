@@ -260,6 +260,14 @@ pub trait Instrument: Send {
     fn seek_noise(&mut self, index: u64) {
         let _ = index;
     }
+    /// Seconds of the instrument's own time (integration, lamp, measuring and wire time)
+    /// spent since it was opened, at the real instrument's pace, where the instrument
+    /// counts it: a simulation does, whatever its time scale, so a session at `time_scale`
+    /// 0 still learns what its readings would have cost. None for a real instrument, whose
+    /// time is the wall time of its calls.
+    fn instrument_time_s(&self) -> Option<f64> {
+        None
+    }
 }
 
 #[cfg(test)]

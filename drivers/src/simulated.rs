@@ -3,6 +3,7 @@
 //! option values (so a journal records them and a resume with others is refused), and the
 //! emulator's noise stream positioned per reading ([`Instrument::seek_noise`]).
 
+use crate::i1pro::{Clock, ManualClock};
 use crate::instrument::{
     CalibrationCondition, CalibrationOutcome, Capabilities, Instrument, InstrumentInfo,
     MeasureMode, Reading, Request,
@@ -19,19 +20,24 @@ pub struct Simulated {
     inner: Box<dyn Instrument>,
     noise: NoiseCursor,
     settings: Vec<(String, String)>,
+    /// The emulator's own time at the real instrument's pace.
+    pace: ManualClock,
 }
 
 impl Simulated {
-    /// Wraps `inner`, whose emulator draws its noise through `noise`.
+    /// Wraps `inner`, whose emulator draws its noise through `noise` and counts its time
+    /// at the real pace on `pace`.
     pub fn wrap(
         inner: Box<dyn Instrument>,
         noise: NoiseCursor,
+        pace: ManualClock,
         settings: &SimSettings,
     ) -> Box<dyn Instrument> {
         Box::new(Simulated {
             inner,
             noise,
             settings: settings_values(settings),
+            pace,
         })
     }
 }
@@ -86,5 +92,8 @@ impl Instrument for Simulated {
     }
     fn seek_noise(&mut self, index: u64) {
         self.noise.seek(index);
+    }
+    fn instrument_time_s(&self) -> Option<f64> {
+        Some(self.pace.now_s())
     }
 }

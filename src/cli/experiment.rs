@@ -103,6 +103,10 @@ pub struct Args {
     /// Do not mirror the reproduced image (the paper views the display in a mirror).
     #[arg(long)]
     no_mirror: bool,
+    /// The operator's time per placement the budget printed before the first reading
+    /// assumes, seconds (default 30: a person's half minute to place, aim and confirm).
+    #[arg(long, value_name = "S", value_parser = super::parse_placement_seconds)]
+    placement_seconds: Option<f64>,
     /// Nobody is at the rig: take every reading without asking anyone to place, aim or
     /// calibrate the instruments. Real instruments without a terminal on stdin need it.
     #[arg(long)]
@@ -116,6 +120,7 @@ pub fn run_cli(args: Args) -> CliResult {
     shown.finish();
     let outcome = outcome.map_err(refusal)?;
     print_outcomes(&outcome.stages, outcome.given_box.as_deref())?;
+    print_cost(&metamer::experiment::budget::total(&outcome.budget))?;
     for line in outcome.comparison_lines() {
         outln!("{line}")?;
     }
@@ -171,8 +176,17 @@ fn request(args: Args) -> Result<Request, CliError> {
         run: RunOptions {
             stop_after: None,
             interrupt: Some(on_ctrl_c()),
+            placement_s: args.placement_seconds,
         },
     })
+}
+
+/// What the measuring stages cost against their budget, when every one of them says.
+pub(super) fn print_cost(total: &metamer::session::CostReport) -> CliResult {
+    if let Some(actual) = &total.actual {
+        outln!("{}", actual.after("the measuring stages", &total.estimate))?;
+    }
+    Ok(())
 }
 
 /// A refusal of the request in the words of the command line (exit 2), or what stopped
@@ -218,9 +232,10 @@ impl StageProgress {
                 b.set_length(total as u64);
                 b.set_position(done as u64);
             }
+            // A hidden bar (no terminal) prints nothing, not even its println.
             Progress::Note(text) => match self.bar.borrow().as_ref() {
-                Some(b) => b.println(format!("  {text}")),
-                None => super::console::reported_at_exit(errln!("  {text}")),
+                Some(b) if !b.is_hidden() => b.println(format!("  {text}")),
+                _ => super::console::reported_at_exit(errln!("  {text}")),
             },
         }
     }

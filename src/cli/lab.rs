@@ -8,7 +8,7 @@ use metamer::experiment::lab::{run_lab, LabError, LabOptions, LabSummary, LAB_FI
 use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
-use super::experiment::{print_outcomes, refusal, StageProgress};
+use super::experiment::{print_cost, print_outcomes, refusal, StageProgress};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -64,6 +64,10 @@ pub struct Args {
     /// Continue an interrupted measuring stage from its journal.
     #[arg(long)]
     resume: bool,
+    /// The operator's time per placement the budget printed before the first reading
+    /// assumes, seconds (default 30: a person's half minute to place, aim and confirm).
+    #[arg(long, value_name = "S", value_parser = super::parse_placement_seconds)]
+    placement_seconds: Option<f64>,
     /// Run every stage again, even those whose inputs are unchanged (earlier measurements
     /// are moved aside, never deleted).
     #[arg(long)]
@@ -94,6 +98,7 @@ pub fn run(args: Args) -> CliResult {
     let run = RunOptions {
         stop_after: None,
         interrupt: Some(on_ctrl_c()),
+        placement_s: args.placement_seconds,
     };
     let shown = StageProgress::default();
     let summary = run_lab(&args.out, &options, args.resume, args.force, run, &|p| {
@@ -105,6 +110,7 @@ pub fn run(args: Args) -> CliResult {
         e => CliError::from(e),
     })?;
     print_outcomes(&outcomes, None)?;
+    print_cost(&summary.budget_total)?;
     print_summary(&summary)?;
     outln!(
         "report: {}; summary: {}",

@@ -51,6 +51,10 @@ pub struct Args {
     /// calibrate the instruments. Real instruments without a terminal on stdin need it.
     #[arg(long)]
     unattended: bool,
+    /// The operator's time per placement the budget printed before the first reading
+    /// assumes, seconds (default 30: a person's half minute to place, aim and confirm).
+    #[arg(long, value_name = "S", value_parser = super::parse_placement_seconds)]
+    placement_seconds: Option<f64>,
     /// Stop after N new readings, as if interrupted (tests; splitting a long session).
     #[arg(long, value_name = "N", hide = true)]
     stop_after: Option<usize>,
@@ -76,6 +80,7 @@ pub fn run(args: Args) -> CliResult {
         run: RunOptions {
             stop_after: args.stop_after,
             interrupt: Some(on_ctrl_c()),
+            placement_s: args.placement_seconds,
         },
         // Asked as the flags and the terminal say; the spots stay in summary.json.
         attendance: None,

@@ -202,6 +202,11 @@ fn needs_force(error: &(dyn std::error::Error + 'static)) -> bool {
     false
 }
 
+/// Parses `--placement-seconds` for clap: a usage error when out of range.
+pub fn parse_placement_seconds(s: &str) -> Result<f64, String> {
+    metamer::session::budget::placement_s(s).map_err(|e| e.to_string())
+}
+
 /// Parses `X,Y,Z` (three finite numbers) for clap.
 pub fn parse_triple(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

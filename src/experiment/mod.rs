@@ -9,6 +9,7 @@
 //! resume after any interruption. [`Request::run`] is the whole experiment as one call;
 //! [`lab`] is its preset for the simulated rig ([`lab::LabOptions::request`]).
 
+pub mod budget;
 pub mod cache;
 pub mod display;
 pub mod display_spots;

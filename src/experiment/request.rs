@@ -98,6 +98,10 @@ pub struct Outcome {
     pub validation: Option<ValidationResult>,
     /// The validation report, when it exists.
     pub report: Option<PathBuf>,
+    /// Each measuring stage's budget before its first reading and what it took, as the
+    /// stage's files keep them (a stage they keep none for: its plan's budget, nothing
+    /// taken).
+    pub budget: Vec<super::budget::StageBudget>,
 }
 
 impl Outcome {
@@ -238,7 +242,9 @@ impl Request {
         };
         let validation = self.dir.join(Stage::Validation.name());
         let report = validation.join(HTML_FILE);
+        let budget = super::budget::recorded(&self.dir, &super::budget::budget(&options));
         Ok(Outcome {
+            budget,
             stages,
             given_box: match &self.box_source {
                 BoxRequest::Given { spots, .. } => Some(spots.clone()),

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::budget::StageBudget;
 use super::cache::{Inputs, StageDir, RECORD_FILE};
 use super::display::{characterize_display, DisplaySetting};
 use super::error::ExperimentError;
@@ -109,6 +110,8 @@ pub fn run(
         }
     }
     super::preflight::check(opts)?;
+    let planned = super::budget::budget(opts);
+    say_budget(opts, &planned, progress);
     // The user's box files are this run's inputs: no stage may write onto them, by any
     // name (a link, a hard link), whatever policy it writes with.
     let _given = match &opts.box_source {
@@ -185,6 +188,15 @@ pub fn run(
             });
         }
         let files = files?;
+        if stage.measures() {
+            let kept = super::budget::recorded(root, &planned);
+            if let Some(c) = kept.iter().find(|c| c.stage == stage.name()) {
+                if let Some(actual) = &c.cost.actual {
+                    let what = format!("the {stage} stage");
+                    progress(Progress::Note(actual.after(&what, &c.cost.estimate)));
+                }
+            }
+        }
         let seconds = start.elapsed().as_secs_f64();
         sd.finish(&inputs, &files, seconds)?;
         outcomes.push(StageOutcome {
@@ -196,6 +208,23 @@ pub fn run(
         });
     }
     Ok(outcomes)
+}
+
+/// The measuring stages' budget before the first stage, each as if it ran in full, and
+/// their sum; a stage that is re-used or resumed takes less.
+fn say_budget(opts: &ExperimentOptions, planned: &[StageBudget], progress: &dyn Fn(Progress)) {
+    let runs = |s: &StageBudget| opts.stage.is_none_or(|only| only.name() == s.stage);
+    let shown: Vec<StageBudget> = planned.iter().filter(|s| runs(s)).cloned().collect();
+    for s in &shown {
+        let what = format!("the {} stage", s.stage);
+        progress(Progress::Note(s.cost.estimate.before(&what)));
+    }
+    if shown.len() > 1 {
+        let total = super::budget::total(&shown);
+        progress(Progress::Note(total.estimate.before(
+            "the measuring stages (each in full; a stage re-used or resumed takes less)",
+        )));
+    }
 }
 
 fn interrupted(opts: &ExperimentOptions) -> bool {

@@ -22,7 +22,7 @@ use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
 use crate::render::scene::DistributionFile;
-use crate::session::{Entry, InstrumentRecord};
+use crate::session::{CostReport, Entry, InstrumentRecord};
 use crate::validation::repeatability;
 
 /// What each stage journal's header says besides its plan.
@@ -122,6 +122,10 @@ pub struct Summary {
     pub render: RenderComparison,
     pub provenance: Provenance,
     pub files: Files,
+    /// Each stage measured in this call, by name: its budget before its first reading and
+    /// what it took (a stage complete before this call has none).
+    #[serde(default)]
+    pub cost: BTreeMap<String, CostReport>,
 }
 
 /// The readings could not become a scene.
@@ -286,6 +290,7 @@ pub fn assemble(
     entries: &StageEntries,
     instruments: &BTreeMap<String, InstrumentRecord>,
     details: &BoxDetails,
+    cost: &BTreeMap<String, CostReport>,
 ) -> Result<Summary, AssembleError> {
     let (stages, flags) = reduce_stages(entries)?;
     let light = fit_light(&falloff_readings(&stages.falloff))?;
@@ -340,6 +345,7 @@ pub fn assemble(
         render,
         provenance,
         files,
+        cost: cost.clone(),
     };
     write_json(&policy, &summary.files.summary, &summary)?;
     Ok(summary)

@@ -13,9 +13,10 @@ use super::plan::{BoxPlan, BoxStage, BoxStep, SPECTRAL, SPOT};
 use super::spot_rule::SpotStopping;
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
+use crate::session::budget::meters_of;
 use crate::session::{
-    placements, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig, RunEnd,
-    RunOptions, Session, SessionError, StageOf,
+    placements, CostReport, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig,
+    RunEnd, RunOptions, Session, SessionError, StageOf,
 };
 use crate::validation::repeatability;
 
@@ -184,6 +185,42 @@ fn set_aside(stage: BoxStage, path: &Path) -> Result<(), MeasureBoxError> {
     })
 }
 
+/// Runs one stage's session, its budget said before its first reading and its cost after.
+fn run_costed(
+    session: &mut Session<BoxDetails, BoxStep>,
+    rig: &mut Rig<'_>,
+    options: &BoxOptions,
+    stage: BoxStage,
+    progress: &mut dyn ProgressSink,
+) -> Result<(RunEnd, CostReport), MeasureBoxError> {
+    let estimate = session.estimate(
+        &meters_of(&rig.instruments),
+        &|_| BOX_TARGET_CD_M2,
+        BOX_LIGHT_ASSUMPTION,
+        options.run.placement_s(),
+    );
+    let named = format!("the box's {stage} stage");
+    progress.note(&estimate.before(&named));
+    let end = session
+        .run(rig, &options.run, progress)
+        .map_err(|source| MeasureBoxError::Session { stage, source })?;
+    let spent = session.spent().clone();
+    progress.note(&spent.after(&named, &estimate));
+    let cost = CostReport {
+        estimate,
+        actual: Some(spent),
+    };
+    Ok((end, cost))
+}
+
+/// The light every box target is budgeted at, cd/m²: a light tile's before its gain in the
+/// simulated box; a real box's light is not known before it is measured.
+pub const BOX_TARGET_CD_M2: f64 = super::simulated_box::TILE_CD_M2;
+
+/// What [`BOX_TARGET_CD_M2`] assumes, as the budget says it.
+pub const BOX_LIGHT_ASSUMPTION: &str =
+    "every box target read at a light tile's 100 cd/m² (the simulated box's tiles before their gain)";
+
 fn open_stage(
     options: &BoxOptions,
     stage: BoxStage,
@@ -243,6 +280,7 @@ pub fn run(
         ],
         operator,
     };
+    let mut cost = BTreeMap::new();
     for &stage in &stages {
         let path = stage.journal(&options.dir);
         if options.stage.is_some() && !options.resume {
@@ -279,9 +317,8 @@ pub fn run(
         } else {
             progress.note(&what);
         }
-        let end = session
-            .run(&mut rig, &options.run, progress)
-            .map_err(|source| MeasureBoxError::Session { stage, source })?;
+        let (end, costs) = run_costed(&mut session, &mut rig, options, stage, progress)?;
+        cost.insert(stage.name().to_string(), costs);
         if end != RunEnd::Complete {
             return Ok(Outcome::Incomplete {
                 stage,
@@ -305,6 +342,7 @@ pub fn run(
         &entries,
         &records,
         &options.details,
+        &cost,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }

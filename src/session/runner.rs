@@ -15,11 +15,12 @@ use metamer_drivers::{MeasureMode, Reading};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
+use super::budget::{estimate, Cost, Meter, PLACEMENT_S};
 use super::journal::{
     CalibrationRecord, Header, Journal, JournalError, JOURNAL_FORMAT, JOURNAL_VERSION,
 };
 use super::operator::Recheck;
-use super::plan::{placements, Prepare, SessionPlan};
+use super::plan::{placements, Prepare, SessionPlan, Step};
 use super::progress::{reading_summary, ProgressSink, StepProgress};
 use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 use super::repeats::deviation;
@@ -112,6 +113,8 @@ pub struct RunOptions {
     pub stop_after: Option<usize>,
     /// Set from elsewhere (a Ctrl-C handler) to stop before the next step.
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// The operator's time per placement the budget assumes; None: [`PLACEMENT_S`].
+    pub placement_s: Option<f64>,
 }
 
 /// Where a run ended.
@@ -128,6 +131,11 @@ pub enum RunEnd {
 }
 
 impl RunOptions {
+    /// The operator's time per placement the budget assumes.
+    pub fn placement_s(&self) -> f64 {
+        self.placement_s.unwrap_or(PLACEMENT_S)
+    }
+
     /// How a run ends before its next step, with `missing` steps missing, when it has taken
     /// `new` steps: interrupted, or stopped after as many as asked; None to go on.
     fn end_before_step(&self, new: usize, missing: usize) -> Option<RunEnd> {
@@ -186,6 +194,8 @@ pub struct Session<H, D> {
     /// What resuming repaired that the operator should know (readings of a second session
     /// set aside); [`Session::run`] reports them first.
     pub notes: Vec<String>,
+    /// What this process's runs took.
+    spent: Cost,
 }
 
 /// Puts each journalled entry of `recovered` (with its line) at its step in `entries`,
@@ -355,6 +365,7 @@ where
                 torn_bytes: 0,
                 set_aside,
                 notes: Vec::new(),
+                spent: Cost::default(),
             });
         };
         let journal: SessionJournal<H, D> = journal;
@@ -379,6 +390,7 @@ where
             torn_bytes: recovered.torn_bytes,
             set_aside: None,
             notes,
+            spent: Cost::default(),
         })
     }
 
@@ -433,6 +445,35 @@ where
         &self.calibrations
     }
 
+    /// The cost of the steps the journal lacks ([`estimate`]), with the rig's instruments
+    /// as `meters`, each step's expected light from `light` (where it comes from said by
+    /// `light_assumption`) and `placement_s` seconds per placement.
+    pub fn estimate(
+        &self,
+        meters: &BTreeMap<String, Meter>,
+        light: &dyn Fn(&Step<D>) -> f64,
+        light_assumption: &str,
+        placement_s: f64,
+    ) -> Cost {
+        estimate(
+            &self.plan,
+            &|i| self.entries[i].is_some(),
+            meters,
+            light,
+            light_assumption,
+            placement_s,
+        )
+    }
+
+    /// What this process's runs of the session took: the readings journalled, the
+    /// placements the operator confirmed, the calibrations, the instruments' own time (a
+    /// simulation's at the real pace, whatever its time scale; a real instrument's by the
+    /// clock around its calls), the time requests waited for the operator, the settle
+    /// waits, and the wall time of the runs.
+    pub fn spent(&self) -> &Cost {
+        &self.spent
+    }
+
     /// Every entry in plan order; None until every step is measured or skipped by the
     /// stopping rule.
     pub fn complete_entries(&self) -> Option<Vec<&Entry<D>>> {
@@ -460,7 +501,23 @@ where
         }
         let total = self.plan.steps.len();
         progress.start(self.done(), total);
-        let result = self.run_steps(rig, options, progress);
+        let started = Instant::now();
+        let clocks: Vec<Option<f64>> = rig
+            .instruments
+            .iter()
+            .map(|(_, i)| i.instrument_time_s())
+            .collect();
+        let mut wall_in_calls = vec![0.0; clocks.len()];
+        let result = self.run_steps(rig, options, progress, &mut wall_in_calls);
+        // An instrument that counts its own time says it; another's is the clock's around
+        // its calls.
+        for (k, (_, instrument)) in rig.instruments.iter().enumerate() {
+            self.spent.instrument_s += match (clocks[k], instrument.instrument_time_s()) {
+                (Some(before), Some(after)) => after - before,
+                _ => wall_in_calls[k],
+            };
+        }
+        self.spent.wall_s += started.elapsed().as_secs_f64();
         progress.finish();
         result
     }
@@ -507,6 +564,7 @@ where
         rig: &mut Rig<'_>,
         options: &RunOptions,
         progress: &mut dyn ProgressSink,
+        wall_in_calls: &mut [f64],
     ) -> Result<RunEnd, SessionError> {
         let total = self.plan.steps.len();
         let mut placed = None;
@@ -547,6 +605,8 @@ where
                     progress,
                     placement: placement.clone(),
                     placed: &mut placed,
+                    spent: &mut self.spent,
+                    wall_in_calls: &mut *wall_in_calls,
                 };
                 let Some(reading) = taker.take().map_err(fail)? else {
                     return Ok(RunEnd::Aborted { missing });
@@ -576,17 +636,13 @@ where
                     break reading;
                 }
                 let why = what_differs(&placement, index, &step.label);
-                let operator = &mut *rig.operator;
-                let mut answer = Ok(Recheck::Keep);
-                progress.suspend(&mut || answer = operator.recheck(&why));
+                let answer = recheck(&mut *rig.operator, progress, &mut self.spent, &why);
                 match answer.map_err(|e| fail(StepFailure::Operator(e)))? {
                     Recheck::Keep => break reading,
                     Recheck::Stop => return Ok(RunEnd::Aborted { missing }),
                     Recheck::Again => {
-                        progress.note(&format!(
-                            "  set aside: {}; reading it again",
-                            reading_summary(step.mode, &reading)
-                        ));
+                        let again = reading_summary(step.mode, &reading);
+                        progress.note(&format!("  set aside: {again}; reading it again"));
                         // The operator re-aimed and confirmed: the placement stands.
                         placed = placement.as_ref().map(|r| r.start);
                     }
@@ -598,10 +654,29 @@ where
                 .map_err(|e| fail(StepFailure::Journal(e)))?;
             done += 1;
             new += 1;
+            self.spent.readings += 1;
             self.entries[index] = Some(entry);
         }
         Ok(RunEnd::Complete)
     }
+}
+
+/// Puts a reading that differs (`why`) to the operator with the progress display out of
+/// the way; the time it waits is the operator's, and reading again is a placement.
+fn recheck(
+    operator: &mut dyn super::operator::Operator,
+    progress: &mut dyn ProgressSink,
+    spent: &mut Cost,
+    why: &str,
+) -> Result<Recheck, super::operator::OperatorError> {
+    let mut answer = Ok(Recheck::Keep);
+    let asked = Instant::now();
+    progress.suspend(&mut || answer = operator.recheck(why));
+    spent.operator_s += asked.elapsed().as_secs_f64();
+    if matches!(answer, Ok(Recheck::Again)) {
+        spent.placements += 1;
+    }
+    answer
 }
 
 /// Whether readings of the instrument `now` are comparable with those of `logged`: the same

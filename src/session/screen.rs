@@ -87,6 +87,13 @@ pub trait Screen {
     fn meter_aim(&self) -> Option<MeterAim> {
         None
     }
+    /// The luminance (cd/m²) showing `rgb` is known to give, for a measurement's budget
+    /// before it runs: a simulated monitor knows it; None for a real screen, whose
+    /// response is what is being measured.
+    fn expected_cd_m2(&self, rgb: [u8; 3]) -> Option<f64> {
+        let _ = rgb;
+        None
+    }
 }
 
 /// A screen could not show a colour.

@@ -10,7 +10,9 @@ use metamer_drivers::{
 };
 use serde::de::DeserializeOwned;
 use serde::Serialize;
+use std::time::Instant;
 
+use super::budget::Cost;
 use super::journal::{CalibrationRecord, JournalError};
 use super::operator::{Answer, Operator, OperatorError, PlacementReadings};
 use super::plan::{Prepare, Step};
@@ -97,6 +99,11 @@ pub(super) struct StepTaker<'s, 'r, 'a, H, D> {
     /// its later readings are taken without asking again. A calibration (the instrument
     /// moved to its tile or capped) clears it.
     pub(super) placed: &'s mut Option<usize>,
+    /// What the run has taken so far, added to as the step is taken.
+    pub(super) spent: &'s mut Cost,
+    /// Wall seconds in each of the rig's instruments' calls (by their order in the rig),
+    /// the instrument time of those that do not count their own.
+    pub(super) wall_in_calls: &'s mut [f64],
 }
 
 impl<'a, H, D> StepTaker<'_, '_, 'a, H, D>
@@ -117,12 +124,15 @@ where
                 return Ok(None);
             }
             std::thread::sleep(self.step.settle);
+            self.spent.settle_s += self.step.settle.as_secs_f64();
             let model = self.instrument()?.info().model;
             let beat = Heartbeat::start(format!(
                 "the {} instrument ({model}) measures {}",
                 self.step.role, self.step.label
             ));
+            let called = Instant::now();
             let measured = self.instrument()?.measure(&request);
+            self.in_call(called);
             drop(beat);
             match measured {
                 Ok(reading) => return Ok(Some(reading)),
@@ -141,6 +151,14 @@ where
                 }
                 Err(e) => return Err(e.into()),
             }
+        }
+    }
+
+    /// Adds the wall time since `called` to the step's instrument's calls.
+    fn in_call(&mut self, called: Instant) {
+        let role = &self.step.role;
+        if let Some(k) = self.rig.instruments.iter().position(|(r, _)| r == role) {
+            self.wall_in_calls[k] += called.elapsed().as_secs_f64();
         }
     }
 
@@ -212,7 +230,9 @@ where
             let beat = Heartbeat::start(format!(
                 "the {role} instrument ({model}) calibrates for {mode} readings"
             ));
+            let called = Instant::now();
             let outcome = self.instrument()?.calibrate(mode, &condition);
+            self.in_call(called);
             drop(beat);
             let outcome = outcome?;
             let record = CalibrationRecord {
@@ -226,6 +246,7 @@ where
             };
             self.journal.append_calibration(&record)?;
             self.calibrations.push(record);
+            self.spent.calibrations += 1;
             // Whatever the operator had set up, the instrument was moved for this.
             *self.placed = None;
             let how = calibrated(&condition);
@@ -260,7 +281,9 @@ where
     fn ask(&mut self, prompt: &str) -> Result<Answer, OperatorError> {
         let operator = &mut *self.rig.operator;
         let mut answer = Ok(Answer::Abort);
+        let asked = Instant::now();
         self.progress.suspend(&mut || answer = operator.ask(prompt));
+        self.spent.operator_s += asked.elapsed().as_secs_f64();
         answer
     }
 
@@ -276,7 +299,9 @@ where
             }
             Prepare::Operator { prompt } => {
                 let Some(range) = self.placement.clone() else {
-                    return Ok(self.ask(prompt)? == Answer::Confirmed);
+                    let confirmed = self.ask(prompt)? == Answer::Confirmed;
+                    self.spent.placements += usize::from(confirmed);
+                    return Ok(confirmed);
                 };
                 if *self.placed == Some(range.start) {
                     return Ok(true);
@@ -287,11 +312,14 @@ where
                 };
                 let operator = &mut *self.rig.operator;
                 let mut answer = Ok(Answer::Abort);
+                let asked = Instant::now();
                 self.progress
                     .suspend(&mut || answer = operator.ask_placement(prompt, readings));
+                self.spent.operator_s += asked.elapsed().as_secs_f64();
                 let confirmed = answer? == Answer::Confirmed;
                 if confirmed {
                     *self.placed = Some(range.start);
+                    self.spent.placements += 1;
                 }
                 Ok(confirmed)
             }

@@ -4,6 +4,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod budget_cli;
 mod characterize_cli;
 mod color_cli;
 mod devices_cli;

@@ -54,6 +54,7 @@ fn run(dir: &Path, resume: bool, stop_after: Option<usize>) -> Outcome {
         run: RunOptions {
             stop_after,
             interrupt: None,
+            placement_s: None,
         },
         output: OutputPolicy::new(false),
     };

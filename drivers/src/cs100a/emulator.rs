@@ -21,6 +21,7 @@ use metamer_color::Xyz;
 use metamer_protocols::cs100a::{self, Command, Mode, Status, Yxy};
 
 use super::Speed;
+use crate::i1pro::ManualClock;
 use crate::link::{LineSettings, LinkError, SerialLink};
 use crate::noise::NoiseCursor;
 use crate::world::World;
@@ -65,6 +66,9 @@ pub struct Cs100aEmulator {
     config: EmulatorConfig,
     noise: NoiseCursor,
     speed: Speed,
+    /// The meter's own time at the real pace, whatever the time scale: every measurement's
+    /// measuring time and its command and reply on the wire add to it.
+    real_pace: ManualClock,
 }
 
 impl Cs100aEmulator {
@@ -75,12 +79,19 @@ impl Cs100aEmulator {
             config,
             // The power-on speed is not documented; FAST is assumed [I].
             speed: Speed::Fast,
+            real_pace: ManualClock::new(),
         }
     }
 
     /// The handle a session moves the noise stream with (see [`NoiseCursor`]).
     pub fn noise_cursor(&self) -> NoiseCursor {
         self.noise.clone()
+    }
+
+    /// The clock the meter's measurements advance at the real meter's pace (a session's
+    /// instrument time, also when it runs at `time_scale` 0).
+    pub fn real_pace_clock(&self) -> ManualClock {
+        self.real_pace.clone()
     }
 
     /// The reply to one command line and how long the meter takes before sending it.
@@ -95,6 +106,10 @@ impl Cs100aEmulator {
                 };
                 let t = Duration::from_secs_f64(crate::cs100a::response_time_s(self.speed))
                     + wire(reply.len());
+                // The host's command on the wire is the meter's time too, though it is not
+                // the emulator's to wait out.
+                let command = wire(Command::Measure.encode().len());
+                self.real_pace.advance((t + command).as_secs_f64());
                 (reply, self.scaled(t))
             }
             Ok(Command::SetMode(mode)) => {

@@ -47,8 +47,14 @@ pub fn sim(
     let (host, device) = pair(LineSettings::CS100A, &sim_connection(MODEL));
     let emulator = Cs100aEmulator::new(world, config);
     let noise = emulator.noise_cursor();
+    let pace = emulator.real_pace_clock();
     emulator.spawn(device);
-    Ok(Simulated::wrap(connect(host, options)?, noise, settings))
+    Ok(Simulated::wrap(
+        connect(host, options)?,
+        noise,
+        pace,
+        settings,
+    ))
 }
 
 /// Puts the meter in absolute mode, recording the session when asked.

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use metamer_protocols::i1pro::{Revision, VENDOR_ID};
 
-use super::clock::{Clock, ScaledClock, SystemClock};
+use super::clock::{Clock, ManualClock, ScaledClock, SystemClock};
 use super::emulator::{default_light, EmulatorConfig, I1ProEmulator};
 use super::{I1Pro, MODEL};
 use crate::instrument::Instrument;
@@ -78,8 +78,8 @@ pub fn sim(
         None => Arc::new(SharedWorld::new(View::radiance(default_light())?)) as Arc<dyn World>,
     };
     let clock = Arc::new(ScaledClock::new(settings.time_scale));
-    let (instrument, noise) = sim_parts(world, config, options, clock)?;
-    Ok(Simulated::wrap(instrument, noise, settings))
+    let (instrument, noise, pace) = sim_parts(world, config, options, clock)?;
+    Ok(Simulated::wrap(instrument, noise, pace, settings))
 }
 
 /// The emulator with every setting given, for tests that inject faults or a clock.
@@ -89,7 +89,7 @@ pub fn sim_with(
     options: &OpenOptions,
     clock: Arc<dyn Clock>,
 ) -> Result<Box<dyn Instrument>, DriverError> {
-    sim_parts(world, config, options, clock).map(|(instrument, _)| instrument)
+    sim_parts(world, config, options, clock).map(|(instrument, _, _)| instrument)
 }
 
 fn sim_parts(
@@ -97,11 +97,12 @@ fn sim_parts(
     config: EmulatorConfig,
     options: &OpenOptions,
     clock: Arc<dyn Clock>,
-) -> Result<(Box<dyn Instrument>, NoiseCursor), DriverError> {
+) -> Result<(Box<dyn Instrument>, NoiseCursor, ManualClock), DriverError> {
     let device = I1ProEmulator::new(world, config).map_err(DriverError::Simulation)?;
     let noise = device.noise_cursor();
+    let pace = device.real_pace_clock();
     let (host, _thread) = usb_pair(device, &sim_connection(MODEL));
-    Ok((connect(host, options, clock, false)?, noise))
+    Ok((connect(host, options, clock, false)?, noise, pace))
 }
 
 /// Opens the driver on `link`, recording the session when asked; `settle` waits out a

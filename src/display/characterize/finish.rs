@@ -15,6 +15,7 @@ use crate::display::model::{FitError, Sample};
 use crate::display::verify::Verification;
 use crate::display::{fit_profile, write_ti3, ModelKind, ProfileError, Residuals};
 use crate::output::{OutputError, OutputPolicy};
+use crate::session::CostReport;
 
 pub const PROFILE_FILE: &str = "profile.json";
 pub const TI3_FILE: &str = "readings.ti3";
@@ -55,6 +56,8 @@ pub struct MeasuredBy<'a> {
     pub display_description: &'a str,
     pub instrument: &'a str,
     pub instrument_info: &'a InstrumentInfo,
+    /// The measurement's budget and what it took.
+    pub cost: &'a CostReport,
 }
 
 /// What a finished characterization found; also written as `summary.json`.
@@ -78,6 +81,9 @@ pub struct Summary {
     #[serde(serialize_with = "crate::display::verify::serialize_held_out")]
     pub verification: Verification,
     pub files: Files,
+    /// The readings, placements and time estimated before the first reading of this run
+    /// and what the run took.
+    pub cost: CostReport,
 }
 
 /// The files written.
@@ -192,6 +198,7 @@ pub fn finish(
         fit_residuals: diagnostics.residuals.clone(),
         verification,
         files: files.clone(),
+        cost: who.cost.clone(),
     };
     let text = serde_json::to_string_pretty(&summary).expect("a summary serializes") + "\n";
     out.write(&files.summary, text.as_bytes())?;

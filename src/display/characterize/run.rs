@@ -14,9 +14,11 @@ use super::plan::{DriveStep, Plan, PlanError, PlanOptions, METER};
 use crate::display::ModelKind;
 use crate::output::{OutputError, OutputPolicy};
 use crate::rig::Screen;
+use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
+use crate::session::plan::{Prepare, Step};
 use crate::session::{
-    Answer, InstrumentRecord, Operator, OperatorError, ProgressSink, Rig, RunEnd, RunOptions,
-    Session, SessionError,
+    Answer, Cost, CostReport, InstrumentRecord, Meter, Operator, OperatorError, ProgressSink, Rig,
+    RunEnd, RunOptions, Session, SessionError,
 };
 
 /// The journal's file name inside the output directory.
@@ -150,17 +152,20 @@ pub fn run(
         total,
         log: session.journal_path().to_path_buf(),
     };
-    if session.done() < total && display.stimulus().is_none() {
-        display.show([255; 3]).map_err(CharacterizeError::Aim)?;
-        let prompt = format!(
-            "aim the instrument at the middle of the white {}",
-            display.describe()
-        );
-        if operator.ask(&prompt)? == Answer::Abort {
-            let missing = total - session.done();
-            return Ok(incomplete(&session, RunEnd::Aborted { missing }));
-        }
+    // A real screen: the operator aims the instrument at its white once, before the first
+    // patch; that is the session's one placement.
+    let aim = session.done() < total && display.stimulus().is_none();
+    let mut cost = CostReport {
+        estimate: estimate(&session, display, &*instrument, options, aim),
+        actual: None,
+    };
+    if session.done() < total {
+        progress.note(&cost.estimate.before("the display's patches"));
     }
+    let Some(aimed) = aim_at_white(aim, display, operator)? else {
+        let missing = total - session.done();
+        return Ok(incomplete(&session, RunEnd::Aborted { missing }));
+    };
     let end = {
         let mut rig = Rig {
             screen: Some(display),
@@ -169,6 +174,10 @@ pub fn run(
         };
         session.run(&mut rig, &options.run, progress)?
     };
+    let mut spent = session.spent().clone();
+    spent.add(&aimed);
+    progress.note(&spent.after("the display's patches", &cost.estimate));
+    cost.actual = Some(spent);
     if end != RunEnd::Complete {
         return Ok(incomplete(&session, end));
     }
@@ -188,10 +197,80 @@ pub fn run(
             display_description: &details.display_description,
             instrument: &details.instrument,
             instrument_info: info,
+            cost: &cost,
         },
         &out,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+/// Has the operator aim the instrument at the white of a real screen (`aim`): the
+/// placement and the time it took (nothing without `aim`), or None when the operator
+/// declined.
+fn aim_at_white(
+    aim: bool,
+    display: &mut dyn Screen,
+    operator: &mut dyn Operator,
+) -> Result<Option<Cost>, CharacterizeError> {
+    if !aim {
+        return Ok(Some(Cost::default()));
+    }
+    display.show([255; 3]).map_err(CharacterizeError::Aim)?;
+    let prompt = format!(
+        "aim the instrument at the middle of the white {}",
+        display.describe()
+    );
+    let asked = std::time::Instant::now();
+    if operator.ask(&prompt)? == Answer::Abort {
+        return Ok(None);
+    }
+    let operator_s = asked.elapsed().as_secs_f64();
+    Ok(Some(Cost {
+        placements: 1,
+        operator_s,
+        wall_s: operator_s,
+        ..Cost::default()
+    }))
+}
+
+/// The budget of the patches the journal of `session` lacks: each patch's luminance as the
+/// screen knows it (a simulated monitor), else as an sRGB display of the standard's 80 cd/m²
+/// white would give it; with the operator's aim at the white of a real screen (`aim`).
+fn estimate(
+    session: &Session<LogDetails, DriveStep>,
+    display: &dyn Screen,
+    instrument: &dyn Instrument,
+    options: &Options,
+    aim: bool,
+) -> Cost {
+    let placement_s = options.run.placement_s();
+    let meters = [(METER.to_string(), Meter::of(instrument))].into();
+    let known = display.expected_cd_m2([255; 3]).is_some();
+    let rgb = |step: &Step<DriveStep>| match step.prepare {
+        Prepare::Show { rgb } => rgb,
+        _ => step.data.rgb,
+    };
+    let light = |step: &Step<DriveStep>| {
+        let rgb = rgb(step);
+        display
+            .expected_cd_m2(rgb)
+            .unwrap_or_else(|| srgb_luminance(rgb, SRGB_WHITE_CD_M2))
+    };
+    let assumption = if known {
+        format!(
+            "a patch's luminance as the simulated {} shows it",
+            display.spec()
+        )
+    } else {
+        srgb_assumption(SRGB_WHITE_CD_M2)
+    };
+    let mut cost = session.estimate(&meters, &light, &assumption, placement_s);
+    if aim {
+        cost.placements += 1;
+        cost.operator_s += placement_s;
+        cost.wall_s += placement_s;
+    }
+    cost
 }
 
 /// What resuming `session` found in its journal (readings, a torn last line set aside),

@@ -34,10 +34,11 @@ use super::reproduction::{PatchDrive, PatchRegion};
 use crate::color::Xyz;
 use crate::image::{Drive8Image, ScreenSpot};
 use crate::rig::{MeterAim, Placement};
+use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::{
-    Answer, Entry, InstrumentRecord, Operator, OperatorError, PlacementReadings, Prepare, Recheck,
-    Rig, RunEnd, RunOptions, ScriptedOperator, Session, SessionPlan, Step, StepProgress, Stopping,
-    TerminalOperator,
+    Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError, PlacementReadings,
+    Prepare, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session, SessionPlan,
+    Step, StepProgress, Stopping, TerminalOperator,
 };
 use crate::validation::covariance;
 use crate::validation::repeatability::{self, Repeatability};
@@ -82,6 +83,9 @@ pub struct SpotRecord {
     /// Why, when it is not the image.
     pub note: Option<String>,
     pub aims: Vec<PatchAim>,
+    /// The readings' budget before the first of this run and what the run took.
+    #[serde(default)]
+    pub cost: Option<CostReport>,
 }
 
 /// The operator's request for patch `r` at `spot` on the screen.
@@ -372,6 +376,32 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
     }
 }
 
+/// The light a display spot is budgeted at: its patch's drive values as the screen shows
+/// them (a simulated monitor), else on an sRGB display; and what that assumes.
+pub fn patch_light<'a>(
+    drives: &'a [PatchDrive],
+    screen: &'a dyn Screen,
+) -> (impl Fn(&Step<SpotStep>) -> f64 + 'a, String) {
+    let light = move |step: &Step<SpotStep>| {
+        let rgb = drives
+            .iter()
+            .find(|d| d.patch == step.data.patch)
+            .map_or([255; 3], |d| d.rgb8);
+        screen
+            .expected_cd_m2(rgb)
+            .unwrap_or_else(|| srgb_luminance(rgb, SRGB_WHITE_CD_M2))
+    };
+    let assumption = if screen.expected_cd_m2([255; 3]).is_some() {
+        format!(
+            "a spot's luminance from its patch's drive values as the simulated {} shows them",
+            screen.spec()
+        )
+    } else {
+        srgb_assumption(SRGB_WHITE_CD_M2)
+    };
+    (light, assumption)
+}
+
 /// The reproduced image and each patch's spot on it.
 pub struct ShownImage<'a> {
     pub file: &'a Path,
@@ -420,7 +450,7 @@ pub fn measure(
     } else {
         screen.default_settle()
     };
-    let (mut plan, record) = match &s.image {
+    let (mut plan, mut record) = match &s.image {
         Some(shown) => {
             let image =
                 Drive8Image::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
@@ -435,6 +465,7 @@ pub fn measure(
                 shown: "image".into(),
                 note: None,
                 aims,
+                cost: None,
             };
             (plan, record)
         }
@@ -446,6 +477,7 @@ pub fn measure(
                 shown: "patch colours".into(),
                 note: Some(note.into()),
                 aims: Vec::new(),
+                cost: None,
             };
             let mut plan = plan(drives, repeats);
             plan.options.extend(rule.options());
@@ -521,6 +553,11 @@ pub fn measure(
             }
         }
     }
+    let meters = [("spot".to_string(), Meter::of(meter.as_ref()))].into();
+    let estimate = {
+        let (light, assumption) = patch_light(drives, screen.as_ref());
+        session.estimate(&meters, &light, &assumption, run.placement_s())
+    };
     let mut rig = Rig {
         screen: s.image.is_none().then_some(screen.as_mut()),
         instruments: vec![("spot".to_string(), meter.as_mut())],
@@ -533,6 +570,11 @@ pub fn measure(
         })
     };
     let end = session.run(&mut rig, run, &mut sink)?;
+    let spent = session.spent().clone();
+    record.cost = Some(CostReport {
+        estimate,
+        actual: Some(spent),
+    });
     if end != RunEnd::Complete {
         return Err(ExperimentError::Incomplete {
             stage: "display-spots",

@@ -18,6 +18,7 @@ use serde::Serialize;
 use crate::color::Xyz;
 use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
+use crate::experiment::budget::{total, StageBudget};
 use crate::experiment::display::DisplayOptions;
 use crate::experiment::reproduction::ReproductionOptions;
 use crate::experiment::request::{check_dir, check_image_size, check_repeats, check_target_de};
@@ -27,7 +28,7 @@ use crate::experiment::{BoxRequest, Progress, Request, RequestError, Stage, Stag
 use crate::measure_box::BoxPlan;
 use crate::output::OutputPolicy;
 use crate::rig::{Preset, Scenario, ScreenSpec};
-use crate::session::RunOptions;
+use crate::session::{CostReport, RunOptions};
 use crate::validation::assess::{Assessment, JndCount, JndVerdict, Stat};
 use crate::validation::export::HTML_FILE;
 use crate::validation::propagate::Interval;
@@ -224,6 +225,11 @@ impl From<&StageOutcome> for StageSummary {
 pub struct LabSummary {
     pub options: LabOptions,
     pub stages: Vec<StageSummary>,
+    /// Each measuring stage's budget before its first reading and what it took, as the
+    /// stage's files keep them.
+    pub budget: Vec<StageBudget>,
+    /// Their sum (what was taken only where every stage keeps it).
+    pub budget_total: CostReport,
     /// Wall time of this call, s (a fully re-used run takes next to none).
     pub seconds: f64,
     /// CIELAB's reference white: the display's measured white, cd/m².
@@ -281,7 +287,8 @@ pub fn run_lab(
 ) -> Result<(Vec<StageOutcome>, LabSummary), LabError> {
     let start = std::time::Instant::now();
     opts.check(dir)?;
-    let stages = opts.request(dir, resume, force, run).run(progress)?.stages;
+    let outcome = opts.request(dir, resume, force, run).run(progress)?;
+    let stages = outcome.stages;
     let file = dir.join(Stage::Validation.name()).join(COMPARISONS_FILE);
     let bad = |message: String| LabError::BadResult {
         file: file.clone(),
@@ -297,6 +304,8 @@ pub fn run_lab(
     let summary = LabSummary {
         options,
         stages: stages.iter().map(StageSummary::from).collect(),
+        budget_total: total(&outcome.budget),
+        budget: outcome.budget,
         seconds: start.elapsed().as_secs_f64(),
         white: v.white,
         out_of_gamut_patches: v.out_of_gamut_patches.clone(),

@@ -134,6 +134,10 @@ impl Screen for VirtualDisplay {
         Ok(())
     }
 
+    fn expected_cd_m2(&self, rgb: [u8; 3]) -> Option<f64> {
+        Some(self.lit.panel.xyz(rgb).y)
+    }
+
     fn spec(&self) -> String {
         format!("virtual:{}", self.lit.panel.name())
     }

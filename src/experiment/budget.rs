@@ -1,0 +1,270 @@
+//! The experiment's budget before its first stage: each measuring stage's plan costed as
+//! if it ran in full ([`budget`]), and, once the stages have run, each one's budget and
+//! what it took as its own files record them ([`recorded`]).
+//!
+//! Before anything runs some of what a stage's readings see is not known yet: the
+//! simulation sets a simulated monitor's white, and the reproduction the display spots'
+//! drive values. The budget then takes the preset's own white and each spot at its
+//! ColorChecker patch's luminance factor of that white, and says so. Each stage costs its
+//! own plan again right before its first reading, from what it then knows and for the
+//! readings its journal still lacks; that is the estimate its files keep.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::display::DisplayOptions;
+use super::display_spots::{image_plan, PatchAim, SpotStep, RECORD_FILE};
+use super::measure_box::MeasureBox;
+use super::options::{BoxSource, ExperimentOptions};
+use super::stage::Stage;
+use crate::color::{colorchecker, reflectance_to_xyz, ColorCheckerSet, Illuminant, ObserverKind};
+use crate::display::characterize::plan::{Plan, PlanOptions, METER};
+use crate::measure_box::plan::{BoxStage, SPECTRAL, SPOT};
+use crate::measure_box::run::{BOX_LIGHT_ASSUMPTION, BOX_TARGET_CD_M2};
+use crate::measure_box::BoxPlan;
+use crate::rig::window::DEFAULT_SETTLE;
+use crate::rig::{ScreenSpec, VirtualPanel};
+use crate::session::budget::{estimate, srgb_assumption, srgb_luminance, Meter, SRGB_WHITE_CD_M2};
+use crate::session::plan::{Prepare, Step};
+use crate::session::{Cost, CostReport};
+
+/// One measuring stage's budget, by the stage's directory name.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageBudget {
+    pub stage: String,
+    pub cost: CostReport,
+}
+
+/// Each measuring stage of `opts` costed from its plan as if it ran in full (a box given
+/// as files costs nothing), in the order they run.
+pub fn budget(opts: &ExperimentOptions) -> Vec<StageBudget> {
+    let placement_s = opts.run.placement_s();
+    let mut out = Vec::new();
+    let mut patches = BoxPlan::default().patches;
+    if let BoxSource::Measure(m) = &opts.box_source {
+        let plan = box_plan(m);
+        patches = plan.patches.clone();
+        out.push(stage(Stage::Box, box_cost(&plan, m, placement_s)));
+    }
+    out.push(stage(
+        Stage::Display,
+        display_cost(&opts.display, placement_s),
+    ));
+    out.push(stage(
+        Stage::DisplaySpots,
+        spots_cost(
+            &opts.display,
+            &patches,
+            opts.repeats.max(1),
+            opts.simulation.image.is_some() || opts.simulation.external_image.is_some(),
+            placement_s,
+        ),
+    ));
+    out
+}
+
+fn stage(stage: Stage, estimate: Cost) -> StageBudget {
+    StageBudget {
+        stage: stage.name().to_string(),
+        cost: CostReport {
+            estimate,
+            actual: None,
+        },
+    }
+}
+
+/// The sum of `costs`' estimates and, where every one has it, of what they took.
+pub fn total(costs: &[StageBudget]) -> CostReport {
+    let mut estimate = Cost::default();
+    let mut actual = Some(Cost::default());
+    for c in costs {
+        estimate.add(&c.cost.estimate);
+        actual = match (actual, &c.cost.actual) {
+            (Some(mut sum), Some(a)) => {
+                sum.add(a);
+                Some(sum)
+            }
+            _ => None,
+        };
+    }
+    CostReport { estimate, actual }
+}
+
+/// The box plan the stage measures: the plan file's, else the paper's; with the repeat
+/// count asked for. A plan file that does not load is refused by the checks before the
+/// first stage, so the paper's stands in here.
+fn box_plan(m: &MeasureBox) -> BoxPlan {
+    let mut plan = m
+        .plan
+        .as_deref()
+        .and_then(|p| BoxPlan::load(p).ok())
+        .unwrap_or_default();
+    if let Some(n) = m.repeats {
+        plan.repeats = n;
+    }
+    plan
+}
+
+fn box_cost(plan: &BoxPlan, m: &MeasureBox, placement_s: f64) -> Cost {
+    let meters: BTreeMap<String, Meter> = [
+        (SPECTRAL.to_string(), Meter::of_spec(&m.spectral)),
+        (SPOT.to_string(), Meter::of_spec(&m.spot)),
+    ]
+    .into();
+    let mut cost = Cost::default();
+    for s in BoxStage::ALL {
+        cost.add(&estimate(
+            &plan.session_plan(s, &BTreeMap::new()),
+            &|_| false,
+            &meters,
+            &|_| BOX_TARGET_CD_M2,
+            BOX_LIGHT_ASSUMPTION,
+            placement_s,
+        ));
+    }
+    cost
+}
+
+/// A patch's luminance (cd/m²) from its drive values.
+type PatchLight = Box<dyn Fn([u8; 3]) -> f64>;
+
+/// A patch's luminance on the stage's screen before the simulation sets a simulated
+/// monitor's white (its preset's), or on an sRGB display for a real one; and what that
+/// assumes.
+fn screen_light(screen: &ScreenSpec) -> (PatchLight, String) {
+    match screen {
+        ScreenSpec::Virtual(p) => {
+            let panel = VirtualPanel::preset(*p);
+            let said = format!(
+                "a patch's luminance as the simulated {} shows it at its preset's white (the simulation sets it later)",
+                screen.canonical()
+            );
+            (Box::new(move |rgb| panel.xyz(rgb).y), said)
+        }
+        ScreenSpec::Window { .. } => (
+            Box::new(|rgb| srgb_luminance(rgb, SRGB_WHITE_CD_M2)),
+            srgb_assumption(SRGB_WHITE_CD_M2),
+        ),
+    }
+}
+
+fn display_cost(d: &DisplayOptions, placement_s: f64) -> Cost {
+    let defaults = PlanOptions::default();
+    let options = PlanOptions::for_model(d.model, defaults.ramp_steps, defaults.repeats, None);
+    let Ok(plan) = Plan::new(options) else {
+        return Cost::default();
+    };
+    let settle = match d.screen {
+        ScreenSpec::Virtual(_) => std::time::Duration::ZERO,
+        ScreenSpec::Window { .. } => DEFAULT_SETTLE,
+    };
+    let plan = plan.session_plan(&d.screen.canonical(), settle);
+    let meters = [(METER.to_string(), Meter::of_spec(&d.spot))].into();
+    let (light, said) = screen_light(&d.screen);
+    let of_step = |s: &Step<_>| match s.prepare {
+        Prepare::Show { rgb } => light(rgb),
+        _ => light([255; 3]),
+    };
+    estimate(&plan, &|_| false, &meters, &of_step, &said, placement_s)
+}
+
+/// The display spots: `patches` ColorChecker patches (1–24) read `repeats` times, on the
+/// image (one placement per patch) or full-screen; each at the patch's luminance factor
+/// (BabelColor average under D65) of the display's white.
+fn spots_cost(
+    d: &DisplayOptions,
+    patches: &[usize],
+    repeats: usize,
+    image: bool,
+    placement_s: f64,
+) -> Cost {
+    let chart = colorchecker(ColorCheckerSet::BabelColorAverage);
+    let d65 = Illuminant::D65.spectrum();
+    let factor = |patch: usize| {
+        chart.get(patch.wrapping_sub(1)).map_or(1.0, |s| {
+            reflectance_to_xyz(s, &d65, ObserverKind::Cie1931).y / 100.0
+        })
+    };
+    let aims: Vec<PatchAim> = patches
+        .iter()
+        .map(|&patch| PatchAim {
+            patch,
+            x: 0.5,
+            y: 0.5,
+            radius: 0.0,
+            prompt: format!("aim the meter at patch {patch}"),
+        })
+        .collect();
+    let mut plan = image_plan(&aims, repeats);
+    if !image {
+        for s in &mut plan.steps {
+            s.prepare = Prepare::Show { rgb: [255; 3] };
+        }
+    }
+    let meters = [("spot".to_string(), Meter::of_spec(&d.spot))].into();
+    let (light, said) = screen_light(&d.screen);
+    let white = light([255; 3]);
+    let of_step = |s: &Step<SpotStep>| white * factor(s.data.patch);
+    let said =
+        format!("{said}; a display spot at its ColorChecker patch's luminance factor of the white");
+    estimate(&plan, &|_| false, &meters, &of_step, &said, placement_s)
+}
+
+/// Each measuring stage's budget and what it took, as its own files in `dir` keep them
+/// (`box/summary.json`, `display/summary.json`, `display-spots/display-spots.json`); a
+/// stage whose files keep none has its entry of `planned`, with nothing taken.
+pub fn recorded(dir: &Path, planned: &[StageBudget]) -> Vec<StageBudget> {
+    planned
+        .iter()
+        .map(|p| {
+            let stage_dir = dir.join(&p.stage);
+            let kept = match p.stage.as_str() {
+                s if s == Stage::Box.name() => read::<BoxCost>(&stage_dir.join("summary.json"))
+                    .filter(|b| !b.cost.is_empty())
+                    .map(|b| {
+                        let mut estimate = Cost::default();
+                        let mut actual = Cost::default();
+                        for c in b.cost.values() {
+                            estimate.add(&c.estimate);
+                            if let Some(a) = &c.actual {
+                                actual.add(a);
+                            }
+                        }
+                        CostReport {
+                            estimate,
+                            actual: Some(actual),
+                        }
+                    }),
+                s if s == Stage::Display.name() => {
+                    read::<OneCost>(&stage_dir.join("summary.json")).and_then(|c| c.cost)
+                }
+                _ => read::<OneCost>(&stage_dir.join(RECORD_FILE)).and_then(|c| c.cost),
+            };
+            StageBudget {
+                stage: p.stage.clone(),
+                cost: kept.unwrap_or_else(|| p.cost.clone()),
+            }
+        })
+        .collect()
+}
+
+/// The part of the box's `summary.json` this reads.
+#[derive(Deserialize)]
+struct BoxCost {
+    #[serde(default)]
+    cost: BTreeMap<String, CostReport>,
+}
+
+/// The part of the display's `summary.json` or `display-spots.json` this reads.
+#[derive(Deserialize)]
+struct OneCost {
+    #[serde(default)]
+    cost: Option<CostReport>,
+}
+
+fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Option<T> {
+    let text = std::fs::read_to_string(path).ok()?;
+    serde_json::from_str(&text).ok()
+}
