@@ -93,6 +93,9 @@ pub enum CharacterizeError {
     Speed(metamer_drivers::DriverError),
     #[error(transparent)]
     SimulatedMeterOnRealScreen(super::meter::SimulatedMeterOnRealScreen),
+    /// An adaptive plan's rule or targets make no plan.
+    #[error(transparent)]
+    Adaptive(#[from] super::adaptive::AdaptiveError),
 }
 
 /// The journal of a characterization in `dir`.
@@ -190,13 +193,14 @@ pub fn run(
             instrument_info: info,
         },
         &out,
+        None,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }
 
 /// What resuming `session` found in its journal (readings, a torn last line set aside),
 /// if it resumed one.
-fn resuming_note(session: &Session<LogDetails, DriveStep>) -> Option<String> {
+pub(super) fn resuming_note(session: &Session<LogDetails, DriveStep>) -> Option<String> {
     if session.recovered == 0 && session.torn_bytes == 0 {
         return None;
     }

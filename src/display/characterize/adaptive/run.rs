@@ -1,0 +1,480 @@
+//! Measuring an adaptive plan on the session engine: the first pass in `log.jsonl`, each
+//! batch in `log.batch-N.jsonl`, the held-out set in `log.verify.jsonl`, each journal a
+//! session of its own whose steps follow from the journals before it. Resuming walks the
+//! journals in order, fits the same models to the same readings, so finds the same next
+//! batch, and continues the first journal that is not complete.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use metamer_drivers::{
+    CalibrationCondition, CalibrationOutcome, Capabilities, DriverError, Instrument,
+    InstrumentInfo, MeasureMode, Reading, Request,
+};
+use serde::{Deserialize, Serialize};
+
+use super::choice::{decide, verification_codes, Decision, StopReason};
+use super::{Adaptive, Fitted, Rule};
+use crate::display::characterize::finish::{files, finish, MeasuredBy};
+use crate::display::characterize::plan::{
+    DriveStep, Plan, PlanOptions, Purpose, METER, SESSION_KIND,
+};
+use crate::display::characterize::run::{
+    log_path, resuming_note, CharacterizeError, LogDetails, Options, Outcome,
+};
+use crate::display::characterize::verify::usable;
+use crate::display::model::{ModelKind, Sample};
+use crate::output::OutputPolicy;
+use crate::rig::Screen;
+use crate::session::{
+    Answer, InstrumentRecord, Operator, Prepare, ProgressSink, Rig, RunEnd, RunOptions, Session,
+    SessionPlan, Step,
+};
+
+/// Levels per channel of the first pass's sparse grid: the cube's corners, edge and face
+/// centres and its centre, the mixtures a first fit of every model can be judged on.
+pub const SPARSE_GRID: usize = 3;
+/// The noise stream of journal j's step k is j·2¹⁶ + k: no two readings of the session
+/// draw the same simulated noise.
+const NOISE_STRIDE: u64 = 1 << 16;
+
+/// One batch as chosen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Batch {
+    /// Fit readings before it.
+    pub after_readings: usize,
+    /// The predicted ΔE*ab at the worst target before it.
+    pub predicted_de: f64,
+    pub model: ModelKind,
+    pub patches: Vec<[u8; 3]>,
+}
+
+/// How an adaptive plan went; in the summary.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdaptiveReport {
+    pub rule: Rule,
+    pub targets: usize,
+    pub targets_sha256: String,
+    /// `auto`: the model was chosen by cross-validation.
+    pub auto: bool,
+    pub batches: Vec<Batch>,
+    pub stop: StopReason,
+    /// The predicted ΔE*ab at the worst target when the plan stopped.
+    pub predicted_de: f64,
+    /// The competitive candidates at the end.
+    pub candidates: Vec<ModelKind>,
+    pub fit_readings: usize,
+    pub verify_patches: usize,
+}
+
+/// The journal of the adaptive plan's journal `j` in `dir`: 0 the first pass, then the
+/// batches; the held-out set's is [`verify_path`].
+pub fn journal_path(dir: &Path, j: usize) -> PathBuf {
+    if j == 0 {
+        log_path(dir)
+    } else {
+        dir.join(format!("log.batch-{j}.jsonl"))
+    }
+}
+
+pub fn verify_path(dir: &Path) -> PathBuf {
+    dir.join("log.verify.jsonl")
+}
+
+/// The first pass: the fixed plan's fit patches with the sparse grid, without its held-out
+/// set (which the adaptive plan puts at and around the targets).
+pub fn first_pass(plan: PlanOptions) -> Result<Vec<DriveStep>, CharacterizeError> {
+    let plan = Plan::new(PlanOptions {
+        grid_steps: SPARSE_GRID,
+        ..plan
+    })?;
+    Ok(plan
+        .patches
+        .into_iter()
+        .filter(|p| p.purpose == Purpose::Fit)
+        .enumerate()
+        .map(|(i, p)| DriveStep { index: i, ..p })
+        .collect())
+}
+
+/// An instrument whose noise stream is moved by `offset` readings.
+struct Shifted<'a> {
+    inner: &'a mut dyn Instrument,
+    offset: u64,
+}
+
+impl Instrument for Shifted<'_> {
+    fn info(&self) -> InstrumentInfo {
+        self.inner.info()
+    }
+    fn capabilities(&self) -> Capabilities {
+        self.inner.capabilities()
+    }
+    fn calibration_needed(
+        &mut self,
+        mode: MeasureMode,
+    ) -> Result<Option<CalibrationCondition>, DriverError> {
+        self.inner.calibration_needed(mode)
+    }
+    fn calibrate(
+        &mut self,
+        mode: MeasureMode,
+        condition: &CalibrationCondition,
+    ) -> Result<CalibrationOutcome, DriverError> {
+        self.inner.calibrate(mode, condition)
+    }
+    fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
+        self.inner.measure(request)
+    }
+    fn set_option(&mut self, name: &str, value: &str) -> Result<(), DriverError> {
+        self.inner.set_option(name, value)
+    }
+    fn option_values(&self) -> Vec<(String, String)> {
+        self.inner.option_values()
+    }
+    fn seek_noise(&mut self, index: u64) {
+        self.inner.seek_noise(index.wrapping_add(self.offset));
+    }
+}
+
+/// What the run so far has: every complete journal's readings, new readings taken in this
+/// call, and whether the operator has aimed the meter.
+struct Progress<'a> {
+    options: &'a Options,
+    base: BTreeMap<String, String>,
+    settle: Duration,
+    details: LogDetails,
+    taken: Vec<(DriveStep, Reading)>,
+    new: usize,
+    aimed: bool,
+    out: Option<OutputPolicy>,
+}
+
+/// Where one journal ended: complete with its readings, or the outcome to return.
+enum Measured {
+    Complete,
+    Incomplete(Outcome),
+}
+
+impl Progress<'_> {
+    /// Measures what journal `path` (the `j`-th) lacks of `steps`, then adds its readings.
+    #[allow(clippy::too_many_arguments)]
+    fn measure(
+        &mut self,
+        j: u64,
+        path: &Path,
+        name: &str,
+        steps: Vec<DriveStep>,
+        display: &mut dyn Screen,
+        instrument: &mut dyn Instrument,
+        operator: &mut dyn Operator,
+        progress: &mut dyn ProgressSink,
+    ) -> Result<Measured, CharacterizeError> {
+        let mut options = self.base.clone();
+        options.insert("journal".into(), name.into());
+        let plan = SessionPlan {
+            kind: SESSION_KIND.into(),
+            options,
+            steps: steps
+                .iter()
+                .map(|p| Step {
+                    label: p.label.clone(),
+                    role: METER.into(),
+                    mode: MeasureMode::Emissive,
+                    prepare: Prepare::Show { rgb: p.rgb },
+                    settle: self.settle,
+                    data: p.clone(),
+                })
+                .collect(),
+        };
+        let mut shifted = Shifted {
+            inner: instrument,
+            offset: j * NOISE_STRIDE,
+        };
+        let instruments = [(METER.to_string(), InstrumentRecord::of(&shifted))].into();
+        // A journal after the first exists only if the session measured into it before.
+        let resume = self.options.resume || j > 0;
+        let mut session: Session<LogDetails, DriveStep> = Session::open(
+            path,
+            plan,
+            self.details.clone(),
+            instruments,
+            resume,
+        )?;
+        if self.out.is_none() {
+            let mut out = OutputPolicy::new(self.options.force || session.recovered > 0);
+            out.input(session.journal_path());
+            for f in files(&self.options.dir, session.journal_path()).outputs() {
+                out.check(f)?;
+            }
+            self.out = Some(out);
+        }
+        if let Some(note) = resuming_note(&session) {
+            progress.note(&note);
+        }
+        let total = session.plan().steps.len();
+        let incomplete = |session: &Session<LogDetails, DriveStep>, taken: usize, end| {
+            Measured::Incomplete(Outcome::Incomplete {
+                end,
+                done: taken + session.done(),
+                total: taken + total,
+                log: session.journal_path().to_path_buf(),
+            })
+        };
+        if session.done() < total && !self.aimed && display.stimulus().is_none() {
+            display.show([255; 3]).map_err(CharacterizeError::Aim)?;
+            let prompt = format!(
+                "aim the instrument at the middle of the white {}",
+                display.describe()
+            );
+            if operator.ask(&prompt)? == Answer::Abort {
+                let missing = total - session.done();
+                return Ok(incomplete(
+                    &session,
+                    self.taken.len(),
+                    RunEnd::Aborted { missing },
+                ));
+            }
+            self.aimed = true;
+        }
+        let before = session.done();
+        let run = RunOptions {
+            stop_after: self
+                .options
+                .run
+                .stop_after
+                .map(|n| n.saturating_sub(self.new)),
+            interrupt: self.options.run.interrupt.clone(),
+        };
+        let end = {
+            let mut rig = Rig {
+                screen: Some(display),
+                instruments: vec![(METER.to_string(), &mut shifted as &mut dyn Instrument)],
+                operator: &mut *operator,
+            };
+            session.run(&mut rig, &run, progress)?
+        };
+        self.new += session.done() - before;
+        let entries = match (end, session.complete_entries()) {
+            (RunEnd::Complete, Some(entries)) => entries,
+            (RunEnd::Complete, None) => {
+                let missing = total - session.done();
+                return Ok(incomplete(
+                    &session,
+                    self.taken.len(),
+                    RunEnd::Stopped { missing },
+                ));
+            }
+            (end, _) => return Ok(incomplete(&session, self.taken.len(), end)),
+        };
+        self.taken
+            .extend(entries.into_iter().map(|e| (e.data.clone(), e.reading.clone())));
+        Ok(Measured::Complete)
+    }
+
+    /// The fit readings so far, as the models take them.
+    fn samples(&self) -> Vec<Sample> {
+        self.taken
+            .iter()
+            .filter(|(p, r)| p.purpose == Purpose::Fit && usable(r))
+            .map(|(p, r)| Sample::from_rgb8(p.rgb, r.xyz))
+            .collect()
+    }
+
+    fn fit_readings(&self) -> usize {
+        self.taken
+            .iter()
+            .filter(|(p, _)| p.purpose == Purpose::Fit)
+            .count()
+    }
+
+    /// The next distinct patch number.
+    fn next_patch(&self) -> usize {
+        self.taken.iter().map(|(p, _)| p.patch + 1).max().unwrap_or(0)
+    }
+}
+
+/// The options of every journal of an adaptive plan: the fixed plan's, and the rule and the
+/// targets, so a journal is resumed only by the same rule on the same targets.
+fn base_options(
+    options: &Options,
+    adaptive: &Adaptive,
+    display: &str,
+) -> BTreeMap<String, String> {
+    let r = &adaptive.rule;
+    let model = if adaptive.auto {
+        "auto".to_string()
+    } else {
+        options.model.name().to_string()
+    };
+    [
+        ("plan", "adaptive".to_string()),
+        ("ramp_steps", options.plan.ramp_steps.to_string()),
+        ("repeats", options.plan.repeats.to_string()),
+        ("grid_steps", SPARSE_GRID.to_string()),
+        ("display", display.to_string()),
+        ("model", model),
+        ("targets", adaptive.targets.len().to_string()),
+        ("targets_sha256", adaptive.targets_sha256()),
+        ("stop_de", r.stop_de.to_string()),
+        ("max_readings", r.max_readings.to_string()),
+        ("batch", r.batch.to_string()),
+        ("seed", r.seed.to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect()
+}
+
+/// Characterizes `display` with `instrument` on the adaptive plan `adaptive`: measures what
+/// its journals in `options.dir` lack, choosing each batch from the readings before it,
+/// then fits, verifies on the held-out set and writes the profile, `.ti3`, report and
+/// summary (with an [`AdaptiveReport`]).
+pub fn run(
+    options: &Options,
+    adaptive: &Adaptive,
+    display: &mut dyn Screen,
+    instrument: &mut dyn Instrument,
+    operator: &mut dyn Operator,
+    progress: &mut dyn ProgressSink,
+) -> Result<Outcome, CharacterizeError> {
+    let first = first_pass(options.plan)?;
+    adaptive.check(first.len())?;
+    let settle = options.settle.unwrap_or_else(|| display.default_settle());
+    let display_name = display.spec();
+    let details = LogDetails {
+        display: display_name.clone(),
+        display_description: display.describe(),
+        instrument: options.instrument.to_string(),
+    };
+    let mut p = Progress {
+        options,
+        base: base_options(options, adaptive, &display_name),
+        settle,
+        details,
+        taken: Vec::new(),
+        new: 0,
+        aimed: false,
+        out: None,
+    };
+    let dir = options.dir.as_path();
+    macro_rules! measure {
+        ($j:expr, $path:expr, $name:expr, $steps:expr) => {
+            if let Measured::Incomplete(o) = p.measure(
+                $j,
+                $path,
+                $name,
+                $steps,
+                display,
+                instrument,
+                operator,
+                progress,
+            )? {
+                return Ok(o);
+            }
+        };
+    }
+    measure!(0, &journal_path(dir, 0), "first pass", first);
+    let rule = adaptive.rule;
+    let mut batches = Vec::new();
+    let mut j = 0;
+    let (fitted, stop, predicted_de) = loop {
+        let fitted = Fitted::new(&p.samples(), options.model, adaptive.auto).map_err(|source| {
+            crate::display::characterize::finish::FinishError::Fit {
+                model: options.model,
+                source,
+            }
+        })?;
+        let drives = fitted.target_drives(&adaptive.targets);
+        let measured: Vec<[u8; 3]> = p.taken.iter().map(|(s, _)| s.rgb).collect();
+        let room = rule.max_readings.saturating_sub(p.fit_readings());
+        let (decision, at) = decide(
+            &drives,
+            &|rgb| fitted.predicted(rgb),
+            &measured,
+            rule.stop_de,
+            rule.batch,
+            room,
+        );
+        let codes = match decision {
+            Decision::Stop(reason) => break (fitted, reason, at),
+            Decision::Batch(codes) => codes,
+        };
+        j += 1;
+        let start = p.next_patch();
+        let steps: Vec<DriveStep> = codes
+            .iter()
+            .enumerate()
+            .map(|(i, rgb)| DriveStep {
+                index: i,
+                patch: start + i,
+                repeat: 0,
+                rgb: *rgb,
+                purpose: Purpose::Fit,
+                label: format!("batch {j} patch {}", i + 1),
+            })
+            .collect();
+        batches.push(Batch {
+            after_readings: p.fit_readings(),
+            predicted_de: at,
+            model: fitted.model,
+            patches: codes,
+        });
+        measure!(
+            j as u64,
+            &journal_path(dir, j),
+            &format!("batch {j}"),
+            steps
+        );
+    };
+    let drives = fitted.target_drives(&adaptive.targets);
+    let fit_codes: Vec<[u8; 3]> = p.taken.iter().map(|(s, _)| s.rgb).collect();
+    let start = p.next_patch();
+    let held_out: Vec<DriveStep> = verification_codes(&drives, &fit_codes, rule.seed)
+        .into_iter()
+        .enumerate()
+        .map(|(i, rgb)| DriveStep {
+            index: i,
+            patch: start + i,
+            repeat: 0,
+            rgb,
+            purpose: Purpose::Verify,
+            label: format!("near target {}", i + 1),
+        })
+        .collect();
+    let verify_patches = held_out.len();
+    measure!(j as u64 + 1, &verify_path(dir), "verify", held_out);
+    let report = AdaptiveReport {
+        rule,
+        targets: adaptive.targets.len(),
+        targets_sha256: adaptive.targets_sha256(),
+        auto: adaptive.auto,
+        batches,
+        stop,
+        predicted_de,
+        candidates: std::iter::once(fitted.model)
+            .chain(fitted.candidates.iter().map(|(k, _)| *k))
+            .collect(),
+        fit_readings: p.fit_readings(),
+        verify_patches,
+    };
+    let readings: Vec<(&DriveStep, &Reading)> = p.taken.iter().map(|(s, r)| (s, r)).collect();
+    let info = &instrument.info();
+    let out = p.out.take().expect("the first journal set the policy");
+    let summary = finish(
+        dir,
+        &log_path(dir),
+        &readings,
+        fitted.model,
+        &MeasuredBy {
+            display: &p.details.display,
+            display_description: &p.details.display_description,
+            instrument: &p.details.instrument,
+            instrument_info: info,
+        },
+        &out,
+        Some(report),
+    )?;
+    Ok(Outcome::Finished(Box::new(summary)))
+}
