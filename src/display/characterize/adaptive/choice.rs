@@ -6,7 +6,7 @@
 //! same models to the same readings, makes the same choices.
 
 use crate::color::{delta_e76, Xyz};
-use crate::display::DisplayModel;
+use crate::display::{DisplayModel, Sample};
 
 /// Codes (of 255) from a target's drive value to each of its six neighbours, one channel up
 /// or down: the colours around a target that a small change of the model moves it to.
@@ -17,19 +17,40 @@ pub const MIN_SEPARATION_CODES: i32 = 12;
 /// Largest offset, in codes per channel, of a held-out patch from its target's drive value.
 pub const VERIFY_JITTER_CODES: i32 = 12;
 
+/// Codes (of 255, in every channel) within which a reading is near a drive value: the
+/// readings that judge the candidate models there.
+pub const NEAR_CODES: f64 = 24.0;
+
 /// The error predicted at drive value `rgb`: the largest ΔE*ab (CIELAB relative to
 /// `white`) between the reference model's colour and a candidate's there. Where models
 /// fitted to the same readings agree, the readings hold the colour; where they disagree,
-/// the reference's colour rests on its assumptions.
+/// the reference's colour rests on its assumptions. A candidate that misses the `readings`
+/// near `rgb` ([`NEAR_CODES`]) by more than the reference does, plus `slack` (mean ΔE*ab),
+/// is contradicted there by measurement and does not count: its disagreement is its own
+/// error, which no further reading would remove.
 pub fn predicted_error(
     rgb: [f64; 3],
     reference: &dyn DisplayModel,
     candidates: &[&dyn DisplayModel],
+    readings: &[Sample],
+    slack: f64,
     white: Xyz,
 ) -> f64 {
+    let near: Vec<&Sample> = readings
+        .iter()
+        .filter(|s| (0..3).all(|k| (s.rgb[k] - rgb[k]).abs() * 255.0 <= NEAR_CODES))
+        .collect();
+    let miss = |m: &dyn DisplayModel| {
+        near.iter()
+            .map(|s| delta_e76(m.forward(s.rgb).to_lab(white), s.xyz.to_lab(white)))
+            .sum::<f64>()
+            / near.len().max(1) as f64
+    };
+    let allowed = miss(reference) + slack;
     let at = reference.forward(rgb).to_lab(white);
     candidates
         .iter()
+        .filter(|m| near.is_empty() || miss(**m) <= allowed)
         .map(|m| delta_e76(m.forward(rgb).to_lab(white), at))
         .filter(|e| e.is_finite())
         .fold(0.0, f64::max)
@@ -246,7 +267,7 @@ mod tests {
             centre: CENTRE,
         };
         let w = white();
-        let predicted = |rgb| predicted_error(rgb, &reference, &[&other], w);
+        let predicted = |rgb| predicted_error(rgb, &reference, &[&other], &[], 0.5, w);
         let t = targets();
         let (decision, worst) = decide(&t, &predicted, &[], 1.0, 8, 100);
         assert!(worst > 1.0, "{worst}");
@@ -306,7 +327,7 @@ mod tests {
                 bump,
                 centre: CENTRE,
             };
-            let predicted = |rgb| predicted_error(rgb, &reference, &[&other], w);
+            let predicted = |rgb| predicted_error(rgb, &reference, &[&other], &[], 0.5, w);
             let (decision, at) = decide(&t, &predicted, &[], stop_de, 8, 100);
             // The linearised ΔE: within 2 % of the exact one for this small a step.
             assert!((at - bump * de_per_cd).abs() < 0.02 * 1.5 + 1e-9, "{at}");
@@ -328,6 +349,38 @@ mod tests {
                 assert_eq!(left, Decision::Stop(StopReason::NothingLeft));
             }
         }
+    }
+
+    /// A reading near the disagreement that the reference holds and the candidate misses
+    /// by 3 cd/m² of Y (ΔE*ab well above the slack) rules the candidate out there: nothing
+    /// is predicted; a reading the candidate holds as well keeps it.
+    #[test]
+    fn a_candidate_the_readings_near_by_contradict_does_not_count() {
+        let reference = Synthetic {
+            bump: 0.0,
+            centre: CENTRE,
+        };
+        let other = Synthetic {
+            bump: 3.0,
+            centre: CENTRE,
+        };
+        let w = white();
+        let at = [0.76, 0.25, 0.25];
+        let free = predicted_error(at, &reference, &[&other], &[], 0.5, w);
+        assert!(free > 1.0, "{free}");
+        let truth = |m: &Synthetic, rgb| Sample {
+            rgb,
+            xyz: m.forward(rgb),
+        };
+        let held = [truth(&reference, CENTRE)];
+        assert_eq!(predicted_error(at, &reference, &[&other], &held, 0.5, w), 0.0);
+        // The reading is the candidate's: the reference misses it by as much, so both count.
+        let theirs = [truth(&other, CENTRE)];
+        let both = predicted_error(at, &reference, &[&other], &theirs, 0.5, w);
+        assert!((both - free).abs() < 1e-12, "{both} {free}");
+        // A reading far away (more than 24 codes) judges nothing here.
+        let far = [truth(&reference, [0.2, 0.2, 0.2])];
+        assert_eq!(predicted_error(at, &reference, &[&other], &far, 0.5, w), free);
     }
 
     #[test]

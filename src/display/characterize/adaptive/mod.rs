@@ -6,7 +6,8 @@
 //!
 //! The predicted error is the disagreement of the display models fitted to the readings
 //! so far: the largest ΔE*ab between the reference model's colour (the requested model, or
-//! `auto`'s choice) and a competitive candidate's ([`competitive`]). Every choice is a
+//! `auto`'s choice) and another model's, leaving out a model the readings near that colour
+//! contradict ([`choice::predicted_error`]). Every choice is a
 //! function of the readings already journalled, the targets and the rule ([`Rule`], its
 //! seed included), so a resumed session and a re-run choose the same patches; the first
 //! journal's fingerprint covers the rule and the targets' SHA-256. Each batch has its own
@@ -41,12 +42,8 @@ pub const DEFAULT_MAX_READINGS: usize = 120;
 pub const DEFAULT_BATCH: usize = 8;
 /// Most targets a file may hold: each costs a fit's inverse per batch.
 pub const MAX_TARGETS: usize = 1000;
-/// Cross-validation folds of the candidates' scores.
+/// Cross-validation folds of `auto`'s choice.
 pub const FOLDS: usize = 5;
-/// A candidate competes when its cross-validated mean ΔE00 is at most this many times the
-/// best's: one that predicts held-out readings much worse than the best is wrong about the
-/// display, and its disagreement would not shrink with more readings.
-pub const COMPETITIVE_FACTOR: f64 = 2.0;
 
 /// The adaptive plan's rule: when to stop, how many at a time, and the seed of the
 /// held-out patches' offsets.
@@ -173,43 +170,32 @@ pub struct Fitted {
     /// The model the profile will be: the request's, or `auto`'s choice.
     pub model: ModelKind,
     pub reference: Profile,
-    /// The competitive candidates, fitted to every patch.
+    /// Every other model of [`ModelKind::ALL`] that could be fitted, fitted to every patch.
     pub candidates: Vec<(ModelKind, ModelParams)>,
-}
-
-/// The candidates whose cross-validated mean ΔE00 is within [`COMPETITIVE_FACTOR`] of the
-/// best and which the selection did not set aside, and the model `auto` chooses.
-pub fn competitive(samples: &[Sample]) -> Result<(Vec<ModelKind>, ModelKind), FitError> {
-    let selection = select_model(samples, FOLDS, &FitOptions::default())?;
-    let best = selection
-        .candidates
-        .iter()
-        .filter(|c| c.set_aside.is_none())
-        .filter_map(|c| c.cv_mean_de00.as_ref().ok().copied())
-        .fold(f64::INFINITY, f64::min);
-    let kinds = selection
-        .candidates
-        .iter()
-        .filter(|c| c.set_aside.is_none())
-        .filter(|c| {
-            c.cv_mean_de00
-                .as_ref()
-                .is_ok_and(|e| *e <= COMPETITIVE_FACTOR * best)
-        })
-        .map(|c| c.model)
-        .collect();
-    Ok((kinds, selection.model))
+    /// The readings they were fitted to.
+    pub samples: Vec<Sample>,
+    /// How far a candidate may miss the readings near a drive value beyond the reference's
+    /// miss and still count there (see [`choice::predicted_error`]).
+    pub slack: f64,
 }
 
 impl Fitted {
-    /// Fits the reference (`model`, or `auto`'s choice) and the competitive candidates to
-    /// `samples`.
-    pub fn new(samples: &[Sample], model: ModelKind, auto: bool) -> Result<Fitted, FitError> {
-        let (kinds, chosen) = competitive(samples)?;
-        let model = if auto { chosen } else { model };
+    /// Fits the reference (`model`, or with `auto` the model `fit --model auto` chooses)
+    /// and every other model to `samples`; `slack` as [`Fitted::slack`].
+    pub fn new(
+        samples: &[Sample],
+        model: ModelKind,
+        auto: bool,
+        slack: f64,
+    ) -> Result<Fitted, FitError> {
+        let model = if auto {
+            select_model(samples, FOLDS, &FitOptions::default())?.model
+        } else {
+            model
+        };
         let reference = fit_profile(model, samples, None)?;
         let set = SortedSamples::new(samples);
-        let candidates = kinds
+        let candidates = ModelKind::ALL
             .into_iter()
             .filter(|k| *k != model)
             .filter_map(|k| {
@@ -222,6 +208,8 @@ impl Fitted {
             model,
             reference,
             candidates,
+            samples: samples.to_vec(),
+            slack,
         })
     }
 
@@ -233,6 +221,8 @@ impl Fitted {
             rgb,
             self.reference.model(),
             &models,
+            &self.samples,
+            self.slack,
             self.reference.white_xyz,
         )
     }

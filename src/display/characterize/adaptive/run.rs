@@ -62,7 +62,7 @@ pub struct AdaptiveReport {
     pub stop: StopReason,
     /// The predicted ΔE*ab at the worst target when the plan stopped.
     pub predicted_de: f64,
-    /// The competitive candidates at the end.
+    /// The models fitted at the end, the reference first.
     pub candidates: Vec<ModelKind>,
     pub fit_readings: usize,
     pub verify_patches: usize,
@@ -380,7 +380,12 @@ pub fn run(
     let mut batches = Vec::new();
     let mut j = 0;
     let (fitted, stop, predicted_de) = loop {
-        let fitted = Fitted::new(&p.samples(), options.model, adaptive.auto).map_err(|source| {
+        let fitted = Fitted::new(
+            &p.samples(),
+            options.model,
+            adaptive.auto,
+            rule.stop_de / 2.0,
+        ).map_err(|source| {
             crate::display::characterize::finish::FinishError::Fit {
                 model: options.model,
                 source,
@@ -477,4 +482,152 @@ pub fn run(
         Some(report),
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::display::characterize::{
+        characterize, Attend, Listener, PlanOptions, Request, SimulatedMeter,
+    };
+    use crate::rig::{Preset, ScreenSpec};
+    use crate::session::NoProgress;
+
+    struct Quiet(NoProgress);
+    impl Listener for Quiet {
+        fn note(&mut self, _: &str) {}
+        fn warning(&mut self, _: &str) {}
+        fn progress(&mut self, _: bool) -> &mut dyn ProgressSink {
+            &mut self.0
+        }
+    }
+
+    /// The ColorChecker under D65 at a white of 100 cd/m² (tests/data/docs/colorchecker-targets.csv).
+    fn targets() -> Vec<crate::color::Xyz> {
+        let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/docs/colorchecker-targets.csv");
+        super::super::read_targets(&file).unwrap()
+    }
+
+    fn request(tag: &str, resume: bool, stop_after: Option<usize>) -> Request {
+        let out = std::env::temp_dir().join(format!("metamer-adaptive-{tag}-{}", std::process::id()));
+        if !resume {
+            let _ = std::fs::remove_dir_all(&out);
+        }
+        Request {
+            out,
+            screen: ScreenSpec::Virtual(Preset::WideGamutCcfl),
+            virtual_white_cd_m2: None,
+            instrument: "sim:cs100a?time_scale=0&seed=5".into(),
+            speed: None,
+            plan: PlanOptions {
+                ramp_steps: 5,
+                repeats: 1,
+                grid_steps: 0,
+            },
+            adaptive: Some(Adaptive {
+                // A figure no fit on the simulated meter's noise reaches: the plan runs to
+                // its cap, two batches after the first pass.
+                rule: Rule {
+                    stop_de: 0.01,
+                    max_readings: 0,
+                    batch: 6,
+                    seed: 3,
+                },
+                targets: targets(),
+                auto: false,
+            }),
+            model: ModelKind::Lut,
+            settle: Some(Duration::ZERO),
+            resume,
+            force: false,
+            attend: Attend::Terminal { unattended: true },
+            simulated_meter: SimulatedMeter::Warn,
+            run: RunOptions {
+                stop_after,
+                interrupt: None,
+            },
+        }
+    }
+
+    fn with_cap(mut r: Request) -> Request {
+        let first = first_pass(r.plan).unwrap().len();
+        if let Some(a) = &mut r.adaptive {
+            a.rule.max_readings = first + 12;
+        }
+        r
+    }
+
+    /// Every journal's lines of entries (index, label, rgb, XYZ), journal by journal.
+    fn journals(dir: &Path) -> Vec<(String, Vec<serde_json::Value>)> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".jsonl"))
+            .collect();
+        names.sort();
+        names
+            .into_iter()
+            .map(|n| {
+                let text = std::fs::read_to_string(dir.join(&n)).unwrap();
+                let entries = text
+                    .lines()
+                    .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+                    .filter(|l| l["type"] == "entry")
+                    .map(|l| {
+                        serde_json::json!([l["index"], l["label"], l["data"]["rgb"], l["reading"]["xyz"]])
+                    })
+                    .collect();
+                (n, entries)
+            })
+            .collect()
+    }
+
+    /// Interrupted in the middle of the first batch and again in the held-out set, then
+    /// resumed: the same batches, the same readings in the same journals and the same
+    /// verification as one uninterrupted run.
+    #[test]
+    fn a_resumed_adaptive_session_chooses_and_reads_what_an_uninterrupted_one_does() {
+        let straight = with_cap(request("straight", false, None));
+        let Outcome::Finished(a) = characterize(&straight, &mut Quiet(NoProgress)).unwrap() else {
+            panic!("an uninterrupted simulated session finishes")
+        };
+        let report = a.adaptive.clone().unwrap();
+        assert_eq!(report.batches.len(), 2, "{report:?}");
+        assert_eq!(report.stop, StopReason::Cap);
+        assert_eq!(report.verify_patches, 24);
+        let first = first_pass(straight.plan).unwrap().len();
+        assert_eq!(report.fit_readings, first + 12);
+        assert_eq!(a.readings, first + 12 + 24);
+
+        let mut done = 0;
+        for stop in [first + 3, first + 12 + 5, usize::MAX] {
+            let r = with_cap(request("split", done > 0, Some(stop - done)));
+            let outcome = characterize(&r, &mut Quiet(NoProgress)).unwrap();
+            match outcome {
+                Outcome::Incomplete { done: d, .. } => {
+                    assert_eq!(d, stop, "stopped after {stop}");
+                    done = d;
+                }
+                Outcome::Finished(b) => {
+                    assert_eq!(stop, usize::MAX);
+                    assert_eq!(b.adaptive, a.adaptive);
+                    assert_eq!(b.verification.de00.mean, a.verification.de00.mean);
+                    assert_eq!(b.model, a.model);
+                }
+            }
+        }
+        let split = with_cap(request("split", true, None));
+        assert_eq!(journals(&straight.out), journals(&split.out));
+        assert_eq!(journals(&straight.out).len(), 4);
+        // Another rule is another plan: the first journal refuses it.
+        let mut other = with_cap(request("split", true, None));
+        if let Some(a) = &mut other.adaptive {
+            a.rule.batch = 5;
+        }
+        let e = characterize(&other, &mut Quiet(NoProgress)).unwrap_err().to_string();
+        assert!(e.contains("batch"), "{e}");
+        std::fs::remove_dir_all(&straight.out).unwrap();
+        std::fs::remove_dir_all(&split.out).unwrap();
+    }
 }
