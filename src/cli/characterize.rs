@@ -4,9 +4,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::ValueEnum;
-use metamer::display::characterize::adaptive::{
-    read_targets, Adaptive, AdaptiveError, StopReason,
-};
+use metamer::display::characterize::adaptive::{read_targets, Adaptive, AdaptiveError, StopReason};
 use metamer::display::characterize::finish::Summary;
 use metamer::display::characterize::{
     self, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions, Request,

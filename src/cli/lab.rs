@@ -8,8 +8,8 @@ use metamer::experiment::lab::{run_lab, LabError, LabOptions, LabSummary, LAB_FI
 use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
-use super::plan_choice::{PlanKind, RuleArgs};
 use super::experiment::{print_outcomes, refusal, StageProgress};
+use super::plan_choice::{PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]

@@ -305,8 +305,9 @@ mod tests {
         }
     }
 
-    /// The stopping figure: by hand, a bump of b cd/m² of Y on a target whose Y is Y_t
-    /// moves L* by about 116/3·(Y_t/Y_w)^(−2/3)·b/Y_w. Models that agree stop at once;
+    /// The stopping figure: by hand, a bump of b cd/m² of Y alone (X and Z unchanged) on a
+    /// target whose Y is Y_t moves f(Y/Y_w) by about δ = (Y_t/Y_w)^(−2/3)·b/(3·Y_w), so L*
+    /// by 116δ, a* by −500δ and b* by 200δ: ΔE*ab ≈ δ·√(116² + 500² + 200²). Models that agree stop at once;
     /// models that disagree above the figure go on, below it stop; a full cap stops.
     #[test]
     fn the_plan_stops_below_the_figure_or_at_the_cap() {
@@ -317,7 +318,9 @@ mod tests {
         let w = white();
         let t = vec![CENTRE];
         let y_t = reference.forward(CENTRE)[1];
-        let de_per_cd = 116.0 / 3.0 * (y_t / w[1]).powf(-2.0 / 3.0) / w[1];
+        let de_per_cd = (116f64.powi(2) + 500f64.powi(2) + 200f64.powi(2)).sqrt() / 3.0
+            * (y_t / w[1]).powf(-2.0 / 3.0)
+            / w[1];
         for (bump, stop_de, want) in [
             (0.0, 1.0, Some(StopReason::Converged)),
             (1.5 / de_per_cd, 1.0, None),
@@ -373,14 +376,20 @@ mod tests {
             xyz: m.forward(rgb),
         };
         let held = [truth(&reference, CENTRE)];
-        assert_eq!(predicted_error(at, &reference, &[&other], &held, 0.5, w), 0.0);
+        assert_eq!(
+            predicted_error(at, &reference, &[&other], &held, 0.5, w),
+            0.0
+        );
         // The reading is the candidate's: the reference misses it by as much, so both count.
         let theirs = [truth(&other, CENTRE)];
         let both = predicted_error(at, &reference, &[&other], &theirs, 0.5, w);
         assert!((both - free).abs() < 1e-12, "{both} {free}");
         // A reading far away (more than 24 codes) judges nothing here.
         let far = [truth(&reference, [0.2, 0.2, 0.2])];
-        assert_eq!(predicted_error(at, &reference, &[&other], &far, 0.5, w), free);
+        assert_eq!(
+            predicted_error(at, &reference, &[&other], &far, 0.5, w),
+            free
+        );
     }
 
     #[test]

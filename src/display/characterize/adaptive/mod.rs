@@ -241,7 +241,8 @@ mod tests {
     use super::*;
 
     fn file(tag: &str, text: &str) -> PathBuf {
-        let p = std::env::temp_dir().join(format!("metamer-targets-{tag}-{}.csv", std::process::id()));
+        let p =
+            std::env::temp_dir().join(format!("metamer-targets-{tag}-{}.csv", std::process::id()));
         std::fs::write(&p, text).unwrap();
         p
     }

@@ -195,13 +195,8 @@ impl Progress<'_> {
         let instruments = [(METER.to_string(), InstrumentRecord::of(&shifted))].into();
         // A journal after the first exists only if the session measured into it before.
         let resume = self.options.resume || j > 0;
-        let mut session: Session<LogDetails, DriveStep> = Session::open(
-            path,
-            plan,
-            self.details.clone(),
-            instruments,
-            resume,
-        )?;
+        let mut session: Session<LogDetails, DriveStep> =
+            Session::open(path, plan, self.details.clone(), instruments, resume)?;
         if self.out.is_none() {
             let mut out = OutputPolicy::new(self.options.force || session.recovered > 0);
             out.input(session.journal_path());
@@ -268,8 +263,11 @@ impl Progress<'_> {
             }
             (end, _) => return Ok(incomplete(&session, self.taken.len(), end)),
         };
-        self.taken
-            .extend(entries.into_iter().map(|e| (e.data.clone(), e.reading.clone())));
+        self.taken.extend(
+            entries
+                .into_iter()
+                .map(|e| (e.data.clone(), e.reading.clone())),
+        );
         Ok(Measured::Complete)
     }
 
@@ -291,17 +289,17 @@ impl Progress<'_> {
 
     /// The next distinct patch number.
     fn next_patch(&self) -> usize {
-        self.taken.iter().map(|(p, _)| p.patch + 1).max().unwrap_or(0)
+        self.taken
+            .iter()
+            .map(|(p, _)| p.patch + 1)
+            .max()
+            .unwrap_or(0)
     }
 }
 
 /// The options of every journal of an adaptive plan: the fixed plan's, and the rule and the
 /// targets, so a journal is resumed only by the same rule on the same targets.
-fn base_options(
-    options: &Options,
-    adaptive: &Adaptive,
-    display: &str,
-) -> BTreeMap<String, String> {
+fn base_options(options: &Options, adaptive: &Adaptive, display: &str) -> BTreeMap<String, String> {
     let r = &adaptive.rule;
     let model = if adaptive.auto {
         "auto".to_string()
@@ -362,14 +360,7 @@ pub fn run(
     macro_rules! measure {
         ($j:expr, $path:expr, $name:expr, $steps:expr) => {
             if let Measured::Incomplete(o) = p.measure(
-                $j,
-                $path,
-                $name,
-                $steps,
-                display,
-                instrument,
-                operator,
-                progress,
+                $j, $path, $name, $steps, display, instrument, operator, progress,
             )? {
                 return Ok(o);
             }
@@ -385,12 +376,13 @@ pub fn run(
             options.model,
             adaptive.auto,
             rule.stop_de / 2.0,
-        ).map_err(|source| {
-            crate::display::characterize::finish::FinishError::Fit {
+        )
+        .map_err(
+            |source| crate::display::characterize::finish::FinishError::Fit {
                 model: options.model,
                 source,
-            }
-        })?;
+            },
+        )?;
         let drives = fitted.target_drives(&adaptive.targets);
         let measured: Vec<[u8; 3]> = p.taken.iter().map(|(s, _)| s.rgb).collect();
         let room = rule.max_readings.saturating_sub(p.fit_readings());
@@ -504,13 +496,14 @@ mod tests {
 
     /// The ColorChecker under D65 at a white of 100 cd/m² (tests/data/docs/colorchecker-targets.csv).
     fn targets() -> Vec<crate::color::Xyz> {
-        let file = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/docs/colorchecker-targets.csv");
+        let file =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/docs/colorchecker-targets.csv");
         super::super::read_targets(&file).unwrap()
     }
 
     fn request(tag: &str, resume: bool, stop_after: Option<usize>) -> Request {
-        let out = std::env::temp_dir().join(format!("metamer-adaptive-{tag}-{}", std::process::id()));
+        let out =
+            std::env::temp_dir().join(format!("metamer-adaptive-{tag}-{}", std::process::id()));
         if !resume {
             let _ = std::fs::remove_dir_all(&out);
         }
@@ -575,7 +568,12 @@ mod tests {
                     .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
                     .filter(|l| l["type"] == "entry")
                     .map(|l| {
-                        serde_json::json!([l["index"], l["label"], l["data"]["rgb"], l["reading"]["xyz"]])
+                        serde_json::json!([
+                            l["index"],
+                            l["label"],
+                            l["data"]["rgb"],
+                            l["reading"]["xyz"]
+                        ])
                     })
                     .collect();
                 (n, entries)
@@ -625,7 +623,9 @@ mod tests {
         if let Some(a) = &mut other.adaptive {
             a.rule.batch = 5;
         }
-        let e = characterize(&other, &mut Quiet(NoProgress)).unwrap_err().to_string();
+        let e = characterize(&other, &mut Quiet(NoProgress))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("batch"), "{e}");
         std::fs::remove_dir_all(&straight.out).unwrap();
         std::fs::remove_dir_all(&split.out).unwrap();
