@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::{InstrumentInfo, Reading};
 use serde::Serialize;
 
-use super::adaptive::AdaptiveReport;
+use super::adaptive::report::AdaptiveReport;
 use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
 use super::verify::{average, usable, verify_held_out};

@@ -10,8 +10,8 @@ use std::time::Duration;
 
 use metamer_drivers::{Instrument, Spec, Speed, World};
 
+use super::adaptive::rule::Adaptive;
 use super::adaptive::run::first_pass;
-use super::adaptive::Adaptive;
 use super::finish::files;
 use super::hands::{Hands, HandsOperator};
 use super::meter::meter_sees;

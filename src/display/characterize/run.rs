@@ -95,7 +95,7 @@ pub enum CharacterizeError {
     SimulatedMeterOnRealScreen(super::meter::SimulatedMeterOnRealScreen),
     /// An adaptive plan's rule or targets make no plan.
     #[error(transparent)]
-    Adaptive(#[from] super::adaptive::AdaptiveError),
+    Adaptive(#[from] super::adaptive::rule::AdaptiveError),
 }
 
 /// The journal of a characterization in `dir`.

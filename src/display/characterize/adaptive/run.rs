@@ -12,10 +12,11 @@ use metamer_drivers::{
     CalibrationCondition, CalibrationOutcome, Capabilities, DriverError, Instrument,
     InstrumentInfo, MeasureMode, Reading, Request,
 };
-use serde::{Deserialize, Serialize};
 
-use super::choice::{decide, verification_codes, Decision, StopReason};
-use super::{Adaptive, Fitted, Rule};
+use super::choice::{decide, verification_codes, Decision};
+use super::fitted::Fitted;
+use super::report::{AdaptiveReport, Batch};
+use super::rule::Adaptive;
 use crate::display::characterize::finish::{files, finish, MeasuredBy};
 use crate::display::characterize::plan::{
     DriveStep, Plan, PlanOptions, Purpose, METER, SESSION_KIND,
@@ -38,35 +39,6 @@ pub const SPARSE_GRID: usize = 3;
 /// The noise stream of journal j's step k is j·2¹⁶ + k: no two readings of the session
 /// draw the same simulated noise.
 const NOISE_STRIDE: u64 = 1 << 16;
-
-/// One batch as chosen.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Batch {
-    /// Fit readings before it.
-    pub after_readings: usize,
-    /// The predicted ΔE*ab at the worst target before it.
-    pub predicted_de: f64,
-    pub model: ModelKind,
-    pub patches: Vec<[u8; 3]>,
-}
-
-/// How an adaptive plan went; in the summary.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AdaptiveReport {
-    pub rule: Rule,
-    pub targets: usize,
-    pub targets_sha256: String,
-    /// `auto`: the model was chosen by cross-validation.
-    pub auto: bool,
-    pub batches: Vec<Batch>,
-    pub stop: StopReason,
-    /// The predicted ΔE*ab at the worst target when the plan stopped.
-    pub predicted_de: f64,
-    /// The models fitted at the end, the reference first.
-    pub candidates: Vec<ModelKind>,
-    pub fit_readings: usize,
-    pub verify_patches: usize,
-}
 
 /// The journal of the adaptive plan's journal `j` in `dir`: 0 the first pass, then the
 /// batches; the held-out set's is [`verify_path`].
@@ -171,23 +143,7 @@ impl Progress<'_> {
         operator: &mut dyn Operator,
         progress: &mut dyn ProgressSink,
     ) -> Result<Measured, CharacterizeError> {
-        let mut options = self.base.clone();
-        options.insert("journal".into(), name.into());
-        let plan = SessionPlan {
-            kind: SESSION_KIND.into(),
-            options,
-            steps: steps
-                .iter()
-                .map(|p| Step {
-                    label: p.label.clone(),
-                    role: METER.into(),
-                    mode: MeasureMode::Emissive,
-                    prepare: Prepare::Show { rgb: p.rgb },
-                    settle: self.settle,
-                    data: p.clone(),
-                })
-                .collect(),
-        };
+        let plan = self.session_plan(name, &steps);
         let mut shifted = Shifted {
             inner: instrument,
             offset: j * NOISE_STRIDE,
@@ -271,6 +227,57 @@ impl Progress<'_> {
         Ok(Measured::Complete)
     }
 
+    /// Journal `name`'s steps as a session plan: the colours shown and read in emissive
+    /// mode, under the plan's options and the journal's name.
+    fn session_plan(&self, name: &str, steps: &[DriveStep]) -> SessionPlan<DriveStep> {
+        let mut options = self.base.clone();
+        options.insert("journal".into(), name.into());
+        SessionPlan {
+            kind: SESSION_KIND.into(),
+            options,
+            steps: steps
+                .iter()
+                .map(|p| Step {
+                    label: p.label.clone(),
+                    role: METER.into(),
+                    mode: MeasureMode::Emissive,
+                    prepare: Prepare::Show { rgb: p.rgb },
+                    settle: self.settle,
+                    data: p.clone(),
+                })
+                .collect(),
+        }
+    }
+
+    /// Fits `model` to every fit reading, verifies it on the held-out ones and writes the
+    /// files, the summary with `report`.
+    fn finish(
+        mut self,
+        model: ModelKind,
+        info: &InstrumentInfo,
+        report: AdaptiveReport,
+    ) -> Result<Outcome, CharacterizeError> {
+        let dir = self.options.dir.as_path();
+        let readings: Vec<(&DriveStep, &Reading)> =
+            self.taken.iter().map(|(s, r)| (s, r)).collect();
+        let out = self.out.take().expect("the first journal set the policy");
+        let summary = finish(
+            dir,
+            &log_path(dir),
+            &readings,
+            model,
+            &MeasuredBy {
+                display: &self.details.display,
+                display_description: &self.details.display_description,
+                instrument: &self.details.instrument,
+                instrument_info: info,
+            },
+            &out,
+            Some(report),
+        )?;
+        Ok(Outcome::Finished(Box::new(summary)))
+    }
+
     /// The fit readings so far, as the models take them.
     fn samples(&self) -> Vec<Sample> {
         self.taken
@@ -295,6 +302,45 @@ impl Progress<'_> {
             .max()
             .unwrap_or(0)
     }
+}
+
+/// Journal steps measuring `codes` for `purpose`, patches numbered from `start`.
+fn steps_of(
+    codes: &[[u8; 3]],
+    start: usize,
+    purpose: Purpose,
+    label: impl Fn(usize) -> String,
+) -> Vec<DriveStep> {
+    codes
+        .iter()
+        .enumerate()
+        .map(|(i, rgb)| DriveStep {
+            index: i,
+            patch: start + i,
+            repeat: 0,
+            rgb: *rgb,
+            purpose,
+            label: label(i),
+        })
+        .collect()
+}
+
+/// Every model fitted to the fit readings so far; a candidate counts near a reading it
+/// misses by less than half the stopping figure beyond the reference's miss.
+fn fit(p: &Progress, options: &Options, adaptive: &Adaptive) -> Result<Fitted, CharacterizeError> {
+    Fitted::new(
+        &p.samples(),
+        options.model,
+        adaptive.auto,
+        adaptive.rule.stop_de / 2.0,
+    )
+    .map_err(|source| {
+        crate::display::characterize::finish::FinishError::Fit {
+            model: options.model,
+            source,
+        }
+        .into()
+    })
 }
 
 /// The options of every journal of an adaptive plan: the fixed plan's, and the rule and the
@@ -339,17 +385,15 @@ pub fn run(
 ) -> Result<Outcome, CharacterizeError> {
     let first = first_pass(options.plan)?;
     adaptive.check(first.len())?;
-    let settle = options.settle.unwrap_or_else(|| display.default_settle());
-    let display_name = display.spec();
     let details = LogDetails {
-        display: display_name.clone(),
+        display: display.spec(),
         display_description: display.describe(),
         instrument: options.instrument.to_string(),
     };
     let mut p = Progress {
         options,
-        base: base_options(options, adaptive, &display_name),
-        settle,
+        base: base_options(options, adaptive, &details.display),
+        settle: options.settle.unwrap_or_else(|| display.default_settle()),
         details,
         taken: Vec::new(),
         new: 0,
@@ -371,18 +415,7 @@ pub fn run(
     let mut batches = Vec::new();
     let mut j = 0;
     let (fitted, stop, predicted_de) = loop {
-        let fitted = Fitted::new(
-            &p.samples(),
-            options.model,
-            adaptive.auto,
-            rule.stop_de / 2.0,
-        )
-        .map_err(
-            |source| crate::display::characterize::finish::FinishError::Fit {
-                model: options.model,
-                source,
-            },
-        )?;
+        let fitted = fit(&p, options, adaptive)?;
         let drives = fitted.target_drives(&adaptive.targets);
         let measured: Vec<[u8; 3]> = p.taken.iter().map(|(s, _)| s.rgb).collect();
         let room = rule.max_readings.saturating_sub(p.fit_readings());
@@ -400,18 +433,9 @@ pub fn run(
         };
         j += 1;
         let start = p.next_patch();
-        let steps: Vec<DriveStep> = codes
-            .iter()
-            .enumerate()
-            .map(|(i, rgb)| DriveStep {
-                index: i,
-                patch: start + i,
-                repeat: 0,
-                rgb: *rgb,
-                purpose: Purpose::Fit,
-                label: format!("batch {j} patch {}", i + 1),
-            })
-            .collect();
+        let steps = steps_of(&codes, start, Purpose::Fit, |i| {
+            format!("batch {j} patch {}", i + 1)
+        });
         batches.push(Batch {
             after_readings: p.fit_readings(),
             predicted_de: at,
@@ -428,18 +452,10 @@ pub fn run(
     let drives = fitted.target_drives(&adaptive.targets);
     let fit_codes: Vec<[u8; 3]> = p.taken.iter().map(|(s, _)| s.rgb).collect();
     let start = p.next_patch();
-    let held_out: Vec<DriveStep> = verification_codes(&drives, &fit_codes, rule.seed)
-        .into_iter()
-        .enumerate()
-        .map(|(i, rgb)| DriveStep {
-            index: i,
-            patch: start + i,
-            repeat: 0,
-            rgb,
-            purpose: Purpose::Verify,
-            label: format!("near target {}", i + 1),
-        })
-        .collect();
+    let codes = verification_codes(&drives, &fit_codes, rule.seed);
+    let held_out = steps_of(&codes, start, Purpose::Verify, |i| {
+        format!("near target {}", i + 1)
+    });
     let verify_patches = held_out.len();
     measure!(j as u64 + 1, &verify_path(dir), "verify", held_out);
     let report = AdaptiveReport {
@@ -456,32 +472,18 @@ pub fn run(
         fit_readings: p.fit_readings(),
         verify_patches,
     };
-    let readings: Vec<(&DriveStep, &Reading)> = p.taken.iter().map(|(s, r)| (s, r)).collect();
-    let info = &instrument.info();
-    let out = p.out.take().expect("the first journal set the policy");
-    let summary = finish(
-        dir,
-        &log_path(dir),
-        &readings,
-        fitted.model,
-        &MeasuredBy {
-            display: &p.details.display,
-            display_description: &p.details.display_description,
-            instrument: &p.details.instrument,
-            instrument_info: info,
-        },
-        &out,
-        Some(report),
-    )?;
-    Ok(Outcome::Finished(Box::new(summary)))
+    p.finish(fitted.model, &instrument.info(), report)
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::choice::StopReason;
+    use super::super::rule::Rule;
     use super::*;
     use crate::display::characterize::{
         characterize, Attend, Listener, PlanOptions, Request, SimulatedMeter,
     };
+    use crate::display::model::ModelKind;
     use crate::rig::{Preset, ScreenSpec};
     use crate::session::NoProgress;
 
@@ -498,7 +500,7 @@ mod tests {
     fn targets() -> Vec<crate::color::Xyz> {
         let file =
             Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/docs/colorchecker-targets.csv");
-        super::super::read_targets(&file).unwrap()
+        super::super::rule::read_targets(&file).unwrap()
     }
 
     fn request(tag: &str, resume: bool, stop_after: Option<usize>) -> Request {
