@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::ValueEnum;
+use metamer::display::characterize::adaptive::{read_targets, Adaptive, AdaptiveError, StopReason};
 use metamer::display::characterize::finish::Summary;
 use metamer::display::characterize::{
     self, Attend, CharacterizeError, Listener, Outcome, PlanError, PlanOptions, Request,
@@ -14,6 +15,7 @@ use metamer::rig::ScreenSpec;
 use metamer::session::{on_ctrl_c, BarProgress, ProgressSink, RunOptions};
 use metamer_drivers::{Spec, Speed};
 
+use super::plan_choice::{PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -47,9 +49,22 @@ pub struct Args {
     /// virtual display).
     #[arg(long, value_name = "MS")]
     settle_ms: Option<u64>,
-    /// plcc (paper Eq. 9), plcc-gamma, gog, gogo, lut or matrix-lsq.
+    /// plcc (paper Eq. 9), plcc-gamma, plvc, gog, gogo, lut, matrix-lsq, shaper-matrix, or
+    /// (--plan adaptive only) auto: chosen by cross-validation as `fit --model auto` does.
     #[arg(long, default_value = "plcc", value_name = "MODEL")]
     model: String,
+    /// fixed: ramps, the model's grid and 48 held-out colours. adaptive: a first pass (ramps,
+    /// a 3³ grid), then batches where the candidate models disagree most at the --targets,
+    /// until the predicted ΔE*ab there is below --stop-de or --max-readings are taken; the
+    /// held-out patches at and around the targets.
+    #[arg(long, value_enum, default_value = "fixed")]
+    plan: PlanKind,
+    /// adaptive only: the colours to reproduce, a CSV with the header X,Y,Z (cd/m²), the
+    /// file `reproduce --xyz` takes.
+    #[arg(long, value_name = "TARGETS.csv")]
+    targets: Option<PathBuf>,
+    #[command(flatten)]
+    rule: RuleArgs,
     /// Response speed of instruments that have one (the CS-100A); default: the
     /// instrument's (fast).
     #[arg(long, value_enum)]
@@ -79,7 +94,46 @@ pub struct Args {
 
 pub fn run(args: Args) -> CliResult {
     let screen = ScreenSpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
-    let model: ModelKind = args.model.parse().map_err(CliError::Usage)?;
+    let auto = args.model.trim().eq_ignore_ascii_case("auto");
+    let model: ModelKind = if auto {
+        if args.plan == PlanKind::Fixed {
+            return Err(CliError::Usage(
+                "--model auto chooses the model between batches: it needs --plan adaptive \
+                 (for the fixed plan, fit the readings.ti3 with `metamer fit --model auto`)"
+                    .into(),
+            ));
+        }
+        ModelKind::Lut
+    } else {
+        args.model.parse().map_err(CliError::Usage)?
+    };
+    let adaptive = match (args.rule.rule(args.plan)?, &args.targets) {
+        (None, None) => None,
+        (None, Some(_)) => {
+            return Err(CliError::Usage(
+                "--targets names the colours an adaptive plan measures around: it needs --plan adaptive"
+                    .into(),
+            ))
+        }
+        (Some(_), None) => {
+            return Err(CliError::Usage(
+                "--plan adaptive needs --targets TARGETS.csv (X,Y,Z in cd/m²)".into(),
+            ))
+        }
+        (Some(rule), Some(file)) => {
+            if args.grid_steps.is_some() {
+                return Err(CliError::Usage(
+                    "--grid-steps sets the fixed plan's grid; the adaptive plan's first pass has a 3³ grid"
+                        .into(),
+                ));
+            }
+            Some(Adaptive {
+                rule,
+                targets: read_targets(file).map_err(|e| CliError::Failed(e.into()))?,
+                auto,
+            })
+        }
+    };
     let request = Request {
         out: args.out.clone(),
         screen,
@@ -90,6 +144,7 @@ pub fn run(args: Args) -> CliResult {
             SpeedArg::Slow => Speed::Slow,
         }),
         plan: PlanOptions::for_model(model, args.ramp_steps, args.repeats, args.grid_steps),
+        adaptive,
         model,
         settle: args.settle_ms.map(Duration::from_millis),
         resume: args.resume,
@@ -134,6 +189,9 @@ impl Listener for Printer {
 fn refusal(e: CharacterizeError) -> CliError {
     match e {
         CharacterizeError::Plan(e) => CliError::Usage(plan_usage(&e)),
+        CharacterizeError::Adaptive(e @ AdaptiveError::Cap { .. }) => {
+            CliError::Usage(format!("--max-readings: {e}"))
+        }
         CharacterizeError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
         CharacterizeError::Instrument(e) if e.is_spec() => CliError::Usage(e.to_string()),
         e => match e.advice() {
@@ -184,6 +242,23 @@ fn print_summary(s: &Summary) -> Result<(), CliError> {
         v.de00.p95,
         v.de00.max
     )?;
+    if let Some(a) = &s.adaptive {
+        outln!(
+            "adaptive plan: {} fit readings in {} batch{} after the first pass, model {}; \
+             predicted ΔE*ab at the worst of {} targets {:.2} ({})",
+            a.fit_readings,
+            a.batches.len(),
+            if a.batches.len() == 1 { "" } else { "es" },
+            s.model,
+            a.targets,
+            a.predicted_de,
+            match a.stop {
+                StopReason::Converged => format!("below {}", a.rule.stop_de),
+                StopReason::Cap => format!("stopped at the cap of {}", a.rule.max_readings),
+                StopReason::NothingLeft => "no patch near the targets left to measure".into(),
+            }
+        )?;
+    }
     // The verdict already names every failed assumption.
     outln!("verdict: {}", s.verdict)?;
     outln!(

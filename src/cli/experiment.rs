@@ -15,6 +15,7 @@ use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 use metamer_drivers::Spec;
 
+use super::plan_choice::{PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -111,6 +112,12 @@ pub struct Args {
     /// calibrate the instruments. Real instruments without a terminal on stdin need it.
     #[arg(long)]
     unattended: bool,
+    /// The display's characterization: fixed (the paper's patches) or adaptive (patches
+    /// where the candidate models disagree at the rendered colours).
+    #[arg(long, value_enum, default_value = "fixed")]
+    display_plan: PlanKind,
+    #[command(flatten)]
+    rule: RuleArgs,
 }
 
 pub fn run_cli(args: Args) -> CliResult {
@@ -162,6 +169,7 @@ fn request(args: Args) -> Result<Request, CliError> {
             screen: args.display,
             spot,
             model: args.model,
+            adaptive: args.rule.rule(args.display_plan)?,
         },
         reproduction: ReproductionOptions {
             gamut: args.gamut,

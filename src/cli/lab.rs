@@ -9,6 +9,7 @@ use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::experiment::{print_cost, print_outcomes, refusal, StageProgress};
+use super::plan_choice::{PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -72,9 +73,16 @@ pub struct Args {
     /// are moved aside, never deleted).
     #[arg(long)]
     force: bool,
+    /// The display's characterization: fixed (the paper's patches) or adaptive (patches
+    /// where the candidate models disagree at the 24 rendered colours).
+    #[arg(long, value_enum, default_value = "fixed")]
+    display_plan: PlanKind,
+    #[command(flatten)]
+    rule: RuleArgs,
 }
 
 pub fn run(args: Args) -> CliResult {
+    let adaptive = args.rule.rule(args.display_plan)?;
     let ScreenSpec::Virtual(display) = args.display else {
         return Err(CliError::Usage(format!(
             "--display {}: the lab's monitor is simulated; name it virtual:PRESET",
@@ -94,6 +102,7 @@ pub fn run(args: Args) -> CliResult {
         seed: args.seed,
         time_scale: args.time_scale,
         image_size: args.image_size,
+        adaptive,
     };
     let run = RunOptions {
         stop_after: None,

@@ -34,6 +34,7 @@ mod fit;
 mod lab;
 mod light;
 mod measure_box;
+mod plan_choice;
 mod render;
 mod reproduce;
 mod rig;

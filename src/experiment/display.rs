@@ -26,6 +26,11 @@ pub struct DisplayOptions {
     /// The spot meter, as named on the command line.
     pub spot: Spec,
     pub model: ModelKind,
+    /// None: the fixed plan (the paper's patches). Some: the adaptive plan with this rule,
+    /// its targets the rendered readings the display must show. Left out of the stage's
+    /// options when None, so an experiment on the fixed plan keeps its stages' hashes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<characterize::adaptive::Rule>,
 }
 
 /// What `display/display.json` holds: how the monitor was set, so later stages rebuild a
@@ -194,6 +199,11 @@ pub fn characterize_display(
         instrument: opts.spot.clone(),
         speed: None,
         plan: PlanOptions::for_model(opts.model, defaults.ramp_steps, defaults.repeats, None),
+        adaptive: opts.adaptive.map(|rule| characterize::adaptive::Adaptive {
+            rule,
+            targets: targets.to_vec(),
+            auto: false,
+        }),
         model: opts.model,
         settle: None,
         resume,

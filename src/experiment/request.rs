@@ -206,7 +206,7 @@ impl Request {
     ///         light: None,
     ///     },
     ///     simulation: SimulationOptions::new(0.1, 1, 0, 16, None),
-    ///     display: DisplayOptions { screen: "virtual:ips-lcd".parse()?, spot: meter, model: ModelKind::Lut },
+    ///     display: DisplayOptions { screen: "virtual:ips-lcd".parse()?, spot: meter, model: ModelKind::Lut, adaptive: None },
     ///     reproduction: ReproductionOptions { gamut: GamutMapping::NearestLab, mirror: true },
     ///     repeats: 3,
     ///     until_decided: None,

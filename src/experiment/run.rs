@@ -474,6 +474,7 @@ mod tests {
                 screen: ScreenSpec::Virtual(crate::rig::Preset::IpsLcd),
                 spot: "sim:cs100a?time_scale=0".into(),
                 model: ModelKind::MatrixLsq,
+                adaptive: None,
             },
             reproduction: ReproductionOptions {
                 gamut: crate::display::gamut::GamutMapping::Clip,

@@ -460,3 +460,79 @@ fn a_log_that_holds_no_session_says_what_to_do_and_resume_sets_it_aside() {
     assert_eq!(summary(&dir)["readings"], 5 + 4 + 48 + 5);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The adaptive plan's refusals, before anything is measured: a targets file with a row
+/// that is no colour names its file and line (exit 1); the flags that do not go together
+/// are usage errors (exit 2).
+#[test]
+fn adaptive_plan_refusals_name_the_file_line_and_flag() {
+    let dir = unused_dir("adaptive-refusals");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("targets.csv");
+    std::fs::write(&bad, "X,Y,Z\n10,12,5\n# a comment\n4,-1,3\n").unwrap();
+    let out = dir.join("out");
+    let (b, d) = (bad.to_str().unwrap(), out.to_str().unwrap());
+    let o = metamer(&[IPS, &["--plan", "adaptive", "--targets", b, "-o", d]].concat());
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains(&format!("{b}:4: target X=4, Y=-1, Z=3 is no colour")),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    for (args, expect) in [
+        (
+            vec!["--plan", "adaptive"],
+            "--plan adaptive needs --targets",
+        ),
+        (vec!["--targets", b], "--targets names the colours"),
+        (
+            vec!["--model", "auto"],
+            "--model auto chooses the model between batches",
+        ),
+        (
+            vec!["--plan", "adaptive", "--targets", b, "--stop-de", "0"],
+            "--stop-de must be a ΔE*ab above 0",
+        ),
+        (
+            vec!["--plan", "adaptive", "--targets", b, "--grid-steps", "5"],
+            "--grid-steps sets the fixed plan's grid",
+        ),
+    ] {
+        let o = metamer(&[IPS, &args, &["-o", d]].concat());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stderr));
+        assert!(
+            text(&o.stderr).contains(expect),
+            "{args:?}: {}",
+            text(&o.stderr)
+        );
+    }
+    let good = dir.join("good.csv");
+    std::fs::write(&good, "X,Y,Z\n10,12,5\n").unwrap();
+    let g = good.to_str().unwrap();
+    let o = metamer(
+        &[
+            IPS,
+            &[
+                "--plan",
+                "adaptive",
+                "--targets",
+                g,
+                "--max-readings",
+                "20",
+                "-o",
+                d,
+            ],
+        ]
+        .concat(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr)
+            .contains("--max-readings: the cap of 20 readings is below the first pass's"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!out.exists(), "nothing is written on a refusal");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -5,6 +5,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod adaptive_plan;
 mod display_fit;
 mod display_reproduce;
 mod icc_profile;

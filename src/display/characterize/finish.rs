@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::{InstrumentInfo, Reading};
 use serde::Serialize;
 
+use super::adaptive::report::AdaptiveReport;
 use super::plan::{DriveStep, Purpose};
 use super::report::{write_report, Report, ReportError};
 use super::verify::{average, usable, verify_held_out};
@@ -80,6 +81,9 @@ pub struct Summary {
     /// The model against the held-out patches (ΔE00 relative to the measured white).
     #[serde(serialize_with = "crate::display::verify::serialize_held_out")]
     pub verification: Verification,
+    /// How the adaptive plan chose its patches; absent for the fixed plan.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<AdaptiveReport>,
     pub files: Files,
     /// The readings, placements and time estimated before the first reading of this run
     /// and what the run took.
@@ -123,6 +127,7 @@ pub fn finish(
     model: ModelKind,
     who: &MeasuredBy,
     out: &OutputPolicy,
+    adaptive: Option<AdaptiveReport>,
 ) -> Result<Summary, FinishError> {
     let files = files(dir, log);
     // Before the fit: a refusal costs nothing and leaves every file as it was.
@@ -197,6 +202,7 @@ pub fn finish(
         black_xyz: black,
         fit_residuals: diagnostics.residuals.clone(),
         verification,
+        adaptive,
         files: files.clone(),
         cost: who.cost.clone(),
     };

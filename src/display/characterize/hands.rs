@@ -154,6 +154,7 @@ mod tests {
                     repeats: 1,
                     grid_steps: 0,
                 },
+                adaptive: None,
                 model: ModelKind::Plcc,
                 settle: Some(std::time::Duration::ZERO),
                 resume: false,

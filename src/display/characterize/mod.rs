@@ -3,6 +3,7 @@
 //! fitted display model on held-out colours ([`verify`], [`finish`]); [`request`] is the whole
 //! job as one call, for the command and the experiment's display stage.
 
+pub mod adaptive;
 mod advice;
 pub mod finish;
 mod hands;

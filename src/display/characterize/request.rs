@@ -10,6 +10,8 @@ use std::time::Duration;
 
 use metamer_drivers::{Instrument, Spec, Speed, World};
 
+use super::adaptive::rule::Adaptive;
+use super::adaptive::run::first_pass;
 use super::finish::files;
 use super::hands::{Hands, HandsOperator};
 use super::meter::meter_sees;
@@ -62,6 +64,9 @@ pub struct Request {
     /// The meter's response speed, for instruments that have one; None: its default.
     pub speed: Option<Speed>,
     pub plan: PlanOptions,
+    /// None: the fixed plan of `plan`. Some: the adaptive plan ([`super::adaptive`]), whose
+    /// first pass takes `plan`'s ramps and repeats.
+    pub adaptive: Option<Adaptive>,
     pub model: ModelKind,
     /// Wait between showing a colour and measuring it; None: the screen's default.
     pub settle: Option<Duration>,
@@ -120,6 +125,7 @@ pub trait Listener {
 ///     instrument: "sim:cs100a?time_scale=0".into(),
 ///     speed: None,
 ///     plan: PlanOptions { ramp_steps: 3, repeats: 1, grid_steps: 0 },
+///     adaptive: None,
 ///     model: ModelKind::Plcc,
 ///     settle: None,
 ///     resume: false,
@@ -142,6 +148,9 @@ pub fn characterize(
 ) -> Result<Outcome, CharacterizeError> {
     let out = request.out.as_path();
     let plan = Plan::new(request.plan)?;
+    if let Some(adaptive) = &request.adaptive {
+        adaptive.check(first_pass(request.plan)?.len())?;
+    }
     let attended = match request.attend {
         Attend::Terminal { unattended } => {
             attendance(&[&request.instrument], unattended)? == Attendance::Terminal
@@ -166,7 +175,7 @@ pub fn characterize(
     }
     // After every refusal: a note on what the plan can judge is no answer to a command
     // that will not run.
-    if let Some(advice) = plan_advice(&plan) {
+    if let Some(advice) = plan_advice(&plan).filter(|_| request.adaptive.is_none()) {
         listener.note(&advice);
     }
     let mut display = open_screen(&request.screen, request.virtual_white_cd_m2)
@@ -205,13 +214,23 @@ pub fn characterize(
         }
         None => operator.as_mut(),
     };
-    run(
-        &options,
-        display.as_mut(),
-        instrument.as_mut(),
-        operator,
-        listener.progress(attended),
-    )
+    match &request.adaptive {
+        Some(adaptive) => super::adaptive::run(
+            &options,
+            adaptive,
+            display.as_mut(),
+            instrument.as_mut(),
+            operator,
+            listener.progress(attended),
+        ),
+        None => run(
+            &options,
+            display.as_mut(),
+            instrument.as_mut(),
+            operator,
+            listener.progress(attended),
+        ),
+    }
 }
 
 /// The screen `spec` names; a simulated monitor set to `virtual_white_cd_m2` when given.

@@ -95,6 +95,9 @@ pub enum CharacterizeError {
     Speed(metamer_drivers::DriverError),
     #[error(transparent)]
     SimulatedMeterOnRealScreen(super::meter::SimulatedMeterOnRealScreen),
+    /// An adaptive plan's rule or targets make no plan.
+    #[error(transparent)]
+    Adaptive(#[from] super::adaptive::rule::AdaptiveError),
 }
 
 /// The journal of a characterization in `dir`.
@@ -200,6 +203,7 @@ pub fn run(
             cost: &cost,
         },
         &out,
+        None,
     )?;
     Ok(Outcome::Finished(Box::new(summary)))
 }
@@ -236,7 +240,7 @@ fn aim_at_white(
 /// The budget of the patches the journal of `session` lacks: each patch's luminance as the
 /// screen knows it (a simulated monitor), else as an sRGB display of the standard's 80 cd/m²
 /// white would give it; with the operator's aim at the white of a real screen (`aim`).
-fn estimate(
+pub(crate) fn estimate(
     session: &Session<LogDetails, DriveStep>,
     display: &dyn Screen,
     instrument: &dyn Instrument,
@@ -275,7 +279,7 @@ fn estimate(
 
 /// What resuming `session` found in its journal (readings, a torn last line set aside),
 /// if it resumed one.
-fn resuming_note(session: &Session<LogDetails, DriveStep>) -> Option<String> {
+pub(super) fn resuming_note(session: &Session<LogDetails, DriveStep>) -> Option<String> {
     if session.recovered == 0 && session.torn_bytes == 0 {
         return None;
     }

@@ -63,6 +63,10 @@ pub struct LabOptions {
     /// The camera image's side in pixels, shown whole on the display for the spot
     /// readings; 0: no image (each patch's colour is shown full-screen instead).
     pub image_size: usize,
+    /// The display's characterization plan: None the fixed plan, Some the adaptive plan
+    /// with this rule (its targets the rendered readings).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<crate::display::characterize::adaptive::Rule>,
 }
 
 /// Samples per pixel of the image where the path tracer renders it (scenes the radiosity
@@ -128,6 +132,7 @@ impl LabOptions {
                 screen: ScreenSpec::Virtual(self.display),
                 spot: self.instrument("cs100a", Some(self.seed.wrapping_add(2))),
                 model: self.model,
+                adaptive: self.adaptive,
             },
             reproduction: ReproductionOptions {
                 gamut: self.gamut,
@@ -270,6 +275,7 @@ pub struct LabSummary {
 ///     seed: 1,
 ///     time_scale: 0.0,
 ///     image_size: 1014,
+///     adaptive: None,
 /// };
 /// let dir = std::path::Path::new("lab");
 /// let (stages, summary) = run_lab(dir, &options, false, false, RunOptions::default(), &|_| {})?;
