@@ -13,9 +13,10 @@
 use std::process::Command;
 
 use metamer::color::Xyz;
+use metamer::experiment::readings::{write_readings, PatchReading};
 use metamer::export::{self, rgb, ExportRequest, Renderer};
 use metamer::render::job::spots_from_image;
-use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions};
+use metamer::render::radiosity::{render_spots_radiosity, RadiosityOptions, RadiosityResult};
 use metamer::render::Scene;
 
 use crate::support::fresh_dir;
@@ -139,7 +140,56 @@ fn round_trip(name: &str) -> Option<()> {
     // Noise alone gives an rms of z near 1; a bias the per-channel bound let through
     // (a small unit or colour error) shows as an rms well above it.
     assert!(rms < 2.0, "{name}: z rms {rms}");
+    if name == "validation-box" {
+        experiment_takes(&dir, &image, &spectral);
+    }
     Some(())
+}
+
+/// `metamer experiment --simulation-image` takes the Cycles image as the simulation: the
+/// stage names the image, and the report compares box, display and Cycles on 24 patches.
+/// The box's readings are metamer's spectral rendering (a box read without meter noise).
+fn experiment_takes(dir: &std::path::Path, image: &std::path::Path, box_: &RadiosityResult) {
+    let spots = dir.join("box-spots.csv");
+    let rows: Vec<(usize, PatchReading)> = box_
+        .patches
+        .iter()
+        .map(|p| (p.patch, PatchReading::of(&[p.xyz])))
+        .collect();
+    write_readings(&spots, &rows).unwrap();
+    let out = dir.join("experiment");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/scenes/validation-box.json"
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_metamer"))
+        .args(["experiment", "-o"])
+        .arg(&out)
+        .args(["--box-scene", scene, "--box-spots"])
+        .arg(&spots)
+        .arg("--simulation-image")
+        .arg(image)
+        .args(["--target-de", "0.5", "--repeats", "1"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
+    let sim: serde_json::Value = serde_json::from_str(&read("simulation/simulation.json")).unwrap();
+    assert_eq!(sim["method"], "external image");
+    assert_eq!(sim["source"]["image"], image.to_str().unwrap());
+    let v: serde_json::Value = serde_json::from_str(&read("validation/comparisons.json")).unwrap();
+    for side in [
+        "display_vs_box",
+        "simulation_vs_box",
+        "display_vs_simulation",
+    ] {
+        assert!(
+            v[side]["max_de76"]["value"].as_f64().is_some(),
+            "{side}: {v}"
+        );
+    }
+    assert!(read("validation/report.html")
+        .contains(&format!("external renderer: the image {}", image.display())));
 }
 
 #[test]
