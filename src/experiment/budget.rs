@@ -218,36 +218,38 @@ fn spots_cost(
 pub fn recorded(dir: &Path, planned: &[StageBudget]) -> Vec<StageBudget> {
     planned
         .iter()
-        .map(|p| {
-            let stage_dir = dir.join(&p.stage);
-            let kept = match p.stage.as_str() {
-                s if s == Stage::Box.name() => read::<BoxCost>(&stage_dir.join("summary.json"))
-                    .filter(|b| !b.cost.is_empty())
-                    .map(|b| {
-                        let mut estimate = Cost::default();
-                        let mut actual = Cost::default();
-                        for c in b.cost.values() {
-                            estimate.add(&c.estimate);
-                            if let Some(a) = &c.actual {
-                                actual.add(a);
-                            }
-                        }
-                        CostReport {
-                            estimate,
-                            actual: Some(actual),
-                        }
-                    }),
-                s if s == Stage::Display.name() => {
-                    read::<OneCost>(&stage_dir.join("summary.json")).and_then(|c| c.cost)
-                }
-                _ => read::<OneCost>(&stage_dir.join(RECORD_FILE)).and_then(|c| c.cost),
-            };
-            StageBudget {
-                stage: p.stage.clone(),
-                cost: kept.unwrap_or_else(|| p.cost.clone()),
-            }
+        .map(|p| StageBudget {
+            stage: p.stage.clone(),
+            cost: kept(&p.stage, &dir.join(&p.stage)).unwrap_or_else(|| p.cost.clone()),
         })
         .collect()
+}
+
+/// The budget and cost the files of measuring stage `stage` (by its directory name) in
+/// `stage_dir` keep; None when they keep none (not run, or run before budgets were kept).
+pub fn kept(stage: &str, stage_dir: &Path) -> Option<CostReport> {
+    match stage {
+        s if s == Stage::Box.name() => read::<BoxCost>(&stage_dir.join("summary.json"))
+            .filter(|b| !b.cost.is_empty())
+            .map(|b| {
+                let mut estimate = Cost::default();
+                let mut actual = Cost::default();
+                for c in b.cost.values() {
+                    estimate.add(&c.estimate);
+                    if let Some(a) = &c.actual {
+                        actual.add(a);
+                    }
+                }
+                CostReport {
+                    estimate,
+                    actual: Some(actual),
+                }
+            }),
+        s if s == Stage::Display.name() => {
+            read::<OneCost>(&stage_dir.join("summary.json")).and_then(|c| c.cost)
+        }
+        _ => read::<OneCost>(&stage_dir.join(RECORD_FILE)).and_then(|c| c.cost),
+    }
 }
 
 /// The part of the box's `summary.json` this reads.

@@ -409,6 +409,7 @@ fn stages_context(report: &mut ReportInput, sides: &Sides, sections: &Sections) 
     report.light_fit = sections.light_fit.clone();
     report.render_confidence = sections.render_confidence.clone();
     report.instruments = sections.instruments.clone();
+    report.measuring_cost = sections.measuring_cost.clone();
     report.inputs = inputs;
     report.notes = notes;
 }

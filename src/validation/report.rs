@@ -18,13 +18,13 @@ use super::figures::{
 use super::readings::UncertaintySource;
 use super::verdict::verdict_paragraph;
 use sections::{
-    display_section, inputs_section, instruments_section, light_section, render_section,
-    uncertainty_section,
+    cost_section, display_section, inputs_section, instruments_section, light_section,
+    render_section, uncertainty_section,
 };
 
 pub use super::report_data::{
-    DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
-    RenderUncertainty, ReportInput, Sections,
+    CostFigures, DisplayModelSection, InputFile, InstrumentUsed, LightFitSection,
+    RenderConfidenceSection, RenderUncertainty, ReportInput, Sections, StageCost,
 };
 
 /// The page's style: readable from a 390 px phone to print. Text runs at most 1000 px wide,
@@ -137,6 +137,9 @@ pub fn render_html(input: &ReportInput) -> String {
     }
     if !input.instruments.is_empty() {
         instruments_section(&mut h, &input.instruments);
+    }
+    if !input.measuring_cost.is_empty() {
+        cost_section(&mut h, &input.measuring_cost);
     }
     if !input.inputs.is_empty() {
         inputs_section(&mut h, &input.inputs);

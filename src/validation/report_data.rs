@@ -39,7 +39,33 @@ pub struct ReportInput {
     /// a side not named here is described from its readings' uncertainty source.
     #[serde(default)]
     pub uncertainty: Vec<(String, String)>,
+    /// Each measuring stage's budget before its first reading and what it took.
+    #[serde(default)]
+    pub measuring_cost: Vec<StageCost>,
     pub notes: Vec<String>,
+}
+
+/// One measuring stage's cost as the report shows it: the budget made before its first
+/// reading and, once it ran, what it took (the instrument's time at its real pace, whatever
+/// a simulation's time scale; the wall time as the clock ran).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageCost {
+    pub stage: String,
+    pub budget: CostFigures,
+    pub taken: Option<CostFigures>,
+}
+
+/// Counts and seconds of a budget or of what a stage took.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CostFigures {
+    pub readings: usize,
+    pub placements: usize,
+    pub calibrations: usize,
+    pub instrument_s: f64,
+    /// Instrument, operator and settle time: the session's length at the rig (what was
+    /// taken counts the instrument at its real pace here too, so a simulation at another
+    /// time scale shows what a real rig would have taken, but the operator's waits).
+    pub rig_s: f64,
 }
 
 /// The display's characterization: the model, its diagnostics and its verification.
@@ -122,6 +148,7 @@ pub struct Sections {
     pub render_uncertainty: Option<RenderUncertainty>,
     pub instruments: Vec<InstrumentUsed>,
     pub inputs: Vec<InputFile>,
+    pub measuring_cost: Vec<StageCost>,
     pub notes: Vec<String>,
 }
 

@@ -233,6 +233,7 @@ fn experiment_report_has_every_section_in_headless_chromium() {
         "light-chart",
         "render-confidence",
         "instruments",
+        "cost",
         "inputs",
     ] {
         assert!(dom.contains(&format!("id=\"{id}\"")), "the DOM lacks #{id}");
@@ -253,6 +254,12 @@ fn experiment_report_has_every_section_in_headless_chromium() {
     assert_eq!(dom.matches("on white tile").count(), 2);
     // The render's bound enters the simulation's intervals.
     assert!(dom.contains("radiosity solver's per-patch error bound"));
+    // The display's and the display spots' costs as their files keep them (the box's
+    // readings were given, and cost nothing here), and their total: 194 + 72 readings.
+    assert!(
+        dom.contains("<td class=\"l\">all</td><td>266</td><td>24</td>"),
+        "the cost table's total"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

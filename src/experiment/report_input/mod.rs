@@ -16,7 +16,8 @@ mod render;
 use std::path::{Path, PathBuf};
 
 use crate::digest::sha256_file;
-use crate::validation::report::InputFile;
+use crate::session::Cost;
+use crate::validation::report::{CostFigures, InputFile, StageCost};
 pub use crate::validation::report::{RenderUncertainty, Sections};
 
 /// Where the stages' files are.
@@ -80,7 +81,35 @@ pub fn gather(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Sections {
     s.instruments = instruments;
     s.notes.extend(notes);
     s.inputs = inputs(layout, readings);
+    s.measuring_cost = measuring_cost(layout);
     s
+}
+
+/// Each measuring stage's budget and cost as its files keep them, box first; a stage
+/// whose files keep none (given readings, or a run before budgets were kept) is left out.
+fn measuring_cost(layout: &Layout) -> Vec<StageCost> {
+    let figures = |c: &Cost| CostFigures {
+        readings: c.readings,
+        placements: c.placements,
+        calibrations: c.calibrations,
+        instrument_s: c.instrument_s,
+        rig_s: c.instrument_s + c.operator_s + c.settle_s,
+    };
+    [
+        (super::Stage::Box, &layout.box_dir),
+        (super::Stage::Display, &layout.display_dir),
+        (super::Stage::DisplaySpots, &layout.display_spots_dir),
+    ]
+    .into_iter()
+    .filter_map(|(stage, dir)| {
+        let kept = super::budget::kept(stage.name(), dir)?;
+        Some(StageCost {
+            stage: stage.name().to_string(),
+            budget: figures(&kept.estimate),
+            taken: kept.actual.as_ref().map(figures),
+        })
+    })
+    .collect()
 }
 
 /// The files the report rests on, each with its SHA-256: the three readings files first
