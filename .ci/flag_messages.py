@@ -65,7 +65,7 @@ KNOWN = {
     "src/render/job/mod.rs: --white",
     "src/render/probes.rs: --max-seconds",
     "src/render/radiosity/mod.rs: --max-seconds",
-    "src/session/runner.rs: --resume",
+    "src/session/runner/error.rs: --resume",
     "src/spot.rs: --count",
     "src/spot.rs: --integration",
     "src/spot.rs: --spectrum",

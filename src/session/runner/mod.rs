@@ -26,84 +26,10 @@ use super::record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
 use super::repeats::deviation;
 use super::step::{Rig, StepFailure, StepTaker};
 
-/// The session could not start or go on.
-#[derive(Debug, thiserror::Error)]
-pub enum SessionError {
-    /// The journal's directory cannot be made or used (a file stands where it should be).
-    #[error(transparent)]
-    Dir(#[from] crate::output::OutputError),
-    #[error(transparent)]
-    Journal(#[from] JournalError),
-    #[error("the plan's steps do not serialize to JSON: {0}")]
-    Plan(#[source] serde_json::Error),
-    #[error("{}, line {line}: {message}", path.display())]
-    Entry {
-        path: PathBuf,
-        line: usize,
-        message: String,
-    },
-    #[error("{} was written with {role} instrument {logged}, this session has {now}; resume with the same instrument model, or choose another output directory", path.display())]
-    InstrumentDiffers {
-        path: PathBuf,
-        role: String,
-        logged: String,
-        now: String,
-    },
-    /// The same model, but readings taken another way (another unit, speed, integration
-    /// time, or a simulation's seed, noise or time scale) would not be comparable.
-    #[error("{} was written with {} instrument {} whose {} was {}; this session's is {}; resume with the settings it was started with, or choose another output directory", .0.path.display(), .0.role, .0.model, .0.setting, .0.logged, .0.now)]
-    InstrumentSettingDiffers(Box<SettingDiffers>),
-    /// The rig cannot take a step of the plan; found before anything is measured.
-    #[error("step {} ({label}) {need}; nothing was measured", index + 1)]
-    RigLacks {
-        index: usize,
-        label: String,
-        need: String,
-    },
-    #[error("step {} of {total} ({label}, {prepare}): {source}\n  {done} of {total} steps are safe in {}; fix the cause and resume the session", index + 1, journal.display())]
-    Step {
-        index: usize,
-        total: usize,
-        label: String,
-        prepare: Prepare,
-        done: usize,
-        journal: PathBuf,
-        source: Box<StepFailure>,
-    },
-}
-
-impl SessionError {
-    /// For a reading that failed midway: the failure, then that the readings before it are
-    /// safe in the journal and how to go on. The caller puts which reading it was in front,
-    /// in its own words. None for the other errors.
-    pub fn safe_so_far(&self) -> Option<String> {
-        let SessionError::Step {
-            total,
-            done,
-            journal,
-            source,
-            ..
-        } = self
-        else {
-            return None;
-        };
-        Some(format!(
-            "{source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
-            journal.display()
-        ))
-    }
-}
-
-/// Which setting of which instrument differs between a journal and the session resuming it.
-#[derive(Debug)]
-pub struct SettingDiffers {
-    pub path: PathBuf,
-    pub role: String,
-    pub model: String,
-    pub setting: String,
-    pub logged: String,
-    pub now: String,
-}
+mod error;
+mod resume;
+pub use error::{SessionError, SettingDiffers};
+use resume::{duplicates_note, place_entries, same_instrument};
 
 /// How to run.
 #[derive(Clone, Debug, Default)]
@@ -198,51 +124,6 @@ pub struct Session<H, D> {
     spent: Cost,
 }
 
-/// Puts each journalled entry of `recovered` (with its line) at its step in `entries`,
-/// refusing one the plan does not have or planned otherwise.
-fn place_entries<D: Serialize + PartialEq>(
-    path: &Path,
-    plan: &SessionPlan<D>,
-    recovered: Vec<(usize, Entry<D>)>,
-    entries: &mut [Option<Entry<D>>],
-) -> Result<(), SessionError> {
-    let bad = |line: usize, message: String| SessionError::Entry {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
-    for (line, entry) in recovered {
-        let step = plan.steps.get(entry.index).ok_or_else(|| {
-            bad(
-                line,
-                format!(
-                    "step index {} is beyond the plan's {}",
-                    entry.index,
-                    plan.steps.len()
-                ),
-            )
-        })?;
-        if step.label != entry.label || step.data != entry.data {
-            return Err(bad(
-                line,
-                format!(
-                    "step {} was planned as '{}' ({}) but journalled as '{}' ({})",
-                    entry.index,
-                    step.label,
-                    serde_json::to_string(&step.data).unwrap_or_default(),
-                    entry.label,
-                    serde_json::to_string(&entry.data).unwrap_or_default(),
-                ),
-            ));
-        }
-        // The journal has refused readings no instrument gave and set aside a step's
-        // later entries (see JournalEntry), so each step is here once.
-        let i = entry.index;
-        entries[i] = Some(entry);
-    }
-    Ok(())
-}
-
 /// The repeatability stated for the instrument in `role` in `mode` (its model's, or a
 /// default when the rig has none in that role).
 fn stated_repeatability(rig: &mut Rig<'_>, role: &str, mode: MeasureMode) -> Repeatability {
@@ -285,25 +166,6 @@ fn deviation_from_earlier<D>(
         .filter_map(|i| entries[i].as_ref().map(|e| &e.reading))
         .collect();
     deviation(&earlier, reading, repeatability)
-}
-
-/// What the operator should know of the readings of steps already journalled (`(line,
-/// step)`) that resuming moved aside, if any.
-fn duplicates_note(path: &Path, duplicates: &[(usize, usize)]) -> Option<String> {
-    if duplicates.is_empty() {
-        return None;
-    }
-    let lines: Vec<String> = duplicates
-        .iter()
-        .map(|(line, step)| format!("line {line} (step {step})"))
-        .collect();
-    Some(format!(
-        "{} held {} reading(s) of steps it already had, written by a second session at the same time: the first of each is kept, the others were moved to {} ({})",
-        path.display(),
-        lines.len(),
-        super::journal::duplicates_path(path).display(),
-        lines.join(", ")
-    ))
 }
 
 impl<H, D> Session<H, D>
@@ -677,49 +539,4 @@ fn recheck(
         spent.placements += 1;
     }
     answer
-}
-
-/// Whether readings of the instrument `now` are comparable with those of `logged`: the same
-/// model, the same unit where both report a serial, and every setting the same.
-fn same_instrument(
-    path: &Path,
-    role: &str,
-    logged: &InstrumentRecord,
-    now: &InstrumentRecord,
-) -> Result<(), SessionError> {
-    if logged.info.model != now.info.model {
-        return Err(SessionError::InstrumentDiffers {
-            path: path.to_path_buf(),
-            role: role.to_string(),
-            logged: logged.info.model.clone(),
-            now: now.info.model.clone(),
-        });
-    }
-    let differs = |setting: &str, a: Option<&String>, b: Option<&String>| {
-        let shown = |v: Option<&String>| v.cloned().unwrap_or_else(|| "(not set)".into());
-        SessionError::InstrumentSettingDiffers(Box::new(SettingDiffers {
-            path: path.to_path_buf(),
-            role: role.to_string(),
-            model: now.info.model.clone(),
-            setting: setting.to_string(),
-            logged: shown(a),
-            now: shown(b),
-        }))
-    };
-    if logged.info.serial != now.info.serial {
-        return Err(differs(
-            "serial number",
-            logged.info.serial.as_ref(),
-            now.info.serial.as_ref(),
-        ));
-    }
-    let names: std::collections::BTreeSet<&String> =
-        logged.options.keys().chain(now.options.keys()).collect();
-    for name in names {
-        let (a, b) = (logged.options.get(name), now.options.get(name));
-        if a != b {
-            return Err(differs(name, a, b));
-        }
-    }
-    Ok(())
 }
