@@ -33,6 +33,11 @@ pub struct Args {
     /// Readings per target in the box (default: the plan's).
     #[arg(long, value_name = "N")]
     box_repeats: Option<usize>,
+    /// The box's tiles and fall-off: fixed (every tile and angle, the paper's) or adaptive
+    /// (a subset first, then where the spatial and distribution models leave the spots
+    /// most in doubt, up to a cap).
+    #[arg(long, value_enum, default_value = "fixed")]
+    box_plan: PlanKind,
     /// Instead of measuring the box here: its measured scene (`scene.json` of
     /// `metamer measure-box`) …
     #[arg(
@@ -149,6 +154,7 @@ fn request(args: Args) -> Result<Request, CliError> {
                 spot: spot.clone(),
                 plan: args.plan,
                 repeats: args.box_repeats,
+                adaptive: args.box_plan == PlanKind::Adaptive,
                 seed: args.seed,
                 light: args.scenario,
             },

@@ -52,6 +52,11 @@ pub struct Args {
     /// Readings of each tile and spot in the box (default: the box plan's 5).
     #[arg(long, value_name = "N")]
     box_repeats: Option<usize>,
+    /// The box's tiles and fall-off: fixed (every tile and angle, the paper's) or adaptive
+    /// (a subset first, then where the spatial and distribution models leave the spots
+    /// most in doubt, up to a cap).
+    #[arg(long, value_enum, default_value = "fixed")]
+    box_plan: PlanKind,
     /// Seed of the simulated box and of its instruments' noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -99,6 +104,7 @@ pub fn run(args: Args) -> CliResult {
         until_decided: args.until_decided,
         plan: args.plan,
         box_repeats: args.box_repeats,
+        box_adaptive: args.box_plan == PlanKind::Adaptive,
         seed: args.seed,
         time_scale: args.time_scale,
         image_size: args.image_size,

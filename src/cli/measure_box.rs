@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use metamer::measure_box::job::{self, MeasureBoxJobError, MeasureBoxRequest};
+use metamer::measure_box::run::advice::JournalConflict;
 use metamer::measure_box::{BoxPlanError, Outcome, Summary};
 use metamer::rig::Scenario;
 use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
@@ -85,6 +86,7 @@ pub fn run(args: Args) -> CliResult {
         // Asked as the flags and the terminal say; the spots stay in summary.json.
         attendance: None,
         spot_readings: false,
+        adaptive: false,
     };
     let outcome = job::measure(
         &request,
@@ -108,16 +110,33 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
         MeasureBoxJobError::Rig(e) => CliError::from(e),
         // Not asked for by the command (`spot_readings: false`).
         MeasureBoxJobError::SpotReadings(e) => CliError::from(e),
-        MeasureBoxJobError::Measure(e) => match e.advice() {
-            Some(t) => CliError::Failed(t.into()),
-            None => CliError::from(e),
+        MeasureBoxJobError::Measure(e) => match (e.conflict(), e.advice()) {
+            (Some(c @ JournalConflict::Earlier { stage, .. }), _) => CliError::Failed(
+                format!(
+                    "{c}: continue it with --resume, measure the stage again with --stage {stage}, or choose another output directory"
+                )
+                .into(),
+            ),
+            (Some(c @ JournalConflict::OtherSession { .. }), _) => CliError::Failed(
+                format!(
+                    "{c}; run with the same --plan/--repeats/--seed and --resume, or choose another output directory"
+                )
+                .into(),
+            ),
+            (None, Some(t)) => CliError::Failed(t.into()),
+            (None, None) => CliError::from(e),
         },
     }
 }
 
-/// Where the session ended, and what is left to do.
+/// Where the session ended, and what is left to do, with the flags that go on.
 fn report(outcome: Outcome) -> CliResult {
-    match (&outcome, outcome.left_to_do()) {
+    let go_on = match &outcome {
+        Outcome::StagesMissing(_) => " (--stage NAME, or the whole session with --resume)",
+        _ => ": continue with --resume",
+    };
+    let left = outcome.left_to_do().map(|t| format!("{t}{go_on}"));
+    match (&outcome, left) {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
         (_, text) => {
@@ -141,6 +160,18 @@ fn print_summary(s: &Summary) -> CliResult {
         s.materials.len(),
         s.spots.len()
     )?;
+    if let Some(a) = &s.adaptive {
+        outln!(
+            "adaptive plan: {} tiles read in {} round(s), {} predicted by the spatial model ({}); {} fall-off angles read in {} round(s) ({})",
+            a.tiles_read.len(),
+            a.tile_rounds,
+            a.tiles_predicted.len(),
+            a.tiles.why,
+            a.falloff_read.len(),
+            a.falloff_rounds,
+            a.falloff.why
+        )?;
+    }
     let flagged = &s.provenance.outliers;
     if flagged.is_empty() {
         outln!("no outliers; every group's spread within the instruments' noise")?;

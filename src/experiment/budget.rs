@@ -104,6 +104,7 @@ fn box_plan(m: &MeasureBox) -> BoxPlan {
     if let Some(n) = m.repeats {
         plan.repeats = n;
     }
+    plan.choose_adaptive(m.adaptive);
     plan
 }
 
@@ -116,7 +117,7 @@ fn box_cost(plan: &BoxPlan, m: &MeasureBox, placement_s: f64) -> Cost {
     let mut cost = Cost::default();
     for s in BoxStage::ALL {
         cost.add(&estimate(
-            &plan.session_plan(s, &BTreeMap::new()),
+            &plan.round_plan(s, 0, plan.most_steps(s), &BTreeMap::new()),
             &|_| false,
             &meters,
             &|_| BOX_TARGET_CD_M2,

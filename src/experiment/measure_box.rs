@@ -27,6 +27,10 @@ pub struct MeasureBox {
     /// A plan file; None: the paper's plan.
     pub plan: Option<PathBuf>,
     pub repeats: Option<usize>,
+    /// Read the tiles and the fall-off adaptively; left out of the stage's hash when not,
+    /// so a fixed plan's box stage stays valid.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub adaptive: bool,
     /// The simulated box's seed (and its instruments').
     pub seed: u64,
     /// The simulated box's light (None: the default). A real box has its own light, so it
@@ -60,6 +64,7 @@ impl MeasureBox {
             spot: self.spot.clone(),
             plan: self.plan.clone(),
             repeats: self.repeats,
+            adaptive: self.adaptive,
             resume,
             stage: None,
             seed: self.seed,

@@ -43,6 +43,8 @@ pub enum BoxRequest {
         plan: Option<PathBuf>,
         /// Readings per target; None: the plan's.
         repeats: Option<usize>,
+        /// Read the tiles and the fall-off adaptively.
+        adaptive: bool,
         /// The simulated box's seed (and its instruments').
         seed: u64,
         /// The simulated box's light, refused with real instruments, whose box has its own
@@ -202,6 +204,7 @@ impl Request {
     ///         spot: meter.clone(),
     ///         plan: None,
     ///         repeats: Some(1),
+    ///         adaptive: false,
     ///         seed: 1,
     ///         light: None,
     ///     },
@@ -280,9 +283,11 @@ impl Request {
                 spot,
                 plan,
                 repeats,
+                adaptive,
                 seed,
                 light,
             } => BoxSource::Measure(MeasureBox {
+                adaptive: *adaptive,
                 spectral: spectral.clone(),
                 spot: spot.clone(),
                 plan: plan.clone(),

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::adaptive::spatial::complete_spectra;
+use super::adaptive::AdaptiveSummary;
 use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
 use super::plan::{BoxPlan, BoxStage, BoxStep, Geometry, Plane, Target};
@@ -35,7 +37,12 @@ pub struct BoxDetails {
 
 /// Every stage's journal path and entries, complete.
 pub struct StageEntries {
+    /// Each stage's first journal and the entries of all its rounds.
     pub stages: BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)>,
+    /// An adaptive stage's journals after its first, in order.
+    pub later_rounds: BTreeMap<BoxStage, Vec<PathBuf>>,
+    /// What the adaptive plan read and decided; None for the fixed plan.
+    pub adaptive: Option<AdaptiveSummary>,
 }
 
 /// A group of readings flagged.
@@ -86,6 +93,9 @@ pub struct Provenance {
     pub clamped_values: usize,
     /// The chart frame's reflectance is the nominal 0.03, not measured.
     pub nominal_frame_reflectance: f64,
+    /// Tiles not read, [row, col], whose spectra are the adaptive plan's spatial model's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub predicted_tiles: Vec<[usize; 2]>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -126,6 +136,9 @@ pub struct Summary {
     /// what it took (a stage complete before this call has none).
     #[serde(default)]
     pub cost: BTreeMap<String, CostReport>,
+    /// What the adaptive plan read, predicted and decided; None for the fixed plan.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<AdaptiveSummary>,
 }
 
 /// The readings could not become a scene.
@@ -143,6 +156,8 @@ pub enum AssembleError {
     LightFiles(#[from] LightFilesError),
     #[error("the {0} stage's readings are missing")]
     Missing(BoxStage),
+    #[error("the light's spatial model cannot be fitted to the {0} tile(s) read: it needs 6 that span the panel")]
+    TooFewTiles(usize),
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -312,6 +327,7 @@ pub fn assemble(
         nominal_patches: materials.nominal_patches,
         clamped_values: materials.clamped_values,
         nominal_frame_reflectance: super::scene::FRAME_REFLECTANCE,
+        predicted_tiles: materials.predicted_tiles,
     };
     let contents = BoxContents {
         wall: materials.wall,
@@ -332,6 +348,13 @@ pub fn assemble(
     );
     let mut policy = policy.clone();
     policy.inputs(entries.stages.values().map(|(p, _)| p.as_path()));
+    policy.inputs(
+        entries
+            .later_rounds
+            .values()
+            .flatten()
+            .map(PathBuf::as_path),
+    );
     let files = write_scene_files(&policy, dir, &scene, &light, g, &date[..10])?;
     let spot_xyz = spot_xyz(&stages.spots);
     let render = compare_render(&scene, &spot_xyz)?;
@@ -346,6 +369,7 @@ pub fn assemble(
         provenance,
         files,
         cost: cost.clone(),
+        adaptive: entries.adaptive.clone(),
     };
     write_json(&policy, &summary.files.summary, &summary)?;
     Ok(summary)
@@ -416,6 +440,8 @@ struct Materials {
     nominal_patches: Vec<usize>,
     /// Values clamped: negative radiance, reflectance outside 0–1.
     clamped_values: usize,
+    /// Tiles not read, whose spectra the spatial model gives.
+    predicted_tiles: Vec<[usize; 2]>,
 }
 
 /// The tiles' and the materials' spectra of the reduced stages.
@@ -425,13 +451,25 @@ fn measured_materials(
     materials: &StageReduced,
 ) -> Result<Materials, AssembleError> {
     let mut clamped_values = 0;
-    let mut tile_spectra = vec![None; g.rows * g.cols];
+    let mut tile_spectra: Vec<Option<Spectrum>> = vec![None; g.rows * g.cols];
     for (t, s) in tiles.targets.iter().zip(&tiles.spectra) {
         if let (Target::Tile { row, col }, Some(s)) = (t, s) {
             tile_spectra[row * g.cols + col] = Some(
                 clamped(s, 0.0, f64::INFINITY, &mut clamped_values).with_outside(Outside::Zero),
             );
         }
+    }
+    let predicted_tiles: Vec<[usize; 2]> = (0..g.rows * g.cols)
+        .filter(|&k| tile_spectra[k].is_none())
+        .map(|k| [k / g.cols, k % g.cols])
+        .collect();
+    if !predicted_tiles.is_empty() {
+        let read = tile_spectra.iter().flatten().count();
+        let all = complete_spectra(g, &tile_spectra).ok_or(AssembleError::TooFewTiles(read))?;
+        tile_spectra = all
+            .iter()
+            .map(|s| Some(clamped(s, 0.0, f64::INFINITY, &mut clamped_values)))
+            .collect();
     }
     let tile_spectra: Vec<Spectrum> = tile_spectra
         .into_iter()
@@ -463,6 +501,7 @@ fn measured_materials(
         patches,
         nominal_patches,
         clamped_values,
+        predicted_tiles,
     })
 }
 
@@ -470,11 +509,14 @@ fn measured_materials(
 fn journal_digests(entries: &StageEntries) -> Result<Vec<JournalDigest>, AssembleError> {
     let mut journals = Vec::new();
     for (stage, (path, _)) in &entries.stages {
-        journals.push(JournalDigest {
-            stage: *stage,
-            file: path.clone(),
-            sha256: sha256_file(path)?,
-        });
+        let later = entries.later_rounds.get(stage).into_iter().flatten();
+        for path in std::iter::once(path).chain(later) {
+            journals.push(JournalDigest {
+                stage: *stage,
+                file: path.clone(),
+                sha256: sha256_file(path)?,
+            });
+        }
     }
     Ok(journals)
 }

@@ -44,6 +44,9 @@ pub struct MeasureBoxRequest {
     pub plan: Option<PathBuf>,
     /// Readings of each tile and each spot; `None`: the plan's.
     pub repeats: Option<usize>,
+    /// Read the tiles and the fall-off adaptively ([`crate::measure_box::adaptive`]) with
+    /// the default rule where the plan names none.
+    pub adaptive: bool,
     /// Continue the journals in `out`.
     pub resume: bool,
     /// Only this stage, by name (tiles, falloff, materials, spots). A name, not a
@@ -125,6 +128,7 @@ pub enum MeasureBoxJobError {
 ///     spot: "sim:cs100a?time_scale=0".into(),
 ///     plan: None,
 ///     repeats: Some(1),
+///     adaptive: false,
 ///     resume: false,
 ///     stage: Some("tiles".into()),
 ///     seed: 1,
@@ -258,6 +262,7 @@ fn plan(request: &MeasureBoxRequest) -> Result<BoxPlan, MeasureBoxJobError> {
     if let Some(n) = request.repeats {
         plan.repeats = n;
     }
+    plan.choose_adaptive(request.adaptive);
     plan.validate().map_err(|e| match e {
         BoxPlanError::Invalid { field, message } if field == "repeats" => {
             MeasureBoxJobError::Repeats(message)

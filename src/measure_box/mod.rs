@@ -8,8 +8,10 @@
 //! measured scene and its provenance together, and [`compare`] renders it against the box's
 //! spot readings. [`setup`] opens the rig a session measures with: the real box, or the
 //! simulated truth box and its operator ([`simulated_box`]); [`spot_rule`] ends a spot's
-//! repeats by the plan's rule.
+//! repeats by the plan's rule; [`adaptive`] reads the tiles and the fall-off in rounds
+//! until what is not read cannot move the spots.
 
+pub mod adaptive;
 pub mod assemble;
 pub mod compare;
 pub mod falloff;

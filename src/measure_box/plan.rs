@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::light::fit::Plane;
 
+use super::adaptive::rule::AdaptiveRule;
 use crate::color::COLORCHECKER_NAMES;
 use crate::session::{Prepare, SessionPlan, Step};
 use crate::validation::sequential::RepeatRule;
@@ -56,6 +57,11 @@ impl BoxStage {
             BoxStage::Materials => "materials",
             BoxStage::Spots => "spots",
         }
+    }
+
+    /// Whether an adaptive plan reads the stage in rounds ([`super::adaptive`]).
+    pub fn in_rounds(self) -> bool {
+        matches!(self, BoxStage::Tiles | BoxStage::Falloff)
     }
 
     /// The stage's journal inside the output directory.
@@ -165,6 +171,10 @@ pub struct BoxPlan {
     /// display's white, as in the validation.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spot_white: Option<[f64; 3]>,
+    /// Read the tiles and the fall-off in rounds by this rule ([`super::adaptive`]); None:
+    /// every tile and angle, as the paper did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<AdaptiveRule>,
 }
 
 impl Default for BoxPlan {
@@ -179,6 +189,7 @@ impl Default for BoxPlan {
             geometry: Geometry::default(),
             spot_rule: None,
             spot_white: None,
+            adaptive: None,
         }
     }
 }
@@ -191,7 +202,7 @@ pub enum BoxPlanError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}: not a valid plan: {source} (fields: repeats, material_repeats, falloff_repeats, falloff_angles_deg, falloff_tile, patches, geometry {{size_m, light_m, rows, cols, viewpoint_m, acceptance_deg}}, spot_rule, spot_white)", path.display())]
+    #[error("{}: not a valid plan: {source} (fields: repeats, material_repeats, falloff_repeats, falloff_angles_deg, falloff_tile, patches, geometry {{size_m, light_m, rows, cols, viewpoint_m, acceptance_deg}}, spot_rule, spot_white, adaptive {{tile_repeats, tile_effect_jnd, max_tiles, angle_agreement, max_falloff}})", path.display())]
     Json {
         path: PathBuf,
         source: serde_json::Error,
@@ -243,6 +254,13 @@ impl BoxPlan {
         Ok(plan)
     }
 
+    /// With `adaptive`, the adaptive plan: the plan's own rule, or the default one.
+    pub fn choose_adaptive(&mut self, adaptive: bool) {
+        if adaptive && self.adaptive.is_none() {
+            self.adaptive = Some(AdaptiveRule::default());
+        }
+    }
+
     /// The most readings of each spot: the rule's, or `repeats`.
     pub fn spot_repeats(&self) -> usize {
         self.spot_rule
@@ -256,62 +274,113 @@ impl BoxPlan {
             .unwrap_or([self.geometry.rows / 2, self.geometry.cols / 2])
     }
 
-    /// The steps of one stage.
-    pub fn steps(&self, stage: BoxStage) -> Vec<Step<BoxStep>> {
-        let step = |target: Target, repeat: usize, role: &str, mode, prompt: String| Step {
-            label: label(&target, repeat),
-            role: role.to_string(),
-            mode,
-            prepare: Prepare::Operator { prompt },
-            settle: std::time::Duration::ZERO,
-            data: BoxStep {
-                stage,
-                target,
-                repeat,
-            },
-        };
-        let mut steps = Vec::new();
+    /// Every target of one stage, in the order the fixed plan reads them.
+    pub fn targets(&self, stage: BoxStage) -> Vec<Target> {
+        let g = &self.geometry;
+        match stage {
+            BoxStage::Tiles => (0..g.rows * g.cols)
+                .map(|k| Target::Tile {
+                    row: k / g.cols,
+                    col: k % g.cols,
+                })
+                .collect(),
+            BoxStage::Falloff => [Plane::Horizontal, Plane::Vertical]
+                .into_iter()
+                .flat_map(|plane| {
+                    self.falloff_angles_deg
+                        .iter()
+                        .map(move |&angle_deg| Target::Falloff { plane, angle_deg })
+                })
+                .collect(),
+            BoxStage::Materials => std::iter::once(Target::Wall)
+                .chain(self.patches.iter().map(|&patch| Target::Patch { patch }))
+                .collect(),
+            BoxStage::Spots => self
+                .patches
+                .iter()
+                .map(|&patch| Target::Spot { patch })
+                .collect(),
+        }
+    }
+
+    /// The first pass of a stage an adaptive plan reads in rounds ([`super::adaptive`]
+    /// argues the choice): the tiles at the centre, corners and edge midpoints; the
+    /// fall-off at the normal and, on each side, the outermost angle and every second one
+    /// inwards. Every target of another stage.
+    pub fn first_pass(&self, stage: BoxStage) -> Vec<Target> {
         match stage {
             BoxStage::Tiles => {
-                for row in 0..self.geometry.rows {
-                    for col in 0..self.geometry.cols {
-                        for r in 0..self.repeats {
-                            let t = Target::Tile { row, col };
-                            let p = self.prompt(&t);
-                            steps.push(step(t, r, SPECTRAL, MeasureMode::Emissive, p));
-                        }
-                    }
-                }
+                let three = |n: usize| {
+                    let mut v = vec![0, n / 2, n.saturating_sub(1)];
+                    v.dedup();
+                    v
+                };
+                let cols = three(self.geometry.cols);
+                three(self.geometry.rows)
+                    .into_iter()
+                    .flat_map(|row| cols.iter().map(move |&col| Target::Tile { row, col }))
+                    .collect()
             }
             BoxStage::Falloff => {
-                for plane in [Plane::Horizontal, Plane::Vertical] {
-                    for &angle_deg in &self.falloff_angles_deg {
-                        for r in 0..self.falloff_repeats {
-                            let t = Target::Falloff { plane, angle_deg };
-                            let p = self.prompt(&t);
-                            steps.push(step(t, r, SPOT, MeasureMode::Emissive, p));
-                        }
-                    }
-                }
+                let first = first_angles(&self.falloff_angles_deg);
+                [Plane::Horizontal, Plane::Vertical]
+                    .into_iter()
+                    .flat_map(|plane| {
+                        first
+                            .iter()
+                            .map(move |&angle_deg| Target::Falloff { plane, angle_deg })
+                    })
+                    .collect()
             }
-            BoxStage::Materials => {
-                let targets = std::iter::once(Target::Wall)
-                    .chain(self.patches.iter().map(|&patch| Target::Patch { patch }));
-                for t in targets {
-                    for r in 0..self.material_repeats {
-                        let p = self.prompt(&t);
-                        steps.push(step(t.clone(), r, SPECTRAL, MeasureMode::Reflective, p));
-                    }
-                }
-            }
-            BoxStage::Spots => {
-                for &patch in &self.patches {
-                    for r in 0..self.spot_repeats() {
-                        let t = Target::Spot { patch };
-                        let p = self.prompt(&t);
-                        steps.push(step(t, r, SPOT, MeasureMode::Emissive, p));
-                    }
-                }
+            _ => self.targets(stage),
+        }
+    }
+
+    /// Readings of each target of `stage`.
+    pub fn stage_repeats(&self, stage: BoxStage) -> usize {
+        match (stage, &self.adaptive) {
+            (BoxStage::Tiles, Some(rule)) => rule.tile_repeats,
+            (BoxStage::Tiles, None) => self.repeats,
+            (BoxStage::Falloff, _) => self.falloff_repeats,
+            (BoxStage::Materials, _) => self.material_repeats,
+            (BoxStage::Spots, _) => self.spot_repeats(),
+        }
+    }
+
+    /// The steps of one stage: every target, or an adaptive stage's first pass.
+    pub fn steps(&self, stage: BoxStage) -> Vec<Step<BoxStep>> {
+        let targets = match self.adaptive {
+            Some(_) if stage.in_rounds() => self.first_pass(stage),
+            _ => self.targets(stage),
+        };
+        self.steps_of(stage, &targets)
+    }
+
+    /// The steps that read `targets` of `stage`, each its repeats in a row.
+    pub fn steps_of(&self, stage: BoxStage, targets: &[Target]) -> Vec<Step<BoxStep>> {
+        let (role, mode) = match stage {
+            BoxStage::Tiles => (SPECTRAL, MeasureMode::Emissive),
+            BoxStage::Falloff | BoxStage::Spots => (SPOT, MeasureMode::Emissive),
+            BoxStage::Materials => (SPECTRAL, MeasureMode::Reflective),
+        };
+        let mut steps = Vec::new();
+        for target in targets {
+            let prompt = self.prompt(target);
+            for repeat in 0..self.stage_repeats(stage) {
+                steps.push(Step {
+                    label: label(target, repeat),
+                    role: role.to_string(),
+                    mode,
+                    prepare: Prepare::Operator {
+                        prompt: prompt.clone(),
+                    },
+                    settle: std::time::Duration::ZERO,
+                    data: BoxStep {
+                        stage,
+                        target: target.clone(),
+                        repeat,
+                    },
+                });
             }
         }
         steps
@@ -395,16 +464,67 @@ impl BoxPlan {
         stage: BoxStage,
         extra: &BTreeMap<String, String>,
     ) -> SessionPlan<BoxStep> {
+        self.round_plan(stage, 0, self.steps(stage), extra)
+    }
+
+    /// Round `round` of an adaptive stage as a session plan reading `steps`: the first
+    /// round is [`BoxPlan::session_plan`]'s, a later one names its round among the options.
+    pub fn round_plan(
+        &self,
+        stage: BoxStage,
+        round: usize,
+        steps: Vec<Step<BoxStep>>,
+        extra: &BTreeMap<String, String>,
+    ) -> SessionPlan<BoxStep> {
         let mut options = extra.clone();
         options.insert("stage".into(), stage.name().into());
+        if round > 0 {
+            options.insert("round".into(), round.to_string());
+        }
         let value = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
         options.insert("plan".into(), value.to_string());
         SessionPlan {
             kind: SESSION_KIND.into(),
             options,
-            steps: self.steps(stage),
+            steps,
         }
     }
+
+    /// One stage at its most: an adaptive stage at its rule's cap (which targets a later
+    /// round reads is not known before, but each costs as one of them), what a budget
+    /// before the first reading counts.
+    pub fn most_steps(&self, stage: BoxStage) -> Vec<Step<BoxStep>> {
+        let Some(rule) = self.adaptive.as_ref().filter(|_| stage.in_rounds()) else {
+            return self.steps(stage);
+        };
+        let mut targets = self.first_pass(stage);
+        let cap = match stage {
+            BoxStage::Tiles => rule.max_tiles,
+            _ => rule.max_falloff,
+        };
+        for t in self.targets(stage) {
+            if targets.len() >= cap {
+                break;
+            }
+            if !targets.contains(&t) {
+                targets.push(t);
+            }
+        }
+        self.steps_of(stage, &targets)
+    }
+}
+
+/// The normal and, on each side, the outermost angle and every second one inwards,
+/// increasing.
+fn first_angles(angles: &[f64]) -> Vec<f64> {
+    let neg: Vec<f64> = angles.iter().copied().filter(|&a| a < 0.0).collect();
+    let pos: Vec<f64> = angles.iter().copied().filter(|&a| a > 0.0).collect();
+    let mut out: Vec<f64> = neg.iter().copied().step_by(2).collect();
+    out.push(0.0);
+    let mut right: Vec<f64> = pos.iter().rev().copied().step_by(2).collect();
+    right.reverse();
+    out.extend(right);
+    out
 }
 
 /// `1st`, `2nd`, `3rd`, `4th`, … `11th`, `21st`.
@@ -461,106 +581,4 @@ mod validate;
 mod angle_tests;
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_default_plan_is_the_papers() {
-        let p = BoxPlan::default();
-        p.validate().unwrap();
-        // 25 tiles × 5, 2 planes × 9 angles, wall + 24 patches, 24 spots × 5.
-        let counts: Vec<usize> = BoxStage::ALL.iter().map(|&s| p.steps(s).len()).collect();
-        assert_eq!(counts, [125, 18, 25, 120]);
-        let tiles = p.steps(BoxStage::Tiles);
-        assert_eq!(
-            tiles[5 * 13].prepare,
-            Prepare::Operator {
-                prompt: "place the i1Pro on tile row 2, column 3 of the light on the left wall \
-                         (3rd row from the top, 4th column from the open front)"
-                    .into()
-            }
-        );
-        let place = |r, c| p.tile_place(r, c);
-        assert_eq!(place(0, 0), "the top corner nearest the open front");
-        assert_eq!(place(4, 4), "the bottom corner nearest the back");
-        assert_eq!(place(2, 2), "the centre tile");
-        assert_eq!(place(0, 2), "top row, 3rd column from the open front");
-        assert_eq!(
-            place(3, 0),
-            "4th row from the top, column nearest the open front"
-        );
-        assert_eq!(ordinal(12), "12th");
-        assert_eq!(ordinal(22), "22nd");
-        assert_eq!(p.falloff_tile(), [2, 2]);
-        assert_eq!(Plane::Vertical.c_gamma(-40.0), (270.0, 40.0));
-        assert_eq!(Plane::Horizontal.c_gamma(20.0), (0.0, 20.0));
-    }
-
-    #[test]
-    fn bad_plans_name_the_field() {
-        let check = |json: &str, want: &str| {
-            let dir = std::env::temp_dir().join(format!("metamer-boxplan-{}", std::process::id()));
-            std::fs::create_dir_all(&dir).unwrap();
-            let path = dir.join("plan.json");
-            std::fs::write(&path, json).unwrap();
-            let e = BoxPlan::load(&path).unwrap_err().to_string();
-            assert!(e.contains(want), "{json}: {e}");
-        };
-        check(
-            r#"{"repeats":0}"#,
-            "plan: repeats: must be between 1 and 100, got 0",
-        );
-        check(r#"{"falloff_angles_deg":[-20,20]}"#, "must contain 0");
-        check(r#"{"falloff_angles_deg":[0,95]}"#, "95.0 is not an angle");
-        // A number no one can read in 309 digits.
-        check(
-            r#"{"falloff_angles_deg":[0,1e308]}"#,
-            "falloff_angles_deg: 1e308 is not an angle",
-        );
-        check(r#"{"geometry":{"size_m":1e308}}"#, "and 5 m, got 1e308");
-        // serde would read an array as the fields in order: three repeat counts.
-        check(
-            "[1, 2, 3]",
-            "not a valid plan: a plan is a JSON object of named fields",
-        );
-        check(
-            r#"{"geometry": [0.5]}"#,
-            "not a valid plan: geometry is a JSON object of named fields",
-        );
-        check(r#"{"falloff_angles_deg":[0,20,10]}"#, "10 follows 20");
-        check(
-            r#"{"falloff_angles_deg":[0,20,40,60]}"#,
-            "falloff_angles_deg: needs an angle on each side of the normal, and has no negative one",
-        );
-        check(
-            r#"{"falloff_angles_deg":[-60,-30,0]}"#,
-            "has no positive one",
-        );
-        check(r#"{"patches":[1,25]}"#, "25 is not a patch number");
-        check(r#"{"patches":[3,3]}"#, "patch 3 is listed twice");
-        check(
-            r#"{"geometry":{"rows":0}}"#,
-            "geometry.rows: must be between 1 and 64",
-        );
-        check(
-            r#"{"geometry":{"light_m":[0.4,0.1,0.1,0.4]}}"#,
-            "geometry.light_m",
-        );
-        check(r#"{"geometry":{"viewpoint_m":[0,0,1]}}"#, "z < 0");
-        check(r#"{"falloff_tile":[5,0]}"#, "outside the 5 × 5 grid");
-        check(r#"{"repeat":3}"#, "unknown field `repeat`");
-        check(
-            r#"{"spot_rule":{"rule":"width","half_width_jnd":0.2,"most":10}}"#,
-            "plan: spot_white: a width rule needs the white",
-        );
-        check(
-            r#"{"spot_rule":{"rule":"verdict","margin":0.1,"most":10}}"#,
-            "plan: spot_rule: a verdict needs the display's reading",
-        );
-        check(
-            r#"{"spot_rule":{"rule":"width","half_width_jnd":0.2,"most":1},"spot_white":[1,1,1]}"#,
-            "plan: spot_rule: the most readings must be between 2 and 100, got 1",
-        );
-        check(r#"{"repeats":"x"}"#, "not a valid plan");
-    }
-}
+mod tests;

@@ -8,15 +8,17 @@ use std::path::{Path, PathBuf};
 
 use metamer_drivers::{Instrument, MeasureMode};
 
+use super::adaptive::shifted::{RoundShifted, ROUND_STRIDE};
+use super::adaptive::{self, AdaptiveRule, AdaptiveSummary, RoundDecision};
 use super::assemble::{assemble, AssembleError, BoxDetails, StageEntries, Summary};
-use super::plan::{BoxPlan, BoxStage, BoxStep, SPECTRAL, SPOT};
+use super::plan::{BoxPlan, BoxStage, BoxStep, Target, SPECTRAL, SPOT};
 use super::spot_rule::SpotStopping;
 use crate::color::Xyz;
 use crate::output::OutputPolicy;
 use crate::session::budget::meters_of;
 use crate::session::{
-    placements, CostReport, Entry, InstrumentRecord, JournalError, Operator, ProgressSink, Rig,
-    RunEnd, RunOptions, Session, SessionError, StageOf,
+    placements, CostReport, Entry, InstrumentRecord, Operator, ProgressSink, Rig, RunEnd,
+    RunOptions, Session, SessionError, StageOf,
 };
 use crate::validation::repeatability;
 
@@ -82,87 +84,7 @@ pub enum MeasureBoxError {
     Assemble(#[from] AssembleError),
 }
 
-impl MeasureBoxError {
-    /// What to do next, said with `measure-box`'s flags, where the session engine's own
-    /// message cannot say it: a journal of an earlier session, one written with other
-    /// options, or a reading that failed midway (the others are safe in the journal).
-    pub fn advice(&self) -> Option<String> {
-        let MeasureBoxError::Session { stage, source } = self else {
-            return None;
-        };
-        match source {
-            SessionError::Journal(JournalError::Exists { path, entries }) => Some(format!(
-                "stage {stage}: {} exists with {entries} reading(s) of an earlier session: continue it with --resume, measure the stage again with --stage {stage}, or choose another output directory",
-                path.display()
-            )),
-            SessionError::Journal(JournalError::OptionDiffers {
-                path,
-                option,
-                logged,
-                now,
-            }) => Some(format!(
-                "stage {stage}: {} was written by another session: its {option} is {logged}, this one's is {now}; run with the same --plan/--repeats/--seed and --resume, or choose another output directory",
-                path.display()
-            )),
-            SessionError::Step {
-                index,
-                total,
-                label,
-                prepare,
-                ..
-            } => Some(format!(
-                "stage {stage}, reading {} of {total} ({label}: {prepare}): {}",
-                index + 1,
-                source.safe_so_far()?
-            )),
-            _ => None,
-        }
-    }
-}
-
-impl Outcome {
-    /// Whether the session was interrupted (Ctrl-C, a signal): a failure to the caller,
-    /// though every reading taken is safe.
-    pub fn is_interrupted(&self) -> bool {
-        matches!(self, Outcome::Incomplete { end, .. } if end.is_interrupted())
-    }
-
-    /// What is still to measure and how to continue, said with `measure-box`'s flags;
-    /// None when finished.
-    pub fn left_to_do(&self) -> Option<String> {
-        let (stage, end, done, total, log) = match self {
-            Outcome::Finished(_) => return None,
-            Outcome::StagesMissing(stages) => {
-                let names: Vec<&str> = stages.iter().map(|s| s.name()).collect();
-                return Some(format!(
-                    "stage(s) {} still to measure before the scene can be assembled (--stage NAME, or the whole session with --resume)",
-                    names.join(", ")
-                ));
-            }
-            Outcome::Incomplete {
-                stage,
-                end,
-                done,
-                total,
-                log,
-            } => (stage, end, *done, *total, log),
-        };
-        let text = if done == 0 {
-            format!("stage {stage}: none of its {total} readings taken yet: continue with --resume")
-        } else {
-            format!(
-                "stage {stage}: {} of {total} readings still to take; the others are safe in {}: continue with --resume",
-                total - done,
-                log.display()
-            )
-        };
-        Some(match end {
-            RunEnd::Interrupted { .. } => format!("interrupted: {text}"),
-            RunEnd::Aborted { .. } => format!("stopped at your request: {text}"),
-            RunEnd::Stopped { .. } | RunEnd::Complete => format!("stopped: {text}"),
-        })
-    }
-}
+pub mod advice;
 
 /// Moves an earlier journal of a stage to be measured again out of the way, to
 /// `NAME.replaced-K.jsonl` (nothing measured is deleted).
@@ -170,9 +92,13 @@ fn set_aside(stage: BoxStage, path: &Path) -> Result<(), MeasureBoxError> {
     if !path.exists() {
         return Ok(());
     }
+    let stem = path.file_stem().map_or_else(
+        || stage.name().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
     let mut k = 1;
     let target = loop {
-        let t = path.with_file_name(format!("{}.replaced-{k}.jsonl", stage.name()));
+        let t = path.with_file_name(format!("{stem}.replaced-{k}.jsonl"));
         if !t.exists() {
             break t;
         }
@@ -185,21 +111,57 @@ fn set_aside(stage: BoxStage, path: &Path) -> Result<(), MeasureBoxError> {
     })
 }
 
-/// Runs one stage's session, its budget said before its first reading and its cost after.
+/// Runs one stage's session (round `round` of an adaptive stage), its budget said before
+/// its first reading and its cost after.
 fn run_costed(
     session: &mut Session<BoxDetails, BoxStep>,
-    rig: &mut Rig<'_>,
+    instruments: &mut Instruments<'_>,
+    operator: &mut dyn Operator,
+    round: usize,
     options: &BoxOptions,
-    stage: BoxStage,
     progress: &mut dyn ProgressSink,
 ) -> Result<(RunEnd, CostReport), MeasureBoxError> {
+    let offset = round as u64 * ROUND_STRIDE;
+    let mut spectral = RoundShifted {
+        inner: &mut *instruments.spectral,
+        offset,
+    };
+    let mut spot = RoundShifted {
+        inner: &mut *instruments.spot,
+        offset,
+    };
+    let mut rig = Rig {
+        screen: None,
+        instruments: vec![
+            (SPECTRAL.to_string(), &mut spectral),
+            (SPOT.to_string(), &mut spot),
+        ],
+        operator,
+    };
+    let rig = &mut rig;
+    let stage = session
+        .plan()
+        .steps
+        .first()
+        .map_or(BoxStage::Tiles, |s| s.data.stage);
     let estimate = session.estimate(
         &meters_of(&rig.instruments),
         &|_| BOX_TARGET_CD_M2,
         BOX_LIGHT_ASSUMPTION,
         options.run.placement_s(),
     );
-    let named = format!("the box's {stage} stage");
+    let named =
+        match (round, &options.plan.adaptive) {
+            (0, Some(rule)) if stage.in_rounds() => {
+                format!(
+            "the box's {stage} stage, its first pass (the adaptive plan reads at most {} {})",
+            if stage == BoxStage::Tiles { rule.max_tiles } else { rule.max_falloff },
+            if stage == BoxStage::Tiles { "tiles" } else { "fall-off angles" }
+        )
+            }
+            (0, _) => format!("the box's {stage} stage"),
+            _ => format!("the box's {stage} stage, round {round}"),
+        };
     progress.note(&estimate.before(&named));
     let end = session
         .run(rig, &options.run, progress)
@@ -221,42 +183,11 @@ pub const BOX_TARGET_CD_M2: f64 = super::simulated_box::TILE_CD_M2;
 pub const BOX_LIGHT_ASSUMPTION: &str =
     "every box target read at a light tile's 100 cd/m² (the simulated box's tiles before their gain)";
 
-fn open_stage(
-    options: &BoxOptions,
-    stage: BoxStage,
-    instruments: &BTreeMap<String, InstrumentRecord>,
-    resume: bool,
-) -> Result<Session<BoxDetails, BoxStep>, MeasureBoxError> {
-    let session = Session::open(
-        &stage.journal(&options.dir),
-        options.plan.session_plan(stage, &options.rig_options),
-        options.details.clone(),
-        instruments.clone(),
-        resume,
-    )
-    .map_err(|source| MeasureBoxError::Session { stage, source })?;
-    let plan = &options.plan;
-    Ok(match (&plan.spot_rule, plan.spot_white, stage) {
-        (Some(rule), Some(white), BoxStage::Spots) => {
-            let model = instruments
-                .get(SPOT)
-                .map(|r| r.info.model.clone())
-                .unwrap_or_default();
-            session.with_stopping(Box::new(SpotStopping {
-                rule: rule.clone(),
-                stated: repeatability::stated(&model, MeasureMode::Emissive),
-                white: Xyz::new(white[0], white[1], white[2]),
-            }))
-        }
-        _ => session,
-    })
-}
-
 /// Measures what the journals in `options.dir` lack (every stage, or `options.stage`),
 /// then, when all four stages are complete, writes the measured scene and its files.
 pub fn run(
     options: &BoxOptions,
-    instruments: Instruments<'_>,
+    mut instruments: Instruments<'_>,
     operator: &mut dyn Operator,
     progress: &mut dyn ProgressSink,
 ) -> Result<Outcome, MeasureBoxError> {
@@ -272,61 +203,69 @@ pub fn run(
         Some(s) => vec![s],
         None => BoxStage::ALL.to_vec(),
     };
-    let mut rig = Rig {
-        screen: None,
-        instruments: vec![
-            (SPECTRAL.to_string(), instruments.spectral),
-            (SPOT.to_string(), instruments.spot),
-        ],
-        operator,
-    };
     let mut cost = BTreeMap::new();
     for &stage in &stages {
         let path = stage.journal(&options.dir);
         if options.stage.is_some() && !options.resume {
+            for later in adaptive::later_rounds(&options.dir, stage)
+                .into_iter()
+                .rev()
+            {
+                set_aside(stage, &later)?;
+            }
             set_aside(stage, &path)?;
         }
-        let mut session = open_stage(options, stage, &records, options.resume)?;
-        let total = session.plan().steps.len();
-        if session.done() == total {
-            // Nothing to run, so the session does not report what resuming repaired.
-            for note in &session.notes {
-                progress.note(note);
+        let mut taken: Vec<Entry<BoxStep>> = Vec::new();
+        let mut stage_cost: Option<CostReport> = None;
+        for round in 0.. {
+            let Some(steps) = round_steps(options, stage, round, &taken) else {
+                break;
+            };
+            let plan = options
+                .plan
+                .round_plan(stage, round, steps, &options.rig_options);
+            let mut session = open_round(options, stage, round, plan, &records, options.resume)?;
+            let total = session.plan().steps.len();
+            let log = session.journal_path().to_path_buf();
+            if session.done() < total {
+                announce(&session, stage, round, progress);
+                let (end, costs) = run_costed(
+                    &mut session,
+                    &mut instruments,
+                    operator,
+                    round,
+                    options,
+                    progress,
+                )?;
+                stage_cost = Some(summed(stage_cost, costs));
+                if end != RunEnd::Complete {
+                    if let Some(c) = stage_cost {
+                        cost.insert(stage.name().to_string(), c);
+                    }
+                    return Ok(Outcome::Incomplete {
+                        stage,
+                        end,
+                        done: taken.len() + session.done(),
+                        total: taken.len() + total,
+                        log,
+                    });
+                }
+            } else {
+                // Nothing to run, so the session does not report what resuming repaired.
+                for note in &session.notes {
+                    progress.note(note);
+                }
             }
-            continue;
+            taken.extend(
+                session
+                    .complete_entries()
+                    .unwrap_or_default()
+                    .into_iter()
+                    .cloned(),
+            );
         }
-        let number = BoxStage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;
-        let of = BoxStage::ALL.len();
-        progress.stage(&StageOf {
-            number,
-            of,
-            name: stage.name().into(),
-        });
-        let placed = placements(&session.plan().steps)
-            .iter()
-            .enumerate()
-            .filter(|(i, r)| r.as_ref().is_some_and(|r| r.start == *i))
-            .count();
-        let what = format!("stage {number}/{of} {stage}: {total} readings at {placed} placements");
-        if session.recovered > 0 || session.torn_bytes > 0 {
-            progress.note(&format!(
-                "resuming {what}; {} of them are in {}",
-                session.recovered,
-                path.display()
-            ));
-        } else {
-            progress.note(&what);
-        }
-        let (end, costs) = run_costed(&mut session, &mut rig, options, stage, progress)?;
-        cost.insert(stage.name().to_string(), costs);
-        if end != RunEnd::Complete {
-            return Ok(Outcome::Incomplete {
-                stage,
-                end,
-                done: session.done(),
-                total,
-                log: path,
-            });
+        if let Some(c) = stage_cost {
+            cost.insert(stage.name().to_string(), c);
         }
     }
     let entries = match completed_stages(options, &records)? {
@@ -347,6 +286,164 @@ pub fn run(
     Ok(Outcome::Finished(Box::new(summary)))
 }
 
+/// The steps of round `round` of `stage` after the entries `taken` of the rounds before
+/// it: the whole stage as round 0 of a fixed stage, the adaptive plan's rounds of an
+/// adaptive one; None when the stage has no such round.
+fn round_steps(
+    options: &BoxOptions,
+    stage: BoxStage,
+    round: usize,
+    taken: &[Entry<BoxStep>],
+) -> Option<Vec<crate::session::Step<BoxStep>>> {
+    let plan = &options.plan;
+    match (round, adaptive_rule(plan, stage)) {
+        (0, _) => Some(plan.steps(stage)),
+        (_, None) => None,
+        (_, Some(rule)) => {
+            let next = adaptive::next_round(plan, rule, stage, taken).next;
+            (!next.is_empty()).then(|| plan.steps_of(stage, &next))
+        }
+    }
+}
+
+fn adaptive_rule(plan: &BoxPlan, stage: BoxStage) -> Option<&AdaptiveRule> {
+    plan.adaptive.as_ref().filter(|_| stage.in_rounds())
+}
+
+/// The stage's (or the round's) readings and placements, said before it starts.
+fn announce(
+    session: &Session<BoxDetails, BoxStep>,
+    stage: BoxStage,
+    round: usize,
+    progress: &mut dyn ProgressSink,
+) {
+    let number = BoxStage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;
+    let of = BoxStage::ALL.len();
+    if round == 0 {
+        progress.stage(&StageOf {
+            number,
+            of,
+            name: stage.name().into(),
+        });
+    }
+    let total = session.plan().steps.len();
+    let placed = placements(&session.plan().steps)
+        .iter()
+        .enumerate()
+        .filter(|(i, r)| r.as_ref().is_some_and(|r| r.start == *i))
+        .count();
+    let round_name = if round == 0 {
+        String::new()
+    } else {
+        format!(" round {round}")
+    };
+    let what =
+        format!("stage {number}/{of} {stage}{round_name}: {total} readings at {placed} placements");
+    if session.recovered > 0 || session.torn_bytes > 0 {
+        progress.note(&format!(
+            "resuming {what}; {} of them are in {}",
+            session.recovered,
+            session.journal_path().display()
+        ));
+    } else {
+        progress.note(&what);
+    }
+}
+
+/// Two rounds' budgets and costs as one.
+fn summed(a: Option<CostReport>, b: CostReport) -> CostReport {
+    let Some(mut a) = a else {
+        return b;
+    };
+    a.estimate.add(&b.estimate);
+    a.actual = match (a.actual, b.actual) {
+        (Some(mut x), Some(y)) => {
+            x.add(&y);
+            Some(x)
+        }
+        (x, y) => x.or(y),
+    };
+    a
+}
+
+/// Opens round `round` of `stage` (round 0: the stage's own journal). A later round's
+/// journal exists only if this measurement wrote it, so it is always continued.
+fn open_round(
+    options: &BoxOptions,
+    stage: BoxStage,
+    round: usize,
+    plan: crate::session::SessionPlan<BoxStep>,
+    instruments: &BTreeMap<String, InstrumentRecord>,
+    resume: bool,
+) -> Result<Session<BoxDetails, BoxStep>, MeasureBoxError> {
+    let session = Session::open(
+        &adaptive::round_journal(&options.dir, stage, round),
+        plan,
+        options.details.clone(),
+        instruments.clone(),
+        resume || round > 0,
+    )
+    .map_err(|source| MeasureBoxError::Session { stage, source })?;
+    let plan = &options.plan;
+    Ok(match (&plan.spot_rule, plan.spot_white, stage) {
+        (Some(rule), Some(white), BoxStage::Spots) => {
+            let model = instruments
+                .get(SPOT)
+                .map(|r| r.info.model.clone())
+                .unwrap_or_default();
+            session.with_stopping(Box::new(SpotStopping {
+                rule: rule.clone(),
+                stated: repeatability::stated(&model, MeasureMode::Emissive),
+                white: Xyz::new(white[0], white[1], white[2]),
+            }))
+        }
+        _ => session,
+    })
+}
+
+/// A stage's complete readings over its rounds, from the journals: its journals, its
+/// entries, how many rounds and the last decision (None for a fixed stage); None when a
+/// round is missing or incomplete.
+type Loaded = (
+    Vec<PathBuf>,
+    Vec<Entry<BoxStep>>,
+    Option<(usize, RoundDecision)>,
+);
+
+fn load_stage(
+    options: &BoxOptions,
+    stage: BoxStage,
+    records: &BTreeMap<String, InstrumentRecord>,
+) -> Result<Option<Loaded>, MeasureBoxError> {
+    let mut paths = Vec::new();
+    let mut taken: Vec<Entry<BoxStep>> = Vec::new();
+    for round in 0.. {
+        let Some(steps) = round_steps(options, stage, round, &taken) else {
+            break;
+        };
+        let path = adaptive::round_journal(&options.dir, stage, round);
+        if !path.exists() {
+            return Ok(None);
+        }
+        let plan = options
+            .plan
+            .round_plan(stage, round, steps, &options.rig_options);
+        let session = open_round(options, stage, round, plan, records, true)?;
+        let Some(entries) = session.complete_entries() else {
+            return Ok(None);
+        };
+        taken.extend(entries.into_iter().cloned());
+        paths.push(path);
+    }
+    let decided = adaptive_rule(&options.plan, stage).map(|rule| {
+        (
+            paths.len(),
+            adaptive::next_round(&options.plan, rule, stage, &taken),
+        )
+    });
+    Ok(Some((paths, taken, decided)))
+}
+
 /// Every stage's readings, from the journals (earlier runs' included), or the stages that
 /// have no complete journal yet.
 fn completed_stages(
@@ -354,17 +451,18 @@ fn completed_stages(
     records: &BTreeMap<String, InstrumentRecord>,
 ) -> Result<Result<StageEntries, Vec<BoxStage>>, MeasureBoxError> {
     let mut missing = Vec::new();
-    let mut loaded: BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)> = BTreeMap::new();
+    let mut loaded = BTreeMap::new();
+    let mut rounds = BTreeMap::new();
+    let mut decided = BTreeMap::new();
     for stage in BoxStage::ALL {
-        let path = stage.journal(&options.dir);
-        if !path.exists() {
-            missing.push(stage);
-            continue;
-        }
-        let session = open_stage(options, stage, records, true)?;
-        match session.complete_entries() {
-            Some(entries) => {
-                loaded.insert(stage, (path, entries.into_iter().cloned().collect()));
+        match load_stage(options, stage, records)? {
+            Some((mut paths, entries, decision)) => {
+                let first = paths.remove(0);
+                loaded.insert(stage, (first, entries));
+                rounds.insert(stage, paths);
+                if let Some(d) = decision {
+                    decided.insert(stage, d);
+                }
             }
             None => missing.push(stage),
         }
@@ -372,5 +470,62 @@ fn completed_stages(
     if !missing.is_empty() {
         return Ok(Err(missing));
     }
-    Ok(Ok(StageEntries { stages: loaded }))
+    let adaptive = options
+        .plan
+        .adaptive
+        .as_ref()
+        .map(|rule| adaptive_summary(&options.plan, rule, &loaded, &mut decided));
+    Ok(Ok(StageEntries {
+        stages: loaded,
+        later_rounds: rounds,
+        adaptive,
+    }))
+}
+
+/// What the adaptive rounds read and decided.
+fn adaptive_summary(
+    plan: &BoxPlan,
+    rule: &AdaptiveRule,
+    loaded: &BTreeMap<BoxStage, (PathBuf, Vec<Entry<BoxStep>>)>,
+    decided: &mut BTreeMap<BoxStage, (usize, RoundDecision)>,
+) -> AdaptiveSummary {
+    let entries = |stage| loaded.get(&stage).map_or(&[][..], |(_, e)| e.as_slice());
+    let tiles_read: Vec<[usize; 2]> = adaptive::spatial::tiles_read(entries(BoxStage::Tiles))
+        .into_iter()
+        .map(|t| t.0)
+        .collect();
+    let g = &plan.geometry;
+    let tiles_predicted = (0..g.rows * g.cols)
+        .map(|k| [k / g.cols, k % g.cols])
+        .filter(|t| !tiles_read.contains(t))
+        .collect();
+    let falloff_read = entries(BoxStage::Falloff)
+        .iter()
+        .filter_map(|e| match e.data.target {
+            Target::Falloff { plane, angle_deg } if e.data.repeat == 0 => Some((plane, angle_deg)),
+            _ => None,
+        })
+        .collect();
+    let none = || {
+        (
+            0,
+            RoundDecision {
+                next: Vec::new(),
+                figure: 0.0,
+                why: String::new(),
+            },
+        )
+    };
+    let (tile_rounds, tiles) = decided.remove(&BoxStage::Tiles).unwrap_or_else(none);
+    let (falloff_rounds, falloff) = decided.remove(&BoxStage::Falloff).unwrap_or_else(none);
+    AdaptiveSummary {
+        tiles_read,
+        tiles_predicted,
+        tiles,
+        tile_rounds,
+        falloff_read,
+        falloff,
+        falloff_rounds,
+        rule: rule.clone(),
+    }
 }

@@ -225,3 +225,25 @@ pub fn build(value: &Value) -> Result<Scene, BuildError> {
     Scene::build(&file, std::path::Path::new("."))
         .map_err(|e| BuildError(format!("{}: {}", e.path, e.message)))
 }
+
+/// The centre of ColorChecker patch `patch` (1–24) on the chart, as [`chart`] places it.
+pub fn patch_centre(g: &Geometry, patch: usize) -> [f64; 3] {
+    let i = patch.saturating_sub(1);
+    let (r, col) = ((i / 6) as f64, (i % 6) as f64);
+    let centre = chart_centre(g);
+    [
+        g.size_m - PATCH_OFF_M,
+        centre[1] + (2.5 - col) * PITCH_M,
+        centre[2] + (r - 1.5) * PITCH_M,
+    ]
+}
+
+/// The centre of tile (row, col) of the light, as [`emitter`] lays the tiles out.
+pub fn tile_centre(g: &Geometry, row: usize, col: usize) -> [f64; 3] {
+    let [y0, y1, z0, z1] = g.light_m;
+    [
+        0.0,
+        y1 - (row as f64 + 0.5) * (y1 - y0) / g.rows as f64,
+        z0 + (col as f64 + 0.5) * (z1 - z0) / g.cols as f64,
+    ]
+}

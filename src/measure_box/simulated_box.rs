@@ -245,11 +245,11 @@ impl BoxOperator {
     /// The operator of the truth box's plan, moving what `world` shows.
     pub fn new(truth: SimulatedBox, world: Arc<SharedWorld>) -> BoxOperator {
         let mut targets = HashMap::new();
+        // Every target of the plan, not only its steps': an adaptive plan's later rounds
+        // read targets its first pass does not.
         for stage in BoxStage::ALL {
-            for step in truth.plan.steps(stage) {
-                targets
-                    .entry(truth.plan.prompt(&step.data.target))
-                    .or_insert(step.data.target);
+            for target in truth.plan.targets(stage) {
+                targets.entry(truth.plan.prompt(&target)).or_insert(target);
             }
         }
         BoxOperator {

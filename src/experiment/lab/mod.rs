@@ -57,6 +57,9 @@ pub struct LabOptions {
     /// Readings of each tile and spot in the box; None: the box plan's (`lab.json` records
     /// the number used).
     pub box_repeats: Option<usize>,
+    /// Read the box's tiles and fall-off adaptively (the box plan's rule, or the default).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub box_adaptive: bool,
     pub seed: u64,
     /// The simulated instruments' time scale (1 = their real pace).
     pub time_scale: f64,
@@ -118,6 +121,7 @@ impl LabOptions {
                 spot: self.instrument("cs100a", None),
                 plan: self.plan.clone(),
                 repeats: self.box_repeats,
+                adaptive: self.box_adaptive,
                 seed: self.seed,
                 light: Some(self.scenario),
             },
@@ -272,6 +276,7 @@ pub struct LabSummary {
 ///     until_decided: None,
 ///     plan: None,
 ///     box_repeats: None,
+///     box_adaptive: false,
 ///     seed: 1,
 ///     time_scale: 0.0,
 ///     image_size: 1014,

@@ -13,6 +13,7 @@ impl BoxPlan {
         check_falloff_angles(&self.falloff_angles_deg)?;
         check_patches(&self.patches)?;
         check_grid(&self.geometry, self.falloff_tile)?;
+        self.check_adaptive()?;
         self.geometry.check_walls()
     }
 
@@ -54,6 +55,53 @@ impl BoxPlan {
             },
             RepeatRule::Fixed { .. } => Ok(()),
         }
+    }
+}
+
+impl BoxPlan {
+    /// An adaptive rule whose figures are figures and whose caps leave room for the first
+    /// pass.
+    fn check_adaptive(&self) -> Result<(), BoxPlanError> {
+        let Some(rule) = &self.adaptive else {
+            return Ok(());
+        };
+        if !(1..=MAX_REPEATS).contains(&rule.tile_repeats) {
+            return Err(invalid(
+                "adaptive.tile_repeats",
+                format!(
+                    "must be between 1 and {MAX_REPEATS}, got {}",
+                    rule.tile_repeats
+                ),
+            ));
+        }
+        for (field, v) in [
+            ("adaptive.tile_effect_jnd", rule.tile_effect_jnd),
+            ("adaptive.angle_agreement", rule.angle_agreement),
+        ] {
+            if !(v.is_finite() && v > 0.0 && v <= 10.0) {
+                return Err(invalid(
+                    field,
+                    format!("must be above 0 and at most 10, got {v}"),
+                ));
+            }
+        }
+        for (field, cap, stage) in [
+            ("adaptive.max_tiles", rule.max_tiles, super::BoxStage::Tiles),
+            (
+                "adaptive.max_falloff",
+                rule.max_falloff,
+                super::BoxStage::Falloff,
+            ),
+        ] {
+            let first = self.first_pass(stage).len();
+            if cap < first {
+                return Err(invalid(
+                    field,
+                    format!("must be at least the first pass's {first}, got {cap}"),
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
