@@ -150,6 +150,7 @@ mod tests {
             spot: Spec::new("sim:cs100a?time_scale=0"),
             plan: None,
             repeats: Some(1),
+            adaptive: false,
             seed: 3,
             light: Some(Scenario::default()),
         };

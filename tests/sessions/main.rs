@@ -8,6 +8,7 @@ mod support;
 mod cs100a_sim;
 mod i1pro_resume;
 mod measure_box;
+mod measure_box_adaptive;
 mod operator_session;
 mod operator_tmux;
 mod session_engine;
