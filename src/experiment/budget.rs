@@ -116,12 +116,19 @@ fn box_cost(plan: &BoxPlan, m: &MeasureBox, placement_s: f64) -> Cost {
     .into();
     let mut cost = Cost::default();
     for s in BoxStage::ALL {
+        let said = match &plan.adaptive {
+            Some(rule) if s.in_rounds() => format!(
+                "{BOX_LIGHT_ASSUMPTION}; the adaptive plan at its caps, {} tiles and {} fall-off angles",
+                rule.max_tiles, rule.max_falloff
+            ),
+            _ => BOX_LIGHT_ASSUMPTION.to_string(),
+        };
         cost.add(&estimate(
             &plan.round_plan(s, 0, plan.most_steps(s), &BTreeMap::new()),
             &|_| false,
             &meters,
             &|_| BOX_TARGET_CD_M2,
-            BOX_LIGHT_ASSUMPTION,
+            &said,
             placement_s,
         ));
     }
