@@ -10,7 +10,7 @@ use metamer::render::job::convergence::ConvergenceRequest;
 use metamer::render::job::image::ImageRequest;
 use metamer::render::job::probes::{ProbesReport, ProbesRequest};
 use metamer::render::job::spots::{Readings, SpotsRequest};
-use metamer::render::job::spots_from_image::Request as SpotsFromImageRequest;
+use metamer::render::job::spots_from_image::SpotsFromImageRequest;
 use metamer::render::job::{self, RenderError, RenderEvent};
 use metamer::render::method::{self, Solver};
 use metamer::render::probes::ProbeOptions;
@@ -24,20 +24,20 @@ pub struct Args {
     command: Cmd,
 }
 
-/// How the spot readings are computed.
+/// The `--method` value: how the spot readings are computed, as the command spells it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
+pub enum MethodArg {
     Radiosity,
     Path,
     Auto,
 }
 
-impl From<Method> for method::Method {
-    fn from(m: Method) -> Self {
+impl From<MethodArg> for method::Method {
+    fn from(m: MethodArg) -> Self {
         match m {
-            Method::Radiosity => method::Method::Radiosity,
-            Method::Path => method::Method::PathTracer,
-            Method::Auto => method::Method::Auto,
+            MethodArg::Radiosity => method::Method::Radiosity,
+            MethodArg::Path => method::Method::PathTracer,
+            MethodArg::Auto => method::Method::Auto,
         }
     }
 }
@@ -78,8 +78,8 @@ struct SpotsArgs {
     seed: u64,
     /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
     /// path: the path tracer; auto: radiosity when the scene qualifies.
-    #[arg(long, value_enum, default_value_t = Method::Auto)]
-    method: Method,
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    method: MethodArg,
     #[arg(long)]
     json: bool,
 }
@@ -119,8 +119,8 @@ struct ImageArgs {
     spp: u64,
     /// path: the path tracer; radiosity: the deterministic solver's reflected radiance
     /// at every ray's first hit (convex scenes of Lambertian rectangles).
-    #[arg(long, value_enum, default_value_t = Method::Path)]
-    method: Method,
+    #[arg(long, value_enum, default_value_t = MethodArg::Path)]
+    method: MethodArg,
     /// Radiosity: the finest mesh level (the indirect light is extrapolated from it and
     /// the level before, as the spot readings are).
     #[arg(long, default_value_t = 3)]
@@ -147,8 +147,8 @@ struct ProbesArgs {
     scene: PathBuf,
     #[arg(long)]
     points: PathBuf,
-    #[arg(long, value_enum, default_value_t = Method::Auto)]
-    method: Method,
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    method: MethodArg,
     /// Radiosity: refine until every bound is below this fraction of the total.
     #[arg(long, default_value_t = 0.001)]
     rel_tolerance: f64,

@@ -424,14 +424,14 @@ pub struct SpotSession<'a> {
 }
 
 /// Each patch's readings by patch number, and the files written.
-pub type Measured = (Vec<(usize, PatchReading)>, Vec<&'static str>);
+pub type MeasuredPatches = (Vec<(usize, PatchReading)>, Vec<&'static str>);
 
 /// Shows and reads every patch into `dir`.
 pub fn measure(
     dir: &Path,
     s: &SpotSession<'_>,
     progress: &dyn Fn(Progress),
-) -> Result<Measured, ExperimentError> {
+) -> Result<MeasuredPatches, ExperimentError> {
     let SpotSession {
         setting,
         spot_spec,
