@@ -298,26 +298,65 @@ impl Diagnostics {
     }
 
     fn judge(&mut self, additivity_weight: f64, drift_weights: &[f64]) {
+        let mut checks = self.sort_checks(additivity_weight, drift_weights);
+        let power_law_model = matches!(self.model, ModelKind::PlccGamma);
+        if power_law_model {
+            checks.failures.append(&mut checks.power_notes);
+        }
+        let mut verdict = self.assumptions_verdict(&checks);
+        if let Some(n) = self.noise.as_ref().filter(|n| !n.disagreeing.is_empty()) {
+            verdict = format!(
+                "Warning: repeated readings disagree beyond the instrument's repeatability \
+                 ({}); that is a reading gone wrong, not noise, and it inflates the noise \
+                 figure this verdict allows for: re-measure those patches. {verdict}",
+                n.disagreeing.join("; ")
+            );
+        }
+        if !power_law_model && !checks.power_notes.is_empty() {
+            verdict.push_str(&format!(
+                " Note: {} (plcc-gamma would not cope; measured-ramp TRCs do).",
+                checks.power_notes.join("; ")
+            ));
+        }
+        if let Some(mixed) = self.few_mixtures {
+            verdict.push(' ');
+            verdict.push_str(&self.mixture_note(mixed));
+        }
+        if let Some([folded, total]) = self.folded_tetrahedra {
+            verdict.push(' ');
+            verdict.push_str(&fold_note(folded, total));
+        }
+        let r = &self.residuals;
+        verdict.push_str(&format!(
+            " The fitted {} reproduces the {} readings it was fitted to with mean ΔE00 {:.2}, \
+             95th percentile {:.2}, max {:.2}.",
+            self.model, r.patches, r.mean_de00, r.p95_de00, r.max_de00
+        ));
+        self.failures = checks.failures;
+        self.verdict = verdict;
+    }
+
+    /// Each assumption's check sorted into failed, within the noise, passed (its short
+    /// figure) and not checked, with the TRCs that are no power law aside.
+    fn sort_checks(&self, additivity_weight: f64, drift_weights: &[f64]) -> Checks {
         let tol = self.tolerance_de00;
         let sigma = self.noise.as_ref().map(|n| n.de00);
         // A check combining patches averaged over n₁, n₂, … readings scatters by about
         // σ·√(Σ 1/nᵢ); beyond tolerance + twice that the display, not the meter, is to blame.
         let margin = |weight: f64| sigma.map_or(0.0, |s| 2.0 * s * weight.sqrt());
-        let mut failures = Vec::new();
-        let mut in_noise = Vec::new();
-        let mut unchecked = Vec::new();
-        let mut largest: Vec<String> = Vec::new();
-        let mut judge = |value: f64, readings: f64, failure: String, short: String| {
+        let judge = |c: &mut Checks, value: f64, readings: f64, failure: String, short: String| {
             if value <= tol {
-                largest.push(short);
+                c.largest.push(short);
             } else if value <= tol + margin(readings) {
-                in_noise.push(short);
+                c.in_noise.push(short);
             } else {
-                failures.push(failure);
+                c.failures.push(failure);
             }
         };
+        let mut c = Checks::default();
         match &self.additivity {
             Some(a) => judge(
+                &mut c,
                 a.de00,
                 additivity_weight,
                 format!(
@@ -327,17 +366,20 @@ impl Diagnostics {
                 ),
                 format!("additivity {:.2}", a.de00),
             ),
-            None => unchecked.push("additivity (needs black, the three primaries and white)"),
+            None => c
+                .unchecked
+                .push("additivity (needs black, the three primaries and white)"),
         }
         if self.channels.is_empty() {
-            unchecked.push("chromaticity constancy (needs black and the three primaries)");
+            c.unchecked
+                .push("chromaticity constancy (needs black and the three primaries)");
         }
-        let mut power_notes = Vec::new();
-        for (c, ch) in self.channels.iter().enumerate() {
+        for (i, ch) in self.channels.iter().enumerate() {
             match (ch.chromaticity_drift_de00, ch.levels) {
                 (Some(e), n) if n > 0 => judge(
+                    &mut c,
                     e,
-                    drift_weights.get(c).copied().unwrap_or(2.0),
+                    drift_weights.get(i).copied().unwrap_or(2.0),
                     format!(
                         "the {} channel's chromaticity drifts along its ramp: ΔE00 {:.2} at \
                          drive {:.3}{}",
@@ -350,11 +392,13 @@ impl Diagnostics {
                     ),
                     format!("{} drift {:.2}", ch.channel, e),
                 ),
-                _ => unchecked.push("chromaticity constancy of a channel without a ramp"),
+                _ => c
+                    .unchecked
+                    .push("chromaticity constancy of a channel without a ramp"),
             }
             if let (Some(e), Some(g)) = (ch.power_law_de00, ch.gamma) {
                 if e > tol + margin(1.0) {
-                    power_notes.push(format!(
+                    c.power_notes.push(format!(
                         "the {} TRC is not a power law: it deviates from γ = {:.2} by up to \
                          ΔE00 {:.2}",
                         ch.channel, g, e
@@ -362,44 +406,27 @@ impl Diagnostics {
                 }
             }
         }
-        let power_law_model = matches!(self.model, ModelKind::PlccGamma);
-        if power_law_model {
-            failures.append(&mut power_notes);
-        }
-        unchecked.dedup();
-        let r = &self.residuals;
-        let fit = format!(
-            "The fitted {} reproduces the {} readings it was fitted to with mean ΔE00 {:.2}, 95th percentile \
-             {:.2}, max {:.2}.",
-            self.model, r.patches, r.mean_de00, r.p95_de00, r.max_de00
-        );
-        let noise_note = match &self.noise {
-            Some(n) if !in_noise.is_empty() => format!(
-                " Within measurement noise (one reading ±{:.2} ΔE00 1σ, from {}): {}.",
-                n.de00,
-                n.source,
-                in_noise.join(", ")
-            ),
-            Some(_) => String::new(),
-            None if !failures.is_empty() => " No patch was measured twice, so measurement \
-                noise is not separated from the display's behaviour: measure repeats to tell \
-                them apart."
-                .to_string(),
-            None => String::new(),
-        };
-        let mut verdict = if failures.is_empty() && unchecked.is_empty() {
-            if in_noise.is_empty() {
+        c.unchecked.dedup();
+        c
+    }
+
+    /// The verdict on PLCC's assumptions from the sorted checks, with what the noise
+    /// explains.
+    fn assumptions_verdict(&self, c: &Checks) -> String {
+        let tol = self.tolerance_de00;
+        let mut verdict = if c.failures.is_empty() && c.unchecked.is_empty() {
+            if c.in_noise.is_empty() {
                 format!(
                     "PLCC's assumptions hold within ΔE00 {tol} (largest: {}).",
-                    largest.join(", ")
+                    c.largest.join(", ")
                 )
             } else {
                 format!("PLCC's assumptions hold within ΔE00 {tol} and the measurement noise.")
             }
-        } else if failures.is_empty() {
+        } else if c.failures.is_empty() {
             format!(
                 "No PLCC assumption fails within ΔE00 {tol} among those checked; not checked: {}.",
-                unchecked.join("; ")
+                c.unchecked.join("; ")
             )
         } else if self.model == ModelKind::Lut {
             // The fitted model is the answer to these failures, so the verdict says that
@@ -407,42 +434,30 @@ impl Diagnostics {
             format!(
                 "The lut assumes neither constant chromaticity nor additivity, so it holds \
                  where PLCC's assumptions fail, as they do here: {}.",
-                failures.join("; ")
+                c.failures.join("; ")
             )
         } else {
             format!(
                 "PLCC's assumptions fail: {}. Models that do not assume them: lut (needs a full \
                  grid of patches) or matrix-lsq (fits over all patches).",
-                failures.join("; ")
+                c.failures.join("; ")
             )
         };
-        verdict.push_str(&noise_note);
-        if let Some(n) = self.noise.as_ref().filter(|n| !n.disagreeing.is_empty()) {
-            verdict = format!(
-                "Warning: repeated readings disagree beyond the instrument's repeatability \
-                 ({}); that is a reading gone wrong, not noise, and it inflates the noise \
-                 figure this verdict allows for: re-measure those patches. {verdict}",
-                n.disagreeing.join("; ")
-            );
+        match &self.noise {
+            Some(n) if !c.in_noise.is_empty() => verdict.push_str(&format!(
+                " Within measurement noise (one reading ±{:.2} ΔE00 1σ, from {}): {}.",
+                n.de00,
+                n.source,
+                c.in_noise.join(", ")
+            )),
+            Some(_) => {}
+            None if !c.failures.is_empty() => verdict.push_str(
+                " No patch was measured twice, so measurement noise is not separated from the \
+                 display's behaviour: measure repeats to tell them apart.",
+            ),
+            None => {}
         }
-        if !power_law_model && !power_notes.is_empty() {
-            verdict.push_str(&format!(
-                " Note: {} (plcc-gamma would not cope; measured-ramp TRCs do).",
-                power_notes.join("; ")
-            ));
-        }
-        if let Some(mixed) = self.few_mixtures {
-            verdict.push(' ');
-            verdict.push_str(&self.mixture_note(mixed));
-        }
-        if let Some([folded, total]) = self.folded_tetrahedra {
-            verdict.push(' ');
-            verdict.push_str(&fold_note(folded, total));
-        }
-        verdict.push(' ');
-        verdict.push_str(&fit);
-        self.failures = failures;
-        self.verdict = verdict;
+        verdict
     }
 
     /// What a profile fitted without (enough) mixtures rests on, in a few sentences.
@@ -574,4 +589,17 @@ pub fn percentile(sorted: &[f64], q: f64) -> f64 {
     let lo = rank.floor() as usize;
     let hi = rank.ceil() as usize;
     sorted[lo] + (sorted[hi] - sorted[lo]) * (rank - lo as f64)
+}
+
+/// The assumptions' checks sorted by how they came out.
+#[derive(Default)]
+struct Checks {
+    failures: Vec<String>,
+    /// Beyond the tolerance but within the measurement noise: the short figures.
+    in_noise: Vec<String>,
+    /// Within the tolerance: the short figures.
+    largest: Vec<String>,
+    unchecked: Vec<&'static str>,
+    /// TRCs that are no power law; a failure only for the model that assumes one.
+    power_notes: Vec<String>,
 }
