@@ -3,10 +3,11 @@
 
 use std::path::PathBuf;
 
+use super::plan_choice::ModelChoice;
 use super::{CliError, CliResult};
 use metamer::display::icc::IccVersion;
 use metamer::display::job::fit::{self, Event, Request};
-use metamer::display::{FitOptions, ModelKind};
+use metamer::display::FitOptions;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -44,25 +45,6 @@ pub struct Args {
     /// The ICC version of --icc: 4 (default) or 2.4.
     #[arg(long, value_name = "4|2.4")]
     icc_version: Option<IccVersion>,
-}
-
-/// A model by name, or `auto`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum ModelChoice {
-    Auto,
-    Kind(ModelKind),
-}
-
-impl std::str::FromStr for ModelChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        if s.trim().eq_ignore_ascii_case("auto") {
-            return Ok(ModelChoice::Auto);
-        }
-        s.parse::<ModelKind>()
-            .map(ModelChoice::Kind)
-            .map_err(|e| format!("{e}, or auto"))
-    }
 }
 
 pub fn run(args: Args) -> CliResult {

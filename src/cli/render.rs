@@ -13,7 +13,7 @@ use metamer::render::job::spots::{Readings, SpotsRequest};
 use metamer::render::job::spots_from_image::SpotsFromImageRequest;
 use metamer::render::job::{self, RenderError, RenderEvent};
 use metamer::render::method::{self, Solver};
-use metamer::render::probes::ProbeOptions;
+use metamer::render::probes::{ProbeError, ProbeOptions};
 use metamer::render::radiosity::probes::ProbeProgress;
 use metamer::render::spot::Uncertainty;
 use metamer::render::Scene;
@@ -217,11 +217,42 @@ fn convergence(a: ConvergenceArgs) -> CliResult {
 
 /// A usage error for a bad request (exit 2), else a failure (exit 1).
 fn cli_error(e: RenderError) -> CliError {
-    if e.is_bad_request() {
-        CliError::Usage(e.to_string())
-    } else {
-        CliError::Failed(Box::new(e))
-    }
+    let usage = match e {
+        RenderError::TargetDe => "--target-de must be > 0".into(),
+        RenderError::MaxSeconds => "--max-seconds must be > 0".into(),
+        RenderError::White => "--white must be finite with Y > 0".into(),
+        RenderError::Seconds(why) => format!("--seconds: {why}"),
+        RenderError::Spp => "--spp must be ≥ 1".into(),
+        RenderError::Size => "--width and --height must be ≥ 1".into(),
+        RenderError::PreviewIsImage { preview, image } => format!(
+            "--preview {} is the same file as --output {}",
+            preview.display(),
+            image.display()
+        ),
+        e if e.is_bad_request() => e.to_string(),
+        RenderError::Probes {
+            file,
+            error:
+                ProbeError::TimeLimit {
+                    seconds,
+                    samples,
+                    done,
+                    of,
+                },
+        } => {
+            return CliError::Failed(
+                format!(
+                    "{}: no result within the time limit of {seconds} s: the path tracer \
+                     finished its first {samples} paths for {done} of {of} probes (give more \
+                     time with --max-seconds, or fewer points)",
+                    file.display()
+                )
+                .into(),
+            )
+        }
+        e => return CliError::Failed(Box::new(e)),
+    };
+    CliError::Usage(usage)
 }
 
 /// The events every command shows the same way.

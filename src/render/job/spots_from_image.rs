@@ -295,9 +295,9 @@ pub fn run(
 fn short_white_warning(t: &TracedWhite) -> String {
     format!(
         "the reference white stopped at the time limit ({} s) with a ΔE*ab 95 % half-width of \
-         {:.3}, above its target of {:.3} (a third of --target-de): the readings' XYZ are as \
-         read, but their CIELAB and ΔE95 carry the white's extra noise; give --white, or more \
-         --max-seconds or a larger --target-de",
+         {:.3}, above its target of {:.3} (a third of the ΔE*ab target): the readings' XYZ are \
+         as read, but their CIELAB and ΔE95 carry the white's extra noise; give a measured \
+         white, or more time or a larger ΔE*ab target",
         t.max_seconds, t.de_ci95, t.target_de
     )
 }
