@@ -39,9 +39,9 @@ use crate::image::{Drive8Image, ScreenSpot};
 use crate::rig::{MeterAim, Placement};
 use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::{
-    Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError, PlacementReadings,
-    Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session, SessionPlan, Step,
-    StepProgress, Stopping, TerminalOperator,
+    patch_so_far, Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError,
+    PlacementReadings, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session,
+    SessionPlan, Step, StepProgress, Stopping, TerminalOperator,
 };
 use crate::validation::covariance;
 use crate::validation::repeatability::{self, Repeatability};
@@ -270,21 +270,14 @@ impl Stopping<SpotStep> for VerdictStopping {
         steps: &[Step<SpotStep>],
         entries: &[Option<Entry<SpotStep>>],
     ) -> bool {
-        let Some(patch) = steps.get(index).map(|s| s.data.patch) else {
+        let Some((patch, first, this)) =
+            patch_so_far(index, steps, entries, |s| Some(s.data.patch))
+        else {
             return false;
         };
         let Some(reference) = self.references.get(&patch) else {
             return false;
         };
-        let first = steps
-            .iter()
-            .position(|s| s.data.patch == patch)
-            .unwrap_or(index);
-        let this: Vec<Xyz> = entries[first..index]
-            .iter()
-            .flatten()
-            .map(|e| e.reading.xyz)
-            .collect();
         let pool = pool_by_patch(entries[..first].iter().flatten(), &self.stated);
         verdict(
             self.margin,
