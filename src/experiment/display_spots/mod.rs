@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 mod plan;
-pub use plan::{image_plan, plan};
+pub use plan::{image_plan, plan, PatchAim, SpotStep};
 
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
@@ -47,13 +47,6 @@ use crate::validation::covariance;
 use crate::validation::repeatability::{self, Repeatability};
 use crate::validation::sequential::{verdict, Pool, Reference};
 
-/// A display-spot step's own data in the journal.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SpotStep {
-    pub patch: usize,
-    pub repeat: usize,
-}
-
 /// The journal header's caller part.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SpotHeader {
@@ -65,17 +58,6 @@ pub const JOURNAL_FILE: &str = "journal.jsonl";
 pub const SPOTS_FILE: &str = "spots.csv";
 /// What was shown and where the meter was aimed.
 pub const RECORD_FILE: &str = "display-spots.json";
-
-/// Where the operator aims the meter for one patch.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PatchAim {
-    pub patch: usize,
-    /// The spot on the screen (fractions of its width and height from the top-left).
-    pub x: f64,
-    pub y: f64,
-    pub radius: f64,
-    pub prompt: String,
-}
 
 /// What `display-spots.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,13 +1,31 @@
-//! The display-spots session's plans: on the whole image, or each patch's colour
-//! full-screen.
+//! The display-spots session's plans, on the whole image or each patch's colour
+//! full-screen, and their steps' data: the patch read and where the meter is aimed.
 
 use std::collections::BTreeMap;
 
 use metamer_drivers::MeasureMode;
+use serde::{Deserialize, Serialize};
 
-use super::{PatchAim, SpotStep};
 use crate::experiment::reproduction::PatchDrive;
 use crate::session::{Prepare, SessionPlan, Step};
+
+/// A display-spot step's own data in the journal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpotStep {
+    pub patch: usize,
+    pub repeat: usize,
+}
+
+/// Where the operator aims the meter for one patch.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PatchAim {
+    pub patch: usize,
+    /// The spot on the screen (fractions of its width and height from the top-left).
+    pub x: f64,
+    pub y: f64,
+    pub radius: f64,
+    pub prompt: String,
+}
 
 /// The plan on the whole image: every patch, `repeats` times; the meter is aimed before
 /// each patch's first reading and stays there for the rest.
