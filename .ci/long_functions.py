@@ -25,16 +25,8 @@ REASON = re.compile(r"^\s*//\s*Over 100 lines:\s*\S")
 # "FILE:FUNCTION". Each is a debt: split it by its sections, then delete its entry (the
 # script says when one has become stale).
 KNOWN = {
-    "src/display/diagnostics.rs:judge",
-    "src/display/icc/lut.rs:b2a",
-    "src/experiment/display_spots/mod.rs:measure",
     "src/experiment/report_input/display.rs:section",
     "src/experiment/report_input/light.rs:section",
-    "src/experiment/run.rs:run",
-    "src/experiment/run.rs:run_stage",
-    "src/export/mitsuba3.rs:files",
-    "src/light/chart.rs:draw",
-    "src/light/chart.rs:draw_scores",
     "src/render/radiosity/image.rs:render_image_from",
     "src/render/radiosity/mod.rs:render_spots_radiosity_solved",
     "src/render/radiosity/probes.rs:probe_illuminance",

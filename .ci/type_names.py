@@ -49,23 +49,11 @@ ROLE_NAMES = {
 # Names defined twice for different concepts in code someone else is changing, as
 # "NAME": {files}. Each is a debt: rename one of the types, then delete its entry (the
 # script says when one has become stale).
-KNOWN = {
-    # The i1Pro's product (protocol) and the drivers' registry row.
-    "Model": {"protocols/src/i1pro.rs", "drivers/src/registry/mod.rs"},
-    # The i1Pro's USB request's error and the experiment request's.
-    "RequestError": {"protocols/src/i1pro/commands.rs", "src/experiment/request.rs"},
-    # The export's approximation and the display-spots stage's readings.
-    "Measured": {"src/export/approximation.rs", "src/experiment/display_spots/mod.rs"},
-    # The render command's clap copy of the method choice.
-    "Method": {"src/render/method.rs", "src/cli/render.rs"},
-}
+KNOWN = {}
 
 # `use … as` aliases of names defined twice, in code someone else is changing, as
 # "FILE: NAME as ALIAS". Each is a debt, like KNOWN.
-KNOWN_ALIASES = {
-    "src/cli/fit.rs: Error as FitJobError",
-    "src/cli/render.rs: Request as SpotsFromImageRequest",
-}
+KNOWN_ALIASES = set()
 
 DEFINITION = re.compile(
     r"(?m)^[ \t]*pub[ \t]+(?:unsafe[ \t]+)?(struct|enum|trait|type|union)[ \t]+([A-Za-z_]\w*)"

@@ -36,12 +36,12 @@ pub enum ColorJobError {
     OneSample { file: PathBuf, line: usize, nm: f64 },
     /// No sample lies where the colour-matching functions are summed, so the result would
     /// be zero, or (a reflectance held at its end values) a flat spectrum nobody measured.
+    /// The range is `method`'s.
     #[error(
         "{}:{first_line}: column '{}': its samples ({first_nm}–{last_nm} nm) lie outside \
          {start_nm}–{end_nm} nm, the wavelengths the colour-matching functions are summed \
-         over{}",
-        file.display(), text::echo(column),
-        if *method == Integration::Linear { " with --method linear" } else { "" }
+         over",
+        file.display(), text::echo(column)
     )]
     OutsideSummation {
         file: PathBuf,

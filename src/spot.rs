@@ -190,11 +190,24 @@ pub struct SpotRequest {
 /// Why [`run`] did not finish.
 #[derive(Debug, thiserror::Error)]
 pub enum SpotRunError {
-    /// The request itself is wrong (a count of 0, an existing recording, a spectrum from a
-    /// colorimeter, an option the instrument does not have): the command line calls it a
-    /// usage error.
-    #[error("{0}")]
-    BadRequest(String),
+    /// The request itself is wrong (from here to [`SpotRunError::BadIntegration`]): the
+    /// command line calls it a usage error.
+    #[error("the count of readings must be at least 1")]
+    Count,
+    #[error("{}: exists; a recording is never overwritten, choose another file name", .0.display())]
+    RecordingExists(PathBuf),
+    /// The instrument spec names no instrument that can be opened this way.
+    #[error(transparent)]
+    Spec(DriverError),
+    /// A spectrum was asked of an instrument that measures none (a colorimeter).
+    #[error("the {model} measures no spectrum (a colorimeter)")]
+    NotSpectral { model: String },
+    #[error("the {model} returned readings without a spectrum")]
+    NoSpectrum { model: String },
+    #[error("the {instrument} has no integration time to set")]
+    NoIntegration { instrument: String },
+    #[error("integration time {value}: {message}")]
+    BadIntegration { value: String, message: String },
     /// A real instrument with nobody to place it.
     #[error(transparent)]
     Nobody(#[from] NobodyAtTheRig),
@@ -212,7 +225,16 @@ pub enum SpotRunError {
 impl SpotRunError {
     /// Whether the request, not the data or the machine, is at fault.
     pub fn is_bad_request(&self) -> bool {
-        matches!(self, SpotRunError::BadRequest(_))
+        matches!(
+            self,
+            SpotRunError::Count
+                | SpotRunError::RecordingExists(_)
+                | SpotRunError::Spec(_)
+                | SpotRunError::NotSpectral { .. }
+                | SpotRunError::NoSpectrum { .. }
+                | SpotRunError::NoIntegration { .. }
+                | SpotRunError::BadIntegration { .. }
+        )
     }
 }
 
@@ -268,15 +290,11 @@ pub fn run(
     request: &SpotRequest,
     events: &mut dyn FnMut(SpotEvent) -> std::io::Result<()>,
 ) -> Result<SpotReport, SpotRunError> {
-    let bad = |m: String| Err(SpotRunError::BadRequest(m));
     if request.count == 0 {
-        return bad("--count must be at least 1".into());
+        return Err(SpotRunError::Count);
     }
     if let Some(path) = request.record.as_ref().filter(|p| p.exists()) {
-        return bad(format!(
-            "{} exists; a recording is never overwritten, choose another file name",
-            path.display()
-        ));
+        return Err(SpotRunError::RecordingExists(path.clone()));
     }
     let spec = &request.instrument;
     let mut policy = OutputPolicy::new(request.force);
@@ -328,10 +346,7 @@ pub fn run(
     }
     if let Some(path) = request.spectrum.as_ref().filter(|_| !readings.is_empty()) {
         let Some(csv) = spectra_csv(&readings) else {
-            return bad(format!(
-                "--spectrum: the {} returned readings without a spectrum",
-                info.model
-            ));
+            return Err(SpotRunError::NoSpectrum { model: info.model });
         };
         policy.write(path, csv.as_bytes())?;
     }
@@ -353,15 +368,14 @@ fn open(
         record: request.record.clone(),
     };
     let mut instrument = spec.open_with(&options).map_err(|e| match e {
-        e if e.is_spec() => SpotRunError::BadRequest(e.to_string()),
+        e if e.is_spec() => SpotRunError::Spec(e),
         e => e.into(),
     })?;
     // Before measuring: a colorimeter's readings would be taken and then have no spectrum.
     if request.spectrum.is_some() && !instrument.capabilities().spectral {
-        return Err(SpotRunError::BadRequest(format!(
-            "--spectrum: the {} measures no spectrum (a colorimeter); leave --spectrum out",
-            instrument.info().model
-        )));
+        return Err(SpotRunError::NotSpectral {
+            model: instrument.info().model,
+        });
     }
     if let Some(speed) = request.speed {
         instrument.set_option("speed", speed.name())?;
@@ -370,12 +384,13 @@ fn open(
         instrument
             .set_option("integration_s", t)
             .map_err(|e| match e {
-                DriverError::UnknownOption { instrument, .. } => SpotRunError::BadRequest(format!(
-                    "--integration: the {instrument} has no integration time to set"
-                )),
-                DriverError::BadOption { message, .. } => {
-                    SpotRunError::BadRequest(format!("--integration {t}: {message}"))
+                DriverError::UnknownOption { instrument, .. } => {
+                    SpotRunError::NoIntegration { instrument }
                 }
+                DriverError::BadOption { message, .. } => SpotRunError::BadIntegration {
+                    value: t.clone(),
+                    message,
+                },
                 e => e.into(),
             })?;
     }

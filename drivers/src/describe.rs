@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::budget::TimeQuery;
 use crate::instrument::Capabilities;
 use crate::mode::MeasureMode;
-use crate::registry::{self, Model};
+use crate::registry::{self, ModelEntry};
 use crate::spec::{self, words, Spec};
 use crate::DriverError;
 
@@ -129,7 +129,7 @@ pub fn describe(name: &str) -> Result<ModelDescription, DriverError> {
 
 /// The capabilities its driver reports on each simulated unit its row names, opened
 /// instantly and without noise.
-fn units(model: &Model) -> Result<Vec<Unit>, DriverError> {
+fn units(model: &ModelEntry) -> Result<Vec<Unit>, DriverError> {
     if model.sim.is_none() {
         return Ok(Vec::new());
     }

@@ -270,6 +270,63 @@ pub trait Instrument: Send {
     }
 }
 
+/// An instrument that passes every call on to the one it wraps, but for the ones it
+/// overrides here: the one place wrappers (the simulation's, a session's shifted noise
+/// stream) delegate, so a method added to [`Instrument`] reaches every wrapped instrument.
+pub trait Forwarding: Send {
+    fn inner(&self) -> &dyn Instrument;
+    fn inner_mut(&mut self) -> &mut dyn Instrument;
+    /// [`Instrument::option_values`].
+    fn option_values(&self) -> Vec<(String, String)> {
+        self.inner().option_values()
+    }
+    /// [`Instrument::seek_noise`].
+    fn seek_noise(&mut self, index: u64) {
+        self.inner_mut().seek_noise(index);
+    }
+    /// [`Instrument::instrument_time_s`].
+    fn instrument_time_s(&self) -> Option<f64> {
+        self.inner().instrument_time_s()
+    }
+}
+
+impl<T: Forwarding> Instrument for T {
+    fn info(&self) -> InstrumentInfo {
+        self.inner().info()
+    }
+    fn capabilities(&self) -> Capabilities {
+        self.inner().capabilities()
+    }
+    fn calibration_needed(
+        &mut self,
+        mode: MeasureMode,
+    ) -> Result<Option<CalibrationCondition>, crate::DriverError> {
+        self.inner_mut().calibration_needed(mode)
+    }
+    fn calibrate(
+        &mut self,
+        mode: MeasureMode,
+        condition: &CalibrationCondition,
+    ) -> Result<CalibrationOutcome, crate::DriverError> {
+        self.inner_mut().calibrate(mode, condition)
+    }
+    fn measure(&mut self, request: &Request) -> Result<Reading, crate::DriverError> {
+        self.inner_mut().measure(request)
+    }
+    fn set_option(&mut self, name: &str, value: &str) -> Result<(), crate::DriverError> {
+        self.inner_mut().set_option(name, value)
+    }
+    fn option_values(&self) -> Vec<(String, String)> {
+        Forwarding::option_values(self)
+    }
+    fn seek_noise(&mut self, index: u64) {
+        Forwarding::seek_noise(self, index);
+    }
+    fn instrument_time_s(&self) -> Option<f64> {
+        Forwarding::instrument_time_s(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

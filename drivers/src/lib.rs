@@ -30,8 +30,8 @@ pub use cs100a::Speed;
 pub use error::DriverError;
 pub use i1pro::I1ProError;
 pub use instrument::{
-    CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Instrument,
-    InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,
+    CalibrationCondition, CalibrationNeed, CalibrationOutcome, Capabilities, Flag, Forwarding,
+    Instrument, InstrumentInfo, MeasureMode, ModeInfo, OptionInfo, OptionValues, Reading, Request,
 };
 pub use open::{OpenOptions, SimSettings, TIME_SCALE_ENV};
 pub use permissions::{SERIAL_PERMISSION_FIX, USB_PERMISSION_FIX};

@@ -4,13 +4,9 @@
 //! emulator's noise stream positioned per reading ([`Instrument::seek_noise`]).
 
 use crate::i1pro::{Clock, ManualClock};
-use crate::instrument::{
-    CalibrationCondition, CalibrationOutcome, Capabilities, Instrument, InstrumentInfo,
-    MeasureMode, Reading, Request,
-};
+use crate::instrument::{Forwarding, Instrument};
 use crate::noise::NoiseCursor;
 use crate::open::SimSettings;
-use crate::DriverError;
 
 /// Prefix of the simulation's settings among the option values, apart from the model's own.
 pub const SIM_OPTION_PREFIX: &str = "sim_";
@@ -59,31 +55,12 @@ pub fn settings_values(s: &SimSettings) -> Vec<(String, String)> {
         .collect()
 }
 
-impl Instrument for Simulated {
-    fn info(&self) -> InstrumentInfo {
-        self.inner.info()
+impl Forwarding for Simulated {
+    fn inner(&self) -> &dyn Instrument {
+        self.inner.as_ref()
     }
-    fn capabilities(&self) -> Capabilities {
-        self.inner.capabilities()
-    }
-    fn calibration_needed(
-        &mut self,
-        mode: MeasureMode,
-    ) -> Result<Option<CalibrationCondition>, DriverError> {
-        self.inner.calibration_needed(mode)
-    }
-    fn calibrate(
-        &mut self,
-        mode: MeasureMode,
-        condition: &CalibrationCondition,
-    ) -> Result<CalibrationOutcome, DriverError> {
-        self.inner.calibrate(mode, condition)
-    }
-    fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
-        self.inner.measure(request)
-    }
-    fn set_option(&mut self, name: &str, value: &str) -> Result<(), DriverError> {
-        self.inner.set_option(name, value)
+    fn inner_mut(&mut self) -> &mut dyn Instrument {
+        self.inner.as_mut()
     }
     fn option_values(&self) -> Vec<(String, String)> {
         let mut v = self.inner.option_values();

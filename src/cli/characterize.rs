@@ -15,7 +15,8 @@ use metamer::rig::ScreenSpec;
 use metamer::session::{on_ctrl_c, BarProgress, ProgressSink, RunOptions};
 use metamer_drivers::{Spec, Speed};
 
-use super::plan_choice::{PlanKind, RuleArgs};
+use super::characterize_advice::{advice, left_to_do};
+use super::plan_choice::{ModelChoice, PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -31,10 +32,10 @@ pub struct Args {
     /// window (the first monitor), window:N (monitor N, from 0), virtual (= virtual:ips-lcd)
     /// or virtual:PRESET (ideal-crt, ips-lcd, wide-gamut-ccfl).
     #[arg(long, value_name = "DISPLAY")]
-    display: String,
+    display: ScreenSpec,
     /// cs100a:PORT, replay:FILE.jsonl, or sim:cs100a (options: sim:cs100a?time_scale=0.01).
     #[arg(long, value_name = "SPEC")]
-    instrument: String,
+    instrument: Spec,
     /// Levels per channel ramp, 0 and 255 included.
     #[arg(long, default_value_t = DEFAULT_RAMP_STEPS, value_name = "N")]
     ramp_steps: usize,
@@ -52,7 +53,7 @@ pub struct Args {
     /// plcc (paper Eq. 9), plcc-gamma, plvc, gog, gogo, lut, matrix-lsq, shaper-matrix, or
     /// (--plan adaptive only) auto: chosen by cross-validation as `fit --model auto` does.
     #[arg(long, default_value = "plcc", value_name = "MODEL")]
-    model: String,
+    model: ModelChoice,
     /// fixed: ramps, the model's grid and 48 held-out colours. adaptive: a first pass (ramps,
     /// a 3³ grid), then batches where the candidate models disagree most at the --targets,
     /// until the predicted ΔE*ab there is below --stop-de or --max-readings are taken; the
@@ -93,19 +94,17 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> CliResult {
-    let screen = ScreenSpec::parse(&args.display).map_err(|e| CliError::Usage(e.to_string()))?;
-    let auto = args.model.trim().eq_ignore_ascii_case("auto");
-    let model: ModelKind = if auto {
-        if args.plan == PlanKind::Fixed {
+    let auto = args.model == ModelChoice::Auto;
+    let model = match args.model {
+        ModelChoice::Auto if args.plan == PlanKind::Fixed => {
             return Err(CliError::Usage(
                 "--model auto chooses the model between batches: it needs --plan adaptive \
                  (for the fixed plan, fit the readings.ti3 with `metamer fit --model auto`)"
                     .into(),
             ));
         }
-        ModelKind::Lut
-    } else {
-        args.model.parse().map_err(CliError::Usage)?
+        ModelChoice::Auto => ModelKind::Lut,
+        ModelChoice::Kind(kind) => kind,
     };
     let adaptive = match (args.rule.rule(args.plan)?, &args.targets) {
         (None, None) => None,
@@ -136,9 +135,9 @@ pub fn run(args: Args) -> CliResult {
     };
     let request = Request {
         out: args.out.clone(),
-        screen,
+        screen: args.display,
         virtual_white_cd_m2: None,
-        instrument: Spec::new(args.instrument.as_str()),
+        instrument: args.instrument,
         speed: args.speed.map(|s| match s {
             SpeedArg::Fast => Speed::Fast,
             SpeedArg::Slow => Speed::Slow,
@@ -160,7 +159,7 @@ pub fn run(args: Args) -> CliResult {
         },
     };
     let outcome = characterize::characterize(&request, &mut Printer(None)).map_err(refusal)?;
-    match (&outcome, outcome.left_to_do()) {
+    match (&outcome, left_to_do(&outcome)) {
         (Outcome::Finished(summary), _) => print_summary(summary),
         (_, Some(text)) if outcome.is_interrupted() => Err(CliError::Failed(text.into())),
         (_, text) => {
@@ -194,7 +193,7 @@ fn refusal(e: CharacterizeError) -> CliError {
         }
         CharacterizeError::NobodyAtTheRig(e) => super::rig::nobody_at_the_rig(e),
         CharacterizeError::Instrument(e) if e.is_spec() => CliError::Usage(e.to_string()),
-        e => match e.advice() {
+        e => match advice(&e) {
             Some(t) => CliError::Failed(t.into()),
             None => CliError::from(e),
         },

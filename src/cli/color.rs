@@ -97,6 +97,11 @@ pub fn run(args: Args) -> CliResult {
 fn color_error(e: ColorJobError) -> CliError {
     match e {
         ColorJobError::UnknownIlluminant(_) => CliError::Usage(e.to_string()),
+        // The range summed over is the method's: the flag that chose it is named.
+        ColorJobError::OutsideSummation {
+            method: Integration::Linear,
+            ..
+        } => CliError::Failed(format!("{e} with --method linear").into()),
         ColorJobError::NotFinite { .. }
         | ColorJobError::PairNotFinite { .. }
         | ColorJobError::OneSample { .. }

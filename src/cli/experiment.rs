@@ -10,7 +10,9 @@ use metamer::display::ModelKind;
 use metamer::experiment::display::DisplayOptions;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::SimulationOptions;
-use metamer::experiment::{BoxRequest, Progress, Request, RequestError, Stage, StageOutcome};
+use metamer::experiment::{
+    BoxRequest, ExperimentError, Progress, Request, RequestError, Stage, StageOutcome,
+};
 use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 use metamer_drivers::Spec;
@@ -211,8 +213,36 @@ pub(super) fn refusal(e: RequestError) -> CliError {
         RequestError::BoxLight(e) => {
             super::rig::box_light_refusal(e, Some(metamer::experiment::DEFAULT_SPOT))
         }
-        e if e.is_usage() => CliError::Usage(e.to_string()),
+        RequestError::Experiment(ExperimentError::ImageInStage { file, dir }) => CliError::Failed(
+            format!(
+                "--simulation-image {}: lies in the simulation stage's directory {}, which \
+                     the experiment replaces: copy it elsewhere and give that copy",
+                file.display(),
+                dir.display()
+            )
+            .into(),
+        ),
+        e if e.is_usage() => CliError::Usage(usage(&e)),
         e => CliError::from(e),
+    }
+}
+
+/// A refusal of the request's own values, naming the flag that gave the value.
+fn usage(e: &RequestError) -> String {
+    match e {
+        RequestError::TargetDe => "--target-de must be above 0".into(),
+        RequestError::Repeats { most, got } => {
+            format!("--repeats must be from 1 to {most}, got {got}")
+        }
+        RequestError::BoxRepeats => "--box-repeats must be at least 1".into(),
+        RequestError::UntilDecided(why) => format!("--until-decided with --repeats: {why}"),
+        RequestError::TimeScale => "--time-scale must be 0 or more".into(),
+        RequestError::ImageSize => format!(
+            "--image-size must be at most {}",
+            metamer::experiment::MAX_IMAGE_SIZE
+        ),
+        RequestError::ImageSpp => "--image-spp must be at least 1".into(),
+        e => e.to_string(),
     }
 }
 

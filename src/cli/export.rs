@@ -51,7 +51,15 @@ pub fn run(args: Args) -> CliResult {
         measure_difference: !args.no_difference,
     };
     let report = export::run(&request).map_err(|e| match e {
-        ExportError::BadSpp => CliError::Usage(e.to_string()),
+        ExportError::BadSpp => CliError::Usage("--spp must be at least 1".into()),
+        ExportError::NotEmpty { dir } => CliError::Failed(
+            format!(
+                "refusing to export into {}: the directory is not empty (add --force to write \
+                 into it)",
+                dir.display()
+            )
+            .into(),
+        ),
         e => e.into(),
     })?;
     for f in &report.files {

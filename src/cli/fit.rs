@@ -3,10 +3,11 @@
 
 use std::path::PathBuf;
 
+use super::plan_choice::ModelChoice;
 use super::{CliError, CliResult};
 use metamer::display::icc::IccVersion;
-use metamer::display::job::fit::{self, Error as FitJobError, Event, Request};
-use metamer::display::{FitOptions, ModelKind};
+use metamer::display::job::fit::{self, Event, Request};
+use metamer::display::FitOptions;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -44,25 +45,6 @@ pub struct Args {
     /// The ICC version of --icc: 4 (default) or 2.4.
     #[arg(long, value_name = "4|2.4")]
     icc_version: Option<IccVersion>,
-}
-
-/// A model by name, or `auto`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum ModelChoice {
-    Auto,
-    Kind(ModelKind),
-}
-
-impl std::str::FromStr for ModelChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        if s.trim().eq_ignore_ascii_case("auto") {
-            return Ok(ModelChoice::Auto);
-        }
-        s.parse::<ModelKind>()
-            .map(ModelChoice::Kind)
-            .map_err(|e| format!("{e}, or auto"))
-    }
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -151,26 +133,24 @@ fn print_event(event: Event<'_>) -> Result<(), super::console::ConsoleError> {
 }
 
 /// The library's refusals of options in this command's flags.
-fn refusal(e: FitJobError, args: &Args) -> CliError {
+fn refusal(e: fit::Error, args: &Args) -> CliError {
     let usage = |text: String| CliError::Usage(text);
     match e {
-        FitJobError::OutputIsDirectory(path) => usage(format!(
+        fit::Error::OutputIsDirectory(path) => usage(format!(
             "-o {}: is a directory; give the profile file to write",
             path.display()
         )),
-        FitJobError::GammaWithoutPlccGamma => {
+        fit::Error::GammaWithoutPlccGamma => {
             usage("--gamma applies to --model plcc-gamma only".into())
         }
-        FitJobError::BadGamma(g) => usage(format!("--gamma must be a positive number, got {g}")),
-        FitJobError::IccVersionWithoutIcc => usage("--icc-version needs --icc OUT.icc".into()),
-        FitJobError::ChartWithoutSelection => {
+        fit::Error::BadGamma(g) => usage(format!("--gamma must be a positive number, got {g}")),
+        fit::Error::IccVersionWithoutIcc => usage("--icc-version needs --icc OUT.icc".into()),
+        fit::Error::ChartWithoutSelection => {
             usage("--chart draws the model selection: it needs --model auto".into())
         }
-        FitJobError::BadNoise(n) => {
-            usage(format!("--noise must be a non-negative number, got {n}"))
-        }
-        FitJobError::Folds(_) => usage(format!("--folds must be at least 2, got {}", args.folds)),
-        FitJobError::Chart { .. } => CliError::Failed(e.to_string().into()),
+        fit::Error::BadNoise(n) => usage(format!("--noise must be a non-negative number, got {n}")),
+        fit::Error::Folds(_) => usage(format!("--folds must be at least 2, got {}", args.folds)),
+        fit::Error::Chart { .. } => CliError::Failed(e.to_string().into()),
         e => CliError::from(e),
     }
 }

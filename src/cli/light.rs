@@ -87,6 +87,14 @@ fn output_error(e: OutputError) -> CliError {
 fn light_error(e: LightError) -> CliError {
     match e {
         LightError::BadRequest(message) => CliError::Usage(message),
+        LightError::PanelSize => CliError::Usage(
+            "--ies and --ldt need the panel's size: give both --width-m and --height-m".into(),
+        ),
+        LightError::NoLuminance => CliError::Usage(
+            "the readings are relative (1 at the normal): give the panel's luminance with \
+             --luminance CD_M2"
+                .into(),
+        ),
         LightError::Output(e) => output_error(e),
         LightError::Fit { .. } => CliError::Failed(e.to_string().into()),
         e => CliError::from(e),

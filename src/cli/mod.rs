@@ -26,6 +26,7 @@ macro_rules! errln {
 
 mod budget;
 mod characterize;
+mod characterize_advice;
 mod color;
 mod devices;
 mod experiment;

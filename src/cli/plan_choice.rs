@@ -5,6 +5,7 @@ use clap::ValueEnum;
 use metamer::display::characterize::adaptive::{
     Rule, DEFAULT_BATCH, DEFAULT_MAX_READINGS, DEFAULT_STOP_DE,
 };
+use metamer::display::ModelKind;
 
 use super::CliError;
 
@@ -55,5 +56,24 @@ impl RuleArgs {
             batch: self.batch,
             ..Rule::default()
         }))
+    }
+}
+
+/// A model by name, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum ModelChoice {
+    Auto,
+    Kind(ModelKind),
+}
+
+impl std::str::FromStr for ModelChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim().eq_ignore_ascii_case("auto") {
+            return Ok(ModelChoice::Auto);
+        }
+        s.parse::<ModelKind>()
+            .map(ModelChoice::Kind)
+            .map_err(|e| format!("{e}, or auto"))
     }
 }

@@ -10,10 +10,10 @@ use metamer::render::job::convergence::ConvergenceRequest;
 use metamer::render::job::image::ImageRequest;
 use metamer::render::job::probes::{ProbesReport, ProbesRequest};
 use metamer::render::job::spots::{Readings, SpotsRequest};
-use metamer::render::job::spots_from_image::Request as SpotsFromImageRequest;
+use metamer::render::job::spots_from_image::SpotsFromImageRequest;
 use metamer::render::job::{self, RenderError, RenderEvent};
 use metamer::render::method::{self, Solver};
-use metamer::render::probes::ProbeOptions;
+use metamer::render::probes::{ProbeError, ProbeOptions};
 use metamer::render::radiosity::probes::ProbeProgress;
 use metamer::render::spot::Uncertainty;
 use metamer::render::Scene;
@@ -24,20 +24,20 @@ pub struct Args {
     command: Cmd,
 }
 
-/// How the spot readings are computed.
+/// The `--method` value: how the spot readings are computed, as the command spells it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Method {
+pub enum MethodArg {
     Radiosity,
     Path,
     Auto,
 }
 
-impl From<Method> for method::Method {
-    fn from(m: Method) -> Self {
+impl From<MethodArg> for method::Method {
+    fn from(m: MethodArg) -> Self {
         match m {
-            Method::Radiosity => method::Method::Radiosity,
-            Method::Path => method::Method::PathTracer,
-            Method::Auto => method::Method::Auto,
+            MethodArg::Radiosity => method::Method::Radiosity,
+            MethodArg::Path => method::Method::PathTracer,
+            MethodArg::Auto => method::Method::Auto,
         }
     }
 }
@@ -78,8 +78,8 @@ struct SpotsArgs {
     seed: u64,
     /// radiosity: the deterministic solver (convex scenes of Lambertian rectangles);
     /// path: the path tracer; auto: radiosity when the scene qualifies.
-    #[arg(long, value_enum, default_value_t = Method::Auto)]
-    method: Method,
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    method: MethodArg,
     #[arg(long)]
     json: bool,
 }
@@ -119,8 +119,8 @@ struct ImageArgs {
     spp: u64,
     /// path: the path tracer; radiosity: the deterministic solver's reflected radiance
     /// at every ray's first hit (convex scenes of Lambertian rectangles).
-    #[arg(long, value_enum, default_value_t = Method::Path)]
-    method: Method,
+    #[arg(long, value_enum, default_value_t = MethodArg::Path)]
+    method: MethodArg,
     /// Radiosity: the finest mesh level (the indirect light is extrapolated from it and
     /// the level before, as the spot readings are).
     #[arg(long, default_value_t = 3)]
@@ -147,8 +147,8 @@ struct ProbesArgs {
     scene: PathBuf,
     #[arg(long)]
     points: PathBuf,
-    #[arg(long, value_enum, default_value_t = Method::Auto)]
-    method: Method,
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    method: MethodArg,
     /// Radiosity: refine until every bound is below this fraction of the total.
     #[arg(long, default_value_t = 0.001)]
     rel_tolerance: f64,
@@ -217,11 +217,42 @@ fn convergence(a: ConvergenceArgs) -> CliResult {
 
 /// A usage error for a bad request (exit 2), else a failure (exit 1).
 fn cli_error(e: RenderError) -> CliError {
-    if e.is_bad_request() {
-        CliError::Usage(e.to_string())
-    } else {
-        CliError::Failed(Box::new(e))
-    }
+    let usage = match e {
+        RenderError::TargetDe => "--target-de must be > 0".into(),
+        RenderError::MaxSeconds => "--max-seconds must be > 0".into(),
+        RenderError::White => "--white must be finite with Y > 0".into(),
+        RenderError::Seconds(why) => format!("--seconds: {why}"),
+        RenderError::Spp => "--spp must be ≥ 1".into(),
+        RenderError::Size => "--width and --height must be ≥ 1".into(),
+        RenderError::PreviewIsImage { preview, image } => format!(
+            "--preview {} is the same file as --output {}",
+            preview.display(),
+            image.display()
+        ),
+        e if e.is_bad_request() => e.to_string(),
+        RenderError::Probes {
+            file,
+            error:
+                ProbeError::TimeLimit {
+                    seconds,
+                    samples,
+                    done,
+                    of,
+                },
+        } => {
+            return CliError::Failed(
+                format!(
+                    "{}: no result within the time limit of {seconds} s: the path tracer \
+                     finished its first {samples} paths for {done} of {of} probes (give more \
+                     time with --max-seconds, or fewer points)",
+                    file.display()
+                )
+                .into(),
+            )
+        }
+        e => return CliError::Failed(Box::new(e)),
+    };
+    CliError::Usage(usage)
 }
 
 /// The events every command shows the same way.

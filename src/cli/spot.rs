@@ -109,7 +109,20 @@ pub fn run(args: Args) -> CliResult {
         }
     })
     .map_err(|e| match e {
-        SpotRunError::BadRequest(message) => CliError::Usage(message),
+        SpotRunError::Count => CliError::Usage("--count must be at least 1".into()),
+        SpotRunError::NotSpectral { model } => CliError::Usage(format!(
+            "--spectrum: the {model} measures no spectrum (a colorimeter); leave --spectrum out"
+        )),
+        SpotRunError::NoSpectrum { model } => CliError::Usage(format!(
+            "--spectrum: the {model} returned readings without a spectrum"
+        )),
+        SpotRunError::NoIntegration { instrument } => CliError::Usage(format!(
+            "--integration: the {instrument} has no integration time to set"
+        )),
+        SpotRunError::BadIntegration { value, message } => {
+            CliError::Usage(format!("--integration {value}: {message}"))
+        }
+        e if e.is_bad_request() => CliError::Usage(e.to_string()),
         SpotRunError::Nobody(e) => super::rig::nobody_at_the_rig(e),
         SpotRunError::Output(e) => CliError::from(e),
         e => CliError::from(e),

@@ -17,7 +17,7 @@ pub struct MixtureGain {
 
 /// When the study was measured, and how ([`MEASURED_MIXTURE_GAINS`]).
 pub const MIXTURE_GAINS_MEASURED: &str =
-    "metamer budget (--trials 3 --seed 1), measured 2026-12-02";
+    "metamer budget's mixture study, 3 trials with seed 1, measured 2026-12-02";
 
 /// [`super::budget::run_mixture_study`] on the two LCD presets with 3 trials and seed 1 (`print_mixture_study` in tests/display/ramp_fit.rs prints
 /// them); what `fit` tells a user whose set has no
@@ -42,8 +42,8 @@ pub fn mixture_advice() -> String {
     format!(
         "On the simulated LCDs, adding a 4³ grid ({} patches) to a 50-patch ramp plan cut the \
          mean ΔE00 of reproduced colours from {:.2} to {:.2} ({}) and from {:.2} to {:.2} ({}), \
-         a 5³ grid ({} patches) to {:.2} and {:.2} ({}): measure a grid besides the ramps \
-         (characterize --grid-steps 5) and fit the lut.",
+         a 5³ grid ({} patches) to {:.2} and {:.2} ({}): measure a grid of 5 steps per axis \
+         besides the ramps and fit the lut.",
         a.with_grid[0].1,
         a.ramps_only_de00,
         a.with_grid[0].2,

@@ -81,8 +81,8 @@ pub enum ExperimentError {
     /// Another renderer's image does not fit the scene's camera.
     #[error(transparent)]
     ReadBack(#[from] crate::render::spot::cone::ReadBackError),
-    /// `--simulation-image` lies where the simulation stage writes its own copy.
-    #[error("--simulation-image {}: lies in the simulation stage's directory {}, which the experiment replaces: copy it elsewhere and give that copy", file.display(), dir.display())]
+    /// Another renderer's image lies where the simulation stage writes its own copy.
+    #[error("the simulation's image {}: lies in the simulation stage's directory {}, which the experiment replaces: copy it elsewhere and give that copy", file.display(), dir.display())]
     ImageInStage { file: PathBuf, dir: PathBuf },
     #[error("the display's white is {white_cd_m2:.1} cd/m², but the rendering needs at least {needed_cd_m2:.1} cd/m² to be shown without tone mapping: raise the monitor's brightness (backlight) until full white reads at least that, then move {} aside and run the display stage again", dir.display())]
     DisplayTooDim {

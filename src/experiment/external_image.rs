@@ -19,7 +19,7 @@ use super::simulation::{
 };
 use crate::image::write_xyz_image;
 use crate::output::OutputPolicy;
-use crate::render::job::spots_from_image::{self, Request};
+use crate::render::job::spots_from_image::{self, SpotsFromImageRequest};
 
 /// What the summary and report call the source.
 pub const RENDERER: &str = "external renderer";
@@ -37,11 +37,11 @@ pub fn read_back(
         "reading the 24 meter cones from {} (an external renderer's image)",
         image.display()
     )));
-    let request = Request {
+    let request = SpotsFromImageRequest {
         target_de: opts.target_de,
         max_seconds: opts.max_seconds,
         seed: opts.seed,
-        ..Request::new(image.to_path_buf(), Some(scene_file.to_path_buf()))
+        ..SpotsFromImageRequest::new(image.to_path_buf(), Some(scene_file.to_path_buf()))
     };
     let report = spots_from_image::run(&request, &|_| {}).map_err(from_render)?;
     // The read-back's warnings (a reference white cut short) are the operator's to see: the

@@ -342,24 +342,25 @@ impl Request {
 }
 
 /// Why an experiment was refused before its first stage, or stopped in one. The refusals
-/// of the request's own values name the command's flags (see [`RequestError::is_usage`]).
+/// of the request's own values say which value is wrong (see [`RequestError::is_usage`]);
+/// a command names its flag.
 #[derive(Debug, thiserror::Error)]
 pub enum RequestError {
-    #[error("--target-de must be above 0")]
+    #[error("the simulation's ΔE*ab target must be above 0")]
     TargetDe,
-    #[error("--repeats must be from 1 to {most}, got {got}")]
+    #[error("the readings per display patch must be from 1 to {most}, got {got}")]
     Repeats { most: usize, got: usize },
-    #[error("--box-repeats must be at least 1")]
+    #[error("the readings per box spot must be at least 1")]
     BoxRepeats,
-    /// The verdict rule on the display's patches cannot work: the margin, or `--repeats`
-    /// as its most readings.
-    #[error("--until-decided with --repeats: {0}")]
+    /// The verdict rule on the display's patches cannot work: the margin, or the readings
+    /// per patch as its most readings.
+    #[error("reading each display patch until decided: {0}")]
     UntilDecided(String),
-    #[error("--time-scale must be 0 or more")]
+    #[error("the instruments' time scale must be 0 or more")]
     TimeScale,
-    #[error("--image-size must be at most {}", MAX_IMAGE_SIZE)]
+    #[error("the simulation image's size must be at most {}", MAX_IMAGE_SIZE)]
     ImageSize,
-    #[error("--image-spp must be at least 1")]
+    #[error("the simulation image's samples per pixel must be at least 1")]
     ImageSpp,
     #[error("-o {}: exists and is not a directory", .0.display())]
     OutNotDir(PathBuf),

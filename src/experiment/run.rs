@@ -129,85 +129,117 @@ pub fn run(
         let sd = StageDir::new(root, stage.name());
         let start = Instant::now();
         let inputs = inputs_of(stage, opts)?;
-        let forced = opts.stage == Some(stage);
-        let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
-        let record = if forced || (stage == Stage::Box && given_box) {
-            None
-        } else {
-            sd.reusable(&inputs, super::products::products(stage))
-        };
-        if !forced && ((stage == Stage::Box && given_box) || record.is_some()) {
-            if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
-                progress(Progress::Note(format!(
-                    "box: given, measured earlier or elsewhere ({} and {})",
-                    scene.display(),
-                    spots.display()
-                )));
-            } else {
-                progress(Progress::Stage {
-                    stage,
-                    reused: true,
-                });
-            }
-            outcomes.push(StageOutcome {
-                stage,
-                reused: true,
-                seconds: start.elapsed().as_secs_f64(),
-                ran_seconds: record.map_or(0.0, |r| r.seconds),
-                dir: sd.dir.clone(),
-            });
+        if let Some(outcome) = reuse(stage, opts, &sd, &inputs, start, progress) {
+            outcomes.push(outcome);
             continue;
         }
-        if interrupted(opts) {
-            return Err(ExperimentError::InterruptedBefore {
-                stage: stage.name(),
-            });
-        }
-        progress(Progress::Stage {
-            stage,
-            reused: false,
-        });
-        if stage.measures() {
-            if let Some(aside) = set_aside_stale(&sd)? {
-                progress(Progress::Note(format!(
-                    "the {stage} stage's inputs changed: its earlier measurements are kept in {}",
-                    aside.display()
-                )));
-            }
-        } else {
-            sd.invalidate()?;
-        }
-        let files = run_stage(stage, opts, &sd, progress);
-        // A stage that takes no readings is cut short by Ctrl-C (the render stops at its
-        // next check, with a result or with "no result in time"): what it wrote is not
-        // this stage's result, so it is not recorded. A measuring stage says itself where
-        // its journal stopped.
-        if interrupted(opts) && !stage.measures() {
-            return Err(ExperimentError::Interrupted {
-                stage: stage.name(),
-            });
-        }
-        let files = files?;
-        if stage.measures() {
-            let kept = super::budget::recorded(root, &planned);
-            if let Some(c) = kept.iter().find(|c| c.stage == stage.name()) {
-                if let Some(actual) = &c.cost.actual {
-                    let what = format!("the {stage} stage");
-                    progress(Progress::Note(actual.after(&what, &c.cost.estimate)));
-                }
-            }
-        }
-        let seconds = start.elapsed().as_secs_f64();
-        sd.finish(&inputs, &files, seconds)?;
-        outcomes.push(StageOutcome {
-            stage,
-            reused: false,
-            seconds,
-            ran_seconds: seconds,
-            dir: sd.dir.clone(),
-        });
+        outcomes.push(run_afresh(
+            stage, opts, &sd, &inputs, &planned, start, progress,
+        )?);
     }
     Ok(outcomes)
+}
+
+/// The stage's outcome when it is not run: its record matches its inputs (or its box is
+/// given as files) and it was not asked for by name.
+fn reuse(
+    stage: Stage,
+    opts: &ExperimentOptions,
+    sd: &StageDir,
+    inputs: &Inputs,
+    start: Instant,
+    progress: &dyn Fn(Progress),
+) -> Option<StageOutcome> {
+    let forced = opts.stage == Some(stage);
+    let given_box = matches!(opts.box_source, BoxSource::Existing { .. });
+    let record = if forced || (stage == Stage::Box && given_box) {
+        None
+    } else {
+        sd.reusable(inputs, super::products::products(stage))
+    };
+    if forced || !((stage == Stage::Box && given_box) || record.is_some()) {
+        return None;
+    }
+    if let (Stage::Box, BoxSource::Existing { scene, spots }) = (stage, &opts.box_source) {
+        progress(Progress::Note(format!(
+            "box: given, measured earlier or elsewhere ({} and {})",
+            scene.display(),
+            spots.display()
+        )));
+    } else {
+        progress(Progress::Stage {
+            stage,
+            reused: true,
+        });
+    }
+    Some(StageOutcome {
+        stage,
+        reused: true,
+        seconds: start.elapsed().as_secs_f64(),
+        ran_seconds: record.map_or(0.0, |r| r.seconds),
+        dir: sd.dir.clone(),
+    })
+}
+
+/// Runs the stage from the start (a measuring stage resumes its journal), its earlier
+/// outputs set aside or invalidated first, and records it.
+fn run_afresh(
+    stage: Stage,
+    opts: &ExperimentOptions,
+    sd: &StageDir,
+    inputs: &Inputs,
+    planned: &[StageBudget],
+    start: Instant,
+    progress: &dyn Fn(Progress),
+) -> Result<StageOutcome, ExperimentError> {
+    if interrupted(opts) {
+        return Err(ExperimentError::InterruptedBefore {
+            stage: stage.name(),
+        });
+    }
+    progress(Progress::Stage {
+        stage,
+        reused: false,
+    });
+    if stage.measures() {
+        if let Some(aside) = set_aside_stale(sd)? {
+            progress(Progress::Note(format!(
+                "the {stage} stage's inputs changed: its earlier measurements are kept in {}",
+                aside.display()
+            )));
+        }
+    } else {
+        sd.invalidate()?;
+    }
+    let files = run_stage(stage, opts, sd, progress);
+    // A stage that takes no readings is cut short by Ctrl-C (the render stops at its
+    // next check, with a result or with "no result in time"): what it wrote is not
+    // this stage's result, so it is not recorded. A measuring stage says itself where
+    // its journal stopped.
+    if interrupted(opts) && !stage.measures() {
+        return Err(ExperimentError::Interrupted {
+            stage: stage.name(),
+        });
+    }
+    let files = files?;
+    if stage.measures() {
+        let kept = super::budget::recorded(&opts.dir, planned);
+        if let Some(c) = kept.iter().find(|c| c.stage == stage.name()) {
+            if let Some(actual) = &c.cost.actual {
+                let what = format!("the {stage} stage");
+                progress(Progress::Note(actual.after(&what, &c.cost.estimate)));
+            }
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    sd.finish(inputs, &files, seconds)?;
+    Ok(StageOutcome {
+        stage,
+        reused: false,
+        seconds,
+        ran_seconds: seconds,
+        dir: sd.dir.clone(),
+    })
 }
 
 /// The measuring stages' budget before the first stage, each as if it ran in full, and
@@ -391,62 +423,71 @@ fn run_stage(
             )?;
             Ok(owned(files))
         }
-        Stage::DisplaySpots => {
-            let r: Reproduction =
-                read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
-            let setting: DisplaySetting =
-                read_json(&stage_path(opts, Stage::Display, display::SETTING_FILE))?;
-            let png = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
-            let rule = match opts.until_decided {
-                Some(margin) => {
-                    let (_, box_spots) = box_files(opts);
-                    let profile =
-                        Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
-                    let box_readings = super::readings::read_readings(&box_spots)?;
-                    display_spots::DisplayRule::verdict(
-                        margin,
-                        opts.repeats,
-                        &box_readings,
-                        profile.white_xyz,
-                    )
-                }
-                None => display_spots::DisplayRule::Fixed(opts.repeats),
-            };
-            let session = display_spots::SpotSession {
-                setting: &setting,
-                spot_spec: &opts.display.spot,
-                drives: &r.patches,
-                image: (png.exists() && !r.image_patches.is_empty()).then(|| {
-                    display_spots::ShownImage {
-                        file: &png,
-                        regions: &r.image_patches,
-                    }
-                }),
-                rule: &rule,
-                resume: opts.resume,
-                unattended: opts.unattended,
-                run: &opts.run,
-            };
-            let (_, files) = display_spots::measure(&sd.dir, &session, progress)?;
-            Ok(owned(files))
-        }
-        Stage::Validation => {
+        Stage::DisplaySpots => Ok(owned(display_spots_stage(opts, sd, progress)?)),
+        Stage::Validation => validation_stage(opts, sd),
+    }
+}
+
+/// The display-spots stage: the reproduction shown and read, each patch by the rule
+/// the options give.
+fn display_spots_stage(
+    opts: &ExperimentOptions,
+    sd: &StageDir,
+    progress: &dyn Fn(Progress),
+) -> Result<Vec<&'static str>, ExperimentError> {
+    let r: Reproduction = read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
+    let setting: DisplaySetting =
+        read_json(&stage_path(opts, Stage::Display, display::SETTING_FILE))?;
+    let png = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
+    let rule = match opts.until_decided {
+        Some(margin) => {
             let (_, box_spots) = box_files(opts);
             let profile = Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
-            let r: Reproduction =
-                read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
-            let sim_spots = stage_path(opts, Stage::Simulation, simulation::SPOTS_FILE);
-            let display_spots = stage_path(opts, Stage::DisplaySpots, display_spots::SPOTS_FILE);
-            let files = ReadingFiles {
-                box_readings: &box_spots,
-                display: &display_spots,
-                simulation: Some(&sim_spots),
-            };
-            let (_, written) =
-                validate::validate(&sd.dir, profile.white_xyz, &files, &r.out_of_gamut_patches)?;
-            Ok(written)
+            let box_readings = super::readings::read_readings(&box_spots)?;
+            display_spots::DisplayRule::verdict(
+                margin,
+                opts.repeats,
+                &box_readings,
+                profile.white_xyz,
+            )
         }
-    }
+        None => display_spots::DisplayRule::Fixed(opts.repeats),
+    };
+    let session = display_spots::SpotSession {
+        setting: &setting,
+        spot_spec: &opts.display.spot,
+        drives: &r.patches,
+        image: (png.exists() && !r.image_patches.is_empty()).then(|| display_spots::ShownImage {
+            file: &png,
+            regions: &r.image_patches,
+        }),
+        rule: &rule,
+        resume: opts.resume,
+        unattended: opts.unattended,
+        run: &opts.run,
+    };
+    let (_, files) = display_spots::measure(&sd.dir, &session, progress)?;
+    Ok(files)
+}
+
+/// The validation stage: the box, the simulation and the display compared.
+fn validation_stage(
+    opts: &ExperimentOptions,
+    sd: &StageDir,
+) -> Result<Vec<String>, ExperimentError> {
+    let (_, box_spots) = box_files(opts);
+    let profile = Profile::load(&stage_path(opts, Stage::Display, display::PROFILE_FILE))?;
+    let r: Reproduction = read_json(&stage_path(opts, Stage::Reproduction, reproduction::FILE))?;
+    let sim_spots = stage_path(opts, Stage::Simulation, simulation::SPOTS_FILE);
+    let display_spots = stage_path(opts, Stage::DisplaySpots, display_spots::SPOTS_FILE);
+    let files = ReadingFiles {
+        box_readings: &box_spots,
+        display: &display_spots,
+        simulation: Some(&sim_spots),
+    };
+    let (_, written) =
+        validate::validate(&sd.dir, profile.white_xyz, &files, &r.out_of_gamut_patches)?;
+    Ok(written)
 }
 
 #[cfg(test)]

@@ -22,12 +22,13 @@ pub enum ExportError {
         emitter: usize,
         what: String,
     },
+    /// The caller may ask to write into it anyway.
     #[error(
-        "refusing to export into {}: the directory is not empty (add --force to write into it)",
+        "refusing to export into {}: the directory is not empty",
         dir.display()
     )]
     NotEmpty { dir: PathBuf },
-    #[error("--spp must be at least 1")]
+    #[error("the samples per pixel must be at least 1")]
     BadSpp,
     #[error("{0}")]
     Output(#[from] OutputError),

@@ -130,6 +130,20 @@ pub(super) fn files(
     </integrator>
 "#,
     );
+    sensor(&mut x, scene, camera, &mut spectra);
+    shapes(&mut x, scene, approximation, &mut spectra);
+    let _ = writeln!(x, "</scene>");
+    let mut out = vec![File {
+        rel: PathBuf::from(SCENE_FILE),
+        text: x,
+    }];
+    out.extend(spectra.files);
+    out
+}
+
+/// The camera: a perspective sensor whose film records X, Y and Z in cd/m² (the CIE 1931
+/// functions times K_m as its response functions).
+fn sensor(x: &mut String, scene: &Scene, camera: &Camera, spectra: &mut Spectra) {
     let target = (camera.position + camera.forward).to_array();
     let _ = writeln!(x, r#"    <sensor type="perspective">"#);
     let _ = writeln!(
@@ -174,6 +188,10 @@ pub(super) fn files(
     }
     let _ = writeln!(x, r#"        </film>"#);
     let _ = writeln!(x, r#"    </sensor>"#);
+}
+
+/// The box's surfaces and the emitters' tiles, each a rectangle with its spectra.
+fn shapes(x: &mut String, scene: &Scene, approximation: &Approximation, spectra: &mut Spectra) {
     for (i, s) in scene.surfaces.iter().enumerate() {
         let id = format!("surface_{i:03}_{}", slug(&s.name));
         let _ = writeln!(x, r#"    <shape type="rectangle" id="{id}">"#);
@@ -223,13 +241,6 @@ pub(super) fn files(
         let _ = writeln!(x, r#"        </bsdf>"#);
         let _ = writeln!(x, r#"    </shape>"#);
     }
-    let _ = writeln!(x, "</scene>");
-    let mut out = vec![File {
-        rel: PathBuf::from(SCENE_FILE),
-        text: x,
-    }];
-    out.extend(spectra.files);
-    out
 }
 
 #[cfg(test)]

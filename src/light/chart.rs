@@ -66,15 +66,6 @@ fn draw(fit: &LdcFit, svg: &mut String) -> Result<(), LdcError> {
         .iter()
         .filter(|c| c.halves.len() == 4)
         .collect();
-    let curve = |cand: &Candidate, neg: HalfPlane, pos: HalfPlane| -> Vec<(f64, f64)> {
-        (-89..=89)
-            .map(|a| {
-                let a = f64::from(a);
-                let half = if a < 0.0 { neg } else { pos };
-                (a, cand.halves[half.index()].params.eval(a.abs()).max(0.0))
-            })
-            .collect()
-    };
     // Room above the highest reading and curve (a Lambertian f = 1 must not sit on the
     // frame), but not for a curve that runs away between the readings.
     let measured_top = fit
@@ -99,74 +90,98 @@ fn draw(fit: &LdcFit, svg: &mut String) -> Result<(), LdcError> {
         .iter()
         .zip([Plane::Horizontal, Plane::Vertical])
     {
-        let (neg, pos) = match plane {
-            Plane::Horizontal => (HalfPlane::C180, HalfPlane::C0),
-            Plane::Vertical => (HalfPlane::C270, HalfPlane::C90),
-        };
-        let mut chart = ChartBuilder::on(area)
-            .caption(
-                format!("{plane} plane (C{} ← 0° → C{})", neg.c_deg(), pos.c_deg()),
-                ("sans-serif", 18),
-            )
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(52)
-            .build_cartesian_2d(-90.0f64..90.0, 0.0f64..y_top)
-            .map_err(|e| chart_err(&e))?;
-        chart
-            .configure_mesh()
-            .light_line_style(RGBColor(238, 238, 238))
-            .bold_line_style(RGBColor(215, 215, 215))
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 15))
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .x_desc("angle off the normal (°)")
-            .y_desc("relative luminance (reading / normal luminance)")
-            .draw()
-            .map_err(|e| chart_err(&e))?;
-        let chosen = fitted.iter().find(|c| c.model == fit.model);
-        if let Some(c) = chosen {
-            let (colour, _, _) = style_of(c.model);
-            let points = curve(c, neg, pos);
-            chart
-                .draw_series(LineSeries::new(
-                    points.clone(),
-                    colour.mix(0.3).stroke_width(7),
-                ))
-                .map_err(|e| chart_err(&e))?;
-            chart
-                .draw_series(LineSeries::new(points, colour.stroke_width(2)))
-                .map_err(|e| chart_err(&e))?;
-        }
-        for c in fitted.iter().filter(|c| c.model != fit.model) {
-            let (colour, dash, gap) = style_of(c.model);
-            chart
-                .draw_series(DashedLineSeries::new(
-                    curve(c, neg, pos),
-                    dash,
-                    gap,
-                    colour.stroke_width(2),
-                ))
-                .map_err(|e| chart_err(&e))?;
-        }
-        let points: Vec<(f64, f64)> = fit
-            .residuals
-            .iter()
-            .filter(|r| r.plane == plane)
-            .map(|r| (r.angle_deg, r.measured))
-            .collect();
-        chart
-            .draw_series(points.iter().map(|&p| {
-                EmptyElement::at(p)
-                    + Circle::new((0, 0), 5, WHITE.filled())
-                    + Circle::new((0, 0), 4, BLACK.filled())
-            }))
-            .map_err(|e| chart_err(&e))?;
+        draw_plane(fit, &fitted, plane, y_top, area)?;
     }
     let (legend, bars) = bottom.split_horizontally(420);
     draw_legend(fit, &legend)?;
     draw_scores(fit, &bars)?;
     root.present().map_err(|e| chart_err(&e))?;
+    Ok(())
+}
+
+/// A fitted model's curve across a plane, `neg` the half at negative angles.
+fn curve(cand: &Candidate, neg: HalfPlane, pos: HalfPlane) -> Vec<(f64, f64)> {
+    (-89..=89)
+        .map(|a| {
+            let a = f64::from(a);
+            let half = if a < 0.0 { neg } else { pos };
+            (a, cand.halves[half.index()].params.eval(a.abs()).max(0.0))
+        })
+        .collect()
+}
+
+/// One plane's readings with every fitted model's curve, the chosen one a band under the
+/// rest.
+fn draw_plane(
+    fit: &LdcFit,
+    fitted: &[&Candidate],
+    plane: Plane,
+    y_top: f64,
+    area: &Area,
+) -> Result<(), LdcError> {
+    let (neg, pos) = match plane {
+        Plane::Horizontal => (HalfPlane::C180, HalfPlane::C0),
+        Plane::Vertical => (HalfPlane::C270, HalfPlane::C90),
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!("{plane} plane (C{} ← 0° → C{})", neg.c_deg(), pos.c_deg()),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(36)
+        .y_label_area_size(52)
+        .build_cartesian_2d(-90.0f64..90.0, 0.0f64..y_top)
+        .map_err(|e| chart_err(&e))?;
+    chart
+        .configure_mesh()
+        .light_line_style(RGBColor(238, 238, 238))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 15))
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .x_desc("angle off the normal (°)")
+        .y_desc("relative luminance (reading / normal luminance)")
+        .draw()
+        .map_err(|e| chart_err(&e))?;
+    let chosen = fitted.iter().find(|c| c.model == fit.model);
+    if let Some(c) = chosen {
+        let (colour, _, _) = style_of(c.model);
+        let points = curve(c, neg, pos);
+        chart
+            .draw_series(LineSeries::new(
+                points.clone(),
+                colour.mix(0.3).stroke_width(7),
+            ))
+            .map_err(|e| chart_err(&e))?;
+        chart
+            .draw_series(LineSeries::new(points, colour.stroke_width(2)))
+            .map_err(|e| chart_err(&e))?;
+    }
+    for c in fitted.iter().filter(|c| c.model != fit.model) {
+        let (colour, dash, gap) = style_of(c.model);
+        chart
+            .draw_series(DashedLineSeries::new(
+                curve(c, neg, pos),
+                dash,
+                gap,
+                colour.stroke_width(2),
+            ))
+            .map_err(|e| chart_err(&e))?;
+    }
+    let points: Vec<(f64, f64)> = fit
+        .residuals
+        .iter()
+        .filter(|r| r.plane == plane)
+        .map(|r| (r.angle_deg, r.measured))
+        .collect();
+    chart
+        .draw_series(points.iter().map(|&p| {
+            EmptyElement::at(p)
+                + Circle::new((0, 0), 5, WHITE.filled())
+                + Circle::new((0, 0), 4, BLACK.filled())
+        }))
+        .map_err(|e| chart_err(&e))?;
     Ok(())
 }
 
@@ -254,21 +269,7 @@ fn draw_legend(fit: &LdcFit, area: &Area) -> Result<(), LdcError> {
 /// model with the fewest parameters under the line is the one `auto` chooses.
 fn draw_scores(fit: &LdcFit, area: &Area) -> Result<(), LdcError> {
     let n = fit.candidates.len();
-    let scores: Vec<Option<f64>> = fit.candidates.iter().map(|c| c.cv_rms).collect();
-    let positive = scores.iter().flatten().filter(|v| **v > 0.0);
-    let lo_data = positive.clone().fold(f64::INFINITY, |m, v| m.min(*v));
-    let hi = positive.fold(0.0f64, |m, v| m.max(*v)).max(1e-3) * 3.0;
-    let best = scores
-        .iter()
-        .flatten()
-        .fold(f64::INFINITY, |m, v| m.min(*v));
-    let limit = best.is_finite().then(|| tie_limit(best));
-    // A perfect score (0) has no place on a log scale: it is drawn at the floor.
-    let lo = lo_data
-        .min(limit.unwrap_or(f64::INFINITY))
-        .min(hi / 10.0)
-        .max(1e-7)
-        / 3.0;
+    let (lo, hi, limit) = score_range(fit);
     let mut chart = ChartBuilder::on(area)
         .caption(
             "held-out error: leave-one-out RMS (relative luminance, log scale)",
@@ -354,6 +355,26 @@ fn draw_scores(fit: &LdcFit, area: &Area) -> Result<(), LdcError> {
             .map_err(|e| chart_err(&e))?;
     }
     Ok(())
+}
+
+/// The scores' axis, bottom and top, and the tie limit (None without a score).
+fn score_range(fit: &LdcFit) -> (f64, f64, Option<f64>) {
+    let scores: Vec<Option<f64>> = fit.candidates.iter().map(|c| c.cv_rms).collect();
+    let positive = scores.iter().flatten().filter(|v| **v > 0.0);
+    let lo_data = positive.clone().fold(f64::INFINITY, |m, v| m.min(*v));
+    let hi = positive.fold(0.0f64, |m, v| m.max(*v)).max(1e-3) * 3.0;
+    let best = scores
+        .iter()
+        .flatten()
+        .fold(f64::INFINITY, |m, v| m.min(*v));
+    let limit = best.is_finite().then(|| tie_limit(best));
+    // A perfect score (0) has no place on a log scale: it is drawn at the floor.
+    let lo = lo_data
+        .min(limit.unwrap_or(f64::INFINITY))
+        .min(hi / 10.0)
+        .max(1e-7)
+        / 3.0;
+    (lo, hi, limit)
 }
 
 /// `v` to `digits` significant digits, in exponent form below 0.001.

@@ -24,6 +24,12 @@ pub enum LightError {
     /// differently; the command line calls it a usage error.
     #[error("{0}")]
     BadRequest(String),
+    /// Light files asked for, or one side of the panel given, without both its sides.
+    #[error("the light files need the panel's size: both its width and its height")]
+    PanelSize,
+    /// The light files need an absolute luminance the relative readings do not carry.
+    #[error("the readings are relative (1 at the normal): the panel's luminance is needed")]
+    NoLuminance,
     /// The fall-off file could not be read.
     #[error(transparent)]
     Read(LdcError),
@@ -44,7 +50,10 @@ pub enum LightError {
 impl LightError {
     /// Whether the request, not the data or the machine, is at fault.
     pub fn is_bad_request(&self) -> bool {
-        matches!(self, LightError::BadRequest(_))
+        matches!(
+            self,
+            LightError::BadRequest(_) | LightError::PanelSize | LightError::NoLuminance
+        )
     }
 }
 
@@ -174,9 +183,7 @@ fn check_outputs(request: &FitRequest) -> Result<OutputPolicy, LightError> {
     if exports && (request.width_m.is_none() || request.height_m.is_none())
         || request.width_m.is_some() != request.height_m.is_some()
     {
-        return Err(LightError::BadRequest(
-            "--ies and --ldt need the panel's size: give both --width-m and --height-m".into(),
-        ));
+        return Err(LightError::PanelSize);
     }
     let mut policy = OutputPolicy::new(request.force);
     policy.input(&request.falloff);
@@ -216,11 +223,7 @@ fn panel(request: &FitRequest, falloff: &Falloff) -> Result<Option<Panel>, Light
             })?;
             let l0 = (normal[0] + normal[1]) / 2.0;
             if l0 == 1.0 {
-                return Err(LightError::BadRequest(
-                    "the readings are relative (1 at the normal): give the panel's \
-                     luminance with --luminance CD_M2"
-                        .into(),
-                ));
+                return Err(LightError::NoLuminance);
             }
             l0
         }

@@ -7,7 +7,7 @@
 use super::plan::{BoxStep, Target};
 use super::stats::GroupStats;
 use crate::color::Xyz;
-use crate::session::{Entry, Step, Stopping};
+use crate::session::{patch_so_far, Entry, Step, Stopping};
 use crate::validation::readings::PatchReading;
 use crate::validation::repeatability::Repeatability;
 use crate::validation::sequential::{width_decided, Pool, RepeatNoise, RepeatRule};
@@ -70,18 +70,9 @@ impl Stopping<BoxStep> for SpotStopping {
         else {
             return false;
         };
-        let Some(patch) = steps.get(index).and_then(spot) else {
+        let Some((_, first, this)) = patch_so_far(index, steps, entries, spot) else {
             return false;
         };
-        let first = steps
-            .iter()
-            .position(|s| spot(s) == Some(patch))
-            .unwrap_or(index);
-        let this: Vec<Xyz> = entries[first..index]
-            .iter()
-            .flatten()
-            .map(|e| e.reading.xyz)
-            .collect();
         // The spots before this one, each its readings in plan order.
         let mut pool = Pool::default();
         let mut group: (Option<usize>, Vec<Xyz>) = (None, Vec::new());

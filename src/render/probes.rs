@@ -57,8 +57,7 @@ pub enum ProbeError {
     Radiosity(#[from] RadiosityError),
     #[error(
         "no result within the time limit of {seconds} s: the path tracer finished its first \
-         {samples} paths for {done} of {of} probes (give more time with --max-seconds, or \
-         fewer points)"
+         {samples} paths for {done} of {of} probes (give more time, or fewer points)"
     )]
     TimeLimit {
         seconds: f64,

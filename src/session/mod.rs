@@ -36,6 +36,8 @@ pub use progress::{
     pace_note, BarProgress, Heartbeat, NoProgress, ProgressSink, StageOf, StepProgress,
 };
 pub use record::{Entry, InstrumentRecord, SessionHeader, SessionJournal};
-pub use runner::{RunEnd, RunOptions, Session, SessionError, SettingDiffers, Stopping};
+pub use runner::{
+    patch_so_far, RunEnd, RunOptions, Session, SessionError, SettingDiffers, Stopping,
+};
 pub use screen::{MeterAim, Placement, Screen, ScreenError};
 pub use step::{Rig, StepFailure, AIM_AT_SCREEN_AGAIN};

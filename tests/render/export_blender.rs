@@ -76,7 +76,8 @@ fn round_trip(name: &str) -> Option<()> {
     };
     let expected = render_spots_radiosity(&form, &options, &|_| {}).unwrap();
 
-    let mut request = spots_from_image::Request::new(image.clone(), Some(name.into()));
+    let mut request =
+        spots_from_image::SpotsFromImageRequest::new(image.clone(), Some(name.into()));
     request.white = Some(spectral.white);
     let back = spots_from_image::run(&request, &|_| {}).unwrap();
     let json: serde_json::Value = serde_json::from_str(&back.to_json().unwrap()).unwrap();

@@ -1,6 +1,6 @@
 //! What can go wrong with an i1Pro, with what the user can do about it.
 
-use metamer_protocols::i1pro::commands::RequestError;
+use metamer_protocols::i1pro::commands::ControlRequestError;
 use metamer_protocols::i1pro::replies::ReplyError;
 use metamer_protocols::i1pro::timing::TimingError;
 use metamer_protocols::i1pro::{CalibrationError, EepromError, PipelineError, ReadingError};
@@ -18,7 +18,7 @@ pub enum I1ProError {
     },
     /// The driver built a request the instrument's revision does not have (a driver bug).
     #[error("i1Pro request: {0}")]
-    Request(#[from] RequestError),
+    Request(#[from] ControlRequestError),
     /// The EEPROM could not be read as a directory of items.
     #[error("the i1Pro's EEPROM is not readable ({0}); unplug and replug it, and if it stays, the unit needs service")]
     Eeprom(#[from] EepromError),

@@ -75,9 +75,9 @@ pub struct OtherName {
     pub sim_options: &'static str,
 }
 
-/// One instrument model.
+/// One instrument model: the registry's entry for it.
 #[derive(Clone, Copy)]
-pub struct Model {
+pub struct ModelEntry {
     /// Short stable name used in readings, transcripts and `sim:NAME` (`cs100a`).
     pub name: &'static str,
     /// What people call it (`Konica Minolta CS-100A`).
@@ -111,7 +111,7 @@ pub struct Model {
     pub unsupported: Option<&'static str>,
 }
 
-impl Model {
+impl ModelEntry {
     /// Its stated repeatability in `mode`, where its row states one.
     pub fn stated_repeatability(&self, mode: MeasureMode) -> Option<Repeatability> {
         self.repeatability
@@ -237,8 +237,8 @@ const I1PRO_REFLECTIVE: Repeatability = Repeatability {
 };
 
 /// Every known model. USB IDs from ArgyllCMS `usb/55-Argyll.rules` (facts only).
-pub const MODELS: &[Model] = &[
-    Model {
+pub const MODELS: &[ModelEntry] = &[
+    ModelEntry {
         name: crate::cs100a::MODEL,
         title: "Konica Minolta CS-100A",
         usb: &[],
@@ -258,7 +258,7 @@ pub const MODELS: &[Model] = &[
         other_names: &[],
         unsupported: None,
     },
-    Model {
+    ModelEntry {
         name: crate::i1pro::MODEL,
         title: "X-Rite i1Pro / i1Pro 2",
         usb: &[UsbId {
@@ -299,7 +299,7 @@ pub const MODELS: &[Model] = &[
         }],
         unsupported: None,
     },
-    Model {
+    ModelEntry {
         name: "i1pro3",
         title: "X-Rite i1Pro 3",
         usb: &[UsbId {
@@ -323,7 +323,7 @@ pub const MODELS: &[Model] = &[
              i1Pro's and the i1Pro 2's (protocols/i1pro/README.md)",
         ),
     },
-    Model {
+    ModelEntry {
         name: "colormunki",
         title: "X-Rite ColorMunki",
         usb: &[UsbId {
@@ -343,7 +343,7 @@ pub const MODELS: &[Model] = &[
         other_names: &[],
         unsupported: Some("metamer has no codec for its protocol"),
     },
-    Model {
+    ModelEntry {
         name: "i1d3",
         title: "X-Rite i1Display Pro",
         usb: &[UsbId {
@@ -369,24 +369,24 @@ pub const MODELS: &[Model] = &[
 pub use crate::spec::words::{REPLAY_PREFIX, SIM_PREFIX};
 
 /// The model with this stable name.
-pub fn by_name(name: &str) -> Option<&'static Model> {
+pub fn by_name(name: &str) -> Option<&'static ModelEntry> {
     MODELS.iter().find(|m| m.name == name)
 }
 
 /// The model a real-hardware spec prefix opens.
-pub fn by_prefix(prefix: &str) -> Option<&'static Model> {
+pub fn by_prefix(prefix: &str) -> Option<&'static ModelEntry> {
     MODELS.iter().find(|m| m.spec_prefixes.contains(&prefix))
 }
 
 /// The model with this USB ID on this bus.
-pub fn by_usb(vid: u16, pid: u16, bus: Bus) -> Option<&'static Model> {
+pub fn by_usb(vid: u16, pid: u16, bus: Bus) -> Option<&'static ModelEntry> {
     MODELS
         .iter()
         .find(|m| m.usb.contains(&UsbId { vid, pid, bus }))
 }
 
 /// Every USB ID of every model, with its model.
-pub fn usb_ids() -> impl Iterator<Item = (&'static Model, UsbId)> {
+pub fn usb_ids() -> impl Iterator<Item = (&'static ModelEntry, UsbId)> {
     MODELS
         .iter()
         .flat_map(|m| m.usb.iter().map(move |id| (m, *id)))
@@ -413,7 +413,7 @@ pub fn replayable() -> Vec<&'static str> {
 /// The real-hardware spec forms (`cs100a:PORT`, `i1pro[:SERIAL]` where the address may be
 /// left out), each with the model's first prefix.
 pub fn real_specs() -> Vec<String> {
-    MODELS.iter().filter_map(Model::real_spec).collect()
+    MODELS.iter().filter_map(ModelEntry::real_spec).collect()
 }
 
 /// Every spec form, for "expected …" messages: `cs100a:PORT, replay:FILE.jsonl or

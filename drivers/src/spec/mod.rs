@@ -31,7 +31,7 @@ use std::sync::Arc;
 use crate::instrument::Instrument;
 use crate::link::replay::Transcript;
 use crate::open::OpenOptions;
-use crate::registry::{self, Model};
+use crate::registry::{self, ModelEntry};
 use crate::world::World;
 use crate::DriverError;
 use sim_options::sim_settings;
@@ -200,11 +200,11 @@ impl Spec {
     /// The registry model this spec names by its stable name (`sim:MODEL`) or a prefix
     /// (`PREFIX[:ADDRESS]`), whether or not it could be opened; None for a transcript, whose
     /// model only its header says.
-    pub fn model(&self) -> Option<&'static Model> {
+    pub fn model(&self) -> Option<&'static ModelEntry> {
         self.model_in(registry::MODELS)
     }
 
-    fn model_in<'m>(&self, models: &'m [Model]) -> Option<&'m Model> {
+    fn model_in<'m>(&self, models: &'m [ModelEntry]) -> Option<&'m ModelEntry> {
         match &self.kind {
             SpecForm::Simulated { model, .. } => models.iter().find(|m| m.name == model),
             SpecForm::Device { prefix, .. } => models
@@ -217,7 +217,7 @@ impl Spec {
     /// Why the spec opens nothing: a word for a model that is named otherwise (`i1pro2`),
     /// a model metamer does not drive (`i1pro3`), or else an unknown form, with every
     /// form the registry offers.
-    fn unknown_in(&self, models: &[Model]) -> DriverError {
+    fn unknown_in(&self, models: &[ModelEntry]) -> DriverError {
         let word = match &self.kind {
             SpecForm::Simulated { model, .. } => model.as_str(),
             SpecForm::Device { prefix, .. } => prefix.as_str(),
@@ -248,7 +248,7 @@ impl Spec {
         }
     }
 
-    fn is_physical_in(&self, models: &[Model]) -> bool {
+    fn is_physical_in(&self, models: &[ModelEntry]) -> bool {
         match &self.kind {
             SpecForm::Device { prefix, .. } => models
                 .iter()
@@ -257,7 +257,7 @@ impl Spec {
         }
     }
 
-    fn check_in(&self, models: &[Model]) -> Result<(), DriverError> {
+    fn check_in(&self, models: &[ModelEntry]) -> Result<(), DriverError> {
         match &self.kind {
             SpecForm::Replay { file } if !file.is_empty() => Ok(()),
             SpecForm::Simulated { model, options } => {
@@ -272,7 +272,10 @@ impl Spec {
     }
 
     /// The registry row and address of a physical instrument, or the unknown-spec error.
-    fn real_in<'m>(&self, models: &'m [Model]) -> Result<(&'m registry::Real, &str), DriverError> {
+    fn real_in<'m>(
+        &self,
+        models: &'m [ModelEntry],
+    ) -> Result<(&'m registry::Real, &str), DriverError> {
         // A bare prefix (`i1pro`) names a model whose address may be left out; `replay:`
         // with no file, or a prefix no row has, names nothing.
         let SpecForm::Device { prefix, address } = &self.kind else {
@@ -291,7 +294,7 @@ impl Spec {
     /// Opens the spec from the rows of `models` (the registry's, or a test's own).
     fn open_in(
         &self,
-        models: &[Model],
+        models: &[ModelEntry],
         options: &OpenOptions,
     ) -> Result<Box<dyn Instrument>, DriverError> {
         let by_name = |name: &str| models.iter().find(|m| m.name == name);
@@ -399,7 +402,7 @@ pub fn check_spec(spec: &str) -> Result<(), DriverError> {
 /// name (`cs100a`, `CS-100A`: case and hyphens aside), another word for it (`i1pro2`), or
 /// a spec naming it (`sim:i1pro?seed=2`, `cs100a:/dev/ttyUSB0`). None for anything else,
 /// a transcript among them (only its header says its model).
-pub fn model_named(name: &str) -> Option<&'static Model> {
+pub fn model_named(name: &str) -> Option<&'static ModelEntry> {
     let word: String = name
         .trim()
         .chars()

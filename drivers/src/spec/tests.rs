@@ -4,7 +4,7 @@
 use super::*;
 use crate::instrument::{MeasureMode, Request};
 use crate::open::OpenOptions;
-use crate::registry::{self, Model};
+use crate::registry::{self, ModelEntry};
 use crate::world::SharedWorld;
 
 #[test]
@@ -203,7 +203,7 @@ fn fake_open(address: &str, _: &OpenOptions) -> Result<Box<dyn Instrument>, Driv
 }
 
 /// A USB-like model whose address (a serial number) may be left out.
-const FAKE: &[Model] = &[Model {
+const FAKE: &[ModelEntry] = &[ModelEntry {
     name: "fake",
     title: "Fake",
     usb: &[],

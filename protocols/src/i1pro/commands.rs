@@ -251,10 +251,10 @@ impl Request {
     }
 
     /// The control transfer for `revision`.
-    pub fn encode(&self, revision: Revision) -> Result<Transfer, RequestError> {
+    pub fn encode(&self, revision: Revision) -> Result<Transfer, ControlRequestError> {
         if let Some(only) = self.only() {
             if only != revision {
-                return Err(RequestError::WrongRevision {
+                return Err(ControlRequestError::WrongRevision {
                     request: self.name(),
                     revision,
                 });
@@ -306,9 +306,9 @@ impl Request {
 
     /// The request a transfer carries, as a simulated instrument of `revision` sees it; the
     /// inverse of [`Request::encode`].
-    pub fn decode(transfer: &Transfer, revision: Revision) -> Result<Request, RequestError> {
+    pub fn decode(transfer: &Transfer, revision: Revision) -> Result<Request, ControlRequestError> {
         let setup = transfer.setup();
-        let unknown = || RequestError::Unknown {
+        let unknown = || ControlRequestError::Unknown {
             request_type: setup.request_type,
             request: setup.request,
         };
@@ -370,7 +370,7 @@ impl Request {
         };
         if let Some(only) = request.only() {
             if only != revision {
-                return Err(RequestError::WrongRevision {
+                return Err(ControlRequestError::WrongRevision {
                     request: request.name(),
                     revision,
                 });
@@ -380,16 +380,16 @@ impl Request {
     }
 }
 
-fn bad_data(request: &'static str, data: &[u8]) -> RequestError {
-    RequestError::BadData {
+fn bad_data(request: &'static str, data: &[u8]) -> ControlRequestError {
+    ControlRequestError::BadData {
         request,
         data: data.to_vec(),
     }
 }
 
-/// A request that cannot be encoded or decoded.
+/// A USB control request of the i1Pro that cannot be encoded or decoded.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum RequestError {
+pub enum ControlRequestError {
     #[error("the {request} request does not exist on a Rev {revision:?} i1Pro")]
     WrongRevision {
         request: &'static str,

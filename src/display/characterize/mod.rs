@@ -4,7 +4,6 @@
 //! job as one call, for the command and the experiment's display stage.
 
 pub mod adaptive;
-mod advice;
 pub mod finish;
 mod hands;
 pub mod meter;

@@ -67,6 +67,14 @@ pub enum Outcome {
     },
 }
 
+impl Outcome {
+    /// Whether the session was interrupted (Ctrl-C, a signal): a failure to the caller,
+    /// though every reading taken is safe.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, Outcome::Incomplete { end, .. } if end.is_interrupted())
+    }
+}
+
 /// A characterization failed.
 #[derive(Debug, thiserror::Error)]
 pub enum CharacterizeError {

@@ -307,33 +307,7 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<Tables, IccError> {
     let axes: [Axis; 3] = std::array::from_fn(|c| Axis::new(lut, c));
     let at = |rgb: [f64; 3]| pcs.to_pcs(lut.forward(rgb));
     let black = at([0.0; 3]);
-    // Columns: each primary at full drive minus black, in PCS.
-    let mut p = [[0.0; 3]; 3];
-    for c in 0..3 {
-        let mut e = [0.0; 3];
-        e[c] = 1.0;
-        let v = at(e);
-        for r in 0..3 {
-            p[r][c] = v[r] - black[r];
-        }
-    }
-    let mut q = pcs::inverse(&p).ok_or(IccError::Singular)?;
-    // The gamut's surface in the matrix's coordinates. The lut16 matrix has no offset and
-    // its outputs below 0 are clipped, so a channel whose coordinate goes negative
-    // somewhere in the gamut (crosstalk, or a black outside the primaries' cone) gets a
-    // share of Y added (Y ≥ 0 everywhere): the grid is then sheared, not cut.
-    let surface = cube_surface();
-    let points: Vec<Xyz> = surface.iter().map(|&d| at(d)).collect();
-    for c in 0..3 {
-        let low = points
-            .iter()
-            .filter(|x| x[1] > 1e-9)
-            .map(|x| pcs::mul(&q, *x)[c] / x[1])
-            .fold(0.0f64, f64::min);
-        if low < 0.0 {
-            q[c][1] += -1.05 * low + 1e-4;
-        }
-    }
+    let (q, points) = coordinates(lut, pcs)?;
     // Per channel: coordinate t = q·x, black at k, the channel's primary at k + gain; the
     // linear estimate l = (t − k) / gain is 0 at black and 1 at the primary.
     let k = pcs::mul(&q, black);
@@ -348,31 +322,8 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<Tables, IccError> {
             (lo.min(l), hi.max(l))
         })
     });
-    // Node positions: on the model's levels like A2B0's (denser), plus one beyond each end
-    // the gamut reaches past.
-    let inner = a2b_nodes(&axes, B2A_TARGET_POINTS - 2);
-    let nodes: [Vec<f64>; 3] = std::array::from_fn(|c| {
-        let (lo, hi) = reach[c];
-        let mut v = Vec::with_capacity(inner[c].len() + 2);
-        if lo < -1e-6 {
-            v.push(lo - 0.02);
-        }
-        v.extend(&inner[c]);
-        if hi > 1.0 + 1e-6 {
-            v.push(hi + 0.02);
-        }
-        v
-    });
-    // Axes may now differ in length; lut16 needs one count: pad the shorter ones at their
-    // top end with nodes past the last (harmless: outside the gamut).
-    let n = nodes.iter().map(Vec::len).max().expect("three axes");
-    let nodes: [Vec<f64>; 3] = nodes.map(|mut v| {
-        while v.len() < n {
-            let last = *v.last().expect("never empty");
-            v.push(last + 0.02);
-        }
-        v
-    });
+    let nodes = b2a_nodes(&axes, reach);
+    let n = nodes[0].len();
     // Table input τ = t / top, so the top node's coordinate is 1.
     let top: [f64; 3] = std::array::from_fn(|c| k[c] + gain[c] * nodes[c][n - 1]);
     // The lut16 matrix acts on PCS values normalised to 0–1 (0x8000 is XYZ 1.0) and gives
@@ -417,6 +368,71 @@ pub(super) fn b2a(lut: &Lut3d, pcs: &Pcs) -> Result<Tables, IccError> {
         points: n,
         clut,
         output,
+    })
+}
+
+/// The matrix from PCS XYZ to the channels' coordinates (each primary's column minus
+/// black, inverted), sheared so no coordinate goes negative in the gamut, and the gamut's
+/// surface in PCS.
+fn coordinates(lut: &Lut3d, pcs: &Pcs) -> Result<(Mat3, Vec<Xyz>), IccError> {
+    let at = |rgb: [f64; 3]| pcs.to_pcs(lut.forward(rgb));
+    let black = at([0.0; 3]);
+    // Columns: each primary at full drive minus black, in PCS.
+    let mut p = [[0.0; 3]; 3];
+    for c in 0..3 {
+        let mut e = [0.0; 3];
+        e[c] = 1.0;
+        let v = at(e);
+        for r in 0..3 {
+            p[r][c] = v[r] - black[r];
+        }
+    }
+    let mut q = pcs::inverse(&p).ok_or(IccError::Singular)?;
+    // The gamut's surface in the matrix's coordinates. The lut16 matrix has no offset and
+    // its outputs below 0 are clipped, so a channel whose coordinate goes negative
+    // somewhere in the gamut (crosstalk, or a black outside the primaries' cone) gets a
+    // share of Y added (Y ≥ 0 everywhere): the grid is then sheared, not cut.
+    let surface = cube_surface();
+    let points: Vec<Xyz> = surface.iter().map(|&d| at(d)).collect();
+    for c in 0..3 {
+        let low = points
+            .iter()
+            .filter(|x| x[1] > 1e-9)
+            .map(|x| pcs::mul(&q, *x)[c] / x[1])
+            .fold(0.0f64, f64::min);
+        if low < 0.0 {
+            q[c][1] += -1.05 * low + 1e-4;
+        }
+    }
+    Ok((q, points))
+}
+
+/// Each axis's node positions (linear estimates): on the model's levels like A2B0's
+/// (denser), plus one beyond each end the gamut reaches past, all axes as long as the
+/// longest.
+fn b2a_nodes(axes: &[Axis; 3], reach: [(f64, f64); 3]) -> [Vec<f64>; 3] {
+    let inner = a2b_nodes(axes, B2A_TARGET_POINTS - 2);
+    let nodes: [Vec<f64>; 3] = std::array::from_fn(|c| {
+        let (lo, hi) = reach[c];
+        let mut v = Vec::with_capacity(inner[c].len() + 2);
+        if lo < -1e-6 {
+            v.push(lo - 0.02);
+        }
+        v.extend(&inner[c]);
+        if hi > 1.0 + 1e-6 {
+            v.push(hi + 0.02);
+        }
+        v
+    });
+    // Axes may now differ in length; lut16 needs one count: pad the shorter ones at their
+    // top end with nodes past the last (harmless: outside the gamut).
+    let n = nodes.iter().map(Vec::len).max().expect("three axes");
+    nodes.map(|mut v| {
+        while v.len() < n {
+            let last = *v.last().expect("never empty");
+            v.push(last + 0.02);
+        }
+        v
     })
 }
 

@@ -26,6 +26,9 @@ use metamer_drivers::{MeasureMode, Spec};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+mod plan;
+pub use plan::{image_plan, plan, PatchAim, SpotStep};
+
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
 use super::progress::Progress;
@@ -36,20 +39,13 @@ use crate::image::{Drive8Image, ScreenSpot};
 use crate::rig::{MeterAim, Placement};
 use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::{
-    Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError, PlacementReadings,
-    Prepare, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session, SessionPlan,
-    Step, StepProgress, Stopping, TerminalOperator,
+    patch_so_far, Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError,
+    PlacementReadings, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session,
+    SessionPlan, Step, StepProgress, Stopping, TerminalOperator,
 };
 use crate::validation::covariance;
 use crate::validation::repeatability::{self, Repeatability};
 use crate::validation::sequential::{verdict, Pool, Reference};
-
-/// A display-spot step's own data in the journal.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SpotStep {
-    pub patch: usize,
-    pub repeat: usize,
-}
 
 /// The journal header's caller part.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,17 +58,6 @@ pub const JOURNAL_FILE: &str = "journal.jsonl";
 pub const SPOTS_FILE: &str = "spots.csv";
 /// What was shown and where the meter was aimed.
 pub const RECORD_FILE: &str = "display-spots.json";
-
-/// Where the operator aims the meter for one patch.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PatchAim {
-    pub patch: usize,
-    /// The spot on the screen (fractions of its width and height from the top-left).
-    pub x: f64,
-    pub y: f64,
-    pub radius: f64,
-    pub prompt: String,
-}
 
 /// What `display-spots.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -175,47 +160,29 @@ impl DisplayRule {
     }
 }
 
-/// The plan on the whole image: every patch, `repeats` times; the meter is aimed before
-/// each patch's first reading and stays there for the rest.
-pub fn image_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
-    let mut steps = Vec::new();
-    for a in aims {
-        for repeat in 1..=repeats {
-            steps.push(Step {
-                label: format!("patch {} reading {repeat}", a.patch),
-                role: "spot".into(),
-                mode: MeasureMode::Emissive,
-                prepare: if repeat == 1 {
-                    Prepare::Operator {
-                        prompt: a.prompt.clone(),
-                    }
-                } else {
-                    Prepare::None
-                },
-                settle: std::time::Duration::ZERO,
-                data: SpotStep {
-                    patch: a.patch,
-                    repeat,
-                },
-            });
-        }
-    }
-    let mut options = BTreeMap::new();
-    options.insert("repeats".to_string(), repeats.to_string());
-    options.insert("shown".to_string(), "image".to_string());
-    SessionPlan {
-        kind: "display-spots".into(),
-        options,
-        steps,
-    }
-}
-
 /// Passes every request on to the operator; on a simulated screen it also aims the
 /// simulated meter where an aiming request says.
 struct Aiming<'a> {
     aims: BTreeMap<String, ScreenSpot>,
     meter: Option<MeterAim>,
     inner: &'a mut dyn Operator,
+}
+
+impl<'a> Aiming<'a> {
+    fn new(aims: &[PatchAim], meter: Option<MeterAim>, inner: &'a mut dyn Operator) -> Self {
+        let aims = aims
+            .iter()
+            .map(|a| {
+                let spot = ScreenSpot {
+                    x: a.x,
+                    y: a.y,
+                    radius: a.radius,
+                };
+                (a.prompt.clone(), spot)
+            })
+            .collect();
+        Aiming { aims, meter, inner }
+    }
 }
 
 impl Operator for Aiming<'_> {
@@ -255,6 +222,29 @@ struct VerdictStopping {
     stated: Repeatability,
 }
 
+impl VerdictStopping {
+    /// The stopping of a verdict rule, for readings by a meter of `model`; None for a fixed
+    /// count.
+    fn of(rule: &DisplayRule, model: &str) -> Option<VerdictStopping> {
+        let DisplayRule::Verdict {
+            margin,
+            most,
+            references,
+            white,
+        } = rule
+        else {
+            return None;
+        };
+        Some(VerdictStopping {
+            margin: *margin,
+            most: *most,
+            references: references.clone(),
+            white: *white,
+            stated: repeatability::stated(model, MeasureMode::Emissive),
+        })
+    }
+}
+
 impl Stopping<SpotStep> for VerdictStopping {
     fn skip(
         &self,
@@ -262,21 +252,14 @@ impl Stopping<SpotStep> for VerdictStopping {
         steps: &[Step<SpotStep>],
         entries: &[Option<Entry<SpotStep>>],
     ) -> bool {
-        let Some(patch) = steps.get(index).map(|s| s.data.patch) else {
+        let Some((patch, first, this)) =
+            patch_so_far(index, steps, entries, |s| Some(s.data.patch))
+        else {
             return false;
         };
         let Some(reference) = self.references.get(&patch) else {
             return false;
         };
-        let first = steps
-            .iter()
-            .position(|s| s.data.patch == patch)
-            .unwrap_or(index);
-        let this: Vec<Xyz> = entries[first..index]
-            .iter()
-            .flatten()
-            .map(|e| e.reading.xyz)
-            .collect();
         let pool = pool_by_patch(entries[..first].iter().flatten(), &self.stated);
         verdict(
             self.margin,
@@ -349,33 +332,6 @@ fn reduce(
     PatchReading::group(&readings)
 }
 
-/// The plan: every patch, `repeats` times, in patch order.
-pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
-    let mut steps = Vec::new();
-    for d in drives {
-        for repeat in 1..=repeats {
-            steps.push(Step {
-                label: format!("patch {} reading {repeat}", d.patch),
-                role: "spot".into(),
-                mode: MeasureMode::Emissive,
-                prepare: Prepare::Show { rgb: d.rgb8 },
-                settle: std::time::Duration::ZERO,
-                data: SpotStep {
-                    patch: d.patch,
-                    repeat,
-                },
-            });
-        }
-    }
-    let mut options = BTreeMap::new();
-    options.insert("repeats".to_string(), repeats.to_string());
-    SessionPlan {
-        kind: "display-spots".into(),
-        options,
-        steps,
-    }
-}
-
 /// The light a display spot is budgeted at: its patch's drive values as the screen shows
 /// them (a simulated monitor), else on an sRGB display; and what that assumes.
 pub fn patch_light<'a>(
@@ -424,14 +380,14 @@ pub struct SpotSession<'a> {
 }
 
 /// Each patch's readings by patch number, and the files written.
-pub type Measured = (Vec<(usize, PatchReading)>, Vec<&'static str>);
+pub type MeasuredPatches = (Vec<(usize, PatchReading)>, Vec<&'static str>);
 
 /// Shows and reads every patch into `dir`.
 pub fn measure(
     dir: &Path,
     s: &SpotSession<'_>,
     progress: &dyn Fn(Progress),
-) -> Result<Measured, ExperimentError> {
+) -> Result<MeasuredPatches, ExperimentError> {
     let SpotSession {
         setting,
         spot_spec,
@@ -441,7 +397,6 @@ pub fn measure(
         run,
         ..
     } = *s;
-    let repeats = rule.most();
     let mut screen = open_screen(&setting.screen, setting.virtual_white_cd_m2)?;
     let mut meter = open_meter(spot_spec, &setting.screen, screen.as_ref())?;
     // A real monitor takes a moment to settle after a change; a simulated one does not.
@@ -450,69 +405,19 @@ pub fn measure(
     } else {
         screen.default_settle()
     };
-    let (mut plan, mut record) = match &s.image {
-        Some(shown) => {
-            let image =
-                Drive8Image::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
-                    file: shown.file.to_path_buf(),
-                    message: e.to_string(),
-                })?;
-            let placement = screen.show_image(&image)?;
-            let aims = aims_on(&placement, shown.regions);
-            let mut plan = image_plan(&aims, repeats);
-            plan.options.extend(rule.options());
-            let record = SpotRecord {
-                shown: "image".into(),
-                note: None,
-                aims,
-                cost: None,
-            };
-            (plan, record)
-        }
-        None => {
-            let note = "no image was rendered: each patch's drive values were shown over the \
-                        whole screen instead of the reproduced image";
-            progress(Progress::Note(note.into()));
-            let record = SpotRecord {
-                shown: "patch colours".into(),
-                note: Some(note.into()),
-                aims: Vec::new(),
-                cost: None,
-            };
-            let mut plan = plan(drives, repeats);
-            plan.options.extend(rule.options());
-            (plan, record)
-        }
-    };
+    let (mut plan, mut record) = show(s, screen.as_mut(), progress)?;
     plan.steps.iter_mut().for_each(|s| s.settle = settle);
     let mut instruments = BTreeMap::new();
     instruments.insert("spot".to_string(), InstrumentRecord::of(meter.as_ref()));
     let model = meter.info().model;
     let journal: PathBuf = dir.join(JOURNAL_FILE);
-    let mut session = Session::open(
-        &journal,
-        plan,
-        SpotHeader {
-            screen: setting.screen.canonical(),
-            virtual_white_cd_m2: setting.virtual_white_cd_m2,
-        },
-        instruments,
-        resume,
-    )?;
-    if let DisplayRule::Verdict {
-        margin,
-        most,
-        references,
-        white,
-    } = rule
-    {
-        session = session.with_stopping(Box::new(VerdictStopping {
-            margin: *margin,
-            most: *most,
-            references: references.clone(),
-            white: *white,
-            stated: repeatability::stated(&model, MeasureMode::Emissive),
-        }));
+    let header = SpotHeader {
+        screen: setting.screen.canonical(),
+        virtual_white_cd_m2: setting.virtual_white_cd_m2,
+    };
+    let mut session = Session::open(&journal, plan, header, instruments, resume)?;
+    if let Some(stopping) = VerdictStopping::of(rule, &model) {
+        session = session.with_stopping(Box::new(stopping));
     }
     let mut scripted = ScriptedOperator::confirming();
     let mut terminal = TerminalOperator;
@@ -521,37 +426,15 @@ pub fn measure(
     } else {
         &mut terminal
     };
-    let mut operator = Aiming {
-        aims: record
-            .aims
-            .iter()
-            .map(|a| {
-                let spot = ScreenSpot {
-                    x: a.x,
-                    y: a.y,
-                    radius: a.radius,
-                };
-                (a.prompt.clone(), spot)
-            })
-            .collect(),
-        meter: screen.meter_aim(),
-        inner,
+    let mut operator = Aiming::new(&record.aims, screen.meter_aim(), inner);
+    let incomplete = |session: &Session<SpotHeader, SpotStep>| ExperimentError::Incomplete {
+        stage: "display-spots",
+        done: session.done(),
+        total: session.plan().steps.len(),
+        journal: journal.clone(),
     };
-    // A resumed session may continue mid-patch, after that patch's aiming request.
-    let next = session.done();
-    if let Some(step) = session.plan().steps.get(next) {
-        if step.data.repeat > 1 {
-            if let Some(a) = record.aims.iter().find(|a| a.patch == step.data.patch) {
-                if operator.ask(&a.prompt)? == Answer::Abort {
-                    return Err(ExperimentError::Incomplete {
-                        stage: "display-spots",
-                        done: next,
-                        total: session.plan().steps.len(),
-                        journal,
-                    });
-                }
-            }
-        }
+    if !aim_again(&session, &record.aims, &mut operator)? {
+        return Err(incomplete(&session));
     }
     let meters = [("spot".to_string(), Meter::of(meter.as_ref()))].into();
     let estimate = {
@@ -570,18 +453,12 @@ pub fn measure(
         })
     };
     let end = session.run(&mut rig, run, &mut sink)?;
-    let spent = session.spent().clone();
     record.cost = Some(CostReport {
         estimate,
-        actual: Some(spent),
+        actual: Some(session.spent().clone()),
     });
     if end != RunEnd::Complete {
-        return Err(ExperimentError::Incomplete {
-            stage: "display-spots",
-            done: session.done(),
-            total: session.plan().steps.len(),
-            journal,
-        });
+        return Err(incomplete(&session));
     }
     let entries = session.complete_entries().unwrap_or_default();
     let stats = reduce(&entries, rule, &model);
@@ -589,6 +466,67 @@ pub fn measure(
     let text = serde_json::to_string_pretty(&record).map_err(ExperimentError::Json)?;
     super::cache::write_atomic(&dir.join(RECORD_FILE), text.as_bytes())?;
     Ok((stats, vec![JOURNAL_FILE, SPOTS_FILE, RECORD_FILE]))
+}
+
+/// Puts the session's picture on the screen (the image, or nothing: each patch's colour
+/// is shown by its step) and gives the plan for it with the record of what was shown.
+fn show(
+    s: &SpotSession<'_>,
+    screen: &mut dyn Screen,
+    progress: &dyn Fn(Progress),
+) -> Result<(SessionPlan<SpotStep>, SpotRecord), ExperimentError> {
+    let repeats = s.rule.most();
+    let (mut plan, record) = match &s.image {
+        Some(shown) => {
+            let image =
+                Drive8Image::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
+                    file: shown.file.to_path_buf(),
+                    message: e.to_string(),
+                })?;
+            let placement = screen.show_image(&image)?;
+            let aims = aims_on(&placement, shown.regions);
+            let plan = image_plan(&aims, repeats);
+            let record = SpotRecord {
+                shown: "image".into(),
+                note: None,
+                aims,
+                cost: None,
+            };
+            (plan, record)
+        }
+        None => {
+            let note = "no image was rendered: each patch's drive values were shown over the \
+                        whole screen instead of the reproduced image";
+            progress(Progress::Note(note.into()));
+            let record = SpotRecord {
+                shown: "patch colours".into(),
+                note: Some(note.into()),
+                aims: Vec::new(),
+                cost: None,
+            };
+            (plan(s.drives, repeats), record)
+        }
+    };
+    plan.options.extend(s.rule.options());
+    Ok((plan, record))
+}
+
+/// A resumed session may continue mid-patch, after that patch's aiming request: asks it
+/// again. False when the operator aborts.
+fn aim_again(
+    session: &Session<SpotHeader, SpotStep>,
+    aims: &[PatchAim],
+    operator: &mut dyn Operator,
+) -> Result<bool, ExperimentError> {
+    let Some(step) = session.plan().steps.get(session.done()) else {
+        return Ok(true);
+    };
+    if step.data.repeat > 1 {
+        if let Some(a) = aims.iter().find(|a| a.patch == step.data.patch) {
+            return Ok(operator.ask(&a.prompt)? != Answer::Abort);
+        }
+    }
+    Ok(true)
 }
 
 /// Each patch's aim on the screen, for the image placed at `placement`.

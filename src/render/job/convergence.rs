@@ -69,8 +69,7 @@ pub fn run(
     events: &dyn Fn(RenderEvent),
 ) -> Result<ConvergenceReport, RenderError> {
     let r = request;
-    convergence::check_seconds(r.seconds)
-        .map_err(|e| RenderError::BadRequest(format!("--seconds: {e}")))?;
+    convergence::check_seconds(r.seconds).map_err(|e| RenderError::Seconds(e.to_string()))?;
     let mut out = OutputPolicy::new(r.force);
     if let Some(s) = &r.scene {
         out.input(s);

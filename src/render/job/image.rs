@@ -152,7 +152,7 @@ pub fn run(
 ) -> Result<ImageReport, RenderError> {
     let r = request;
     if r.spp == 0 {
-        return Err(RenderError::BadRequest("--spp must be ≥ 1".into()));
+        return Err(RenderError::Spp);
     }
     let out = output_policy(r)?;
     let name = r
@@ -164,9 +164,7 @@ pub fn run(
     let width = r.width.unwrap_or(camera.width);
     let height = r.height.unwrap_or(camera.height);
     if width == 0 || height == 0 {
-        return Err(RenderError::BadRequest(
-            "--width and --height must be ≥ 1".into(),
-        ));
+        return Err(RenderError::Size);
     }
     let t = Instant::now();
     if r.method == Method::Radiosity {
@@ -222,11 +220,10 @@ fn output_policy(r: &ImageRequest) -> Result<OutputPolicy, RenderError> {
         let mut besides_image = out.clone();
         besides_image.input(&r.output);
         if let Err(OutputError::IsInput { .. }) = besides_image.check(p) {
-            return Err(RenderError::BadRequest(format!(
-                "--preview {} is the same file as --output {}",
-                p.display(),
-                r.output.display()
-            )));
+            return Err(RenderError::PreviewIsImage {
+                preview: p.clone(),
+                image: r.output.clone(),
+            });
         }
         out.check(p)?;
     }
@@ -252,13 +249,13 @@ mod tests {
         assert_eq!(
             e.to_string(),
             format!(
-                "--preview {} is the same file as --output {}",
+                "the preview {} is the same file as the image {}",
                 output.display(),
                 output.display()
             )
         );
         let e = run(&ImageRequest::new(0, output), &|_| panic!("no event")).unwrap_err();
-        assert_eq!(e.to_string(), "--spp must be ≥ 1");
+        assert_eq!(e.to_string(), "the samples per pixel must be ≥ 1");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -34,10 +34,26 @@ use crate::render::spot::{SpotError, SpotProgress};
 /// messages already name the file and what to do), so wrapping adds no text.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// The request itself is wrong (an option out of range, two outputs the same file):
-    /// the caller can fix it by asking differently; the command line calls it a usage error.
+    /// The request itself is wrong (from here to [`RenderError::PreviewIsImage`]: an option
+    /// out of range, two outputs the same file): the caller can fix it by asking
+    /// differently; the command line calls it a usage error.
+    ///
+    /// The ΔE*ab target of a traced reading (the white's, or the spots'): not above 0.
+    #[error("the ΔE*ab target must be > 0")]
+    TargetDe,
+    #[error("the time limit must be > 0")]
+    MaxSeconds,
+    #[error("the given reference white must be finite with Y > 0")]
+    White,
+    /// The convergence chart's time budget per strategy.
     #[error("{0}")]
-    BadRequest(String),
+    Seconds(String),
+    #[error("the samples per pixel must be ≥ 1")]
+    Spp,
+    #[error("the image's width and height must be ≥ 1")]
+    Size,
+    #[error("the preview {} is the same file as the image {}", preview.display(), image.display())]
+    PreviewIsImage { preview: PathBuf, image: PathBuf },
     #[error(transparent)]
     Scene(#[from] SceneError),
     /// The built-in scene did not build (a defect of the program, not of the request).
@@ -75,7 +91,16 @@ pub enum RenderError {
 impl RenderError {
     /// Whether the request, not the data or the machine, is at fault.
     pub fn is_bad_request(&self) -> bool {
-        matches!(self, RenderError::BadRequest(_))
+        matches!(
+            self,
+            RenderError::TargetDe
+                | RenderError::MaxSeconds
+                | RenderError::White
+                | RenderError::Seconds(_)
+                | RenderError::Spp
+                | RenderError::Size
+                | RenderError::PreviewIsImage { .. }
+        )
     }
 }
 
@@ -128,16 +153,15 @@ pub(crate) fn check_white_request(
     max_seconds: f64,
     white: Option<Xyz>,
 ) -> Result<(), RenderError> {
-    let bad = |m: &str| Err(RenderError::BadRequest(m.into()));
     if target_de.is_nan() || target_de <= 0.0 {
-        return bad("--target-de must be > 0");
+        return Err(RenderError::TargetDe);
     }
     if max_seconds.is_nan() || max_seconds <= 0.0 {
-        return bad("--max-seconds must be > 0");
+        return Err(RenderError::MaxSeconds);
     }
     if let Some(w) = white {
         if !(w.iter().all(|x| x.is_finite()) && w[1] > 0.0) {
-            return bad("--white must be finite with Y > 0");
+            return Err(RenderError::White);
         }
     }
     Ok(())

@@ -32,7 +32,7 @@
 //! validation to find.
 //!
 //! ```
-//! use metamer::render::job::spots_from_image::{run, Request};
+//! use metamer::render::job::spots_from_image::{run, SpotsFromImageRequest};
 //! # let dir = std::env::temp_dir().join(format!("metamer-doc-sfi-{}", std::process::id()));
 //! # std::fs::create_dir_all(&dir)?;
 //! # let image = dir.join("box.exr");
@@ -44,9 +44,9 @@
 //! #     ..metamer::render::job::image::ImageRequest::new(1, image.clone())
 //! # }, &|_| {})?;
 //! // An image of the scene's camera by any renderer, as absolute XYZ.
-//! let request = Request {
+//! let request = SpotsFromImageRequest {
 //!     target_de: 0.5,
-//!     ..Request::new(image, None) // None: the built-in validation box
+//!     ..SpotsFromImageRequest::new(image, None) // None: the built-in validation box
 //! };
 //! let report = run(&request, &|_| {})?;
 //! for r in &report.patches {
@@ -79,7 +79,7 @@ pub const METHOD: &str = "external image";
 
 /// What to read back.
 #[derive(Clone, Debug)]
-pub struct Request {
+pub struct SpotsFromImageRequest {
     /// The image, `.exr` or `.pfm`.
     pub image: PathBuf,
     /// The scene the image is of; None is the built-in validation box.
@@ -94,10 +94,10 @@ pub struct Request {
     pub seed: u64,
 }
 
-impl Request {
+impl SpotsFromImageRequest {
     /// `render spots`' defaults for the white.
     pub fn new(image: PathBuf, scene: Option<PathBuf>) -> Self {
-        Request {
+        SpotsFromImageRequest {
             image,
             scene,
             white: None,
@@ -110,7 +110,7 @@ impl Request {
 
 /// The readings taken from the image.
 #[derive(Debug)]
-pub struct Report {
+pub struct SpotsFromImageReport {
     pub scene: Scene,
     pub image: PathBuf,
     /// SHA-256 of the image file, tying the readings to the bytes read.
@@ -166,7 +166,7 @@ struct WhiteTrace<'a> {
     reached: bool,
 }
 
-impl Report {
+impl SpotsFromImageReport {
     /// One JSON object in the shape of `render spots --json` (`method`, `provenance`,
     /// `white`, `patches` with `XYZ`, `XYZ_stderr`, `de_ci95`, `samples`), plus `image`:
     /// the file, its digest and size. `validate --simulation` reads it.
@@ -195,7 +195,10 @@ impl Report {
 
 /// Checks the request, loads the scene and the image, reads the 24 cones, finds the
 /// white and checks the units. Nothing is written.
-pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, RenderError> {
+pub fn run(
+    request: &SpotsFromImageRequest,
+    events: &dyn Fn(RenderEvent),
+) -> Result<SpotsFromImageReport, RenderError> {
     let start = Instant::now();
     check_white_request(request.target_de, request.max_seconds, request.white)?;
     let name = request
@@ -273,7 +276,7 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
             source,
         })
     })?;
-    Ok(Report {
+    Ok(SpotsFromImageReport {
         scene,
         pixels: image,
         image: file,
@@ -292,9 +295,9 @@ pub fn run(request: &Request, events: &dyn Fn(RenderEvent)) -> Result<Report, Re
 fn short_white_warning(t: &TracedWhite) -> String {
     format!(
         "the reference white stopped at the time limit ({} s) with a ΔE*ab 95 % half-width of \
-         {:.3}, above its target of {:.3} (a third of --target-de): the readings' XYZ are as \
-         read, but their CIELAB and ΔE95 carry the white's extra noise; give --white, or more \
-         --max-seconds or a larger --target-de",
+         {:.3}, above its target of {:.3} (a third of the ΔE*ab target): the readings' XYZ are \
+         as read, but their CIELAB and ΔE95 carry the white's extra noise; give a measured \
+         white, or more time or a larger ΔE*ab target",
         t.max_seconds, t.de_ci95, t.target_de
     )
 }
@@ -342,18 +345,18 @@ mod tests {
 
     #[test]
     fn the_first_bad_option_is_the_one_reported_before_anything_is_read() {
-        let r = Request {
+        let r = SpotsFromImageRequest {
             target_de: 0.0,
             white: Some(Xyz::new(1.0, 0.0, 1.0)),
-            ..Request::new("none.exr".into(), Some("none.json".into()))
+            ..SpotsFromImageRequest::new("none.exr".into(), Some("none.json".into()))
         };
         let e = run(&r, &|_| panic!("no event")).unwrap_err();
-        assert_eq!(e.to_string(), "--target-de must be > 0");
-        let r = Request {
+        assert!(matches!(e, RenderError::TargetDe), "{e}");
+        let r = SpotsFromImageRequest {
             white: Some(Xyz::new(1.0, 0.0, 1.0)),
-            ..Request::new("none.exr".into(), Some("none.json".into()))
+            ..SpotsFromImageRequest::new("none.exr".into(), Some("none.json".into()))
         };
         let e = run(&r, &|_| panic!("no event")).unwrap_err();
-        assert_eq!(e.to_string(), "--white must be finite with Y > 0");
+        assert!(matches!(e, RenderError::White), "{e}");
     }
 }

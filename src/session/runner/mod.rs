@@ -28,8 +28,10 @@ use super::step::{Rig, StepFailure, StepTaker};
 
 mod error;
 mod resume;
+mod stopping;
 pub use error::{SessionError, SettingDiffers};
 use resume::{duplicates_note, place_entries, same_instrument};
+pub use stopping::patch_so_far;
 
 /// How to run.
 #[derive(Clone, Debug, Default)]

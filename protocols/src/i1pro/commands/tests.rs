@@ -123,7 +123,7 @@ fn requests_of_the_other_revision_are_refused() {
     let e = Request::Trigger.encode(Revision::E).unwrap_err();
     assert_eq!(
         e,
-        RequestError::WrongRevision {
+        ControlRequestError::WrongRevision {
             request: "trigger measurement",
             revision: Revision::E
         }
@@ -187,7 +187,7 @@ fn every_request_decodes_to_itself() {
 fn malformed_transfers_are_errors() {
     assert_eq!(
         Request::decode(&out(0xEE, &[]), Revision::AToD).unwrap_err(),
-        RequestError::Unknown {
+        ControlRequestError::Unknown {
             request_type: 0x40,
             request: 0xEE
         }
@@ -195,15 +195,15 @@ fn malformed_transfers_are_errors() {
     // A Rev A–D EEPROM read is 8 bytes; 6 is the Rev E form.
     assert!(matches!(
         Request::decode(&out(0xC4, &[0, 0, 0, 0, 1, 0]), Revision::AToD),
-        Err(RequestError::BadData { .. })
+        Err(ControlRequestError::BadData { .. })
     ));
     assert!(matches!(
         Request::decode(&out(0xC1, &[1, 2, 3]), Revision::AToD),
-        Err(RequestError::BadData { .. })
+        Err(ControlRequestError::BadData { .. })
     ));
     assert!(matches!(
         Request::decode(&out(0xD4, &[0; 14]), Revision::AToD),
-        Err(RequestError::WrongRevision { .. })
+        Err(ControlRequestError::WrongRevision { .. })
     ));
 }
 

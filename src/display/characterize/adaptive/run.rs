@@ -8,10 +8,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use metamer_drivers::{
-    CalibrationCondition, CalibrationOutcome, Capabilities, DriverError, Instrument,
-    InstrumentInfo, MeasureMode, Reading, Request,
-};
+use metamer_drivers::{Forwarding, Instrument, InstrumentInfo, MeasureMode, Reading};
 
 use super::choice::{decide, verification_codes, Decision};
 use super::fitted::Fitted;
@@ -76,34 +73,12 @@ struct Shifted<'a> {
     offset: u64,
 }
 
-impl Instrument for Shifted<'_> {
-    fn info(&self) -> InstrumentInfo {
-        self.inner.info()
+impl Forwarding for Shifted<'_> {
+    fn inner(&self) -> &dyn Instrument {
+        &*self.inner
     }
-    fn capabilities(&self) -> Capabilities {
-        self.inner.capabilities()
-    }
-    fn calibration_needed(
-        &mut self,
-        mode: MeasureMode,
-    ) -> Result<Option<CalibrationCondition>, DriverError> {
-        self.inner.calibration_needed(mode)
-    }
-    fn calibrate(
-        &mut self,
-        mode: MeasureMode,
-        condition: &CalibrationCondition,
-    ) -> Result<CalibrationOutcome, DriverError> {
-        self.inner.calibrate(mode, condition)
-    }
-    fn measure(&mut self, request: &Request) -> Result<Reading, DriverError> {
-        self.inner.measure(request)
-    }
-    fn set_option(&mut self, name: &str, value: &str) -> Result<(), DriverError> {
-        self.inner.set_option(name, value)
-    }
-    fn option_values(&self) -> Vec<(String, String)> {
-        self.inner.option_values()
+    fn inner_mut(&mut self) -> &mut dyn Instrument {
+        &mut *self.inner
     }
     fn seek_noise(&mut self, index: u64) {
         self.inner.seek_noise(index.wrapping_add(self.offset));
