@@ -13,6 +13,7 @@ use metamer::render::job::spots::{Readings, SpotsRequest};
 use metamer::render::job::spots_from_image::Request as SpotsFromImageRequest;
 use metamer::render::job::{self, RenderError, RenderEvent};
 use metamer::render::method::{self, Solver};
+use metamer::render::probes::ProbeError;
 use metamer::render::probes::ProbeOptions;
 use metamer::render::radiosity::probes::ProbeProgress;
 use metamer::render::spot::Uncertainty;
@@ -217,8 +218,18 @@ fn convergence(a: ConvergenceArgs) -> CliResult {
 
 /// A usage error for a bad request (exit 2), else a failure (exit 1).
 fn cli_error(e: RenderError) -> CliError {
+    let time_limit = match &e {
+        RenderError::Radiosity(r) => r.is_time_limit(),
+        RenderError::Probes {
+            error: ProbeError::Radiosity(r),
+            ..
+        } => r.is_time_limit(),
+        _ => false,
+    };
     if e.is_bad_request() {
         CliError::Usage(e.to_string())
+    } else if time_limit {
+        CliError::Failed(format!("{e}; give it more with --max-seconds").into())
     } else {
         CliError::Failed(Box::new(e))
     }
