@@ -252,6 +252,9 @@ fn solve_bands(
             let mut last_change = f64::INFINITY;
             let mut last_ratio = f64::NAN;
             let mut accelerated = false;
+            // The slowest contraction seen: after an extrapolation the last two sweeps may
+            // show a faster mode while the slowest one still holds what is left.
+            let mut slowest: f64 = 0.0;
             let rel_err;
             loop {
                 sweeps += 1;
@@ -266,7 +269,7 @@ fn solve_bands(
                     // What the sweeps not taken would still add: a contraction by q per
                     // sweep leaves change·q/(1 − q), q from the last two sweeps.
                     let q = if last_change.is_finite() && last_change > 0.0 {
-                        (change / last_change).min(0.999)
+                        (change / last_change).max(slowest).min(0.999)
                     } else {
                         0.999
                     };
@@ -281,6 +284,9 @@ fn solve_bands(
                     return Err(SolveFailure::Diverges { sweeps });
                 }
                 let ratio = change / last_change;
+                if ratio.is_finite() {
+                    slowest = slowest.max(ratio);
+                }
                 if ratio > ACCELERATE_ABOVE
                     && ratio < 1.0
                     && (ratio - last_ratio).abs() <= 0.01 * ratio
