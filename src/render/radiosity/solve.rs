@@ -307,6 +307,17 @@ fn solve_bands(
             Ok((l, sweeps, rel_err))
         })
         .collect();
+    merge(&ranges, parts, n, bands)
+}
+
+/// The band chunks' solutions put back together (N × bands), with the most sweeps and the
+/// largest error estimate of any chunk.
+fn merge(
+    ranges: &[(usize, usize)],
+    parts: Vec<Result<BandChunk, SolveFailure>>,
+    n: usize,
+    bands: usize,
+) -> Result<Solution, SolveFailure> {
     let mut out = vec![0.0; n * bands];
     let mut sweeps = 0;
     let mut rel_err: f64 = 0.0;
