@@ -229,7 +229,7 @@ fn cli_error(e: RenderError) -> CliError {
     if e.is_bad_request() {
         CliError::Usage(e.to_string())
     } else if time_limit {
-        CliError::Failed(format!("{e}; give it more with --max-seconds").into())
+        CliError::Failed(format!("{e} (--max-seconds)").into())
     } else {
         CliError::Failed(Box::new(e))
     }

@@ -55,7 +55,7 @@ pub enum RadiosityError {
     TooDetailed { what: String, max: usize },
     #[error(
         "no result within the time limit of {seconds} s: it ran out {during} (a result \
-         needs three mesh levels; give it more time)"
+         needs three mesh levels: give it a longer time limit)"
     )]
     TimeLimit { seconds: f64, during: String },
     #[error(
