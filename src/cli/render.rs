@@ -250,6 +250,13 @@ fn cli_error(e: RenderError) -> CliError {
                 .into(),
             )
         }
+        RenderError::Radiosity(ref r) if r.is_time_limit() => {
+            return CliError::Failed(format!("{e} (--max-seconds)").into())
+        }
+        RenderError::Probes {
+            error: ProbeError::Radiosity(ref r),
+            ..
+        } if r.is_time_limit() => return CliError::Failed(format!("{e} (--max-seconds)").into()),
         e => return CliError::Failed(Box::new(e)),
     };
     CliError::Usage(usage)

@@ -225,6 +225,41 @@ pub fn render_image_radiosity(
     render_image_from(scene, &levels, ropts, opts)
 }
 
+/// What each of the k×k sample rays per pixel hits, and the emitter radiance it sees
+/// directly (XYZ).
+fn sample_rays(
+    scene: &Scene,
+    faces: &[Face],
+    origin: Vec3,
+    frame: &Frame,
+    k: usize,
+) -> Vec<(Seen, [f64; 3])> {
+    (0..frame.width * frame.height * k * k)
+        .into_par_iter()
+        .map(|idx| {
+            let (pixel, sub) = (idx / (k * k), idx % (k * k));
+            let (px, py) = (pixel % frame.width, pixel / frame.width);
+            let fx = px as f64 + ((sub % k) as f64 + 0.5) / k as f64;
+            let fy = py as f64 + ((sub / k) as f64 + 0.5) / k as f64;
+            let d = pixel_direction(frame, fx, fy);
+            let Some((fi, _, a, b)) = hit(faces, origin, d) else {
+                return (Seen::Nothing, [0.0; 3]);
+            };
+            let mut emitted = [0.0; 3];
+            if let FaceKind::Emitter(e) = faces[fi].kind {
+                let em = &scene.emitters[e];
+                let tile = em.tile_at(a, b);
+                let s = &em.spectra[em.tile_spectrum[tile] as usize];
+                let w = em.gains[tile] * em.directional(d.times(-1.0));
+                emitted = std::array::from_fn(|k| {
+                    w * K_M * (0..N_BINS).map(|i| s[i] * scene.cmf[k][i]).sum::<f64>()
+                });
+            }
+            (Seen::Face { face: fi, a, b }, emitted)
+        })
+        .collect()
+}
+
 /// Renders the camera's image from solved levels (one, or the last two of a spot run:
 /// see [`super::render_spots_radiosity_solved`]); `opts.level` is not used.
 pub fn render_image_from(
@@ -254,30 +289,7 @@ pub fn render_image_from(
     let k = opts.subpixels.max(1);
     let faces = &p.faces;
     // Pass 1: what each sample ray hits, and the emitter radiance it sees directly.
-    let samples: Vec<(Seen, [f64; 3])> = (0..frame.width * frame.height * k * k)
-        .into_par_iter()
-        .map(|idx| {
-            let (pixel, sub) = (idx / (k * k), idx % (k * k));
-            let (px, py) = (pixel % frame.width, pixel / frame.width);
-            let fx = px as f64 + ((sub % k) as f64 + 0.5) / k as f64;
-            let fy = py as f64 + ((sub / k) as f64 + 0.5) / k as f64;
-            let d = pixel_direction(&frame, fx, fy);
-            let Some((fi, _, a, b)) = hit(faces, cam.position, d) else {
-                return (Seen::Nothing, [0.0; 3]);
-            };
-            let mut emitted = [0.0; 3];
-            if let FaceKind::Emitter(e) = faces[fi].kind {
-                let em = &scene.emitters[e];
-                let tile = em.tile_at(a, b);
-                let s = &em.spectra[em.tile_spectrum[tile] as usize];
-                let w = em.gains[tile] * em.directional(d.times(-1.0));
-                emitted = std::array::from_fn(|k| {
-                    w * K_M * (0..N_BINS).map(|i| s[i] * scene.cmf[k][i]).sum::<f64>()
-                });
-            }
-            (Seen::Face { face: fi, a, b }, emitted)
-        })
-        .collect();
+    let samples = sample_rays(scene, faces, cam.position, &frame, k);
     // Pass 2: a node grid on every face some ray sees.
     let mut visible = vec![false; faces.len()];
     for (s, _) in &samples {

@@ -12,6 +12,7 @@
 
 pub mod bound;
 pub mod direct;
+pub mod first_bounce;
 pub mod form;
 pub mod gather;
 pub mod image;
@@ -54,7 +55,7 @@ pub enum RadiosityError {
     TooDetailed { what: String, max: usize },
     #[error(
         "no result within the time limit of {seconds} s: it ran out {during} (a result \
-         needs three mesh levels; give more time with --max-seconds)"
+         needs three mesh levels: give it a longer time limit)"
     )]
     TimeLimit { seconds: f64, during: String },
     #[error(
@@ -156,6 +157,13 @@ pub struct Prepared<'a> {
     pub white_face: Option<usize>,
 }
 
+impl RadiosityError {
+    /// The time limit ran out before three levels: a longer limit would give a result.
+    pub fn is_time_limit(&self) -> bool {
+        matches!(self, RadiosityError::TimeLimit { .. })
+    }
+}
+
 impl<'a> Prepared<'a> {
     /// For the meter readings: the scene must have patch 19 for the reference white.
     pub fn new(scene: &'a Scene) -> Result<Prepared<'a>, RadiosityError> {
@@ -213,6 +221,8 @@ pub struct Solved {
     pub mesh: Mesh,
     pub bands: Bands,
     pub l: Vec<Vec<f64>>,
+    /// g/π per element for each light component: the system's source term.
+    pub src: Vec<Vec<f64>>,
     pub sweeps: usize,
     /// The largest relative error the stopped iteration leaves in ℓ (an estimate).
     pub algebraic: f64,
@@ -280,6 +290,7 @@ pub fn solve_level(
         mesh,
         bands,
         l,
+        src,
         sweeps,
         algebraic,
     })
@@ -386,35 +397,8 @@ pub fn render_spots_radiosity_solved(
     progress: &dyn Fn(&Level),
 ) -> Result<(RadiosityResult, LastLevels), RadiosityError> {
     let start = Instant::now();
-    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
-        return Err(RadiosityError::BadOption {
-            what: "the time limit",
-            need: "> 0 s",
-            got: opts.max_seconds,
-        });
-    }
+    check_options(opts)?;
     let deadline = Deadline::after(opts.max_seconds);
-    if opts.target_de.is_nan() || opts.target_de <= 0.0 {
-        return Err(RadiosityError::BadOption {
-            what: "the ΔE*ab target",
-            need: "> 0",
-            got: opts.target_de,
-        });
-    }
-    if let Some(b) = opts.base_m {
-        if !(b > 0.0 && b.is_finite()) {
-            return Err(RadiosityError::BadOption {
-                what: "the base element size",
-                need: "> 0 m",
-                got: b,
-            });
-        }
-    }
-    if let Some(w) = opts.white {
-        if !(w.is_finite() && w[1] > 0.0) {
-            return Err(SpotError::BadWhite(w.to_array()).into());
-        }
-    }
     let p = Prepared::new(scene)?;
     let mut levels: Vec<Level> = Vec::new();
     let mut best: Option<(Vec<RenderedReading>, Xyz)> = None;
@@ -486,6 +470,39 @@ pub fn render_spots_radiosity_solved(
         }
         best = Some((patches, white));
     }
+}
+
+/// The options of a spot run, checked before any work.
+fn check_options(opts: &RadiosityOptions) -> Result<(), RadiosityError> {
+    if opts.max_seconds.is_nan() || opts.max_seconds <= 0.0 {
+        return Err(RadiosityError::BadOption {
+            what: "the time limit",
+            need: "> 0 s",
+            got: opts.max_seconds,
+        });
+    }
+    if opts.target_de.is_nan() || opts.target_de <= 0.0 {
+        return Err(RadiosityError::BadOption {
+            what: "the ΔE*ab target",
+            need: "> 0",
+            got: opts.target_de,
+        });
+    }
+    if let Some(b) = opts.base_m {
+        if !(b > 0.0 && b.is_finite()) {
+            return Err(RadiosityError::BadOption {
+                what: "the base element size",
+                need: "> 0 m",
+                got: b,
+            });
+        }
+    }
+    if let Some(w) = opts.white {
+        if !(w.is_finite() && w[1] > 0.0) {
+            return Err(SpotError::BadWhite(w.to_array()).into());
+        }
+    }
+    Ok(())
 }
 
 /// Readings and bounds from the last levels (three, or four for the step check).

@@ -5,6 +5,7 @@
 use super::super::geometry::Vec3;
 use super::bound::{extrapolated_with_bound, MIN_ORDER};
 use super::direct::irradiance_factor;
+use super::first_bounce::{first_bounce, pieces, FirstBounce};
 use super::lights::Lights;
 use super::polygon::point_to_rect;
 use super::{solve_level, Prepared, RadiosityError, RadiosityOptions, Solved};
@@ -68,6 +69,56 @@ pub fn indirect_lux(scene: &Scene, lights: &Lights, solved: &Solved, x: Vec3, n:
                 if *fj != 0.0 {
                     for (qb, lb) in q.iter_mut().zip(&solved.l[e][j * nb..(j + 1) * nb]) {
                         *qb += fj * lb;
+                    }
+                }
+            }
+            let q = solved.bands.interpolate(&q);
+            photometric(scene, lights, e, |i| std::f64::consts::PI * q[i])
+        })
+        .sum()
+}
+
+/// Indirect illuminance at `x` facing `n` (lux) from a solved level whose reflectances
+/// per face (1 nm) are `refl`, with the first bounce at that point integrated apart
+/// ([`first_bounce`]): the mesh gathers only ℓ − ρ·g/π, the light that has bounced at least
+/// twice.
+pub fn indirect_lux_with(
+    scene: &Scene,
+    lights: &Lights,
+    solved: &Solved,
+    refl: &[&[f64]],
+    first: &FirstBounce,
+    x: Vec3,
+    n: Vec3,
+) -> f64 {
+    let nb = solved.bands.len();
+    let f: Vec<f64> = solved
+        .mesh
+        .elements
+        .iter()
+        .map(|el| point_to_rect(x, n, &el.rect))
+        .collect();
+    (0..lights.len())
+        .map(|e| {
+            let mut q = vec![0.0; nb];
+            for (j, fj) in f.iter().enumerate() {
+                if *fj == 0.0 {
+                    continue;
+                }
+                let rho = refl[solved.mesh.elements[j].face];
+                let s = solved.src[e][j];
+                for (b, (qb, lb)) in q
+                    .iter_mut()
+                    .zip(&solved.l[e][j * nb..(j + 1) * nb])
+                    .enumerate()
+                {
+                    *qb += fj * (lb - rho[solved.bands.bins[b]] * s);
+                }
+            }
+            for (face, v) in first.per_face[e].iter().enumerate() {
+                if *v != 0.0 {
+                    for (qb, &bin) in q.iter_mut().zip(&solved.bands.bins) {
+                        *qb += refl[face][bin] * v;
                     }
                 }
             }
@@ -154,32 +205,141 @@ pub enum ProbeProgress<'a> {
 /// Probes are evaluated in chunks of this many, between which the deadline is checked.
 const CHUNK: usize = 4096;
 
+/// The point-independent parts of a probe run: the scene, each probe's direct light, first
+/// bounce and its error in lux.
+struct Fixed<'p, 'a> {
+    p: &'p Prepared<'a>,
+    refl: Vec<&'a [f64]>,
+    direct: Vec<f64>,
+    first: Vec<FirstBounce>,
+    /// What the first bounce's quadrature may be off by at each probe (lux).
+    first_err: Vec<f64>,
+}
+
 /// Indirect lux at every probe from one solved level, or None when the deadline passed.
 fn evaluate(
-    scene: &Scene,
-    lights: &Lights,
+    fixed: &Fixed,
     solved: &Solved,
     probes: &[Probe],
     deadline: Deadline,
     progress: &(dyn Fn(ProbeProgress) + Sync),
 ) -> Option<Vec<f64>> {
     use rayon::prelude::*;
+    let (scene, lights) = (fixed.p.scene, &fixed.p.lights);
     let mut out = Vec::with_capacity(probes.len());
-    for chunk in probes.chunks(CHUNK) {
+    for (k, chunk) in probes.chunks(CHUNK).enumerate() {
         if deadline.passed() {
             return None;
         }
-        out.par_extend(
-            chunk
-                .par_iter()
-                .map(|q| indirect_lux(scene, lights, solved, q.position, q.normal)),
-        );
+        out.par_extend(chunk.par_iter().enumerate().map(|(i, q)| {
+            let first = &fixed.first[k * CHUNK + i];
+            indirect_lux_with(
+                scene,
+                lights,
+                solved,
+                &fixed.refl,
+                first,
+                q.position,
+                q.normal,
+            )
+        }));
         progress(ProbeProgress::Evaluated {
             done: out.len(),
             of: probes.len(),
         });
     }
     Some(out)
+}
+
+/// The direct light and the first bounce at every probe, or the time limit's error.
+fn fixed_parts<'p, 'a>(
+    p: &'p Prepared<'a>,
+    probes: &[Probe],
+    opts: &RadiosityOptions,
+    deadline: Deadline,
+) -> Result<Fixed<'p, 'a>, RadiosityError> {
+    use rayon::prelude::*;
+    let scene = p.scene;
+    let pieces = pieces(scene, &p.faces, &p.decals);
+    let mut direct = Vec::with_capacity(probes.len());
+    let mut first = Vec::with_capacity(probes.len());
+    for chunk in probes.chunks(CHUNK) {
+        if deadline.passed() {
+            return Err(RadiosityError::TimeLimit {
+                seconds: opts.max_seconds,
+                during: "while computing the direct light and its first bounce".into(),
+            });
+        }
+        direct.extend(
+            chunk
+                .iter()
+                .map(|q| direct_lux(scene, &p.lights, q.position, q.normal)),
+        );
+        first.par_extend(
+            chunk
+                .par_iter()
+                .map(|q| first_bounce(scene, &p.lights, &p.faces, &pieces, q.position, q.normal)),
+        );
+    }
+    let first_err = first
+        .iter()
+        .map(|f| {
+            (0..p.lights.len())
+                .map(|c| photometric(scene, &p.lights, c, |_| std::f64::consts::PI * f.error[c]))
+                .sum()
+        })
+        .collect();
+    Ok(Fixed {
+        p,
+        refl: p.faces.iter().map(|f| f.reflectance.as_slice()).collect(),
+        direct,
+        first,
+        first_err,
+    })
+}
+
+/// The estimates after the last level: each probe extrapolated from the last levels (up to
+/// four), whether all converged, and how many are within the tolerance but converge more
+/// slowly than trusted.
+fn estimates(
+    fixed: &Fixed,
+    raw: &[Vec<f64>],
+    levels_alg: &[f64],
+    hs_all: &[f64],
+    opts: &RadiosityOptions,
+    rel_tolerance: f64,
+) -> (Vec<Illuminance>, bool, usize) {
+    let m = raw.len();
+    let first = m.saturating_sub(4);
+    let hs = &hs_all[first..m];
+    // What the stopped iteration may leave, in lux, at the finest level.
+    let algebraic = levels_alg.iter().skip(first).fold(0.0f64, |a, &b| a.max(b));
+    // Probes whose estimate is not converged although within the tolerance: their last
+    // levels converge more slowly than the slowest order trusted.
+    let mut slow = 0;
+    let mut done = true;
+    let out = (0..fixed.direct.len())
+        .map(|i| {
+            let direct = fixed.direct[i];
+            let v: Vec<f64> = raw[first..].iter().map(|r| r[i]).collect();
+            let abs_err = algebraic * (v[v.len() - 1].abs() + direct.abs());
+            let e = extrapolated_with_bound(&v, hs, opts.order, abs_err);
+            let total = direct + e.value;
+            let tol = rel_tolerance * total.abs();
+            let bound = e.bound + fixed.first_err[i];
+            if !(e.converged(tol) && bound <= tol) {
+                done = false;
+                slow += usize::from(bound <= tol);
+            }
+            Illuminance {
+                direct_lux: direct,
+                indirect_lux: e.value,
+                total_lux: total,
+                bound_lux: bound,
+            }
+        })
+        .collect();
+    (out, done, slow)
 }
 
 /// Illuminance at every probe: levels 1, 2, 3 (then finer while any bound exceeds
@@ -195,32 +355,14 @@ pub fn probe_illuminance(
 ) -> Result<ProbeRun, RadiosityError> {
     let p = Prepared::for_probes(scene)?;
     let deadline = Deadline::after(opts.max_seconds);
-    let time = |level: usize| RadiosityError::TimeLimit {
-        seconds: opts.max_seconds,
-        during: if level == 0 {
-            "while computing the direct light".into()
-        } else {
-            format!("on mesh level {level}")
-        },
-    };
-    let refl: Vec<&[f64]> = p.faces.iter().map(|f| f.reflectance.as_slice()).collect();
-    let mut direct = Vec::with_capacity(probes.len());
-    for chunk in probes.chunks(CHUNK) {
-        if deadline.passed() {
-            return Err(time(0));
-        }
-        direct.extend(
-            chunk
-                .iter()
-                .map(|q| direct_lux(scene, &p.lights, q.position, q.normal)),
-        );
-    }
+    let fixed = fixed_parts(&p, probes, opts, deadline)?;
     let mut raw: Vec<Vec<f64>> = Vec::new();
     let mut levels_alg: Vec<f64> = Vec::new();
     let mut levels: Vec<ProbeLevel> = Vec::new();
     let mut best: Option<Vec<Illuminance>> = None;
     let base = p.base(opts);
     let finest = opts.max_level.max(3);
+    let hs: Vec<f64> = (1..=finest).map(|k| base / k as f64).collect();
     loop {
         let level = raw.len() + 1;
         let start = std::time::Instant::now();
@@ -232,9 +374,12 @@ pub fn probe_illuminance(
                 converged: false,
                 stopped: Some(why),
             }),
-            None => Err(time(level)),
+            None => Err(RadiosityError::TimeLimit {
+                seconds: opts.max_seconds,
+                during: format!("on mesh level {level}"),
+            }),
         };
-        let solved = match solve_level(&p, &refl, opts, level, None, deadline) {
+        let solved = match solve_level(&p, &fixed.refl, opts, level, None, deadline) {
             Ok(s) => s,
             Err(RadiosityError::TimeLimit { .. }) => {
                 let why = format!(
@@ -253,7 +398,7 @@ pub fn probe_illuminance(
             level,
             elements: solved.mesh.elements.len(),
         });
-        let Some(values) = evaluate(scene, &p.lights, &solved, probes, deadline, progress) else {
+        let Some(values) = evaluate(&fixed, &solved, probes, deadline, progress) else {
             let why = format!(
                 "the time limit of {} s ran out while evaluating the probes on level {level}",
                 opts.max_seconds
@@ -264,7 +409,7 @@ pub fn probe_illuminance(
         levels_alg.push(solved.algebraic);
         levels.push(ProbeLevel {
             level,
-            h_m: base / level as f64,
+            h_m: hs[level - 1],
             elements: solved.mesh.elements.len(),
             seconds: start.elapsed().as_secs_f64(),
             worst_relative_bound: None,
@@ -272,34 +417,7 @@ pub fn probe_illuminance(
         if raw.len() < 3 {
             continue;
         }
-        let m = raw.len();
-        let first = m.saturating_sub(4);
-        let hs: Vec<f64> = (first + 1..=m).map(|k| base / k as f64).collect();
-        // What the stopped iteration may leave, in lux, at the finest level.
-        let algebraic = levels_alg.iter().skip(first).fold(0.0f64, |a, &b| a.max(b));
-        // Probes whose estimate is not converged although within the tolerance: their last
-        // levels converge more slowly than the slowest order trusted.
-        let mut slow = 0;
-        let mut done = true;
-        let out: Vec<Illuminance> = (0..probes.len())
-            .map(|i| {
-                let v: Vec<f64> = raw[first..].iter().map(|r| r[i]).collect();
-                let abs_err = algebraic * (v[v.len() - 1].abs() + direct[i].abs());
-                let e = extrapolated_with_bound(&v, &hs, opts.order, abs_err);
-                let total = direct[i] + e.value;
-                let tol = rel_tolerance * total.abs();
-                if !e.converged(tol) {
-                    done = false;
-                    slow += usize::from(e.bound <= tol);
-                }
-                Illuminance {
-                    direct_lux: direct[i],
-                    indirect_lux: e.value,
-                    total_lux: total,
-                    bound_lux: e.bound,
-                }
-            })
-            .collect();
+        let (out, done, slow) = estimates(&fixed, &raw, &levels_alg, &hs, opts, rel_tolerance);
         progress(ProbeProgress::Estimated {
             level,
             probes: &out,
@@ -311,31 +429,27 @@ pub fn probe_illuminance(
         if let Some(l) = levels.last_mut() {
             l.worst_relative_bound = Some(worst);
         }
-        if done {
+        if done || level >= finest {
             return Ok(ProbeRun {
                 probes: out,
                 levels,
-                converged: true,
-                stopped: None,
-            });
-        }
-        if level >= finest {
-            return Ok(ProbeRun {
-                probes: out,
-                levels,
-                converged: false,
-                stopped: Some(if slow > 0 {
-                    format!(
-                        "level {level} is the finest the solver tries, and at {slow} probe(s) \
-                         the last levels still converge more slowly than order {MIN_ORDER} (a \
-                         point nearer an edge than the elements are small): their bound is a \
-                         rough figure"
-                    )
-                } else {
-                    format!("level {level} is the finest the solver tries")
-                }),
+                converged: done,
+                stopped: (!done).then(|| finest_reason(level, slow)),
             });
         }
         best = Some(out);
+    }
+}
+
+/// Why a run that reached the finest level did not converge.
+fn finest_reason(level: usize, slow: usize) -> String {
+    if slow > 0 {
+        format!(
+            "level {level} is the finest the solver tries, and at {slow} probe(s) the last \
+             levels still converge more slowly than order {MIN_ORDER} (a point nearer an \
+             edge than the elements are small): their bound is a rough figure"
+        )
+    } else {
+        format!("level {level} is the finest the solver tries")
     }
 }

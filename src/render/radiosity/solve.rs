@@ -9,7 +9,9 @@
 //! Gauss–Seidel converges when the largest reflectance times the fraction of light that
 //! stays in the scene is below 1; a closed box with reflectances a little above 1 (measured
 //! noise) and an absorbing emitter still qualifies but needs more sweeps, so the sweep
-//! limit is generous and a solution that grows instead of settling is reported.
+//! limit is generous and a solution that grows instead of settling is reported. In such a
+//! room the change per sweep shrinks by a steady factor q close to ρ; once three sweeps
+//! agree on it, the slowest mode's remaining sum Δ·q/(1 − q) is added in one step.
 
 use rayon::prelude::*;
 
@@ -177,6 +179,45 @@ pub fn solve(
     Ok(Solution { l, ..sol })
 }
 
+/// Gauss–Seidel stalls when the change shrinks by more than this factor per sweep (a bright
+/// closed room: about ρ per sweep); its slowest mode is then extrapolated.
+const ACCELERATE_ABOVE: f64 = 0.5;
+
+/// One Gauss–Seidel sweep over ℓ (N × k, row-major) with reflectances `r` (N × k): the
+/// largest change and the largest value.
+fn sweep(
+    mesh: &Mesh,
+    src: &[f64],
+    r: &[f64],
+    l: &mut [f64],
+    acc: &mut [f64],
+    k: usize,
+) -> (f64, f64) {
+    let n = mesh.elements.len();
+    let mut change: f64 = 0.0;
+    let mut size: f64 = 0.0;
+    for i in 0..n {
+        acc.iter_mut().for_each(|a| *a = src[i]);
+        let row = &mesh.form[i * n..(i + 1) * n];
+        for (j, &f) in row.iter().enumerate() {
+            if f != 0.0 {
+                let lj = &l[j * k..(j + 1) * k];
+                for (a, v) in acc.iter_mut().zip(lj) {
+                    *a += f * v;
+                }
+            }
+        }
+        let li = &mut l[i * k..(i + 1) * k];
+        for ((v, a), rr) in li.iter_mut().zip(acc.iter()).zip(&r[i * k..(i + 1) * k]) {
+            let new = rr * a;
+            change = change.max((new - *v).abs());
+            size = size.max(new.abs());
+            *v = new;
+        }
+    }
+    (change, size)
+}
+
 /// One chunk of bands solved: its radiosities, its sweeps and its algebraic error estimate.
 type BandChunk = (Vec<f64>, usize, f64);
 
@@ -208,40 +249,29 @@ fn solve_bands(
                 }
             }
             let mut acc = vec![0.0; k];
+            let mut before = vec![0.0; n * k];
             let mut sweeps = 0;
             let mut last_change = f64::INFINITY;
+            let mut last_ratio = f64::NAN;
+            let mut accelerated = false;
+            // The slowest contraction seen: after an extrapolation the last two sweeps may
+            // show a faster mode while the slowest one still holds what is left.
+            let mut slowest: f64 = 0.0;
             let rel_err;
             loop {
                 sweeps += 1;
                 if deadline.passed() {
                     return Err(SolveFailure::Time);
                 }
-                let mut change: f64 = 0.0;
-                let mut size: f64 = 0.0;
-                for i in 0..n {
-                    acc.iter_mut().for_each(|a| *a = src[i]);
-                    let row = &mesh.form[i * n..(i + 1) * n];
-                    for (j, &f) in row.iter().enumerate() {
-                        if f != 0.0 {
-                            let lj = &l[j * k..(j + 1) * k];
-                            for (a, v) in acc.iter_mut().zip(lj) {
-                                *a += f * v;
-                            }
-                        }
-                    }
-                    let li = &mut l[i * k..(i + 1) * k];
-                    for ((v, a), rr) in li.iter_mut().zip(&acc).zip(&r[i * k..(i + 1) * k]) {
-                        let new = rr * a;
-                        change = change.max((new - *v).abs());
-                        size = size.max(new.abs());
-                        *v = new;
-                    }
-                }
-                if change <= TOLERANCE * size {
+                before.copy_from_slice(&l);
+                let (change, size) = sweep(mesh, src, &r, &mut l, &mut acc, k);
+                // After an extrapolation the error estimate needs two plain sweeps.
+                let may_stop = last_change.is_finite() || !accelerated;
+                if change <= TOLERANCE * size && may_stop {
                     // What the sweeps not taken would still add: a contraction by q per
                     // sweep leaves change·q/(1 − q), q from the last two sweeps.
                     let q = if last_change.is_finite() && last_change > 0.0 {
-                        (change / last_change).min(0.999)
+                        (change / last_change).max(slowest).min(0.999)
                     } else {
                         0.999
                     };
@@ -252,14 +282,44 @@ fn solve_bands(
                     };
                     break;
                 }
-                last_change = change;
                 if sweeps >= MAX_SWEEPS || !size.is_finite() || size > 1e30 {
                     return Err(SolveFailure::Diverges { sweeps });
                 }
+                let ratio = change / last_change;
+                if ratio.is_finite() {
+                    slowest = slowest.max(ratio);
+                }
+                if ratio > ACCELERATE_ABOVE
+                    && ratio < 1.0
+                    && (ratio - last_ratio).abs() <= 0.01 * ratio
+                {
+                    // The slowest mode dominates: add its remaining sum Δ·q/(1 − q) now.
+                    let gain = ratio / (1.0 - ratio);
+                    for (v, b) in l.iter_mut().zip(&before) {
+                        *v += (*v - b) * gain;
+                    }
+                    accelerated = true;
+                    last_change = f64::INFINITY;
+                    last_ratio = f64::NAN;
+                    continue;
+                }
+                last_ratio = ratio;
+                last_change = change;
             }
             Ok((l, sweeps, rel_err))
         })
         .collect();
+    merge(&ranges, parts, n, bands)
+}
+
+/// The band chunks' solutions put back together (N × bands), with the most sweeps and the
+/// largest error estimate of any chunk.
+fn merge(
+    ranges: &[(usize, usize)],
+    parts: Vec<Result<BandChunk, SolveFailure>>,
+    n: usize,
+    bands: usize,
+) -> Result<Solution, SolveFailure> {
     let mut out = vec![0.0; n * bands];
     let mut sweeps = 0;
     let mut rel_err: f64 = 0.0;
