@@ -131,7 +131,8 @@ mod tests {
     }
 
     /// The words a user acts on after a reading failed, written out by hand: which patch,
-    /// what failed, what is safe, and the flag that goes on. The same tail as measure-box's.
+    /// what failed, what is safe, and the flag that goes on. measure-box's says the same, its command adding
+    /// how to go on.
     #[test]
     fn a_failed_reading_says_which_patch_what_is_safe_and_how_to_go_on() {
         let e = CharacterizeError::Session(failed_step());
@@ -148,8 +149,7 @@ mod tests {
         assert_eq!(
             box_error.advice().unwrap(),
             "stage spots, reading 7 of 62 (red 3: RGB [128, 0, 0]): the plan shows drive \
-             values but the rig has no screen\n  6 of 62 readings are safe in out/log.jsonl; \
-             fix the cause and run the same command with --resume"
+             values but the rig has no screen\n  6 of 62 readings are safe in out/log.jsonl"
         );
     }
 }

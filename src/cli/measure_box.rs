@@ -123,7 +123,9 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
                 )
                 .into(),
             ),
-            (None, Some(t)) => CliError::Failed(t.into()),
+            (None, Some(t)) => CliError::Failed(
+                format!("{t}; fix the cause and run the same command with --resume").into(),
+            ),
             (None, None) => CliError::from(e),
         },
     }

@@ -54,8 +54,8 @@ pub enum SessionError {
 
 impl SessionError {
     /// For a reading that failed midway: the failure, then that the readings before it are
-    /// safe in the journal and how to go on. The caller puts which reading it was in front,
-    /// in its own words. None for the other errors.
+    /// safe in the journal. The caller puts which reading it was in front and how to go on
+    /// after, in its own words and options. None for the other errors.
     pub fn safe_so_far(&self) -> Option<String> {
         let SessionError::Step {
             total,
@@ -68,7 +68,7 @@ impl SessionError {
             return None;
         };
         Some(format!(
-            "{source}\n  {done} of {total} readings are safe in {}; fix the cause and run the same command with --resume",
+            "{source}\n  {done} of {total} readings are safe in {}",
             journal.display()
         ))
     }
