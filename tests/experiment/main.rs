@@ -9,4 +9,5 @@ mod experiment_external;
 mod experiment_image;
 mod experiment_kill;
 mod lab;
+mod lab_study;
 mod report_browser;

@@ -6,6 +6,7 @@
 //! `metamer experiment`, and is re-used while its inputs are unchanged. `lab.json` sums the
 //! validation up.
 
+pub mod compare;
 mod error;
 
 pub use error::LabError;
