@@ -28,11 +28,31 @@ pub struct LogLogChart<'a> {
 /// their output policy.
 pub fn log_log_svg(chart: &LogLogChart) -> Result<String, String> {
     let mut svg = String::new();
-    draw_log_log(chart, &mut svg)?;
+    draw_log_log(chart, &mut svg, &SeriesLook::of)?;
     Ok(svg)
 }
 
-fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
+/// Draws `chart` as [`log_log_svg`] does, series `i` in the colour and marker of
+/// `looks[i].0` and dashed where `looks[i].1`: for a chart whose series come in pairs to
+/// be told apart by one feature each (a side by its colour, a plan by its dash).
+pub fn log_log_svg_paired(chart: &LogLogChart, looks: &[(usize, bool)]) -> Result<String, String> {
+    let mut svg = String::new();
+    let look = |i: usize| {
+        let (k, dashed) = looks.get(i).copied().unwrap_or((i, false));
+        SeriesLook {
+            dashed,
+            ..SeriesLook::of(k)
+        }
+    };
+    draw_log_log(chart, &mut svg, &look)?;
+    Ok(svg)
+}
+
+fn draw_log_log(
+    chart: &LogLogChart,
+    svg: &mut String,
+    look_of: &dyn Fn(usize) -> SeriesLook,
+) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let points = chart
         .series
@@ -73,7 +93,7 @@ fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
         .draw()
         .map_err(|e| err(&e))?;
     for (i, s) in chart.series.iter().enumerate() {
-        let look = SeriesLook::of(i);
+        let look = look_of(i);
         let line = look.colour.stroke_width(2);
         let fill = look.colour.filled();
         let pts: Vec<(f64, f64)> = s

@@ -71,6 +71,10 @@ pub struct Request {
     /// Read each patch on the display until its ΔE*ab against the box is decided, this
     /// margin beyond the JND; None: always `repeats` readings.
     pub until_decided: Option<f64>,
+    /// Another run's folder, measured with another plan on the same rig: the report's
+    /// cost section sets its measuring cost and accuracy beside this run's, from its saved
+    /// files alone.
+    pub compare_with: Option<PathBuf>,
     /// Run only this stage (again, even if its inputs are unchanged).
     pub stage: Option<Stage>,
     /// Every stage again, one at a time, even those whose inputs are unchanged (earlier
@@ -210,6 +214,7 @@ impl Request {
     ///     reproduction: ReproductionOptions { gamut: GamutMapping::NearestLab, mirror: true },
     ///     repeats: 3,
     ///     until_decided: None,
+    ///     compare_with: None,
     ///     stage: Some(Stage::Box),
     ///     rerun_all: false,
     ///     resume: false,
@@ -269,6 +274,9 @@ impl Request {
         }
         check_dir(&self.dir)?;
         check_until_decided(self.until_decided, self.repeats)?;
+        if let Some(d) = self.compare_with.as_ref().filter(|d| !d.is_dir()) {
+            return Err(RequestError::CompareWith(d.clone()));
+        }
         let given_readings = self.check_inputs()?;
         let box_source = match &self.box_source {
             BoxRequest::Given { scene, spots } => BoxSource::Existing {
@@ -305,6 +313,7 @@ impl Request {
             reproduction: self.reproduction.clone(),
             repeats: self.repeats,
             until_decided: self.until_decided,
+            compare_with: self.compare_with.clone(),
             stage: self.stage,
             resume: self.resume,
             unattended: self.unattended,
@@ -358,6 +367,8 @@ pub enum RequestError {
     ImageSpp,
     #[error("-o {}: exists and is not a directory", .0.display())]
     OutNotDir(PathBuf),
+    #[error("--compare-with {}: not a directory", .0.display())]
+    CompareWith(PathBuf),
     /// The instruments and the box's light make no rig.
     #[error(transparent)]
     BoxLight(#[from] BoxLightError),
@@ -381,6 +392,7 @@ impl RequestError {
         matches!(
             self,
             RequestError::TargetDe
+                | RequestError::CompareWith(_)
                 | RequestError::Repeats { .. }
                 | RequestError::BoxRepeats
                 | RequestError::UntilDecided(_)

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::error::ExperimentError;
-use super::report_input::{gather, Layout};
+use super::report_input::{compare_with, gather, Layout};
 use crate::color::Xyz;
 use crate::validation::job::{self, Context, Coverage, ReadingFiles, Request, White};
 use crate::validation::{AssessOptions, ReportInput, ValidationError};
@@ -21,6 +21,7 @@ fn request<'a>(
     white: Xyz,
     files: &ReadingFiles<'a>,
     out_of_gamut: &[usize],
+    compare: Option<&Path>,
 ) -> Request<'a> {
     let root = dir.parent().unwrap_or(dir);
     let layout = Layout::of(root, files.box_readings);
@@ -30,7 +31,10 @@ fn request<'a>(
         sides.push(("simulation", simulation, 0));
     }
     sides.push(("display", files.display, 0));
-    let sections = gather(&layout, &sides);
+    let mut sections = gather(&layout, &sides);
+    if let Some(other) = compare {
+        compare_with(&mut sections, other);
+    }
     Request {
         readings: *files,
         white: White::Measured {
@@ -82,19 +86,22 @@ pub fn report_input(
     files: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
 ) -> Result<ReportInput, ExperimentError> {
-    job::report(&request(dir, white, files, out_of_gamut)).map_err(stage_error)
+    job::report(&request(dir, white, files, out_of_gamut, None)).map_err(stage_error)
 }
 
 /// Compares box, display and simulation: the point comparisons' CSV and ΔE chart each,
 /// then the assessments with uncertainty into `comparisons.json` and the report. The
-/// readings are read from `inputs`, once, by the validation's reader.
+/// readings are read from `inputs`, once, by the validation's reader; the report's cost
+/// section sets the run saved in `compare` beside this one.
 pub fn validate(
     dir: &Path,
     white: Xyz,
     inputs: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
+    compare: Option<&Path>,
 ) -> Result<(ValidationResult, Vec<String>), ExperimentError> {
-    let outcome = job::validate(&request(dir, white, inputs, out_of_gamut)).map_err(stage_error)?;
+    let outcome =
+        job::validate(&request(dir, white, inputs, out_of_gamut, compare)).map_err(stage_error)?;
     let files = outcome
         .files
         .iter()

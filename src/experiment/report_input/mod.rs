@@ -7,6 +7,7 @@
 //! the inputs with their SHA-256. A file that is missing or unreadable leaves its section
 //! out with a note saying which file and why; it never fails the report.
 
+mod cost;
 mod display;
 mod files;
 mod instruments;
@@ -16,9 +17,9 @@ mod render;
 use std::path::{Path, PathBuf};
 
 use crate::digest::sha256_file;
-use crate::session::Cost;
-use crate::validation::report::{CostFigures, InputFile, StageCost};
+use crate::validation::report::InputFile;
 pub use crate::validation::report::{RenderUncertainty, Sections};
+pub use cost::{compare_with, compared_files};
 
 /// Where the stages' files are.
 #[derive(Clone, Debug)]
@@ -81,35 +82,11 @@ pub fn gather(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Sections {
     s.instruments = instruments;
     s.notes.extend(notes);
     s.inputs = inputs(layout, readings);
-    s.measuring_cost = measuring_cost(layout);
+    s.measuring_cost = cost::measuring_cost(layout);
+    let (curves, notes) = cost::curves(layout, crate::validation::cost_curve::THIS_RUN);
+    s.cost_curves = curves;
+    s.notes.extend(notes);
     s
-}
-
-/// Each measuring stage's budget and cost as its files keep them, box first; a stage
-/// whose files keep none (given readings, or a run before budgets were kept) is left out.
-fn measuring_cost(layout: &Layout) -> Vec<StageCost> {
-    let figures = |c: &Cost| CostFigures {
-        readings: c.readings,
-        placements: c.placements,
-        calibrations: c.calibrations,
-        instrument_s: c.instrument_s,
-        rig_s: c.instrument_s + c.operator_s + c.settle_s,
-    };
-    [
-        (super::Stage::Box, &layout.box_dir),
-        (super::Stage::Display, &layout.display_dir),
-        (super::Stage::DisplaySpots, &layout.display_spots_dir),
-    ]
-    .into_iter()
-    .filter_map(|(stage, dir)| {
-        let kept = super::budget::kept(stage.name(), dir)?;
-        Some(StageCost {
-            stage: stage.name().to_string(),
-            budget: figures(&kept.estimate),
-            taken: kept.actual.as_ref().map(figures),
-        })
-    })
-    .collect()
 }
 
 /// The files the report rests on, each with its SHA-256: the three readings files first
