@@ -28,13 +28,14 @@ pub struct LogLogChart<'a> {
 /// their output policy.
 pub fn log_log_svg(chart: &LogLogChart) -> Result<String, String> {
     let mut svg = String::new();
-    draw_log_log(chart, &mut svg, &SeriesLook::of)?;
+    draw_log_log(chart, &mut svg, &SeriesLook::of, false)?;
     Ok(svg)
 }
 
 /// Draws `chart` as [`log_log_svg`] does, series `i` in the colour and marker of
 /// `looks[i].0` and dashed where `looks[i].1`: for a chart whose series come in pairs to
-/// be told apart by one feature each (a side by its colour, a plan by its dash).
+/// be told apart by one feature each (a side by its colour, a plan by its dash). The legend
+/// stands to the right of the plot, where it hides no line.
 pub fn log_log_svg_paired(chart: &LogLogChart, looks: &[(usize, bool)]) -> Result<String, String> {
     let mut svg = String::new();
     let look = |i: usize| {
@@ -44,7 +45,7 @@ pub fn log_log_svg_paired(chart: &LogLogChart, looks: &[(usize, bool)]) -> Resul
             ..SeriesLook::of(k)
         }
     };
-    draw_log_log(chart, &mut svg, &look)?;
+    draw_log_log(chart, &mut svg, &look, true)?;
     Ok(svg)
 }
 
@@ -52,6 +53,7 @@ fn draw_log_log(
     chart: &LogLogChart,
     svg: &mut String,
     look_of: &dyn Fn(usize) -> SeriesLook,
+    legend_right: bool,
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let points = chart
@@ -75,7 +77,13 @@ fn draw_log_log(
     }
     let root = SVGBackend::with_string(svg, chart.size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut c = ChartBuilder::on(&root)
+    let (plot, side) = if legend_right {
+        let (p, s) = root.split_horizontally(chart.size.0 * 62 / 100);
+        (p, Some(s))
+    } else {
+        (root.clone(), None)
+    };
+    let mut c = ChartBuilder::on(&plot)
         .caption(chart.title, ("sans-serif", 20))
         .margin(15)
         .x_label_area_size(40)
@@ -135,13 +143,54 @@ fn draw_log_log(
         .label(label)
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
     }
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
+    match side {
+        Some(side) => legend_beside(&side, chart, look_of).map_err(|e| err(&e))?,
+        None => c
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?,
+    }
     root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// The legend in its own area: each series' line, dash and marker with its name, one a
+/// row, then the target line's.
+fn legend_beside<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &LogLogChart,
+    look_of: &dyn Fn(usize) -> SeriesLook,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = ("sans-serif", 13).into_font();
+    let row = |i: usize| 60 + 22 * i as i32;
+    for (i, s) in chart.series.iter().enumerate() {
+        let look = look_of(i);
+        let y = row(i);
+        let line = look.colour.stroke_width(2);
+        let gap = if look.dashed { 5 } else { 0 };
+        area.draw(&PathElement::new(vec![(8, y), (28 - gap, y)], line))?;
+        area.draw(&PathElement::new(vec![(28 + gap, y), (48, y)], line))?;
+        let mark: Vec<(i32, i32)> = look
+            .marker
+            .outline()
+            .iter()
+            .map(|&(x, dy)| (x + 28, y + dy))
+            .collect();
+        area.draw(&Polygon::new(mark, look.colour.filled()))?;
+        area.draw(&Text::new(
+            s.name.as_str(),
+            (56, y - 7),
+            font.clone().color(&BLACK),
+        ))?;
+    }
+    if let Some((_, label)) = chart.target {
+        let y = row(chart.series.len());
+        area.draw(&PathElement::new(vec![(8, y), (48, y)], BLACK.mix(0.4)))?;
+        area.draw(&Text::new(label, (56, y - 7), font.color(&BLACK)))?;
+    }
     Ok(())
 }
 

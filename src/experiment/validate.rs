@@ -78,15 +78,17 @@ fn stage_error(e: ValidationError) -> ExperimentError {
 /// The report's input from the stages' files: the three comparisons with every side's
 /// uncertainty (the meters' repeatability from their repeats, the render's per-patch
 /// confidence on the simulation's side) and every optional section the earlier stages'
-/// files allow, each missing one noted. `dir` is the validation stage's directory inside
-/// the experiment's.
+/// files allow, each missing one noted, and the measuring cost of the run saved in
+/// `compare` beside this one's. `dir` is the validation stage's directory inside the
+/// experiment's.
 pub fn report_input(
     dir: &Path,
     white: Xyz,
     files: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
+    compare: Option<&Path>,
 ) -> Result<ReportInput, ExperimentError> {
-    job::report(&request(dir, white, files, out_of_gamut, None)).map_err(stage_error)
+    job::report(&request(dir, white, files, out_of_gamut, compare)).map_err(stage_error)
 }
 
 /// Compares box, display and simulation: the point comparisons' CSV and ΔE chart each,
@@ -267,7 +269,7 @@ mod tests {
             simulation: Some(&exp.join("simulation/spots.csv")),
         };
         let white = Xyz::new(29.424_122_518_279_695, 31.015, 34.538_708_337_905_01);
-        let input = report_input(&exp.join("validation"), white, &files, &[]).unwrap();
+        let input = report_input(&exp.join("validation"), white, &files, &[], None).unwrap();
         let formats: Vec<(&str, &str, usize)> = input.inputs[..3]
             .iter()
             .map(|i| (i.role.as_str(), i.format.as_str(), i.patches))

@@ -14,10 +14,11 @@
 //! that of one reading over √m. Its last point is the run as measured. The half-width is
 //! the side's own share of the verdict intervals: a comparison's interval holds both sides'.
 //!
-//! **Minutes.** A point's time is its readings at the stage's mean instrument and settle
-//! time per reading, plus the stage's placements at the budget's time per placement, both
-//! from the cost the stage's files keep (the instrument's time at its real pace): the same
-//! for a simulated rig, whatever its time scale, as for a real one.
+//! **Minutes.** A point's time is its readings at the stage's budgeted instrument and
+//! settle time per reading, plus the stage's placements at the budget's time per
+//! placement, from the budget the stage's files keep (the instrument's time at its real
+//! pace, from each model's protocol facts): the same for a simulated rig, whatever its time
+//! scale, as for a real one.
 
 use serde::{Deserialize, Serialize};
 
@@ -184,7 +185,7 @@ pub fn charts(curves: &[CostCurve]) -> Result<[String; 2], String> {
                 y_desc: "ΔE*ab",
                 series,
                 target: Some((super::assess::JND_DE76, &jnd)),
-                size: (720, 440),
+                size: (1000, 440),
             },
             &looks,
         )

@@ -187,18 +187,20 @@ fn cost_report(v: &Value) -> Option<CostReport> {
     serde_json::from_value(v.clone()).ok()
 }
 
-/// The stage's time per reading (instrument and settle, from what it took, else its
-/// budget), its placements and the budget's time per placement; nothing without a cost.
+/// The stage's time per reading (instrument and settle) and per placement as its budget
+/// states them, and its placements (what it took, else its budget); nothing without a
+/// cost. The budget's figures, not the clock's, so a simulated rig's minutes are a real
+/// one's.
 fn pace(c: Option<&CostReport>) -> Pace {
     let Some(c) = c else {
         return Pace::default();
     };
-    let taken = c.actual.as_ref().unwrap_or(&c.estimate);
+    let b = &c.estimate;
     let per = |s: f64, n: usize| if n > 0 { s / n as f64 } else { 0.0 };
     Pace {
-        reading_s: per(taken.instrument_s + taken.settle_s, taken.readings),
-        placement_s: per(c.estimate.operator_s, c.estimate.placements),
-        placements: taken.placements,
+        reading_s: per(b.instrument_s + b.settle_s, b.readings),
+        placement_s: per(b.operator_s, b.placements),
+        placements: c.actual.as_ref().unwrap_or(b).placements,
     }
 }
 
@@ -352,8 +354,8 @@ mod tests {
     use super::super::files::testdir;
     use super::*;
 
-    /// A hand-built display-spot journal: patch 1 read twice, patch 2 once, with a cost
-    /// of 3 readings taking 0.6 s and 2 placements budgeted at 30 s each. The curve's
+    /// A hand-built display-spot journal: patch 1 read twice, patch 2 once, with a budget
+    /// of 4 readings of 0.8 s and 2 placements of 30 s each (3 readings taken). The curve's
     /// readings are 2 (one each) then 3; its minutes (2·0.2 + 60)/60 and (3·0.2 + 60)/60;
     /// at m = 1 the median of the two one-reading half-widths h₁, h₂ is (h₁ + h₂)/2, at
     /// m = 2 it is (h₁/√2 + h₂)/2, so their difference is h₁(1 − 1/√2)/2.
@@ -378,13 +380,14 @@ mod tests {
             estimate: Cost {
                 readings: 4,
                 placements: 2,
+                instrument_s: 0.8,
                 operator_s: 60.0,
                 ..Cost::default()
             },
             actual: Some(Cost {
                 readings: 3,
                 placements: 2,
-                instrument_s: 0.6,
+                instrument_s: 0.9,
                 ..Cost::default()
             }),
         };

@@ -51,9 +51,9 @@ fn cost_chart(h: &mut String, input: &ReportInput) {
         h,
         "<figure id=\"cost-chart\"><div class=\"scroll\">{}</div><div class=\"scroll\">{}</div>\
          <figcaption><b>Accuracy against measuring cost.</b> Top: against readings; bottom: \
-         against the minutes a rig takes for them (each reading at its stage's instrument and \
-         settle time per reading, at the instrument's real pace, and every placement of the \
-         stage at the budget's time per placement). Box and display spots: the median over the \
+         against the minutes a rig takes for them (each reading at its stage's budgeted \
+         instrument and settle time per reading, at the instrument's real pace, and every \
+         placement of the stage at the budget's time per placement). Box and display spots: the median over the \
          patches of the 95 % half-width (ΔE*ab) of each patch's mean reading in CIELAB \
          relative to the display's white, had every patch stopped after its first m readings \
          (m = 1, 2, …; the last point is the run as measured); one reading's noise is the \
@@ -78,7 +78,7 @@ fn cost_chart(h: &mut String, input: &ReportInput) {
         };
         let _ = write!(
             h,
-            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.1}</td><td>{:.3}</td></tr>",
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.2}</td><td>{:.3}</td></tr>",
             esc(&c.side),
             esc(&c.plan),
             esc(if c.run == THIS_RUN { THIS_RUN } else { &c.run }),
