@@ -28,8 +28,6 @@ KNOWN = {
     "src/display/diagnostics.rs:judge",
     "src/display/icc/lut.rs:b2a",
     "src/experiment/display_spots/mod.rs:measure",
-    "src/experiment/report_input/display.rs:section",
-    "src/experiment/report_input/light.rs:section",
     "src/experiment/run.rs:run",
     "src/experiment/run.rs:run_stage",
     "src/export/mitsuba3.rs:files",

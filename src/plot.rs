@@ -56,25 +56,7 @@ fn draw_log_log(
     legend_right: bool,
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
-    let points = chart
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
-    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
-    for &(x, y) in points {
-        xmin = xmin.min(x);
-        xmax = xmax.max(x);
-        ymin = ymin.min(y);
-        ymax = ymax.max(y);
-    }
-    if let Some((t, _)) = chart.target {
-        ymin = ymin.min(t);
-        ymax = ymax.max(t);
-    }
-    if xmax <= 0.0 || ymax <= 0.0 {
-        return Err("no positive points to draw".into());
-    }
+    let (xmin, xmax, ymin, ymax) = extent(chart)?;
     let root = SVGBackend::with_string(svg, chart.size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (plot, side) = if legend_right {
@@ -155,6 +137,30 @@ fn draw_log_log(
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+/// The smallest and largest x and y of the chart's positive points and its target.
+fn extent(chart: &LogLogChart) -> Result<(f64, f64, f64, f64), String> {
+    let points = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for &(x, y) in points {
+        xmin = xmin.min(x);
+        xmax = xmax.max(x);
+        ymin = ymin.min(y);
+        ymax = ymax.max(y);
+    }
+    if let Some((t, _)) = chart.target {
+        ymin = ymin.min(t);
+        ymax = ymax.max(t);
+    }
+    if xmax <= 0.0 || ymax <= 0.0 {
+        return Err("no positive points to draw".into());
+    }
+    Ok((xmin, xmax, ymin, ymax))
 }
 
 /// The legend in its own area: each series' line, dash and marker with its name, one a

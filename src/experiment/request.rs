@@ -367,7 +367,7 @@ pub enum RequestError {
     ImageSpp,
     #[error("-o {}: exists and is not a directory", .0.display())]
     OutNotDir(PathBuf),
-    #[error("--compare-with {}: not a directory", .0.display())]
+    #[error("the run to compare with, {}, is not a directory", .0.display())]
     CompareWith(PathBuf),
     /// The instruments and the box's light make no rig.
     #[error(transparent)]

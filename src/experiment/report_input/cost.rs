@@ -10,7 +10,6 @@ use metamer_drivers::MeasureMode;
 use serde_json::Value;
 
 use super::files::read_json;
-use super::Layout;
 use crate::color::{delta_e76, Xyz};
 use crate::experiment::display_spots;
 use crate::experiment::Stage;
@@ -20,7 +19,7 @@ use crate::validation::cost_curve::{
     DISPLAY_SPOTS,
 };
 use crate::validation::repeatability;
-use crate::validation::report::{ComparedCost, CostFigures, StageCost};
+use crate::validation::report::{CostFigures, StageCost};
 
 /// The box's spot journal, beside its summary.
 const BOX_SPOTS_JOURNAL: &str = "spots.jsonl";
@@ -33,7 +32,7 @@ const MAX_JOURNAL_BYTES: u64 = 64 << 20;
 
 /// Each measuring stage's budget and cost as its files keep them, box first; a stage
 /// whose files keep none (given readings, or a run before budgets were kept) is left out.
-pub fn measuring_cost(layout: &Layout) -> Vec<StageCost> {
+pub fn measuring_cost(layout: RunDirs) -> Vec<StageCost> {
     let figures = |c: &Cost| CostFigures {
         readings: c.readings,
         placements: c.placements,
@@ -54,17 +53,17 @@ pub fn measuring_cost(layout: &Layout) -> Vec<StageCost> {
         .collect()
 }
 
-fn stage_dirs(layout: &Layout) -> [(Stage, &Path); 3] {
+fn stage_dirs(layout: RunDirs<'_>) -> [(Stage, &Path); 3] {
     [
-        (Stage::Box, &layout.box_dir),
-        (Stage::Display, &layout.display_dir),
-        (Stage::DisplaySpots, &layout.display_spots_dir),
+        (Stage::Box, layout.box_dir),
+        (Stage::Display, layout.display_dir),
+        (Stage::DisplaySpots, layout.display_spots_dir),
     ]
 }
 
 /// Every side's curve of the run under `layout`, named `run`, with a note for each side
 /// whose files do not give one.
-pub fn curves(layout: &Layout, run: &str) -> (Vec<CostCurve>, Vec<String>) {
+pub fn curves(layout: RunDirs, run: &str) -> (Vec<CostCurve>, Vec<String>) {
     let mut out = Vec::new();
     let mut notes = Vec::new();
     let display = read_json(
@@ -126,32 +125,17 @@ pub fn curves(layout: &Layout, run: &str) -> (Vec<CostCurve>, Vec<String>) {
     (out, notes)
 }
 
-/// Adds the run saved in `dir` (an experiment's or `lab`'s folder, measured with another
-/// plan on the same rig) to `sections`: its stages' costs and its curves, named by the
-/// folder's name. A folder without these files adds notes only.
-pub fn compare_with(sections: &mut super::Sections, dir: &Path) {
-    let run = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| dir.display().to_string());
-    let layout = Layout::of(dir, &dir.join(Stage::Box.name()).join("spots.csv"));
-    let stages = measuring_cost(&layout);
-    if stages.is_empty() {
-        sections.notes.push(format!(
-            "the compared run {} keeps no measuring cost",
-            dir.display()
-        ));
-    }
-    let (curves, notes) = curves(&layout, &run);
-    sections.compared_cost = Some(ComparedCost { run, stages });
-    sections.cost_curves.extend(curves);
-    sections.notes.extend(notes);
+/// The measuring stages' directories of one run.
+#[derive(Clone, Copy, Debug)]
+pub struct RunDirs<'a> {
+    pub box_dir: &'a Path,
+    pub display_dir: &'a Path,
+    pub display_spots_dir: &'a Path,
 }
 
-/// The files of the run in `dir` that [`compare_with`] reads, by a name for each, those
-/// that exist.
-pub fn compared_files(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
-    let layout = Layout::of(dir, &dir.join(Stage::Box.name()).join("spots.csv"));
+/// The files of the run in `layout` that a comparison with it reads, by a name for each,
+/// those that exist.
+pub fn compared_files(layout: RunDirs) -> Vec<(String, std::path::PathBuf)> {
     [
         ("compared box", layout.box_dir.join("summary.json")),
         ("compared box spots", layout.box_dir.join(BOX_SPOTS_JOURNAL)),
@@ -428,11 +412,15 @@ mod tests {
     #[test]
     fn a_run_without_its_files_gives_notes_only() {
         let dir = testdir::fresh("cost-none");
-        let layout = Layout::of(&dir, &dir.join("box/spots.csv"));
-        let (c, notes) = curves(&layout, "this run");
+        let layout = RunDirs {
+            box_dir: &dir.join("box"),
+            display_dir: &dir.join("display"),
+            display_spots_dir: &dir.join("display-spots"),
+        };
+        let (c, notes) = curves(layout, "this run");
         assert!(c.is_empty());
         assert_eq!(notes.len(), 2, "{notes:?}");
-        assert!(measuring_cost(&layout).is_empty());
+        assert!(measuring_cost(layout).is_empty());
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -17,9 +17,8 @@ mod render;
 use std::path::{Path, PathBuf};
 
 use crate::digest::sha256_file;
-use crate::validation::report::InputFile;
+use crate::validation::report::{ComparedCost, InputFile};
 pub use crate::validation::report::{RenderUncertainty, Sections};
-pub use cost::{compare_with, compared_files};
 
 /// Where the stages' files are.
 #[derive(Clone, Debug)]
@@ -51,6 +50,43 @@ impl Layout {
             display_spots_dir: stage(super::Stage::DisplaySpots),
         }
     }
+
+    /// The measuring stages' directories.
+    pub fn dirs(&self) -> cost::RunDirs<'_> {
+        cost::RunDirs {
+            box_dir: &self.box_dir,
+            display_dir: &self.display_dir,
+            display_spots_dir: &self.display_spots_dir,
+        }
+    }
+}
+
+/// The files of the run saved in `dir` that [`compare_with`] reads, by a name for each.
+pub fn compared_files(dir: &Path) -> Vec<(String, PathBuf)> {
+    let layout = Layout::of(dir, &dir.join(super::Stage::Box.name()).join("spots.csv"));
+    cost::compared_files(layout.dirs())
+}
+
+/// Adds the run saved in `dir` (an experiment's or `lab`'s folder, measured with another
+/// plan on the same rig) to `sections`: its stages' costs and its curves, named by the
+/// folder's name. A folder without these files adds notes only.
+pub fn compare_with(sections: &mut Sections, dir: &Path) {
+    let run = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string());
+    let layout = Layout::of(dir, &dir.join(super::Stage::Box.name()).join("spots.csv"));
+    let stages = cost::measuring_cost(layout.dirs());
+    if stages.is_empty() {
+        sections.notes.push(format!(
+            "the compared run {} keeps no measuring cost",
+            dir.display()
+        ));
+    }
+    let (curves, notes) = cost::curves(layout.dirs(), &run);
+    sections.compared_cost = Some(ComparedCost { run, stages });
+    sections.cost_curves.extend(curves);
+    sections.notes.extend(notes);
 }
 
 /// Gathers every section from the files under `layout`.
@@ -82,8 +118,8 @@ pub fn gather(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Sections {
     s.instruments = instruments;
     s.notes.extend(notes);
     s.inputs = inputs(layout, readings);
-    s.measuring_cost = cost::measuring_cost(layout);
-    let (curves, notes) = cost::curves(layout, crate::validation::cost_curve::THIS_RUN);
+    s.measuring_cost = cost::measuring_cost(layout.dirs());
+    let (curves, notes) = cost::curves(layout.dirs(), crate::validation::cost_curve::THIS_RUN);
     s.cost_curves = curves;
     s.notes.extend(notes);
     s
