@@ -57,6 +57,22 @@ fn draw_log_log(
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let (xmin, xmax, ymin, ymax) = extent(chart)?;
+    // The paired charts' axes start at a power of ten, where plotters' log axis starts its
+    // labels, and label 1, 2 and 5 of each decade, so a range within one decade is
+    // labelled too without crowding its top.
+    let (x0, y0) = if legend_right {
+        (decade_below(xmin * 0.8), decade_below(ymin * 0.8))
+    } else {
+        (xmin * 0.8, ymin * 0.8)
+    };
+    let labels = if legend_right { 30 } else { 10 };
+    let label = |v: &f64| {
+        if legend_right && !one_two_five(*v) {
+            String::new()
+        } else {
+            tick(*v)
+        }
+    };
     let root = SVGBackend::with_string(svg, chart.size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (plot, side) = if legend_right {
@@ -70,14 +86,13 @@ fn draw_log_log(
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(
-            (xmin * 0.8..xmax * 1.25).log_scale(),
-            (ymin * 0.8..ymax * 1.25).log_scale(),
-        )
+        .build_cartesian_2d((x0..xmax * 1.25).log_scale(), (y0..ymax * 1.25).log_scale())
         .map_err(|e| err(&e))?;
     c.configure_mesh()
-        .x_label_formatter(&|x| tick(*x))
-        .y_label_formatter(&|y| tick(*y))
+        .x_labels(labels)
+        .y_labels(labels)
+        .x_label_formatter(&label)
+        .y_label_formatter(&label)
         .x_desc(chart.x_desc)
         .y_desc(chart.y_desc)
         .draw()
@@ -139,6 +154,19 @@ fn draw_log_log(
     Ok(())
 }
 
+/// The largest power of ten at or below `v` (> 0).
+fn decade_below(v: f64) -> f64 {
+    10f64.powf(v.log10().floor())
+}
+
+/// Whether `v` is 1, 2 or 5 times a power of ten.
+fn one_two_five(v: f64) -> bool {
+    let m = v / decade_below(v);
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .any(|k| (m - k).abs() < 1e-6 * k)
+}
+
 /// The smallest and largest x and y of the chart's positive points and its target.
 fn extent(chart: &LogLogChart) -> Result<(f64, f64, f64, f64), String> {
     let points = chart
@@ -176,9 +204,15 @@ fn legend_beside<DB: DrawingBackend>(
         let look = look_of(i);
         let y = row(i);
         let line = look.colour.stroke_width(2);
-        let gap = if look.dashed { 5 } else { 0 };
-        area.draw(&PathElement::new(vec![(8, y), (28 - gap, y)], line))?;
-        area.draw(&PathElement::new(vec![(28 + gap, y), (48, y)], line))?;
+        // A dashed line's sample in dashes on either side of the marker.
+        let dashes: &[(i32, i32)] = if look.dashed {
+            &[(4, 10), (14, 20), (36, 42), (46, 52)]
+        } else {
+            &[(4, 52)]
+        };
+        for &(a, b) in dashes {
+            area.draw(&PathElement::new(vec![(a, y), (b, y)], line))?;
+        }
         let mark: Vec<(i32, i32)> = look
             .marker
             .outline()
@@ -188,14 +222,14 @@ fn legend_beside<DB: DrawingBackend>(
         area.draw(&Polygon::new(mark, look.colour.filled()))?;
         area.draw(&Text::new(
             s.name.as_str(),
-            (56, y - 7),
+            (60, y - 7),
             font.clone().color(&BLACK),
         ))?;
     }
     if let Some((_, label)) = chart.target {
         let y = row(chart.series.len());
-        area.draw(&PathElement::new(vec![(8, y), (48, y)], BLACK.mix(0.4)))?;
-        area.draw(&Text::new(label, (56, y - 7), font.color(&BLACK)))?;
+        area.draw(&PathElement::new(vec![(4, y), (52, y)], BLACK.mix(0.4)))?;
+        area.draw(&Text::new(label, (60, y - 7), font.color(&BLACK)))?;
     }
     Ok(())
 }
@@ -282,6 +316,18 @@ fn tick(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn paired_axes_label_one_two_and_five_of_each_decade() {
+        assert_eq!(decade_below(0.24), 0.1);
+        assert_eq!(decade_below(19.2), 10.0);
+        for v in [0.1, 0.2, 0.5, 1.0, 20.0, 500.0] {
+            assert!(one_two_five(v), "{v}");
+        }
+        for v in [0.3, 0.7, 3.0, 90.0] {
+            assert!(!one_two_five(v), "{v}");
+        }
+    }
 
     #[test]
     fn ticks_drop_spurious_decimals() {

@@ -202,4 +202,64 @@ mod tests {
         cost_table(&mut h, &[not_run], None);
         assert!(h.contains("budget 72 (not run)"), "{h}");
     }
+
+    /// With a compared run: its stages' rows and total after this run's, the chart drawn
+    /// against readings and minutes with a line per run, and each line's last point.
+    #[test]
+    fn a_compared_run_joins_the_table_and_the_chart() {
+        use crate::validation::cost_curve::{CostCurve, CurvePoint, BOX_SPOTS};
+        let f = |readings| CostFigures {
+            readings,
+            ..CostFigures::default()
+        };
+        let stage = |readings| StageCost {
+            stage: "box".into(),
+            budget: f(readings),
+            taken: Some(f(readings)),
+        };
+        let point = |readings, minutes, value| CurvePoint {
+            readings,
+            minutes,
+            value,
+        };
+        let curve = |plan: &str, run: &str, last| CostCurve {
+            side: BOX_SPOTS.into(),
+            plan: plan.into(),
+            run: run.into(),
+            measure: String::new(),
+            points: vec![point(24, 12.0, 0.6), last],
+        };
+        let input = ReportInput {
+            measuring_cost: vec![stage(72)],
+            compared_cost: Some(ComparedCost {
+                run: "fixed-run".into(),
+                stages: vec![stage(120)],
+            }),
+            cost_curves: vec![
+                curve("until narrow enough", THIS_RUN, point(72, 12.2, 0.35)),
+                curve("fixed, 5 readings", "fixed-run", point(120, 12.4, 0.27)),
+            ],
+            ..ReportInput::default()
+        };
+        let mut h = String::new();
+        cost_section(&mut h, &input);
+        assert!(h.contains("<td class=\"l\">all</td><td>72</td>"), "{h}");
+        assert!(
+            h.contains("<td class=\"l\">all (fixed-run)</td><td>120</td>"),
+            "{h}"
+        );
+        assert!(h.contains("id=\"cost-chart\""), "{h}");
+        assert!(h.contains("dashed: fixed-run."), "{h}");
+        for line in [
+            "box spots, until narrow enough (this run)",
+            "box spots, fixed, 5 readings (fixed-run)",
+        ] {
+            assert_eq!(h.matches(line).count(), 2, "{line}");
+        }
+        assert!(h.contains("<td>72</td><td>12.20</td><td>0.350</td>"), "{h}");
+        assert!(
+            h.contains("<td>120</td><td>12.40</td><td>0.270</td>"),
+            "{h}"
+        );
+    }
 }
