@@ -60,8 +60,12 @@ fn draw_log_log(
     // The paired charts' axes start at a power of ten, where plotters' log axis starts its
     // labels, and label 1, 2 and 5 of each decade, so a range within one decade is
     // labelled too without crowding its top.
+    // (A hair below it: plotters rounds the log of an exact power of ten up past it.)
     let (x0, y0) = if legend_right {
-        (decade_below(xmin * 0.8), decade_below(ymin * 0.8))
+        (
+            decade_below(xmin * 0.8) * 0.999,
+            decade_below(ymin * 0.8) * 0.999,
+        )
     } else {
         (xmin * 0.8, ymin * 0.8)
     };
@@ -88,15 +92,18 @@ fn draw_log_log(
         .y_label_area_size(60)
         .build_cartesian_2d((x0..xmax * 1.25).log_scale(), (y0..ymax * 1.25).log_scale())
         .map_err(|e| err(&e))?;
-    c.configure_mesh()
-        .x_labels(labels)
+    let mut mesh = c.configure_mesh();
+    mesh.x_labels(labels)
         .y_labels(labels)
         .x_label_formatter(&label)
         .y_label_formatter(&label)
         .x_desc(chart.x_desc)
-        .y_desc(chart.y_desc)
-        .draw()
-        .map_err(|e| err(&e))?;
+        .y_desc(chart.y_desc);
+    if legend_right {
+        // Only the labelled decades' lines: the lines between them would grey the plot.
+        mesh.light_line_style(WHITE);
+    }
+    mesh.draw().map_err(|e| err(&e))?;
     for (i, s) in chart.series.iter().enumerate() {
         let look = look_of(i);
         let line = look.colour.stroke_width(2);
@@ -133,7 +140,7 @@ fn draw_log_log(
     }
     if let Some((t, label)) = chart.target {
         c.draw_series(LineSeries::new(
-            vec![(xmin * 0.8, t), (xmax * 1.25, t)],
+            vec![(x0, t), (xmax * 1.25, t)],
             BLACK.mix(0.4),
         ))
         .map_err(|e| err(&e))?
