@@ -231,9 +231,10 @@ mod tests {
         let c = repeats_curve(&[t(4, 2.0), t(1, 0.5), t(2, 1.0)], pace);
         let readings: Vec<usize> = c.iter().map(|p| p.readings).collect();
         assert_eq!(readings, [3, 5, 6, 7]);
-        let expect = [1.0, 0.707_107, 0.707_107, 0.707_107];
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        let expect = [1.0, r, r, r];
         for (p, e) in c.iter().zip(expect) {
-            assert!((p.value - e).abs() < 1e-6, "{c:?}");
+            assert!((p.value - e).abs() < 1e-12, "{c:?}");
         }
         let minutes = [66.0 / 60.0, 70.0 / 60.0, 72.0 / 60.0, 74.0 / 60.0];
         for (p, e) in c.iter().zip(minutes) {
