@@ -57,26 +57,12 @@ fn draw_log_log(
 ) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let (xmin, xmax, ymin, ymax) = extent(chart)?;
-    // The paired charts' axes start at a power of ten, where plotters' log axis starts its
-    // labels, and label 1, 2 and 5 of each decade, so a range within one decade is
-    // labelled too without crowding its top.
-    // (A hair below it: plotters rounds the log of an exact power of ten up past it.)
-    let (x0, y0) = if legend_right {
-        (
-            decade_below(xmin * 0.8) * 0.999,
-            decade_below(ymin * 0.8) * 0.999,
-        )
-    } else {
-        (xmin * 0.8, ymin * 0.8)
-    };
+    let (x0, y0) = (
+        axis_start(xmin, legend_right),
+        axis_start(ymin, legend_right),
+    );
     let labels = if legend_right { 30 } else { 10 };
-    let label = |v: &f64| {
-        if legend_right && !one_two_five(*v) {
-            String::new()
-        } else {
-            tick(*v)
-        }
-    };
+    let label = |v: &f64| paired_tick(*v, legend_right);
     let root = SVGBackend::with_string(svg, chart.size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (plot, side) = if legend_right {
@@ -159,6 +145,28 @@ fn draw_log_log(
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+/// Where an axis whose smallest value is `min` starts: a fifth below it; for a paired
+/// chart at the power of ten below that, where plotters' log axis starts its labels, so a
+/// range within one decade is labelled too (a hair below it: plotters rounds the log of an
+/// exact power of ten up past it).
+fn axis_start(min: f64, paired: bool) -> f64 {
+    if paired {
+        decade_below(min * 0.8) * 0.999
+    } else {
+        min * 0.8
+    }
+}
+
+/// A tick's label; a paired chart labels only 1, 2 and 5 of each decade, so its labels
+/// do not crowd a decade's top.
+fn paired_tick(v: f64, paired: bool) -> String {
+    if paired && !one_two_five(v) {
+        String::new()
+    } else {
+        tick(v)
+    }
 }
 
 /// The largest power of ten at or below `v` (> 0).
