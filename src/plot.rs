@@ -28,52 +28,70 @@ pub struct LogLogChart<'a> {
 /// their output policy.
 pub fn log_log_svg(chart: &LogLogChart) -> Result<String, String> {
     let mut svg = String::new();
-    draw_log_log(chart, &mut svg)?;
+    draw_log_log(chart, &mut svg, &SeriesLook::of, false)?;
     Ok(svg)
 }
 
-fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
+/// Draws `chart` as [`log_log_svg`] does, series `i` in the colour and marker of
+/// `looks[i].0` and dashed where `looks[i].1`: for a chart whose series come in pairs to
+/// be told apart by one feature each (a side by its colour, a plan by its dash). The legend
+/// stands to the right of the plot, where it hides no line.
+pub fn log_log_svg_paired(chart: &LogLogChart, looks: &[(usize, bool)]) -> Result<String, String> {
+    let mut svg = String::new();
+    let look = |i: usize| {
+        let (k, dashed) = looks.get(i).copied().unwrap_or((i, false));
+        SeriesLook {
+            dashed,
+            ..SeriesLook::of(k)
+        }
+    };
+    draw_log_log(chart, &mut svg, &look, true)?;
+    Ok(svg)
+}
+
+fn draw_log_log(
+    chart: &LogLogChart,
+    svg: &mut String,
+    look_of: &dyn Fn(usize) -> SeriesLook,
+    legend_right: bool,
+) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
-    let points = chart
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
-    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
-    for &(x, y) in points {
-        xmin = xmin.min(x);
-        xmax = xmax.max(x);
-        ymin = ymin.min(y);
-        ymax = ymax.max(y);
-    }
-    if let Some((t, _)) = chart.target {
-        ymin = ymin.min(t);
-        ymax = ymax.max(t);
-    }
-    if xmax <= 0.0 || ymax <= 0.0 {
-        return Err("no positive points to draw".into());
-    }
+    let (xmin, xmax, ymin, ymax) = extent(chart)?;
+    let (x0, y0) = (
+        axis_start(xmin, legend_right),
+        axis_start(ymin, legend_right),
+    );
+    let labels = if legend_right { 30 } else { 10 };
+    let label = |v: &f64| paired_tick(*v, legend_right);
     let root = SVGBackend::with_string(svg, chart.size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut c = ChartBuilder::on(&root)
+    let (plot, side) = if legend_right {
+        let (p, s) = root.split_horizontally(chart.size.0 * 62 / 100);
+        (p, Some(s))
+    } else {
+        (root.clone(), None)
+    };
+    let mut c = ChartBuilder::on(&plot)
         .caption(chart.title, ("sans-serif", 20))
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(
-            (xmin * 0.8..xmax * 1.25).log_scale(),
-            (ymin * 0.8..ymax * 1.25).log_scale(),
-        )
+        .build_cartesian_2d((x0..xmax * 1.25).log_scale(), (y0..ymax * 1.25).log_scale())
         .map_err(|e| err(&e))?;
-    c.configure_mesh()
-        .x_label_formatter(&|x| tick(*x))
-        .y_label_formatter(&|y| tick(*y))
+    let mut mesh = c.configure_mesh();
+    mesh.x_labels(labels)
+        .y_labels(labels)
+        .x_label_formatter(&label)
+        .y_label_formatter(&label)
         .x_desc(chart.x_desc)
-        .y_desc(chart.y_desc)
-        .draw()
-        .map_err(|e| err(&e))?;
+        .y_desc(chart.y_desc);
+    if legend_right {
+        // Only the labelled decades' lines: the lines between them would grey the plot.
+        mesh.light_line_style(WHITE);
+    }
+    mesh.draw().map_err(|e| err(&e))?;
     for (i, s) in chart.series.iter().enumerate() {
-        let look = SeriesLook::of(i);
+        let look = look_of(i);
         let line = look.colour.stroke_width(2);
         let fill = look.colour.filled();
         let pts: Vec<(f64, f64)> = s
@@ -108,20 +126,126 @@ fn draw_log_log(chart: &LogLogChart, svg: &mut String) -> Result<(), String> {
     }
     if let Some((t, label)) = chart.target {
         c.draw_series(LineSeries::new(
-            vec![(xmin * 0.8, t), (xmax * 1.25, t)],
+            vec![(x0, t), (xmax * 1.25, t)],
             BLACK.mix(0.4),
         ))
         .map_err(|e| err(&e))?
         .label(label)
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
     }
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
+    match side {
+        Some(side) => legend_beside(&side, chart, look_of).map_err(|e| err(&e))?,
+        None => c
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?,
+    }
     root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// Where an axis whose smallest value is `min` starts: a fifth below it; for a paired
+/// chart at the power of ten below that, where plotters' log axis starts its labels, so a
+/// range within one decade is labelled too (a hair below it: plotters rounds the log of an
+/// exact power of ten up past it).
+fn axis_start(min: f64, paired: bool) -> f64 {
+    if paired {
+        decade_below(min * 0.8) * 0.999
+    } else {
+        min * 0.8
+    }
+}
+
+/// A tick's label; a paired chart labels only 1, 2 and 5 of each decade, so its labels
+/// do not crowd a decade's top.
+fn paired_tick(v: f64, paired: bool) -> String {
+    if paired && !one_two_five(v) {
+        String::new()
+    } else {
+        tick(v)
+    }
+}
+
+/// The largest power of ten at or below `v` (> 0).
+fn decade_below(v: f64) -> f64 {
+    10f64.powf(v.log10().floor())
+}
+
+/// Whether `v` is 1, 2 or 5 times a power of ten.
+fn one_two_five(v: f64) -> bool {
+    let m = v / decade_below(v);
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .any(|k| (m - k).abs() < 1e-6 * k)
+}
+
+/// The smallest and largest x and y of the chart's positive points and its target.
+fn extent(chart: &LogLogChart) -> Result<(f64, f64, f64, f64), String> {
+    let points = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0);
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for &(x, y) in points {
+        xmin = xmin.min(x);
+        xmax = xmax.max(x);
+        ymin = ymin.min(y);
+        ymax = ymax.max(y);
+    }
+    if let Some((t, _)) = chart.target {
+        ymin = ymin.min(t);
+        ymax = ymax.max(t);
+    }
+    if xmax <= 0.0 || ymax <= 0.0 {
+        return Err("no positive points to draw".into());
+    }
+    Ok((xmin, xmax, ymin, ymax))
+}
+
+/// The legend in its own area: each series' line, dash and marker with its name, one a
+/// row, then the target line's.
+fn legend_beside<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &LogLogChart,
+    look_of: &dyn Fn(usize) -> SeriesLook,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = ("sans-serif", 13).into_font();
+    let row = |i: usize| 60 + 22 * i as i32;
+    for (i, s) in chart.series.iter().enumerate() {
+        let look = look_of(i);
+        let y = row(i);
+        let line = look.colour.stroke_width(2);
+        // A dashed line's sample in dashes on either side of the marker.
+        let dashes: &[(i32, i32)] = if look.dashed {
+            &[(4, 10), (14, 20), (36, 42), (46, 52)]
+        } else {
+            &[(4, 52)]
+        };
+        for &(a, b) in dashes {
+            area.draw(&PathElement::new(vec![(a, y), (b, y)], line))?;
+        }
+        let mark: Vec<(i32, i32)> = look
+            .marker
+            .outline()
+            .iter()
+            .map(|&(x, dy)| (x + 28, y + dy))
+            .collect();
+        area.draw(&Polygon::new(mark, look.colour.filled()))?;
+        area.draw(&Text::new(
+            s.name.as_str(),
+            (60, y - 7),
+            font.clone().color(&BLACK),
+        ))?;
+    }
+    if let Some((_, label)) = chart.target {
+        let y = row(chart.series.len());
+        area.draw(&PathElement::new(vec![(4, y), (52, y)], BLACK.mix(0.4)))?;
+        area.draw(&Text::new(label, (60, y - 7), font.color(&BLACK)))?;
+    }
     Ok(())
 }
 
@@ -207,6 +331,18 @@ fn tick(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn paired_axes_label_one_two_and_five_of_each_decade() {
+        assert_eq!(decade_below(0.24), 0.1);
+        assert_eq!(decade_below(19.2), 10.0);
+        for v in [0.1, 0.2, 0.5, 1.0, 20.0, 500.0] {
+            assert!(one_two_five(v), "{v}");
+        }
+        for v in [0.3, 0.7, 3.0, 90.0] {
+            assert!(!one_two_five(v), "{v}");
+        }
+    }
 
     #[test]
     fn ticks_drop_spurious_decimals() {

@@ -99,6 +99,11 @@ pub struct Args {
     /// times (e.g. 0.1); without it every patch is read --repeats times.
     #[arg(long, value_name = "ΔE")]
     until_decided: Option<f64>,
+    /// Another run's folder (an experiment's or `lab`'s, measured with another plan on the
+    /// same rig), whose measuring cost and accuracy the report's cost section sets beside
+    /// this run's; read from its saved files, nothing measured again.
+    #[arg(long, value_name = "DIR")]
+    compare_with: Option<PathBuf>,
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Run only this stage (again): box, simulation, display, reproduction, display-spots,
@@ -185,6 +190,7 @@ fn request(args: Args) -> Result<Request, CliError> {
         },
         repeats: args.repeats,
         until_decided: args.until_decided,
+        compare_with: args.compare_with,
         stage: args.stage,
         rerun_all: false,
         resume: args.resume,

@@ -45,6 +45,11 @@ pub struct Args {
     /// times (e.g. 0.1); without it every patch is read --repeats times.
     #[arg(long, value_name = "ΔE")]
     until_decided: Option<f64>,
+    /// Another run's folder (an experiment's or `lab`'s, measured with another plan on the
+    /// same rig), whose measuring cost and accuracy the report's cost section sets beside
+    /// this run's; read from its saved files, nothing measured again.
+    #[arg(long, value_name = "DIR")]
+    compare_with: Option<PathBuf>,
     /// The box measurement plan (see `metamer measure-box --help`), e.g. a spot rule;
     /// default: the paper's.
     #[arg(long, value_name = "PLAN.json")]
@@ -102,6 +107,7 @@ pub fn run(args: Args) -> CliResult {
         target_de: args.target_de,
         repeats: args.repeats,
         until_decided: args.until_decided,
+        compare_with: args.compare_with,
         plan: args.plan,
         box_repeats: args.box_repeats,
         box_adaptive: args.box_plan == PlanKind::Adaptive,

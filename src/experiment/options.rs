@@ -41,6 +41,10 @@ pub struct ExperimentOptions {
     /// margin (ΔE*ab) beyond the JND at 95 % (the verdict rule of
     /// [`crate::validation::sequential`]); None: always `repeats` readings.
     pub until_decided: Option<f64>,
+    /// Another run's folder, measured with another plan on the same rig: the report's
+    /// cost section sets its measuring cost and accuracy beside this run's, from its saved
+    /// files alone.
+    pub compare_with: Option<PathBuf>,
     /// Run only this stage (again, even if its inputs are unchanged).
     pub stage: Option<Stage>,
     /// Continue an interrupted measuring stage's journal.

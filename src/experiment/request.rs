@@ -73,6 +73,10 @@ pub struct Request {
     /// Read each patch on the display until its ΔE*ab against the box is decided, this
     /// margin beyond the JND; None: always `repeats` readings.
     pub until_decided: Option<f64>,
+    /// Another run's folder, measured with another plan on the same rig: the report's
+    /// cost section sets its measuring cost and accuracy beside this run's, from its saved
+    /// files alone.
+    pub compare_with: Option<PathBuf>,
     /// Run only this stage (again, even if its inputs are unchanged).
     pub stage: Option<Stage>,
     /// Every stage again, one at a time, even those whose inputs are unchanged (earlier
@@ -213,6 +217,7 @@ impl Request {
     ///     reproduction: ReproductionOptions { gamut: GamutMapping::NearestLab, mirror: true },
     ///     repeats: 3,
     ///     until_decided: None,
+    ///     compare_with: None,
     ///     stage: Some(Stage::Box),
     ///     rerun_all: false,
     ///     resume: false,
@@ -272,6 +277,9 @@ impl Request {
         }
         check_dir(&self.dir)?;
         check_until_decided(self.until_decided, self.repeats)?;
+        if let Some(d) = self.compare_with.as_ref().filter(|d| !d.is_dir()) {
+            return Err(RequestError::CompareWith(d.clone()));
+        }
         let given_readings = self.check_inputs()?;
         let box_source = match &self.box_source {
             BoxRequest::Given { scene, spots } => BoxSource::Existing {
@@ -310,6 +318,7 @@ impl Request {
             reproduction: self.reproduction.clone(),
             repeats: self.repeats,
             until_decided: self.until_decided,
+            compare_with: self.compare_with.clone(),
             stage: self.stage,
             resume: self.resume,
             unattended: self.unattended,
@@ -364,6 +373,8 @@ pub enum RequestError {
     ImageSpp,
     #[error("-o {}: exists and is not a directory", .0.display())]
     OutNotDir(PathBuf),
+    #[error("the run to compare with, {}, is not a directory", .0.display())]
+    CompareWith(PathBuf),
     /// The instruments and the box's light make no rig.
     #[error(transparent)]
     BoxLight(#[from] BoxLightError),
@@ -387,6 +398,7 @@ impl RequestError {
         matches!(
             self,
             RequestError::TargetDe
+                | RequestError::CompareWith(_)
                 | RequestError::Repeats { .. }
                 | RequestError::BoxRepeats
                 | RequestError::UntilDecided(_)

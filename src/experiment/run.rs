@@ -339,16 +339,30 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
                 i
             }
         }
-        Stage::Validation => Inputs::new()
-            .file("box", &need(stage, box_spots)?)?
-            .file("simulation", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
-            .file(
-                "display",
-                &p(Stage::DisplaySpots, display_spots::SPOTS_FILE)?,
-            )?
-            .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?
-            .file("reproduction", &p(Stage::Reproduction, reproduction::FILE)?)?
-            .value("result", &validate::RESULT_VERSION),
+        Stage::Validation => {
+            let i = Inputs::new()
+                .file("box", &need(stage, box_spots)?)?
+                .file("simulation", &p(Stage::Simulation, simulation::SPOTS_FILE)?)?
+                .file(
+                    "display",
+                    &p(Stage::DisplaySpots, display_spots::SPOTS_FILE)?,
+                )?
+                .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?
+                .file("reproduction", &p(Stage::Reproduction, reproduction::FILE)?)?
+                .value("result", &validate::RESULT_VERSION);
+            // The compared run's files the report reads, so the report is drawn again when
+            // they change; without one the hash stays as it was.
+            match &opts.compare_with {
+                Some(other) => {
+                    let mut i = i.value("compare_with", other);
+                    for (name, path) in super::report_input::compared_files(other) {
+                        i = i.file(&name, &path)?;
+                    }
+                    i
+                }
+                None => i,
+            }
+        }
     })
 }
 
@@ -485,8 +499,13 @@ fn validation_stage(
         display: &display_spots,
         simulation: Some(&sim_spots),
     };
-    let (_, written) =
-        validate::validate(&sd.dir, profile.white_xyz, &files, &r.out_of_gamut_patches)?;
+    let (_, written) = validate::validate(
+        &sd.dir,
+        profile.white_xyz,
+        &files,
+        &r.out_of_gamut_patches,
+        opts.compare_with.as_deref(),
+    )?;
     Ok(written)
 }
 
@@ -523,6 +542,7 @@ mod tests {
             },
             repeats: 1,
             until_decided: None,
+            compare_with: None,
             stage: None,
             resume: false,
             unattended: true,

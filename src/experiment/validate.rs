@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::error::ExperimentError;
-use super::report_input::{gather, Layout};
+use super::report_input::{compare_with, gather, Layout};
 use crate::color::Xyz;
 use crate::validation::job::{self, Context, Coverage, ReadingFiles, Request, White};
 use crate::validation::{AssessOptions, ReportInput, ValidationError};
@@ -21,6 +21,7 @@ fn request<'a>(
     white: Xyz,
     files: &ReadingFiles<'a>,
     out_of_gamut: &[usize],
+    compare: Option<&Path>,
 ) -> Request<'a> {
     let root = dir.parent().unwrap_or(dir);
     let layout = Layout::of(root, files.box_readings);
@@ -30,7 +31,10 @@ fn request<'a>(
         sides.push(("simulation", simulation, 0));
     }
     sides.push(("display", files.display, 0));
-    let sections = gather(&layout, &sides);
+    let mut sections = gather(&layout, &sides);
+    if let Some(other) = compare {
+        compare_with(&mut sections, other);
+    }
     Request {
         readings: *files,
         white: White::Measured {
@@ -74,27 +78,32 @@ fn stage_error(e: ValidationError) -> ExperimentError {
 /// The report's input from the stages' files: the three comparisons with every side's
 /// uncertainty (the meters' repeatability from their repeats, the render's per-patch
 /// confidence on the simulation's side) and every optional section the earlier stages'
-/// files allow, each missing one noted. `dir` is the validation stage's directory inside
-/// the experiment's.
+/// files allow, each missing one noted, and the measuring cost of the run saved in
+/// `compare` beside this one's. `dir` is the validation stage's directory inside the
+/// experiment's.
 pub fn report_input(
     dir: &Path,
     white: Xyz,
     files: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
+    compare: Option<&Path>,
 ) -> Result<ReportInput, ExperimentError> {
-    job::report(&request(dir, white, files, out_of_gamut)).map_err(stage_error)
+    job::report(&request(dir, white, files, out_of_gamut, compare)).map_err(stage_error)
 }
 
 /// Compares box, display and simulation: the point comparisons' CSV and ΔE chart each,
 /// then the assessments with uncertainty into `comparisons.json` and the report. The
-/// readings are read from `inputs`, once, by the validation's reader.
+/// readings are read from `inputs`, once, by the validation's reader; the report's cost
+/// section sets the run saved in `compare` beside this one.
 pub fn validate(
     dir: &Path,
     white: Xyz,
     inputs: &ReadingFiles<'_>,
     out_of_gamut: &[usize],
+    compare: Option<&Path>,
 ) -> Result<(ValidationResult, Vec<String>), ExperimentError> {
-    let outcome = job::validate(&request(dir, white, inputs, out_of_gamut)).map_err(stage_error)?;
+    let outcome =
+        job::validate(&request(dir, white, inputs, out_of_gamut, compare)).map_err(stage_error)?;
     let files = outcome
         .files
         .iter()
@@ -260,7 +269,7 @@ mod tests {
             simulation: Some(&exp.join("simulation/spots.csv")),
         };
         let white = Xyz::new(29.424_122_518_279_695, 31.015, 34.538_708_337_905_01);
-        let input = report_input(&exp.join("validation"), white, &files, &[]).unwrap();
+        let input = report_input(&exp.join("validation"), white, &files, &[], None).unwrap();
         let formats: Vec<(&str, &str, usize)> = input.inputs[..3]
             .iter()
             .map(|i| (i.role.as_str(), i.format.as_str(), i.patches))

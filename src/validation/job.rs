@@ -410,6 +410,8 @@ fn stages_context(report: &mut ReportInput, sides: &Sides, sections: &Sections) 
     report.render_confidence = sections.render_confidence.clone();
     report.instruments = sections.instruments.clone();
     report.measuring_cost = sections.measuring_cost.clone();
+    report.cost_curves = sections.cost_curves.clone();
+    report.compared_cost = sections.compared_cost.clone();
     report.inputs = inputs;
     report.notes = notes;
 }

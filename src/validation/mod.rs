@@ -16,6 +16,7 @@ pub mod assess;
 mod chart;
 mod compare;
 pub mod comparisons;
+pub mod cost_curve;
 pub mod covariance;
 #[cfg(test)]
 mod coverage;

@@ -6,6 +6,7 @@
 //! gathered elsewhere (`experiment::report_input`), into [`Sections`], the one type that
 //! crosses from the gathering to the validation.
 
+mod cost;
 mod sections;
 
 use std::fmt::Write;
@@ -17,14 +18,15 @@ use super::figures::{
 };
 use super::readings::UncertaintySource;
 use super::verdict::verdict_paragraph;
+use cost::cost_section;
 use sections::{
-    cost_section, display_section, inputs_section, instruments_section, light_section,
-    render_section, uncertainty_section,
+    display_section, inputs_section, instruments_section, light_section, render_section,
+    uncertainty_section,
 };
 
 pub use super::report_data::{
-    CostFigures, DisplayModelSection, InputFile, InstrumentUsed, LightFitSection,
-    RenderConfidenceSection, RenderUncertainty, ReportInput, Sections, StageCost,
+    ComparedCost, CostCurve, CostFigures, DisplayModelSection, InputFile, InstrumentUsed,
+    LightFitSection, RenderConfidenceSection, RenderUncertainty, ReportInput, Sections, StageCost,
 };
 
 /// The page's style: readable from a 390 px phone to print. Text runs at most 1000 px wide,
@@ -139,7 +141,7 @@ pub fn render_html(input: &ReportInput) -> String {
         instruments_section(&mut h, &input.instruments);
     }
     if !input.measuring_cost.is_empty() {
-        cost_section(&mut h, &input.measuring_cost);
+        cost_section(&mut h, input);
     }
     if !input.inputs.is_empty() {
         inputs_section(&mut h, &input.inputs);

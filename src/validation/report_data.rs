@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::assess::Assessment;
+pub use super::cost_curve::CostCurve;
 use super::readings::{ReadingSet, UncertaintySource};
 
 /// Everything a report can show. `display_vs_box` is the paper's result and always there;
@@ -42,7 +43,23 @@ pub struct ReportInput {
     /// Each measuring stage's budget before its first reading and what it took.
     #[serde(default)]
     pub measuring_cost: Vec<StageCost>,
+    /// Each side's accuracy against its readings and minutes, this run's and the compared
+    /// run's (`validation::cost_curve`).
+    #[serde(default)]
+    pub cost_curves: Vec<CostCurve>,
+    /// Another run, made with another plan on the same rig, whose cost the report sets
+    /// beside this one's.
+    #[serde(default)]
+    pub compared_cost: Option<ComparedCost>,
     pub notes: Vec<String>,
+}
+
+/// Another run's measuring cost, from its saved folder.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ComparedCost {
+    /// How the report names it (its folder's name).
+    pub run: String,
+    pub stages: Vec<StageCost>,
 }
 
 /// One measuring stage's cost as the report shows it: the budget made before its first
@@ -149,6 +166,8 @@ pub struct Sections {
     pub instruments: Vec<InstrumentUsed>,
     pub inputs: Vec<InputFile>,
     pub measuring_cost: Vec<StageCost>,
+    pub cost_curves: Vec<CostCurve>,
+    pub compared_cost: Option<ComparedCost>,
     pub notes: Vec<String>,
 }
 

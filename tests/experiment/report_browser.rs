@@ -170,7 +170,9 @@ fn validate_report(dir: &Path) -> PathBuf {
 }
 
 /// The experiment's report with every section, from the cut-down experiment directory
-/// `tests/data/report/` (a lab run lit by LED-RGB1), in `dir`.
+/// `tests/data/report/experiment` (a lab run lit by LED-RGB1), compared with the cut-down
+/// run `tests/data/report/adaptive` (the display characterized by the adaptive plan, its
+/// spots read until decided), in `dir`.
 fn experiment_report(dir: &Path) -> PathBuf {
     use metamer::experiment::validate::report_input;
     use metamer::output::OutputPolicy;
@@ -185,7 +187,8 @@ fn experiment_report(dir: &Path) -> PathBuf {
     };
     let white = metamer::color::Xyz::new(29.424_122_518_279_695, 31.015, 34.538_708_337_905_01);
     let oog = [1, 4, 7, 9, 11, 12, 14, 15, 16];
-    let input = report_input(&exp.join("validation"), white, &files, &oog).unwrap();
+    let other = exp.with_file_name("adaptive");
+    let input = report_input(&exp.join("validation"), white, &files, &oog, Some(&other)).unwrap();
     write_report_files(dir, &input, &OutputPolicy::new(true)).unwrap();
     dir.join("report.html")
 }
@@ -234,6 +237,8 @@ fn experiment_report_has_every_section_in_headless_chromium() {
         "render-confidence",
         "instruments",
         "cost",
+        "cost-chart",
+        "cost-curves",
         "inputs",
     ] {
         assert!(dom.contains(&format!("id=\"{id}\"")), "the DOM lacks #{id}");
@@ -260,6 +265,27 @@ fn experiment_report_has_every_section_in_headless_chromium() {
         dom.contains("<td class=\"l\">all</td><td>266</td><td>24</td>"),
         "the cost table's total"
     );
+    // The compared run's total beside it (its files keep no box: the box's cost was
+    // measured by the same fixed plan): its display's 128 readings (104 fitted, 24 held
+    // out) and its display spots' 50 (every patch read twice or more, until decided).
+    assert!(
+        dom.contains("<td class=\"l\">all (adaptive)</td><td>178 (budget 200)</td>"),
+        "the compared run's total"
+    );
+    // The chart's lines, one per side and plan: this run's display model (fixed, held out:
+    // its spot journals keep no readings) and the compared run's.
+    for line in [
+        "display model, held out, fixed (this run)",
+        "display model, adaptive (adaptive)",
+        "display model, held out, adaptive (adaptive)",
+        "display spots, until decided (adaptive)",
+    ] {
+        assert_eq!(
+            dom.matches(line).count(),
+            2,
+            "{line}: once against readings, once against minutes"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -52,6 +52,11 @@ pub struct LabOptions {
     /// beyond the JND; None: always `repeats` readings.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub until_decided: Option<f64>,
+    /// Another run's folder, measured with another plan on the same rig: the report's
+    /// cost section sets its measuring cost and accuracy beside this run's, from its saved
+    /// files alone.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compare_with: Option<PathBuf>,
     /// The box plan file; None: the paper's plan.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plan: Option<PathBuf>,
@@ -145,6 +150,7 @@ impl LabOptions {
             },
             repeats: self.repeats,
             until_decided: self.until_decided,
+            compare_with: self.compare_with.clone(),
             stage: None,
             rerun_all: force,
             resume,
@@ -275,6 +281,7 @@ pub struct LabSummary {
 ///     target_de: 0.1,
 ///     repeats: 3,
 ///     until_decided: None,
+///     compare_with: None,
 ///     plan: None,
 ///     box_repeats: None,
 ///     box_adaptive: false,

@@ -39,28 +39,7 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
     }
     let fit = &v["fit_residuals"];
     let ver = &v["verification"];
-    // The session's readings are the fit's (its colours, some read more than once) and the
-    // held-out verification patches'; the fit residuals are over the fit's readings.
-    let fit_readings = fit["patches"].as_u64();
-    if let Some(r) = v["readings"].as_u64() {
-        let held_out = ver["patches"].as_array().map(|p| p.len() as u64);
-        let s = match (fit_readings, v["fit_patches"].as_u64(), held_out) {
-            (Some(fr), Some(fc), Some(vc)) if fr >= fc && fr + vc <= r => {
-                let mut s = format!("{r}: {fr} for the fit");
-                if fr > fc {
-                    s += &format!(" ({fc} colours, {} of them read again)", fr - fc);
-                } else {
-                    s += &format!(" ({fc} colours)");
-                }
-                s += &format!(" and {vc} held out for verification");
-                if r > fr + vc {
-                    s += &format!("; {} not used", r - fr - vc);
-                }
-                s
-            }
-            (_, Some(fc), _) => format!("{r} ({fc} colours fitted)"),
-            _ => r.to_string(),
-        };
+    if let Some(s) = readings_text(&v) {
         row("readings", s);
     }
     if let Some(w) = triple(&v["white_xyz"]) {
@@ -69,21 +48,7 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
     if let Some(b) = triple(&v["black_xyz"]) {
         row("black X, Y, Z (cd/m²)", b);
     }
-    if let (Some(mean), Some(p95), Some(max)) = (
-        num(&fit["mean_de00"]),
-        num(&fit["p95_de00"]),
-        num(&fit["max_de00"]),
-    ) {
-        let mut s = format!("ΔE00 mean {mean:.3}, p95 {p95:.3}, max {max:.3}");
-        if let Some(n) = fit_readings {
-            s += &format!(" over the {n} fit readings");
-        }
-        if let Some(w) = triple(&fit["worst_rgb"]) {
-            s += &format!(" (worst at drive {w})");
-        }
-        if let Some(r) = num(&fit["rms_xyz"]) {
-            s += &format!("; XYZ RMS {r:.4} cd/m²");
-        }
+    if let Some(s) = residuals_text(fit) {
         row("fit residuals", s);
     }
     for f in v["failures"].as_array().into_iter().flatten() {
@@ -96,32 +61,8 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
         _ => None,
     };
     let patches = ver["patches"].as_array();
-    let worst = patches.and_then(|p| {
-        p.iter()
-            .filter(|q| num(&q["delta_e00"]).is_some())
-            .max_by(|a, b| {
-                num(&a["delta_e00"])
-                    .unwrap_or(0.0)
-                    .total_cmp(&num(&b["delta_e00"]).unwrap_or(0.0))
-            })
-    });
-    if let Some(w) = worst {
-        row(
-            "worst verification patch",
-            format!(
-                "{} (RGB {}): ΔE00 {:.2}",
-                w["label"].as_str().unwrap_or("?"),
-                w["rgb8"]
-                    .as_array()
-                    .map(|a| a
-                        .iter()
-                        .map(|x| x.to_string())
-                        .collect::<Vec<_>>()
-                        .join(", "))
-                    .unwrap_or_default(),
-                num(&w["delta_e00"]).unwrap_or(0.0)
-            ),
-        );
+    if let Some(w) = worst_patch(patches) {
+        row("worst verification patch", w);
     }
     if verification_de00.is_none() {
         rows.push((
@@ -136,6 +77,78 @@ pub fn section(dir: &Path) -> Result<DisplayModelSection, String> {
         verification_de00,
         verification_patches: patches.map_or(0, Vec::len),
     })
+}
+
+/// How the session's readings divide: the fit's (its colours, some read more than once)
+/// and the held-out verification patches'; the fit residuals are over the fit's readings.
+fn readings_text(v: &Value) -> Option<String> {
+    let fit_readings = v["fit_residuals"]["patches"].as_u64();
+    let r = v["readings"].as_u64()?;
+    let held_out = v["verification"]["patches"]
+        .as_array()
+        .map(|p| p.len() as u64);
+    Some(match (fit_readings, v["fit_patches"].as_u64(), held_out) {
+        (Some(fr), Some(fc), Some(vc)) if fr >= fc && fr + vc <= r => {
+            let mut s = format!("{r}: {fr} for the fit");
+            if fr > fc {
+                s += &format!(" ({fc} colours, {} of them read again)", fr - fc);
+            } else {
+                s += &format!(" ({fc} colours)");
+            }
+            s += &format!(" and {vc} held out for verification");
+            if r > fr + vc {
+                s += &format!("; {} not used", r - fr - vc);
+            }
+            s
+        }
+        (_, Some(fc), _) => format!("{r} ({fc} colours fitted)"),
+        _ => r.to_string(),
+    })
+}
+
+/// The fit's residuals over its readings, in words.
+fn residuals_text(fit: &Value) -> Option<String> {
+    let (mean, p95, max) = (
+        num(&fit["mean_de00"])?,
+        num(&fit["p95_de00"])?,
+        num(&fit["max_de00"])?,
+    );
+    let mut s = format!("ΔE00 mean {mean:.3}, p95 {p95:.3}, max {max:.3}");
+    if let Some(n) = fit["patches"].as_u64() {
+        s += &format!(" over the {n} fit readings");
+    }
+    if let Some(w) = triple(&fit["worst_rgb"]) {
+        s += &format!(" (worst at drive {w})");
+    }
+    if let Some(r) = num(&fit["rms_xyz"]) {
+        s += &format!("; XYZ RMS {r:.4} cd/m²");
+    }
+    Some(s)
+}
+
+/// The verification patch of the largest ΔE00, in words.
+fn worst_patch(patches: Option<&Vec<Value>>) -> Option<String> {
+    let w = patches?
+        .iter()
+        .filter(|q| num(&q["delta_e00"]).is_some())
+        .max_by(|a, b| {
+            num(&a["delta_e00"])
+                .unwrap_or(0.0)
+                .total_cmp(&num(&b["delta_e00"]).unwrap_or(0.0))
+        })?;
+    Some(format!(
+        "{} (RGB {}): ΔE00 {:.2}",
+        w["label"].as_str().unwrap_or("?"),
+        w["rgb8"]
+            .as_array()
+            .map(|a| a
+                .iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(", "))
+            .unwrap_or_default(),
+        num(&w["delta_e00"]).unwrap_or(0.0)
+    ))
 }
 
 #[cfg(test)]

@@ -45,27 +45,7 @@ pub fn section(box_dir: &Path) -> Result<(LightFitSection, Vec<String>), String>
     let scene_file = box_dir.join("scene.json");
     let scene = read_json(&scene_file);
     let mut notes = Vec::new();
-    // Without light.json (a box given as its scene and readings) the scene's provenance
-    // still records the chosen model, why, and its residuals.
-    let (v, file) = match read_json(&file) {
-        Ok(v) => (v, file),
-        Err(why) => match scene
-            .as_ref()
-            .ok()
-            .map(|s| &s["provenance"]["distribution_fit"])
-            .filter(|f| f.is_object())
-        {
-            Some(fit) => {
-                notes.push(format!(
-                    "{} {why}: the light fit is shown as {} records it (no half-plane parameters or candidates)",
-                    file.display(),
-                    scene_file.display()
-                ));
-                (fit.clone(), scene_file.clone())
-            }
-            None => return Err(unusable(WHAT, &file, why)),
-        },
-    };
+    let (v, file) = fit_source(file, &scene, &scene_file, &mut notes)?;
     let model = v["model"]
         .as_str()
         .ok_or_else(|| unusable(WHAT, &file, "names no chosen \"model\""))?;
@@ -97,6 +77,56 @@ pub fn section(box_dir: &Path) -> Result<(LightFitSection, Vec<String>), String>
             s,
         ));
     }
+    residual_rows(&v, &mut rows);
+    match &scene {
+        Ok(scene) => provenance(&scene["provenance"], &mut rows),
+        Err(why) => notes.push(format!(
+            "the light fit's section has no measurement details: {} {why}",
+            scene_file.display()
+        )),
+    }
+    let chart_svg = chart(box_dir, &mut notes);
+    Ok((
+        LightFitSection {
+            summary: rows,
+            chart_svg,
+        },
+        notes,
+    ))
+}
+
+/// The fit as `light.json` holds it; without it (a box given as its scene and readings)
+/// as the scene's provenance still records it (the chosen model, why, its residuals),
+/// with a note; with neither, the note saying why there is no section.
+fn fit_source(
+    file: std::path::PathBuf,
+    scene: &Result<Value, String>,
+    scene_file: &Path,
+    notes: &mut Vec<String>,
+) -> Result<(Value, std::path::PathBuf), String> {
+    match read_json(&file) {
+        Ok(v) => Ok((v, file)),
+        Err(why) => match scene
+            .as_ref()
+            .ok()
+            .map(|s| &s["provenance"]["distribution_fit"])
+            .filter(|f| f.is_object())
+        {
+            Some(fit) => {
+                notes.push(format!(
+                    "{} {why}: the light fit is shown as {} records it (no half-plane parameters or candidates)",
+                    file.display(),
+                    scene_file.display()
+                ));
+                Ok((fit.clone(), scene_file.to_path_buf()))
+            }
+            None => Err(unusable(WHAT, &file, why)),
+        },
+    }
+}
+
+/// The residuals' summary and each candidate model's errors.
+fn residual_rows(v: &Value, rows: &mut Vec<(String, String)>) {
     let residuals: Vec<(String, f64)> = v["residuals"]
         .as_array()
         .into_iter()
@@ -143,15 +173,12 @@ pub fn section(box_dir: &Path) -> Result<(LightFitSection, Vec<String>), String>
         }
         rows.push((format!("candidate {name}"), s));
     }
-    match &scene {
-        Ok(scene) => provenance(&scene["provenance"], &mut rows),
-        Err(why) => notes.push(format!(
-            "the light fit's section has no measurement details: {} {why}",
-            scene_file.display()
-        )),
-    }
+}
+
+/// The fit's chart `light.svg`, or a note saying why it is not shown.
+fn chart(box_dir: &Path, notes: &mut Vec<String>) -> Option<String> {
     let chart = box_dir.join("light.svg");
-    let chart_svg = match std::fs::read_to_string(&chart) {
+    match std::fs::read_to_string(&chart) {
         Ok(svg) => Some(svg),
         Err(e) => {
             notes.push(format!(
@@ -165,14 +192,7 @@ pub fn section(box_dir: &Path) -> Result<(LightFitSection, Vec<String>), String>
             ));
             None
         }
-    };
-    Ok((
-        LightFitSection {
-            summary: rows,
-            chart_svg,
-        },
-        notes,
-    ))
+    }
 }
 
 /// What the measured scene's provenance says about the measurement.

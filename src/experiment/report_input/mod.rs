@@ -7,6 +7,7 @@
 //! the inputs with their SHA-256. A file that is missing or unreadable leaves its section
 //! out with a note saying which file and why; it never fails the report.
 
+mod cost;
 mod display;
 mod files;
 mod instruments;
@@ -16,8 +17,7 @@ mod render;
 use std::path::{Path, PathBuf};
 
 use crate::digest::sha256_file;
-use crate::session::Cost;
-use crate::validation::report::{CostFigures, InputFile, StageCost};
+use crate::validation::report::{ComparedCost, InputFile};
 pub use crate::validation::report::{RenderUncertainty, Sections};
 
 /// Where the stages' files are.
@@ -50,6 +50,43 @@ impl Layout {
             display_spots_dir: stage(super::Stage::DisplaySpots),
         }
     }
+
+    /// The measuring stages' directories.
+    pub fn dirs(&self) -> cost::RunDirs<'_> {
+        cost::RunDirs {
+            box_dir: &self.box_dir,
+            display_dir: &self.display_dir,
+            display_spots_dir: &self.display_spots_dir,
+        }
+    }
+}
+
+/// The files of the run saved in `dir` that [`compare_with`] reads, by a name for each.
+pub fn compared_files(dir: &Path) -> Vec<(String, PathBuf)> {
+    let layout = Layout::of(dir, &dir.join(super::Stage::Box.name()).join("spots.csv"));
+    cost::compared_files(layout.dirs())
+}
+
+/// Adds the run saved in `dir` (an experiment's or `lab`'s folder, measured with another
+/// plan on the same rig) to `sections`: its stages' costs and its curves, named by the
+/// folder's name. A folder without these files adds notes only.
+pub fn compare_with(sections: &mut Sections, dir: &Path) {
+    let run = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string());
+    let layout = Layout::of(dir, &dir.join(super::Stage::Box.name()).join("spots.csv"));
+    let stages = cost::measuring_cost(layout.dirs());
+    if stages.is_empty() {
+        sections.notes.push(format!(
+            "the compared run {} keeps no measuring cost",
+            dir.display()
+        ));
+    }
+    let (curves, notes) = cost::curves(layout.dirs(), &run);
+    sections.compared_cost = Some(ComparedCost { run, stages });
+    sections.cost_curves.extend(curves);
+    sections.notes.extend(notes);
 }
 
 /// Gathers every section from the files under `layout`.
@@ -81,35 +118,11 @@ pub fn gather(layout: &Layout, readings: &[(&str, &Path, usize)]) -> Sections {
     s.instruments = instruments;
     s.notes.extend(notes);
     s.inputs = inputs(layout, readings);
-    s.measuring_cost = measuring_cost(layout);
+    s.measuring_cost = cost::measuring_cost(layout.dirs());
+    let (curves, notes) = cost::curves(layout.dirs(), crate::validation::cost_curve::THIS_RUN);
+    s.cost_curves = curves;
+    s.notes.extend(notes);
     s
-}
-
-/// Each measuring stage's budget and cost as its files keep them, box first; a stage
-/// whose files keep none (given readings, or a run before budgets were kept) is left out.
-fn measuring_cost(layout: &Layout) -> Vec<StageCost> {
-    let figures = |c: &Cost| CostFigures {
-        readings: c.readings,
-        placements: c.placements,
-        calibrations: c.calibrations,
-        instrument_s: c.instrument_s,
-        rig_s: c.instrument_s + c.operator_s + c.settle_s,
-    };
-    [
-        (super::Stage::Box, &layout.box_dir),
-        (super::Stage::Display, &layout.display_dir),
-        (super::Stage::DisplaySpots, &layout.display_spots_dir),
-    ]
-    .into_iter()
-    .filter_map(|(stage, dir)| {
-        let kept = super::budget::kept(stage.name(), dir)?;
-        Some(StageCost {
-            stage: stage.name().to_string(),
-            budget: figures(&kept.estimate),
-            taken: kept.actual.as_ref().map(figures),
-        })
-    })
-    .collect()
 }
 
 /// The files the report rests on, each with its SHA-256: the three readings files first

@@ -9,8 +9,8 @@ use crate::validation::assess::Assessment;
 use crate::validation::figures::esc;
 use crate::validation::readings::UncertaintySource;
 use crate::validation::report_data::{
-    CostFigures, DisplayModelSection, InputFile, InstrumentUsed, LightFitSection,
-    RenderConfidenceSection, ReportInput, StageCost,
+    DisplayModelSection, InputFile, InstrumentUsed, LightFitSection, RenderConfidenceSection,
+    ReportInput,
 };
 
 fn rows(h: &mut String, rows: &[(String, String)]) {
@@ -221,65 +221,6 @@ pub fn instruments_section(h: &mut String, list: &[InstrumentUsed]) {
     h.push_str("</table></div>\n");
 }
 
-/// The measuring stages' budgets against what they took, a total row under them: what the
-/// verdict cost at the rig, in readings, the operator's placements and minutes.
-pub fn cost_section(h: &mut String, stages: &[StageCost]) {
-    h.push_str(
-        "<h2 id=\"cost\">Measuring cost</h2>\n<p>Each measuring stage's budget, made before its \
-         first reading, and what it took: the instrument's time at its real pace (a simulated \
-         instrument's too, whatever its time scale) and the session's length at the rig \
-         (instrument, operator and settle time; what was taken counts the operator's actual \
-         waits, none for a simulated operator).</p>\n\
-         <div class=\"scroll\"><table><tr><th>stage</th><th>readings</th><th>placements</th>\
-         <th>calibrations</th><th>instrument</th><th>at the rig</th></tr>",
-    );
-    let minutes = |s: f64| format!("{:.1} min", s / 60.0);
-    let pair = |budget: String, taken: Option<String>| match taken {
-        Some(t) if t != budget => format!("{} (budget {})", esc(&t), esc(&budget)),
-        Some(t) => esc(&t),
-        None => format!("budget {} (not run)", esc(&budget)),
-    };
-    let mut total = StageCost {
-        stage: "all".into(),
-        taken: stages
-            .iter()
-            .all(|s| s.taken.is_some())
-            .then(CostFigures::default),
-        ..StageCost::default()
-    };
-    for s in stages {
-        add(&mut total.budget, &s.budget);
-        if let (Some(t), Some(a)) = (&mut total.taken, &s.taken) {
-            add(t, a);
-        }
-    }
-    for s in stages.iter().chain(std::iter::once(&total)) {
-        let t = s.taken.as_ref();
-        let _ = write!(
-            h,
-            "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            esc(&s.stage),
-            pair(s.budget.readings.to_string(), t.map(|t| t.readings.to_string())),
-            pair(s.budget.placements.to_string(), t.map(|t| t.placements.to_string())),
-            pair(
-                s.budget.calibrations.to_string(),
-                t.map(|t| t.calibrations.to_string())
-            ),
-            pair(minutes(s.budget.instrument_s), t.map(|t| minutes(t.instrument_s))),
-            pair(minutes(s.budget.rig_s), t.map(|t| minutes(t.rig_s))),
-        );
-    }
-    h.push_str("</table></div>\n");
-}
-
-fn add(sum: &mut CostFigures, c: &CostFigures) {
-    sum.readings += c.readings;
-    sum.placements += c.placements;
-    sum.calibrations += c.calibrations;
-    sum.instrument_s += c.instrument_s;
-    sum.rig_s += c.rig_s;
-}
-
 pub fn inputs_section(h: &mut String, files: &[InputFile]) {
     h.push_str("<h2 id=\"inputs\">Inputs</h2>\n<div class=\"scroll\"><table><tr><th>role</th><th>file</th><th>format</th><th>patches</th><th>SHA-256</th></tr>");
     for f in files {
@@ -423,51 +364,5 @@ mod tests {
         }
         assert!(inline_svg("<svg><use href=\"#a\"/></svg>").starts_with("<svg class"));
         assert!(inline_svg("not an image").contains("not an SVG"));
-    }
-
-    /// The cost table: each stage's figures, what was taken beside a differing budget,
-    /// "not run" without a cost taken, and the total of the stages (hand sums).
-    #[test]
-    fn the_cost_table_sums_the_stages_and_shows_each_budget_beside_what_was_taken() {
-        let f = |readings, placements, instrument_s, rig_s| CostFigures {
-            readings,
-            placements,
-            calibrations: 0,
-            instrument_s,
-            rig_s,
-        };
-        let stages = [
-            StageCost {
-                stage: "display".into(),
-                budget: f(194, 0, 34.07, 34.07),
-                taken: Some(f(194, 0, 34.07, 34.07)),
-            },
-            StageCost {
-                stage: "display-spots".into(),
-                budget: f(72, 24, 12.64, 732.64),
-                taken: Some(f(56, 24, 9.84, 9.84)),
-            },
-        ];
-        let mut h = String::new();
-        cost_section(&mut h, &stages);
-        assert!(h.contains("id=\"cost\""), "{h}");
-        assert!(
-            h.contains("<td class=\"l\">display</td><td>194</td><td>0</td>"),
-            "{h}"
-        );
-        // 732.64 s is 12.2 min, 9.84 s is 0.2 min; 56 readings of a budget of 72.
-        assert!(h.contains("<td>56 (budget 72)</td>"), "{h}");
-        assert!(h.contains("<td>0.2 min (budget 12.2 min)</td></tr>"), "{h}");
-        // The total: 194 + 56 taken of 194 + 72, 34.07 + 9.84 = 43.91 s of 46.71 s.
-        assert!(
-            h.contains("<td class=\"l\">all</td><td>250 (budget 266)</td><td>24</td>"),
-            "{h}"
-        );
-        assert!(h.contains("<td>0.7 min (budget 0.8 min)</td>"), "{h}");
-        let mut h = String::new();
-        let mut not_run = stages[1].clone();
-        not_run.taken = None;
-        cost_section(&mut h, &[not_run]);
-        assert!(h.contains("budget 72 (not run)"), "{h}");
     }
 }
