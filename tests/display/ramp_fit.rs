@@ -435,7 +435,8 @@ fn the_fit_report_on_ramps_says_mixtures_were_not_measured() {
         v.contains(&format!("differs by ΔE00 {de:.2}")),
         "{de:.2}: {v}"
     );
-    assert!(v.contains("--grid-steps"), "{v}");
+    // What to measure, in the library's words; the command that reads it names the flag.
+    assert!(v.contains("measure a grid of 5 steps per axis"), "{v}");
     // A set with a grid says nothing of the kind.
     let mut with_grid = patches.clone();
     with_grid.extend(measure(&panel, &grid_codes(3)));
