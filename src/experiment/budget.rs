@@ -20,6 +20,7 @@ use super::measure_box::MeasureBox;
 use super::options::{BoxSource, ExperimentOptions};
 use super::stage::Stage;
 use crate::color::{colorchecker, reflectance_to_xyz, ColorCheckerSet, Illuminant, ObserverKind};
+use crate::display::characterize::adaptive::run::first_pass;
 use crate::display::characterize::plan::{Plan, PlanOptions, METER};
 use crate::measure_box::plan::{BoxStage, SPECTRAL, SPOT};
 use crate::measure_box::run::{BOX_LIGHT_ASSUMPTION, BOX_TARGET_CD_M2};
@@ -50,7 +51,7 @@ pub fn budget(opts: &ExperimentOptions) -> Vec<StageBudget> {
     }
     out.push(stage(
         Stage::Display,
-        display_cost(&opts.display, placement_s),
+        display_cost(&opts.display, patches.len(), placement_s),
     ));
     out.push(stage(
         Stage::DisplaySpots,
@@ -116,20 +117,19 @@ fn box_cost(plan: &BoxPlan, m: &MeasureBox, placement_s: f64) -> Cost {
     .into();
     let mut cost = Cost::default();
     for s in BoxStage::ALL {
-        let said = match &plan.adaptive {
-            Some(rule) if s.in_rounds() => format!(
-                "{BOX_LIGHT_ASSUMPTION}; the adaptive plan at its caps, {} tiles and {} fall-off angles",
-                rule.max_tiles, rule.max_falloff
-            ),
-            _ => BOX_LIGHT_ASSUMPTION.to_string(),
-        };
         cost.add(&estimate(
             &plan.round_plan(s, 0, plan.most_steps(s), &BTreeMap::new()),
             &|_| false,
             &meters,
             &|_| BOX_TARGET_CD_M2,
-            &said,
+            BOX_LIGHT_ASSUMPTION,
             placement_s,
+        ));
+    }
+    if let Some(rule) = &plan.adaptive {
+        cost.assumptions.push(format!(
+            "the adaptive plan at its caps, {} tiles and {} fall-off angles",
+            rule.max_tiles, rule.max_falloff
         ));
     }
     cost
@@ -158,24 +158,54 @@ fn screen_light(screen: &ScreenSpec) -> (PatchLight, String) {
     }
 }
 
-fn display_cost(d: &DisplayOptions, placement_s: f64) -> Cost {
+/// The display's patches: the fixed plan's; or the adaptive plan's at its cap, its first
+/// pass as planned, the patches it chooses after it (not known before its readings) read
+/// like the first pass's in turn, and one held-out patch for each of the `targets`.
+fn display_cost(d: &DisplayOptions, targets: usize, placement_s: f64) -> Cost {
     let defaults = PlanOptions::default();
     let options = PlanOptions::for_model(d.model, defaults.ramp_steps, defaults.repeats, None);
-    let Ok(plan) = Plan::new(options) else {
-        return Cost::default();
-    };
     let settle = match d.screen {
         ScreenSpec::Virtual(_) => std::time::Duration::ZERO,
         ScreenSpec::Window { .. } => DEFAULT_SETTLE,
     };
-    let plan = plan.session_plan(&d.screen.canonical(), settle);
+    let Ok(plan) = Plan::new(options.clone()) else {
+        return Cost::default();
+    };
+    let mut plan = plan.session_plan(&d.screen.canonical(), settle);
+    let mut cap_said = None;
+    if let Some(rule) = &d.adaptive {
+        let Ok(first) = first_pass(options) else {
+            return Cost::default();
+        };
+        let cap = rule.max_readings.max(first.len()) + targets;
+        let template = plan.steps.first().cloned();
+        plan.steps = first
+            .iter()
+            .cycle()
+            .take(cap)
+            .filter_map(|p| {
+                let mut step = template.clone()?;
+                step.label = p.label.clone();
+                step.prepare = Prepare::Show { rgb: p.rgb };
+                step.data = p.clone();
+                Some(step)
+            })
+            .collect();
+        cap_said = Some(format!(
+            "the adaptive plan at its cap, {} fit readings ({} in the first pass, the rest read like it) and {targets} held out",
+            rule.max_readings.max(first.len()),
+            first.len()
+        ));
+    }
     let meters = [(METER.to_string(), Meter::of_spec(&d.spot))].into();
     let (light, said) = screen_light(&d.screen);
     let of_step = |s: &Step<_>| match s.prepare {
         Prepare::Show { rgb } => light(rgb),
         _ => light([255; 3]),
     };
-    estimate(&plan, &|_| false, &meters, &of_step, &said, placement_s)
+    let mut cost = estimate(&plan, &|_| false, &meters, &of_step, &said, placement_s);
+    cost.assumptions.extend(cap_said);
+    cost
 }
 
 /// The display spots: `patches` ColorChecker patches (1–24) read `repeats` times, on the
@@ -277,4 +307,98 @@ struct OneCost {
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Option<T> {
     let text = std::fs::read_to_string(path).ok()?;
     serde_json::from_str(&text).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::*;
+    use crate::display::characterize::adaptive::Rule;
+    use crate::display::ModelKind;
+    use crate::experiment::reproduction::ReproductionOptions;
+    use crate::experiment::simulation::SimulationOptions;
+    use crate::session::RunOptions;
+
+    fn options(adaptive: Option<Rule>) -> ExperimentOptions {
+        ExperimentOptions {
+            dir: PathBuf::from("unused"),
+            box_source: BoxSource::Existing {
+                scene: PathBuf::from("scene.json"),
+                spots: PathBuf::from("spots.csv"),
+            },
+            given_readings: None,
+            simulation: SimulationOptions {
+                external_image: None,
+                target_de: 0.5,
+                seed: 1,
+                max_seconds: 60.0,
+                image: None,
+            },
+            display: DisplayOptions {
+                screen: ScreenSpec::Virtual(crate::rig::Preset::IpsLcd),
+                spot: "sim:cs100a?time_scale=0".into(),
+                model: ModelKind::Lut,
+                adaptive,
+            },
+            reproduction: ReproductionOptions {
+                gamut: crate::display::gamut::GamutMapping::Clip,
+                mirror: true,
+            },
+            repeats: 3,
+            until_decided: None,
+            compare_with: None,
+            stage: None,
+            resume: false,
+            unattended: true,
+            run: RunOptions::default(),
+        }
+    }
+
+    /// The adaptive display plan is budgeted at its cap: its fit readings and one held-out
+    /// patch for each of the 24 colours, not the fixed plan's patches.
+    #[test]
+    fn the_adaptive_display_is_budgeted_at_its_cap() {
+        let display = |b: &[StageBudget]| {
+            b.iter()
+                .find(|s| s.stage == Stage::Display.name())
+                .unwrap()
+                .cost
+                .estimate
+                .clone()
+        };
+        let fixed = display(&budget(&options(None)));
+        let planned = Plan::new(PlanOptions::for_model(
+            ModelKind::Lut,
+            PlanOptions::default().ramp_steps,
+            PlanOptions::default().repeats,
+            None,
+        ))
+        .unwrap();
+        assert_eq!(fixed.readings, planned.patches.len());
+        let rule = Rule {
+            max_readings: 70,
+            ..Rule::default()
+        };
+        let adaptive = display(&budget(&options(Some(rule))));
+        assert_eq!(adaptive.readings, 70 + 24);
+        assert!(adaptive
+            .assumptions
+            .iter()
+            .any(|a| a.contains("at its cap, 70 fit readings") && a.contains("24 held out")));
+        // Below the first pass, the cap is the first pass.
+        let first = first_pass(PlanOptions::for_model(
+            ModelKind::Lut,
+            PlanOptions::default().ramp_steps,
+            PlanOptions::default().repeats,
+            None,
+        ))
+        .unwrap()
+        .len();
+        let rule = Rule {
+            max_readings: 1,
+            ..Rule::default()
+        };
+        assert_eq!(display(&budget(&options(Some(rule)))).readings, first + 24);
+    }
 }
