@@ -168,7 +168,7 @@ fn display_cost(d: &DisplayOptions, targets: usize, placement_s: f64) -> Cost {
         ScreenSpec::Virtual(_) => std::time::Duration::ZERO,
         ScreenSpec::Window { .. } => DEFAULT_SETTLE,
     };
-    let Ok(plan) = Plan::new(options.clone()) else {
+    let Ok(plan) = Plan::new(options) else {
         return Cost::default();
     };
     let mut plan = plan.session_plan(&d.screen.canonical(), settle);
