@@ -311,48 +311,16 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Option<T> {
 
 #[cfg(test)]
 mod tests {
-    use std::path::PathBuf;
-
     use super::*;
     use crate::display::characterize::adaptive::Rule;
     use crate::display::ModelKind;
-    use crate::experiment::reproduction::ReproductionOptions;
-    use crate::experiment::simulation::SimulationOptions;
-    use crate::session::RunOptions;
+    use crate::experiment::run::tests::given;
 
     fn options(adaptive: Option<Rule>) -> ExperimentOptions {
-        ExperimentOptions {
-            dir: PathBuf::from("unused"),
-            box_source: BoxSource::Existing {
-                scene: PathBuf::from("scene.json"),
-                spots: PathBuf::from("spots.csv"),
-            },
-            given_readings: None,
-            simulation: SimulationOptions {
-                external_image: None,
-                target_de: 0.5,
-                seed: 1,
-                max_seconds: 60.0,
-                image: None,
-            },
-            display: DisplayOptions {
-                screen: ScreenSpec::Virtual(crate::rig::Preset::IpsLcd),
-                spot: "sim:cs100a?time_scale=0".into(),
-                model: ModelKind::Lut,
-                adaptive,
-            },
-            reproduction: ReproductionOptions {
-                gamut: crate::display::gamut::GamutMapping::Clip,
-                mirror: true,
-            },
-            repeats: 3,
-            until_decided: None,
-            compare_with: None,
-            stage: None,
-            resume: false,
-            unattended: true,
-            run: RunOptions::default(),
-        }
+        let mut o = given(Path::new("unused"), "scene.json".into(), "spots.csv".into());
+        o.display.model = ModelKind::Lut;
+        o.display.adaptive = adaptive;
+        o
     }
 
     /// The adaptive display plan is budgeted at its cap: its fit readings and one held-out

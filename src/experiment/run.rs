@@ -510,7 +510,7 @@ fn validation_stage(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::display::ModelKind;
     use crate::experiment::display::DisplayOptions;
@@ -518,7 +518,8 @@ mod tests {
     use crate::experiment::simulation::SimulationOptions;
     use crate::session::RunOptions;
 
-    fn given(dir: &Path, scene: PathBuf, spots: PathBuf) -> ExperimentOptions {
+    /// Options for a box given as files, on the simulated ips-lcd at no simulated time.
+    pub(crate) fn given(dir: &Path, scene: PathBuf, spots: PathBuf) -> ExperimentOptions {
         ExperimentOptions {
             dir: dir.to_path_buf(),
             box_source: BoxSource::Existing { scene, spots },
