@@ -53,15 +53,21 @@ pub fn direct_lux(scene: &Scene, lights: &Lights, x: Vec3, n: Vec3) -> f64 {
         .sum()
 }
 
-/// Indirect illuminance at `x` facing `n` (lux) from a solved level.
-pub fn indirect_lux(scene: &Scene, lights: &Lights, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
-    let nb = solved.bands.len();
-    let f: Vec<f64> = solved
+/// Each element's point-to-rectangle factor seen from `x` facing `n`: the weights of a
+/// gather from a solved level.
+fn element_factors(solved: &Solved, x: Vec3, n: Vec3) -> Vec<f64> {
+    solved
         .mesh
         .elements
         .iter()
         .map(|el| point_to_rect(x, n, &el.rect))
-        .collect();
+        .collect()
+}
+
+/// Indirect illuminance at `x` facing `n` (lux) from a solved level.
+pub fn indirect_lux(scene: &Scene, lights: &Lights, solved: &Solved, x: Vec3, n: Vec3) -> f64 {
+    let nb = solved.bands.len();
+    let f = element_factors(solved, x, n);
     (0..lights.len())
         .map(|e| {
             let mut q = vec![0.0; nb];
@@ -92,12 +98,7 @@ pub fn indirect_lux_with(
     n: Vec3,
 ) -> f64 {
     let nb = solved.bands.len();
-    let f: Vec<f64> = solved
-        .mesh
-        .elements
-        .iter()
-        .map(|el| point_to_rect(x, n, &el.rect))
-        .collect();
+    let f = element_factors(solved, x, n);
     (0..lights.len())
         .map(|e| {
             let mut q = vec![0.0; nb];
