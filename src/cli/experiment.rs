@@ -8,6 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
 use metamer::experiment::display::DisplayOptions;
+use metamer::experiment::display_spots::SpotsShown;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::SimulationOptions;
 use metamer::experiment::{
@@ -99,6 +100,12 @@ pub struct Args {
     /// times (e.g. 0.1); without it every patch is read --repeats times.
     #[arg(long, value_name = "ΔE")]
     until_decided: Option<f64>,
+    /// How each patch is put in front of the meter on the display: aimed (the paper's: the
+    /// image shown whole, the meter re-aimed at every patch), under-meter (the image slid
+    /// so each patch in turn lies under the meter, aimed once at the middle of the screen)
+    /// or full-screen (each patch's drive values over the whole screen).
+    #[arg(long, default_value = "aimed", value_name = "HOW")]
+    display_spots: SpotsShown,
     /// Another run's folder (an experiment's or `lab`'s, measured with another plan on the
     /// same rig), whose measuring cost and accuracy the report's cost section sets beside
     /// this run's; read from its saved files, nothing measured again.
@@ -190,6 +197,7 @@ fn request(args: Args) -> Result<Request, CliError> {
         },
         repeats: args.repeats,
         until_decided: args.until_decided,
+        spots_shown: args.display_spots,
         compare_with: args.compare_with,
         stage: args.stage,
         rerun_all: false,

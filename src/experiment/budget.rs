@@ -15,7 +15,10 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::display::DisplayOptions;
-use super::display_spots::{image_plan, PatchAim, SpotStep, RECORD_FILE};
+use super::display_spots::shown::aim_cost;
+use super::display_spots::{
+    image_plan, under_meter_plan, PatchAim, SpotStep, SpotsShown, RECORD_FILE,
+};
 use super::measure_box::MeasureBox;
 use super::options::{BoxSource, ExperimentOptions};
 use super::stage::Stage;
@@ -59,7 +62,7 @@ pub fn budget(opts: &ExperimentOptions) -> Vec<StageBudget> {
             &opts.display,
             &patches,
             opts.repeats.max(1),
-            opts.simulation.image.is_some() || opts.simulation.external_image.is_some(),
+            spots_shown(opts),
             placement_s,
         ),
     ));
@@ -208,14 +211,26 @@ fn display_cost(d: &DisplayOptions, targets: usize, placement_s: f64) -> Cost {
     cost
 }
 
+/// How the display spots will be shown: as asked, but full-screen where no image will be
+/// rendered to show.
+fn spots_shown(opts: &ExperimentOptions) -> SpotsShown {
+    let image = opts.simulation.image.is_some() || opts.simulation.external_image.is_some();
+    if image {
+        opts.spots_shown
+    } else {
+        SpotsShown::FullScreen
+    }
+}
+
 /// The display spots: `patches` ColorChecker patches (1–24) read `repeats` times, on the
-/// image (one placement per patch) or full-screen; each at the patch's luminance factor
-/// (BabelColor average under D65) of the display's white.
+/// image (one placement per patch, or one for all with the image moved under the meter)
+/// or full-screen; each at the patch's luminance factor (BabelColor average under D65) of
+/// the display's white.
 fn spots_cost(
     d: &DisplayOptions,
     patches: &[usize],
     repeats: usize,
-    image: bool,
+    shown: SpotsShown,
     placement_s: f64,
 ) -> Cost {
     let chart = colorchecker(ColorCheckerSet::BabelColorAverage);
@@ -233,10 +248,16 @@ fn spots_cost(
             y: 0.5,
             radius: 0.0,
             prompt: format!("aim the meter at patch {patch}"),
+            // The slides are known only once the image is reproduced; a slide costs no
+            // operator's time, whatever its size.
+            shift: None,
         })
         .collect();
-    let mut plan = image_plan(&aims, repeats);
-    if !image {
+    let mut plan = match shown {
+        SpotsShown::UnderMeter => under_meter_plan(&aims, repeats),
+        _ => image_plan(&aims, repeats),
+    };
+    if shown == SpotsShown::FullScreen {
         for s in &mut plan.steps {
             s.prepare = Prepare::Show { rgb: [255; 3] };
         }
@@ -247,7 +268,11 @@ fn spots_cost(
     let of_step = |s: &Step<SpotStep>| white * factor(s.data.patch);
     let said =
         format!("{said}; a display spot at its ColorChecker patch's luminance factor of the white");
-    estimate(&plan, &|_| false, &meters, &of_step, &said, placement_s)
+    let mut cost = estimate(&plan, &|_| false, &meters, &of_step, &said, placement_s);
+    if shown == SpotsShown::UnderMeter {
+        cost.add(&aim_cost(placement_s));
+    }
+    cost
 }
 
 /// Each measuring stage's budget and what it took, as its own files in `dir` keep them

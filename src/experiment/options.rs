@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use super::display::DisplayOptions;
+use super::display_spots::SpotsShown;
 use super::measure_box::MeasureBox;
 use super::reproduction::ReproductionOptions;
 use super::simulation::SimulationOptions;
@@ -41,6 +42,8 @@ pub struct ExperimentOptions {
     /// margin (ΔE*ab) beyond the JND at 95 % (the verdict rule of
     /// [`crate::validation::sequential`]); None: always `repeats` readings.
     pub until_decided: Option<f64>,
+    /// How each patch is put in front of the meter on the display.
+    pub spots_shown: SpotsShown,
     /// Another run's folder, measured with another plan on the same rig: the report's
     /// cost section sets its measuring cost and accuracy beside this run's, from its saved
     /// files alone.

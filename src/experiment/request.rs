@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use metamer_drivers::{DriverError, Spec};
 
 use super::display::DisplayOptions;
+use super::display_spots::SpotsShown;
 use super::error::ExperimentError;
 use super::measure_box::MeasureBox;
 use super::options::{BoxSource, ExperimentOptions};
@@ -73,6 +74,9 @@ pub struct Request {
     /// Read each patch on the display until its ΔE*ab against the box is decided, this
     /// margin beyond the JND; None: always `repeats` readings.
     pub until_decided: Option<f64>,
+    /// How each patch is put in front of the meter on the display: the paper's aimed
+    /// image, the image moved under a meter that stays put, or each patch full-screen.
+    pub spots_shown: SpotsShown,
     /// Another run's folder, measured with another plan on the same rig: the report's
     /// cost section sets its measuring cost and accuracy beside this run's, from its saved
     /// files alone.
@@ -217,6 +221,7 @@ impl Request {
     ///     reproduction: ReproductionOptions { gamut: GamutMapping::NearestLab, mirror: true },
     ///     repeats: 3,
     ///     until_decided: None,
+    ///     spots_shown: Default::default(),
     ///     compare_with: None,
     ///     stage: Some(Stage::Box),
     ///     rerun_all: false,
@@ -318,6 +323,7 @@ impl Request {
             reproduction: self.reproduction.clone(),
             repeats: self.repeats,
             until_decided: self.until_decided,
+            spots_shown: self.spots_shown,
             compare_with: self.compare_with.clone(),
             stage: self.stage,
             resume: self.resume,

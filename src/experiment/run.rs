@@ -332,6 +332,12 @@ fn inputs_of(stage: Stage, opts: &ExperimentOptions) -> Result<Inputs, Experimen
                     .file("profile", &p(Stage::Display, display::PROFILE_FILE)?)?,
                 None => i,
             };
+            // Another way of showing the spots than the paper's is an input too (the
+            // paper's hash stays as it was).
+            let i = match opts.spots_shown {
+                display_spots::SpotsShown::Aimed => i,
+                shown => i.value("shown", &shown),
+            };
             let image = stage_path(opts, Stage::Reproduction, reproduction::IMAGE_FILE);
             if image.exists() {
                 i.file("image", &image)?
@@ -475,6 +481,7 @@ fn display_spots_stage(
             file: &png,
             regions: &r.image_patches,
         }),
+        shown: opts.spots_shown,
         rule: &rule,
         resume: opts.resume,
         unattended: opts.unattended,
@@ -543,6 +550,7 @@ pub(crate) mod tests {
             },
             repeats: 1,
             until_decided: None,
+            spots_shown: Default::default(),
             compare_with: None,
             stage: None,
             resume: false,

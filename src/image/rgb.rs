@@ -86,6 +86,31 @@ impl Drive8Image {
         self.pixels[y * self.width + x]
     }
 
+    /// The image slid `by` of its pixels (right, down) within its own frame: what leaves
+    /// the frame is cut off and what the slide uncovers is black, the colour a screen
+    /// shows around an image that does not fill it. A slide by whole pixels moves the
+    /// drive values without resampling them.
+    pub fn shifted(&self, by: [i64; 2]) -> Drive8Image {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let mut pixels = vec![[0u8; 3]; self.pixels.len()];
+        // Only the rows and columns that stay inside the frame are copied: a slide wider
+        // than the image leaves it black.
+        let (dx, dy) = (by[0].clamp(-w, w), by[1].clamp(-h, h));
+        let columns = (dx.max(0) as usize, (w + dx.min(0)) as usize);
+        for y in dy.max(0)..h + dy.min(0) {
+            let from = ((y - dy) * w) as usize;
+            let to = (y * w) as usize;
+            let (x0, x1) = columns;
+            let src = (x0 as i64 - dx) as usize;
+            pixels[to + x0..to + x1].copy_from_slice(&self.pixels[from + src..from + src + x1 - x0]);
+        }
+        Drive8Image {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
+
     /// How many pixels of each colour lie inside `spot` (fractions of this image; pixel
     /// centres inside the disc), or of the whole image without one. A spot smaller than a
     /// pixel counts the pixel under its centre.
@@ -115,5 +140,30 @@ impl Drive8Image {
             }
         }
         counts.into_iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 3 × 2 image whose pixels are numbered in reading order, slid by hand-worked
+    /// offsets: each pixel lands `by` away, and the uncovered ones are black.
+    #[test]
+    fn a_slide_moves_pixels_and_uncovers_black() {
+        let px = |n: u8| [n, n, n];
+        let image = Drive8Image::new(3, 2, (1..=6).map(px).collect()).unwrap();
+        let b = px(0);
+        assert_eq!(image.shifted([0, 0]), image);
+        assert_eq!(
+            image.shifted([1, 0]).pixels,
+            vec![b, px(1), px(2), b, px(4), px(5)]
+        );
+        assert_eq!(
+            image.shifted([-2, 1]).pixels,
+            vec![b, b, b, px(3), b, b]
+        );
+        assert_eq!(image.shifted([3, 0]).pixels, vec![b; 6]);
+        assert_eq!(image.shifted([i64::MIN, i64::MAX]).pixels, vec![b; 6]);
     }
 }

@@ -18,6 +18,10 @@ pub enum Prepare {
     /// Ask the operator to do something and wait for confirmation ("place the i1Pro on
     /// tile row 2, column 3").
     Operator { prompt: String },
+    /// Slide the image the screen shows by this many of its pixels (right, down), so
+    /// that another part of it lies under an instrument that stays where it is
+    /// ([`super::Screen::shift_image`]).
+    ShiftImage { by: [i64; 2] },
     /// Nothing to do (a simulated rig, or a step that measures what the last one set up).
     None,
 }
@@ -27,6 +31,9 @@ impl std::fmt::Display for Prepare {
         match self {
             Prepare::Show { rgb } => write!(f, "RGB {rgb:?}"),
             Prepare::Operator { prompt } => write!(f, "{prompt}"),
+            Prepare::ShiftImage { by } => {
+                write!(f, "the image slid {} right, {} down", by[0], by[1])
+            }
             Prepare::None => f.write_str("no preparation"),
         }
     }

@@ -73,6 +73,12 @@ pub trait Screen {
     /// it); returns where it landed. The same wait as after showing a colour
     /// ([`Screen::show`]) applies: [`Screen::default_settle`].
     fn show_image(&mut self, image: &Drive8Image) -> Result<Placement, ScreenError>;
+    /// Shows the image last given to [`Screen::show_image`] slid `by` of its own pixels
+    /// (right, down) within the area it was given, as [`Drive8Image::shifted`] slides it:
+    /// what leaves the area is not shown, what the slide uncovers is black. Not
+    /// cumulative: `[0, 0]` shows it where `show_image` put it. The same wait as after
+    /// showing a colour applies.
+    fn shift_image(&mut self, by: [i64; 2]) -> Result<(), ScreenError>;
     /// The wait between showing a colour and measuring it when the user gives none.
     fn default_settle(&self) -> Duration;
     /// Conditions the user should know before measuring (e.g. an active video LUT).
@@ -107,4 +113,7 @@ pub enum ScreenError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// An image was to be slid across the screen before any image was shown on it.
+    #[error("{screen}: no image has been shown to slide across the screen")]
+    NoImage { screen: String },
 }

@@ -255,7 +255,11 @@ where
                     self.progress.note(&format!(
                         "calibrated the {role} instrument ({model}) for {mode} readings {how}"
                     ));
-                    if moved && matches!(self.step.prepare, Prepare::Show { .. }) {
+                    let on_screen = matches!(
+                        self.step.prepare,
+                        Prepare::Show { .. } | Prepare::ShiftImage { .. }
+                    );
+                    if moved && on_screen {
                         let prompt = format!("{role} instrument ({model}): {AIM_AT_SCREEN_AGAIN}");
                         return Ok(self.ask(&prompt)? == Answer::Confirmed);
                     }
@@ -294,6 +298,13 @@ where
                 let screen = self.rig.screen.as_mut().ok_or(StepFailure::NoScreen)?;
                 screen
                     .show(*rgb)
+                    .map_err(|e| StepFailure::Screen(Box::new(e)))?;
+                Ok(true)
+            }
+            Prepare::ShiftImage { by } => {
+                let screen = self.rig.screen.as_mut().ok_or(StepFailure::NoScreen)?;
+                screen
+                    .shift_image(*by)
                     .map_err(|e| StepFailure::Screen(Box::new(e)))?;
                 Ok(true)
             }

@@ -8,7 +8,9 @@
 //! rendered) each patch's drive values are shown over the whole screen instead: a patch
 //! region is uniform where the 1° spot falls, so that puts the same light in front of the
 //! meter, but leaves out the display's dependence on the rest of the picture (power-supply
-//! loading, backlight dimming). `display-spots.json` records which was shown.
+//! loading, backlight dimming). A third way keeps the picture and the meter still: the
+//! image is slid so each patch in turn lies under the meter ([`SpotsShown::UnderMeter`],
+//! [`shown`]). `display-spots.json` records which was shown.
 //!
 //! **Until decided.** With a verdict rule ([`DisplayRule`]) each patch is read at least
 //! twice and at most `most` times, until the 95 % interval of its ΔE*ab against the box's
@@ -27,7 +29,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 mod plan;
-pub use plan::{image_plan, plan, PatchAim, SpotStep};
+pub mod shown;
+pub use plan::{image_plan, plan, under_meter_plan, PatchAim, SpotStep};
+pub use shown::SpotsShown;
 
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
@@ -40,8 +44,8 @@ use crate::rig::{MeterAim, Placement};
 use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::{
     patch_so_far, Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError,
-    PlacementReadings, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator, Session,
-    SessionPlan, Step, StepProgress, Stopping, TerminalOperator,
+    PlacementReadings, Prepare, Recheck, Rig, RunEnd, RunOptions, Screen, ScriptedOperator,
+    Session, SessionPlan, Step, StepProgress, Stopping, TerminalOperator,
 };
 use crate::validation::covariance;
 use crate::validation::repeatability::{self, Repeatability};
@@ -62,8 +66,10 @@ pub const RECORD_FILE: &str = "display-spots.json";
 /// What `display-spots.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SpotRecord {
-    /// `image` (the reproduced image, the meter aimed patch by patch) or `patch colours`
-    /// (each patch's drive values full-screen).
+    /// `image` (the reproduced image, the meter aimed patch by patch), `image moved under
+    /// the meter` (the image slid so each patch lies under the meter, which stays at the
+    /// middle of the screen; each aim's `shift` says by how much) or `patch colours` (each
+    /// patch's drive values full-screen).
     pub shown: String,
     /// Why, when it is not the image.
     pub note: Option<String>,
@@ -372,6 +378,9 @@ pub struct SpotSession<'a> {
     pub drives: &'a [PatchDrive],
     /// None: each patch's colour full-screen.
     pub image: Option<ShownImage<'a>>,
+    /// How each patch is put in front of the meter (with no image, full-screen whatever
+    /// this says).
+    pub shown: SpotsShown,
     pub rule: &'a DisplayRule,
     pub resume: bool,
     /// Nobody at the rig: every request counts as done.
@@ -407,6 +416,15 @@ pub fn measure(
     };
     let (mut plan, mut record) = show(s, screen.as_mut(), progress)?;
     plan.steps.iter_mut().for_each(|s| s.settle = settle);
+    // The runner shows the colours, or slides the image, itself; an image the meter is
+    // aimed at stays as `show` put it.
+    let on_screen = plan.steps.iter().any(|s| {
+        matches!(
+            s.prepare,
+            Prepare::Show { .. } | Prepare::ShiftImage { .. }
+        )
+    });
+    let moving = record.aims.iter().any(|a| a.shift.is_some());
     let mut instruments = BTreeMap::new();
     instruments.insert("spot".to_string(), InstrumentRecord::of(meter.as_ref()));
     let model = meter.info().model;
@@ -433,16 +451,28 @@ pub fn measure(
         total: session.plan().steps.len(),
         journal: journal.clone(),
     };
-    if !aim_again(&session, &record.aims, &mut operator)? {
-        return Err(incomplete(&session));
-    }
+    let remaining = session.done() < session.plan().steps.len();
     let meters = [("spot".to_string(), Meter::of(meter.as_ref()))].into();
     let estimate = {
         let (light, assumption) = patch_light(drives, screen.as_ref());
-        session.estimate(&meters, &light, &assumption, run.placement_s())
+        let mut cost = session.estimate(&meters, &light, &assumption, run.placement_s());
+        if moving && remaining {
+            cost.add(&shown::aim_cost(run.placement_s()));
+        }
+        cost
+    };
+    // The image moving under the meter: the meter is aimed once, whenever readings remain
+    // (it may have moved since an interrupted run).
+    let aimed = match (moving, remaining) {
+        (true, true) => shown::aim_at_middle(&mut operator)?,
+        (true, false) => Some(Default::default()),
+        (false, _) => aim_again(&session, &record.aims, &mut operator)?.then(Default::default),
+    };
+    let Some(aimed) = aimed else {
+        return Err(incomplete(&session));
     };
     let mut rig = Rig {
-        screen: s.image.is_none().then_some(screen.as_mut()),
+        screen: on_screen.then_some(screen.as_mut()),
         instruments: vec![("spot".to_string(), meter.as_mut())],
         operator: &mut operator,
     };
@@ -453,9 +483,11 @@ pub fn measure(
         })
     };
     let end = session.run(&mut rig, run, &mut sink)?;
+    let mut spent = session.spent().clone();
+    spent.add(&aimed);
     record.cost = Some(CostReport {
         estimate,
-        actual: Some(session.spent().clone()),
+        actual: Some(spent),
     });
     if end != RunEnd::Complete {
         return Err(incomplete(&session));
@@ -476,18 +508,27 @@ fn show(
     progress: &dyn Fn(Progress),
 ) -> Result<(SessionPlan<SpotStep>, SpotRecord), ExperimentError> {
     let repeats = s.rule.most();
-    let (mut plan, record) = match &s.image {
-        Some(shown) => {
+    let image = s.image.as_ref().filter(|_| s.shown != SpotsShown::FullScreen);
+    let (mut plan, record) = match image {
+        Some(given) => {
             let image =
-                Drive8Image::read_png(shown.file).map_err(|e| ExperimentError::BadFile {
-                    file: shown.file.to_path_buf(),
+                Drive8Image::read_png(given.file).map_err(|e| ExperimentError::BadFile {
+                    file: given.file.to_path_buf(),
                     message: e.to_string(),
                 })?;
             let placement = screen.show_image(&image)?;
-            let aims = aims_on(&placement, shown.regions);
-            let plan = image_plan(&aims, repeats);
+            let (aims, plan) = if s.shown == SpotsShown::UnderMeter {
+                let size = (image.width, image.height);
+                let aims = shown::aims_under_meter(&placement, size, given.regions);
+                let plan = under_meter_plan(&aims, repeats);
+                (aims, plan)
+            } else {
+                let aims = aims_on(&placement, given.regions);
+                let plan = image_plan(&aims, repeats);
+                (aims, plan)
+            };
             let record = SpotRecord {
-                shown: "image".into(),
+                shown: s.shown.record_name(true).into(),
                 note: None,
                 aims,
                 cost: None,
@@ -495,11 +536,16 @@ fn show(
             (plan, record)
         }
         None => {
-            let note = "no image was rendered: each patch's drive values were shown over the \
-                        whole screen instead of the reproduced image";
+            let note = if s.image.is_some() {
+                "each patch's drive values were shown over the whole screen, as asked, \
+                 instead of the reproduced image"
+            } else {
+                "no image was rendered: each patch's drive values were shown over the \
+                 whole screen instead of the reproduced image"
+            };
             progress(Progress::Note(note.into()));
             let record = SpotRecord {
-                shown: "patch colours".into(),
+                shown: SpotsShown::FullScreen.record_name(false).into(),
                 note: Some(note.into()),
                 aims: Vec::new(),
                 cost: None,
@@ -545,6 +591,7 @@ pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> 
                 y: spot.y,
                 radius: spot.radius,
                 prompt: aim_prompt(r, spot),
+                shift: None,
             }
         })
         .collect()

@@ -1,5 +1,6 @@
-//! The display-spots session's plans, on the whole image or each patch's colour
-//! full-screen, and their steps' data: the patch read and where the meter is aimed.
+//! The display-spots session's plans, on the whole image (the meter aimed at each patch,
+//! or the image moved under it) or each patch's colour full-screen, and their steps'
+//! data: the patch read and where the meter is aimed.
 
 use std::collections::BTreeMap;
 
@@ -25,6 +26,10 @@ pub struct PatchAim {
     pub y: f64,
     pub radius: f64,
     pub prompt: String,
+    /// With the image moved under the meter: the slide, in the image's pixels (right,
+    /// down), that puts the patch's spot under the meter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift: Option<[i64; 2]>,
 }
 
 /// The plan on the whole image: every patch, `repeats` times; the meter is aimed before
@@ -39,6 +44,30 @@ pub fn image_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
     let mut plan = patch_plan(patches, repeats);
     plan.options
         .insert("shown".to_string(), "image".to_string());
+    plan
+}
+
+/// The plan on the image moved under a meter that stays put (aimed once, outside the
+/// plan): every patch, `repeats` times, each reading preceded by its patch's slide, so a
+/// session resumed mid-patch puts the image back where that patch's readings need it. The
+/// slides are steps' data, so the fingerprint covers them. An aim without a slide stays
+/// where the image was shown.
+pub fn under_meter_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
+    let patches = aims.iter().map(|a| {
+        let slide = Prepare::ShiftImage {
+            by: a.shift.unwrap_or_default(),
+        };
+        (a.patch, slide.clone(), slide)
+    });
+    let mut plan = patch_plan(patches, repeats);
+    plan.options.insert(
+        "shown".to_string(),
+        super::SpotsShown::UnderMeter.record_name(true).to_string(),
+    );
+    plan.options.insert(
+        "meter at".to_string(),
+        format!("{:?}", super::shown::METER_AT),
+    );
     plan
 }
 

@@ -60,6 +60,7 @@ fn a_resumed_verdict_session_takes_the_uninterrupted_ones_readings() {
                 spot_spec: &spec,
                 drives: &drives,
                 image: None,
+                shown: SpotsShown::Aimed,
                 rule,
                 resume,
                 unattended: true,

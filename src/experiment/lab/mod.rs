@@ -21,6 +21,7 @@ use crate::display::gamut::GamutMapping;
 use crate::display::ModelKind;
 use crate::experiment::budget::{total, StageBudget};
 use crate::experiment::display::DisplayOptions;
+use crate::experiment::display_spots::SpotsShown;
 use crate::experiment::reproduction::ReproductionOptions;
 use crate::experiment::request::{check_dir, check_image_size, check_repeats, check_target_de};
 use crate::experiment::simulation::SimulationOptions;
@@ -52,6 +53,9 @@ pub struct LabOptions {
     /// beyond the JND; None: always `repeats` readings.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub until_decided: Option<f64>,
+    /// How each patch is put in front of the meter on the display.
+    #[serde(default, skip_serializing_if = "is_aimed")]
+    pub spots_shown: SpotsShown,
     /// Another run's folder, measured with another plan on the same rig: the report's
     /// cost section sets its measuring cost and accuracy beside this run's, from its saved
     /// files alone.
@@ -76,6 +80,10 @@ pub struct LabOptions {
     /// with this rule (its targets the rendered readings).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<crate::display::characterize::adaptive::Rule>,
+}
+
+fn is_aimed(s: &SpotsShown) -> bool {
+    *s == SpotsShown::Aimed
 }
 
 /// Samples per pixel of the image where the path tracer renders it (scenes the radiosity
@@ -150,6 +158,7 @@ impl LabOptions {
             },
             repeats: self.repeats,
             until_decided: self.until_decided,
+            spots_shown: self.spots_shown,
             compare_with: self.compare_with.clone(),
             stage: None,
             rerun_all: force,
@@ -281,6 +290,7 @@ pub struct LabSummary {
 ///     target_de: 0.1,
 ///     repeats: 3,
 ///     until_decided: None,
+///     spots_shown: Default::default(),
 ///     compare_with: None,
 ///     plan: None,
 ///     box_repeats: None,

@@ -58,6 +58,14 @@ struct LitPanel {
     aim: MeterAim,
 }
 
+/// The image last given to `show_image` and the slide it is shown at now, so a slide is
+/// made from the image as given, never from one already slid.
+#[derive(Default)]
+struct Given {
+    image: Option<Arc<Drive8Image>>,
+    by: [i64; 2],
+}
+
 impl World for LitPanel {
     fn view(&self) -> View {
         let shown = self.shown.read().unwrap_or_else(|e| e.into_inner()).clone();
@@ -83,6 +91,7 @@ impl World for LitPanel {
 /// over the whole screen (the simulated screen takes the image's size).
 pub struct VirtualDisplay {
     lit: Arc<LitPanel>,
+    given: Given,
 }
 
 impl VirtualDisplay {
@@ -93,6 +102,7 @@ impl VirtualDisplay {
                 shown: RwLock::new(Shown::Colour([0; 3])),
                 aim: MeterAim::default(),
             }),
+            given: Given::default(),
         }
     }
 
@@ -155,9 +165,28 @@ impl Screen for VirtualDisplay {
     }
 
     fn show_image(&mut self, image: &Drive8Image) -> Result<Placement, ScreenError> {
-        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) =
-            Shown::Image(Arc::new(image.clone()));
+        let image = Arc::new(image.clone());
+        self.given = Given {
+            image: Some(image.clone()),
+            by: [0, 0],
+        };
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Image(image);
         Ok(Placement::WHOLE)
+    }
+
+    fn shift_image(&mut self, by: [i64; 2]) -> Result<(), ScreenError> {
+        let Some(image) = &self.given.image else {
+            return Err(ScreenError::NoImage { screen: self.spec() });
+        };
+        let shown = self.lit.shown.read().unwrap_or_else(|e| e.into_inner()).clone();
+        // Repeated readings of one spot slide by the same amount: nothing to redo.
+        if self.given.by == by && matches!(shown, Shown::Image(_)) {
+            return Ok(());
+        }
+        let slid = Arc::new(image.shifted(by));
+        self.given.by = by;
+        *self.lit.shown.write().unwrap_or_else(|e| e.into_inner()) = Shown::Image(slid);
+        Ok(())
     }
 
     /// The simulated panel changes instantly.

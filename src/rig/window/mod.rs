@@ -98,6 +98,9 @@ pub struct WindowDisplay {
     /// The root window's depth, which the window has (its pixmaps need it too).
     depth: u8,
     shown: [u8; 3],
+    /// The image last given to `show_image`, and the slide it is on screen at (None while
+    /// a colour covers it), so a slide is made from the image as given.
+    given: Option<(Drive8Image, Option<[i64; 2]>)>,
 }
 
 impl WindowDisplay {
@@ -173,6 +176,7 @@ impl WindowDisplay {
             format,
             depth: screen.root_depth,
             shown: [0; 3],
+            given: None,
         };
         this.show_rgb([0; 3])?;
         Ok(this)
@@ -210,6 +214,9 @@ impl WindowDisplay {
             .check()
             .map_err(perr(&self.display, "ClearArea"))?;
         self.shown = rgb;
+        if let Some((_, on_screen)) = &mut self.given {
+            *on_screen = None;
+        }
         Ok(())
     }
 
@@ -346,10 +353,31 @@ impl Screen for WindowDisplay {
     }
 
     fn show_image(&mut self, image: &Drive8Image) -> Result<Placement, ScreenError> {
-        self.show_scaled(image).map_err(|e| ScreenError::Backend {
+        let placement = self.show_scaled(image).map_err(|e| ScreenError::Backend {
             screen: self.spec(),
             source: Box::new(e),
-        })
+        })?;
+        self.given = Some((image.clone(), Some([0, 0])));
+        Ok(placement)
+    }
+
+    fn shift_image(&mut self, by: [i64; 2]) -> Result<(), ScreenError> {
+        let Some((image, now)) = &self.given else {
+            return Err(ScreenError::NoImage { screen: self.spec() });
+        };
+        // Repeated readings of one spot slide by the same amount: the picture stays.
+        if *now == Some(by) {
+            return Ok(());
+        }
+        let slid = image.shifted(by);
+        self.show_scaled(&slid).map_err(|e| ScreenError::Backend {
+            screen: self.spec(),
+            source: Box::new(e),
+        })?;
+        if let Some((_, now)) = &mut self.given {
+            *now = Some(by);
+        }
+        Ok(())
     }
 
     fn default_settle(&self) -> Duration {

@@ -419,6 +419,9 @@ where
             if matches!(step.prepare, Prepare::Show { .. }) && !has_screen {
                 return Err(lacks("shows a colour and the rig has no screen".into()));
             }
+            if matches!(step.prepare, Prepare::ShiftImage { .. }) && !has_screen {
+                return Err(lacks("slides an image and the rig has no screen".into()));
+            }
         }
         Ok(())
     }

@@ -47,6 +47,10 @@ impl Screen for FakeScreen {
             source: "the made-up screen shows colours only".into(),
         })
     }
+    /// No image is ever shown here, so none can slide.
+    fn shift_image(&mut self, _: [i64; 2]) -> Result<(), ScreenError> {
+        Err(ScreenError::NoImage { screen: self.spec() })
+    }
     fn default_settle(&self) -> Duration {
         Duration::ZERO
     }

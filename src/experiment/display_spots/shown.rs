@@ -1,0 +1,158 @@
+//! How the display spots put each patch in front of the meter: the paper's way (the
+//! reproduced image where it lies, the meter re-aimed at every patch), the image slid so
+//! each patch in turn lies under a meter that stays put, or each patch's drive values over
+//! the whole screen.
+//!
+//! **Under the meter.** The meter is aimed once, at the middle of the screen, where the
+//! display was characterized (characterize asks for the middle of the white screen; a
+//! simulated meter reads the uniform screen the same anywhere), and stays there. Before
+//! each reading the image is slid by whole pixels so that its patch's spot comes under
+//! the meter: the drive values are moved, never resampled, and the display reads them
+//! where its characterization read its patches. What the slide uncovers is black, the
+//! colour a screen shows around an image that does not fill it (`Screen::show_image`): an
+//! edge or mirror fill would show picture content the rendering never had. One placement
+//! for the whole stage, against one per patch.
+
+use serde::{Deserialize, Serialize};
+
+use super::plan::PatchAim;
+use crate::experiment::reproduction::PatchRegion;
+use crate::image::ScreenSpot;
+use crate::rig::Placement;
+use crate::session::{Answer, Cost, Operator, OperatorError};
+
+/// How the display spots put each patch in front of the meter.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpotsShown {
+    /// The paper's: the reproduced image shown whole, the meter re-aimed at each patch
+    /// (a placement per patch).
+    #[default]
+    Aimed,
+    /// The reproduced image shown whole and slid so each patch in turn lies under the
+    /// meter, aimed once at the middle of the screen (one placement).
+    UnderMeter,
+    /// Each patch's drive values over the whole screen: no re-aiming, but without the
+    /// picture around the patch (the display's dependence on it is left out).
+    FullScreen,
+}
+
+impl SpotsShown {
+    pub const ALL: [SpotsShown; 3] = [
+        SpotsShown::Aimed,
+        SpotsShown::UnderMeter,
+        SpotsShown::FullScreen,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SpotsShown::Aimed => "aimed",
+            SpotsShown::UnderMeter => "under-meter",
+            SpotsShown::FullScreen => "full-screen",
+        }
+    }
+
+    /// What `display-spots.json`'s `shown` and the journal's plan options call what was
+    /// shown this way; `image` says whether a reproduced image was there to show.
+    pub fn record_name(self, image: bool) -> &'static str {
+        match (self, image) {
+            (SpotsShown::Aimed, true) => "image",
+            (SpotsShown::UnderMeter, true) => "image moved under the meter",
+            _ => "patch colours",
+        }
+    }
+}
+
+impl std::fmt::Display for SpotsShown {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A way to show the display spots that is not one of [`SpotsShown::ALL`].
+#[derive(Debug, thiserror::Error)]
+#[error("unknown way to show the display spots '{0}': aimed, under-meter or full-screen")]
+pub struct UnknownSpotsShown(pub String);
+
+impl std::str::FromStr for SpotsShown {
+    type Err = UnknownSpotsShown;
+
+    fn from_str(s: &str) -> Result<SpotsShown, UnknownSpotsShown> {
+        SpotsShown::ALL
+            .into_iter()
+            .find(|w| w.name() == s)
+            .ok_or_else(|| UnknownSpotsShown(s.to_string()))
+    }
+}
+
+/// Where the meter stays when the image moves under it: the middle of the screen, as
+/// fractions of its width and height, where the display was characterized.
+pub const METER_AT: [f64; 2] = [0.5, 0.5];
+
+/// The operator's one request when the image moves under the meter.
+pub const AIM_AT_MIDDLE: &str = "aim the meter at the middle of the screen, where the display \
+     was characterized, and leave it there: the image moves so that each patch in turn lies \
+     under it";
+
+/// Each patch's aim when the image, `width × height` pixels placed at `placement`, is slid
+/// so that the patch's spot lies under the meter at [`METER_AT`]: the meter's spot, with
+/// the patch's radius, and the slide in whole pixels of the image (the patch's centre
+/// lands within half a pixel of the meter's).
+pub fn aims_under_meter(
+    placement: &Placement,
+    size: (usize, usize),
+    regions: &[PatchRegion],
+) -> Vec<PatchAim> {
+    let (w, h) = (size.0 as f64, size.1 as f64);
+    // The meter's point in the image's pixels.
+    let at = [
+        (METER_AT[0] - placement.left) / placement.width * w,
+        (METER_AT[1] - placement.top) / placement.height * h,
+    ];
+    regions
+        .iter()
+        .map(|r| {
+            let spot = placement.on_screen(ScreenSpot {
+                x: r.x,
+                y: r.y,
+                radius: r.radius,
+            });
+            let slide = [(at[0] - r.x * w).round(), (at[1] - r.y * h).round()];
+            PatchAim {
+                patch: r.patch,
+                x: METER_AT[0],
+                y: METER_AT[1],
+                radius: spot.radius,
+                prompt: AIM_AT_MIDDLE.to_string(),
+                shift: Some(slide.map(|v| v as i64)),
+            }
+        })
+        .collect()
+}
+
+/// The one placement of the image moved under the meter, at `placement_s` seconds.
+pub fn aim_cost(placement_s: f64) -> Cost {
+    Cost {
+        placements: 1,
+        operator_s: placement_s,
+        wall_s: placement_s,
+        assumptions: vec![format!("{placement_s} s per placement")],
+        ..Cost::default()
+    }
+}
+
+/// Asks the operator to aim the meter at the middle of the screen: the placement and the
+/// time it took, or None when the operator aborts.
+pub(super) fn aim_at_middle(operator: &mut dyn Operator) -> Result<Option<Cost>, OperatorError> {
+    let asked = std::time::Instant::now();
+    if operator.ask(AIM_AT_MIDDLE)? == Answer::Abort {
+        return Ok(None);
+    }
+    let operator_s = asked.elapsed().as_secs_f64();
+    Ok(Some(Cost {
+        placements: 1,
+        operator_s,
+        wall_s: operator_s,
+        ..Cost::default()
+    }))
+}
