@@ -102,7 +102,8 @@ impl Drive8Image {
             let to = (y * w) as usize;
             let (x0, x1) = columns;
             let src = (x0 as i64 - dx) as usize;
-            pixels[to + x0..to + x1].copy_from_slice(&self.pixels[from + src..from + src + x1 - x0]);
+            pixels[to + x0..to + x1]
+                .copy_from_slice(&self.pixels[from + src..from + src + x1 - x0]);
         }
         Drive8Image {
             width: self.width,
@@ -159,10 +160,7 @@ mod tests {
             image.shifted([1, 0]).pixels,
             vec![b, px(1), px(2), b, px(4), px(5)]
         );
-        assert_eq!(
-            image.shifted([-2, 1]).pixels,
-            vec![b, b, b, px(3), b, b]
-        );
+        assert_eq!(image.shifted([-2, 1]).pixels, vec![b, b, b, px(3), b, b]);
         assert_eq!(image.shifted([3, 0]).pixels, vec![b; 6]);
         assert_eq!(image.shifted([i64::MIN, i64::MAX]).pixels, vec![b; 6]);
     }

@@ -418,12 +418,10 @@ pub fn measure(
     plan.steps.iter_mut().for_each(|s| s.settle = settle);
     // The runner shows the colours, or slides the image, itself; an image the meter is
     // aimed at stays as `show` put it.
-    let on_screen = plan.steps.iter().any(|s| {
-        matches!(
-            s.prepare,
-            Prepare::Show { .. } | Prepare::ShiftImage { .. }
-        )
-    });
+    let on_screen = plan
+        .steps
+        .iter()
+        .any(|s| matches!(s.prepare, Prepare::Show { .. } | Prepare::ShiftImage { .. }));
     let moving = record.aims.iter().any(|a| a.shift.is_some());
     let mut instruments = BTreeMap::new();
     instruments.insert("spot".to_string(), InstrumentRecord::of(meter.as_ref()));
@@ -508,7 +506,10 @@ fn show(
     progress: &dyn Fn(Progress),
 ) -> Result<(SessionPlan<SpotStep>, SpotRecord), ExperimentError> {
     let repeats = s.rule.most();
-    let image = s.image.as_ref().filter(|_| s.shown != SpotsShown::FullScreen);
+    let image = s
+        .image
+        .as_ref()
+        .filter(|_| s.shown != SpotsShown::FullScreen);
     let (mut plan, record) = match image {
         Some(given) => {
             let image =

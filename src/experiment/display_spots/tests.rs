@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::display::ModelKind;
+use crate::rig::{Placement, VirtualPanel};
 use crate::validation::readings::read_readings;
 
 /// Each journal entry's patch and reading, in the order taken.
@@ -143,4 +144,203 @@ fn the_aiming_wrapper_passes_on_the_reading_count_and_the_recheck() {
         inner: &mut stopper,
     };
     assert_eq!(aiming.recheck("Y differs").unwrap(), Recheck::Stop);
+}
+
+/// The patches' colours, their centres in pixels of a 60 × 40 image (each on a pixel
+/// corner) and the grey around them.
+const PATCHES: [([u8; 3], [usize; 2]); 3] = [
+    ([200, 60, 50], [15, 10]),
+    ([60, 120, 200], [45, 10]),
+    ([128, 128, 128], [30, 30]),
+];
+const SURROUND: [u8; 3] = [40, 40, 40];
+
+/// A 60 × 40 image of [`PATCHES`], each 10 × 10 pixels on [`SURROUND`], written as a PNG
+/// into `dir`; with the patches' drive values and their regions (a spot of 3 px radius).
+fn three_patches(dir: &Path) -> (PathBuf, Vec<PatchDrive>, Vec<PatchRegion>) {
+    let (w, h) = (60usize, 40usize);
+    let mut pixels = vec![SURROUND; w * h];
+    for (rgb, [cx, cy]) in PATCHES {
+        for y in cy - 5..cy + 5 {
+            pixels[y * w + cx - 5..y * w + cx + 5].fill(rgb);
+        }
+    }
+    std::fs::create_dir_all(dir).unwrap();
+    let file = dir.join("image.png");
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, w as u32, h as u32);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().unwrap();
+    writer.write_image_data(&pixels.concat()).unwrap();
+    writer.finish().unwrap();
+    std::fs::write(&file, bytes).unwrap();
+    let drives = PATCHES
+        .iter()
+        .enumerate()
+        .map(|(i, (rgb, _))| PatchDrive {
+            patch: i + 1,
+            target_xyz: Xyz::new(0.0, 0.0, 0.0),
+            unclipped_rgb: [0.0; 3],
+            out_of_gamut: false,
+            rgb8: *rgb,
+        })
+        .collect();
+    let regions = PATCHES
+        .iter()
+        .enumerate()
+        .map(|(i, (_, [cx, cy]))| PatchRegion {
+            patch: i + 1,
+            row: 1,
+            column: i + 1,
+            x: *cx as f64 / w as f64,
+            y: *cy as f64 / h as f64,
+            radius: 3.0 / h as f64,
+            pixels: 28,
+            out_of_gamut_pixels: 0,
+        })
+        .collect();
+    (file, drives, regions)
+}
+
+/// The slides that bring each patch under the meter at the middle, (30, 20) px, worked by
+/// hand from the patches' centres; read with each patch's slide, a still meter sees that
+/// patch's colour, and with another patch's slide that other patch's colour: a wrong
+/// slide shows in the reading.
+#[test]
+fn a_slide_by_the_wrong_patch_reads_the_wrong_colour() {
+    let dir = std::env::temp_dir().join(format!("metamer-slide-{}", std::process::id()));
+    let (file, _, regions) = three_patches(&dir);
+    let image = Drive8Image::read_png(&file).unwrap();
+    let aims = shown::aims_under_meter(&Placement::WHOLE, (60, 40), &regions);
+    let slides: Vec<[i64; 2]> = aims.iter().map(|a| a.shift.unwrap()).collect();
+    assert_eq!(slides, vec![[15, 10], [-15, 10], [0, -10]]);
+    assert!(aims
+        .iter()
+        .all(|a| [a.x, a.y] == shown::METER_AT && a.radius == 3.0 / 40.0));
+    let mut display = crate::rig::VirtualDisplay::preset(crate::rig::Preset::IpsLcd);
+    display.show_image(&image).unwrap();
+    let world = display.stimulus().unwrap();
+    let a = &aims[0];
+    display.meter_aim().unwrap().set(Some(ScreenSpot {
+        x: a.x,
+        y: a.y,
+        radius: a.radius,
+    }));
+    let seen = || match world.view() {
+        metamer_drivers::View::Emissive(metamer_drivers::Light::Radiance(s)) => {
+            metamer_color::radiance_to_xyz(&s, metamer_color::ObserverKind::Cie1931)
+        }
+        _ => panic!("a display emits"),
+    };
+    let panel = display.panel().clone();
+    for (j, slide) in slides.iter().enumerate() {
+        display.shift_image(*slide).unwrap();
+        let got = seen();
+        for (i, (rgb, _)) in PATCHES.iter().enumerate() {
+            let want = panel.xyz(*rgb);
+            let off = (got.y - want.y).abs() / want.y;
+            if i == j {
+                assert!(off < 1e-12, "patch {} read {got:?}, want {want:?}", i + 1);
+            } else {
+                assert!(off > 0.05, "patch {}'s slide read patch {}", j + 1, i + 1);
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The image moved under a still meter reads exactly what the meter aimed at each patch
+/// reads (the same pixels under the spot, the same noise stream), in one placement
+/// against one per patch; the slides are in the record and the plan, so an aimed
+/// journal is not resumed by it, and a session stopped mid-patch and resumed slides the
+/// image back and journals the uninterrupted session's readings.
+#[test]
+fn the_image_under_the_meter_reads_as_aiming_does_in_one_placement() {
+    let root = std::env::temp_dir().join(format!("metamer-under-meter-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let (file, drives, regions) = three_patches(&root.join("reproduction"));
+    let setting = DisplaySetting {
+        screen: "virtual:ips-lcd".parse().unwrap(),
+        virtual_white_cd_m2: Some(100.0),
+        white_xyz: Xyz::new(95.047, 100.0, 108.883),
+        needed_white_cd_m2: 100.0,
+        model: ModelKind::Lut,
+    };
+    let spec = Spec::new("sim:cs100a?time_scale=0&seed=11");
+    let rule = DisplayRule::Fixed(2);
+    let measure_in = |dir: &Path, shown: SpotsShown, resume: bool, run: &RunOptions| {
+        std::fs::create_dir_all(dir).unwrap();
+        measure(
+            dir,
+            &SpotSession {
+                setting: &setting,
+                spot_spec: &spec,
+                drives: &drives,
+                image: Some(ShownImage {
+                    file: &file,
+                    regions: &regions,
+                }),
+                shown,
+                rule: &rule,
+                resume,
+                unattended: true,
+                run,
+            },
+            &|_| {},
+        )
+    };
+    let record = |dir: &Path| -> SpotRecord {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(RECORD_FILE)).unwrap()).unwrap()
+    };
+    let run = RunOptions::default();
+    let aimed = root.join("aimed");
+    measure_in(&aimed, SpotsShown::Aimed, false, &run).unwrap();
+    let under = root.join("under");
+    measure_in(&under, SpotsShown::UnderMeter, false, &run).unwrap();
+    let readings = journalled(&under);
+    assert_eq!(readings.len(), 6);
+    assert_eq!(readings, journalled(&aimed));
+    // Each patch's colour as the panel emits it, within the meter's noise.
+    let panel = VirtualPanel::preset(crate::rig::Preset::IpsLcd).with_white_luminance(100.0);
+    for (patch, xyz) in &readings {
+        let want = panel.xyz(PATCHES[patch - 1].0);
+        assert!(
+            (xyz[1] / want.y - 1.0).abs() < 0.01,
+            "{patch}: {xyz:?} {want:?}"
+        );
+    }
+    let (a, u) = (record(&aimed), record(&under));
+    assert_eq!(
+        (a.shown.as_str(), u.shown.as_str()),
+        ("image", "image moved under the meter")
+    );
+    let placements = |r: &SpotRecord| {
+        let c = r.cost.as_ref().unwrap();
+        (c.estimate.placements, c.actual.as_ref().unwrap().placements)
+    };
+    assert_eq!((placements(&a), placements(&u)), ((3, 3), (1, 1)));
+    let slides: Vec<_> = u.aims.iter().map(|a| a.shift).collect();
+    assert_eq!(
+        slides,
+        vec![Some([15, 10]), Some([-15, 10]), Some([0, -10])]
+    );
+
+    let e = measure_in(&aimed, SpotsShown::UnderMeter, true, &run)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("another session") && e.contains("meter at"),
+        "{e}"
+    );
+    let resumed = root.join("resumed");
+    let stop = RunOptions {
+        stop_after: Some(3),
+        ..RunOptions::default()
+    };
+    assert!(measure_in(&resumed, SpotsShown::UnderMeter, false, &stop).is_err());
+    assert_eq!(journalled(&resumed).len(), 3);
+    measure_in(&resumed, SpotsShown::UnderMeter, true, &run).unwrap();
+    assert_eq!(journalled(&resumed), readings);
+    std::fs::remove_dir_all(&root).unwrap();
 }

@@ -176,9 +176,16 @@ impl Screen for VirtualDisplay {
 
     fn shift_image(&mut self, by: [i64; 2]) -> Result<(), ScreenError> {
         let Some(image) = &self.given.image else {
-            return Err(ScreenError::NoImage { screen: self.spec() });
+            return Err(ScreenError::NoImage {
+                screen: self.spec(),
+            });
         };
-        let shown = self.lit.shown.read().unwrap_or_else(|e| e.into_inner()).clone();
+        let shown = self
+            .lit
+            .shown
+            .read()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
         // Repeated readings of one spot slide by the same amount: nothing to redo.
         if self.given.by == by && matches!(shown, Shown::Image(_)) {
             return Ok(());

@@ -420,3 +420,49 @@ fn an_aimed_meter_sees_the_mean_emission_under_its_spot() {
     }));
     assert!(near(&seen(), &mean));
 }
+
+/// A still meter over a slid image: the image's left half red and right half blue, the
+/// meter's spot inside the left half. Slid two pixels right, the spot sees what the slide
+/// uncovered (black); slid two left, the blue half; slid back, red; slid a row up, black
+/// again. A slide before any
+/// image is refused, and a colour shown in between is replaced by the image slid.
+#[test]
+fn a_still_meter_sees_what_the_slide_brings_under_it() {
+    let (red, blue) = ([255, 0, 0], [0, 0, 255]);
+    let pixels = (0..8).map(|i| if i % 4 < 2 { red } else { blue }).collect();
+    let image = Drive8Image::new(4, 2, pixels).unwrap();
+    let mut display = VirtualDisplay::preset(Preset::IpsLcd);
+    assert!(matches!(
+        display.shift_image([1, 0]),
+        Err(ScreenError::NoImage { .. })
+    ));
+    display.show_image(&image).unwrap();
+    let world = display.stimulus().unwrap();
+    display.meter_aim().unwrap().set(Some(ScreenSpot {
+        x: 0.25,
+        y: 0.5,
+        radius: 0.3,
+    }));
+    let seen = || match world.view() {
+        View::Emissive(Light::Radiance(s)) => {
+            metamer_color::radiance_to_xyz(&s, metamer_color::ObserverKind::Cie1931)
+        }
+        _ => panic!("a display emits"),
+    };
+    let panel = display.panel().clone();
+    for (by, under) in [
+        ([2, 0], [0, 0, 0]),
+        ([-2, 0], blue),
+        ([0, 0], red),
+        // The spot, under 1 px across, counts the pixel under its centre, (1, 1): the
+        // slide up leaves that row black.
+        ([0, -1], [0, 0, 0]),
+    ] {
+        display.shift_image(by).unwrap();
+        assert!(close(seen(), panel.xyz(under), 1e-12), "{by:?}");
+        assert_eq!(display.shown(), under, "{by:?}");
+    }
+    display.show([0, 255, 0]).unwrap();
+    display.shift_image([0, 0]).unwrap();
+    assert_eq!(display.shown(), red);
+}

@@ -363,7 +363,9 @@ impl Screen for WindowDisplay {
 
     fn shift_image(&mut self, by: [i64; 2]) -> Result<(), ScreenError> {
         let Some((image, now)) = &self.given else {
-            return Err(ScreenError::NoImage { screen: self.spec() });
+            return Err(ScreenError::NoImage {
+                screen: self.spec(),
+            });
         };
         // Repeated readings of one spot slide by the same amount: the picture stays.
         if *now == Some(by) {

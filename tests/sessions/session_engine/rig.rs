@@ -49,7 +49,9 @@ impl Screen for FakeScreen {
     }
     /// No image is ever shown here, so none can slide.
     fn shift_image(&mut self, _: [i64; 2]) -> Result<(), ScreenError> {
-        Err(ScreenError::NoImage { screen: self.spec() })
+        Err(ScreenError::NoImage {
+            screen: self.spec(),
+        })
     }
     fn default_settle(&self) -> Duration {
         Duration::ZERO
