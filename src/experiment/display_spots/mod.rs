@@ -30,8 +30,8 @@ use sha2::{Digest, Sha256};
 
 mod plan;
 pub mod shown;
-pub use plan::{image_plan, plan, under_meter_plan, PatchAim, SpotStep};
-pub use shown::SpotsShown;
+pub use plan::{aim_prompt, aims_on, image_plan, plan, PatchAim, SpotStep};
+pub use shown::{under_meter_plan, SpotsShown};
 
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
@@ -40,7 +40,7 @@ use super::readings::{write_readings, PatchReading, ReadingSet};
 use super::reproduction::{PatchDrive, PatchRegion};
 use crate::color::Xyz;
 use crate::image::{Drive8Image, ScreenSpot};
-use crate::rig::{MeterAim, Placement};
+use crate::rig::MeterAim;
 use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::{
     patch_so_far, Answer, CostReport, Entry, InstrumentRecord, Meter, Operator, OperatorError,
@@ -77,19 +77,6 @@ pub struct SpotRecord {
     /// The readings' budget before the first of this run and what the run took.
     #[serde(default)]
     pub cost: Option<CostReport>,
-}
-
-/// The operator's request for patch `r` at `spot` on the screen.
-pub fn aim_prompt(r: &PatchRegion, spot: ScreenSpot) -> String {
-    format!(
-        "aim the meter at patch {} (row {}, column {}) — at {:.1} % from the left, {:.1} % \
-         from the top of the screen",
-        r.patch,
-        r.row,
-        r.column,
-        100.0 * spot.x,
-        100.0 * spot.y
-    )
 }
 
 /// How many times each patch is read.
@@ -449,24 +436,16 @@ pub fn measure(
         total: session.plan().steps.len(),
         journal: journal.clone(),
     };
-    let remaining = session.done() < session.plan().steps.len();
     let meters = [("spot".to_string(), Meter::of(meter.as_ref()))].into();
     let estimate = {
         let (light, assumption) = patch_light(drives, screen.as_ref());
         let mut cost = session.estimate(&meters, &light, &assumption, run.placement_s());
-        if moving && remaining {
+        if moving && session.done() < session.plan().steps.len() {
             cost.add(&shown::aim_cost(run.placement_s()));
         }
         cost
     };
-    // The image moving under the meter: the meter is aimed once, whenever readings remain
-    // (it may have moved since an interrupted run).
-    let aimed = match (moving, remaining) {
-        (true, true) => shown::aim_at_middle(&mut operator)?,
-        (true, false) => Some(Default::default()),
-        (false, _) => aim_again(&session, &record.aims, &mut operator)?.then(Default::default),
-    };
-    let Some(aimed) = aimed else {
+    let Some(aimed) = aim_before(&session, &record.aims, moving, &mut operator)? else {
         return Err(incomplete(&session));
     };
     let mut rig = Rig {
@@ -558,6 +537,24 @@ fn show(
     Ok((plan, record))
 }
 
+/// Has the operator aim the meter before the readings the journal lacks: for the image
+/// moved under the meter (`moving`) once at the middle of the screen, whenever readings
+/// remain (it may have moved since an interrupted run); else again at the patch a resumed
+/// session continues mid-way. The placement that took, or None when the operator aborts.
+fn aim_before(
+    session: &Session<SpotHeader, SpotStep>,
+    aims: &[PatchAim],
+    moving: bool,
+    operator: &mut dyn Operator,
+) -> Result<Option<crate::session::Cost>, ExperimentError> {
+    let remaining = session.done() < session.plan().steps.len();
+    Ok(match (moving, remaining) {
+        (true, true) => shown::aim_at_middle(operator)?,
+        (true, false) => Some(Default::default()),
+        (false, _) => aim_again(session, aims, operator)?.then(Default::default),
+    })
+}
+
 /// A resumed session may continue mid-patch, after that patch's aiming request: asks it
 /// again. False when the operator aborts.
 fn aim_again(
@@ -574,28 +571,6 @@ fn aim_again(
         }
     }
     Ok(true)
-}
-
-/// Each patch's aim on the screen, for the image placed at `placement`.
-pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> {
-    regions
-        .iter()
-        .map(|r| {
-            let spot = placement.on_screen(ScreenSpot {
-                x: r.x,
-                y: r.y,
-                radius: r.radius,
-            });
-            PatchAim {
-                patch: r.patch,
-                x: spot.x,
-                y: spot.y,
-                radius: spot.radius,
-                prompt: aim_prompt(r, spot),
-                shift: None,
-            }
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -7,7 +7,9 @@ use std::collections::BTreeMap;
 use metamer_drivers::MeasureMode;
 use serde::{Deserialize, Serialize};
 
-use crate::experiment::reproduction::PatchDrive;
+use crate::experiment::reproduction::{PatchDrive, PatchRegion};
+use crate::image::ScreenSpot;
+use crate::rig::Placement;
 use crate::session::{Prepare, SessionPlan, Step};
 
 /// A display-spot step's own data in the journal.
@@ -47,30 +49,6 @@ pub fn image_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
     plan
 }
 
-/// The plan on the image moved under a meter that stays put (aimed once, outside the
-/// plan): every patch, `repeats` times, each reading preceded by its patch's slide, so a
-/// session resumed mid-patch puts the image back where that patch's readings need it. The
-/// slides are steps' data, so the fingerprint covers them. An aim without a slide stays
-/// where the image was shown.
-pub fn under_meter_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
-    let patches = aims.iter().map(|a| {
-        let slide = Prepare::ShiftImage {
-            by: a.shift.unwrap_or_default(),
-        };
-        (a.patch, slide.clone(), slide)
-    });
-    let mut plan = patch_plan(patches, repeats);
-    plan.options.insert(
-        "shown".to_string(),
-        super::SpotsShown::UnderMeter.record_name(true).to_string(),
-    );
-    plan.options.insert(
-        "meter at".to_string(),
-        format!("{:?}", super::shown::METER_AT),
-    );
-    plan
-}
-
 /// The plan: every patch, `repeats` times, in patch order.
 pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
     let patches = drives.iter().map(|d| {
@@ -82,7 +60,7 @@ pub fn plan(drives: &[PatchDrive], repeats: usize) -> SessionPlan<SpotStep> {
 
 /// Every patch `repeats` times in the order given, each as (patch, what its first reading
 /// needs, what each further reading needs).
-fn patch_plan(
+pub(super) fn patch_plan(
     patches: impl Iterator<Item = (usize, Prepare, Prepare)>,
     repeats: usize,
 ) -> SessionPlan<SpotStep> {
@@ -110,4 +88,39 @@ fn patch_plan(
         options,
         steps,
     }
+}
+
+/// The operator's request for patch `r` at `spot` on the screen.
+pub fn aim_prompt(r: &PatchRegion, spot: ScreenSpot) -> String {
+    format!(
+        "aim the meter at patch {} (row {}, column {}) — at {:.1} % from the left, {:.1} % \
+         from the top of the screen",
+        r.patch,
+        r.row,
+        r.column,
+        100.0 * spot.x,
+        100.0 * spot.y
+    )
+}
+
+/// Each patch's aim on the screen, for the image placed at `placement`.
+pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> {
+    regions
+        .iter()
+        .map(|r| {
+            let spot = placement.on_screen(ScreenSpot {
+                x: r.x,
+                y: r.y,
+                radius: r.radius,
+            });
+            PatchAim {
+                patch: r.patch,
+                x: spot.x,
+                y: spot.y,
+                radius: spot.radius,
+                prompt: aim_prompt(r, spot),
+                shift: None,
+            }
+        })
+        .collect()
 }

@@ -15,11 +15,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::plan::PatchAim;
+use super::plan::{PatchAim, SpotStep};
 use crate::experiment::reproduction::PatchRegion;
 use crate::image::ScreenSpot;
 use crate::rig::Placement;
-use crate::session::{Answer, Cost, Operator, OperatorError};
+use crate::session::{Answer, Cost, Operator, OperatorError, Prepare, SessionPlan};
 
 /// How the display spots put each patch in front of the meter.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -128,6 +128,28 @@ pub fn aims_under_meter(
             }
         })
         .collect()
+}
+
+/// The plan on the image moved under a meter that stays put (aimed once, outside the
+/// plan): every patch, `repeats` times, each reading preceded by its patch's slide, so a
+/// session resumed mid-patch puts the image back where that patch's readings need it. The
+/// slides are steps' data, so the fingerprint covers them. An aim without a slide stays
+/// where the image was shown.
+pub fn under_meter_plan(aims: &[PatchAim], repeats: usize) -> SessionPlan<SpotStep> {
+    let patches = aims.iter().map(|a| {
+        let slide = Prepare::ShiftImage {
+            by: a.shift.unwrap_or_default(),
+        };
+        (a.patch, slide.clone(), slide)
+    });
+    let mut plan = super::plan::patch_plan(patches, repeats);
+    plan.options.insert(
+        "shown".to_string(),
+        SpotsShown::UnderMeter.record_name(true).to_string(),
+    );
+    plan.options
+        .insert("meter at".to_string(), format!("{:?}", METER_AT));
+    plan
 }
 
 /// The one placement of the image moved under the meter, at `placement_s` seconds.
