@@ -340,6 +340,7 @@ mod tests {
     use crate::display::characterize::adaptive::Rule;
     use crate::display::ModelKind;
     use crate::experiment::run::tests::given;
+    use crate::session::budget::PLACEMENT_S;
 
     fn options(adaptive: Option<Rule>) -> ExperimentOptions {
         let mut o = given(Path::new("unused"), "scene.json".into(), "spots.csv".into());
@@ -393,5 +394,31 @@ mod tests {
             ..Rule::default()
         };
         assert_eq!(display(&budget(&options(Some(rule)))).readings, first + 24);
+    }
+
+    /// The display spots' placements before the first reading: one per patch with the
+    /// meter aimed at each (24), one for the image moved under the meter, none where each
+    /// patch is shown full-screen; the readings are the same 24 × 3 in every way.
+    #[test]
+    fn the_image_under_the_meter_is_budgeted_at_one_placement() {
+        let spots = |shown: SpotsShown| {
+            let mut o = options(None);
+            o.repeats = 3;
+            o.spots_shown = shown;
+            o.simulation.image =
+                Some(crate::experiment::simulation::ImageSpec { size: 64, spp: 1 });
+            let b = budget(&o);
+            let c = &b
+                .iter()
+                .find(|s| s.stage == Stage::DisplaySpots.name())
+                .unwrap()
+                .cost
+                .estimate;
+            (c.readings, c.placements, c.operator_s)
+        };
+        let s = PLACEMENT_S;
+        assert_eq!(spots(SpotsShown::Aimed), (72, 24, 24.0 * s));
+        assert_eq!(spots(SpotsShown::UnderMeter), (72, 1, s));
+        assert_eq!(spots(SpotsShown::FullScreen), (72, 0, 0.0));
     }
 }
