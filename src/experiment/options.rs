@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use super::display::DisplayOptions;
 use super::measure_box::MeasureBox;
+use super::measuring::MeasuringPlan;
 use super::reproduction::ReproductionOptions;
 use super::simulation::SimulationOptions;
 use super::stage::Stage;
@@ -26,6 +27,8 @@ pub enum BoxSource {
 #[derive(Clone, Debug)]
 pub struct ExperimentOptions {
     pub dir: PathBuf,
+    /// The measuring plan the options were expanded from: each stage's record names it.
+    pub measuring: MeasuringPlan,
     pub box_source: BoxSource,
     /// A given box's spot readings as [`Request`](super::Request) read them in its checks,
     /// so the checks before the first stage use them rather than read the file again.
