@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::digest::{hex, sha256_file};
 use super::measuring::MeasuringPlan;
+use crate::digest::{hex, sha256_file};
 use crate::output::{OutputError, OutputPolicy};
 
 /// The record's file name inside a stage directory.
@@ -279,7 +279,8 @@ mod tests {
             always: true,
         }];
         assert!(s.reusable(&inputs, &products).is_none());
-        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &products).is_some());
         // Another option value: run again.
         assert!(s
@@ -295,7 +296,8 @@ mod tests {
         // An output edited or removed: run again.
         std::fs::write(s.path("spots.csv"), "1,2,4").unwrap();
         assert!(s.reusable(&inputs, &products).is_none());
-        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         std::fs::remove_file(s.path("spots.csv")).unwrap();
         assert!(s.reusable(&inputs, &products).is_none());
         s.invalidate().unwrap();
@@ -312,7 +314,9 @@ mod tests {
         std::fs::write(root.join("elsewhere"), "x").unwrap();
         std::fs::write(s.path("profile.json"), "{}").unwrap();
         let inputs = Inputs::new().value("model", &"lut");
-        let good = s.finish(&inputs, &["profile.json"], 1.0, MeasuringPlan::Paper).unwrap();
+        let good = s
+            .finish(&inputs, &["profile.json"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &[]).is_some());
         let x_hash = hash_file(&root.join("elsewhere")).unwrap();
         std::os::unix::fs::symlink(root.join("elsewhere"), s.path("link")).unwrap();
@@ -352,17 +356,26 @@ mod tests {
                 always: false,
             },
         ];
-        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &products).is_some());
-        s.finish(&inputs, &[] as &[&str], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(&inputs, &[] as &[&str], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &products).is_none(), "outputs {{}}");
-        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         std::fs::write(s.path("image.exr"), "an image no record vouches for").unwrap();
         assert!(
             s.reusable(&inputs, &products).is_none(),
             "an unrecorded image"
         );
-        s.finish(&inputs, &["spots.csv", "image.exr"], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(
+            &inputs,
+            &["spots.csv", "image.exr"],
+            1.0,
+            MeasuringPlan::Paper,
+        )
+        .unwrap();
         assert!(s.reusable(&inputs, &products).is_some());
     }
 
@@ -375,7 +388,8 @@ mod tests {
         let s = StageDir::new(&root, "display");
         std::fs::create_dir_all(&s.dir).unwrap();
         let inputs = Inputs::new().value("model", &"lut");
-        s.finish(&inputs, &[] as &[&str], 1.0, MeasuringPlan::Paper).unwrap();
+        s.finish(&inputs, &[] as &[&str], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &[]).is_some());
         let record = s.path(RECORD_FILE);
         let c = std::ffi::CString::new(record.as_os_str().as_encoded_bytes()).unwrap();

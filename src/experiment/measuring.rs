@@ -42,9 +42,7 @@ impl MeasuringPlan {
     /// The stages' options this plan stands for, each given one of `choices` in its place.
     pub fn expand(self, choices: &MeasuringChoices) -> Measures {
         let plan = self.measures();
-        let display_adaptive = choices
-            .display_adaptive
-            .unwrap_or(plan.display.is_some());
+        let display_adaptive = choices.display_adaptive.unwrap_or(plan.display.is_some());
         let base = plan.display.unwrap_or_default();
         let display = display_adaptive.then(|| Rule {
             stop_de: choices.stop_de.unwrap_or(base.stop_de),
@@ -209,6 +207,9 @@ mod tests {
             assert_eq!(p.name().parse::<MeasuringPlan>(), Ok(p));
             assert_eq!(serde_json::to_value(p).unwrap(), p.name());
         }
-        assert!("quick".parse::<MeasuringPlan>().unwrap_err().contains("paper or lean"));
+        assert!("quick"
+            .parse::<MeasuringPlan>()
+            .unwrap_err()
+            .contains("paper or lean"));
     }
 }

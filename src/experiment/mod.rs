@@ -32,7 +32,7 @@ mod stage;
 pub mod validate;
 
 pub use error::ExperimentError;
-pub use measuring::{MeasuringChoices, MeasuringPlan, Measures};
+pub use measuring::{Measures, MeasuringChoices, MeasuringPlan};
 pub use options::{BoxSource, ExperimentOptions};
 pub use progress::Progress;
 pub use request::{BoxRequest, Outcome, Request, RequestError, DEFAULT_SPOT, MAX_IMAGE_SIZE};

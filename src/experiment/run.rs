@@ -513,8 +513,8 @@ fn validation_stage(
 pub(crate) mod tests {
     use super::*;
     use crate::display::ModelKind;
-    use crate::experiment::measuring::{MeasuringChoices, MeasuringPlan};
     use crate::experiment::display::DisplayOptions;
+    use crate::experiment::measuring::{MeasuringChoices, MeasuringPlan};
     use crate::experiment::reproduction::ReproductionOptions;
     use crate::experiment::simulation::SimulationOptions;
     use crate::session::RunOptions;

@@ -417,7 +417,10 @@ mod tests {
         assert_eq!(held_out_targets(&predicted, Some(3)), vec![1, 3, 4]);
         assert_eq!(held_out_targets(&predicted[..4], Some(1)), vec![1]);
         assert_eq!(held_out_targets(&predicted, None), vec![0, 1, 2, 3, 4, 5]);
-        assert_eq!(held_out_targets(&predicted, Some(9)), vec![0, 1, 2, 3, 4, 5]);
+        assert_eq!(
+            held_out_targets(&predicted, Some(9)),
+            vec![0, 1, 2, 3, 4, 5]
+        );
     }
 
     #[test]
