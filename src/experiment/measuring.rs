@@ -70,9 +70,8 @@ impl MeasuringPlan {
                 repeats: 3,
                 until_decided: None,
             },
-            // The figures of the lab study's leanest arm that kept every verdict
-            // (docs/benchmarks.md, the lab study with the adaptive box plan); the
-            // held-out count's in docs/benchmarks.md too.
+            // The lab study's leanest arm ("box-lean", docs/benchmarks.md) with 12 held
+            // out where the models agree least (the held-out count's table there).
             MeasuringPlan::Lean => Measures {
                 box_adaptive: true,
                 box_spot_rule: Some(RepeatRule::Width {
