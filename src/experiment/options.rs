@@ -15,6 +15,8 @@ use crate::session::RunOptions;
 use crate::validation::readings::ReadingSet;
 
 /// Where the box's measurements come from.
+// One per experiment, never in a collection: its size costs nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum BoxSource {
     /// Measured here, by the `measure-box` session into `box/`.
