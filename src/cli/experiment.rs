@@ -8,7 +8,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
 use metamer::experiment::display::DisplayOptions;
-use metamer::experiment::display_spots::SpotsShown;
 use metamer::experiment::reproduction::ReproductionOptions;
 use metamer::experiment::simulation::SimulationOptions;
 use metamer::experiment::{
@@ -18,7 +17,7 @@ use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 use metamer_drivers::Spec;
 
-use super::plan_choice::{PlanKind, RuleArgs};
+use super::plan_choice::MeasuringArgs;
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -30,17 +29,13 @@ pub struct Args {
     /// stage is the `measure-box` session; sim:i1pro measures the simulated box).
     #[arg(long, value_name = "SPEC", required_unless_present = "box_scene")]
     spectral: Option<Spec>,
-    /// The box measurement plan (see `metamer measure-box --help`); default: the paper's.
+    /// The box measurement plan (see `metamer measure-box --help`); its spot_rule and
+    /// spot_white, given, replace the measuring plan's; default: the paper's.
     #[arg(long, value_name = "PLAN.json")]
     plan: Option<PathBuf>,
     /// Readings per target in the box (default: the plan's).
     #[arg(long, value_name = "N")]
     box_repeats: Option<usize>,
-    /// The box's tiles and fall-off: fixed (every tile and angle, the paper's) or adaptive
-    /// (a subset first, then where the spatial and distribution models leave the spots
-    /// most in doubt, up to a cap).
-    #[arg(long, value_enum, default_value = "fixed")]
-    box_plan: PlanKind,
     /// Instead of measuring the box here: its measured scene (`scene.json` of
     /// `metamer measure-box`) …
     #[arg(
@@ -92,20 +87,6 @@ pub struct Args {
     /// or led-rgb1 (CIE LED-RGB1, whose saturated colours no virtual display can show).
     #[arg(long, value_name = "LIGHT", conflicts_with = "box_scene")]
     scenario: Option<Scenario>,
-    /// Spot readings averaged per patch on the display.
-    #[arg(long, default_value_t = 3, value_name = "K")]
-    repeats: usize,
-    /// Read each patch on the display until its ΔE*ab against the box is decided at 95 %
-    /// with this margin beyond the JND (ΔE*ab 2.3), at least twice and at most --repeats
-    /// times (e.g. 0.1); without it every patch is read --repeats times.
-    #[arg(long, value_name = "ΔE")]
-    until_decided: Option<f64>,
-    /// How each patch is put in front of the meter on the display: aimed (the paper's: the
-    /// image shown whole, the meter re-aimed at every patch), under-meter (the image slid
-    /// so each patch in turn lies under the meter, aimed once at the middle of the screen)
-    /// or full-screen (each patch's drive values over the whole screen).
-    #[arg(long, default_value = "aimed", value_name = "HOW")]
-    display_spots: SpotsShown,
     /// Another run's folder (an experiment's or `lab`'s, measured with another plan on the
     /// same rig), whose measuring cost and accuracy the report's cost section sets beside
     /// this run's; read from its saved files, nothing measured again.
@@ -131,12 +112,8 @@ pub struct Args {
     /// calibrate the instruments. Real instruments without a terminal on stdin need it.
     #[arg(long)]
     unattended: bool,
-    /// The display's characterization: fixed (the paper's patches) or adaptive (patches
-    /// where the candidate models disagree at the rendered colours).
-    #[arg(long, value_enum, default_value = "fixed")]
-    display_plan: PlanKind,
     #[command(flatten)]
-    rule: RuleArgs,
+    measuring: MeasuringArgs,
 }
 
 pub fn run_cli(args: Args) -> CliResult {
@@ -159,8 +136,11 @@ pub fn run_cli(args: Args) -> CliResult {
 /// The flags as the library's request; the library checks and completes it.
 fn request(args: Args) -> Result<Request, CliError> {
     let spot = args.spot;
+    let measuring = args.measuring.measuring;
+    let m = measuring.expand(&args.measuring.choices()?);
     Ok(Request {
         dir: args.out.clone(),
+        measuring,
         box_source: match (args.box_scene, args.box_spots, args.spectral) {
             (Some(scene), Some(spots), _) => BoxRequest::Given { scene, spots },
             (_, _, Some(spectral)) => BoxRequest::Measure {
@@ -168,7 +148,8 @@ fn request(args: Args) -> Result<Request, CliError> {
                 spot: spot.clone(),
                 plan: args.plan,
                 repeats: args.box_repeats,
-                adaptive: args.box_plan == PlanKind::Adaptive,
+                adaptive: m.box_adaptive,
+                spot_rule: m.box_spot_rule,
                 seed: args.seed,
                 light: args.scenario,
             },
@@ -189,15 +170,15 @@ fn request(args: Args) -> Result<Request, CliError> {
             screen: args.display,
             spot,
             model: args.model,
-            adaptive: args.rule.rule(args.display_plan)?,
+            adaptive: m.display,
         },
         reproduction: ReproductionOptions {
             gamut: args.gamut,
             mirror: !args.no_mirror,
         },
-        repeats: args.repeats,
-        until_decided: args.until_decided,
-        spots_shown: args.display_spots,
+        repeats: m.repeats,
+        until_decided: m.until_decided,
+        spots_shown: m.spots_shown,
         compare_with: args.compare_with,
         stage: args.stage,
         rerun_all: false,

@@ -4,13 +4,12 @@ use std::path::PathBuf;
 
 use metamer::display::gamut::GamutMapping;
 use metamer::display::ModelKind;
-use metamer::experiment::display_spots::SpotsShown;
 use metamer::experiment::lab::{run_lab, LabError, LabOptions, LabSummary, LAB_FILE};
 use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::experiment::{print_cost, print_outcomes, refusal, StageProgress};
-use super::plan_choice::{PlanKind, RuleArgs};
+use super::plan_choice::MeasuringArgs;
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -38,37 +37,18 @@ pub struct Args {
     /// The simulation's accuracy: 95 % half-width of every patch's ΔE*ab.
     #[arg(long, default_value_t = 0.1, value_name = "ΔE")]
     target_de: f64,
-    /// Spot readings averaged per patch on the display.
-    #[arg(long, default_value_t = 3, value_name = "K")]
-    repeats: usize,
-    /// Read each patch on the display until its ΔE*ab against the box is decided at 95 %
-    /// with this margin beyond the JND (ΔE*ab 2.3), at least twice and at most --repeats
-    /// times (e.g. 0.1); without it every patch is read --repeats times.
-    #[arg(long, value_name = "ΔE")]
-    until_decided: Option<f64>,
-    /// How each patch is put in front of the meter on the display: aimed (the paper's: the
-    /// image shown whole, the meter re-aimed at every patch), under-meter (the image slid
-    /// so each patch in turn lies under the meter, aimed once at the middle of the screen)
-    /// or full-screen (each patch's drive values over the whole screen).
-    #[arg(long, default_value = "aimed", value_name = "HOW")]
-    display_spots: SpotsShown,
     /// Another run's folder (an experiment's or `lab`'s, measured with another plan on the
     /// same rig), whose measuring cost and accuracy the report's cost section sets beside
     /// this run's; read from its saved files, nothing measured again.
     #[arg(long, value_name = "DIR")]
     compare_with: Option<PathBuf>,
-    /// The box measurement plan (see `metamer measure-box --help`), e.g. a spot rule;
-    /// default: the paper's.
+    /// The box measurement plan (see `metamer measure-box --help`); its spot_rule and
+    /// spot_white, given, replace the measuring plan's; default: the paper's.
     #[arg(long, value_name = "PLAN.json")]
     plan: Option<PathBuf>,
     /// Readings of each tile and spot in the box (default: the box plan's 5).
     #[arg(long, value_name = "N")]
     box_repeats: Option<usize>,
-    /// The box's tiles and fall-off: fixed (every tile and angle, the paper's) or adaptive
-    /// (a subset first, then where the spatial and distribution models leave the spots
-    /// most in doubt, up to a cap).
-    #[arg(long, value_enum, default_value = "fixed")]
-    box_plan: PlanKind,
     /// Seed of the simulated box and of its instruments' noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -90,16 +70,13 @@ pub struct Args {
     /// are moved aside, never deleted).
     #[arg(long)]
     force: bool,
-    /// The display's characterization: fixed (the paper's patches) or adaptive (patches
-    /// where the candidate models disagree at the 24 rendered colours).
-    #[arg(long, value_enum, default_value = "fixed")]
-    display_plan: PlanKind,
     #[command(flatten)]
-    rule: RuleArgs,
+    measuring: MeasuringArgs,
 }
 
 pub fn run(args: Args) -> CliResult {
-    let adaptive = args.rule.rule(args.display_plan)?;
+    let measuring = args.measuring.measuring;
+    let m = measuring.expand(&args.measuring.choices()?);
     let ScreenSpec::Virtual(display) = args.display else {
         return Err(CliError::Usage(format!(
             "--display {}: the lab's monitor is simulated; name it virtual:PRESET",
@@ -107,22 +84,24 @@ pub fn run(args: Args) -> CliResult {
         )));
     };
     let options = LabOptions {
+        measuring,
         scenario: args.scenario,
         display,
         model: args.model,
         gamut: args.gamut,
         target_de: args.target_de,
-        repeats: args.repeats,
-        until_decided: args.until_decided,
-        spots_shown: args.display_spots,
+        repeats: m.repeats,
+        until_decided: m.until_decided,
+        spots_shown: m.spots_shown,
         compare_with: args.compare_with,
         plan: args.plan,
         box_repeats: args.box_repeats,
-        box_adaptive: args.box_plan == PlanKind::Adaptive,
+        box_adaptive: m.box_adaptive,
+        box_spot_rule: m.box_spot_rule,
         seed: args.seed,
         time_scale: args.time_scale,
         image_size: args.image_size,
-        adaptive,
+        adaptive: m.display,
     };
     let run = RunOptions {
         stop_after: None,

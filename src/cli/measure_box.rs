@@ -87,6 +87,9 @@ pub fn run(args: Args) -> CliResult {
         attendance: None,
         spot_readings: false,
         adaptive: false,
+        // The plan file's rule and white, as measure-box has no measuring plan.
+        spot_rule: None,
+        spot_white: None,
     };
     let outcome = job::measure(
         &request,

@@ -2,10 +2,10 @@
 //! the paper's fixed patches, or the adaptive plan and its rule.
 
 use clap::ValueEnum;
-use metamer::display::characterize::adaptive::{
-    Rule, DEFAULT_BATCH, DEFAULT_MAX_READINGS, DEFAULT_STOP_DE,
-};
+use metamer::display::characterize::adaptive::Rule;
 use metamer::display::ModelKind;
+use metamer::experiment::display_spots::SpotsShown;
+use metamer::experiment::measuring::{MeasuringChoices, MeasuringPlan, DEFAULT_MEASURING};
 
 use super::CliError;
 
@@ -20,42 +20,125 @@ pub enum PlanKind {
 
 /// The adaptive plan's rule; the plan itself is chosen by each command's own flag
 /// (`characterize --plan`, `experiment` and `lab --display-plan`: the experiment's `--plan`
-/// is the box's).
+/// is the box's). A figure not given is the default rule's (`characterize`) or the
+/// measuring plan's (`experiment`, `lab`).
 #[derive(clap::Args, Clone, Debug)]
 pub struct RuleArgs {
-    /// adaptive only: stop when the predicted ΔE*ab at every target is below this.
-    #[arg(long, value_name = "ΔE", default_value_t = DEFAULT_STOP_DE)]
-    pub stop_de: f64,
-    /// adaptive only: the cap on fit readings, the first pass included.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_READINGS)]
-    pub max_readings: usize,
-    /// adaptive only: patches per batch.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_BATCH)]
-    pub batch: usize,
+    /// adaptive only: stop when the predicted ΔE*ab at every target is below this
+    /// (default 1; experiment and lab: their --measuring plan's, lean 2).
+    #[arg(long, value_name = "ΔE")]
+    pub stop_de: Option<f64>,
+    /// adaptive only: the cap on fit readings, the first pass included (default 120;
+    /// experiment and lab: their --measuring plan's, lean 56).
+    #[arg(long, value_name = "N")]
+    pub max_readings: Option<usize>,
+    /// adaptive only: patches per batch (default 8).
+    #[arg(long, value_name = "N")]
+    pub batch: Option<usize>,
+    /// adaptive only: held-out patches read after the fit, one near each of this many
+    /// targets, those the candidate models agree on least (default: one near every
+    /// target; experiment and lab: their --measuring plan's, lean 12).
+    #[arg(long, value_name = "N")]
+    pub held_out: Option<usize>,
 }
 
 impl RuleArgs {
     /// The adaptive rule for `plan`, or None for the fixed plan; its numbers checked in
     /// the words of these flags.
     pub fn rule(&self, plan: PlanKind) -> Result<Option<Rule>, CliError> {
+        self.check()?;
         if plan == PlanKind::Fixed {
             return Ok(None);
         }
-        if !(self.stop_de.is_finite() && self.stop_de > 0.0) {
+        let base = Rule::default();
+        Ok(Some(Rule {
+            stop_de: self.stop_de.unwrap_or(base.stop_de),
+            max_readings: self.max_readings.unwrap_or(base.max_readings),
+            batch: self.batch.unwrap_or(base.batch),
+            held_out: self.held_out,
+            ..base
+        }))
+    }
+
+    /// The figures given, checked in the words of these flags.
+    pub fn check(&self) -> Result<(), CliError> {
+        if let Some(stop_de) = self.stop_de.filter(|s| !(s.is_finite() && *s > 0.0)) {
             return Err(CliError::Usage(format!(
-                "--stop-de must be a ΔE*ab above 0, got {}",
-                self.stop_de
+                "--stop-de must be a ΔE*ab above 0, got {stop_de}"
             )));
         }
-        if self.batch == 0 {
+        if self.batch == Some(0) {
             return Err(CliError::Usage("--batch must be at least 1".into()));
         }
-        Ok(Some(Rule {
-            stop_de: self.stop_de,
-            max_readings: self.max_readings,
-            batch: self.batch,
-            ..Rule::default()
-        }))
+        if self.held_out == Some(0) {
+            return Err(CliError::Usage("--held-out must be at least 1".into()));
+        }
+        Ok(())
+    }
+}
+
+/// The measuring plan's flags `experiment` and `lab` share: the plan by name and each of
+/// its options, which, given, replaces the plan's own.
+#[derive(clap::Args, Clone, Debug)]
+pub struct MeasuringArgs {
+    /// Which readings to take: paper (the paper's fixed plan: every box tile, fall-off angle
+    /// and spot 5 times; the display's ramps, grid and 48 held-out colours; every display
+    /// spot --repeats times) or lean (what the verdicts need: the box's tiles and fall-off
+    /// adaptively and its spots until their CIELAB is known to ±0.3 JND, at most 10
+    /// readings; the display adaptively, --stop-de 2 --max-readings 56 --held-out 12; each
+    /// display spot until its verdict is decided, --until-decided 0, at most 3 readings).
+    /// Every flag below replaces its part of the plan.
+    #[arg(long, value_name = "PLAN", default_value_t = DEFAULT_MEASURING)]
+    pub measuring: MeasuringPlan,
+    /// The box's tiles and fall-off: fixed (every tile and angle, the paper's) or adaptive
+    /// (a subset first, then where the spatial and distribution models leave the spots
+    /// most in doubt, up to a cap). Default: the measuring plan's.
+    #[arg(long, value_enum)]
+    pub box_plan: Option<PlanKind>,
+    /// The display's characterization: fixed (the paper's patches) or adaptive (patches
+    /// where the candidate models disagree at the rendered colours). Default: the
+    /// measuring plan's.
+    #[arg(long, value_enum)]
+    pub display_plan: Option<PlanKind>,
+    #[command(flatten)]
+    pub rule: RuleArgs,
+    /// Spot readings averaged per patch on the display, with --until-decided the most
+    /// (default 3).
+    #[arg(long, value_name = "K")]
+    pub repeats: Option<usize>,
+    /// Read each patch on the display until its ΔE*ab against the box is decided at 95 %
+    /// with this margin beyond the JND (ΔE*ab 2.3), at least twice and at most --repeats
+    /// times (e.g. 0.1); default: the measuring plan's (paper: every patch read --repeats
+    /// times; lean: 0).
+    #[arg(long, value_name = "ΔE")]
+    pub until_decided: Option<f64>,
+    /// How each patch is put in front of the meter on the display: aimed (the paper's: the
+    /// image shown whole, the meter re-aimed at every patch), under-meter (the image slid
+    /// so each patch in turn lies under the meter, aimed once at the middle of the screen)
+    /// or full-screen (each patch's drive values over the whole screen). Default: the
+    /// measuring plan's (paper: aimed; lean: under-meter).
+    #[arg(long, value_name = "HOW")]
+    pub display_spots: Option<SpotsShown>,
+}
+
+impl MeasuringArgs {
+    /// The options given in place of the plan's, their figures checked in the words of
+    /// these flags.
+    pub fn choices(&self) -> Result<MeasuringChoices, CliError> {
+        self.rule.check()?;
+        let adaptive = |p: Option<PlanKind>| p.map(|p| p == PlanKind::Adaptive);
+        Ok(MeasuringChoices {
+            box_adaptive: adaptive(self.box_plan),
+            box_spot_rule: None,
+            display_adaptive: adaptive(self.display_plan),
+            stop_de: self.rule.stop_de,
+            max_readings: self.rule.max_readings,
+            batch: self.rule.batch,
+            held_out: self.rule.held_out,
+            repeats: self.repeats,
+            until_decided: self.until_decided,
+            spots_shown: self.display_spots,
+        })
     }
 }
 

@@ -163,7 +163,8 @@ fn screen_light(screen: &ScreenSpec) -> (PatchLight, String) {
 
 /// The display's patches: the fixed plan's; or the adaptive plan's at its cap, its first
 /// pass as planned, the patches it chooses after it (not known before its readings) read
-/// like the first pass's in turn, and one held-out patch for each of the `targets`.
+/// like the first pass's in turn, and one held-out patch for each of the `targets` (or as
+/// many as its rule holds out).
 fn display_cost(d: &DisplayOptions, targets: usize, placement_s: f64) -> Cost {
     let defaults = PlanOptions::default();
     let options = PlanOptions::for_model(d.model, defaults.ramp_steps, defaults.repeats, None);
@@ -180,6 +181,7 @@ fn display_cost(d: &DisplayOptions, targets: usize, placement_s: f64) -> Cost {
         let Ok(first) = first_pass(options) else {
             return Cost::default();
         };
+        let targets = rule.held_out_count(targets);
         let cap = rule.max_readings.max(first.len()) + targets;
         let template = plan.steps.first().cloned();
         plan.steps = first

@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::measuring::MeasuringPlan;
 use crate::digest::{hex, sha256_file};
 use crate::output::{OutputError, OutputPolicy};
 
@@ -61,6 +62,11 @@ pub struct StageRecord {
     pub outputs: BTreeMap<String, String>,
     /// Wall time of the run that produced the outputs.
     pub seconds: f64,
+    /// The measuring plan of the run that produced the outputs. Not an input: the options
+    /// it stands for are, so a stage measured by the plan and one measured by the same
+    /// options chosen one by one are the same stage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measuring: Option<MeasuringPlan>,
 }
 
 /// SHA-256 of a file's bytes. Only a regular file (or a link to one) is hashed: a FIFO
@@ -201,6 +207,7 @@ impl StageDir {
         inputs: &Inputs,
         outputs: &[S],
         seconds: f64,
+        measuring: MeasuringPlan,
     ) -> Result<StageRecord, CacheError> {
         let mut hashes = BTreeMap::new();
         for f in outputs {
@@ -213,6 +220,7 @@ impl StageDir {
             inputs: inputs.0.clone(),
             outputs: hashes,
             seconds,
+            measuring: Some(measuring),
         };
         let text = serde_json::to_string_pretty(&record).unwrap_or_default();
         write_atomic(&self.path(RECORD_FILE), text.as_bytes())?;
@@ -271,7 +279,8 @@ mod tests {
             always: true,
         }];
         assert!(s.reusable(&inputs, &products).is_none());
-        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &products).is_some());
         // Another option value: run again.
         assert!(s
@@ -287,7 +296,8 @@ mod tests {
         // An output edited or removed: run again.
         std::fs::write(s.path("spots.csv"), "1,2,4").unwrap();
         assert!(s.reusable(&inputs, &products).is_none());
-        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         std::fs::remove_file(s.path("spots.csv")).unwrap();
         assert!(s.reusable(&inputs, &products).is_none());
         s.invalidate().unwrap();
@@ -304,7 +314,9 @@ mod tests {
         std::fs::write(root.join("elsewhere"), "x").unwrap();
         std::fs::write(s.path("profile.json"), "{}").unwrap();
         let inputs = Inputs::new().value("model", &"lut");
-        let good = s.finish(&inputs, &["profile.json"], 1.0).unwrap();
+        let good = s
+            .finish(&inputs, &["profile.json"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &[]).is_some());
         let x_hash = hash_file(&root.join("elsewhere")).unwrap();
         std::os::unix::fs::symlink(root.join("elsewhere"), s.path("link")).unwrap();
@@ -344,17 +356,26 @@ mod tests {
                 always: false,
             },
         ];
-        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &products).is_some());
-        s.finish(&inputs, &[] as &[&str], 1.0).unwrap();
+        s.finish(&inputs, &[] as &[&str], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &products).is_none(), "outputs {{}}");
-        s.finish(&inputs, &["spots.csv"], 1.0).unwrap();
+        s.finish(&inputs, &["spots.csv"], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         std::fs::write(s.path("image.exr"), "an image no record vouches for").unwrap();
         assert!(
             s.reusable(&inputs, &products).is_none(),
             "an unrecorded image"
         );
-        s.finish(&inputs, &["spots.csv", "image.exr"], 1.0).unwrap();
+        s.finish(
+            &inputs,
+            &["spots.csv", "image.exr"],
+            1.0,
+            MeasuringPlan::Paper,
+        )
+        .unwrap();
         assert!(s.reusable(&inputs, &products).is_some());
     }
 
@@ -367,7 +388,8 @@ mod tests {
         let s = StageDir::new(&root, "display");
         std::fs::create_dir_all(&s.dir).unwrap();
         let inputs = Inputs::new().value("model", &"lut");
-        s.finish(&inputs, &[] as &[&str], 1.0).unwrap();
+        s.finish(&inputs, &[] as &[&str], 1.0, MeasuringPlan::Paper)
+            .unwrap();
         assert!(s.reusable(&inputs, &[]).is_some());
         let record = s.path(RECORD_FILE);
         let c = std::ffi::CString::new(record.as_os_str().as_encoded_bytes()).unwrap();

@@ -15,6 +15,7 @@ use crate::measure_box::setup::RigError;
 use crate::measure_box::{BoxPlanError, Outcome};
 use crate::rig::Scenario;
 use crate::session::{Attendance, RunOptions, StepProgress};
+use crate::validation::sequential::RepeatRule;
 
 pub use crate::measure_box::job::SPOTS_FILE;
 
@@ -31,6 +32,13 @@ pub struct MeasureBox {
     /// so a fixed plan's box stage stays valid.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub adaptive: bool,
+    /// How each spot is read where the plan file names no rule (the measuring plan's),
+    /// and the white its CIELAB is relative to where the plan file names none; left out
+    /// of the stage's hash when None, so the paper's plan's box stage stays valid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spot_rule: Option<RepeatRule>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spot_white: Option<[f64; 3]>,
     /// The simulated box's seed (and its instruments').
     pub seed: u64,
     /// The simulated box's light (None: the default). A real box has its own light, so it
@@ -65,6 +73,8 @@ impl MeasureBox {
             plan: self.plan.clone(),
             repeats: self.repeats,
             adaptive: self.adaptive,
+            spot_rule: self.spot_rule.clone(),
+            spot_white: self.spot_white,
             resume,
             stage: None,
             seed: self.seed,
@@ -151,6 +161,8 @@ mod tests {
             plan: None,
             repeats: Some(1),
             adaptive: false,
+            spot_rule: None,
+            spot_white: None,
             seed: 3,
             light: Some(Scenario::default()),
         };

@@ -17,6 +17,7 @@ mod error;
 pub mod external_image;
 pub mod lab;
 pub mod measure_box;
+pub mod measuring;
 mod options;
 mod preflight;
 mod products;
@@ -31,6 +32,7 @@ mod stage;
 pub mod validate;
 
 pub use error::ExperimentError;
+pub use measuring::{Measures, MeasuringChoices, MeasuringPlan};
 pub use options::{BoxSource, ExperimentOptions};
 pub use progress::Progress;
 pub use request::{BoxRequest, Outcome, Request, RequestError, DEFAULT_SPOT, MAX_IMAGE_SIZE};

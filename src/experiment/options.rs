@@ -8,6 +8,7 @@ use serde::Serialize;
 use super::display::DisplayOptions;
 use super::display_spots::SpotsShown;
 use super::measure_box::MeasureBox;
+use super::measuring::MeasuringPlan;
 use super::reproduction::ReproductionOptions;
 use super::simulation::SimulationOptions;
 use super::stage::Stage;
@@ -15,6 +16,8 @@ use crate::session::RunOptions;
 use crate::validation::readings::ReadingSet;
 
 /// Where the box's measurements come from.
+// One per experiment, never in a collection: its size costs nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum BoxSource {
     /// Measured here, by the `measure-box` session into `box/`.
@@ -27,6 +30,8 @@ pub enum BoxSource {
 #[derive(Clone, Debug)]
 pub struct ExperimentOptions {
     pub dir: PathBuf,
+    /// The measuring plan the options were expanded from: each stage's record names it.
+    pub measuring: MeasuringPlan,
     pub box_source: BoxSource,
     /// A given box's spot readings as [`Request`](super::Request) read them in its checks,
     /// so the checks before the first stage use them rather than read the file again.

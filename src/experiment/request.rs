@@ -10,6 +10,7 @@ use super::display::DisplayOptions;
 use super::display_spots::SpotsShown;
 use super::error::ExperimentError;
 use super::measure_box::MeasureBox;
+use super::measuring::{nominal_white, MeasuringPlan};
 use super::options::{BoxSource, ExperimentOptions};
 use super::progress::Progress;
 use super::readings::{read_readings, ReadingSet, ReadingsError};
@@ -46,6 +47,11 @@ pub enum BoxRequest {
         repeats: Option<usize>,
         /// Read the tiles and the fall-off adaptively.
         adaptive: bool,
+        /// How each spot is read where the plan file names no rule (the measuring plan's
+        /// [`box_spot_rule`](super::measuring::Measures::box_spot_rule)); its CIELAB is relative to the plan file's
+        /// `spot_white`, or else a simulated monitor's nominal white
+        /// ([`super::measuring::nominal_white`]).
+        spot_rule: Option<RepeatRule>,
         /// The simulated box's seed (and its instruments').
         seed: u64,
         /// The simulated box's light, refused with real instruments, whose box has its own
@@ -62,6 +68,10 @@ pub enum BoxRequest {
 pub struct Request {
     /// Each stage writes into its own subdirectory of this.
     pub dir: PathBuf,
+    /// The measuring plan the options below were expanded from
+    /// ([`MeasuringPlan::expand`]), recorded in each stage's record; the options, not the
+    /// name, are what the stages' hashes cover.
+    pub measuring: MeasuringPlan,
     pub box_source: BoxRequest,
     pub simulation: SimulationOptions,
     /// The monitor, the meter that reads it, and the display model. The command reads the
@@ -207,12 +217,14 @@ impl Request {
     /// let meter = Spec::new("sim:cs100a?time_scale=0");
     /// let request = Request {
     ///     dir: dir.clone(),
+    ///     measuring: Default::default(),
     ///     box_source: BoxRequest::Measure {
     ///         spectral: Spec::new("sim:i1pro?time_scale=0"),
     ///         spot: meter.clone(),
     ///         plan: None,
     ///         repeats: Some(1),
     ///         adaptive: false,
+    ///         spot_rule: None,
     ///         seed: 1,
     ///         light: None,
     ///     },
@@ -271,7 +283,7 @@ impl Request {
     }
 
     /// The checks, in order, and the options every stage reads.
-    fn options(&self) -> Result<ExperimentOptions, RequestError> {
+    pub(crate) fn options(&self) -> Result<ExperimentOptions, RequestError> {
         check_target_de(self.simulation.target_de)?;
         check_repeats(self.repeats)?;
         if let Some(image) = &self.simulation.image {
@@ -297,10 +309,15 @@ impl Request {
                 plan,
                 repeats,
                 adaptive,
+                spot_rule,
                 seed,
                 light,
             } => BoxSource::Measure(MeasureBox {
                 adaptive: *adaptive,
+                spot_rule: spot_rule.clone(),
+                spot_white: spot_rule
+                    .as_ref()
+                    .and_then(|_| nominal_white(&self.display.screen)),
                 spectral: spectral.clone(),
                 spot: spot.clone(),
                 plan: plan.clone(),
@@ -316,6 +333,7 @@ impl Request {
         crate::session::attendance(&specs, self.unattended)?;
         Ok(ExperimentOptions {
             dir: self.dir.clone(),
+            measuring: self.measuring,
             box_source,
             given_readings,
             simulation: self.simulation.clone(),

@@ -232,7 +232,7 @@ fn run_afresh(
         }
     }
     let seconds = start.elapsed().as_secs_f64();
-    sd.finish(inputs, &files, seconds)?;
+    sd.finish(inputs, &files, seconds, opts.measuring)?;
     Ok(StageOutcome {
         stage,
         reused: false,
@@ -521,6 +521,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::display::ModelKind;
     use crate::experiment::display::DisplayOptions;
+    use crate::experiment::measuring::{MeasuringChoices, MeasuringPlan};
     use crate::experiment::reproduction::ReproductionOptions;
     use crate::experiment::simulation::SimulationOptions;
     use crate::session::RunOptions;
@@ -529,6 +530,7 @@ pub(crate) mod tests {
     pub(crate) fn given(dir: &Path, scene: PathBuf, spots: PathBuf) -> ExperimentOptions {
         ExperimentOptions {
             dir: dir.to_path_buf(),
+            measuring: Default::default(),
             box_source: BoxSource::Existing { scene, spots },
             given_readings: None,
             simulation: SimulationOptions {
@@ -587,6 +589,94 @@ pub(crate) mod tests {
         .to_string();
         assert!(e.contains("scene") && e.contains("gone.json"), "{e}");
         assert!(!dir.join("exp").exists(), "nothing was started");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The lab with the measuring plan `plan`, each of `choices` in place of its own, as
+    /// the command makes it.
+    fn lab(plan: MeasuringPlan, choices: &MeasuringChoices) -> crate::experiment::lab::LabOptions {
+        let m = plan.expand(choices);
+        crate::experiment::lab::LabOptions {
+            measuring: plan,
+            scenario: crate::rig::Scenario::default(),
+            display: crate::rig::Preset::IpsLcd,
+            model: ModelKind::Lut,
+            gamut: crate::display::gamut::GamutMapping::NearestLab,
+            target_de: 0.1,
+            repeats: m.repeats,
+            until_decided: m.until_decided,
+            compare_with: None,
+            plan: None,
+            box_repeats: None,
+            box_adaptive: m.box_adaptive,
+            box_spot_rule: m.box_spot_rule,
+            seed: 1,
+            time_scale: 0.0,
+            image_size: 0,
+            adaptive: m.display,
+            spots_shown: m.spots_shown,
+        }
+    }
+
+    /// The lean measuring plan is its options chosen one by one: the measuring stages'
+    /// fingerprints (their inputs' hashes, upstream files alike) are the same, and none is
+    /// the paper's plan's. The box's spots are read by the width rule relative to the
+    /// simulated monitor's nominal white.
+    #[test]
+    fn the_lean_plan_has_the_fingerprints_of_its_options_chosen_one_by_one() {
+        let dir = std::env::temp_dir().join(format!("metamer-measuring-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for (stage, file) in [
+            (Stage::Box, measure_box::SPOTS_FILE),
+            (Stage::Simulation, simulation::SPOTS_FILE),
+            (Stage::Simulation, simulation::SUMMARY_FILE),
+            (Stage::Display, display::SETTING_FILE),
+            (Stage::Display, display::PROFILE_FILE),
+            (Stage::Reproduction, reproduction::FILE),
+        ] {
+            let d = dir.join(stage.name());
+            std::fs::create_dir_all(&d).unwrap();
+            std::fs::write(d.join(file), file).unwrap();
+        }
+        let by_hand = MeasuringChoices {
+            box_adaptive: Some(true),
+            box_spot_rule: Some(crate::validation::sequential::RepeatRule::Width {
+                half_width_jnd: 0.3,
+                most: 10,
+            }),
+            display_adaptive: Some(true),
+            stop_de: Some(2.0),
+            max_readings: Some(56),
+            held_out: Some(12),
+            until_decided: Some(0.0),
+            spots_shown: Some(display_spots::SpotsShown::UnderMeter),
+            ..MeasuringChoices::default()
+        };
+        let fingerprints = |o: &crate::experiment::lab::LabOptions| {
+            let options = o
+                .request(&dir, false, false, RunOptions::default())
+                .options()
+                .unwrap();
+            [Stage::Box, Stage::Display, Stage::DisplaySpots]
+                .map(|s| inputs_of(s, &options).unwrap().0)
+        };
+        let lean = fingerprints(&lab(MeasuringPlan::Lean, &MeasuringChoices::default()));
+        let chosen = fingerprints(&lab(MeasuringPlan::Paper, &by_hand));
+        let paper = fingerprints(&lab(MeasuringPlan::Paper, &MeasuringChoices::default()));
+        assert_eq!(lean, chosen);
+        for (l, p) in lean.iter().zip(&paper) {
+            assert_ne!(l, p);
+        }
+        let options = lab(MeasuringPlan::Lean, &MeasuringChoices::default())
+            .request(&dir, false, false, RunOptions::default())
+            .options()
+            .unwrap();
+        let BoxSource::Measure(m) = &options.box_source else {
+            panic!("the lab measures its box")
+        };
+        let white = crate::rig::VirtualPanel::preset(crate::rig::Preset::IpsLcd).xyz([255; 3]);
+        assert_eq!(m.spot_white, Some([white.x, white.y, white.z]));
+        assert_eq!(options.measuring, MeasuringPlan::Lean);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -47,6 +47,11 @@ pub struct MeasureBoxRequest {
     /// Read the tiles and the fall-off adaptively ([`crate::measure_box::adaptive`]) with
     /// the default rule where the plan names none.
     pub adaptive: bool,
+    /// How each spot is read where the plan file names no rule (the experiment's measuring
+    /// plan), and the white its CIELAB is relative to where the plan names none: a plan
+    /// file's own `spot_rule` and `spot_white` stay. None: the plan's.
+    pub spot_rule: Option<RepeatRule>,
+    pub spot_white: Option<[f64; 3]>,
     /// Continue the journals in `out`.
     pub resume: bool,
     /// Only this stage, by name (tiles, falloff, materials, spots). A name, not a
@@ -129,6 +134,8 @@ pub enum MeasureBoxJobError {
 ///     plan: None,
 ///     repeats: Some(1),
 ///     adaptive: false,
+///     spot_rule: None,
+///     spot_white: None,
 ///     resume: false,
 ///     stage: Some("tiles".into()),
 ///     seed: 1,
@@ -263,6 +270,12 @@ fn plan(request: &MeasureBoxRequest) -> Result<BoxPlan, MeasureBoxJobError> {
         plan.repeats = n;
     }
     plan.choose_adaptive(request.adaptive);
+    if plan.spot_rule.is_none() {
+        plan.spot_rule = request.spot_rule.clone();
+    }
+    if plan.spot_white.is_none() {
+        plan.spot_white = request.spot_white;
+    }
     plan.validate().map_err(|e| match e {
         BoxPlanError::Invalid { field, message } if field == "repeats" => {
             MeasureBoxJobError::Repeats(message)

@@ -161,3 +161,92 @@ fn print_adaptive_table() {
         }
     }
 }
+
+/// The held-out set's count: the lean measuring plan's rule (stop at ΔE*ab 2, at most 56
+/// fit readings) on each simulated monitor and meter seed, the held-out ΔE*ab (mean / max
+/// over the held-out patches, against the meter's readings) of all 24, of every second
+/// target's and of the 12 the models agree on least, beside the noise-free error at the
+/// in-gamut targets they estimate. The fit is the same in all three (the held-out set is
+/// read after it), so the profile and its error at the targets are too.
+#[test]
+#[ignore = "a study: cargo test --release --test display -- --ignored --nocapture adaptive_plan::print_held_out_table"]
+fn print_held_out_table() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let targets = read_targets(&root.join("tests/data/docs/colorchecker-targets.csv")).unwrap();
+    println!("| display | seed | at the targets, noise-free: mean / max | held out, all 24: mean / max | every second (12) | the 12 least certain |");
+    println!("| --- | --- | --- | --- | --- | --- |");
+    for preset in Preset::ALL {
+        let panel = VirtualPanel::preset(preset);
+        for seed in [1, 2, 3] {
+            let run = |held_out: Option<usize>| {
+                let out = std::env::temp_dir().join(format!(
+                    "metamer-held-out-{}-{seed}-{held_out:?}-{}",
+                    preset.name(),
+                    std::process::id()
+                ));
+                let _ = std::fs::remove_dir_all(&out);
+                let request = Request {
+                    out: out.clone(),
+                    screen: ScreenSpec::Virtual(preset),
+                    virtual_white_cd_m2: None,
+                    instrument: format!("sim:cs100a?time_scale=0&seed={seed}")
+                        .as_str()
+                        .into(),
+                    speed: None,
+                    plan: PlanOptions::for_model(ModelKind::Lut, 9, 1, None),
+                    adaptive: Some(Adaptive {
+                        rule: Rule {
+                            stop_de: 2.0,
+                            max_readings: 56,
+                            held_out,
+                            ..Rule::default()
+                        },
+                        targets: targets.clone(),
+                        auto: false,
+                    }),
+                    model: ModelKind::Lut,
+                    settle: Some(std::time::Duration::ZERO),
+                    resume: false,
+                    force: false,
+                    attend: Attend::Terminal { unattended: true },
+                    simulated_meter: SimulatedMeter::Warn,
+                    run: RunOptions::default(),
+                };
+                let Outcome::Finished(summary) =
+                    characterize(&request, &mut Quiet(NoProgress)).unwrap()
+                else {
+                    panic!("a simulated session finishes")
+                };
+                let profile = Profile::load(&summary.files.profile).unwrap();
+                std::fs::remove_dir_all(&out).unwrap();
+                (summary, profile)
+            };
+            let (all, profile) = run(None);
+            let (least, _) = run(Some(12));
+            let (truth, _) = truth_errors(&profile, &panel, &targets);
+            let de = |v: &metamer::display::characterize::finish::Summary| {
+                (v.verification.de76.mean, v.verification.de76.max)
+            };
+            let second: Vec<f64> = all
+                .verification
+                .patches
+                .iter()
+                .step_by(2)
+                .map(|p| p.de76)
+                .collect();
+            let (a, s, l) = (de(&all), stats(&second), de(&least));
+            println!(
+                "| {} | {seed} | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} |",
+                preset.name(),
+                truth.0,
+                truth.1,
+                a.0,
+                a.1,
+                s.0,
+                s.1,
+                l.0,
+                l.1
+            );
+        }
+    }
+}

@@ -237,7 +237,9 @@ fn seed_stage_record(dir: &Path) -> Vec<u8> {
     std::fs::create_dir_all(&stage.dir).unwrap();
     std::fs::write(stage.path("out.txt"), b"output\n").unwrap();
     let inputs = Inputs::new().value("options", &1);
-    stage.finish(&inputs, &["out.txt"], 1.5).unwrap();
+    stage
+        .finish(&inputs, &["out.txt"], 1.5, Default::default())
+        .unwrap();
     let bytes = std::fs::read(stage.path("stage.json")).unwrap();
     let products = [Product {
         file: "out.txt",

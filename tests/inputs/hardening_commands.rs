@@ -427,6 +427,47 @@ fn a_billion_repeats_is_refused_before_measuring() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A measuring plan of no name, or a held-out set of no patch, is refused by its flag before
+/// anything is written, on both commands that take the measuring plan; `--help` names both
+/// plans.
+#[test]
+fn a_measuring_plan_is_refused_by_its_flag_before_measuring() {
+    let dir = fresh_dir("measuring");
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    for command in ["lab", "experiment"] {
+        for (flags, expect) in [
+            (&["--measuring", "quick"][..], "paper or lean"),
+            (
+                &["--measuring", "lean", "--held-out", "0"][..],
+                "--held-out must be at least 1",
+            ),
+            (
+                &["--measuring", "lean", "--stop-de", "0"][..],
+                "--stop-de must be a ΔE*ab above 0",
+            ),
+        ] {
+            let args = [&[command, "-o", out, "--spectral", "sim:i1pro"][..], flags].concat();
+            let args = if command == "lab" {
+                [&args[..3], &args[5..]].concat()
+            } else {
+                args
+            };
+            let o = metamer_unscaled(&args);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+            assert!(stderr(&o).contains(expect), "{args:?}: {}", stderr(&o));
+            assert!(!Path::new(out).exists());
+        }
+        let help = metamer_unscaled(&[command, "--help"]);
+        let help = String::from_utf8_lossy(&help.stdout);
+        assert!(
+            help.contains("--measuring") && help.contains("paper") && help.contains("lean"),
+            "{help}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A white in other units than the readings (`--white 0.95,1,1.09` against cd/m²: L* 290)
 /// or of 1e-300 gave NaN and infinite colour differences with exit 0; readings taken on the
 /// instrument's lamp (reflectance, white = 100) were compared as light without a word.

@@ -19,6 +19,8 @@ fn request(out: &Path, plan: Option<PathBuf>, adaptive: bool) -> MeasureBoxReque
         plan,
         repeats: None,
         adaptive,
+        spot_rule: None,
+        spot_white: None,
         resume: false,
         stage: None,
         seed: 1,

@@ -22,6 +22,7 @@ use crate::display::ModelKind;
 use crate::experiment::budget::{total, StageBudget};
 use crate::experiment::display::DisplayOptions;
 use crate::experiment::display_spots::SpotsShown;
+use crate::experiment::measuring::MeasuringPlan;
 use crate::experiment::reproduction::ReproductionOptions;
 use crate::experiment::request::{check_dir, check_image_size, check_repeats, check_target_de};
 use crate::experiment::simulation::SimulationOptions;
@@ -34,10 +35,15 @@ use crate::session::{CostReport, RunOptions};
 use crate::validation::assess::{Assessment, JndCount, JndVerdict, Stat};
 use crate::validation::export::HTML_FILE;
 use crate::validation::propagate::Interval;
+use crate::validation::sequential::RepeatRule;
 
 /// What a lab run is made of.
 #[derive(Clone, Debug, Serialize)]
 pub struct LabOptions {
+    /// The measuring plan the measuring options below were expanded from
+    /// ([`MeasuringPlan::expand`]: `box_adaptive`, `box_spot_rule`, `adaptive`, `repeats`,
+    /// `until_decided`).
+    pub measuring: MeasuringPlan,
     /// The simulated box's light.
     pub scenario: Scenario,
     /// The simulated monitor.
@@ -70,6 +76,10 @@ pub struct LabOptions {
     /// Read the box's tiles and fall-off adaptively (the box plan's rule, or the default).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub box_adaptive: bool,
+    /// How each box spot is read where the box plan file names no rule; its CIELAB is
+    /// relative to the simulated monitor's nominal white.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub box_spot_rule: Option<RepeatRule>,
     pub seed: u64,
     /// The simulated instruments' time scale (1 = their real pace).
     pub time_scale: f64,
@@ -130,12 +140,14 @@ impl LabOptions {
     pub fn request(&self, dir: &Path, resume: bool, force: bool, run: RunOptions) -> Request {
         Request {
             dir: dir.to_path_buf(),
+            measuring: self.measuring,
             box_source: BoxRequest::Measure {
                 spectral: self.instrument("i1pro", None),
                 spot: self.instrument("cs100a", None),
                 plan: self.plan.clone(),
                 repeats: self.box_repeats,
                 adaptive: self.box_adaptive,
+                spot_rule: self.box_spot_rule.clone(),
                 seed: self.seed,
                 light: Some(self.scenario),
             },
@@ -283,6 +295,7 @@ pub struct LabSummary {
 /// use metamer::session::RunOptions;
 ///
 /// let options = LabOptions {
+///     measuring: Default::default(),
 ///     scenario: Scenario::default(),
 ///     display: "ips-lcd".parse::<Preset>()?,
 ///     model: ModelKind::Lut,
@@ -295,6 +308,7 @@ pub struct LabSummary {
 ///     plan: None,
 ///     box_repeats: None,
 ///     box_adaptive: false,
+///     box_spot_rule: None,
 ///     seed: 1,
 ///     time_scale: 0.0,
 ///     image_size: 1014,

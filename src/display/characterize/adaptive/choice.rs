@@ -168,6 +168,21 @@ pub fn decide(
     (Decision::Batch(chosen), at_targets)
 }
 
+/// The targets the held-out set is read near, in target order: every one, or with `count`
+/// the `count` whose `predicted` error (the fitted models' disagreement at their drive
+/// values) is highest, ties to the earlier target. Where the models disagree most, a model
+/// is most likely wrong, so the held-out readings there bound the error at the targets
+/// rather than average it away.
+pub fn held_out_targets(predicted: &[f64], count: Option<usize>) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..predicted.len()).collect();
+    if let Some(n) = count.filter(|n| *n < predicted.len()) {
+        order.sort_by(|a, b| predicted[*b].total_cmp(&predicted[*a]).then(a.cmp(b)));
+        order.truncate(n);
+        order.sort_unstable();
+    }
+    order
+}
+
 /// The held-out patches: one per target, at its drive value moved by a seeded offset of at
 /// most [`VERIFY_JITTER_CODES`] per channel, drawn again (up to 16 times) while it falls on
 /// a fit patch or an earlier held-out one, so the model is judged at and around the
@@ -389,6 +404,22 @@ mod tests {
         assert_eq!(
             predicted_error(at, &reference, &[&other], &far, 0.5, w),
             free
+        );
+    }
+
+    /// The count keeps the targets of highest predicted error, in target order; a tie goes
+    /// to the earlier target; no count, or one above the targets, keeps them all.
+    #[test]
+    fn the_held_out_set_keeps_the_least_certain_targets() {
+        let predicted = [0.5, 3.0, 1.0, 3.0, f64::NAN, 2.0];
+        // NaN sorts above every number in total_cmp: a target whose models give no colour
+        // is among the least certain.
+        assert_eq!(held_out_targets(&predicted, Some(3)), vec![1, 3, 4]);
+        assert_eq!(held_out_targets(&predicted[..4], Some(1)), vec![1]);
+        assert_eq!(held_out_targets(&predicted, None), vec![0, 1, 2, 3, 4, 5]);
+        assert_eq!(
+            held_out_targets(&predicted, Some(9)),
+            vec![0, 1, 2, 3, 4, 5]
         );
     }
 

@@ -29,6 +29,19 @@ pub struct Rule {
     /// Patches per batch.
     pub batch: usize,
     pub seed: u64,
+    /// Held-out patches read after the fit, one near each of this many targets: those the
+    /// fitted models leave least certain ([`super::choice::held_out_targets`]). None: one
+    /// near every target. Left out of the fingerprint when None, so a plan made before the
+    /// count could be set is the same plan.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held_out: Option<usize>,
+}
+
+impl Rule {
+    /// The held-out patches read for `targets` target colours.
+    pub fn held_out_count(&self, targets: usize) -> usize {
+        self.held_out.map_or(targets, |n| n.min(targets))
+    }
 }
 
 impl Default for Rule {
@@ -38,6 +51,7 @@ impl Default for Rule {
             max_readings: DEFAULT_MAX_READINGS,
             batch: DEFAULT_BATCH,
             seed: VERIFICATION_SEED,
+            held_out: None,
         }
     }
 }
@@ -74,6 +88,8 @@ pub enum AdaptiveError {
     StopDe(f64),
     #[error("a batch must hold at least 1 patch")]
     Batch,
+    #[error("the held-out set must hold at least 1 patch")]
+    HeldOut,
     #[error("the cap of {cap} readings is below the first pass's {first}")]
     Cap { cap: usize, first: usize },
 }
@@ -115,6 +131,9 @@ impl Adaptive {
         }
         if r.batch == 0 {
             return Err(AdaptiveError::Batch);
+        }
+        if r.held_out == Some(0) {
+            return Err(AdaptiveError::HeldOut);
         }
         if r.max_readings < first_pass {
             return Err(AdaptiveError::Cap {

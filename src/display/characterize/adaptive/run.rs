@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use metamer_drivers::{Forwarding, Instrument, InstrumentInfo, MeasureMode, Reading};
 
-use super::choice::{decide, verification_codes, Decision};
+use super::choice::{decide, held_out_targets, verification_codes, Decision};
 use super::fitted::Fitted;
 use super::report::{AdaptiveReport, Batch};
 use super::rule::Adaptive;
@@ -450,9 +450,12 @@ pub fn run(
     let drives = fitted.target_drives(&adaptive.targets);
     let fit_codes: Vec<[u8; 3]> = p.taken.iter().map(|(s, _)| s.rgb).collect();
     let start = p.next_patch();
-    let codes = verification_codes(&drives, &fit_codes, rule.seed);
+    let predicted: Vec<f64> = drives.iter().map(|d| fitted.predicted(*d)).collect();
+    let chosen = held_out_targets(&predicted, rule.held_out);
+    let chosen_drives: Vec<[f64; 3]> = chosen.iter().map(|&i| drives[i]).collect();
+    let codes = verification_codes(&chosen_drives, &fit_codes, rule.seed);
     let held_out = steps_of(&codes, start, Purpose::Verify, |i| {
-        format!("near target {}", i + 1)
+        format!("near target {}", chosen[i] + 1)
     });
     let verify_patches = held_out.len();
     measure!(j as u64 + 1, &verify_path(dir), "verify", held_out);
@@ -526,6 +529,7 @@ mod tests {
                     max_readings: 0,
                     batch: 6,
                     seed: 3,
+                    held_out: None,
                 },
                 targets: targets(),
                 auto: false,
@@ -630,5 +634,52 @@ mod tests {
         assert!(e.contains("batch"), "{e}");
         std::fs::remove_dir_all(&straight.out).unwrap();
         std::fs::remove_dir_all(&split.out).unwrap();
+    }
+
+    /// A held-out count reads that many patches, each near another target, after the same
+    /// fit readings as the full held-out set; the fit, and so the profile, is unchanged.
+    #[test]
+    fn a_held_out_count_reads_fewer_patches_after_the_same_fit() {
+        let all = with_cap(request("held-all", false, None));
+        let mut some = with_cap(request("held-some", false, None));
+        if let Some(a) = &mut some.adaptive {
+            a.rule.held_out = Some(8);
+        }
+        let finished = |r: &Request| match characterize(r, &mut Quiet(NoProgress)).unwrap() {
+            Outcome::Finished(s) => s,
+            _ => panic!("a simulated session finishes"),
+        };
+        let (a, b) = (finished(&all), finished(&some));
+        assert_eq!(a.adaptive.as_ref().unwrap().verify_patches, 24);
+        assert_eq!(b.adaptive.as_ref().unwrap().verify_patches, 8);
+        assert_eq!(b.readings + 16, a.readings);
+        let (ja, jb) = (journals(&all.out), journals(&some.out));
+        assert_eq!(ja.len(), jb.len());
+        for ((na, ea), (nb, eb)) in ja.iter().zip(&jb) {
+            assert_eq!(na, nb);
+            if na != "log.verify.jsonl" {
+                assert_eq!(ea, eb, "{na}");
+            }
+        }
+        let verify = &jb.last().unwrap().1;
+        let targets: Vec<usize> = verify
+            .iter()
+            .map(|e| {
+                let label = e[1].as_str().unwrap();
+                label.strip_prefix("near target ").unwrap().parse().unwrap()
+            })
+            .collect();
+        assert_eq!(targets.len(), 8);
+        assert!(targets.windows(2).all(|w| w[0] < w[1]), "{targets:?}");
+        assert!(targets.iter().all(|t| (1..=24).contains(t)), "{targets:?}");
+        let load = |s: &crate::display::characterize::finish::Summary| {
+            crate::display::Profile::load(&s.files.profile).unwrap()
+        };
+        let (pa, pb) = (load(&a), load(&b));
+        for rgb in [[0.2, 0.5, 0.8], [1.0, 1.0, 1.0], [0.9, 0.1, 0.3]] {
+            assert_eq!(pa.forward(rgb), pb.forward(rgb));
+        }
+        std::fs::remove_dir_all(&all.out).unwrap();
+        std::fs::remove_dir_all(&some.out).unwrap();
     }
 }
