@@ -73,6 +73,8 @@ pub mod pool;
 
 #[cfg(test)]
 mod coverage;
+#[cfg(test)]
+mod coverage_pairs;
 
 use std::collections::BTreeMap;
 use std::sync::Mutex;
