@@ -19,7 +19,7 @@ use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
 use super::plan::{BoxPlan, BoxStage, BoxStep, Geometry, Plane, Target};
 use super::scene::{scene_json, BoxContents};
-use super::stats::{group, mean_spectrum, pooled_noise, GroupStats, StatsError};
+use super::stats::{group, mean_spectrum, pooled_noise_of, GroupStats, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
@@ -217,22 +217,14 @@ fn reduce(
         targets: Vec::new(),
     };
     let groups = by_target(entries);
-    let stated = |g: &[&Entry<BoxStep>]| repeatability::stated(&g[0].reading.instrument, g[0].mode);
     // The tiles, many targets read alike, are tested against the figure pooled over the
     // other tiles, as the spots' intervals take theirs.
-    let pooled = (stage == BoxStage::Tiles && !groups.is_empty()).then(|| {
-        let ys: Vec<Vec<f64>> = groups
-            .iter()
-            .map(|(_, g)| g.iter().map(|e| e.reading.xyz[1]).collect())
-            .collect();
-        pooled_noise(&ys, stated(&groups[0].1))
-    });
+    let pooled = (stage == BoxStage::Tiles).then(|| pooled_noise_of(&groups));
     for (j, (target, group_entries)) in groups.into_iter().enumerate() {
         let w = what(&target);
         let readings: Vec<_> = group_entries.iter().map(|e| &e.reading).collect();
-        let noise = pooled
-            .as_ref()
-            .map_or_else(|| stated(&group_entries), |p| p[j]);
+        let noise = repeatability::stated(&readings[0].instrument, group_entries[0].mode);
+        let noise = pooled.as_ref().map_or(noise, |p| p[j]);
         let err = |source| AssembleError::Stats {
             what: format!("{stage} {w}"),
             source,

@@ -18,6 +18,7 @@ use metamer_drivers::Reading;
 use serde::{Deserialize, Serialize};
 
 use crate::color::{Spectrum, Xyz};
+use crate::session::Entry;
 use crate::validation::covariance::{self, Cov3};
 pub use crate::validation::repeatability::Repeatability;
 
@@ -122,6 +123,20 @@ pub fn pooled_noise(groups: &[Vec<f64>], noise: Repeatability) -> Vec<Repeatabil
             }
         })
         .collect()
+}
+
+/// [`pooled_noise`] of groups of journal entries (a stage's targets, each its repeats),
+/// on the stated figure of the first one's instrument and mode.
+pub fn pooled_noise_of<T, D>(groups: &[(T, Vec<&Entry<D>>)]) -> Vec<Repeatability> {
+    let Some(first) = groups.first().and_then(|(_, g)| g.first()) else {
+        return Vec::new();
+    };
+    let stated = crate::validation::repeatability::stated(&first.reading.instrument, first.mode);
+    let ys: Vec<Vec<f64>> = groups
+        .iter()
+        .map(|(_, g)| g.iter().map(|e| e.reading.xyz[1]).collect())
+        .collect();
+    pooled_noise(&ys, stated)
 }
 
 /// Reduces the readings of one target.
