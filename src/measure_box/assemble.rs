@@ -19,7 +19,7 @@ use super::compare::{compare_render, CompareError, RenderComparison};
 use super::falloff::{fit_light, light_files, LightFilesError};
 use super::plan::{BoxPlan, BoxStage, BoxStep, Geometry, Plane, Target};
 use super::scene::{scene_json, BoxContents};
-use super::stats::{group, mean_spectrum, GroupStats, StatsError};
+use super::stats::{group, mean_spectrum, pooled_noise_of, GroupStats, StatsError};
 use crate::color::{colorchecker, ColorCheckerSet, Outside, Spectrum, Xyz};
 use crate::light::fit::{LdcError, LdcFit, LdcModel, Residual};
 use crate::output::{OutputError, OutputPolicy};
@@ -216,10 +216,15 @@ fn reduce(
         spectra: Vec::new(),
         targets: Vec::new(),
     };
-    for (target, group_entries) in by_target(entries) {
+    let groups = by_target(entries);
+    // The tiles, many targets read alike, are tested against the figure pooled over the
+    // other tiles, as the spots' intervals take theirs.
+    let pooled = (stage == BoxStage::Tiles).then(|| pooled_noise_of(&groups));
+    for (j, (target, group_entries)) in groups.into_iter().enumerate() {
         let w = what(&target);
         let readings: Vec<_> = group_entries.iter().map(|e| &e.reading).collect();
         let noise = repeatability::stated(&readings[0].instrument, group_entries[0].mode);
+        let noise = pooled.as_ref().map_or(noise, |p| p[j]);
         let err = |source| AssembleError::Stats {
             what: format!("{stage} {w}"),
             source,

@@ -207,7 +207,10 @@ pub fn measure<'p>(
     // The model the meter reports, not a guess from its spec: `replay:box-spots.jsonl`
     // names none. Asked only where the readings file is written, as the stage always did.
     let meter = request.spot_readings.then(|| rig.spot.info().model);
-    let by_rule = matches!(options.plan.spot_rule, Some(RepeatRule::Width { .. }));
+    // A plan that states a spot rule, a fixed count among them, reads its spots for the
+    // pooled figure: three readings with the figure pooled over 24 spots (t with ν = 144)
+    // give a narrower interval than five with a spot's own scatter (t with ν = 4).
+    let by_rule = options.plan.spot_rule.is_some();
     let mut sink = progress(!rig.simulated && attended == Attendance::Terminal);
     let outcome = run(
         &options,
@@ -229,8 +232,9 @@ pub fn measure<'p>(
 
 /// Each spot's mean with its scatter in X, Y and Z together, over the repeats the
 /// reduction kept, in the plan's order; a spot read once carries the stated repeatability
-/// of the `meter` (its model). Spots read `by_rule` (a width rule, whose counts rest on
-/// the figure pooled across the spots) carry that figure and its degrees of freedom.
+/// of the `meter` (its model). Spots read `by_rule` (a plan's stated spot rule: a width
+/// rule, whose counts rest on the figure pooled across the spots, or a fixed count) carry
+/// that figure and its degrees of freedom.
 fn spot_readings(summary: &Summary, meter: &str, by_rule: bool) -> Vec<(usize, PatchReading)> {
     let stated = repeatability::emissive_of(meter);
     if let Some(stated) = stated.filter(|_| by_rule) {

@@ -16,8 +16,8 @@ use crate::validation::sequential::{width_decided, Pool, RepeatNoise, RepeatRule
 /// give them) with one reading's covariance the `stated` repeatability scaled by the
 /// figure pooled across every spot's kept readings, and its degrees of freedom: what the
 /// width rule's count rests on, so the validation's intervals take it too (Student's t
-/// with the pooled ν, not each spot's own k − 1). None where nothing pools (no spot read
-/// twice).
+/// with the pooled ν, not each spot's own k − 1); a fixed count states it the same way.
+/// None where nothing pools (no spot read twice).
 pub fn pooled_readings(
     spots: &[(usize, Xyz, GroupStats)],
     stated: &Repeatability,

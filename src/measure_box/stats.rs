@@ -18,6 +18,7 @@ use metamer_drivers::Reading;
 use serde::{Deserialize, Serialize};
 
 use crate::color::{Spectrum, Xyz};
+use crate::session::Entry;
 use crate::validation::covariance::{self, Cov3};
 pub use crate::validation::repeatability::Repeatability;
 
@@ -91,6 +92,51 @@ fn outliers(ys: &[f64], noise: Repeatability) -> Vec<usize> {
         .filter(|(_, y)| ((*y - m) / sigma).abs() > OUTLIER_SIGMAS)
         .map(|(i, _)| i)
         .collect()
+}
+
+/// Each group's noise figure for its outlier and spread tests where many targets are
+/// read alike (the tiles): the stated figure times the factor pooled over the *other*
+/// groups' repeats, as the spots' is pooled (each group's Y scatter whitened by the stated
+/// σ at its level: Σ(y − ȳ)²/σ², with k − 1 degrees of freedom), so a group that scatters
+/// does not widen its own test. The stated figure where the others have no repeats.
+pub fn pooled_noise(groups: &[Vec<f64>], noise: Repeatability) -> Vec<Repeatability> {
+    let parts: Vec<(f64, usize)> = groups
+        .iter()
+        .map(|ys| {
+            if ys.len() < 2 {
+                return (0.0, 0);
+            }
+            let mean = ys.iter().sum::<f64>() / ys.len() as f64;
+            let sigma = noise.sigma_y(mean).max(f64::MIN_POSITIVE);
+            let q = ys.iter().map(|y| ((y - mean) / sigma).powi(2)).sum();
+            (q, ys.len() - 1)
+        })
+        .collect();
+    let (sum, dof) = parts.iter().fold((0.0, 0), |(s, d), (q, k)| (s + q, d + k));
+    parts
+        .iter()
+        .map(|(q, k)| match dof - k {
+            0 => noise,
+            others => {
+                let factor = ((sum - q) / others as f64).sqrt();
+                crate::validation::repeatability::scaled(&noise, factor)
+            }
+        })
+        .collect()
+}
+
+/// [`pooled_noise`] of groups of journal entries (a stage's targets, each its repeats),
+/// on the stated figure of the first one's instrument and mode.
+pub fn pooled_noise_of<T, D>(groups: &[(T, Vec<&Entry<D>>)]) -> Vec<Repeatability> {
+    let Some(first) = groups.first().and_then(|(_, g)| g.first()) else {
+        return Vec::new();
+    };
+    let stated = crate::validation::repeatability::stated(&first.reading.instrument, first.mode);
+    let ys: Vec<Vec<f64>> = groups
+        .iter()
+        .map(|(_, g)| g.iter().map(|e| e.reading.xyz[1]).collect())
+        .collect();
+    pooled_noise(&ys, stated)
 }
 
 /// Reduces the readings of one target.
@@ -171,6 +217,27 @@ mod tests {
             timestamp_s: 0.0,
             ..Reading::from_yxy(y, 0.3, 0.3, "cs100a")
         }
+    }
+
+    /// The pooled figure by hand: three tiles at Y = 100 (CS-100A σ 0.2 there), each read
+    /// twice, 0.4 apart, then 0.2, then 0.6: whitened sums (0.4/0.2)²/2 = 2, 0.5 and 4.5
+    /// on one degree of freedom each. The first tile is tested against the other two's
+    /// (0.5 + 4.5)/2 = 2.5, σ × √2.5; a tile alone keeps the stated figure.
+    #[test]
+    fn each_group_is_tested_against_the_others_pooled_figure() {
+        let noise = crate::validation::repeatability::stated("cs100a", MeasureMode::Emissive);
+        let sigma = noise.sigma_y(100.0);
+        let pair = |d: f64| vec![100.0 - d / 2.0, 100.0 + d / 2.0];
+        let groups = [pair(2.0 * sigma), pair(sigma), pair(3.0 * sigma)];
+        let pooled = pooled_noise(&groups, noise);
+        let whitened = [2.0, 0.5, 4.5];
+        for (j, tested) in pooled.iter().enumerate() {
+            let others = (whitened.iter().sum::<f64>() - whitened[j]) / 2.0;
+            let got = tested.sigma_y(100.0) / sigma;
+            assert!((got - others.sqrt()).abs() < 1e-6, "tile {j}: {got}");
+        }
+        assert!((pooled[0].sigma_y(100.0) / sigma - 2.5f64.sqrt()).abs() < 1e-6);
+        assert_eq!(pooled_noise(&[pair(sigma)], noise), vec![noise]);
     }
 
     #[test]

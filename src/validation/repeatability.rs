@@ -25,6 +25,33 @@ pub fn emissive_of(name: &str) -> Option<Repeatability> {
     model_named(name)?.stated_repeatability(MeasureMode::Emissive)
 }
 
+/// The figure `r` with every σ times `factor`: what a factor pooled on the stated
+/// figure's shape (its readings' whitened scatter) says one reading scatters.
+pub fn scaled(r: &Repeatability, factor: f64) -> Repeatability {
+    let level = match r.level {
+        LevelNoise::Flat => LevelNoise::Flat,
+        LevelNoise::Shot {
+            full_signal_cd_m2,
+            dark_cd_m2,
+        } => LevelNoise::Shot {
+            full_signal_cd_m2,
+            dark_cd_m2: dark_cd_m2 * factor,
+        },
+    };
+    let xy = r.xy.map(|xy| match xy {
+        XyNoise::Fixed(s) => XyNoise::Fixed(s * factor),
+        // Already relative to Y's figure, which scales.
+        XyNoise::PerRelativeY(k) => XyNoise::PerRelativeY(k),
+    });
+    Repeatability {
+        y_relative: r.y_relative * factor,
+        y_absolute: r.y_absolute * factor,
+        level,
+        xy,
+        ..*r
+    }
+}
+
 /// The covariance of X, Y, Z of one reading of `xyz`: with X = xY/y and
 /// Z = (1 − x − y)Y/y, J·diag(σx², σy², σY²)·Jᵀ with J the derivatives of (X, Y, Z) by
 /// (x, y, Y), the last digit's rounding counted as a uniform error (variance d²/12).
@@ -105,6 +132,24 @@ mod tests {
             }
         }
         assert_eq!(covariance(&r, Xyz::default()), None);
+    }
+
+    /// A scaled figure scales σ of Y and of x, y at every level by the factor, the
+    /// CS-100A's (flat) and the i1Pro's (shot noise below full signal) alike.
+    #[test]
+    fn a_scaled_figure_scales_every_sigma() {
+        for model in ["cs100a", "i1pro"] {
+            let r = stated(model, MeasureMode::Emissive);
+            let s = scaled(&r, 1.5);
+            for y in [0.5, 3.0, 25.0, 400.0] {
+                assert!(
+                    (s.sigma_y(y) - 1.5 * r.sigma_y(y)).abs() < 1e-12 * y,
+                    "{model} {y}"
+                );
+                let (a, b) = (s.sigma_xy(y).unwrap(), r.sigma_xy(y).unwrap());
+                assert!((a - 1.5 * b).abs() < 1e-12, "{model} {y}");
+            }
+        }
     }
 
     /// The i1Pro's figure depends on the level: at 25 cd/m² σY/Y is 0.30447 % (0.15 % ·

@@ -14,9 +14,11 @@
 //!   separated by spaces (default every preset, both lights, seeds 1 and 2);
 //! - `METAMER_STUDY_ARMS`: `NAME=ARGS;NAME=ARGS…`, each arm the `lab` options it adds to
 //!   the fixed run's (default: [`DEFAULT_ARM`]). In ARGS, `--plan width:H` stands for a
-//!   box plan whose spots are read by the width rule at H × the JND (at most 10), and
-//!   `--plan width:H:rR` the same with R readings of each tile; any other option (such as
-//!   `--box-plan adaptive`) is passed as it is;
+//!   box plan whose spots are read by the width rule at H × the JND (at most 10),
+//!   `--plan fixed:N` for one whose spots are read N times each under a stated rule (so
+//!   with the figure pooled across the spots), and `width:H:rR` or `fixed:N:rR` the same
+//!   with R readings of each tile; any other option (such as `--box-plan adaptive`) is
+//!   passed as it is;
 //! - `METAMER_STUDY_JOBS`: runs at a time (default 1).
 
 use std::path::{Path, PathBuf};
@@ -44,22 +46,27 @@ fn list(var: &str, default: &str) -> Vec<String> {
         .collect()
 }
 
-/// The plan file for `width:H[:rR]`, written into `plans` once.
-fn width_plan(plans: &Path, spec: &str) -> PathBuf {
-    let mut parts = spec.split(':').skip(1);
-    let h = parts.next().expect("width:H");
+/// The plan file for `width:H[:rR]` or `fixed:N[:rR]`, written into `plans` once.
+fn rule_plan(plans: &Path, spec: &str) -> PathBuf {
+    let mut parts = spec.split(':');
+    let kind = parts.next().expect("width or fixed");
+    let value = parts.next().expect("width:H or fixed:N");
     let repeats = parts.next().map(|r| r.trim_start_matches('r'));
     let (name, lead) = match repeats {
         Some(r) => (
-            format!("width-{h}-r{r}.json"),
+            format!("{kind}-{value}-r{r}.json"),
             format!("\"repeats\": {r}, "),
         ),
-        None => (format!("width-{h}.json"), String::new()),
+        None => (format!("{kind}-{value}.json"), String::new()),
+    };
+    let rule = match kind {
+        "width" => format!(
+            "{{\"rule\": \"width\", \"half_width_jnd\": {value}, \"most\": 10}}, \"spot_white\": {SPOT_WHITE}"
+        ),
+        _ => format!("{{\"rule\": \"fixed\", \"repeats\": {value}}}"),
     };
     let path = plans.join(name);
-    let text = format!(
-        "{{{lead}\"spot_rule\": {{\"rule\": \"width\", \"half_width_jnd\": {h}, \"most\": 10}}, \"spot_white\": {SPOT_WHITE}}}\n"
-    );
+    let text = format!("{{{lead}\"spot_rule\": {rule}}}\n");
     std::fs::create_dir_all(plans).unwrap();
     if std::fs::read_to_string(&path).ok().as_deref() != Some(text.as_str()) {
         std::fs::write(&path, text).unwrap();
@@ -67,7 +74,7 @@ fn width_plan(plans: &Path, spec: &str) -> PathBuf {
     path
 }
 
-/// The arms: name and `lab` options, `--plan width:…` made a file.
+/// The arms: name and `lab` options, `--plan width:…` and `--plan fixed:…` made a file.
 fn arms(plans: &Path) -> Vec<(String, Vec<String>)> {
     std::env::var("METAMER_STUDY_ARMS")
         .unwrap_or_else(|_| DEFAULT_ARM.to_string())
@@ -78,8 +85,8 @@ fn arms(plans: &Path) -> Vec<(String, Vec<String>)> {
             let args = args
                 .split_whitespace()
                 .map(|a| {
-                    if a.starts_with("width:") {
-                        width_plan(plans, a).display().to_string()
+                    if a.starts_with("width:") || a.starts_with("fixed:") {
+                        rule_plan(plans, a).display().to_string()
                     } else {
                         a.to_string()
                     }

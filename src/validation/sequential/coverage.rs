@@ -15,13 +15,13 @@ use super::super::coverage::{moved, readings, yellow, Truth, WHITE};
 use super::*;
 use crate::color::Lab;
 
-const SESSIONS: u64 = 2000;
+pub(super) const SESSIONS: u64 = 2000;
 
-fn cs100a() -> Repeatability {
+pub(super) fn cs100a() -> Repeatability {
     repeatability::stated("cs100a", MeasureMode::Emissive)
 }
 
-fn rng(case: u64, session: u64) -> SplitMix64 {
+pub(super) fn rng(case: u64, session: u64) -> SplitMix64 {
     SplitMix64::new(SplitMix64::mix(case.wrapping_mul(1_000_003) + session))
 }
 
@@ -50,7 +50,7 @@ fn region_holds(taken: &[Xyz], noise: &RepeatNoise, truth: Xyz) -> bool {
     taken.len() as f64 * quadratic(d, &inverse(&c)) <= region_quantile(noise.dof)
 }
 
-fn share(hits: u64, of: u64) -> f64 {
+pub(super) fn share(hits: u64, of: u64) -> f64 {
     hits as f64 / of as f64
 }
 
@@ -348,7 +348,7 @@ fn the_verdict_rule_is_covered_at_the_jnd_and_beyond() {
 
 /// The 24 ColorChecker spots (BabelColor average under D65) as the box shows them: a
 /// white reflector at half the white's luminance, as the spots lie below the light.
-fn colorchecker_spots() -> Vec<Xyz> {
+pub(super) fn colorchecker_spots() -> Vec<Xyz> {
     use crate::color::{colorchecker, reflectance_to_xyz, ColorCheckerSet, Illuminant};
     let d65 = Illuminant::D65.spectrum();
     colorchecker(ColorCheckerSet::BabelColorAverage)
