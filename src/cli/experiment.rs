@@ -17,7 +17,7 @@ use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 use metamer_drivers::Spec;
 
-use super::plan_choice::{PlanKind, RuleArgs};
+use super::plan_choice::{BoxPlanKind, PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -39,7 +39,7 @@ pub struct Args {
     /// (a subset first, then where the spatial and distribution models leave the spots
     /// most in doubt, up to a cap).
     #[arg(long, value_enum, default_value = "fixed")]
-    box_plan: PlanKind,
+    box_plan: BoxPlanKind,
     /// Instead of measuring the box here: its measured scene (`scene.json` of
     /// `metamer measure-box`) …
     #[arg(
@@ -161,7 +161,7 @@ fn request(args: Args) -> Result<Request, CliError> {
                 spot: spot.clone(),
                 plan: args.plan,
                 repeats: args.box_repeats,
-                adaptive: args.box_plan == PlanKind::Adaptive,
+                adaptive: args.box_plan.adaptive(),
                 seed: args.seed,
                 light: args.scenario,
             },

@@ -9,7 +9,7 @@ use metamer::rig::{Scenario, ScreenSpec};
 use metamer::session::{on_ctrl_c, RunOptions};
 
 use super::experiment::{print_cost, print_outcomes, refusal, StageProgress};
-use super::plan_choice::{PlanKind, RuleArgs};
+use super::plan_choice::{BoxPlanKind, PlanKind, RuleArgs};
 use super::{CliError, CliResult};
 
 #[derive(clap::Args)]
@@ -61,7 +61,7 @@ pub struct Args {
     /// (a subset first, then where the spatial and distribution models leave the spots
     /// most in doubt, up to a cap).
     #[arg(long, value_enum, default_value = "fixed")]
-    box_plan: PlanKind,
+    box_plan: BoxPlanKind,
     /// Seed of the simulated box and of its instruments' noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -110,7 +110,7 @@ pub fn run(args: Args) -> CliResult {
         compare_with: args.compare_with,
         plan: args.plan,
         box_repeats: args.box_repeats,
-        box_adaptive: args.box_plan == PlanKind::Adaptive,
+        box_adaptive: args.box_plan.adaptive(),
         seed: args.seed,
         time_scale: args.time_scale,
         image_size: args.image_size,
