@@ -129,20 +129,7 @@ fn draw_log_log(
             });
     }
     if let Some((t, label)) = chart.target {
-        c.draw_series(DashedLineSeries::new(
-            vec![(x0, t), (xmax * 1.25, t)],
-            TARGET_DOT.0,
-            TARGET_DOT.1,
-            target_style(),
-        ))
-        .map_err(|e| err(&e))?
-        .label(label)
-        .legend(|(x, y)| {
-            EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (2, 0)], target_style())
-                + PathElement::new(vec![(9, 0), (11, 0)], target_style())
-                + PathElement::new(vec![(18, 0), (20, 0)], target_style())
-        });
+        draw_target(&mut c, t, label, x0..xmax * 1.25).map_err(|e| err(&e))?;
     }
     match side {
         Some(side) => legend_beside(&side, chart, look_of).map_err(|e| err(&e))?,
@@ -155,6 +142,36 @@ fn draw_log_log(
             .map_err(|e| err(&e))?,
     }
     root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// The axes of a log–log chart.
+type LogLog = Cartesian2d<
+    plotters::coord::combinators::WithKeyPoints<LogCoord<f64>>,
+    plotters::coord::combinators::WithKeyPoints<LogCoord<f64>>,
+>;
+
+/// The target line at `t` across `x`, in dots, with its legend entry.
+fn draw_target<'a, DB: DrawingBackend + 'a>(
+    c: &mut ChartContext<'a, DB, LogLog>,
+    t: f64,
+    label: &str,
+    x: std::ops::Range<f64>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (dot, gap) = TARGET_DOT;
+    c.draw_series(DashedLineSeries::new(
+        vec![(x.start, t), (x.end, t)],
+        dot,
+        gap,
+        target_style(),
+    ))?
+    .label(label)
+    .legend(|(x, y)| {
+        EmptyElement::at((x, y))
+            + PathElement::new(vec![(0, 0), (2, 0)], target_style())
+            + PathElement::new(vec![(9, 0), (11, 0)], target_style())
+            + PathElement::new(vec![(18, 0), (20, 0)], target_style())
+    });
     Ok(())
 }
 

@@ -217,7 +217,6 @@ pub fn run(
         }
         let mut taken: Vec<Entry<BoxStep>> = Vec::new();
         let mut stage_cost: Option<CostReport> = None;
-        let mut announced = false;
         for round in 0.. {
             let Some(steps) = round_steps(options, stage, round, &taken) else {
                 break;
@@ -229,8 +228,7 @@ pub fn run(
             let total = session.plan().steps.len();
             let log = session.journal_path().to_path_buf();
             if session.done() < total {
-                announce(&session, stage, round, !announced, progress);
-                announced = true;
+                announce(&session, stage, round, stage_cost.is_none(), progress);
                 let (end, costs) = run_costed(
                     &mut session,
                     &mut instruments,
@@ -313,8 +311,8 @@ fn adaptive_rule(plan: &BoxPlan, stage: BoxStage) -> Option<&AdaptiveRule> {
 }
 
 /// The stage's (or the round's) readings and placements, said before it starts; the
-/// stage itself told to `progress` before the `first` round this run takes of it, which
-/// is a later round when a resume finds the earlier ones complete.
+/// stage itself told to `progress` before the `first` round this run takes of it (none
+/// costed yet), which is a later round when a resume finds the earlier ones complete.
 fn announce(
     session: &Session<BoxDetails, BoxStep>,
     stage: BoxStage,

@@ -171,8 +171,8 @@ impl ProgressSink for Told {
     }
 }
 
-/// The tiles' rounds (a rule tight enough to need them) stopped every 5 readings and
-/// resumed, with the simulated operator: each call that reads announces the tiles stage
+/// The tiles' rounds (a rule tight enough to need them, each later round one tile read
+/// twice) stopped after every reading and resumed, with the simulated operator: each call that reads announces the tiles stage
 /// (stage 1 of 4) and the round it reads with its readings and placements, as a fresh
 /// round does, a resume of a later round (`tiles.batch-N.jsonl`) among them.
 #[test]
@@ -192,12 +192,12 @@ fn a_resumed_later_round_prints_its_stage_header() {
         name: "tiles".into(),
     };
     let mut resumed_later = 0;
-    for call in 0..50 {
+    for call in 0..100 {
         let r = MeasureBoxRequest {
             stage: Some("tiles".into()),
             resume: call > 0,
             run: RunOptions {
-                stop_after: Some(5),
+                stop_after: Some(1),
                 ..RunOptions::default()
             },
             ..request(&out, Some(plan.clone()), false)
