@@ -209,7 +209,11 @@ fn a_resumed_later_round_prints_its_stage_header() {
         if !matches!(o, Outcome::Incomplete { .. }) {
             break;
         }
-        assert_eq!(stages, [stage.clone()], "call {call}: {notes:?}");
+        assert_eq!(
+            stages,
+            std::slice::from_ref(&stage),
+            "call {call}: {notes:?}"
+        );
         // The round the call stopped in is the stage's last journal; its header is said.
         let last = metamer::measure_box::adaptive::later_rounds(&out, tiles).len();
         let header = if last == 0 {
