@@ -2,6 +2,7 @@
 //! figure here shares (render convergence, display patch budget). SVG only: text stays SVG
 //! `<text>`, so no font files are needed at build or run time.
 
+use plotters::coord::ranged1d::{BoldPoints, LightPoints};
 use plotters::prelude::*;
 
 /// One named curve.
@@ -76,7 +77,10 @@ fn draw_log_log(
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d((x0..xmax * 1.25).log_scale(), (y0..ymax * 1.25).log_scale())
+        .build_cartesian_2d(
+            log_axis(x0..xmax * 1.25, labels),
+            log_axis(y0..ymax * 1.25, labels),
+        )
         .map_err(|e| err(&e))?;
     let mut mesh = c.configure_mesh();
     mesh.x_labels(labels)
@@ -125,13 +129,7 @@ fn draw_log_log(
             });
     }
     if let Some((t, label)) = chart.target {
-        c.draw_series(LineSeries::new(
-            vec![(x0, t), (xmax * 1.25, t)],
-            BLACK.mix(0.4),
-        ))
-        .map_err(|e| err(&e))?
-        .label(label)
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
+        draw_target(&mut c, t, label, x0..xmax * 1.25).map_err(|e| err(&e))?;
     }
     match side {
         Some(side) => legend_beside(&side, chart, look_of).map_err(|e| err(&e))?,
@@ -145,6 +143,73 @@ fn draw_log_log(
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+/// The axes of a log–log chart.
+type LogLog = Cartesian2d<
+    plotters::coord::combinators::WithKeyPoints<LogCoord<f64>>,
+    plotters::coord::combinators::WithKeyPoints<LogCoord<f64>>,
+>;
+
+/// The target line at `t` across `x`, in dots, with its legend entry.
+fn draw_target<'a, DB: DrawingBackend + 'a>(
+    c: &mut ChartContext<'a, DB, LogLog>,
+    t: f64,
+    label: &str,
+    x: std::ops::Range<f64>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (dot, gap) = TARGET_DOT;
+    c.draw_series(DashedLineSeries::new(
+        vec![(x.start, t), (x.end, t)],
+        dot,
+        gap,
+        target_style(),
+    ))?
+    .label(label)
+    .legend(|(x, y)| {
+        EmptyElement::at((x, y))
+            + PathElement::new(vec![(0, 0), (2, 0)], target_style())
+            + PathElement::new(vec![(9, 0), (11, 0)], target_style())
+            + PathElement::new(vec![(18, 0), (20, 0)], target_style())
+    });
+    Ok(())
+}
+
+/// The target line's dots, pixels drawn and left (as a dashed series' dash and gap).
+const TARGET_DOT: (u32, u32) = (2, 5);
+
+/// The target line: black dots, 2 px, where the grid's lines are thin, solid and light
+/// grey and a series' line is coloured, solid or dashed, and carries markers.
+fn target_style() -> ShapeStyle {
+    BLACK.stroke_width(2)
+}
+
+/// A log axis over `range` with plotters' own grid and label points, each once. Asked
+/// for about 30 labels (a paired chart), plotters puts 1…10 in each decade, so the last
+/// point of one decade is the first of the next and its label is drawn twice, one text on
+/// the other.
+fn log_axis(
+    range: std::ops::Range<f64>,
+    labels: usize,
+) -> plotters::coord::combinators::WithKeyPoints<LogCoord<f64>> {
+    let coord: LogCoord<f64> = range.log_scale().into();
+    let bold = distinct(coord.key_points(BoldPoints(labels)));
+    let light = distinct(coord.key_points(LightPoints::new(labels, labels * 10)));
+    coord.with_key_points(bold).with_light_points(light)
+}
+
+/// `points` without the repeats of a value (within rounding), in their order.
+fn distinct(points: Vec<f64>) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::with_capacity(points.len());
+    for p in points {
+        if !out
+            .iter()
+            .any(|q| (p - q).abs() <= 1e-9 * p.abs().max(q.abs()))
+        {
+            out.push(p);
+        }
+    }
+    out
 }
 
 /// Where an axis whose smallest value is `min` starts: a fifth below it; for a paired
@@ -243,7 +308,13 @@ fn legend_beside<DB: DrawingBackend>(
     }
     if let Some((_, label)) = chart.target {
         let y = row(chart.series.len());
-        area.draw(&PathElement::new(vec![(4, y), (52, y)], BLACK.mix(0.4)))?;
+        let (dot, gap) = (TARGET_DOT.0 as i32, TARGET_DOT.1 as i32);
+        for a in (4..52).step_by((dot + gap) as usize) {
+            area.draw(&PathElement::new(
+                vec![(a, y), (a + dot, y)],
+                target_style(),
+            ))?;
+        }
         area.draw(&Text::new(label, (60, y - 7), font.color(&BLACK)))?;
     }
     Ok(())
@@ -382,6 +453,61 @@ mod tests {
             ..chart
         };
         assert!(log_log_svg(&empty).is_err());
+    }
+
+    /// A paired chart over three decades (the cost chart's shape): plotters' grid puts 1…10
+    /// in each decade, so each decade's label once came twice, one text on the other.
+    /// Every label is drawn once, and 1, 10 and 100 are among them; the target line is
+    /// drawn in none of the grid's greys.
+    #[test]
+    fn paired_axes_draw_each_label_once_and_the_target_apart_from_the_grid() {
+        let series = [Series {
+            name: "box".into(),
+            points: vec![(2.0, 3.0), (30.0, 0.9), (300.0, 0.25)],
+        }];
+        let chart = LogLogChart {
+            title: "t",
+            x_desc: "readings",
+            y_desc: "ΔE*ab",
+            series: &series,
+            target: Some((2.3, "JND")),
+            size: (1000, 440),
+        };
+        let svg = log_log_svg_paired(&chart, &[(1, false)]).unwrap();
+        if let Ok(path) = std::env::var("METAMER_KEEP_PAIRED_SVG") {
+            std::fs::write(path, &svg).unwrap();
+        }
+        let texts: Vec<&str> = svg
+            .split("<text")
+            .skip(1)
+            .map(|t| t.split("</text>").next().unwrap())
+            .collect();
+        for (i, t) in texts.iter().enumerate() {
+            assert!(!texts[..i].contains(t), "drawn twice: <text{t}</text>");
+        }
+        let words: Vec<&str> = texts
+            .iter()
+            .map(|t| t.split_once('>').map_or("", |w| w.1.trim()))
+            .collect();
+        for label in ["1", "10", "100", "0.2", "2", "5"] {
+            assert!(words.contains(&label), "{label} is not labelled: {words:?}");
+        }
+        // The grid: thin lines in black at 0.2 opacity (plotters' bold mesh); the target:
+        // black at full opacity, 2 px wide, in dots.
+        let lines: Vec<&str> = svg
+            .split('<')
+            .filter(|e| e.starts_with("polyline") || e.starts_with("line"))
+            .collect();
+        let target: Vec<&&str> = lines
+            .iter()
+            .filter(|e| e.contains("stroke=\"#000000\"") && e.contains("stroke-width=\"2\""))
+            .collect();
+        assert!(target.len() > 50, "the target's dots: {}", target.len());
+        assert!(
+            target.iter().all(|e| !e.contains("opacity=\"0.")),
+            "{:?}",
+            target[0]
+        );
     }
 
     /// Forty series (the budget chart has more than the seven colours there once were)

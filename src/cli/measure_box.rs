@@ -9,6 +9,7 @@ use metamer::rig::Scenario;
 use metamer::session::{on_ctrl_c, BarProgress, RunOptions};
 use metamer_drivers::Spec;
 
+use super::plan_choice::BoxPlanKind;
 use super::rig::{box_light_refusal, nobody_at_the_rig};
 use super::{CliError, CliResult};
 
@@ -27,6 +28,12 @@ pub struct Args {
     /// A plan file (JSON) changing counts, angles and geometry; default the paper's plan.
     #[arg(long, value_name = "FILE.json")]
     plan: Option<PathBuf>,
+    /// The tiles and the fall-off: fixed (every tile and angle, the paper's) or adaptive (a
+    /// subset first, then where the spatial and distribution models leave the spots most
+    /// in doubt, up to a cap: the plan file's `adaptive` rule, or the default one). A plan
+    /// file with an `adaptive` rule is read adaptively either way.
+    #[arg(long, value_enum, default_value = "fixed")]
+    box_plan: BoxPlanKind,
     /// Readings of each tile and each spot (default 5, or the plan file's).
     #[arg(long, value_name = "N")]
     repeats: Option<usize>,
@@ -86,7 +93,7 @@ pub fn run(args: Args) -> CliResult {
         // Asked as the flags and the terminal say; the spots stay in summary.json.
         attendance: None,
         spot_readings: false,
-        adaptive: false,
+        adaptive: args.box_plan.adaptive(),
         // The plan file's rule and white, as measure-box has no measuring plan.
         spot_rule: None,
         spot_white: None,
@@ -122,7 +129,7 @@ fn refusal(e: MeasureBoxJobError) -> CliError {
             ),
             (Some(c @ JournalConflict::OtherSession { .. }), _) => CliError::Failed(
                 format!(
-                    "{c}; run with the same --plan/--repeats/--seed and --resume, or choose another output directory"
+                    "{c}; run with the same --plan/--box-plan/--repeats/--seed and --resume, or choose another output directory"
                 )
                 .into(),
             ),

@@ -1,5 +1,6 @@
 //! The display characterization's plan, as `characterize`, `experiment` and `lab` take it:
-//! the paper's fixed patches, or the adaptive plan and its rule.
+//! the paper's fixed patches, or the adaptive plan and its rule; and the box's plan, as
+//! `measure-box`, `experiment` and `lab` take it.
 
 use clap::ValueEnum;
 use metamer::display::characterize::adaptive::Rule;
@@ -16,6 +17,26 @@ pub enum PlanKind {
     /// A first pass, then batches where the candidate models disagree at the colours to
     /// reproduce, until the predicted ΔE*ab there is below --stop-de or --max-readings.
     Adaptive,
+}
+
+/// The box's tiles and fall-off: the two plans have their own words in `--help`, so the box
+/// flag does not describe the display's patches. The library's plan takes the choice
+/// (`BoxPlan::choose_adaptive`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BoxPlanKind {
+    /// The paper's: every tile of the light and every fall-off angle of the plan.
+    Fixed,
+    /// The tiles' centre, corners and edge midpoints and the fall-off's normal and outer
+    /// angles first, then one tile or angle a round where the spatial and distribution
+    /// models leave the spots most in doubt, up to the rule's caps.
+    Adaptive,
+}
+
+impl BoxPlanKind {
+    /// Whether the box is read adaptively (the library's request field).
+    pub fn adaptive(self) -> bool {
+        self == BoxPlanKind::Adaptive
+    }
 }
 
 /// The adaptive plan's rule; the plan itself is chosen by each command's own flag
@@ -94,7 +115,7 @@ pub struct MeasuringArgs {
     /// (a subset first, then where the spatial and distribution models leave the spots
     /// most in doubt, up to a cap). Default: the measuring plan's.
     #[arg(long, value_enum)]
-    pub box_plan: Option<PlanKind>,
+    pub box_plan: Option<BoxPlanKind>,
     /// The display's characterization: fixed (the paper's patches) or adaptive (patches
     /// where the candidate models disagree at the rendered colours). Default: the
     /// measuring plan's.
@@ -128,7 +149,7 @@ impl MeasuringArgs {
         self.rule.check()?;
         let adaptive = |p: Option<PlanKind>| p.map(|p| p == PlanKind::Adaptive);
         Ok(MeasuringChoices {
-            box_adaptive: adaptive(self.box_plan),
+            box_adaptive: self.box_plan.map(BoxPlanKind::adaptive),
             box_spot_rule: None,
             display_adaptive: adaptive(self.display_plan),
             stop_de: self.rule.stop_de,
@@ -158,5 +179,58 @@ impl std::str::FromStr for ModelChoice {
         s.parse::<ModelKind>()
             .map(ModelChoice::Kind)
             .map_err(|e| format!("{e}, or auto"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// One flag's block of a command's long help, from its line to the next flag's, its
+    /// lines as the terminal's width wrapped them joined by single spaces.
+    fn block(help: &str, flag: &str) -> String {
+        let start = help
+            .find(&format!("      {flag} "))
+            .unwrap_or_else(|| panic!("{flag} is not in the help"));
+        let rest = &help[start + flag.len() + 6..];
+        let end = [rest.find("\n      --"), rest.find("\n  -")]
+            .into_iter()
+            .flatten()
+            .min()
+            .unwrap_or(rest.len());
+        rest[..end].split_whitespace().collect::<Vec<_>>().join(" ")
+    }
+
+    /// `--box-plan` describes the box's tiles and fall-off, `--display-plan` the display's
+    /// patches, in `lab`, `experiment` and `measure-box` (which has the box's only).
+    #[test]
+    fn the_box_plan_and_the_display_plan_are_described_in_their_own_words() {
+        let mut cli = super::super::Cli::command();
+        for name in ["lab", "experiment", "measure-box"] {
+            let help = cli
+                .find_subcommand_mut(name)
+                .unwrap_or_else(|| panic!("no {name} command"))
+                .render_long_help()
+                .to_string();
+            let boxed = block(&help, "--box-plan");
+            for words in ["every tile of the light", "fall-off angle", "adaptive:"] {
+                assert!(boxed.contains(words), "{name} --box-plan: {boxed}");
+            }
+            for words in ["ramps", "held-out", "--stop-de", "candidate models"] {
+                assert!(!boxed.contains(words), "{name} --box-plan: {boxed}");
+            }
+            if name == "measure-box" {
+                assert!(!help.contains("--display-plan"), "{help}");
+                continue;
+            }
+            let display = block(&help, "--display-plan");
+            for words in ["ramps", "48 held-out colours", "--stop-de"] {
+                assert!(display.contains(words), "{name} --display-plan: {display}");
+            }
+            assert!(
+                !display.contains("tile"),
+                "{name} --display-plan: {display}"
+            );
+        }
     }
 }

@@ -14,12 +14,16 @@ use crate::light::ldt::{self, LdtInfo};
 use crate::light::{Panel, PhotometryError};
 
 /// The fall-off readings in the fit's form: `readings` are (plane, signed angle, cd/m²) in
-/// any order; each plane's angles come out increasing.
+/// any order; each plane's angles come out increasing. The normal is one direction
+/// whatever the plane: a plane without a reading at 0° takes the other plane's (the
+/// adaptive plan reads it once), so each half-plane's curve is relative to the same
+/// normal luminance.
 pub fn falloff(readings: &[(Plane, f64, f64)]) -> Falloff {
     let plane = |which: Plane| {
+        let own = readings.iter().any(|r| r.0 == which && r.1 == 0.0);
         let mut points: Vec<(f64, f64)> = readings
             .iter()
-            .filter(|r| r.0 == which)
+            .filter(|r| r.0 == which || (!own && r.1 == 0.0))
             .map(|r| (r.1, r.2))
             .collect();
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -136,6 +140,38 @@ mod tests {
             .map(|r| r.residual.abs())
             .fold(0.0, f64::max);
         assert!(worst < 2e-3, "{worst}");
+    }
+
+    /// The adaptive plan reads the normal once, in the horizontal plane: both planes get
+    /// that reading, so the fit's normal luminance is it and each plane is relative to it.
+    /// A light of cos^0.9 horizontally and cos^1.4 vertically at 80 cd/m² on the normal,
+    /// read at the adaptive first pass's angles, is recovered in both planes.
+    #[test]
+    fn the_normal_read_once_is_the_normal_of_both_planes() {
+        let m = |p: Plane| if p == Plane::Horizontal { 0.9 } else { 1.4 };
+        let mut read = vec![(Plane::Horizontal, 0.0, 80.0)];
+        for plane in [Plane::Horizontal, Plane::Vertical] {
+            for a in [-80.0, -40.0, 40.0, 80.0] {
+                let l = 80.0 * f64::to_radians(a).cos().powf(m(plane));
+                read.push((plane, a, l));
+            }
+        }
+        let f = falloff(&read);
+        assert_eq!(f.horizontal.angles_deg, [-80.0, -40.0, 0.0, 40.0, 80.0]);
+        assert_eq!(f.vertical.angles_deg, [-80.0, -40.0, 0.0, 40.0, 80.0]);
+        assert_eq!(f.vertical.luminance[2], 80.0);
+        let fit = fit_light(&read).unwrap();
+        assert_eq!(fit.normal_luminance, 80.0);
+        for (c, exp) in [(0.0, 0.9), (90.0, 1.4), (180.0, 0.9), (270.0, 1.4)] {
+            let want = 40f64.to_radians().cos().powf(exp);
+            let got = fit.table.at(c, 40.0);
+            assert!((got - want).abs() < 2e-3, "C {c}: {got} vs {want}");
+        }
+        // A plane with its own normal keeps it: the fixed plan's readings are unchanged.
+        let mut both = read.clone();
+        both.push((Plane::Vertical, 0.0, 79.0));
+        assert_eq!(falloff(&both).vertical.luminance[2], 79.0);
+        assert_eq!(falloff(&both).horizontal.luminance[2], 80.0);
     }
 
     #[test]

@@ -102,6 +102,21 @@ pub enum Target {
     Spot { patch: usize },
 }
 
+impl Target {
+    /// Whether `other` reads what this target reads: the same target, or the fall-off's
+    /// normal in either plane (one direction, whatever the C-plane).
+    pub fn same_reading(&self, other: &Target) -> bool {
+        match (self, other) {
+            (Target::Falloff { angle_deg: a, .. }, Target::Falloff { angle_deg: b, .. })
+                if *a == 0.0 && *b == 0.0 =>
+            {
+                true
+            }
+            _ => self == other,
+        }
+    }
+}
+
 /// One step's data in the journal.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BoxStep {
@@ -306,7 +321,9 @@ impl BoxPlan {
     /// The first pass of a stage an adaptive plan reads in rounds ([`super::adaptive`]
     /// argues the choice): the tiles at the centre, corners and edge midpoints; the
     /// fall-off at the normal and, on each side, the outermost angle and every second one
-    /// inwards. Every target of another stage.
+    /// inwards, the normal read once (in the horizontal plane): it is one direction
+    /// whatever the plane, and the fit takes it in both ([`super::falloff::falloff`]).
+    /// Every target of another stage.
     pub fn first_pass(&self, stage: BoxStage) -> Vec<Target> {
         match stage {
             BoxStage::Tiles => {
@@ -328,6 +345,7 @@ impl BoxPlan {
                     .flat_map(|plane| {
                         first
                             .iter()
+                            .filter(move |&&a| plane == Plane::Horizontal || a != 0.0)
                             .map(move |&angle_deg| Target::Falloff { plane, angle_deg })
                     })
                     .collect()
@@ -506,7 +524,7 @@ impl BoxPlan {
             if targets.len() >= cap {
                 break;
             }
-            if !targets.contains(&t) {
+            if !targets.iter().any(|r| r.same_reading(&t)) {
                 targets.push(t);
             }
         }

@@ -228,7 +228,7 @@ pub fn run(
             let total = session.plan().steps.len();
             let log = session.journal_path().to_path_buf();
             if session.done() < total {
-                announce(&session, stage, round, progress);
+                announce(&session, stage, round, stage_cost.is_none(), progress);
                 let (end, costs) = run_costed(
                     &mut session,
                     &mut instruments,
@@ -310,16 +310,19 @@ fn adaptive_rule(plan: &BoxPlan, stage: BoxStage) -> Option<&AdaptiveRule> {
     plan.adaptive.as_ref().filter(|_| stage.in_rounds())
 }
 
-/// The stage's (or the round's) readings and placements, said before it starts.
+/// The stage's (or the round's) readings and placements, said before it starts; the
+/// stage itself told to `progress` before the `first` round this run takes of it (none
+/// costed yet), which is a later round when a resume finds the earlier ones complete.
 fn announce(
     session: &Session<BoxDetails, BoxStep>,
     stage: BoxStage,
     round: usize,
+    first: bool,
     progress: &mut dyn ProgressSink,
 ) {
     let number = BoxStage::ALL.iter().position(|&s| s == stage).unwrap_or(0) + 1;
     let of = BoxStage::ALL.len();
-    if round == 0 {
+    if first {
         progress.stage(&StageOf {
             number,
             of,

@@ -161,7 +161,7 @@ pub fn charts(curves: &[CostCurve]) -> Result<[String; 2], String> {
                 .iter()
                 .position(|s| *s == c.side)
                 .unwrap_or(SIDES.len());
-            // Colour 0 is black, kept for the JND line's grey to stand apart.
+            // Colour 0 is black, kept for the JND line's black dots to stand apart.
             (side + 1, c.run != THIS_RUN)
         })
         .collect();

@@ -286,6 +286,67 @@ fn entries(path: &Path) -> Vec<String> {
         .collect()
 }
 
+/// `--box-plan adaptive` gives the plan the adaptive rule (the plan file names none): the
+/// fall-off stage alone reads the first pass, 0°, ±40° and ±80° in the horizontal plane
+/// and ±40° and ±80° in the vertical (the normal once), 9 of the fixed plan's 18, and the
+/// journal's plan carries the default rule; without the flag the stage reads all 18.
+#[test]
+fn box_plan_adaptive_reads_the_first_pass() {
+    let plan_of = |journal: &Path| -> Value {
+        let text = std::fs::read_to_string(journal).unwrap();
+        let header: Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+        serde_json::from_str(header["options"]["plan"].as_str().unwrap()).unwrap()
+    };
+    let angles = |journal: &Path| -> Vec<(String, f64)> {
+        entries(journal)
+            .iter()
+            .map(|l| {
+                let v: Value = serde_json::from_str(l).unwrap();
+                let d = &v["data"];
+                (
+                    d["plane"].as_str().unwrap().to_string(),
+                    d["angle_deg"].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    let flags = ["--spectral", SPECTRAL, "--spot", SPOT, "--stage", "falloff"];
+    let adaptive = fresh_dir("box-plan-adaptive");
+    let o = run(
+        &adaptive,
+        &[&flags[..], &["--box-plan", "adaptive"]].concat(),
+    );
+    let journal = adaptive.join("out/falloff.jsonl");
+    assert_eq!(plan_of(&journal)["adaptive"]["max_falloff"], 12);
+    let first = angles(&journal);
+    let h = |a: f64| ("horizontal".to_string(), a);
+    let v = |a: f64| ("vertical".to_string(), a);
+    assert_eq!(
+        first,
+        [
+            h(-80.0),
+            h(-40.0),
+            h(0.0),
+            h(40.0),
+            h(80.0),
+            v(-80.0),
+            v(-40.0),
+            v(40.0),
+            v(80.0)
+        ],
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let fixed = fresh_dir("box-plan-fixed");
+    run(&fixed, &flags);
+    let journal = fixed.join("out/falloff.jsonl");
+    assert!(plan_of(&journal)["adaptive"].is_null());
+    assert_eq!(angles(&journal).len(), 18);
+    for d in [adaptive, fixed] {
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}
+
 #[test]
 fn a_session_killed_mid_stage_resumes_to_the_same_scene() {
     let quiet = [

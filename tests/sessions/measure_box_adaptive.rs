@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use metamer::measure_box::job::{measure, MeasureBoxRequest};
-use metamer::measure_box::{Outcome, Summary};
-use metamer::session::{NoProgress, RunOptions};
+use metamer::measure_box::{BoxStage, Outcome, Summary};
+use metamer::session::{NoProgress, ProgressSink, RunOptions, StageOf, StepProgress};
 use metamer::validation::JND_DE76;
 
 use crate::support::fresh_dir;
@@ -156,5 +156,86 @@ fn stopped_rounds_resume_to_the_same_plan() {
     // Each session of a call stops after 5 readings: the first pass's 18 take four calls.
     assert!(calls >= 4, "stopped {calls} times");
     assert_eq!(journals(&stopped), w);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// What a run tells its progress sink: the stages announced and the notes.
+#[derive(Clone, Default)]
+struct Told(std::rc::Rc<std::cell::RefCell<(Vec<StageOf>, Vec<String>)>>);
+
+impl ProgressSink for Told {
+    fn step(&mut self, _: &StepProgress<'_>) {}
+    fn stage(&mut self, stage: &StageOf) {
+        self.0.borrow_mut().0.push(stage.clone());
+    }
+    fn note(&mut self, text: &str) {
+        self.0.borrow_mut().1.push(text.to_string());
+    }
+}
+
+/// The tiles' rounds (a rule tight enough to need them, each later round one tile read
+/// twice) stopped after every reading and resumed, with the simulated operator: each call that reads announces the tiles stage
+/// (stage 1 of 4) and the round it reads with its readings and placements, as a fresh
+/// round does, a resume of a later round (`tiles.batch-N.jsonl`) among them.
+#[test]
+fn a_resumed_later_round_prints_its_stage_header() {
+    let dir = fresh_dir("box-round-header");
+    let plan = dir.join("plan.json");
+    std::fs::write(
+        &plan,
+        r#"{"adaptive": {"tile_effect_jnd": 0.01, "max_tiles": 14}}"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let tiles = BoxStage::Tiles;
+    let stage = StageOf {
+        number: 1,
+        of: 4,
+        name: "tiles".into(),
+    };
+    let mut resumed_later = 0;
+    for call in 0..100 {
+        let r = MeasureBoxRequest {
+            stage: Some("tiles".into()),
+            resume: call > 0,
+            run: RunOptions {
+                stop_after: Some(1),
+                ..RunOptions::default()
+            },
+            ..request(&out, Some(plan.clone()), false)
+        };
+        let told = Told::default();
+        let sink = told.clone();
+        let o = measure(&r, &|_| {}, &mut |_| Box::new(sink.clone())).unwrap();
+        let (stages, notes) = told.0.borrow().clone();
+        if !matches!(o, Outcome::Incomplete { .. }) {
+            break;
+        }
+        assert_eq!(
+            stages,
+            std::slice::from_ref(&stage),
+            "call {call}: {notes:?}"
+        );
+        // The round the call stopped in is the stage's last journal; its header is said.
+        let last = metamer::measure_box::adaptive::later_rounds(&out, tiles).len();
+        let header = if last == 0 {
+            "stage 1/4 tiles: ".to_string()
+        } else {
+            format!("stage 1/4 tiles round {last}: ")
+        };
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains(&header) && n.contains(" readings at ")),
+            "call {call}: no `{header}` in {notes:?}"
+        );
+        if notes
+            .iter()
+            .any(|n| n.starts_with("resuming stage 1/4 tiles round "))
+        {
+            resumed_later += 1;
+        }
+    }
+    assert!(resumed_later > 0, "no later round was resumed");
     std::fs::remove_dir_all(&dir).unwrap();
 }

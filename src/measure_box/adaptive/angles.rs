@@ -85,7 +85,18 @@ pub fn choose(plan: &BoxPlan, rule: &AdaptiveRule, taken: &[Entry<BoxStep>]) -> 
     let unread: Vec<(Plane, f64)> = [Plane::Horizontal, Plane::Vertical]
         .into_iter()
         .flat_map(|p| plan.falloff_angles_deg.iter().map(move |&a| (p, a)))
-        .filter(|&(p, a)| !read.iter().any(|r| r.0 == p && r.1 == a))
+        .filter(|&(p, a)| {
+            let t = Target::Falloff {
+                plane: p,
+                angle_deg: a,
+            };
+            !read.iter().any(|r| {
+                t.same_reading(&Target::Falloff {
+                    plane: r.0,
+                    angle_deg: r.1,
+                })
+            })
+        })
         .collect();
     let fit = match fit_light(&read) {
         Ok(fit) => fit,

@@ -11,7 +11,8 @@
 //!   than [`AdaptiveRule::tile_effect_jnd`] JND, or [`AdaptiveRule::max_tiles`] are read.
 //!   Unread tiles take the model's spectrum, band by band.
 //! - **Fall-off**: first the normal and every second angle of the plan outwards from its
-//!   outermost on each side (0°, ±40°, ±80° of the paper's ±20° steps). Then, one angle a
+//!   outermost on each side (0°, ±40°, ±80° of the paper's ±20° steps), the normal read
+//!   once: it is one direction whatever the C-plane, and the fit takes it in both. Then, one angle a
 //!   round, the plan's unread angle where the distribution models the fit finds plausible
 //!   ([`angles`]) disagree most, until they agree within
 //!   [`AdaptiveRule::angle_agreement`] of the normal luminance everywhere, or

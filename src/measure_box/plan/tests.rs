@@ -113,7 +113,20 @@ fn the_adaptive_first_pass_is_the_subset_argued() {
     let tiles = plan.first_pass(BoxStage::Tiles);
     assert_eq!(tiles.len(), 9);
     assert_eq!(tiles[4], Target::Tile { row: 2, col: 2 });
-    assert_eq!(plan.first_pass(BoxStage::Falloff).len(), 10);
+    // The normal once, in the horizontal plane: 5 + 4 angles, not 5 + 5.
+    let falloff = plan.first_pass(BoxStage::Falloff);
+    assert_eq!(falloff.len(), 9);
+    let normals: Vec<&Target> = falloff
+        .iter()
+        .filter(|t| matches!(t, Target::Falloff { angle_deg, .. } if *angle_deg == 0.0))
+        .collect();
+    assert_eq!(
+        normals,
+        [&Target::Falloff {
+            plane: Plane::Horizontal,
+            angle_deg: 0.0
+        }]
+    );
     // The fixed plan reads every target; the adaptive one its first pass, and at most its
     // caps in the budget.
     let adaptive = BoxPlan {

@@ -62,7 +62,7 @@ fn cost_chart(h: &mut String, input: &ReportInput) {
          Display model: the largest ΔE*ab between the candidate models' predictions at the \
          colours to reproduce, before each batch of an adaptive plan and when it stopped; held \
          out: the largest ΔE*ab between the model and the readings it was not fitted to, at the \
-         fit and held-out readings together. The grey line is the JND (ΔE*ab {JND_DE76}).{compared}\
+         fit and held-out readings together. The dotted black line is the JND (ΔE*ab {JND_DE76}).{compared}\
          </figcaption></figure>",
         inline_svg(&readings),
         inline_svg(&minutes),
