@@ -105,9 +105,9 @@ pub struct MeasuringArgs {
     /// Which readings to take: paper (the paper's fixed plan: every box tile, fall-off angle
     /// and spot 5 times; the display's ramps, grid and 48 held-out colours; every display
     /// spot --repeats times) or lean (what the verdicts need: the box's tiles and fall-off
-    /// adaptively and its spots until their CIELAB is known to ±0.3 JND, at most 10
-    /// readings; the display adaptively, --stop-de 2 --max-readings 56 --held-out 12; each
-    /// display spot until its verdict is decided, --until-decided 0, at most 3 readings).
+    /// adaptively and its spots 3 times, pooled; the display adaptively, --stop-de 2
+    /// --max-readings 56 --held-out 12; each display spot twice, pooled, --until-decided 0
+    /// --repeats 2, the image slid under the meter, --display-spots under-meter).
     /// Every flag below replaces its part of the plan.
     #[arg(long, value_name = "PLAN", default_value_t = DEFAULT_MEASURING)]
     pub measuring: MeasuringPlan,

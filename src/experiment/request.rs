@@ -48,8 +48,8 @@ pub enum BoxRequest {
         /// Read the tiles and the fall-off adaptively.
         adaptive: bool,
         /// How each spot is read where the plan file names no rule (the measuring plan's
-        /// [`box_spot_rule`](super::measuring::Measures::box_spot_rule)); its CIELAB is relative to the plan file's
-        /// `spot_white`, or else a simulated monitor's nominal white
+        /// [`box_spot_rule`](super::measuring::Measures::box_spot_rule)); a width rule's CIELAB is relative to the
+        /// plan file's `spot_white`, or else a simulated monitor's nominal white
         /// ([`super::measuring::nominal_white`]).
         spot_rule: Option<RepeatRule>,
         /// The simulated box's seed (and its instruments').
@@ -315,9 +315,11 @@ impl Request {
             } => BoxSource::Measure(MeasureBox {
                 adaptive: *adaptive,
                 spot_rule: spot_rule.clone(),
-                spot_white: spot_rule
-                    .as_ref()
-                    .and_then(|_| nominal_white(&self.display.screen)),
+                // Only a width rule's stopping needs a white; a fixed count needs none.
+                spot_white: match spot_rule {
+                    Some(RepeatRule::Width { .. }) => nominal_white(&self.display.screen),
+                    _ => None,
+                },
                 spectral: spectral.clone(),
                 spot: spot.clone(),
                 plan: plan.clone(),

@@ -620,8 +620,7 @@ pub(crate) mod tests {
 
     /// The lean measuring plan is its options chosen one by one: the measuring stages'
     /// fingerprints (their inputs' hashes, upstream files alike) are the same, and none is
-    /// the paper's plan's. The box's spots are read by the width rule relative to the
-    /// simulated monitor's nominal white.
+    /// the paper's plan's. The box's spots are read a fixed count, which needs no white.
     #[test]
     fn the_lean_plan_has_the_fingerprints_of_its_options_chosen_one_by_one() {
         let dir = std::env::temp_dir().join(format!("metamer-measuring-{}", std::process::id()));
@@ -640,14 +639,12 @@ pub(crate) mod tests {
         }
         let by_hand = MeasuringChoices {
             box_adaptive: Some(true),
-            box_spot_rule: Some(crate::validation::sequential::RepeatRule::Width {
-                half_width_jnd: 0.3,
-                most: 10,
-            }),
+            box_spot_rule: Some(crate::validation::sequential::RepeatRule::Fixed { repeats: 3 }),
             display_adaptive: Some(true),
             stop_de: Some(2.0),
             max_readings: Some(56),
             held_out: Some(12),
+            repeats: Some(2),
             until_decided: Some(0.0),
             spots_shown: Some(display_spots::SpotsShown::UnderMeter),
             ..MeasuringChoices::default()
@@ -674,8 +671,7 @@ pub(crate) mod tests {
         let BoxSource::Measure(m) = &options.box_source else {
             panic!("the lab measures its box")
         };
-        let white = crate::rig::VirtualPanel::preset(crate::rig::Preset::IpsLcd).xyz([255; 3]);
-        assert_eq!(m.spot_white, Some([white.x, white.y, white.z]));
+        assert_eq!(m.spot_white, None);
         assert_eq!(options.measuring, MeasuringPlan::Lean);
         std::fs::remove_dir_all(&dir).unwrap();
     }
