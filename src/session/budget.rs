@@ -64,6 +64,26 @@ pub struct Cost {
 }
 
 impl Cost {
+    /// Asks the operator for one placement outside a plan's steps (aiming at a screen
+    /// before a stage whose steps need none): what it took, or None when the operator
+    /// aborts.
+    pub fn ask_placement(
+        operator: &mut dyn super::Operator,
+        prompt: &str,
+    ) -> Result<Option<Cost>, super::OperatorError> {
+        let asked = std::time::Instant::now();
+        if operator.ask(prompt)? == super::Answer::Abort {
+            return Ok(None);
+        }
+        let operator_s = asked.elapsed().as_secs_f64();
+        Ok(Some(Cost {
+            placements: 1,
+            operator_s,
+            wall_s: operator_s,
+            ..Cost::default()
+        }))
+    }
+
     /// The sum of two costs (an experiment's of its stages').
     pub fn add(&mut self, other: &Cost) {
         self.readings += other.readings;

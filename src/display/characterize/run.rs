@@ -17,8 +17,8 @@ use crate::rig::Screen;
 use crate::session::budget::{srgb_assumption, srgb_luminance, SRGB_WHITE_CD_M2};
 use crate::session::plan::{Prepare, Step};
 use crate::session::{
-    Answer, Cost, CostReport, InstrumentRecord, Meter, Operator, OperatorError, ProgressSink, Rig,
-    RunEnd, RunOptions, Session, SessionError,
+    Cost, CostReport, InstrumentRecord, Meter, Operator, OperatorError, ProgressSink, Rig, RunEnd,
+    RunOptions, Session, SessionError,
 };
 
 /// The journal's file name inside the output directory.
@@ -232,17 +232,7 @@ fn aim_at_white(
         "aim the instrument at the middle of the white {}",
         display.describe()
     );
-    let asked = std::time::Instant::now();
-    if operator.ask(&prompt)? == Answer::Abort {
-        return Ok(None);
-    }
-    let operator_s = asked.elapsed().as_secs_f64();
-    Ok(Some(Cost {
-        placements: 1,
-        operator_s,
-        wall_s: operator_s,
-        ..Cost::default()
-    }))
+    Ok(Cost::ask_placement(operator, &prompt)?)
 }
 
 /// The budget of the patches the journal of `session` lacks: each patch's luminance as the

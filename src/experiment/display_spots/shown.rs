@@ -19,7 +19,7 @@ use super::plan::{PatchAim, SpotStep};
 use crate::experiment::reproduction::PatchRegion;
 use crate::image::ScreenSpot;
 use crate::rig::Placement;
-use crate::session::{Answer, Cost, Operator, OperatorError, Prepare, SessionPlan};
+use crate::session::{Cost, Operator, OperatorError, Prepare, SessionPlan};
 
 /// How the display spots put each patch in front of the meter.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -166,15 +166,5 @@ pub fn aim_cost(placement_s: f64) -> Cost {
 /// Asks the operator to aim the meter at the middle of the screen: the placement and the
 /// time it took, or None when the operator aborts.
 pub(super) fn aim_at_middle(operator: &mut dyn Operator) -> Result<Option<Cost>, OperatorError> {
-    let asked = std::time::Instant::now();
-    if operator.ask(AIM_AT_MIDDLE)? == Answer::Abort {
-        return Ok(None);
-    }
-    let operator_s = asked.elapsed().as_secs_f64();
-    Ok(Some(Cost {
-        placements: 1,
-        operator_s,
-        wall_s: operator_s,
-        ..Cost::default()
-    }))
+    Cost::ask_placement(operator, AIM_AT_MIDDLE)
 }
