@@ -253,18 +253,21 @@ fn spots_curve(
 }
 
 /// How a spot journal's plan read its patches, from its header's options: a rule
-/// (the display's `rule`, the box plan's `spot_rule`) or a fixed count.
+/// (the display's `rule`, the box plan's `spot_rule`) or a fixed count, and whether the
+/// intervals rest on the figure pooled over the patches (every rule's do).
 fn spots_plan(options: &Value, most: usize) -> String {
     let box_rule = options["plan"]
         .as_str()
         .and_then(|p| serde_json::from_str::<Value>(p).ok())
-        .is_some_and(|p| !p["spot_rule"].is_null());
-    if options["rule"].is_string() {
-        "until decided".into()
-    } else if box_rule {
-        "until narrow enough".into()
-    } else {
-        format!("fixed, {most} readings")
+        .map(|p| p["spot_rule"]["rule"].as_str().map(str::to_string))
+        .unwrap_or_default();
+    // A verdict rule allowed no more than its least readings takes one look: a fixed count.
+    let one_look = most <= crate::validation::sequential::MIN_READINGS;
+    match (options["rule"].is_string(), box_rule.as_deref()) {
+        (true, _) if !one_look => "until decided".into(),
+        (true, _) | (false, Some("fixed")) => format!("fixed, {most} readings, pooled"),
+        (false, Some(_)) => "until narrow enough".into(),
+        (false, None) => format!("fixed, {most} readings"),
     }
 }
 
@@ -337,6 +340,39 @@ fn model_curves(summary: &Value, run: &str) -> Vec<CostCurve> {
 mod tests {
     use super::super::files::testdir;
     use super::*;
+
+    /// Each journal header's way of reading spots gets its own words: the paper's count, a
+    /// box plan's fixed count or width rule, a display rule with room to stop or without.
+    #[test]
+    fn each_spot_plan_is_named_by_how_it_read() {
+        let boxed = |rule: &str| serde_json::json!({ "plan": format!("{{\"spot_rule\":{rule}}}") });
+        let cases = [
+            (serde_json::json!({ "plan": "{}" }), 5, "fixed, 5 readings"),
+            (
+                boxed(r#"{"rule":"fixed","repeats":3}"#),
+                3,
+                "fixed, 3 readings, pooled",
+            ),
+            (
+                boxed(r#"{"rule":"width","half_width_jnd":0.3,"most":10}"#),
+                4,
+                "until narrow enough",
+            ),
+            (
+                serde_json::json!({ "rule": "verdict 0" }),
+                3,
+                "until decided",
+            ),
+            (
+                serde_json::json!({ "rule": "verdict 0" }),
+                2,
+                "fixed, 2 readings, pooled",
+            ),
+        ];
+        for (options, most, words) in cases {
+            assert_eq!(spots_plan(&options, most), words, "{options}");
+        }
+    }
 
     /// A hand-built display-spot journal: patch 1 read twice, patch 2 once, with a budget
     /// of 4 readings of 0.8 s and 2 placements of 30 s each (3 readings taken). The curve's
