@@ -31,7 +31,9 @@ use sha2::{Digest, Sha256};
 mod plan;
 pub mod shown;
 pub use plan::{aim_prompt, aims_on, image_plan, plan, PatchAim, SpotStep};
-pub use shown::{under_meter_plan, SpotsShown};
+pub use shown::under_meter_plan;
+mod spots_shown;
+pub use spots_shown::{SpotsShown, UnknownSpotsShown};
 
 use super::display::{open_meter, open_screen, DisplaySetting};
 use super::error::ExperimentError;
