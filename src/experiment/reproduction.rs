@@ -59,6 +59,17 @@ pub struct PatchRegion {
     pub out_of_gamut_pixels: usize,
 }
 
+impl PatchRegion {
+    /// The patch's spot on the screen, for the image placed at `placement`.
+    pub fn on_screen(&self, placement: &crate::rig::Placement) -> crate::image::ScreenSpot {
+        placement.on_screen(crate::image::ScreenSpot {
+            x: self.x,
+            y: self.y,
+            radius: self.radius,
+        })
+    }
+}
+
 /// What `reproduction/reproduction.json` holds.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Reproduction {

@@ -108,11 +108,7 @@ pub fn aims_on(placement: &Placement, regions: &[PatchRegion]) -> Vec<PatchAim> 
     regions
         .iter()
         .map(|r| {
-            let spot = placement.on_screen(ScreenSpot {
-                x: r.x,
-                y: r.y,
-                radius: r.radius,
-            });
+            let spot = r.on_screen(placement);
             PatchAim {
                 patch: r.patch,
                 x: spot.x,

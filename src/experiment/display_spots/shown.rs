@@ -16,7 +16,6 @@
 use super::plan::{PatchAim, SpotStep};
 use super::SpotsShown;
 use crate::experiment::reproduction::PatchRegion;
-use crate::image::ScreenSpot;
 use crate::rig::Placement;
 use crate::session::{Cost, Operator, OperatorError, Prepare, SessionPlan};
 
@@ -47,11 +46,7 @@ pub fn aims_under_meter(
     regions
         .iter()
         .map(|r| {
-            let spot = placement.on_screen(ScreenSpot {
-                x: r.x,
-                y: r.y,
-                radius: r.radius,
-            });
+            let spot = r.on_screen(placement);
             let slide = [(at[0] - r.x * w).round(), (at[1] - r.y * h).round()];
             PatchAim {
                 patch: r.patch,
