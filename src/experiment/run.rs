@@ -673,6 +673,23 @@ pub(crate) mod tests {
         };
         assert_eq!(m.spot_white, None);
         assert_eq!(options.measuring, MeasuringPlan::Lean);
+        // A width rule stops on CIELAB, so it is given the simulated monitor's full white.
+        let width = MeasuringChoices {
+            box_spot_rule: Some(crate::validation::sequential::RepeatRule::Width {
+                half_width_jnd: 0.3,
+                most: 10,
+            }),
+            ..MeasuringChoices::default()
+        };
+        let options = lab(MeasuringPlan::Lean, &width)
+            .request(&dir, false, false, RunOptions::default())
+            .options()
+            .unwrap();
+        let BoxSource::Measure(m) = &options.box_source else {
+            panic!("the lab measures its box")
+        };
+        let white = crate::rig::VirtualPanel::preset(crate::rig::Preset::IpsLcd).xyz([255; 3]);
+        assert_eq!(m.spot_white, Some([white.x, white.y, white.z]));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
